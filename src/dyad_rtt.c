@@ -1,0 +1,54 @@
+/* dyadfmu: RTT dyad, translational pairs at D_m and E, revolute at D_n
+ * (paper, section 6). Typical: the Scotch yoke, whose yoke (m) slides on the
+ * frame guide i_k and carries a slot along i_m in which the block (n), pinned
+ * to the crank p at D_n, slides.
+ *
+ * Unknowns: the normal forces N_mk = R_mk . j_k, N_mn = R_mn . j_m and the
+ * reactive moments M^R_mk, M^R_mn; R_np follows.
+ *
+ * 1. Forces on link m (eq. 19): N_mk j_k + F_m + N_mn j_m = 0. Dotting with i_m
+ *    removes N_mn, with i_k removes N_mk (eq. 20):
+ *      N_mk = -F_m . i_m / (j_k . i_m)
+ *      N_mn = -F_m . i_k / (j_m . i_k)
+ *    with j_m . i_k = -(j_k . i_m) = -d: it vanishes when slot and guide are
+ *    parallel.
+ * 2. Forces on the whole dyad (eq. 21): R_np = -(R_mk + F_m + F_n).
+ * 3. Moment of link n about E: it receives -R_mn at E and -M^R_mn, so
+ *      -l_n i_n x R_np + (S_n - E) x F_n + M_n - M^R_mn = 0,
+ *      M^R_mn = -l_n i_n x R_np + [(S_n - E) x F_n + M_n].
+ *    Correction: the paper (eq. 22) prints -l_n j_n x R_np; the lever from E
+ *    to D_n is -l_n i_n, so the cross product is with i_n.
+ * 4. Moment of link m about E:
+ *      -l_m i_m x R_mk + (S_m - E) x F_m + M_m + M^R_mk + M^R_mn = 0,
+ *      M^R_mk = l_m i_m x R_mk - [(S_m - E) x F_m + M_m] - M^R_mn.
+ */
+#include "dyad_internal.h"
+
+dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    dyad_status status = dyad_prepare(DYAD_RTT, input, &p, result);
+    const dyad_body* m = &p.m;
+    const dyad_body* n = &p.n;
+    dyad_real d;
+
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    d = dyad_dot(p.j_k, m->i);
+    status = dyad_accept_conditioning(d, dyad_abs(d), input->singular_threshold, result);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+
+    result->n_mk = -dyad_dot(m->f, m->i) / d;
+    result->n_mn = dyad_dot(m->f, p.i_k) / d;
+
+    result->r_mk = dyad_scale(result->n_mk, p.j_k);
+    result->r_mn = dyad_scale(result->n_mn, m->j);
+    result->r_np = dyad_neg(dyad_add(dyad_add(result->r_mk, m->f), n->f));
+    result->m_mn = -n->l * dyad_cross(n->i, result->r_np) + dyad_load_moment_about_e(n);
+    result->m_mk =
+        m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m) - result->m_mn;
+    return dyad_finish(result);
+}

@@ -1,0 +1,47 @@
+/* dyadfmu: TRT dyad, translational pairs at D_m and D_n, revolute at E
+ * (paper, section 3). Typical: two sliders on fixed guides i_k and i_p,
+ * pinned together at E.
+ *
+ * Unknowns: the normal forces N_mk = R_mk . j_k, N_np = R_np . j_p and the
+ * reactive moments M^R_mk, M^R_np; R_mn at E follows.
+ *
+ * 1. Forces on the whole dyad (eq. 9): N_mk j_k + F_m + F_n + N_np j_p = 0.
+ *    Dotting with i_p removes N_np, with i_k removes N_mk (eq. 10):
+ *      N_mk = -(F_m + F_n) . i_p / (j_k . i_p)
+ *      N_np = -(F_m + F_n) . i_k / (j_p . i_k)
+ *    with j_p . i_k = -(j_k . i_p) = -d: it vanishes when the guides are parallel.
+ * 2. Moment of link g about E (eq. 11), where R_mn drops out:
+ *      M^R_gd = l_g i_g x R_gd - [(S_g - E) x F_g + M_g].
+ * 3. Forces on link m (eq. 8): R_mn = -(R_mk + F_m).
+ */
+#include "dyad_internal.h"
+
+dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    dyad_status status = dyad_prepare(DYAD_TRT, input, &p, result);
+    const dyad_body* m = &p.m;
+    const dyad_body* n = &p.n;
+    dyad_real d;
+    dyad_vec2 f_sum;
+
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    d = dyad_dot(p.j_k, p.i_p);
+    status = dyad_accept_conditioning(d, dyad_abs(d), input->singular_threshold, result);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+
+    f_sum = dyad_add(m->f, n->f);
+    result->n_mk = -dyad_dot(f_sum, p.i_p) / d;
+    result->n_np = dyad_dot(f_sum, p.i_k) / d;
+
+    result->r_mk = dyad_scale(result->n_mk, p.j_k);
+    result->r_np = dyad_scale(result->n_np, p.j_p);
+    result->r_mn = dyad_neg(dyad_add(result->r_mk, m->f));
+    result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
+    result->m_np = n->l * dyad_cross(n->i, result->r_np) - dyad_load_moment_about_e(n);
+    return dyad_finish(result);
+}

@@ -1,0 +1,61 @@
+/* dyadfmu: public API of the kinetostatic solvers.
+ *
+ * Every solver takes the kinematics, mass properties and loads of the two links
+ * of one Assur dyad and returns the reactions in its three pairs. The solvers
+ * allocate nothing, keep no state and do no I/O: they are reentrant and may run
+ * from any number of threads at once.
+ *
+ * Each solver returns the status it also stores in result->status. Unless the
+ * status is DYAD_STATUS_OK, every reaction output is NaN; conditioning and
+ * amplification are filled whenever the inputs were valid.
+ */
+#ifndef DYADFMU_DYAD_H
+#define DYADFMU_DYAD_H
+
+#include "dyadfmu/types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Inputs with every field zero, except: directions i_m, i_n, i_k, i_p = (1, 0),
+ *  lengths 1 m, singular threshold DYAD_DEFAULT_SINGULAR_THRESHOLD. */
+dyad_input dyad_input_default(void);
+
+/** Solve the dyad of the given type. */
+dyad_status dyad_solve(dyad_type type, const dyad_input* input, dyad_result* result);
+
+/** The per-type solvers; dyad_solve dispatches to them. */
+dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result);
+
+/** Resultant of link g's active load, weight and inertia (d'Alembert) at its
+ *  centre of mass: force (N, global frame) and moment (N m). This is F_g, M_g
+ *  of the paper. Inputs are not validated here. */
+void dyad_link_resultant(const dyad_link* link, dyad_vec2 gravity, dyad_vec2* force,
+                         dyad_real* moment);
+
+/** Kind of a pair in a type: revolute or translational. */
+dyad_pair_kind dyad_pair_kind_of(dyad_type type, dyad_pair pair);
+
+/** 1 if the type allows link's length to be 0 (a slider whose pin lies on its
+ *  guide), 0 if it must be positive. */
+int dyad_length_may_be_zero(dyad_type type, dyad_link_id link);
+
+/** "RRR", "RRT", ...; "?" for an unknown type. */
+const char* dyad_type_name(dyad_type type);
+
+/** "ok", "singular", "invalid input", "out of range". */
+const char* dyad_status_name(dyad_status status);
+
+/** Dotted field name, e.g. "link_m.length", "guide_k"; "" for NONE. */
+const char* dyad_field_name(dyad_field field);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DYADFMU_DYAD_H */

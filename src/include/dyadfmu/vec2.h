@@ -1,0 +1,89 @@
+/* dyadfmu: inline 2-D vector algebra on dyad_vec2. */
+#ifndef DYADFMU_VEC2_H
+#define DYADFMU_VEC2_H
+
+#include <math.h>
+
+#include "dyadfmu/types.h"
+
+static inline dyad_vec2 dyad_vec2_make(dyad_real x, dyad_real y)
+{
+    dyad_vec2 v;
+    v.x = x;
+    v.y = y;
+    return v;
+}
+
+static inline dyad_vec2 dyad_add(dyad_vec2 a, dyad_vec2 b)
+{
+    return dyad_vec2_make(a.x + b.x, a.y + b.y);
+}
+
+static inline dyad_vec2 dyad_sub(dyad_vec2 a, dyad_vec2 b)
+{
+    return dyad_vec2_make(a.x - b.x, a.y - b.y);
+}
+
+static inline dyad_vec2 dyad_neg(dyad_vec2 a)
+{
+    return dyad_vec2_make(-a.x, -a.y);
+}
+
+static inline dyad_vec2 dyad_scale(dyad_real s, dyad_vec2 a)
+{
+    return dyad_vec2_make(s * a.x, s * a.y);
+}
+
+/** s * a + t * b */
+static inline dyad_vec2 dyad_combine(dyad_real s, dyad_vec2 a, dyad_real t, dyad_vec2 b)
+{
+    return dyad_vec2_make(s * a.x + t * b.x, s * a.y + t * b.y);
+}
+
+static inline dyad_real dyad_dot(dyad_vec2 a, dyad_vec2 b)
+{
+    return a.x * b.x + a.y * b.y;
+}
+
+/** z component of a x b. */
+static inline dyad_real dyad_cross(dyad_vec2 a, dyad_vec2 b)
+{
+    return a.x * b.y - a.y * b.x;
+}
+
+/** k0 x a: a turned by +90 degrees. */
+static inline dyad_vec2 dyad_perp(dyad_vec2 a)
+{
+    return dyad_vec2_make(-a.y, a.x);
+}
+
+static inline dyad_real dyad_length(dyad_vec2 a)
+{
+#ifdef DYAD_REAL_FLOAT
+    return sqrtf(dyad_dot(a, a));
+#else
+    return sqrt(dyad_dot(a, a));
+#endif
+}
+
+/** Unit vector at angle a (rad) from the x axis. */
+static inline dyad_vec2 dyad_dir_from_angle(dyad_real angle)
+{
+#ifdef DYAD_REAL_FLOAT
+    return dyad_vec2_make(cosf(angle), sinf(angle));
+#else
+    return dyad_vec2_make(cos(angle), sin(angle));
+#endif
+}
+
+static inline int dyad_is_valid_real(dyad_real a)
+{
+    return isfinite(a) != 0;
+}
+
+static inline int dyad_is_valid_vec2(dyad_vec2 a)
+{
+    return dyad_is_valid_real(a.x) && dyad_is_valid_real(a.y);
+}
+
+#endif /* DYADFMU_VEC2_H */

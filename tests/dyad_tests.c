@@ -1,0 +1,896 @@
+/* dyadfmu: tests of the kinetostatic core.
+ *
+ * Built twice, against the double and the float core. Every check of a
+ * reaction is made by means independent of the solver's formulas: the
+ * equilibrium of each link is summed here from the inputs and the outputs,
+ * with the acceleration of the centre of mass computed with complex numbers
+ * and the moments taken about an arbitrary point, in double precision.
+ *
+ * Usage: dyad_tests_<real> [test-name ...]   (no name: run them all)
+ */
+#include <complex.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "dyadfmu/dyad.h"
+#include "dyadfmu/vec2.h"
+
+#ifdef DYAD_REAL_FLOAT
+#define REAL_NAME "float"
+/* float carries 24 bits; with amplification up to 10 in the random set a few
+ * units of 6e-8 per term are expected. */
+#define RESIDUAL_LIMIT 1e-5
+#define HAND_LIMIT 1e-5
+#define HUGE_REAL 1e30f
+#else
+#define REAL_NAME "double"
+#define RESIDUAL_LIMIT 1e-12
+#define HAND_LIMIT 1e-12
+#define HUGE_REAL 1e300
+#endif
+
+#define RANDOM_CONFIGURATIONS 10000
+#define WELL_CONDITIONED 0.1
+#define PI 3.14159265358979323846
+
+#define CHECK(cond, ...)                                                                        \
+    do {                                                                                        \
+        if (!(cond)) {                                                                          \
+            printf("    FAIL %s:%d: ", __FILE__, __LINE__);                                     \
+            printf(__VA_ARGS__);                                                                \
+            printf("\n");                                                                       \
+            ++fails;                                                                            \
+        }                                                                                       \
+    } while (0)
+
+static const dyad_type all_types[DYAD_TYPE_COUNT] = {DYAD_RRR, DYAD_RRT, DYAD_RTR, DYAD_TRT,
+                                                     DYAD_RTT};
+
+/* ---- random numbers: splitmix64 ---------------------------------------- */
+
+typedef struct rng {
+    uint64_t state;
+} rng;
+
+static double uniform(rng* r, double lo, double hi)
+{
+    uint64_t z = (r->state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return lo + (hi - lo) * ((double)(z >> 11) / 9007199254740992.0);
+}
+
+static double log_uniform(rng* r, double lo, double hi)
+{
+    return exp(uniform(r, log(lo), log(hi)));
+}
+
+static double signed_log_uniform(rng* r, double lo, double hi)
+{
+    return (uniform(r, 0, 1) < 0.5 ? -1 : 1) * log_uniform(r, lo, hi);
+}
+
+static dyad_vec2 vec(double x, double y)
+{
+    return dyad_vec2_make((dyad_real)x, (dyad_real)y);
+}
+
+static dyad_vec2 polar(double magnitude, double angle)
+{
+    return vec(magnitude * cos(angle), magnitude * sin(angle));
+}
+
+/* ---- equilibrium, summed independently of the solver ------------------- */
+
+typedef struct balance {
+    double fx, fy, mz;   /* sums of forces (N) and of moments about P (N m) */
+    double f_scale;      /* largest force term (N) */
+    double m_scale;      /* largest moment term (N m) */
+} balance;
+
+static void add_force(balance* b, double complex at, double complex force, double complex p)
+{
+    const double complex lever = at - p;
+    const double moment = creal(lever) * cimag(force) - cimag(lever) * creal(force);
+    b->fx += creal(force);
+    b->fy += cimag(force);
+    b->mz += moment;
+    if (cabs(force) > b->f_scale) {
+        b->f_scale = cabs(force);
+    }
+    if (cabs(lever) * cabs(force) > b->m_scale) {
+        b->m_scale = cabs(lever) * cabs(force);
+    }
+}
+
+static void add_moment(balance* b, double moment)
+{
+    b->mz += moment;
+    if (fabs(moment) > b->m_scale) {
+        b->m_scale = fabs(moment);
+    }
+}
+
+/* Worst of |sum of forces| / largest force and |sum of moments| / largest moment. */
+static double relative_imbalance(const balance* b)
+{
+    const double f = b->f_scale > 0 ? hypot(b->fx, b->fy) / b->f_scale : hypot(b->fx, b->fy);
+    const double m = b->m_scale > 0 ? fabs(b->mz) / b->m_scale : fabs(b->mz);
+    return f > m ? f : m;
+}
+
+static double complex cvec(dyad_vec2 v)
+{
+    return (double)v.x + I * (double)v.y;
+}
+
+/* Direction of a link as the solver reads it: normalised. */
+static double complex unit(dyad_vec2 v)
+{
+    const double complex c = cvec(v);
+    return c / cabs(c);
+}
+
+/* Adds a link's active load, weight and d'Alembert inertia. The acceleration
+ * of S is a_D + r (i epsilon - omega^2), r = S - D as a complex number. */
+static void add_link_loads(balance* b, const dyad_link* link, double complex d,
+                           dyad_vec2 gravity, double complex p)
+{
+    const double complex i = unit(link->dir);
+    const double complex r = i * ((double)link->com.x + I * (double)link->com.y);
+    const double complex accel_s =
+        cvec(link->accel_d) + r * (I * (double)link->epsilon - (double)link->omega * link->omega);
+    const double mass = link->mass;
+    add_force(b, d + r, cvec(link->force), p);
+    add_force(b, d + r, mass * cvec(gravity), p);
+    add_force(b, d + r, -mass * accel_s, p);
+    add_moment(b, link->moment);
+    add_moment(b, -(double)link->inertia * link->epsilon);
+}
+
+/* Equilibrium residuals of a solved dyad. */
+typedef struct imbalance {
+    /* Worst link, relative to the largest force or moment term acting on the
+     * whole dyad (loads, weights, inertia, reactions): the backward error. */
+    double dyad;
+    /* Worst link, relative to the largest term acting on that link alone:
+     * stricter where one link's loads dwarf the other's. Reported only. */
+    double link;
+} imbalance;
+
+/* The equilibrium of both links; D_m is placed at d_m, moments are taken about p. */
+static imbalance dyad_imbalance(const dyad_input* in, const dyad_result* out, double complex d_m,
+                                double complex p)
+{
+    const double complex e = d_m + (double)in->m.length * unit(in->m.dir);
+    const double complex d_n = e - (double)in->n.length * unit(in->n.dir);
+    balance link_m = {0, 0, 0, 0, 0};
+    balance link_n = {0, 0, 0, 0, 0};
+    balance scale;
+    imbalance result;
+    double worst_m, worst_n;
+
+    add_link_loads(&link_m, &in->m, d_m, in->gravity, p);
+    add_force(&link_m, d_m, cvec(out->r_mk), p);
+    add_force(&link_m, e, cvec(out->r_mn), p);
+    add_moment(&link_m, out->m_mk);
+    add_moment(&link_m, out->m_mn);
+
+    add_link_loads(&link_n, &in->n, d_n, in->gravity, p);
+    add_force(&link_n, d_n, cvec(out->r_np), p);
+    add_force(&link_n, e, -cvec(out->r_mn), p);
+    add_moment(&link_n, out->m_np);
+    add_moment(&link_n, -(double)out->m_mn);
+
+    worst_m = relative_imbalance(&link_m);
+    worst_n = relative_imbalance(&link_n);
+    result.link = worst_m > worst_n ? worst_m : worst_n;
+
+    scale.f_scale = link_m.f_scale > link_n.f_scale ? link_m.f_scale : link_n.f_scale;
+    scale.m_scale = link_m.m_scale > link_n.m_scale ? link_m.m_scale : link_n.m_scale;
+    scale.fx = link_m.fx, scale.fy = link_m.fy, scale.mz = link_m.mz;
+    worst_m = relative_imbalance(&scale);
+    scale.fx = link_n.fx, scale.fy = link_n.fy, scale.mz = link_n.mz;
+    worst_n = relative_imbalance(&scale);
+    result.dyad = worst_m > worst_n ? worst_m : worst_n;
+    return result;
+}
+
+/* What each pair may carry: a translational pair only a force normal to its
+ * guide (reported as the normal force), a revolute pair no moment. Returns the
+ * worst relative violation; revolute moments and normals must be exactly 0. */
+static double pair_violation(dyad_type type, const dyad_input* in, const dyad_result* out)
+{
+    const dyad_vec2 guides[3] = {in->guide_k, in->m.dir, in->guide_p};
+    const dyad_vec2 forces[3] = {out->r_mk, out->r_mn, out->r_np};
+    const double normals[3] = {out->n_mk, out->n_mn, out->n_np};
+    const double moments[3] = {out->m_mk, out->m_mn, out->m_np};
+    const dyad_pair pairs[3] = {DYAD_PAIR_DM, DYAD_PAIR_E, DYAD_PAIR_DN};
+    double worst = 0;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        if (dyad_pair_kind_of(type, pairs[k]) == DYAD_PAIR_TRANSLATIONAL) {
+            const double complex g = unit(guides[k]);
+            const double complex f = cvec(forces[k]);
+            const double size = cabs(f) > 0 ? cabs(f) : 1;
+            const double along = creal(f * conj(g));
+            const double normal = cimag(f * conj(g));
+            const double v1 = fabs(along) / size;
+            const double v2 = fabs(normal - normals[k]) / size;
+            worst = v1 > worst ? v1 : worst;
+            worst = v2 > worst ? v2 : worst;
+        } else if (normals[k] != 0 || moments[k] != 0) {
+            return INFINITY;
+        }
+    }
+    return worst;
+}
+
+static int all_outputs_nan(const dyad_result* r)
+{
+    const dyad_real v[15] = {r->r_mk.x, r->r_mk.y, r->r_np.x, r->r_np.y, r->r_mn.x,
+                             r->r_mn.y, r->n_mk,   r->n_np,   r->n_mn,   r->m_mk,
+                             r->m_np,   r->m_mn,   0,         0,         0};
+    int k;
+    for (k = 0; k < 12; ++k) {
+        if (!isnan(v[k])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* ---- random configurations ---------------------------------------------- */
+
+/* Conditioning of a configuration from its angles, not from the solver. */
+static double independent_conditioning(dyad_type type, const dyad_input* in)
+{
+    const double complex i_m = unit(in->m.dir);
+    const double complex i_n = unit(in->n.dir);
+    const double complex i_k = unit(in->guide_k);
+    const double complex i_p = unit(in->guide_p);
+    switch (type) {
+    case DYAD_RRR: return fabs(sin(carg(i_n / i_m)));
+    case DYAD_RRT: return fabs(cos(carg(i_n / i_k)));
+    case DYAD_TRT: return fabs(sin(carg(i_p / i_k)));
+    case DYAD_RTT: return fabs(sin(carg(i_m / i_k)));
+    case DYAD_RTR: {
+        const double complex dm_dn = (double)in->m.length * i_m - (double)in->n.length * i_n;
+        const double spread = cabs(dm_dn) / ((double)in->m.length + in->n.length);
+        const double slant = cabs(dm_dn) > 0 ? fabs(cos(carg(dm_dn / i_m))) : 0;
+        return spread < slant ? spread : slant;
+    }
+    case DYAD_TYPE_COUNT: break;
+    }
+    return 0;
+}
+
+static void random_link(rng* r, dyad_link* link, int may_be_zero)
+{
+    const double length =
+        (may_be_zero && uniform(r, 0, 1) < 0.1) ? 0 : log_uniform(r, 1e-3, 1e3);
+    const double size = length > 0 ? length : log_uniform(r, 1e-3, 1);
+    const double mass = uniform(r, 0, 1) < 0.05 ? 0 : log_uniform(r, 1e-3, 1e3);
+    const double radius = size * uniform(r, 0.05, 0.6);
+    link->dir = polar(1, uniform(r, 0, 2 * PI));
+    link->length = (dyad_real)length;
+    link->omega = (dyad_real)signed_log_uniform(r, 1e-2, 1e2);
+    link->epsilon = (dyad_real)signed_log_uniform(r, 1e-2, 1e3);
+    link->accel_d = polar(log_uniform(r, 1e-2, 1e3), uniform(r, 0, 2 * PI));
+    link->com = vec(size * uniform(r, -0.5, 1.5), size * uniform(r, -0.5, 0.5));
+    link->mass = (dyad_real)mass;
+    link->inertia = (dyad_real)(uniform(r, 0, 1) < 0.05 ? 0 : mass * radius * radius);
+    link->force = polar(log_uniform(r, 1e-2, 1e4), uniform(r, 0, 2 * PI));
+    link->moment = (dyad_real)(signed_log_uniform(r, 1e-2, 1e4) * size);
+}
+
+static dyad_input random_input(rng* r, dyad_type type)
+{
+    dyad_input in = dyad_input_default();
+    random_link(r, &in.m, dyad_length_may_be_zero(type, DYAD_LINK_M));
+    random_link(r, &in.n, dyad_length_may_be_zero(type, DYAD_LINK_N));
+    in.guide_k = polar(1, uniform(r, 0, 2 * PI));
+    in.guide_p = polar(1, uniform(r, 0, 2 * PI));
+    in.gravity = uniform(r, 0, 1) < 0.5 ? vec(0, 0) : polar(9.81, uniform(r, 0, 2 * PI));
+    return in;
+}
+
+static int test_equilibrium_random(void)
+{
+    int fails = 0;
+    int t;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x5EED0000u + (uint64_t)t};
+        double worst_imbalance = 0, worst_link = 0, worst_pair = 0;
+        int tried = 0, solved = 0;
+        while (solved < RANDOM_CONFIGURATIONS) {
+            const dyad_input in = random_input(&r, type);
+            const double conditioning = independent_conditioning(type, &in);
+            const double complex d_m = uniform(&r, -1e3, 1e3) + I * uniform(&r, -1e3, 1e3);
+            const double complex p = uniform(&r, -1e3, 1e3) + I * uniform(&r, -1e3, 1e3);
+            dyad_result out;
+            dyad_status status;
+            imbalance residual;
+            double violation;
+            ++tried;
+            if (conditioning < WELL_CONDITIONED) {
+                continue;
+            }
+            status = dyad_solve(type, &in, &out);
+            if (status != DYAD_STATUS_OK) {
+                CHECK(0, "%s: status %s (field %s) at conditioning %.3g", dyad_type_name(type),
+                      dyad_status_name(status), dyad_field_name(out.field), conditioning);
+                if (fails > 10) {
+                    return fails;
+                }
+                continue;
+            }
+            ++solved;
+            residual = dyad_imbalance(&in, &out, d_m, p);
+            violation = pair_violation(type, &in, &out);
+            worst_imbalance = residual.dyad > worst_imbalance ? residual.dyad : worst_imbalance;
+            worst_link = residual.link > worst_link ? residual.link : worst_link;
+            worst_pair = violation > worst_pair ? violation : worst_pair;
+            if (!(fabs((double)out.conditioning - conditioning) <= 1e-4 * conditioning + 1e-6)) {
+                CHECK(0, "%s: conditioning %.9g, expected %.9g", dyad_type_name(type),
+                      (double)out.conditioning, conditioning);
+            }
+        }
+        printf("    %s %s: %d configurations solved (%d drawn); worst equilibrium residual "
+               "%.3e of the dyad's load scale (limit %.0e), %.3e of the link's own; worst "
+               "pair-constraint violation %.3e\n",
+               dyad_type_name(type), REAL_NAME, solved, tried, worst_imbalance, RESIDUAL_LIMIT,
+               worst_link, worst_pair);
+        CHECK(worst_imbalance < RESIDUAL_LIMIT, "%s: residual %.3e", dyad_type_name(type),
+              worst_imbalance);
+        CHECK(worst_pair < RESIDUAL_LIMIT, "%s: pair violation %.3e", dyad_type_name(type),
+              worst_pair);
+    }
+    return fails;
+}
+
+/* ---- hand-checkable cases ------------------------------------------------ */
+
+static int close_to(double got, double want)
+{
+    return fabs(got - want) <= HAND_LIMIT * (1 + fabs(want));
+}
+
+#define CHECK_VEC(v, wx, wy)                                                                   \
+    CHECK(close_to((v).x, (wx)) && close_to((v).y, (wy)), "%s = (%.12g, %.12g), expected "    \
+          "(%.12g, %.12g)", #v, (double)(v).x, (double)(v).y, (double)(wx), (double)(wy))
+#define CHECK_REAL(v, w)                                                                       \
+    CHECK(close_to((v), (w)), "%s = %.12g, expected %.12g", #v, (double)(v), (double)(w))
+
+/* A massless link whose load sits at E: the symmetric RRR truss. */
+static int test_rrr_symmetric_truss(void)
+{
+    /* D_m = (-0.3, 0), D_n = (0.3, 0), E = (0, 0.4): l = 0.5, sin(alpha) = 0.8.
+     * A vertical load P = 1000 N at E, half on each link. Each link is a two-force
+     * member in compression P / (2 sin alpha) = 625 N along its axis. */
+    int fails = 0;
+    dyad_input in = dyad_input_default();
+    dyad_result out;
+    in.m.dir = vec(0.6, 0.8);
+    in.n.dir = vec(-0.6, 0.8);
+    in.m.length = in.n.length = 0.5;
+    in.m.com = in.n.com = vec(0.5, 0);
+    in.m.force = in.n.force = vec(0, -500);
+    CHECK(dyad_solve(DYAD_RRR, &in, &out) == DYAD_STATUS_OK, "status");
+    CHECK_VEC(out.r_mk, 375, 500);
+    CHECK_VEC(out.r_np, -375, 500);
+    CHECK_VEC(out.r_mn, -375, 0);
+    CHECK_REAL(out.conditioning, 0.96);
+    return fails;
+}
+
+/* Slider-crank: slider m on a horizontal guide, massless rod n inclined 30
+ * degrees, gas force P = 1000 N pushing the slider towards the crank. The rod
+ * carries P / cos(phi); the guide pushes down with P tan(phi). */
+static int test_rrt_slider_crank_rod_force(void)
+{
+    int fails = 0;
+    const double phi = PI / 6, P = 1000;
+    dyad_input in = dyad_input_default();
+    dyad_result out;
+    in.guide_k = vec(1, 0);
+    in.m.length = 0;
+    in.m.dir = vec(1, 0);
+    in.m.force = vec(-P, 0);
+    in.n.dir = polar(1, phi);
+    in.n.length = 0.2;
+    CHECK(dyad_solve(DYAD_RRT, &in, &out) == DYAD_STATUS_OK, "status");
+    CHECK_REAL(out.n_mk, -P * tan(phi));
+    CHECK_VEC(out.r_mk, 0, -P * tan(phi));
+    CHECK_VEC(out.r_np, P, P * tan(phi));
+    CHECK_VEC(out.r_mn, P, P * tan(phi));
+    CHECK_REAL(out.m_mk, 0);
+    CHECK_REAL(out.conditioning, cos(phi));
+    return fails;
+}
+
+/* Slider-crank at top dead centre with a 2 kg slider under gravity whose centre
+ * of mass is 50 mm ahead of the pin: the rod carries P, the guide the weight
+ * 19.62 N, and a moment 0.05 m * 19.62 N = 0.981 N m against the weight's. */
+static int test_rrt_dead_centre_with_weight(void)
+{
+    int fails = 0;
+    const double P = 1000, weight = 2 * 9.81;
+    dyad_input in = dyad_input_default();
+    dyad_result out;
+    in.gravity = vec(0, -9.81);
+    in.m.length = 0;
+    in.m.mass = 2;
+    in.m.com = vec(0.05, 0);
+    in.m.force = vec(-P, 0);
+    in.n.length = 0.2;
+    CHECK(dyad_solve(DYAD_RRT, &in, &out) == DYAD_STATUS_OK, "status");
+    CHECK_VEC(out.r_np, P, 0);
+    CHECK_VEC(out.r_mk, 0, weight);
+    CHECK_REAL(out.n_mk, weight);
+    CHECK_REAL(out.m_mk, 0.05 * weight);
+    return fails;
+}
+
+/* Slotted lever: pivot D_m, slot along x, block pinned on the slot line at
+ * 0.5 m; a moment of 100 N m on the lever is held by the block with a normal
+ * force of 200 N. */
+static int test_rtr_lever_torque(void)
+{
+    int fails = 0;
+    dyad_input in = dyad_input_default();
+    dyad_result out;
+    in.m.length = 0.5;
+    in.m.moment = 100;
+    in.n.length = 0;
+    CHECK(dyad_solve(DYAD_RTR, &in, &out) == DYAD_STATUS_OK, "status");
+    CHECK_REAL(out.n_mn, -200);
+    CHECK_VEC(out.r_mn, 0, -200);
+    CHECK_VEC(out.r_np, 0, -200);
+    CHECK_VEC(out.r_mk, 0, 200);
+    CHECK_REAL(out.m_mn, 0);
+    return fails;
+}
+
+/* Two sliders on perpendicular guides pinned at E; slider m's pin stands 0.2 m
+ * above its guide. A load (300, -400) N on m at D_m is held by N_mk = 400 N and
+ * N_np = 300 N; the pin force 300 N at 0.2 m needs a guide moment of -60 N m. */
+static int test_trt_cross_slide(void)
+{
+    int fails = 0;
+    dyad_input in = dyad_input_default();
+    dyad_result out;
+    in.guide_k = vec(1, 0);
+    in.guide_p = vec(0, 1);
+    in.m.dir = vec(0, 1);
+    in.m.length = 0.2;
+    in.m.force = vec(300, -400);
+    in.n.length = 0;
+    CHECK(dyad_solve(DYAD_TRT, &in, &out) == DYAD_STATUS_OK, "status");
+    CHECK_REAL(out.n_mk, 400);
+    CHECK_REAL(out.n_np, 300);
+    CHECK_VEC(out.r_mk, 0, 400);
+    CHECK_VEC(out.r_np, -300, 0);
+    CHECK_VEC(out.r_mn, -300, 0);
+    CHECK_REAL(out.m_mk, -60);
+    CHECK_REAL(out.m_np, 0);
+    return fails;
+}
+
+/* Scotch yoke: yoke m slides on a horizontal guide, slot vertical, block on the
+ * slot 0.1 m above D_m; a resisting force of 500 N on the yoke at D_m. The crank
+ * pushes with 500 N and the guide holds the couple 0.1 m * 500 N = 50 N m. */
+static int test_rtt_scotch_yoke(void)
+{
+    int fails = 0;
+    dyad_input in = dyad_input_default();
+    dyad_result out;
+    in.guide_k = vec(1, 0);
+    in.m.dir = vec(0, 1);
+    in.m.length = 0.1;
+    in.m.force = vec(-500, 0);
+    in.n.dir = vec(0, 1);
+    in.n.length = 0;
+    CHECK(dyad_solve(DYAD_RTT, &in, &out) == DYAD_STATUS_OK, "status");
+    CHECK_REAL(out.n_mk, 0);
+    CHECK_REAL(out.n_mn, -500);
+    CHECK_VEC(out.r_mn, 500, 0);
+    CHECK_VEC(out.r_np, 500, 0);
+    CHECK_REAL(out.m_mk, 50);
+    CHECK_REAL(out.m_mn, 0);
+    return fails;
+}
+
+/* A spinning link: an RRR with only inertia. Link m rotates about a fixed D_m
+ * at omega with its centre of mass at 0.25 m on the axis; link n is massless
+ * and aligned so that it carries no force. The pivot must supply the
+ * centripetal force m omega^2 r towards D_m. */
+static int test_rrr_centripetal(void)
+{
+    int fails = 0;
+    const double mass = 3, omega = 20, r = 0.25;
+    dyad_input in = dyad_input_default();
+    dyad_result out;
+    in.m.dir = vec(0, 1);
+    in.m.length = 0.5;
+    in.m.omega = (dyad_real)omega;
+    in.m.mass = (dyad_real)mass;
+    in.m.com = vec(r, 0);
+    in.n.dir = vec(1, 0);
+    in.n.length = 0.4;
+    CHECK(dyad_solve(DYAD_RRR, &in, &out) == DYAD_STATUS_OK, "status");
+    /* n is a two-force member along x, m must be held along y: R_mn = 0. */
+    CHECK_VEC(out.r_mk, 0, -mass * omega * omega * r);
+    CHECK_VEC(out.r_np, 0, 0);
+    CHECK_VEC(out.r_mn, 0, 0);
+    return fails;
+}
+
+/* ---- invalid input --------------------------------------------------------- */
+
+/* A valid configuration of every type: a generic one from the random set. */
+static dyad_input valid_input(dyad_type type)
+{
+    rng r = {42u + (uint64_t)type};
+    for (;;) {
+        dyad_input in = random_input(&r, type);
+        in.m.length = in.n.length = 0.5;
+        if (independent_conditioning(type, &in) > 0.3) {
+            return in;
+        }
+    }
+}
+
+typedef struct real_field {
+    dyad_field field;
+    size_t offset;
+    int guide; /* 0: always read; 1: guide_k; 2: guide_p */
+} real_field;
+
+static const real_field real_fields[] = {
+    {DYAD_FIELD_M_DIR, offsetof(dyad_input, m.dir.x), 0},
+    {DYAD_FIELD_M_DIR, offsetof(dyad_input, m.dir.y), 0},
+    {DYAD_FIELD_M_LENGTH, offsetof(dyad_input, m.length), 0},
+    {DYAD_FIELD_M_OMEGA, offsetof(dyad_input, m.omega), 0},
+    {DYAD_FIELD_M_EPSILON, offsetof(dyad_input, m.epsilon), 0},
+    {DYAD_FIELD_M_ACCEL_D, offsetof(dyad_input, m.accel_d.x), 0},
+    {DYAD_FIELD_M_ACCEL_D, offsetof(dyad_input, m.accel_d.y), 0},
+    {DYAD_FIELD_M_COM, offsetof(dyad_input, m.com.x), 0},
+    {DYAD_FIELD_M_COM, offsetof(dyad_input, m.com.y), 0},
+    {DYAD_FIELD_M_MASS, offsetof(dyad_input, m.mass), 0},
+    {DYAD_FIELD_M_INERTIA, offsetof(dyad_input, m.inertia), 0},
+    {DYAD_FIELD_M_FORCE, offsetof(dyad_input, m.force.x), 0},
+    {DYAD_FIELD_M_FORCE, offsetof(dyad_input, m.force.y), 0},
+    {DYAD_FIELD_M_MOMENT, offsetof(dyad_input, m.moment), 0},
+    {DYAD_FIELD_N_DIR, offsetof(dyad_input, n.dir.x), 0},
+    {DYAD_FIELD_N_DIR, offsetof(dyad_input, n.dir.y), 0},
+    {DYAD_FIELD_N_LENGTH, offsetof(dyad_input, n.length), 0},
+    {DYAD_FIELD_N_OMEGA, offsetof(dyad_input, n.omega), 0},
+    {DYAD_FIELD_N_EPSILON, offsetof(dyad_input, n.epsilon), 0},
+    {DYAD_FIELD_N_ACCEL_D, offsetof(dyad_input, n.accel_d.x), 0},
+    {DYAD_FIELD_N_ACCEL_D, offsetof(dyad_input, n.accel_d.y), 0},
+    {DYAD_FIELD_N_COM, offsetof(dyad_input, n.com.x), 0},
+    {DYAD_FIELD_N_COM, offsetof(dyad_input, n.com.y), 0},
+    {DYAD_FIELD_N_MASS, offsetof(dyad_input, n.mass), 0},
+    {DYAD_FIELD_N_INERTIA, offsetof(dyad_input, n.inertia), 0},
+    {DYAD_FIELD_N_FORCE, offsetof(dyad_input, n.force.x), 0},
+    {DYAD_FIELD_N_FORCE, offsetof(dyad_input, n.force.y), 0},
+    {DYAD_FIELD_N_MOMENT, offsetof(dyad_input, n.moment), 0},
+    {DYAD_FIELD_GUIDE_K, offsetof(dyad_input, guide_k.x), 1},
+    {DYAD_FIELD_GUIDE_K, offsetof(dyad_input, guide_k.y), 1},
+    {DYAD_FIELD_GUIDE_P, offsetof(dyad_input, guide_p.x), 2},
+    {DYAD_FIELD_GUIDE_P, offsetof(dyad_input, guide_p.y), 2},
+    {DYAD_FIELD_GRAVITY, offsetof(dyad_input, gravity.x), 0},
+    {DYAD_FIELD_GRAVITY, offsetof(dyad_input, gravity.y), 0},
+    {DYAD_FIELD_SINGULAR_THRESHOLD, offsetof(dyad_input, singular_threshold), 0},
+};
+
+static dyad_real* field_at(dyad_input* in, size_t offset)
+{
+    return (dyad_real*)((char*)in + offset);
+}
+
+static int expect_invalid(dyad_type type, const dyad_input* in, dyad_field field,
+                          const char* what)
+{
+    int fails = 0;
+    dyad_result out;
+    const dyad_status status = dyad_solve(type, in, &out);
+    CHECK(status == DYAD_STATUS_INVALID_INPUT && out.status == status && out.field == field,
+          "%s, %s: status %s, field '%s', expected invalid input in '%s'", dyad_type_name(type),
+          what, dyad_status_name(status), dyad_field_name(out.field), dyad_field_name(field));
+    CHECK(all_outputs_nan(&out), "%s, %s: outputs not NaN", dyad_type_name(type), what);
+    return fails;
+}
+
+static int test_invalid_nonfinite(void)
+{
+    int fails = 0;
+    const dyad_real bad_values[3] = {(dyad_real)NAN, (dyad_real)INFINITY, -(dyad_real)INFINITY};
+    int t;
+    size_t f, v;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        const dyad_input base = valid_input(type);
+        dyad_result out;
+        CHECK(dyad_solve(type, &base, &out) == DYAD_STATUS_OK, "%s: base case not ok",
+              dyad_type_name(type));
+        for (f = 0; f < sizeof real_fields / sizeof real_fields[0]; ++f) {
+            const real_field* rf = &real_fields[f];
+            const int read = rf->guide == 0 ||
+                             (rf->guide == 1 && dyad_pair_kind_of(type, DYAD_PAIR_DM) ==
+                                                    DYAD_PAIR_TRANSLATIONAL) ||
+                             (rf->guide == 2 && dyad_pair_kind_of(type, DYAD_PAIR_DN) ==
+                                                    DYAD_PAIR_TRANSLATIONAL);
+            for (v = 0; v < 3; ++v) {
+                dyad_input in = base;
+                *field_at(&in, rf->offset) = bad_values[v];
+                if (read) {
+                    fails += expect_invalid(type, &in, rf->field, "non-finite value");
+                } else {
+                    CHECK(dyad_solve(type, &in, &out) == DYAD_STATUS_OK,
+                          "%s: unused %s must be ignored", dyad_type_name(type),
+                          dyad_field_name(rf->field));
+                }
+            }
+        }
+    }
+    return fails;
+}
+
+static int test_invalid_domain(void)
+{
+    int fails = 0;
+    int t;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        const dyad_input base = valid_input(type);
+        const int zero_m = dyad_length_may_be_zero(type, DYAD_LINK_M);
+        const int zero_n = dyad_length_may_be_zero(type, DYAD_LINK_N);
+        dyad_input in;
+        dyad_result out;
+
+        in = base, in.m.length = -1e-3f;
+        fails += expect_invalid(type, &in, DYAD_FIELD_M_LENGTH, "negative l_m");
+        in = base, in.n.length = -1e-3f;
+        fails += expect_invalid(type, &in, DYAD_FIELD_N_LENGTH, "negative l_n");
+        in = base, in.m.length = 0;
+        if (zero_m) {
+            CHECK(dyad_solve(type, &in, &out) != DYAD_STATUS_INVALID_INPUT, "%s: l_m = 0 allowed",
+                  dyad_type_name(type));
+        } else {
+            fails += expect_invalid(type, &in, DYAD_FIELD_M_LENGTH, "zero l_m");
+        }
+        in = base, in.n.length = 0;
+        if (zero_n) {
+            CHECK(dyad_solve(type, &in, &out) != DYAD_STATUS_INVALID_INPUT, "%s: l_n = 0 allowed",
+                  dyad_type_name(type));
+        } else {
+            fails += expect_invalid(type, &in, DYAD_FIELD_N_LENGTH, "zero l_n");
+        }
+        in = base, in.m.mass = -1;
+        fails += expect_invalid(type, &in, DYAD_FIELD_M_MASS, "negative mass");
+        in = base, in.n.mass = -1e-9f;
+        fails += expect_invalid(type, &in, DYAD_FIELD_N_MASS, "negative mass");
+        in = base, in.m.inertia = -1;
+        fails += expect_invalid(type, &in, DYAD_FIELD_M_INERTIA, "negative inertia");
+        in = base, in.n.inertia = -1;
+        fails += expect_invalid(type, &in, DYAD_FIELD_N_INERTIA, "negative inertia");
+
+        in = base, in.m.dir = vec(2, 0);
+        fails += expect_invalid(type, &in, DYAD_FIELD_M_DIR, "i_m of length 2");
+        in = base, in.n.dir = vec(0, 0);
+        fails += expect_invalid(type, &in, DYAD_FIELD_N_DIR, "zero i_n");
+        in = base, in.m.dir = vec(1, 0.01);
+        fails += expect_invalid(type, &in, DYAD_FIELD_M_DIR, "i_m off unit by 1e-4");
+        if (dyad_pair_kind_of(type, DYAD_PAIR_DM) == DYAD_PAIR_TRANSLATIONAL) {
+            in = base, in.guide_k = vec(0.6, 0.6);
+            fails += expect_invalid(type, &in, DYAD_FIELD_GUIDE_K, "non-unit guide i_k");
+        }
+        if (dyad_pair_kind_of(type, DYAD_PAIR_DN) == DYAD_PAIR_TRANSLATIONAL) {
+            in = base, in.guide_p = vec(0, -0.5);
+            fails += expect_invalid(type, &in, DYAD_FIELD_GUIDE_P, "non-unit guide i_p");
+        }
+        /* Within the tolerance a direction is accepted and normalised. */
+        in = base, in.m.dir = dyad_scale(1 + (dyad_real)1e-7, base.m.dir);
+        CHECK(dyad_solve(type, &in, &out) == DYAD_STATUS_OK, "%s: near-unit i_m rejected",
+              dyad_type_name(type));
+
+        in = base, in.singular_threshold = 0;
+        fails += expect_invalid(type, &in, DYAD_FIELD_SINGULAR_THRESHOLD, "zero threshold");
+        in = base, in.singular_threshold = -1e-3f;
+        fails += expect_invalid(type, &in, DYAD_FIELD_SINGULAR_THRESHOLD, "negative threshold");
+        in = base, in.singular_threshold = 1;
+        fails += expect_invalid(type, &in, DYAD_FIELD_SINGULAR_THRESHOLD, "threshold 1");
+    }
+    {
+        const dyad_input in = valid_input(DYAD_RRR);
+        dyad_result out;
+        CHECK(dyad_solve((dyad_type)99, &in, &out) == DYAD_STATUS_INVALID_INPUT &&
+                  out.field == DYAD_FIELD_TYPE && all_outputs_nan(&out),
+              "unknown type not rejected");
+        CHECK(dyad_solve(DYAD_RTR, NULL, &out) == DYAD_STATUS_INVALID_INPUT &&
+                  out.field == DYAD_FIELD_INPUT,
+              "NULL input not rejected");
+        CHECK(dyad_solve_trt(&in, NULL) == DYAD_STATUS_INVALID_INPUT, "NULL result not rejected");
+        CHECK(strcmp(dyad_field_name(DYAD_FIELD_N_LENGTH), "link_n.length") == 0, "field name");
+    }
+    return fails;
+}
+
+/* Loads so large that the resultants overflow: reported, never inf. */
+static int test_out_of_range(void)
+{
+    int fails = 0;
+    int t;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        dyad_input in = valid_input(type);
+        dyad_result out;
+        in.m.mass = HUGE_REAL;
+        in.m.accel_d = vec(HUGE_REAL, 0);
+        CHECK(dyad_solve(type, &in, &out) == DYAD_STATUS_OUT_OF_RANGE && all_outputs_nan(&out),
+              "%s: overflow not reported (status %s)", dyad_type_name(type),
+              dyad_status_name(out.status));
+    }
+    return fails;
+}
+
+/* ---- singular positions -------------------------------------------------- */
+
+/* A configuration of the type at distance delta (rad or relative length) from
+ * its singular position, with loads that the singular dyad cannot carry. */
+static dyad_input near_singular(dyad_type type, double delta, int variant)
+{
+    dyad_input in = dyad_input_default();
+    const double base = 0.7;
+    in.m.length = 0.5;
+    in.n.length = 0.3;
+    in.m.force = vec(120, -80);
+    in.n.force = vec(-30, 200);
+    in.m.moment = 15;
+    in.n.moment = -7;
+    in.m.com = vec(0.2, 0.05);
+    in.n.com = vec(0.1, -0.02);
+    in.m.mass = 2;
+    in.n.mass = 1;
+    in.m.dir = polar(1, base);
+    in.guide_k = polar(1, base - 0.4);
+    switch (type) {
+    case DYAD_RRR: /* links aligned */
+        in.n.dir = polar(1, base + delta);
+        break;
+    case DYAD_RRT: /* rod normal to the guide */
+        in.n.dir = polar(1, base - 0.4 + PI / 2 - delta);
+        break;
+    case DYAD_TRT: /* parallel guides */
+        in.n.dir = polar(1, base + 1);
+        in.guide_p = polar(1, base - 0.4 + delta);
+        break;
+    case DYAD_RTT: /* slot parallel to the guide */
+        in.n.dir = polar(1, base + 1);
+        in.m.dir = polar(1, base - 0.4 + delta);
+        break;
+    case DYAD_RTR:
+        if (variant == 0) { /* slot normal to D_m D_n: l_n i_n = l_m i_m - (delta, 1) l_m rotated */
+            const double complex i_m = cexp(I * base);
+            const double complex ln_in = 0.5 * i_m * (1 - delta - I);
+            in.n.dir = vec(creal(ln_in / cabs(ln_in)), cimag(ln_in / cabs(ln_in)));
+            in.n.length = (dyad_real)cabs(ln_in);
+        } else { /* D_n approaching D_m along the slot */
+            in.n.dir = in.m.dir;
+            in.n.length = (dyad_real)(0.5 * (1 - delta));
+        }
+        break;
+    case DYAD_TYPE_COUNT: break;
+    }
+    return in;
+}
+
+static int test_singular(void)
+{
+    int fails = 0;
+    int t, variant;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        for (variant = 0; variant < (type == DYAD_RTR ? 2 : 1); ++variant) {
+            dyad_input in = near_singular(type, 0, variant);
+            dyad_result out;
+            double previous = 0;
+            int k, switched = 0;
+            CHECK(dyad_solve(type, &in, &out) == DYAD_STATUS_SINGULAR && all_outputs_nan(&out) &&
+                      out.field == DYAD_FIELD_NONE,
+                  "%s/%d: exact singular position: status %s", dyad_type_name(type), variant,
+                  dyad_status_name(out.status));
+            CHECK(out.conditioning < 10 * DYAD_REAL_EPSILON, "%s/%d: conditioning %.3g at singular",
+                  dyad_type_name(type), variant, (double)out.conditioning);
+            /* Approach: delta = 1e-1 ... 1e-12. */
+            for (k = 1; k <= 12; ++k) {
+                const double delta = pow(10, -k);
+                dyad_status status;
+                in = near_singular(type, delta, variant);
+                status = dyad_solve(type, &in, &out);
+                /* Strictly growing while delta is resolved in the scalar type. */
+                CHECK(out.amplification > previous ||
+                          (delta < 1e3 * DYAD_REAL_EPSILON && out.amplification >= previous),
+                      "%s/%d: amplification %.3g not growing at %.0e", dyad_type_name(type),
+                      variant, (double)out.amplification, delta);
+                previous = out.amplification;
+                if (out.conditioning >= in.singular_threshold) {
+                    CHECK(status == DYAD_STATUS_OK && !switched,
+                          "%s/%d: status %s above threshold at %.0e", dyad_type_name(type),
+                          variant, dyad_status_name(status), delta);
+                    CHECK(dyad_imbalance(&in, &out, 0, 1 + I).dyad <
+                              RESIDUAL_LIMIT * 100 * (double)out.amplification,
+                          "%s/%d: residual at %.0e", dyad_type_name(type), variant, delta);
+                } else {
+                    switched = 1;
+                    CHECK(status == DYAD_STATUS_SINGULAR && all_outputs_nan(&out),
+                          "%s/%d: status %s below threshold at %.0e", dyad_type_name(type),
+                          variant, dyad_status_name(status), delta);
+                }
+            }
+            CHECK(switched, "%s/%d: never reported singular down to 1e-12", dyad_type_name(type),
+                  variant);
+            /* The caller's threshold is honoured. */
+            in = near_singular(type, 1e-2, variant);
+            in.singular_threshold = 0.5;
+            CHECK(dyad_solve(type, &in, &out) == DYAD_STATUS_SINGULAR,
+                  "%s/%d: threshold 0.5 not honoured", dyad_type_name(type), variant);
+        }
+    }
+    return fails;
+}
+
+/* ---- runner --------------------------------------------------------------- */
+
+typedef struct named_test {
+    const char* name;
+    int (*run)(void);
+} named_test;
+
+static const named_test tests[] = {
+    {"equilibrium_random", test_equilibrium_random},
+    {"rrr_symmetric_truss", test_rrr_symmetric_truss},
+    {"rrr_centripetal", test_rrr_centripetal},
+    {"rrt_slider_crank_rod_force", test_rrt_slider_crank_rod_force},
+    {"rrt_dead_centre_with_weight", test_rrt_dead_centre_with_weight},
+    {"rtr_lever_torque", test_rtr_lever_torque},
+    {"trt_cross_slide", test_trt_cross_slide},
+    {"rtt_scotch_yoke", test_rtt_scotch_yoke},
+    {"invalid_nonfinite", test_invalid_nonfinite},
+    {"invalid_domain", test_invalid_domain},
+    {"out_of_range", test_out_of_range},
+    {"singular", test_singular},
+};
+
+int main(int argc, char** argv)
+{
+    const size_t count = sizeof tests / sizeof tests[0];
+    int failed = 0, passed = 0;
+    size_t k;
+    int a;
+    for (k = 0; k < count; ++k) {
+        int selected = argc < 2;
+        for (a = 1; a < argc; ++a) {
+            selected |= strcmp(argv[a], tests[k].name) == 0;
+        }
+        if (!selected) {
+            continue;
+        }
+        printf("[%s] %s\n", REAL_NAME, tests[k].name);
+        if (tests[k].run() == 0) {
+            ++passed;
+        } else {
+            ++failed;
+            printf("    -> FAILED\n");
+        }
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed == 0 && passed > 0 ? 0 : 1;
+}
