@@ -129,9 +129,10 @@ int main(int argc, char** argv)
             ++failures;
             continue;
         }
+        /* "+ 0.0" prints a zero moment as 0 rather than -0. */
         printf("%9.1f %12.3f %12.3f %12.3f %12.3f %12.3f %10.4f %8.5f\n", phi * 180 / PI,
                (double)out.r_np.x, (double)out.r_np.y, (double)out.r_mn.x, (double)out.r_mn.y,
-               (double)out.n_mk, (double)out.m_mk, (double)out.conditioning);
+               (double)out.n_mk, (double)out.m_mk + 0.0, (double)out.conditioning);
     }
     return failures == 0 ? 0 : 1;
 }
