@@ -42,11 +42,13 @@ dyadfmu_ensure_venv() {
     fi
 }
 
-# dyadfmu_build DIR [cmake options...]: configure and build into DIR.
+# dyadfmu_build DIR [cmake options...]: configure and build into DIR, the FMUs
+# with the venv's Python (its fmpy supplies the FMI headers).
 dyadfmu_build() {
     local dir=$1
     shift
     dyadfmu_log "building in $dir $*"
-    cmake -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+    cmake -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
+        -DPython3_EXECUTABLE="$DYADFMU_VENV/bin/python" "$@" >/dev/null
     cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
 }

@@ -229,7 +229,7 @@ static void fill_outputs(dyad_result* result, dyad_real value)
     result->m_mn = value;
 }
 
-static dyad_status reject(dyad_result* result, dyad_status status, dyad_field field)
+dyad_status dyad_reject(dyad_result* result, dyad_status status, dyad_field field)
 {
     fill_outputs(result, (dyad_real)NAN);
     result->status = status;
@@ -284,11 +284,11 @@ dyad_status dyad_prepare(dyad_type type, const dyad_input* input, dyad_prepared*
     result->conditioning = (dyad_real)NAN;
     result->amplification = (dyad_real)NAN;
     if (input == NULL) {
-        return reject(result, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_INPUT);
+        return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_INPUT);
     }
     bad = validate(type, input, prepared);
     if (bad != DYAD_FIELD_NONE) {
-        return reject(result, DYAD_STATUS_INVALID_INPUT, bad);
+        return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, bad);
     }
     fill_outputs(result, 0);
     result->status = DYAD_STATUS_OK;
@@ -303,7 +303,7 @@ dyad_status dyad_accept_conditioning(dyad_real denominator, dyad_real conditioni
     result->conditioning = conditioning;
     result->amplification = 1 / conditioning;
     if (!(conditioning >= threshold)) {
-        return reject(result, DYAD_STATUS_SINGULAR, DYAD_FIELD_NONE);
+        return dyad_reject(result, DYAD_STATUS_SINGULAR, DYAD_FIELD_NONE);
     }
     return DYAD_STATUS_OK;
 }
@@ -316,26 +316,9 @@ dyad_status dyad_finish(dyad_result* result)
                        dyad_is_valid_real(result->m_mk) && dyad_is_valid_real(result->m_np) &&
                        dyad_is_valid_real(result->m_mn);
     if (!finite) {
-        return reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
+        return dyad_reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
     }
     result->status = DYAD_STATUS_OK;
     result->field = DYAD_FIELD_NONE;
     return DYAD_STATUS_OK;
-}
-
-dyad_status dyad_solve(dyad_type type, const dyad_input* input, dyad_result* result)
-{
-    if (result == NULL) {
-        return DYAD_STATUS_INVALID_INPUT;
-    }
-    switch (type) {
-    case DYAD_RRR: return dyad_solve_rrr(input, result);
-    case DYAD_RRT: return dyad_solve_rrt(input, result);
-    case DYAD_RTR: return dyad_solve_rtr(input, result);
-    case DYAD_TRT: return dyad_solve_trt(input, result);
-    case DYAD_RTT: return dyad_solve_rtt(input, result);
-    case DYAD_TYPE_COUNT: break;
-    }
-    result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
-    return reject(result, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_TYPE);
 }

@@ -36,6 +36,9 @@ dyad_status dyad_prepare(dyad_type type, const dyad_input* input, dyad_prepared*
 dyad_status dyad_accept_conditioning(dyad_real denominator, dyad_real conditioning,
                                      dyad_real threshold, dyad_result* result);
 
+/* Marks the result with a failure status and field, outputs NaN; returns status. */
+dyad_status dyad_reject(dyad_result* result, dyad_status status, dyad_field field);
+
 /* Final check once a solver has written its outputs: any non-finite output
  * turns the result into DYAD_STATUS_OUT_OF_RANGE with NaN outputs. */
 dyad_status dyad_finish(dyad_result* result);

@@ -1,0 +1,308 @@
+/* dyadfmu FMU layer: the FMI 2.0 co-simulation API on top of fmu_instance.
+ * Each entry point translates types and names, nothing more. */
+#include <stdlib.h>
+
+#include "fmi2Functions.h"
+#include "fmu_instance.h"
+
+static fmi2Status to_fmi2(fmu_status status)
+{
+    return (fmi2Status)status;
+}
+
+/* The FMI 2 logger takes a format: the message goes through "%s" so that a
+ * '%' in a name or value is never interpreted again. */
+static void fmi2_sink(const fmu_logger* logger, fmu_status status, const char* category,
+                      const char* message)
+{
+    const fmi2CallbackLogger log = (fmi2CallbackLogger)logger->callback;
+    log(logger->environment, logger->instance_name, (fmi2Status)status, category, "%s", message);
+}
+
+const char* fmi2GetTypesPlatform(void)
+{
+    return fmi2TypesPlatform;
+}
+
+const char* fmi2GetVersion(void)
+{
+    return fmi2Version;
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[])
+{
+    return to_fmi2(fmu_set_debug_logging((fmu_instance*)c, loggingOn, nCategories, categories));
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation,
+                              const fmi2CallbackFunctions* functions, fmi2Boolean visible,
+                              fmi2Boolean loggingOn)
+{
+    fmu_logger logger = {NULL, NULL, NULL, NULL};
+    (void)fmuResourceLocation;
+    (void)visible;
+    if (functions == NULL) {
+        return NULL;
+    }
+    if (functions->logger != NULL) {
+        logger.sink = fmi2_sink;
+        logger.callback = (void (*)(void))functions->logger;
+        logger.environment = functions->componentEnvironment;
+    }
+    logger.instance_name = instanceName;
+    if (fmuType != fmi2CoSimulation) {
+        if (logger.sink != NULL) {
+            logger.sink(&logger, FMU_ERROR, "logStatusError",
+                        "fmi2Instantiate: this FMU supports co-simulation only");
+        }
+        return NULL;
+    }
+    return fmu_instantiate(&fmu_this_model, instanceName, fmuGUID, logger, loggingOn,
+                           functions->allocateMemory, functions->freeMemory);
+}
+
+void fmi2FreeInstance(fmi2Component c)
+{
+    fmu_free((fmu_instance*)c);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined,
+                               fmi2Real tolerance, fmi2Real startTime,
+                               fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+{
+    (void)toleranceDefined;
+    (void)tolerance;
+    (void)stopTimeDefined;
+    (void)stopTime;
+    return to_fmi2(fmu_setup_experiment((fmu_instance*)c, startTime));
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+{
+    fmu_instance* instance = (fmu_instance*)c;
+    return to_fmi2(fmu_enter_initialization(instance, instance != NULL ? instance->time : 0));
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+    return to_fmi2(fmu_exit_initialization((fmu_instance*)c));
+}
+
+fmi2Status fmi2Terminate(fmi2Component c)
+{
+    return to_fmi2(fmu_terminate((fmu_instance*)c));
+}
+
+fmi2Status fmi2Reset(fmi2Component c)
+{
+    return to_fmi2(fmu_reset((fmu_instance*)c));
+}
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                       fmi2Real value[])
+{
+    return to_fmi2(fmu_get_real((fmu_instance*)c, vr, nvr, value, "fmi2GetReal"));
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Integer value[])
+{
+    return to_fmi2(fmu_get_integer((fmu_instance*)c, vr, nvr, value, "fmi2GetInteger"));
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Boolean value[])
+{
+    (void)value;
+    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_GET, vr, nvr,
+                                            "fmi2GetBoolean"));
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         fmi2String value[])
+{
+    (void)value;
+    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_GET, vr, nvr,
+                                            "fmi2GetString"));
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                       const fmi2Real value[])
+{
+    return to_fmi2(fmu_set_real((fmu_instance*)c, vr, nvr, value, "fmi2SetReal"));
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Integer value[])
+{
+    return to_fmi2(fmu_set_integer((fmu_instance*)c, vr, nvr, value, "fmi2SetInteger"));
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Boolean value[])
+{
+    (void)value;
+    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_SET, vr, nvr,
+                                            "fmi2SetBoolean"));
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         const fmi2String value[])
+{
+    (void)value;
+    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_SET, vr, nvr,
+                                            "fmi2SetString"));
+}
+
+static const char no_state[] = "canGetAndSetFMUstate is false";
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate)
+{
+    (void)FMUstate;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetFMUstate", no_state));
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+{
+    (void)FMUstate;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SetFMUstate", no_state));
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate)
+{
+    (void)FMUstate;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2FreeFMUstate", no_state));
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size)
+{
+    (void)FMUstate;
+    (void)size;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SerializedFMUstateSize", no_state));
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serialized[],
+                                 size_t size)
+{
+    (void)FMUstate;
+    (void)serialized;
+    (void)size;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SerializeFMUstate", no_state));
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[],
+                                   size_t size, fmi2FMUstate* FMUstate)
+{
+    (void)serializedState;
+    (void)size;
+    (void)FMUstate;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2DeSerializeFMUstate", no_state));
+}
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],
+                                        size_t nUnknown, const fmi2ValueReference vKnown_ref[],
+                                        size_t nKnown, const fmi2Real dvKnown[],
+                                        fmi2Real dvUnknown[])
+{
+    (void)vUnknown_ref;
+    (void)nUnknown;
+    (void)vKnown_ref;
+    (void)nKnown;
+    (void)dvKnown;
+    (void)dvUnknown;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetDirectionalDerivative",
+                                   "providesDirectionalDerivative is false"));
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                       size_t nvr, const fmi2Integer order[],
+                                       const fmi2Real value[])
+{
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SetRealInputDerivatives",
+                                   "canInterpolateInputs is false"));
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                        size_t nvr, const fmi2Integer order[], fmi2Real value[])
+{
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetRealOutputDerivatives",
+                                   "maxOutputDerivativeOrder is 0"));
+}
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                      fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
+{
+    (void)noSetFMUStatePriorToCurrentPoint;
+    return to_fmi2(fmu_do_step((fmu_instance*)c, currentCommunicationPoint,
+                               communicationStepSize, "fmi2DoStep"));
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2CancelStep",
+                                   "fmi2DoStep never returns fmi2Pending"));
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* value)
+{
+    (void)s;
+    (void)value;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetStatus",
+                                   "fmi2DoStep never returns fmi2Pending"));
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value)
+{
+    fmu_instance* instance = (fmu_instance*)c;
+    fmu_status status = fmu_check_call(instance, FMU_OP_STEP_STATUS, "fmi2GetRealStatus");
+    if (status != FMU_OK) {
+        return to_fmi2(status);
+    }
+    if (s != fmi2LastSuccessfulTime || value == NULL) {
+        return to_fmi2(fmu_unsupported(instance, "fmi2GetRealStatus",
+                                       "only fmi2LastSuccessfulTime is a Real status"));
+    }
+    *value = instance->last_successful_time;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer* value)
+{
+    (void)s;
+    (void)value;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetIntegerStatus",
+                                   "there is no Integer status"));
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value)
+{
+    fmu_instance* instance = (fmu_instance*)c;
+    fmu_status status = fmu_check_call(instance, FMU_OP_STEP_STATUS, "fmi2GetBooleanStatus");
+    if (status != FMU_OK) {
+        return to_fmi2(status);
+    }
+    if (s != fmi2Terminated || value == NULL) {
+        return to_fmi2(fmu_unsupported(instance, "fmi2GetBooleanStatus",
+                                       "only fmi2Terminated is a Boolean status"));
+    }
+    *value = instance->terminate_requested ? fmi2True : fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String* value)
+{
+    (void)s;
+    (void)value;
+    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetStringStatus",
+                                   "there is no String status"));
+}

@@ -1,0 +1,801 @@
+/* dyadfmu FMU layer: the FMI 3.0 co-simulation API on top of fmu_instance.
+ * Each entry point translates types and names, nothing more. The FMU has
+ * Float64 and Int32 variables only; every other type's getters and setters
+ * reject any value reference. */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "fmi3Functions.h"
+#include "fmu_instance.h"
+
+static fmi3Status to_fmi3(fmu_status status)
+{
+    return (fmi3Status)status;
+}
+
+static void fmi3_sink(const fmu_logger* logger, fmu_status status, const char* category,
+                      const char* message)
+{
+    const fmi3LogMessageCallback log = (fmi3LogMessageCallback)logger->callback;
+    log(logger->environment, (fmi3Status)status, category, message);
+}
+
+static fmu_logger make_logger(fmi3String instance_name, fmi3InstanceEnvironment environment,
+                              fmi3LogMessageCallback log_message)
+{
+    fmu_logger logger = {NULL, NULL, NULL, NULL};
+    if (log_message != NULL) {
+        logger.sink = fmi3_sink;
+        logger.callback = (void (*)(void))log_message;
+        logger.environment = environment;
+    }
+    logger.instance_name = instance_name;
+    return logger;
+}
+
+static void refuse_interface(fmi3String instance_name, fmi3InstanceEnvironment environment,
+                             fmi3LogMessageCallback log_message, const char* interface_name)
+{
+    fmu_logger logger = make_logger(instance_name, environment, log_message);
+    if (logger.sink != NULL) {
+        char message[160];
+        snprintf(message, sizeof message, "this FMU supports co-simulation only, not %s",
+                 interface_name);
+        logger.sink(&logger, FMU_ERROR, "logStatusError", message);
+    }
+}
+
+/* Every variable is a scalar: as many values as value references. */
+static int scalar_counts(fmu_instance* instance, size_t n_value_references, size_t n_values,
+                         const char* function)
+{
+    if (instance != NULL && n_values != n_value_references) {
+        fmu_log(instance, FMU_ERROR, "%s: nValues = %zu but nValueReferences = %zu (all "
+                "variables are scalars)", function, n_values, n_value_references);
+        return 0;
+    }
+    return 1;
+}
+
+const char* fmi3GetVersion(void)
+{
+    return fmi3Version;
+}
+
+fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
+                               const fmi3String categories[])
+{
+    return to_fmi3(fmu_set_debug_logging((fmu_instance*)instance, loggingOn, nCategories,
+                                         categories));
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
+                                          fmi3String resourcePath, fmi3Boolean visible,
+                                          fmi3Boolean loggingOn,
+                                          fmi3InstanceEnvironment instanceEnvironment,
+                                          fmi3LogMessageCallback logMessage)
+{
+    (void)instantiationToken;
+    (void)resourcePath;
+    (void)visible;
+    (void)loggingOn;
+    refuse_interface(instanceName, instanceEnvironment, logMessage, "model exchange");
+    return NULL;
+}
+
+fmi3Instance fmi3InstantiateCoSimulation(
+    fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath,
+    fmi3Boolean visible, fmi3Boolean loggingOn, fmi3Boolean eventModeUsed,
+    fmi3Boolean earlyReturnAllowed, const fmi3ValueReference requiredIntermediateVariables[],
+    size_t nRequiredIntermediateVariables, fmi3InstanceEnvironment instanceEnvironment,
+    fmi3LogMessageCallback logMessage, fmi3IntermediateUpdateCallback intermediateUpdate)
+{
+    fmu_logger logger = make_logger(instanceName, instanceEnvironment, logMessage);
+    (void)resourcePath;
+    (void)visible;
+    (void)earlyReturnAllowed;
+    (void)requiredIntermediateVariables;
+    (void)intermediateUpdate;
+    if (eventModeUsed) {
+        if (logger.sink != NULL) {
+            logger.sink(&logger, FMU_ERROR, "logStatusError",
+                        "fmi3InstantiateCoSimulation: eventModeUsed is true, but this FMU has "
+                        "no event mode (hasEventMode=\"false\")");
+        }
+        return NULL;
+    }
+    if (nRequiredIntermediateVariables > 0) {
+        if (logger.sink != NULL) {
+            logger.sink(&logger, FMU_ERROR, "logStatusError",
+                        "fmi3InstantiateCoSimulation: this FMU provides no intermediate "
+                        "variables");
+        }
+        return NULL;
+    }
+    return fmu_instantiate(&fmu_this_model, instanceName, instantiationToken, logger, loggingOn,
+                           NULL, NULL);
+}
+
+fmi3Instance fmi3InstantiateScheduledExecution(
+    fmi3String instanceName, fmi3String instantiationToken, fmi3String resourcePath,
+    fmi3Boolean visible, fmi3Boolean loggingOn, fmi3InstanceEnvironment instanceEnvironment,
+    fmi3LogMessageCallback logMessage, fmi3ClockUpdateCallback clockUpdate,
+    fmi3LockPreemptionCallback lockPreemption, fmi3UnlockPreemptionCallback unlockPreemption)
+{
+    (void)instantiationToken;
+    (void)resourcePath;
+    (void)visible;
+    (void)loggingOn;
+    (void)clockUpdate;
+    (void)lockPreemption;
+    (void)unlockPreemption;
+    refuse_interface(instanceName, instanceEnvironment, logMessage, "scheduled execution");
+    return NULL;
+}
+
+void fmi3FreeInstance(fmi3Instance instance)
+{
+    fmu_free((fmu_instance*)instance);
+}
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined,
+                                       fmi3Float64 tolerance, fmi3Float64 startTime,
+                                       fmi3Boolean stopTimeDefined, fmi3Float64 stopTime)
+{
+    (void)toleranceDefined;
+    (void)tolerance;
+    (void)stopTimeDefined;
+    (void)stopTime;
+    return to_fmi3(fmu_enter_initialization((fmu_instance*)instance, startTime));
+}
+
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
+{
+    return to_fmi3(fmu_exit_initialization((fmu_instance*)instance));
+}
+
+fmi3Status fmi3EnterEventMode(fmi3Instance instance)
+{
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterEventMode", "hasEventMode is false"));
+}
+
+fmi3Status fmi3Terminate(fmi3Instance instance)
+{
+    return to_fmi3(fmu_terminate((fmu_instance*)instance));
+}
+
+fmi3Status fmi3Reset(fmi3Instance instance)
+{
+    return to_fmi3(fmu_reset((fmu_instance*)instance));
+}
+
+fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, fmi3Float32 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetFloat32"));
+}
+
+/* FMI 3 declares the independent variable `time` at this value reference. */
+enum { TIME_VR = 0 };
+
+fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, fmi3Float64 values[], size_t nValues)
+{
+    fmu_instance* fmu = (fmu_instance*)instance;
+    fmu_status worst = FMU_OK;
+    size_t k;
+    if (!scalar_counts(fmu, nValueReferences, nValues, "fmi3GetFloat64")) {
+        return fmi3Error;
+    }
+    if (nValueReferences > 0 && (valueReferences == NULL || values == NULL)) {
+        return to_fmi3(fmu_get_real(fmu, valueReferences, nValueReferences, values,
+                                    "fmi3GetFloat64"));
+    }
+    for (k = 0; k < nValueReferences; ++k) {
+        fmu_status status;
+        if (valueReferences[k] == TIME_VR) {
+            status = fmu_check_call(fmu, FMU_OP_GET, "fmi3GetFloat64");
+            if (status == FMU_OK) {
+                values[k] = fmu->time;
+            }
+        } else {
+            status = fmu_get_real(fmu, &valueReferences[k], 1, &values[k], "fmi3GetFloat64");
+        }
+        if (status > worst) {
+            worst = status;
+        }
+        if (worst >= FMU_ERROR) {
+            break;
+        }
+    }
+    return to_fmi3(worst);
+}
+
+fmi3Status fmi3GetInt8(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                       size_t nValueReferences, fmi3Int8 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetInt8"));
+}
+
+fmi3Status fmi3GetUInt8(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, fmi3UInt8 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetUInt8"));
+}
+
+fmi3Status fmi3GetInt16(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, fmi3Int16 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetInt16"));
+}
+
+fmi3Status fmi3GetUInt16(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, fmi3UInt16 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetUInt16"));
+}
+
+fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, fmi3Int32 values[], size_t nValues)
+{
+    if (!scalar_counts((fmu_instance*)instance, nValueReferences, nValues, "fmi3GetInt32")) {
+        return fmi3Error;
+    }
+    return to_fmi3(fmu_get_integer((fmu_instance*)instance, valueReferences, nValueReferences,
+                                   values, "fmi3GetInt32"));
+}
+
+fmi3Status fmi3GetUInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, fmi3UInt32 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetUInt32"));
+}
+
+fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, fmi3Int64 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetInt64"));
+}
+
+fmi3Status fmi3GetUInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, fmi3UInt64 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetUInt64"));
+}
+
+fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, fmi3Boolean values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetBoolean"));
+}
+
+fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, fmi3String values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetString"));
+}
+
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, size_t valueSizes[], fmi3Binary values[],
+                         size_t nValues)
+{
+    (void)valueSizes;
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetBinary"));
+}
+
+fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, fmi3Clock values[])
+{
+    (void)values;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
+                                            nValueReferences, "fmi3GetClock"));
+}
+
+fmi3Status fmi3SetFloat32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, const fmi3Float32 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetFloat32"));
+}
+
+fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, const fmi3Float64 values[], size_t nValues)
+{
+    fmu_instance* fmu = (fmu_instance*)instance;
+    size_t k;
+    if (!scalar_counts(fmu, nValueReferences, nValues, "fmi3SetFloat64")) {
+        return fmi3Error;
+    }
+    for (k = 0; fmu != NULL && valueReferences != NULL && k < nValueReferences; ++k) {
+        if (valueReferences[k] == TIME_VR) {
+            fmu_log(fmu, FMU_ERROR, "fmi3SetFloat64: time (value reference 0) is the "
+                    "independent variable and cannot be set");
+            return fmi3Error;
+        }
+    }
+    return to_fmi3(fmu_set_real(fmu, valueReferences, nValueReferences, values,
+                                "fmi3SetFloat64"));
+}
+
+fmi3Status fmi3SetInt8(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                       size_t nValueReferences, const fmi3Int8 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetInt8"));
+}
+
+fmi3Status fmi3SetUInt8(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, const fmi3UInt8 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetUInt8"));
+}
+
+fmi3Status fmi3SetInt16(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, const fmi3Int16 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetInt16"));
+}
+
+fmi3Status fmi3SetUInt16(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, const fmi3UInt16 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetUInt16"));
+}
+
+fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, const fmi3Int32 values[], size_t nValues)
+{
+    if (!scalar_counts((fmu_instance*)instance, nValueReferences, nValues, "fmi3SetInt32")) {
+        return fmi3Error;
+    }
+    return to_fmi3(fmu_set_integer((fmu_instance*)instance, valueReferences, nValueReferences,
+                                   values, "fmi3SetInt32"));
+}
+
+fmi3Status fmi3SetUInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, const fmi3UInt32 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetUInt32"));
+}
+
+fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, const fmi3Int64 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetInt64"));
+}
+
+fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, const fmi3UInt64 values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetUInt64"));
+}
+
+fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                          size_t nValueReferences, const fmi3Boolean values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetBoolean"));
+}
+
+fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, const fmi3String values[], size_t nValues)
+{
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetString"));
+}
+
+fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                         size_t nValueReferences, const size_t valueSizes[],
+                         const fmi3Binary values[], size_t nValues)
+{
+    (void)valueSizes;
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetBinary"));
+}
+
+fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                        size_t nValueReferences, const fmi3Clock values[])
+{
+    (void)values;
+    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
+                                            nValueReferences, "fmi3SetClock"));
+}
+
+fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
+                                               fmi3ValueReference valueReference,
+                                               size_t* nDependencies)
+{
+    (void)valueReference;
+    (void)nDependencies;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfVariableDependencies", "the dependencies are declared in modelDescription.xml"));
+}
+
+fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent,
+                                       size_t elementIndicesOfDependent[],
+                                       fmi3ValueReference independents[],
+                                       size_t elementIndicesOfIndependents[],
+                                       fmi3DependencyKind dependencyKinds[], size_t nDependencies)
+{
+    (void)dependent;
+    (void)elementIndicesOfDependent;
+    (void)independents;
+    (void)elementIndicesOfIndependents;
+    (void)dependencyKinds;
+    (void)nDependencies;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetVariableDependencies", "the dependencies are declared in modelDescription.xml"));
+}
+
+fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
+{
+    (void)FMUState;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetFMUState", "canGetAndSetFMUState is false"));
+}
+
+fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
+{
+    (void)FMUState;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetFMUState", "canGetAndSetFMUState is false"));
+}
+
+fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
+{
+    (void)FMUState;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3FreeFMUState", "canGetAndSetFMUState is false"));
+}
+
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t* size)
+{
+    (void)FMUState;
+    (void)size;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializedFMUStateSize", "canGetAndSetFMUState is false"));
+}
+
+fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
+                                 fmi3Byte serializedState[], size_t size)
+{
+    (void)FMUState;
+    (void)serializedState;
+    (void)size;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializeFMUState", "canGetAndSetFMUState is false"));
+}
+
+fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[],
+                                   size_t size, fmi3FMUState* FMUState)
+{
+    (void)serializedState;
+    (void)size;
+    (void)FMUState;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3DeserializeFMUState", "canGetAndSetFMUState is false"));
+}
+
+fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[],
+                                        size_t nUnknowns, const fmi3ValueReference knowns[],
+                                        size_t nKnowns, const fmi3Float64 seed[], size_t nSeed,
+                                        fmi3Float64 sensitivity[], size_t nSensitivity)
+{
+    (void)unknowns;
+    (void)nUnknowns;
+    (void)knowns;
+    (void)nKnowns;
+    (void)seed;
+    (void)nSeed;
+    (void)sensitivity;
+    (void)nSensitivity;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetDirectionalDerivative", "providesDirectionalDerivatives is false"));
+}
+
+fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[],
+                                    size_t nUnknowns, const fmi3ValueReference knowns[],
+                                    size_t nKnowns, const fmi3Float64 seed[], size_t nSeed,
+                                    fmi3Float64 sensitivity[], size_t nSensitivity)
+{
+    (void)unknowns;
+    (void)nUnknowns;
+    (void)knowns;
+    (void)nKnowns;
+    (void)seed;
+    (void)nSeed;
+    (void)sensitivity;
+    (void)nSensitivity;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetAdjointDerivative", "providesAdjointDerivatives is false"));
+}
+
+fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance)
+{
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterConfigurationMode", "the FMU has no structural parameters"));
+}
+
+fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance)
+{
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3ExitConfigurationMode", "the FMU has no structural parameters"));
+}
+
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                  size_t nValueReferences, fmi3Float64 intervals[],
+                                  fmi3IntervalQualifier qualifiers[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)intervals;
+    (void)qualifiers;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetIntervalDecimal", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3GetIntervalFraction(fmi3Instance instance,
+                                   const fmi3ValueReference valueReferences[],
+                                   size_t nValueReferences, fmi3UInt64 counters[],
+                                   fmi3UInt64 resolutions[], fmi3IntervalQualifier qualifiers[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)counters;
+    (void)resolutions;
+    (void)qualifiers;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetIntervalFraction", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                               size_t nValueReferences, fmi3Float64 shifts[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)shifts;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftDecimal", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                size_t nValueReferences, fmi3UInt64 counters[],
+                                fmi3UInt64 resolutions[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)counters;
+    (void)resolutions;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftFraction", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                  size_t nValueReferences, const fmi3Float64 intervals[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)intervals;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetIntervalDecimal", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3SetIntervalFraction(fmi3Instance instance,
+                                   const fmi3ValueReference valueReferences[],
+                                   size_t nValueReferences, const fmi3UInt64 counters[],
+                                   const fmi3UInt64 resolutions[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)counters;
+    (void)resolutions;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetIntervalFraction", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                               size_t nValueReferences, const fmi3Float64 shifts[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)shifts;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftDecimal", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                size_t nValueReferences, const fmi3UInt64 counters[],
+                                const fmi3UInt64 resolutions[])
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)counters;
+    (void)resolutions;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftFraction", "the FMU has no clocks"));
+}
+
+fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance)
+{
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EvaluateDiscreteStates", "hasEventMode is false"));
+}
+
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean* discreteStatesNeedUpdate,
+                                    fmi3Boolean* terminateSimulation,
+                                    fmi3Boolean* nominalsOfContinuousStatesChanged,
+                                    fmi3Boolean* valuesOfContinuousStatesChanged,
+                                    fmi3Boolean* nextEventTimeDefined, fmi3Float64* nextEventTime)
+{
+    (void)discreteStatesNeedUpdate;
+    (void)terminateSimulation;
+    (void)nominalsOfContinuousStatesChanged;
+    (void)valuesOfContinuousStatesChanged;
+    (void)nextEventTimeDefined;
+    (void)nextEventTime;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3UpdateDiscreteStates", "hasEventMode is false"));
+}
+
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance)
+{
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterContinuousTimeMode", "model exchange is not supported"));
+}
+
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance,
+                                       fmi3Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi3Boolean* enterEventMode,
+                                       fmi3Boolean* terminateSimulation)
+{
+    (void)noSetFMUStatePriorToCurrentPoint;
+    (void)enterEventMode;
+    (void)terminateSimulation;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3CompletedIntegratorStep", "model exchange is not supported"));
+}
+
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time)
+{
+    (void)time;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetTime", "model exchange is not supported"));
+}
+
+fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[],
+                                   size_t nContinuousStates)
+{
+    (void)continuousStates;
+    (void)nContinuousStates;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetContinuousStates", "model exchange is not supported"));
+}
+
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[],
+                                             size_t nContinuousStates)
+{
+    (void)derivatives;
+    (void)nContinuousStates;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetContinuousStateDerivatives", "model exchange is not supported"));
+}
+
+fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[],
+                                  size_t nEventIndicators)
+{
+    (void)eventIndicators;
+    (void)nEventIndicators;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetEventIndicators", "model exchange is not supported"));
+}
+
+fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[],
+                                   size_t nContinuousStates)
+{
+    (void)continuousStates;
+    (void)nContinuousStates;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetContinuousStates", "model exchange is not supported"));
+}
+
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[],
+                                             size_t nContinuousStates)
+{
+    (void)nominals;
+    (void)nContinuousStates;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNominalsOfContinuousStates", "model exchange is not supported"));
+}
+
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t* nEventIndicators)
+{
+    (void)nEventIndicators;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfEventIndicators", "model exchange is not supported"));
+}
+
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t* nContinuousStates)
+{
+    (void)nContinuousStates;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfContinuousStates", "model exchange is not supported"));
+}
+
+fmi3Status fmi3EnterStepMode(fmi3Instance instance)
+{
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterStepMode", "hasEventMode is false"));
+}
+
+fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance,
+                                    const fmi3ValueReference valueReferences[],
+                                    size_t nValueReferences, const fmi3Int32 orders[],
+                                    fmi3Float64 values[], size_t nValues)
+{
+    (void)valueReferences;
+    (void)nValueReferences;
+    (void)orders;
+    (void)values;
+    (void)nValues;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetOutputDerivatives", "maxOutputDerivativeOrder is 0"));
+}
+
+fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint,
+                      fmi3Float64 communicationStepSize,
+                      fmi3Boolean noSetFMUStatePriorToCurrentPoint,
+                      fmi3Boolean* eventHandlingNeeded, fmi3Boolean* terminateSimulation,
+                      fmi3Boolean* earlyReturn, fmi3Float64* lastSuccessfulTime)
+{
+    fmu_instance* fmu = (fmu_instance*)instance;
+    fmu_status status;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    if (fmu != NULL && (eventHandlingNeeded == NULL || terminateSimulation == NULL ||
+                        earlyReturn == NULL || lastSuccessfulTime == NULL)) {
+        fmu_log(fmu, FMU_ERROR, "fmi3DoStep: an output argument is NULL");
+        return fmi3Error;
+    }
+    status = fmu_do_step(fmu, currentCommunicationPoint, communicationStepSize, "fmi3DoStep");
+    if (fmu != NULL && eventHandlingNeeded != NULL) {
+        *eventHandlingNeeded = fmi3False;
+        *earlyReturn = fmi3False;
+        *terminateSimulation = fmu->terminate_requested ? fmi3True : fmi3False;
+        *lastSuccessfulTime = fmu->last_successful_time;
+    }
+    return to_fmi3(status);
+}
+
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
+                                      fmi3Float64 activationTime)
+{
+    (void)clockReference;
+    (void)activationTime;
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3ActivateModelPartition", "scheduled execution is not supported"));
+}

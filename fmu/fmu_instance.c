@@ -1,0 +1,563 @@
+/* dyadfmu FMU layer: the version-neutral instance (see fmu_instance.h). */
+#include "fmu_instance.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { ALL_STATES = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION | FMU_STATE_STEP |
+                    FMU_STATE_TERMINATED };
+
+/* Where each operation may be called. One table instead of a test per entry point. */
+static const unsigned legal_states[FMU_OP_COUNT] = {
+    [FMU_OP_SETUP_EXPERIMENT] = FMU_STATE_INSTANTIATED,
+    [FMU_OP_ENTER_INITIALIZATION] = FMU_STATE_INSTANTIATED,
+    [FMU_OP_EXIT_INITIALIZATION] = FMU_STATE_INITIALIZATION,
+    [FMU_OP_DO_STEP] = FMU_STATE_STEP,
+    [FMU_OP_TERMINATE] = FMU_STATE_STEP,
+    [FMU_OP_RESET] = ALL_STATES,
+    [FMU_OP_GET] = FMU_STATE_INITIALIZATION | FMU_STATE_STEP | FMU_STATE_TERMINATED,
+    [FMU_OP_SET] = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION | FMU_STATE_STEP,
+    [FMU_OP_STEP_STATUS] = FMU_STATE_STEP | FMU_STATE_TERMINATED,
+    [FMU_OP_DEBUG_LOGGING] = ALL_STATES,
+    [FMU_OP_UNSUPPORTED] = ALL_STATES,
+};
+
+/* Parameters (fixed) may change only while these hold. */
+enum { PARAMETER_STATES = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION };
+
+const char* const fmu_log_category_names[] = {"logStatusError", "logStatusWarning",
+                                              "logStatusDiscard", "logCalls"};
+const size_t fmu_log_category_count = sizeof fmu_log_category_names / sizeof fmu_log_category_names[0];
+enum { LOG_ERROR = 0, LOG_WARNING, LOG_DISCARD, LOG_CALLS };
+
+static const char* state_name(fmu_state state)
+{
+    switch (state) {
+    case FMU_STATE_INSTANTIATED: return "Instantiated";
+    case FMU_STATE_INITIALIZATION: return "Initialization Mode";
+    case FMU_STATE_STEP: return "Step Mode";
+    case FMU_STATE_TERMINATED: return "Terminated";
+    }
+    return "?";
+}
+
+static void emit(const fmu_logger* logger, unsigned categories, fmu_status status,
+                 const char* format, va_list args)
+{
+    char message[512];
+    int category;
+    if (logger->sink == NULL) {
+        return;
+    }
+    switch (status) {
+    case FMU_OK: category = LOG_CALLS; break;
+    case FMU_WARNING: category = LOG_WARNING; break;
+    case FMU_DISCARD: category = LOG_DISCARD; break;
+    default: category = LOG_ERROR; break;
+    }
+    if (status == FMU_OK && !(categories & (1u << LOG_CALLS))) {
+        return;
+    }
+    vsnprintf(message, sizeof message, format, args);
+    logger->sink(logger, status, fmu_log_category_names[category], message);
+}
+
+void fmu_log(const fmu_instance* instance, fmu_status status, const char* format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    emit(&instance->logger, instance->log_categories, status, format, args);
+    va_end(args);
+}
+
+/* Logging before an instance exists. */
+static void log_to(const fmu_logger* logger, fmu_status status, const char* format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void log_to(const fmu_logger* logger, fmu_status status, const char* format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    emit(logger, 0, status, format, args);
+    va_end(args);
+}
+
+static void load_start_values(fmu_instance* instance)
+{
+    size_t k;
+    for (k = 0; k < instance->model->variable_count; ++k) {
+        instance->values[k] = instance->model->variables[k].start;
+    }
+    instance->state = FMU_STATE_INSTANTIATED;
+    instance->time = 0;
+    instance->last_successful_time = 0;
+    instance->terminate_requested = 0;
+    instance->dirty = 1;
+}
+
+fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
+                              const char* token, fmu_logger logger, int logging_on,
+                              fmu_allocate allocate, fmu_release release)
+{
+    fmu_instance* instance;
+    size_t values_size, name_size;
+    char* name;
+
+    logger.instance_name = instance_name != NULL ? instance_name : "";
+    if (instance_name == NULL || instance_name[0] == '\0') {
+        log_to(&logger, FMU_ERROR, "instantiate: the instance name must not be empty");
+        return NULL;
+    }
+    if (token == NULL || strcmp(token, model->token) != 0) {
+        log_to(&logger, FMU_ERROR,
+               "instantiate: instantiation token '%s' does not match this FMU's '%s' (%s); "
+               "was the model description taken from another FMU?",
+               token != NULL ? token : "(null)", model->token, model->identifier);
+        return NULL;
+    }
+    if (allocate == NULL || release == NULL) {
+        allocate = calloc;
+        release = free;
+    }
+    values_size = model->variable_count * sizeof(double);
+    name_size = strlen(instance_name) + 1;
+    instance = (fmu_instance*)allocate(1, sizeof(fmu_instance) + values_size + name_size);
+    if (instance == NULL) {
+        log_to(&logger, FMU_ERROR, "instantiate: out of memory");
+        return NULL;
+    }
+    instance->values = (double*)(instance + 1);
+    name = (char*)(instance->values + model->variable_count);
+    memcpy(name, instance_name, name_size);
+
+    instance->model = model;
+    instance->logger = logger;
+    instance->logger.instance_name = name;
+    instance->release = release;
+    instance->log_categories = logging_on ? ~0u : 0u;
+    load_start_values(instance);
+    fmu_log(instance, FMU_OK, "instantiated %s", model->identifier);
+    return instance;
+}
+
+void fmu_free(fmu_instance* instance)
+{
+    if (instance != NULL) {
+        instance->release(instance);
+    }
+}
+
+fmu_status fmu_check_call(fmu_instance* instance, fmu_operation operation, const char* function)
+{
+    if (instance == NULL) {
+        return FMU_ERROR;
+    }
+    if (!(legal_states[operation] & (unsigned)instance->state)) {
+        fmu_log(instance, FMU_ERROR, "%s: illegal call sequence: not allowed in %s", function,
+                state_name(instance->state));
+        return FMU_ERROR;
+    }
+    fmu_log(instance, FMU_OK, "%s", function);
+    return FMU_OK;
+}
+
+fmu_status fmu_set_debug_logging(fmu_instance* instance, int logging_on, size_t count,
+                                 const char* const categories[])
+{
+    unsigned bits = 0;
+    size_t k, c;
+    fmu_status status = fmu_check_call(instance, FMU_OP_DEBUG_LOGGING, "setDebugLogging");
+    if (status != FMU_OK) {
+        return status;
+    }
+    if (count > 0 && categories == NULL) {
+        fmu_log(instance, FMU_ERROR, "setDebugLogging: %zu categories but a NULL array", count);
+        return FMU_ERROR;
+    }
+    for (k = 0; k < count; ++k) {
+        for (c = 0; c < fmu_log_category_count; ++c) {
+            if (categories[k] != NULL && strcmp(categories[k], fmu_log_category_names[c]) == 0) {
+                break;
+            }
+        }
+        if (c == fmu_log_category_count) {
+            fmu_log(instance, FMU_ERROR, "setDebugLogging: unknown log category '%s'",
+                    categories[k] != NULL ? categories[k] : "(null)");
+            return FMU_ERROR;
+        }
+        bits |= 1u << c;
+    }
+    if (count == 0) {
+        bits = ~0u;
+    }
+    instance->log_categories = logging_on ? (instance->log_categories | bits)
+                                          : (instance->log_categories & ~bits);
+    return FMU_OK;
+}
+
+fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time)
+{
+    fmu_status status = fmu_check_call(instance, FMU_OP_SETUP_EXPERIMENT, "setupExperiment");
+    if (status == FMU_OK) {
+        instance->time = start_time;
+        instance->last_successful_time = start_time;
+    }
+    return status;
+}
+
+/* ---- the solve ----------------------------------------------------------- */
+
+static const fmu_variable* variable_of_field(const fmu_model* model, dyad_field field)
+{
+    size_t k;
+    for (k = 0; k < model->variable_count; ++k) {
+        if (model->variables[k].causality != FMU_OUTPUT && model->variables[k].field == field) {
+            return &model->variables[k];
+        }
+    }
+    return NULL;
+}
+
+/* The solver's input from the variable store, through the table's offsets. */
+static void gather_input(const fmu_instance* instance, dyad_input* input)
+{
+    const fmu_model* model = instance->model;
+    size_t k;
+    *input = dyad_input_default();
+    for (k = 0; k < model->variable_count; ++k) {
+        const fmu_variable* v = &model->variables[k];
+        char* member = (char*)input + v->offset;
+        if (v->target == FMU_TARGET_INPUT_ANGLE) {
+            dyad_vec2* dir = (dyad_vec2*)(void*)member;
+            dir->x = (dyad_real)cos(instance->values[k]);
+            dir->y = (dyad_real)sin(instance->values[k]);
+        } else if (v->target == FMU_TARGET_INPUT_REAL) {
+            *(dyad_real*)(void*)member = (dyad_real)instance->values[k];
+        }
+    }
+}
+
+/* Solves if an input changed since the last solve. Returns FMU_OK, FMU_ERROR
+ * for inputs the solver rejects, or `not_solvable` for a singular or
+ * overflowing configuration; each failure is logged once per solve. */
+static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const char* function)
+{
+    dyad_input input;
+    const dyad_result* r = &instance->result;
+    if (instance->dirty) {
+        gather_input(instance, &input);
+        instance->model->solve(&input, &instance->result);
+        instance->dirty = 0;
+        switch (r->status) {
+        case DYAD_STATUS_OK: break;
+        case DYAD_STATUS_SINGULAR:
+            fmu_log(instance, not_solvable,
+                    "%s: singular configuration at t = %g s: conditioning %.3g is below "
+                    "singular_threshold %.3g; the dyad cannot carry its load, reactions are NaN",
+                    function, instance->time, (double)r->conditioning,
+                    (double)input.singular_threshold);
+            break;
+        case DYAD_STATUS_OUT_OF_RANGE:
+            fmu_log(instance, not_solvable,
+                    "%s: at t = %g s the loads or reactions overflow double; reactions are NaN",
+                    function, instance->time);
+            break;
+        case DYAD_STATUS_INVALID_INPUT: {
+            const fmu_variable* v = variable_of_field(instance->model, r->field);
+            fmu_log(instance, FMU_ERROR, "%s: %s = %g is not valid for this dyad (%s)", function,
+                    v != NULL ? v->name : dyad_field_name(r->field),
+                    v != NULL ? instance->values[v - instance->model->variables] : NAN,
+                    dyad_field_name(r->field));
+            break;
+        }
+        }
+    }
+    switch (r->status) {
+    case DYAD_STATUS_OK: return FMU_OK;
+    case DYAD_STATUS_INVALID_INPUT: return FMU_ERROR;
+    case DYAD_STATUS_SINGULAR:
+    case DYAD_STATUS_OUT_OF_RANGE: break;
+    }
+    return not_solvable;
+}
+
+/* ---- the state machine ---------------------------------------------------- */
+
+fmu_status fmu_enter_initialization(fmu_instance* instance, double start_time)
+{
+    fmu_status status =
+        fmu_check_call(instance, FMU_OP_ENTER_INITIALIZATION, "enterInitializationMode");
+    if (status == FMU_OK) {
+        instance->state = FMU_STATE_INITIALIZATION;
+        instance->time = start_time;
+        instance->last_successful_time = start_time;
+    }
+    return status;
+}
+
+fmu_status fmu_exit_initialization(fmu_instance* instance)
+{
+    fmu_status status =
+        fmu_check_call(instance, FMU_OP_EXIT_INITIALIZATION, "exitInitializationMode");
+    if (status != FMU_OK) {
+        return status;
+    }
+    status = solve(instance, FMU_WARNING, "exitInitializationMode");
+    if (status != FMU_ERROR) {
+        instance->state = FMU_STATE_STEP;
+    }
+    return status;
+}
+
+fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
+                       const char* function)
+{
+    fmu_status status = fmu_check_call(instance, FMU_OP_DO_STEP, function);
+    if (status != FMU_OK) {
+        return status;
+    }
+    if (!isfinite(current_time) || !isfinite(step_size) || !(step_size > 0)) {
+        fmu_log(instance, FMU_ERROR,
+                "%s: currentCommunicationPoint = %g s and communicationStepSize = %g s: the "
+                "step size must be positive and both finite",
+                function, current_time, step_size);
+        return FMU_ERROR;
+    }
+    instance->time = current_time;
+    status = solve(instance, FMU_DISCARD, function);
+    if (status == FMU_OK) {
+        instance->time = current_time + step_size;
+        instance->last_successful_time = instance->time;
+        instance->terminate_requested = 0;
+    } else if (status == FMU_DISCARD) {
+        instance->last_successful_time = current_time;
+        instance->terminate_requested = 1;
+    }
+    return status;
+}
+
+fmu_status fmu_terminate(fmu_instance* instance)
+{
+    fmu_status status = fmu_check_call(instance, FMU_OP_TERMINATE, "terminate");
+    if (status == FMU_OK) {
+        instance->state = FMU_STATE_TERMINATED;
+    }
+    return status;
+}
+
+fmu_status fmu_reset(fmu_instance* instance)
+{
+    fmu_status status = fmu_check_call(instance, FMU_OP_RESET, "reset");
+    if (status == FMU_OK) {
+        load_start_values(instance);
+    }
+    return status;
+}
+
+/* ---- get and set ------------------------------------------------------------ */
+
+static const char* type_name(fmu_value_type type)
+{
+    return type == FMU_REAL ? "Real" : "Integer";
+}
+
+/* The variable of a value reference of the given type, or NULL with a logged error. */
+static const fmu_variable* lookup(const fmu_instance* instance, unsigned int vr,
+                                  fmu_value_type type, const char* function)
+{
+    const fmu_model* model = instance->model;
+    const fmu_variable* v;
+    if (vr >= model->vr_limit || model->index_of_vr[vr] < 0) {
+        fmu_log(instance, FMU_ERROR, "%s: unknown value reference %u", function, vr);
+        return NULL;
+    }
+    v = &model->variables[model->index_of_vr[vr]];
+    if (v->type != type) {
+        fmu_log(instance, FMU_ERROR, "%s: value reference %u (%s) is of type %s, not %s",
+                function, vr, v->name, type_name(v->type), type_name(type));
+        return NULL;
+    }
+    return v;
+}
+
+static fmu_status check_arrays(const fmu_instance* instance, const void* vr, size_t count,
+                               const void* values, const char* function)
+{
+    if (count > 0 && (vr == NULL || values == NULL)) {
+        fmu_log(instance, FMU_ERROR, "%s: %zu values requested but an array is NULL", function,
+                count);
+        return FMU_ERROR;
+    }
+    return FMU_OK;
+}
+
+/* Whether a value may be stored in v now; logs the reason if not. */
+static fmu_status check_settable(const fmu_instance* instance, const fmu_variable* v,
+                                 double value, const char* function)
+{
+    if (v->causality == FMU_OUTPUT) {
+        fmu_log(instance, FMU_ERROR, "%s: %s is an output and cannot be set", function, v->name);
+        return FMU_ERROR;
+    }
+    if (v->causality == FMU_PARAMETER && !((unsigned)instance->state & PARAMETER_STATES)) {
+        fmu_log(instance, FMU_ERROR,
+                "%s: %s is a fixed parameter; it can be set only before initialization ends "
+                "(now in %s)",
+                function, v->name, state_name(instance->state));
+        return FMU_ERROR;
+    }
+    if (!isfinite(value)) {
+        fmu_log(instance, FMU_ERROR, "%s: %s = %g is not a finite number", function, v->name,
+                value);
+        return FMU_ERROR;
+    }
+    if ((v->bounds & FMU_HAS_MIN) &&
+        ((v->bounds & FMU_MIN_EXCLUSIVE) ? !(value > v->min) : !(value >= v->min))) {
+        fmu_log(instance, FMU_ERROR, "%s: %s = %g %s: it must be %s %g", function, v->name, value,
+                v->unit, (v->bounds & FMU_MIN_EXCLUSIVE) ? ">" : ">=", v->min);
+        return FMU_ERROR;
+    }
+    if ((v->bounds & FMU_HAS_MAX) &&
+        ((v->bounds & FMU_MAX_EXCLUSIVE) ? !(value < v->max) : !(value <= v->max))) {
+        fmu_log(instance, FMU_ERROR, "%s: %s = %g %s: it must be %s %g", function, v->name, value,
+                v->unit, (v->bounds & FMU_MAX_EXCLUSIVE) ? "<" : "<=", v->max);
+        return FMU_ERROR;
+    }
+    return FMU_OK;
+}
+
+fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
+                        const double values[], const char* function)
+{
+    size_t k;
+    fmu_status status = fmu_check_call(instance, FMU_OP_SET, function);
+    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    /* All values are checked before any is stored: a rejected call changes nothing. */
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = lookup(instance, vr[k], FMU_REAL, function);
+        if (v == NULL || check_settable(instance, v, values[k], function) != FMU_OK) {
+            return FMU_ERROR;
+        }
+    }
+    for (k = 0; k < count; ++k) {
+        instance->values[instance->model->index_of_vr[vr[k]]] = values[k];
+    }
+    if (count > 0) {
+        instance->dirty = 1;
+    }
+    return FMU_OK;
+}
+
+fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
+                           const int values[], const char* function)
+{
+    size_t k;
+    fmu_status status = fmu_check_call(instance, FMU_OP_SET, function);
+    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = lookup(instance, vr[k], FMU_INTEGER, function);
+        if (v == NULL || check_settable(instance, v, values[k], function) != FMU_OK) {
+            return FMU_ERROR;
+        }
+    }
+    for (k = 0; k < count; ++k) {
+        instance->values[instance->model->index_of_vr[vr[k]]] = values[k];
+    }
+    if (count > 0) {
+        instance->dirty = 1;
+    }
+    return FMU_OK;
+}
+
+/* The value of a variable as a double, solving first if it is an output.
+ * `worst` collects the status of the solve. */
+static double read_variable(fmu_instance* instance, const fmu_variable* v, fmu_status* worst,
+                            const char* function)
+{
+    const char* member = (const char*)&instance->result + v->offset;
+    fmu_status status;
+    if (v->causality != FMU_OUTPUT) {
+        return instance->values[v - instance->model->variables];
+    }
+    status = solve(instance, FMU_WARNING, function);
+    if (status > *worst) {
+        *worst = status;
+    }
+    if (v->target == FMU_TARGET_RESULT_STATUS) {
+        return (double)instance->result.status;
+    }
+    return (double)*(const dyad_real*)(const void*)member;
+}
+
+fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
+                        double values[], const char* function)
+{
+    fmu_status worst = FMU_OK;
+    size_t k;
+    fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
+    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = lookup(instance, vr[k], FMU_REAL, function);
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        values[k] = read_variable(instance, v, &worst, function);
+    }
+    return worst;
+}
+
+fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
+                           int values[], const char* function)
+{
+    fmu_status worst = FMU_OK;
+    size_t k;
+    fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
+    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = lookup(instance, vr[k], FMU_INTEGER, function);
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        values[k] = (int)read_variable(instance, v, &worst, function);
+    }
+    /* The status output itself reports a singular configuration: no warning. */
+    return worst == FMU_ERROR ? FMU_ERROR : FMU_OK;
+}
+
+fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,
+                                    const unsigned int vr[], size_t count,
+                                    const char* function)
+{
+    fmu_status status = fmu_check_call(instance, operation, function);
+    if (status != FMU_OK) {
+        return status;
+    }
+    if (count > 0) {
+        fmu_log(instance, FMU_ERROR, "%s: unknown value reference %u (this FMU has no variables "
+                "of this type)", function, vr != NULL ? vr[0] : 0u);
+        return FMU_ERROR;
+    }
+    return FMU_OK;
+}
+
+fmu_status fmu_unsupported(fmu_instance* instance, const char* function, const char* why)
+{
+    if (instance == NULL) {
+        return FMU_ERROR;
+    }
+    fmu_log(instance, FMU_ERROR, "%s is not supported by this FMU: %s", function, why);
+    return FMU_ERROR;
+}

@@ -1,0 +1,131 @@
+/* dyadfmu FMU layer: one FMU instance, independent of the FMI version.
+ *
+ * The FMI 2 and FMI 3 shims (fmi2_functions.c, fmi3_functions.c) translate
+ * their API onto these functions; everything that does not depend on the
+ * version lives here: the call-sequence rules, the variable store, get/set by
+ * value reference through the generated variable table, the (lazy) solve and
+ * logging. An instance owns all its data: instances never share state. */
+#ifndef DYADFMU_FMU_INSTANCE_H
+#define DYADFMU_FMU_INSTANCE_H
+
+#include <stddef.h>
+
+#include "fmu_model.h"
+
+/* Same numbering as fmi2Status and fmi3Status. */
+typedef enum fmu_status {
+    FMU_OK = 0,
+    FMU_WARNING = 1,
+    FMU_DISCARD = 2,
+    FMU_ERROR = 3,
+    FMU_FATAL = 4
+} fmu_status;
+
+/* The states of the co-simulation state machine, as bits so that each entry
+ * point can name the states it may be called in with one mask. */
+typedef enum fmu_state {
+    FMU_STATE_INSTANTIATED = 1 << 0,
+    FMU_STATE_INITIALIZATION = 1 << 1,
+    FMU_STATE_STEP = 1 << 2,
+    FMU_STATE_TERMINATED = 1 << 3
+} fmu_state;
+
+/* The operations whose legal states fmu_check_call looks up. */
+typedef enum fmu_operation {
+    FMU_OP_SETUP_EXPERIMENT = 0,
+    FMU_OP_ENTER_INITIALIZATION,
+    FMU_OP_EXIT_INITIALIZATION,
+    FMU_OP_DO_STEP,
+    FMU_OP_TERMINATE,
+    FMU_OP_RESET,
+    FMU_OP_GET,
+    FMU_OP_SET,
+    FMU_OP_STEP_STATUS,
+    FMU_OP_DEBUG_LOGGING,
+    FMU_OP_UNSUPPORTED,
+    FMU_OP_COUNT
+} fmu_operation;
+
+struct fmu_logger;
+
+/* Passes one formatted message to the importer's logger. Implemented by each
+ * shim, which knows the importer's callback type. */
+typedef void (*fmu_log_sink)(const struct fmu_logger* logger, fmu_status status,
+                             const char* category, const char* message);
+
+typedef struct fmu_logger {
+    fmu_log_sink sink;       /* NULL: messages are dropped */
+    void (*callback)(void);  /* the importer's logger, cast back by the sink */
+    void* environment;       /* the importer's environment pointer */
+    const char* instance_name;
+} fmu_logger;
+
+typedef void* (*fmu_allocate)(size_t count, size_t size);
+typedef void (*fmu_release)(void* memory);
+
+typedef struct fmu_instance {
+    const fmu_model* model;
+    fmu_logger logger;
+    fmu_release release;
+    unsigned log_categories; /* bit k: category k of fmu_log_category_names is on */
+    fmu_state state;
+    double time;             /* communication point reached (s) */
+    double last_successful_time;
+    int terminate_requested; /* set when a step cannot be completed */
+    int dirty;               /* inputs changed since the last solve */
+    dyad_result result;
+    double* values;          /* one per variable; outputs unused */
+} fmu_instance;
+
+/* Log categories declared in the model descriptions, in bit order. */
+extern const char* const fmu_log_category_names[];
+extern const size_t fmu_log_category_count;
+
+/* Creates an instance with start values, or logs why not and returns NULL. */
+fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
+                              const char* token, fmu_logger logger, int logging_on,
+                              fmu_allocate allocate, fmu_release release);
+void fmu_free(fmu_instance* instance);
+
+/* Error, with a logged reason, unless `operation` is legal in the current state. */
+fmu_status fmu_check_call(fmu_instance* instance, fmu_operation operation, const char* function);
+
+/* Logs printf-style through the instance's logger. Errors, discards and
+ * warnings are always passed on; FMU_OK messages only with logCalls on. */
+void fmu_log(const fmu_instance* instance, fmu_status status, const char* format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+fmu_status fmu_set_debug_logging(fmu_instance* instance, int logging_on, size_t count,
+                                 const char* const categories[]);
+fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time);
+fmu_status fmu_enter_initialization(fmu_instance* instance, double start_time);
+fmu_status fmu_exit_initialization(fmu_instance* instance);
+fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
+                       const char* function);
+fmu_status fmu_terminate(fmu_instance* instance);
+fmu_status fmu_reset(fmu_instance* instance);
+
+/* Get and set by value reference. `type` is the type the importer asked for;
+ * a value reference of another type is an error. */
+fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
+                        double values[], const char* function);
+fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
+                        const double values[], const char* function);
+fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
+                           int values[], const char* function);
+fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
+                           const int values[], const char* function);
+
+/* For variable types the model has none of: accepts an empty list, rejects
+ * any value reference by number. */
+fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,
+                                    const unsigned int vr[], size_t count,
+                                    const char* function);
+
+/* Error with a logged "not supported" for an entry point this FMU does not offer. */
+fmu_status fmu_unsupported(fmu_instance* instance, const char* function, const char* why);
+
+#endif /* DYADFMU_FMU_INSTANCE_H */

@@ -1,0 +1,304 @@
+"""The ten FMUs through fmpy: validation, co-simulation against the C core,
+misuse through fmpy's low-level classes, and a rebuild from sources/."""
+
+import math
+import os
+import shutil
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+from fmpy.validation import validate_fmu
+
+from dyadfmu.core import Core
+
+ROOT = Path(__file__).resolve().parents[2]
+BUILD = Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
+TYPES = ("rrr", "rrt", "rtr", "trt", "rtt")
+VERSIONS = (2, 3)
+ALL = [(t, v) for t in TYPES for v in VERSIONS]
+
+
+def fmu_path(dyad, version):
+    path = BUILD / "fmus" / f"dyad_{dyad}_fmi{version}.fmu"
+    if not path.is_file():
+        pytest.fail(f"{path} is missing: build the FMUs first (scripts/run-tests does)")
+    return path
+
+
+@pytest.fixture(scope="module")
+def core():
+    return Core()
+
+
+# ---- validation ------------------------------------------------------------------
+
+@pytest.mark.parametrize("dyad,version", ALL)
+def test_fmu_validates(dyad, version):
+    path = fmu_path(dyad, version)
+    assert validate_fmu(str(path)) == []
+    with zipfile.ZipFile(path) as archive:
+        names = set(archive.namelist())
+    platform = "linux64" if version == 2 else "x86_64-linux"
+    assert "modelDescription.xml" in names
+    assert f"binaries/{platform}/dyad_{dyad}.so" in names
+    assert "documentation/index.html" in names
+    assert f"sources/dyad_{dyad}.c" in names and "sources/dyadfmu/dyad.h" in names
+    if version == 3:
+        assert "sources/buildDescription.xml" in names
+        with zipfile.ZipFile(path) as archive:
+            assert archive.read("modelDescription.xml") == \
+                (ROOT / "modelDescription" / "golden" / f"dyad_{dyad}_fmi3.xml").read_bytes()
+    else:
+        with zipfile.ZipFile(path) as archive:
+            assert archive.read("modelDescription.xml") == \
+                (ROOT / "modelDescription" / "golden" / f"dyad_{dyad}_fmi2.xml").read_bytes()
+
+
+# ---- co-simulation against the core ----------------------------------------------
+
+def input_signals(md, revolutions=1.0, samples=200):
+    """Smooth time-varying values for every input over one crank revolution
+    (t from 0 to 1 s): each input swings around its start value."""
+    t = np.linspace(0.0, 1.0, samples + 1)
+    phase = 2 * math.pi * revolutions * t
+    inputs = [v for v in md.modelVariables if v.causality == "input"]
+    rows = np.zeros(len(t), dtype=[("time", np.float64)] + [(v.name, np.float64) for v in inputs])
+    rows["time"] = t
+    for k, v in enumerate(inputs):
+        start = float(v.start)
+        if v.name.endswith("angle"):
+            value = start + 0.35 * np.sin(phase + 0.7 * k)        # rad
+        elif v.name.endswith("length"):
+            value = start * (1 + 0.3 * np.sin(phase))             # m, stays positive
+        else:
+            value = start + (1 + k) * 10 * np.cos(phase + 0.3 * k)
+        rows[v.name] = value
+    return rows
+
+
+def link_dicts(row, names, params):
+    """The recorded FMU inputs and the parameters as the dicts of dyadfmu.core."""
+    def get(name, default=0.0):
+        return float(row[name]) if name in names else float(params.get(name, default))
+
+    def link(g):
+        angle = get(f"link_{g}.angle")
+        return dict(dir=(math.cos(angle), math.sin(angle)), length=get(f"link_{g}.length"),
+                    omega=get(f"link_{g}.omega"), epsilon=get(f"link_{g}.epsilon"),
+                    accel_d=(get(f"link_{g}.accel_d.x"), get(f"link_{g}.accel_d.y")),
+                    com=(get(f"link_{g}.com.x"), get(f"link_{g}.com.y")),
+                    mass=get(f"link_{g}.mass"), inertia=get(f"link_{g}.inertia"),
+                    force=(get(f"link_{g}.force.x"), get(f"link_{g}.force.y")),
+                    moment=get(f"link_{g}.moment"))
+
+    guides = {}
+    for guide in ("guide_k", "guide_p"):
+        angle = get(f"{guide}.angle")
+        guides[guide] = (math.cos(angle), math.sin(angle))
+    return link("m"), link("n"), guides, (get("gravity.x"), get("gravity.y"))
+
+
+OUTPUT_OF = {"R_mk.x": ("r_mk", 0), "R_mk.y": ("r_mk", 1), "R_np.x": ("r_np", 0),
+             "R_np.y": ("r_np", 1), "R_mn.x": ("r_mn", 0), "R_mn.y": ("r_mn", 1),
+             "N_mk": ("n_mk", None), "N_np": ("n_np", None), "N_mn": ("n_mn", None),
+             "M_mk": ("m_mk", None), "M_np": ("m_np", None), "M_mn": ("m_mn", None),
+             "conditioning": ("conditioning", None), "amplification": ("amplification", None)}
+
+
+@pytest.mark.parametrize("dyad,version", ALL)
+def test_cosimulation_reproduces_core(core, dyad, version):
+    path = fmu_path(dyad, version)
+    md = read_model_description(str(path))
+    signals = input_signals(md)
+    inputs = [n for n in signals.dtype.names if n != "time"]
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    params = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
+    result = simulate_fmu(str(path), start_time=0, stop_time=1, step_size=0.005,
+                          input=signals, output=inputs + outputs)
+    assert len(result) >= 200
+    assert np.all(result["status"] == 0)
+    worst = 0.0
+    for row in result:
+        m, n, guides, gravity = link_dicts(row, set(inputs), params)
+        want = core.solve(dyad.upper(), m, n, guides["guide_k"], guides["guide_p"], gravity,
+                          singular_threshold=params["singular_threshold"])
+        assert want["status"] == "ok"
+        for name in outputs:
+            if name == "status":
+                continue
+            key, index = OUTPUT_OF[name]
+            expected = want[key] if index is None else want[key][index]
+            got = float(row[name])
+            scale = max(abs(expected), 1e-300)
+            worst = max(worst, abs(got - expected) / scale)
+    print(f"dyad_{dyad}_fmi{version}: {len(result)} steps, worst relative difference to the "
+          f"core {worst:.1e}")
+    assert worst <= 1e-15
+
+
+# ---- misuse through the low-level classes ------------------------------------------
+
+class Slave:
+    """An instantiated FMU of either version, with a name -> value reference map."""
+
+    def __init__(self, dyad, version, tmp_path, name="instance"):
+        path = fmu_path(dyad, version)
+        self.version = version
+        self.md = read_model_description(str(path))
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        unzipdir = tmp_path / f"{dyad}{version}{name}"
+        with zipfile.ZipFile(path) as archive:
+            archive.extractall(unzipdir)
+        cls = FMU2Slave if version == 2 else FMU3Slave
+        self.fmu = cls(guid=self.md.guid, unzipDirectory=str(unzipdir),
+                       modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+        self.fmu.instantiate(loggingOn=False)
+
+    def set(self, name, value):
+        vr = [self.vr[name]]
+        if self.version == 2:
+            self.fmu.setReal(vr, [value])
+        else:
+            self.fmu.setFloat64(vr, [value])
+
+    def get(self, name):
+        vr = [self.vr[name]]
+        if name == "status":
+            return (self.fmu.getInteger if self.version == 2 else self.fmu.getInt32)(vr)[0]
+        return (self.fmu.getReal if self.version == 2 else self.fmu.getFloat64)(vr)[0]
+
+    def initialize(self):
+        if self.version == 2:
+            self.fmu.setupExperiment(startTime=0)
+        self.fmu.enterInitializationMode()
+        self.fmu.exitInitializationMode()
+
+    def step(self, t, h=0.01):
+        return self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+
+    def close(self):
+        self.fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_wrong_call_order_is_an_error(tmp_path, version):
+    s = Slave("rrt", version, tmp_path)
+    with pytest.raises(FMICallException):
+        s.step(0)                       # before initialization
+    with pytest.raises(FMICallException):
+        s.get("R_np.x")                 # outputs need initialization
+    s.initialize()
+    with pytest.raises(FMICallException):
+        s.fmu.enterInitializationMode()
+    with pytest.raises(FMICallException):
+        s.set("link_m.mass", 3.0)       # fixed parameter after initialization
+    s.step(0)
+    s.fmu.terminate()
+    with pytest.raises(FMICallException):
+        s.step(0.01)
+    s.close()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_bad_inputs_and_parameters_are_rejected(tmp_path, version):
+    s = Slave("rrr", version, tmp_path)
+    for name, value in (("link_m.force.x", math.nan), ("link_n.omega", math.inf),
+                        ("link_m.mass", -1.0), ("link_n.length", 0.0),
+                        ("singular_threshold", 1.5)):
+        with pytest.raises(FMICallException):
+            s.set(name, value)
+    s.initialize()
+    s.step(0)                           # still usable, with the start values
+    assert s.get("status") == 0
+    assert math.isfinite(s.get("R_mk.x"))
+    assert s.get("link_m.force.x") == 0.0
+    s.close()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_singular_configuration(tmp_path, version):
+    s = Slave("rrr", version, tmp_path)
+    s.initialize()
+    s.step(0)
+    s.set("link_n.angle", s.get("link_m.angle") + math.pi)   # links aligned
+    with pytest.raises(FMICallException) as error:
+        s.step(0.01)
+    assert error.value.status == 2                           # discard
+    assert s.get("status") == 1
+    assert math.isnan(s.get("R_mn.x")) and math.isnan(s.get("R_np.y"))
+    assert s.get("conditioning") < 1e-12
+    s.set("link_n.angle", 2.0)                               # leave the singular position
+    s.step(0.01)
+    assert s.get("status") == 0 and math.isfinite(s.get("R_mn.x"))
+    s.close()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_two_instances_do_not_interfere(tmp_path, version):
+    a = Slave("rtt", version, tmp_path, "a")
+    b = Slave("rtt", version, tmp_path, "b")
+    a.initialize()
+    b.initialize()
+    a.set("link_m.force.x", -500.0)
+    b.set("link_m.force.x", 800.0)
+    a.step(0)
+    b.step(0)
+    ra, rb = a.get("R_np.x"), b.get("R_np.x")
+    assert ra != rb
+    a.step(0.01)
+    assert a.get("R_np.x") == ra and b.get("R_np.x") == rb
+    a.close()
+    b.close()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_reset_restores_start_values(tmp_path, version):
+    s = Slave("rtr", version, tmp_path)
+    s.initialize()
+    s.step(0)
+    first = s.get("R_mk.y")
+    s.set("link_m.moment", 123.0)
+    s.step(0.01)
+    assert s.get("R_mk.y") != first
+    s.fmu.reset()
+    s.set("link_m.mass", 2.5)                                # parameters settable again
+    s.set("link_m.mass", 2.0)
+    s.initialize()
+    s.step(0)
+    assert s.get("link_m.moment") == 0.0
+    assert s.get("R_mk.y") == first
+    s.close()
+
+
+# ---- rebuild from sources ----------------------------------------------------------
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_source_fmu_rebuilds(tmp_path, version):
+    from fmpy.build import build_platform_binary
+
+    path = fmu_path("rrt", version)
+    unzipdir = tmp_path / "unzipped"
+    with zipfile.ZipFile(path) as archive:
+        archive.extractall(unzipdir)
+    shutil.rmtree(unzipdir / "binaries")
+    build_platform_binary(unzipdir)
+    platform = "linux64" if version == 2 else "x86_64-linux"
+    assert (unzipdir / "binaries" / platform / "dyad_rrt.so").is_file()
+    rebuilt = tmp_path / "rebuilt.fmu"
+    shutil.make_archive(str(rebuilt.with_suffix("")), "zip", unzipdir)
+    shutil.move(str(rebuilt.with_suffix(".zip")), rebuilt)
+    md = read_model_description(str(path))
+    signals = input_signals(md, samples=20)
+    outputs = ["R_mk.y", "R_np.x", "R_np.y", "R_mn.x", "N_mk", "M_mk", "status"]
+    original = simulate_fmu(str(path), stop_time=1, step_size=0.05, input=signals,
+                            output=outputs)
+    again = simulate_fmu(str(rebuilt), stop_time=1, step_size=0.05, input=signals,
+                         output=outputs)
+    for name in outputs:
+        np.testing.assert_allclose(again[name], original[name], rtol=1e-13, atol=0)

@@ -1,0 +1,672 @@
+"""The variable tables of the dyad FMUs and what modelDescription/generate.py makes of them.
+
+(a) The `depends` lists of every table are the true output dependencies, derived
+    here afresh with the independent NumPy reference by perturbing each input.
+(b) The generated model descriptions equal the golden files byte for byte.
+(c) fmpy validates every generated description, and units, causalities, counts
+    and the model structure are what the dyad type calls for.
+(d) Malformed tables are refused with a message that names the variable.
+Also: the generated C tables compile, the start values give a well-conditioned
+solve, and the instantiation token follows the table.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+MD_DIR = ROOT / "modelDescription"
+GENERATOR = MD_DIR / "generate.py"
+for _p in (str(MD_DIR), str(ROOT / "scripts")):
+    if _p not in sys.path:
+        sys.path.insert(0, _p)
+
+import generate  # noqa: E402
+from dyadfmu import reference as ref  # noqa: E402
+
+TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
+PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}  # D_m, E, D_n
+TABLE_OF = {t: MD_DIR / f"dyad_{t.lower()}.toml" for t in TYPES}
+
+
+def load_raw(dyad_type):
+    with open(TABLE_OF[dyad_type], "rb") as f:
+        return tomllib.load(f)
+
+
+def names_of(raw, causality):
+    return [v["name"] for v in raw["variable"] if v["causality"] == causality]
+
+
+# ---------------------------------------------------------------------------
+# The FMU's view of the reference: values by variable name -> outputs by name
+# ---------------------------------------------------------------------------
+def _dir(angle):
+    return (math.cos(angle), math.sin(angle))
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1]
+
+
+def _rot90(v):
+    return (-v[1], v[0])
+
+
+def conditioning(dyad_type, m, n, gk, gp):
+    """The conditioning figure of the solver (README), from the reference's inputs."""
+    i_m, i_n = m["dir"], n["dir"]
+    if dyad_type == "RRR":
+        return abs(_dot(i_m, _rot90(i_n)))
+    if dyad_type == "RRT":
+        return abs(_dot(i_n, gk))
+    if dyad_type == "TRT":
+        return abs(_dot(_rot90(gk), gp))
+    if dyad_type == "RTT":
+        return abs(_dot(_rot90(gk), i_m))
+    d = (m["length"] * i_m[0] - n["length"] * i_n[0], m["length"] * i_m[1] - n["length"] * i_n[1])
+    dist = math.hypot(*d)
+    if dist == 0:
+        return 0.0
+    return min(abs(_dot(d, i_m)) / dist, dist / (m["length"] + n["length"]))
+
+
+def reference_args(values):
+    """Reference solve arguments from FMU variable values keyed by name."""
+    links = {}
+    for g in "mn":
+        p = f"link_{g}."
+        links[g] = dict(
+            dir=_dir(values[p + "angle"]), length=values[p + "length"],
+            omega=values[p + "omega"], epsilon=values[p + "epsilon"],
+            accel_d=(values[p + "accel_d.x"], values[p + "accel_d.y"]),
+            com=(values[p + "com.x"], values[p + "com.y"]),
+            mass=values[p + "mass"], inertia=values[p + "inertia"],
+            force=(values[p + "force.x"], values[p + "force.y"]), moment=values[p + "moment"])
+    gk = _dir(values["guide_k.angle"]) if "guide_k.angle" in values else (1.0, 0.0)
+    gp = _dir(values["guide_p.angle"]) if "guide_p.angle" in values else (1.0, 0.0)
+    return links["m"], links["n"], gk, gp, (values["gravity.x"], values["gravity.y"])
+
+
+def evaluate(dyad_type, values):
+    """Every FMU output (by name) for the given inputs and parameters, by the reference."""
+    m, n, gk, gp, gravity = reference_args(values)
+    out = ref.solve(dyad_type, m, n, gk, gp, gravity)
+    result = {}
+    for pair in ("mk", "np", "mn"):
+        result[f"R_{pair}.x"] = float(out[f"r_{pair}"][0, 0])
+        result[f"R_{pair}.y"] = float(out[f"r_{pair}"][0, 1])
+        result[f"N_{pair}"] = float(out[f"n_{pair}"][0])
+        result[f"M_{pair}"] = float(out[f"m_{pair}"][0])
+    cond = conditioning(dyad_type, m, n, gk, gp)
+    result["conditioning"] = cond
+    result["amplification"] = 1 / cond if cond > 0 else math.inf
+    result["status"] = 0 if cond >= values["singular_threshold"] else 1
+    return result
+
+
+def random_value(name, rng):
+    """A random value of a variable, by its name: generic, nonzero, well inside its domain."""
+    leaf = name.split(".", 1)[1] if name.startswith("link_") else name
+    ranges = {
+        "angle": (0.0, 2 * math.pi), "guide_k.angle": (0.0, 2 * math.pi),
+        "guide_p.angle": (0.0, 2 * math.pi), "length": (0.3, 2.0),
+        "omega": (-10.0, 10.0), "epsilon": (-100.0, 100.0),
+        "accel_d.x": (-50.0, 50.0), "accel_d.y": (-50.0, 50.0),
+        "force.x": (-200.0, 200.0), "force.y": (-200.0, 200.0), "moment": (-50.0, 50.0),
+        "com.x": (-0.5, 1.0), "com.y": (-0.5, 0.5), "mass": (0.5, 5.0), "inertia": (0.01, 0.5),
+        "gravity.x": (-10.0, 10.0), "gravity.y": (-10.0, 10.0),
+    }
+    if leaf == "singular_threshold":
+        return 1.4901161193847656e-08
+    lo, hi = ranges[leaf]
+    return float(rng.uniform(lo, hi))
+
+
+def random_configuration(dyad_type, names, rng, min_conditioning=0.2):
+    while True:
+        values = {name: random_value(name, rng) for name in names}
+        if evaluate(dyad_type, values)["conditioning"] >= min_conditioning:
+            return values
+
+
+def changed_outputs(base, other, output_names):
+    """Outputs that differ by more than round-off between two evaluations."""
+    loads = [abs(r[k]) for r in (base, other) for k in output_names
+             if k[0] in "RNM" and math.isfinite(r[k])]
+    scale = max(loads) if loads else 1.0
+    changed = set()
+    for k in output_names:
+        if k == "status":
+            continue
+        a, b = base[k], other[k]
+        if k == "conditioning":
+            tol = 1e-12
+        elif k == "amplification":
+            tol = 1e-12 * max(abs(a), abs(b))
+        else:
+            tol = 1e-9 * scale
+        if abs(a - b) > tol:
+            changed.add(k)
+    return changed
+
+
+def derive_dependencies(dyad_type, raw, configurations=6, seed=0):
+    """Output name -> set of input names it depends on, by perturbation with the reference.
+
+    At several random valid configurations (nonzero masses, inertias, offsets, loads and
+    lengths), each input in turn is given a fresh random value; an output depends on the
+    input if it changes by more than round-off at any configuration. `status` depends on
+    what `conditioning` depends on (it is the comparison of the conditioning with the
+    threshold)."""
+    rng = np.random.default_rng(seed + TYPES.index(dyad_type))
+    inputs = names_of(raw, "input")
+    known = inputs + names_of(raw, "parameter")
+    outputs = names_of(raw, "output")
+    deps = {name: set() for name in outputs}
+    for _ in range(configurations):
+        values = random_configuration(dyad_type, known, rng)
+        base = evaluate(dyad_type, values)
+        for name in inputs:
+            while True:
+                trial = dict(values, **{name: random_value(name, rng)})
+                result = evaluate(dyad_type, trial)
+                if result["conditioning"] >= 0.1:
+                    break
+            for out in changed_outputs(base, result, outputs):
+                deps[out].add(name)
+    if "status" in deps:
+        deps["status"] = set(deps["conditioning"])
+    return deps
+
+
+# ---------------------------------------------------------------------------
+# (a) declared dependencies are the true ones
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_declared_dependencies_are_the_true_ones(dyad_type):
+    raw = load_raw(dyad_type)
+    derived = derive_dependencies(dyad_type, raw)
+    problems = []
+    for v in raw["variable"]:
+        if v["causality"] != "output":
+            continue
+        declared = set(v["depends"])
+        want = derived[v["name"]]
+        if declared != want:
+            problems.append(f"{v['name']}: missing {sorted(want - declared)}, "
+                            f"extra {sorted(declared - want)}")
+    assert not problems, f"{TABLE_OF[dyad_type].name}:\n" + "\n".join(problems)
+
+
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_dependencies_do_not_depend_on_the_sample(dyad_type):
+    """Another seed gives the same dependencies: the derivation is not luck."""
+    raw = load_raw(dyad_type)
+    assert derive_dependencies(dyad_type, raw, configurations=3, seed=1000) == \
+        derive_dependencies(dyad_type, raw, configurations=3, seed=2000)
+
+
+# ---------------------------------------------------------------------------
+# generating
+# ---------------------------------------------------------------------------
+def run_generator(*args):
+    return subprocess.run([sys.executable, str(GENERATOR), *map(str, args)],
+                          capture_output=True, text=True, timeout=120)
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    """Dyad type -> directory the generator wrote that type's files into."""
+    out = {}
+    base = tmp_path_factory.mktemp("generated")
+    for t in TYPES:
+        proc = run_generator(TABLE_OF[t], "--out", base / t)
+        assert proc.returncode == 0, proc.stderr
+        out[t] = base / t
+    return out
+
+
+def identifier(dyad_type):
+    return f"dyad_{dyad_type.lower()}"
+
+
+def test_generator_writes_every_file(generated):
+    for t, d in generated.items():
+        for rel in ("fmi2/modelDescription.xml", "fmi3/modelDescription.xml",
+                    "fmi3/buildDescription.xml", f"{identifier(t)}_model.c",
+                    "documentation/index.html"):
+            assert (d / rel).is_file(), f"{t}: {rel} missing"
+
+
+# ---------------------------------------------------------------------------
+# (b) golden files
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_generated_xml_equals_golden(generated, dyad_type):
+    for version in ("fmi2", "fmi3"):
+        golden = MD_DIR / "golden" / f"{identifier(dyad_type)}_{version}.xml"
+        produced = generated[dyad_type] / version / "modelDescription.xml"
+        assert golden.is_file(), f"{golden} missing: run generate.py --update-golden"
+        assert produced.read_bytes() == golden.read_bytes(), (
+            f"{produced.name} ({version}) differs from {golden.name}; review the change and run "
+            "modelDescription/generate.py --update-golden")
+
+
+def test_check_golden_passes():
+    proc = run_generator("--check-golden")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_check_golden_reports_a_difference(tmp_path, monkeypatch):
+    monkeypatch.setattr(generate, "GOLDEN_DIR", tmp_path)
+    assert generate.main(["--update-golden"]) == 0
+    target = tmp_path / "dyad_rrt_fmi3.xml"
+    target.write_text(target.read_text().replace('stopTime="1"', 'stopTime="2"'))
+    assert generate.main(["--check-golden"]) == 1
+
+
+def test_output_is_deterministic(generated, tmp_path):
+    for t in TYPES:
+        again = tmp_path / t
+        assert run_generator(TABLE_OF[t], "--out", again).returncode == 0
+        for path in generated[t].rglob("*"):
+            if path.is_file():
+                rel = path.relative_to(generated[t])
+                assert (again / rel).read_bytes() == path.read_bytes(), rel
+                assert b"\r" not in path.read_bytes()
+
+
+# ---------------------------------------------------------------------------
+# (c) fmpy validation, units, causalities, counts, structure
+# ---------------------------------------------------------------------------
+EXPECTED_UNIT = [  # by name pattern, independent of the generator's catalogue
+    (r"link_[mn]\.angle|guide_[kp]\.angle", "rad"), (r"link_[mn]\.omega", "rad/s"),
+    (r"link_[mn]\.epsilon", "rad/s2"), (r"link_[mn]\.accel_d\.[xy]|gravity\.[xy]", "m/s2"),
+    (r"link_[mn]\.force\.[xy]|R_\w\w\.[xy]|N_\w\w", "N"), (r"link_[mn]\.moment|M_\w\w", "N.m"),
+    (r"link_[mn]\.(length|com\.[xy])", "m"), (r"link_[mn]\.mass", "kg"),
+    (r"link_[mn]\.inertia", "kg.m2"), (r"singular_threshold|conditioning|amplification|status",
+                                       None),
+]
+BASE_UNITS = {"rad": {"rad": 1}, "rad/s": {"rad": 1, "s": -1}, "rad/s2": {"rad": 1, "s": -2},
+              "m": {"m": 1}, "m/s2": {"m": 1, "s": -2}, "N": {"kg": 1, "m": 1, "s": -2},
+              "N.m": {"kg": 1, "m": 2, "s": -2}, "kg": {"kg": 1}, "kg.m2": {"kg": 1, "m": 2}}
+
+
+def expected_unit(name):
+    for pattern, unit in EXPECTED_UNIT:
+        if re.fullmatch(pattern, name):
+            return unit
+    raise AssertionError(f"unexpected variable {name}")
+
+
+def expected_names(dyad_type):
+    """The variables a type must have, by causality, written out from the README's table."""
+    d_m, e, d_n = PAIRS[dyad_type]
+    inputs, params = [], []
+    for g in "mn":
+        inputs += [f"link_{g}.{x}" for x in ("angle", "omega", "epsilon", "accel_d.x",
+                                            "accel_d.y", "force.x", "force.y", "moment")]
+        if g == "m" and e == "T":
+            inputs.append("link_m.length")
+        if not (g == "m" and e == "T"):
+            params.append(f"link_{g}.length")
+        params += [f"link_{g}.{x}" for x in ("com.x", "com.y", "mass", "inertia")]
+    if d_m == "T":
+        inputs.append("guide_k.angle")
+    if d_n == "T":
+        inputs.append("guide_p.angle")
+    params += ["gravity.x", "gravity.y", "singular_threshold"]
+    outputs = [f"R_{p}.{c}" for p in ("mk", "np", "mn") for c in "xy"]
+    for p, kind in (("mk", d_m), ("np", d_n), ("mn", e)):
+        if kind == "T":
+            outputs += [f"N_{p}", f"M_{p}"]
+    outputs += ["conditioning", "amplification", "status"]
+    return inputs, params, outputs
+
+
+def read_fmi2(path):
+    from fmpy import read_model_description
+    return read_model_description(str(path), validate=True, validate_variable_names=True,
+                                  validate_model_structure=True)
+
+
+def read_fmi3(generated_dir, tmp_path):
+    """FMI 3 description read from an extracted-FMU layout, so that fmpy also validates
+    sources/buildDescription.xml against its schema."""
+    from fmpy import read_model_description
+    fmu = tmp_path / "fmu3"
+    (fmu / "sources").mkdir(parents=True, exist_ok=True)
+    shutil.copy(generated_dir / "fmi3" / "modelDescription.xml", fmu / "modelDescription.xml")
+    shutil.copy(generated_dir / "fmi3" / "buildDescription.xml",
+                fmu / "sources" / "buildDescription.xml")
+    return read_model_description(str(fmu), validate=True, validate_variable_names=True,
+                                  validate_model_structure=True)
+
+
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
+    raw = load_raw(dyad_type)
+    ident = identifier(dyad_type)
+    inputs, params, outputs = expected_names(dyad_type)
+    md2 = read_fmi2(generated[dyad_type] / "fmi2" / "modelDescription.xml")
+    md3 = read_fmi3(generated[dyad_type], tmp_path)
+
+    # the same token everywhere, UUID-shaped
+    token = md2.guid
+    assert re.fullmatch(r"\{[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}\}", token)
+    assert md3.instantiationToken == token
+    c_text = (generated[dyad_type] / f"{ident}_model.c").read_text()
+    assert f'"{token}"' in c_text
+    assert f'"{ident}"' in c_text and f"dyad_solve_{dyad_type.lower()}" in c_text
+
+    # co-simulation interface and sources
+    for md, shim in ((md2, "fmi2_functions.c"), (md3, "fmi3_functions.c")):
+        assert md.coSimulation is not None and md.modelExchange is None
+        assert md.coSimulation.modelIdentifier == ident
+        assert md.variableNamingConvention == "structured"
+        assert md.defaultExperiment.stopTime == "1" or float(md.defaultExperiment.stopTime) == 1
+        assert [c.name for c in md.logCategories] == [
+            "logStatusError", "logStatusWarning", "logStatusDiscard", "logCalls"]
+        (config,) = md.buildConfigurations
+        assert config.modelIdentifier == ident
+        assert config.sourceFileSets[0].sourceFiles == [
+            "dyad_common.c", f"dyad_{dyad_type.lower()}.c", "fmu_instance.c", shim,
+            f"{ident}_model.c"]
+        units = {u.name: u.baseUnit for u in md.unitDefinitions}
+        assert set(units) == set(BASE_UNITS)
+        for name, exps in BASE_UNITS.items():
+            got = {k: getattr(units[name], k) for k in ("kg", "m", "s", "A", "K", "mol", "cd",
+                                                        "rad") if getattr(units[name], k)}
+            assert got == exps, name
+
+    # variables: names, causalities, units, counts, value references
+    variables2 = md2.modelVariables
+    variables3 = [v for v in md3.modelVariables if v.causality != "independent"]
+    (time,) = [v for v in md3.modelVariables if v.causality == "independent"]
+    assert time.name == "time" and time.valueReference == 0
+    for variables in (variables2, variables3):
+        by_causality = {c: [v.name for v in variables if v.causality == c]
+                        for c in ("input", "parameter", "output")}
+        assert by_causality == {"input": inputs, "parameter": params, "output": outputs}
+        assert len(variables) == len(inputs) + len(params) + len(outputs)
+        assert [v.valueReference for v in variables] == list(range(1, len(variables) + 1))
+        for v in variables:
+            assert v.unit == expected_unit(v.name), v.name
+            if v.causality == "input":
+                assert v.variability == "continuous" and v.start is not None
+            elif v.causality == "parameter":
+                assert (v.variability, v.initial) == ("fixed", "exact") and v.start is not None
+            else:
+                assert v.initial == "calculated" and v.start is None
+                assert v.variability == ("discrete" if v.name == "status" else "continuous")
+            want_type = ("Integer", "Int32") if v.name == "status" else ("Real", "Float64")
+            assert v.type in want_type, v.name
+
+    # type-specific presence
+    names = set(inputs + params + outputs)
+    assert ("guide_p.angle" in names) == (dyad_type == "TRT")
+    assert ("guide_k.angle" in names) == (dyad_type in ("RRT", "TRT", "RTT"))
+    sliding = {v.name for v in variables2 if v.causality == "input" and v.name.endswith("length")}
+    assert sliding == ({"link_m.length"} if dyad_type in ("RTR", "RTT") else set())
+    if dyad_type == "RRR":
+        assert not [n for n in names if re.match(r"[NM]_", n)]
+
+    # bounds where the solver has a domain
+    by_name = {v.name: v for v in variables3}
+    assert float(by_name["singular_threshold"].min) == 0
+    assert float(by_name["singular_threshold"].max) == 1
+    for g in "mn":
+        assert float(by_name[f"link_{g}.mass"].min) == 0
+        assert float(by_name[f"link_{g}.inertia"].min) == 0
+        assert float(by_name[f"link_{g}.length"].min) == 0
+
+    # model structure: outputs, their dependencies as declared, initial unknowns
+    declared = {v["name"]: set(v["depends"]) for v in raw["variable"]
+                if v["causality"] == "output"}
+    for md in (md2, md3):
+        assert [u.variable.name for u in md.outputs] == outputs
+        for unknown in md.outputs:
+            deps = {d.name for d in unknown.dependencies}
+            assert deps == declared[unknown.variable.name], unknown.variable.name
+            assert all(d.causality == "input" for d in unknown.dependencies)
+        assert [u.variable.name for u in md.initialUnknowns] == outputs
+
+
+def test_fmi2_dependencies_are_one_based_indices(generated):
+    text = (generated["RRT"] / "fmi2" / "modelDescription.xml").read_text()
+    raw = load_raw("RRT")
+    index = {v["name"]: k + 1 for k, v in enumerate(raw["variable"])}
+    r_np_x = next(v for v in raw["variable"] if v["name"] == "R_np.x")
+    deps = " ".join(str(i) for i in sorted(index[d] for d in r_np_x["depends"]))
+    assert f'<Unknown index="{index["R_np.x"]}" dependencies="{deps}"/>' in text
+
+
+def test_documentation_is_complete(generated):
+    for t in TYPES:
+        page = (generated[t] / "documentation" / "index.html").read_text()
+        raw = load_raw(t)
+        assert page.startswith("<!DOCTYPE html>") and "</html>" in page
+        assert "http" not in page  # self-contained: no external resources
+        for v in raw["variable"]:
+            assert f"<code>{v['name']}</code>" in page
+        for word in ("singular", "invalid input", "out of range", "Discard", "Error", "NaN",
+                     "counter-clockwise"):
+            assert word in page, (t, word)
+
+
+# ---------------------------------------------------------------------------
+# the C table compiles; the start values solve
+# ---------------------------------------------------------------------------
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available")
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_c_table_compiles(generated, dyad_type, tmp_path):
+    source = generated[dyad_type] / f"{identifier(dyad_type)}_model.c"
+    proc = subprocess.run(
+        ["gcc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
+         f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'fmu'}", "-c", str(source),
+         "-o", str(tmp_path / "model.o")], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+
+
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_c_table_matches_the_table(generated, dyad_type):
+    raw = load_raw(dyad_type)
+    c_text = (generated[dyad_type] / f"{identifier(dyad_type)}_model.c").read_text()
+    rows = re.findall(r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
+                      r'(offsetof\(\w+, [\w.]+\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+), (\w+)\}',
+                      c_text)
+    assert len(rows) == len(raw["variable"])
+    for row, v in zip(rows, raw["variable"]):
+        vr, name, unit, causality, _, target, offset, start = row[:8]
+        assert (int(vr), name, unit) == (v["vr"], v["name"], v.get("unit", ""))
+        assert causality == "FMU_" + v["causality"].upper()
+        assert float(start) == float(v.get("start", 0.0))  # repr round-trips
+        if v["name"].endswith("angle"):
+            assert target == "FMU_TARGET_INPUT_ANGLE"
+        if v["name"] == "link_m.accel_d.x":
+            assert offset == "offsetof(dyad_input, m.accel_d.x)" and row[11] == "DYAD_FIELD_M_ACCEL_D"
+        if v["name"] == "status":
+            assert (target, offset) == ("FMU_TARGET_RESULT_STATUS", "0")
+    vr_limit = len(raw["variable"]) + 1
+    assert re.search(rf"index_of_vr, {vr_limit}\}};", c_text)
+    assert re.search(r"index_of_vr\[\d+\] = \{\s*-1, 0, 1, 2,", c_text)
+
+
+def start_values(raw):
+    return {v["name"]: float(v["start"]) for v in raw["variable"] if "start" in v}
+
+
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_start_values_are_valid_and_far_from_singular(dyad_type):
+    raw = load_raw(dyad_type)
+    values = start_values(raw)
+    result = evaluate(dyad_type, values)
+    assert result["conditioning"] > 0.9
+    assert result["status"] == 0
+    assert all(math.isfinite(result[k]) for k in names_of(raw, "output"))
+    assert values["gravity.y"] == -9.81 and values["gravity.x"] == 0
+
+
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_start_values_solve_ok_in_the_c_core(dyad_type):
+    from dyadfmu.core import Core, library_path
+    if not library_path().is_file():
+        pytest.skip(f"C core not built at {library_path()}")
+    values = start_values(load_raw(dyad_type))
+    m, n, gk, gp, gravity = reference_args(values)
+    got = Core().solve(dyad_type, m, n, gk, gp, gravity,
+                       singular_threshold=values["singular_threshold"])
+    assert got["status"] == "ok", got
+    assert got["conditioning"] > 0.9
+
+
+# ---------------------------------------------------------------------------
+# the token
+# ---------------------------------------------------------------------------
+def test_token_follows_the_table():
+    raw = load_raw("RRT")
+    token = generate.instantiation_token(raw["model"], raw["variable"])
+    assert token == generate.load_table(TABLE_OF["RRT"]).token
+    changed = [dict(v) for v in raw["variable"]]
+    changed[0]["description"] += "."
+    assert generate.instantiation_token(raw["model"], changed) != token
+    as_int = [dict(v, start=int(v["start"])) if v.get("start") == int(v.get("start", 0.5))
+              else v for v in raw["variable"]]
+    assert generate.instantiation_token(raw["model"], as_int) == token  # 0 and 0.0 agree
+    tokens = {generate.load_table(TABLE_OF[t]).token for t in TYPES}
+    assert len(tokens) == len(TYPES)
+
+
+# ---------------------------------------------------------------------------
+# (d) malformed tables
+# ---------------------------------------------------------------------------
+def _toml_value(value):
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value(x) for x in value) + "]"
+    raise TypeError(value)
+
+
+def write_toml(raw, path):
+    lines = ["[model]"] + [f"{k} = {_toml_value(v)}" for k, v in raw["model"].items()]
+    for v in raw["variable"]:
+        lines += ["", "[[variable]]"] + [f"{k} = {_toml_value(x)}" for k, x in v.items()]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def _var(raw, name):
+    return next(v for v in raw["variable"] if v["name"] == name)
+
+
+def _rename_omega(raw):
+    _var(raw, "link_m.omega")["name"] = "link_m.angle"
+
+
+def _vr_twice(raw):
+    _var(raw, "link_n.mass")["vr"] = _var(raw, "link_m.mass")["vr"]
+
+
+def _vr_gap(raw):
+    _var(raw, "link_n.moment")["vr"] += 100
+
+
+def _no_start(raw):
+    del _var(raw, "link_n.inertia")["start"]
+
+
+def _append_guide_p(raw):
+    guide_k = dict(_var(raw, "guide_k.angle"), name="guide_p.angle", lives="input.guide_p@angle",
+                   description="Guide at D_n")
+    raw["variable"].insert(raw["variable"].index(_var(raw, "guide_k.angle")) + 1, guide_k)
+    for k, v in enumerate(raw["variable"]):
+        v["vr"] = k + 1
+
+
+MALFORMED = [
+    # (id, mutation, the variable the message must name, a fragment of the problem)
+    ("duplicate name", _rename_omega, "link_m.angle", "duplicate name"),
+    ("duplicate vr", _vr_twice, "link_n.mass", "duplicate vr"),
+    ("vr not consecutive", _vr_gap, "link_n.moment", "not consecutive"),
+    ("unknown causality", lambda r: _var(r, "link_m.mass").update(causality="local"),
+     "link_m.mass", "unknown causality"),
+    ("unknown type", lambda r: _var(r, "link_m.mass").update(type="Boolean"),
+     "link_m.mass", "unknown type"),
+    ("unknown unit", lambda r: _var(r, "link_m.omega").update(unit="rpm"),
+     "link_m.omega", "unknown unit"),
+    ("wrong unit", lambda r: _var(r, "link_m.omega").update(unit="rad/s2"),
+     "link_m.omega", "unit"),
+    ("start missing", _no_start, "link_n.inertia", "start is missing"),
+    ("start on an output", lambda r: _var(r, "R_mk.x").update(start=0.0),
+     "R_mk.x", "must not have one"),
+    ("start below min", lambda r: _var(r, "link_n.mass").update(start=-1.0),
+     "link_n.mass", "below min"),
+    ("start on an exclusive min", lambda r: _var(r, "link_n.length").update(start=0.0),
+     "link_n.length", "below min"),
+    ("start above max", lambda r: _var(r, "singular_threshold").update(start=1.0),
+     "singular_threshold", "above max"),
+    ("bounds off the domain", lambda r: _var(r, "link_m.mass").pop("min"),
+     "link_m.mass", "domain"),
+    ("depends on a parameter", lambda r: _var(r, "R_mk.x")["depends"].append("link_m.mass"),
+     "R_mk.x", "not an input"),
+    ("depends on an unknown name", lambda r: _var(r, "N_mk")["depends"].append("link_q.angle"),
+     "N_mk", "unknown variable 'link_q.angle'"),
+    ("depends missing", lambda r: _var(r, "conditioning").pop("depends"),
+     "conditioning", "depends is missing"),
+    ("bad lives member", lambda r: _var(r, "link_m.omega").update(lives="input.m.omgea"),
+     "link_m.omega", "no member"),
+    ("bad lives grammar", lambda r: _var(r, "link_m.omega").update(lives="m.omega"),
+     "link_m.omega", "bad lives"),
+    ("angle without @angle", lambda r: _var(r, "link_m.angle").update(lives="input.m.dir"),
+     "link_m.angle", "@angle"),
+    ("lives of another variable", lambda r: _var(r, "link_m.omega").update(lives="input.m.epsilon"),
+     "link_m.omega", "also the home of"),
+    ("field the type lacks", _append_guide_p, "guide_p.angle", "no guide i_p"),
+    ("output the type lacks", lambda r: _var(r, "M_mk").update(name="M_np", lives="result.m_np"),
+     "M_np", "revolute"),
+    ("fixed length as an input",
+     lambda r: _var(r, "link_m.length").update(causality="input"),
+     "link_m.length", "is a parameter"),
+    ("unknown key", lambda r: _var(r, "link_m.mass").update(colour="red"),
+     "link_m.mass", "unknown key 'colour'"),
+    ("missing variable", lambda r: r["variable"].pop(), "status", "missing variable"),
+]
+
+
+@pytest.mark.parametrize("mutation,name,fragment", [m[1:] for m in MALFORMED],
+                         ids=[m[0] for m in MALFORMED])
+def test_malformed_table_is_refused(tmp_path, mutation, name, fragment):
+    raw = load_raw("RRT")
+    mutation(raw)
+    table = tmp_path / "broken_rrt.toml"
+    write_toml(raw, table)
+    proc = run_generator(table, "--out", tmp_path / "out")
+    assert proc.returncode != 0
+    assert not (tmp_path / "out").exists(), "nothing may be written from a bad table"
+    lines = [ln for ln in proc.stderr.splitlines() if fragment in ln]
+    assert lines, proc.stderr
+    assert any("broken_rrt.toml" in ln and f"'{name}'" in ln for ln in lines), proc.stderr
+
+
+def test_unmodified_copy_is_accepted(tmp_path):
+    """The TOML writer of the malformed-table test reproduces a valid table."""
+    raw = load_raw("RRT")
+    table = tmp_path / "dyad_rrt.toml"
+    write_toml(raw, table)
+    proc = run_generator(table, "--out", tmp_path / "out")
+    assert proc.returncode == 0, proc.stderr
