@@ -431,8 +431,23 @@ static fmu_status check_settable(const fmu_instance* instance, const fmu_variabl
     return FMU_OK;
 }
 
-fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
-                        const double values[], const char* function)
+/* The importer's arrays are double (Real) or int (Integer); the store is double. */
+static double value_at(const void* values, fmu_value_type type, size_t k)
+{
+    return type == FMU_REAL ? ((const double*)values)[k] : (double)((const int*)values)[k];
+}
+
+static void store_at(void* values, fmu_value_type type, size_t k, double value)
+{
+    if (type == FMU_REAL) {
+        ((double*)values)[k] = value;
+    } else {
+        ((int*)values)[k] = (int)value;
+    }
+}
+
+static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], size_t count,
+                             const void* values, fmu_value_type type, const char* function)
 {
     size_t k;
     fmu_status status = fmu_check_call(instance, FMU_OP_SET, function);
@@ -441,36 +456,14 @@ fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t 
     }
     /* All values are checked before any is stored: a rejected call changes nothing. */
     for (k = 0; k < count; ++k) {
-        const fmu_variable* v = lookup(instance, vr[k], FMU_REAL, function);
-        if (v == NULL || check_settable(instance, v, values[k], function) != FMU_OK) {
+        const fmu_variable* v = lookup(instance, vr[k], type, function);
+        if (v == NULL ||
+            check_settable(instance, v, value_at(values, type, k), function) != FMU_OK) {
             return FMU_ERROR;
         }
     }
     for (k = 0; k < count; ++k) {
-        instance->values[instance->model->index_of_vr[vr[k]]] = values[k];
-    }
-    if (count > 0) {
-        instance->dirty = 1;
-    }
-    return FMU_OK;
-}
-
-fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
-                           const int values[], const char* function)
-{
-    size_t k;
-    fmu_status status = fmu_check_call(instance, FMU_OP_SET, function);
-    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
-        return FMU_ERROR;
-    }
-    for (k = 0; k < count; ++k) {
-        const fmu_variable* v = lookup(instance, vr[k], FMU_INTEGER, function);
-        if (v == NULL || check_settable(instance, v, values[k], function) != FMU_OK) {
-            return FMU_ERROR;
-        }
-    }
-    for (k = 0; k < count; ++k) {
-        instance->values[instance->model->index_of_vr[vr[k]]] = values[k];
+        instance->values[instance->model->index_of_vr[vr[k]]] = value_at(values, type, k);
     }
     if (count > 0) {
         instance->dirty = 1;
@@ -498,8 +491,9 @@ static double read_variable(fmu_instance* instance, const fmu_variable* v, fmu_s
     return (double)*(const dyad_real*)(const void*)member;
 }
 
-fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
-                        double values[], const char* function)
+/* Returns the worst status of the solves behind the outputs read. */
+static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], size_t count,
+                             void* values, fmu_value_type type, const char* function)
 {
     fmu_status worst = FMU_OK;
     size_t k;
@@ -508,31 +502,37 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
         return FMU_ERROR;
     }
     for (k = 0; k < count; ++k) {
-        const fmu_variable* v = lookup(instance, vr[k], FMU_REAL, function);
+        const fmu_variable* v = lookup(instance, vr[k], type, function);
         if (v == NULL) {
             return FMU_ERROR;
         }
-        values[k] = read_variable(instance, v, &worst, function);
+        store_at(values, type, k, read_variable(instance, v, &worst, function));
     }
     return worst;
+}
+
+fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
+                        const double values[], const char* function)
+{
+    return set_values(instance, vr, count, values, FMU_REAL, function);
+}
+
+fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
+                           const int values[], const char* function)
+{
+    return set_values(instance, vr, count, values, FMU_INTEGER, function);
+}
+
+fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
+                        double values[], const char* function)
+{
+    return get_values(instance, vr, count, values, FMU_REAL, function);
 }
 
 fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
                            int values[], const char* function)
 {
-    fmu_status worst = FMU_OK;
-    size_t k;
-    fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
-    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
-        return FMU_ERROR;
-    }
-    for (k = 0; k < count; ++k) {
-        const fmu_variable* v = lookup(instance, vr[k], FMU_INTEGER, function);
-        if (v == NULL) {
-            return FMU_ERROR;
-        }
-        values[k] = (int)read_variable(instance, v, &worst, function);
-    }
+    const fmu_status worst = get_values(instance, vr, count, values, FMU_INTEGER, function);
     /* The status output itself reports a singular configuration: no warning. */
     return worst == FMU_ERROR ? FMU_ERROR : FMU_OK;
 }
