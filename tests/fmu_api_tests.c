@@ -427,6 +427,91 @@ static int test_fmi2_wrong_token(void)
     return fails;
 }
 
+/* The call-sequence rules of FMI 2.0 co-simulation, written out from the
+ * standard's state machine (not from the FMU's table): for every state and
+ * operation, whether the call is legal. */
+enum { S_INSTANTIATED, S_INITIALIZATION, S_STEP, S_TERMINATED, STATE_COUNT };
+static const char* const state_names[STATE_COUNT] = {"Instantiated", "Initialization",
+                                                     "Step", "Terminated"};
+
+typedef struct call_rule {
+    const char* name;
+    int legal[STATE_COUNT];
+} call_rule;
+
+static const call_rule fmi2_rules[] = {
+    {"fmi2SetupExperiment", {1, 0, 0, 0}},
+    {"fmi2EnterInitializationMode", {1, 0, 0, 0}},
+    {"fmi2ExitInitializationMode", {0, 1, 0, 0}},
+    {"fmi2DoStep", {0, 0, 1, 0}},
+    {"fmi2Terminate", {0, 0, 1, 0}},
+    {"fmi2GetReal (output)", {0, 1, 1, 1}},
+    {"fmi2SetReal (input)", {1, 1, 1, 0}},
+    {"fmi2SetReal (fixed parameter)", {1, 1, 0, 0}},
+    {"fmi2GetBooleanStatus", {0, 0, 1, 1}},
+    {"fmi2Reset", {1, 1, 1, 1}},
+};
+
+static fmi2Component fmi2_in_state(log_book* book, int state)
+{
+    fmi2Component c = new_fmi2(book, "states");
+    if (state >= S_INITIALIZATION) {
+        api2.setup_experiment(c, fmi2False, 0, 0, fmi2False, 0);
+        api2.enter_initialization(c);
+    }
+    if (state >= S_STEP) {
+        api2.exit_initialization(c);
+    }
+    if (state >= S_TERMINATED) {
+        api2.terminate(c);
+    }
+    return c;
+}
+
+static fmi2Status fmi2_call(fmi2Component c, size_t rule)
+{
+    const unsigned output = vr_of("R_mk.x"), input = vr_of("link_m.omega");
+    const unsigned parameter = vr_of("link_n.com.x");
+    double value = 0.5;
+    fmi2Boolean flag;
+    switch (rule) {
+    case 0: return api2.setup_experiment(c, fmi2False, 0, 0, fmi2False, 0);
+    case 1: return api2.enter_initialization(c);
+    case 2: return api2.exit_initialization(c);
+    case 3: return api2.do_step(c, 0, 0.01, fmi2True);
+    case 4: return api2.terminate(c);
+    case 5: return api2.get_real(c, &output, 1, &value);
+    case 6: return api2.set_real(c, &input, 1, &value);
+    case 7: return api2.set_real(c, &parameter, 1, &value);
+    case 8: return api2.get_boolean_status(c, fmi2Terminated, &flag);
+    case 9: return api2.reset(c);
+    }
+    return fmi2Fatal;
+}
+
+static int test_fmi2_state_machine(void)
+{
+    int fails = 0, state;
+    size_t rule;
+    for (state = 0; state < STATE_COUNT; ++state) {
+        for (rule = 0; rule < sizeof fmi2_rules / sizeof fmi2_rules[0]; ++rule) {
+            log_book book = {0, 0, ""};
+            fmi2Component c = fmi2_in_state(&book, state);
+            const fmi2Status status = fmi2_call(c, rule);
+            if (fmi2_rules[rule].legal[state]) {
+                CHECK(status == fmi2OK, "%s in %s: status %d, expected OK (%s)",
+                      fmi2_rules[rule].name, state_names[state], status, book.last);
+            } else {
+                CHECK(status == fmi2Error && book.last[0] != '\0',
+                      "%s in %s: status %d, expected Error with a message (%s)",
+                      fmi2_rules[rule].name, state_names[state], status, book.last);
+            }
+            api2.free_instance(c);
+        }
+    }
+    return fails;
+}
+
 /* ---- FMI 3 ---------------------------------------------------------------------- */
 
 static fmi3Instance new_fmi3(log_book* book, const char* name)
@@ -517,6 +602,76 @@ static int test_fmi3_singular_and_invalid(void)
     return fails;
 }
 
+/* The same for FMI 3.0 co-simulation without event mode. */
+static const call_rule fmi3_rules[] = {
+    {"fmi3EnterInitializationMode", {1, 0, 0, 0}},
+    {"fmi3ExitInitializationMode", {0, 1, 0, 0}},
+    {"fmi3DoStep", {0, 0, 1, 0}},
+    {"fmi3Terminate", {0, 0, 1, 0}},
+    {"fmi3GetFloat64 (output)", {0, 1, 1, 1}},
+    {"fmi3SetFloat64 (input)", {1, 1, 1, 0}},
+    {"fmi3SetFloat64 (fixed parameter)", {1, 1, 0, 0}},
+    {"fmi3Reset", {1, 1, 1, 1}},
+};
+
+static fmi3Instance fmi3_in_state(log_book* book, int state)
+{
+    fmi3Instance c = new_fmi3(book, "states");
+    if (state >= S_INITIALIZATION) {
+        api3.enter_initialization(c, fmi3False, 0, 0, fmi3False, 0);
+    }
+    if (state >= S_STEP) {
+        api3.exit_initialization(c);
+    }
+    if (state >= S_TERMINATED) {
+        api3.terminate(c);
+    }
+    return c;
+}
+
+static fmi3Status fmi3_call(fmi3Instance c, size_t rule)
+{
+    const unsigned output = vr_of("R_mk.x"), input = vr_of("link_m.omega");
+    const unsigned parameter = vr_of("link_n.com.x");
+    double value = 0.5;
+    fmi3Boolean event, terminate, early;
+    fmi3Float64 last;
+    switch (rule) {
+    case 0: return api3.enter_initialization(c, fmi3False, 0, 0, fmi3False, 0);
+    case 1: return api3.exit_initialization(c);
+    case 2: return api3.do_step(c, 0, 0.01, fmi3True, &event, &terminate, &early, &last);
+    case 3: return api3.terminate(c);
+    case 4: return api3.get_float64(c, &output, 1, &value, 1);
+    case 5: return api3.set_float64(c, &input, 1, &value, 1);
+    case 6: return api3.set_float64(c, &parameter, 1, &value, 1);
+    case 7: return api3.reset(c);
+    }
+    return fmi3Fatal;
+}
+
+static int test_fmi3_state_machine(void)
+{
+    int fails = 0, state;
+    size_t rule;
+    for (state = 0; state < STATE_COUNT; ++state) {
+        for (rule = 0; rule < sizeof fmi3_rules / sizeof fmi3_rules[0]; ++rule) {
+            log_book book = {0, 0, ""};
+            fmi3Instance c = fmi3_in_state(&book, state);
+            const fmi3Status status = fmi3_call(c, rule);
+            if (fmi3_rules[rule].legal[state]) {
+                CHECK(status == fmi3OK, "%s in %s: status %d, expected OK (%s)",
+                      fmi3_rules[rule].name, state_names[state], status, book.last);
+            } else {
+                CHECK(status == fmi3Error && book.last[0] != '\0',
+                      "%s in %s: status %d, expected Error with a message (%s)",
+                      fmi3_rules[rule].name, state_names[state], status, book.last);
+            }
+            api3.free_instance(c);
+        }
+    }
+    return fails;
+}
+
 /* ---- runner --------------------------------------------------------------------- */
 
 typedef struct named_test {
@@ -530,8 +685,10 @@ static const named_test tests[] = {
     {"fmi2_invalid_values", test_fmi2_invalid_values},
     {"fmi2_singular", test_fmi2_singular},
     {"fmi2_wrong_token", test_fmi2_wrong_token},
+    {"fmi2_state_machine", test_fmi2_state_machine},
     {"fmi3_cosimulation", test_fmi3_cosimulation},
     {"fmi3_singular_and_invalid", test_fmi3_singular_and_invalid},
+    {"fmi3_state_machine", test_fmi3_state_machine},
 };
 
 int main(int argc, char** argv)
