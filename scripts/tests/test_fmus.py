@@ -16,6 +16,7 @@ from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
 
 from dyadfmu.core import Core
+from dyadfmu.harness import OUTPUTS, links_from_values
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
@@ -82,33 +83,7 @@ def input_signals(md, revolutions=1.0, samples=200):
     return rows
 
 
-def link_dicts(row, names, params):
-    """The recorded FMU inputs and the parameters as the dicts of dyadfmu.core."""
-    def get(name, default=0.0):
-        return float(row[name]) if name in names else float(params.get(name, default))
-
-    def link(g):
-        angle = get(f"link_{g}.angle")
-        return dict(dir=(math.cos(angle), math.sin(angle)), length=get(f"link_{g}.length"),
-                    omega=get(f"link_{g}.omega"), epsilon=get(f"link_{g}.epsilon"),
-                    accel_d=(get(f"link_{g}.accel_d.x"), get(f"link_{g}.accel_d.y")),
-                    com=(get(f"link_{g}.com.x"), get(f"link_{g}.com.y")),
-                    mass=get(f"link_{g}.mass"), inertia=get(f"link_{g}.inertia"),
-                    force=(get(f"link_{g}.force.x"), get(f"link_{g}.force.y")),
-                    moment=get(f"link_{g}.moment"))
-
-    guides = {}
-    for guide in ("guide_k", "guide_p"):
-        angle = get(f"{guide}.angle")
-        guides[guide] = (math.cos(angle), math.sin(angle))
-    return link("m"), link("n"), guides, (get("gravity.x"), get("gravity.y"))
-
-
-OUTPUT_OF = {"R_mk.x": ("r_mk", 0), "R_mk.y": ("r_mk", 1), "R_np.x": ("r_np", 0),
-             "R_np.y": ("r_np", 1), "R_mn.x": ("r_mn", 0), "R_mn.y": ("r_mn", 1),
-             "N_mk": ("n_mk", None), "N_np": ("n_np", None), "N_mn": ("n_mn", None),
-             "M_mk": ("m_mk", None), "M_np": ("m_np", None), "M_mn": ("m_mn", None),
-             "conditioning": ("conditioning", None), "amplification": ("amplification", None)}
+FIGURES = {"conditioning": ("conditioning", None), "amplification": ("amplification", None)}
 
 
 @pytest.mark.parametrize("dyad,version", ALL)
@@ -125,14 +100,16 @@ def test_cosimulation_reproduces_core(core, dyad, version):
     assert np.all(result["status"] == 0)
     worst = 0.0
     for row in result:
-        m, n, guides, gravity = link_dicts(row, set(inputs), params)
-        want = core.solve(dyad.upper(), m, n, guides["guide_k"], guides["guide_p"], gravity,
+        values = dict(params)
+        values.update({name: row[name] for name in inputs})
+        m, n, guide_k, guide_p, gravity = links_from_values(values, dyad.upper())
+        want = core.solve(dyad.upper(), m, n, guide_k, guide_p, gravity,
                           singular_threshold=params["singular_threshold"])
         assert want["status"] == "ok"
         for name in outputs:
             if name == "status":
                 continue
-            key, index = OUTPUT_OF[name]
+            key, index = {**OUTPUTS, **FIGURES}[name]
             expected = want[key] if index is None else want[key][index]
             got = float(row[name])
             scale = max(abs(expected), 1e-300)

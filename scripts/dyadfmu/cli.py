@@ -1,0 +1,115 @@
+"""Command line of the dyadfmu harness: co-simulate a mechanism's dyad FMU with
+fmpy, compare every output with the NumPy reference, write tables and plots."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from . import harness, mechanisms
+
+DEFAULT_SCENE = "slider-crank"
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 4:
+        raise argparse.ArgumentTypeError(f"must be at least 4, got {value}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {value}")
+    return value
+
+
+def parser() -> argparse.ArgumentParser:
+    top = argparse.ArgumentParser(
+        prog="dyadfmu",
+        description="Co-simulate the dyad FMUs of planar mechanisms with fmpy and check every "
+                    "joint reaction against an independent Newton-Euler solve in NumPy.")
+    sub = top.add_subparsers(dest="command", required=True)
+
+    listing = sub.add_parser("list", help="list the scenes (mechanisms) and their dyads")
+    listing.set_defaults(run=_list)
+
+    run = sub.add_parser("run", help="co-simulate scenes and compare them with the reference",
+                         description="Co-simulate each scene's dyad FMU over the crank's motion, "
+                                     "print the error of every output against the reference, "
+                                     "write tables (Markdown, CSV) and plots (PNG).")
+    run.add_argument("scenes", nargs="*", metavar="SCENE", default=[DEFAULT_SCENE],
+                     help=f"scene names (default {DEFAULT_SCENE}; 'all' for every scene; "
+                          f"see 'dyadfmu list')")
+    run.add_argument("--fmi", choices=("2", "3", "both"), default="both",
+                     help="FMI version of the FMU to run (default both)")
+    run.add_argument("--revolutions", type=_positive_float, default=2.0,
+                     help="crank revolutions (oscillations for trt-slot) to simulate (default 2)")
+    run.add_argument("--steps", type=_positive_int, default=360,
+                     help="communication steps per revolution (default 360)")
+    run.add_argument("--motion", choices=("constant", "varying"), default="constant",
+                     help="crank speed: constant, or varying along the cycle (default constant)")
+    run.add_argument("--angle", type=float, default=60.0,
+                     help="crank angle in degrees at which the mechanism is drawn (default 60)")
+    run.add_argument("--out", type=Path, default=Path("out"),
+                     help="directory for tables and plots (default ./out)")
+    run.add_argument("--build", type=Path, default=None,
+                     help="CMake build directory holding fmus/ (default: build/ of the checkout)")
+    run.add_argument("--no-plots", action="store_true", help="write tables only")
+    run.set_defaults(run=_run)
+    return top
+
+
+def _list(args) -> int:
+    for name in mechanisms.NAMES:
+        mech = mechanisms.load(name)
+        print(f"{name:14s} {mech.dyad}  {mech.description}")
+    return 0
+
+
+def _run(args) -> int:
+    scenes = list(mechanisms.NAMES) if args.scenes == ["all"] else args.scenes
+    unknown = [s for s in scenes if s not in mechanisms.NAMES]
+    if unknown:
+        print(f"dyadfmu: unknown scene {', '.join(unknown)}; the scenes are: "
+              f"{', '.join(mechanisms.NAMES)}", file=sys.stderr)
+        return 2
+    versions = (2, 3) if args.fmi == "both" else (int(args.fmi),)
+    written = []
+    worst = 0.0
+    for scene in scenes:
+        for version in versions:
+            try:
+                result = harness.run_scene(scene, version, args.revolutions, args.steps,
+                                           args.motion, args.build, progress=True)
+            except FileNotFoundError as error:
+                print(f"dyadfmu: {error}", file=sys.stderr)
+                return 2
+            print(harness.summary(result))
+            print(harness.format_text(harness.error_table(result)))
+            print()
+            worst = max(worst, result.worst_relative)
+            written += harness.write_tables(result, args.out)
+            if not args.no_plots:
+                from . import plots  # matplotlib only when plotting
+
+                stem = f"{scene}_fmi{version}"
+                written.append(plots.plot_reactions(result, args.out / f"{stem}_reactions.png"))
+                written.append(plots.plot_mechanism(result, args.angle,
+                                                    args.out / f"{stem}_mechanism.png"))
+    print(f"worst relative error of any output: {worst:.2e}")
+    print("written:")
+    for path in written:
+        print(f"  {path}")
+    return 0
+
+
+def main(argv=None) -> int:
+    args = parser().parse_args(argv)
+    return args.run(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
