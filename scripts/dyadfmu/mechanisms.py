@@ -650,6 +650,16 @@ class QuickReturn(Mechanism):
         return {"pivots": {"O": (0.0, 0.0), "O2": tuple(self.O2)}, "guides": {}}
 
 
+def _resistance_along_x(kin, f0, v_ref, c_visc):
+    """Loads of a link m that translates along x against a smooth resisting force
+    F = -f0 tanh(v / v_ref) - c_visc v (N), v the velocity of D_m (m/s)."""
+    v = kin["v_D_m"][:, 0]
+    zero = np.zeros_like(v)
+    fx = -f0 * np.tanh(v / v_ref) - c_visc * v
+    return {"m.force": _vec(fx, zero), "m.moment": zero.copy(),
+            "n.force": _vec(zero, zero), "n.moment": zero.copy()}
+
+
 class ScotchYoke(Mechanism):
     """RTT: block n on the crank pin A (D_n = E, l_n = 0) sliding in the vertical slot
     of the yoke m, which slides on the frame guide along x at y = -h; D_m = (A_x, -h),
@@ -684,11 +694,7 @@ class ScotchYoke(Mechanism):
         return out
 
     def _loads(self, kin):
-        v = kin["v_D_m"][:, 0]
-        zero = np.zeros_like(v)
-        fx = -self.F0 * np.tanh(v / self.v_ref) - self.c_visc * v
-        return {"m.force": _vec(fx, zero), "m.moment": zero.copy(),
-                "n.force": _vec(zero, zero), "n.moment": zero.copy()}
+        return _resistance_along_x(kin, self.F0, self.v_ref, self.c_visc)
 
     def _frame(self):
         r, h = self.crank["radius"], self.h
@@ -762,11 +768,7 @@ class TRTSlot(Mechanism):
         return out
 
     def _loads(self, kin):
-        v = kin["v_D_m"][:, 0]
-        zero = np.zeros_like(v)
-        fx = -self.F0 * np.tanh(v / self.v_ref) - self.c_visc * v
-        return {"m.force": _vec(fx, zero), "m.moment": zero.copy(),
-                "n.force": _vec(zero, zero), "n.moment": zero.copy()}
+        return _resistance_along_x(kin, self.F0, self.v_ref, self.c_visc)
 
     def _frame(self):
         r, h = self.crank["radius"], self.h
