@@ -154,23 +154,30 @@ static int normalise_direction(dyad_vec2 v, dyad_vec2* unit)
 /* F_g and M_g for a link with frame (i, j): eq. (1) gives the acceleration of
  * the centre of mass, a_S = a_D - omega^2 r + epsilon k0 x r with
  * r = x_S i + y_S j; eq. (2) turns it into the inertia force -m a_S and
- * moment -J epsilon, to which the active load and the weight m g are added. */
+ * moment -J epsilon, to which the active load and the weight m g are added.
+ * Also the moment of all that about D_g: the centripetal part m omega^2 r of
+ * the inertia force points along r and has no moment about D_g, so it is left
+ * out of that sum instead of being added and cancelled again; for a fast,
+ * heavy link it would otherwise swamp the moment in round-off. */
 static void link_resultant(const dyad_link* link, dyad_vec2 i, dyad_vec2 gravity,
-                           dyad_vec2* force, dyad_real* moment)
+                           dyad_vec2* force, dyad_real* moment, dyad_real* moment_about_d)
 {
     const dyad_vec2 j = dyad_perp(i);
     const dyad_vec2 r = dyad_combine(link->com.x, i, link->com.y, j);
-    const dyad_vec2 accel_s =
-        dyad_add(link->accel_d,
-                 dyad_combine(-link->omega * link->omega, r, link->epsilon, dyad_perp(r)));
-    *force = dyad_add(link->force, dyad_scale(link->mass, dyad_sub(gravity, accel_s)));
+    const dyad_vec2 tangential = dyad_add(link->accel_d, dyad_scale(link->epsilon, dyad_perp(r)));
+    const dyad_vec2 without_centripetal =
+        dyad_add(link->force, dyad_scale(link->mass, dyad_sub(gravity, tangential)));
+    *force = dyad_add(without_centripetal,
+                      dyad_scale(link->mass * link->omega * link->omega, r));
     *moment = link->moment - link->inertia * link->epsilon;
+    *moment_about_d = *moment + dyad_cross(r, without_centripetal);
 }
 
 void dyad_link_resultant(const dyad_link* link, dyad_vec2 gravity, dyad_vec2* force,
                          dyad_real* moment)
 {
-    link_resultant(link, link->dir, gravity, force, moment);
+    dyad_real moment_about_d;
+    link_resultant(link, link->dir, gravity, force, moment, &moment_about_d);
 }
 
 /* Validates one link and turns it into a body. Returns the offending field,
@@ -212,7 +219,7 @@ static dyad_field prepare_link(const dyad_link* link, int may_be_zero, dyad_fiel
     body->j = dyad_perp(body->i);
     body->l = link->length;
     body->com = link->com;
-    link_resultant(link, body->i, gravity, &body->f, &body->m);
+    link_resultant(link, body->i, gravity, &body->f, &body->m, &body->m_d);
     return DYAD_FIELD_NONE;
 }
 

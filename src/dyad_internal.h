@@ -14,6 +14,7 @@ typedef struct dyad_body {
     dyad_vec2 com; /* (x_S, y_S) in the link frame (m) */
     dyad_vec2 f;   /* F_g, global frame (N) */
     dyad_real m;   /* M_g (N m) */
+    dyad_real m_d; /* moment of F_g and M_g about D_g (N m), see link_resultant */
 } dyad_body;
 
 typedef struct dyad_prepared {
@@ -46,19 +47,41 @@ dyad_status dyad_finish(dyad_result* result);
 /* Moment about D_g of the link's resultant load: (S_g - D_g) x F_g + M_g. */
 static inline dyad_real dyad_load_moment_about_d(const dyad_body* b)
 {
-    return b->com.x * dyad_dot(b->f, b->j) - b->com.y * dyad_dot(b->f, b->i) + b->m;
+    return b->m_d;
 }
 
-/* Moment about E of the link's resultant load: (S_g - E) x F_g + M_g,
- * with S_g - E = (x_S - l_g) i_g + y_S j_g. */
+/* Moment about E of the link's resultant load: (S_g - E) x F_g + M_g
+ * = [(S_g - D_g) x F_g + M_g] - l_g i_g x F_g, since E - D_g = l_g i_g. */
 static inline dyad_real dyad_load_moment_about_e(const dyad_body* b)
 {
-    return (b->com.x - b->l) * dyad_dot(b->f, b->j) - b->com.y * dyad_dot(b->f, b->i) + b->m;
+    return b->m_d - b->l * dyad_dot(b->f, b->j);
 }
 
 static inline dyad_real dyad_abs(dyad_real a)
 {
     return a < 0 ? -a : a;
+}
+
+static inline dyad_real dyad_norm1(dyad_vec2 a)
+{
+    return dyad_abs(a.x) + dyad_abs(a.y);
+}
+
+/* Size of the terms summed in dyad_load_moment_about_d / _about_e: the round-off
+ * of those sums is a few eps times this. */
+static inline dyad_real dyad_load_moment_size(const dyad_body* b, dyad_real lever_x)
+{
+    return (dyad_abs(lever_x) + dyad_abs(b->com.y)) * dyad_norm1(b->f) + dyad_abs(b->m);
+}
+
+/* Where two sums are equal in exact arithmetic (a force or moment closing one
+ * link's balance or the other's), the one built from smaller terms loses
+ * fewer digits to cancellation: a stiff dyad, one link's inertia dwarfing the
+ * other's, then keeps the light link's reactions to full relative accuracy. */
+static inline dyad_vec2 dyad_smaller_sum(dyad_vec2 a, dyad_real a_terms, dyad_vec2 b,
+                                         dyad_real b_terms)
+{
+    return a_terms <= b_terms ? a : b;
 }
 
 #endif /* DYADFMU_INTERNAL_H */

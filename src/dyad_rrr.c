@@ -14,7 +14,10 @@
  *      b = -[t_n (j_n . j_m) + (F_m + F_n) . j_m + t_m] / (i_n . j_m)
  *    with i_n . j_m = -(i_m . j_n). The denominator d = i_m . j_n is the sine
  *    of the angle between the links: it vanishes when m and n are aligned.
- * 3. Forces on link m (eq. 8): R_mn = -(R_mk + F_m).
+ * 3. Forces on link m (eq. 8): R_mn = -(R_mk + F_m), or equally on link n:
+ *    R_mn = R_np + F_n. The solver takes the sum with the smaller terms (see
+ *    dyad_smaller_sum): where link m is heavy and R_mn small, eq. 8 would lose
+ *    R_mn's digits to cancellation.
  */
 #include "dyad_internal.h"
 
@@ -44,6 +47,8 @@ dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
 
     result->r_mk = dyad_combine(a, m->i, t_m, m->j);
     result->r_np = dyad_combine(b, n->i, t_n, n->j);
-    result->r_mn = dyad_neg(dyad_add(result->r_mk, m->f));
+    result->r_mn = dyad_smaller_sum(
+        dyad_neg(dyad_add(result->r_mk, m->f)), dyad_norm1(result->r_mk) + dyad_norm1(m->f),
+        dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     return dyad_finish(result);
 }

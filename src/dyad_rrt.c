@@ -13,7 +13,10 @@
  *      b    = -[t_n (j_n . i_k) + (F_m + F_n) . i_k] / (i_n . i_k)
  *    with j_k . j_n = i_n . i_k = d: it vanishes when the rod stands normal to
  *    the guide.
- * 3. Forces on link m (eq. 8): R_mn = -(R_mk + F_m).
+ * 3. Forces on link m (eq. 8): R_mn = -(R_mk + F_m), or equally on link n:
+ *    R_mn = R_np + F_n. The solver takes the sum with the smaller terms (see
+ *    dyad_smaller_sum): where link m is heavy and R_mn small, eq. 8 would lose
+ *    R_mn's digits to cancellation.
  * 4. Moment of link m about E (eq. 11), where R_mn drops out:
  *      -l_m i_m x R_mk + (S_m - E) x F_m + M_m + M^R_mk = 0, so
  *      M^R_mk = l_m i_m x R_mk - [(S_m - E) x F_m + M_m].
@@ -45,7 +48,9 @@ dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
 
     result->r_mk = dyad_scale(result->n_mk, p.j_k);
     result->r_np = dyad_combine(b, n->i, t_n, n->j);
-    result->r_mn = dyad_neg(dyad_add(result->r_mk, m->f));
+    result->r_mn = dyad_smaller_sum(
+        dyad_neg(dyad_add(result->r_mk, m->f)), dyad_norm1(result->r_mk) + dyad_norm1(m->f),
+        dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
     return dyad_finish(result);
 }

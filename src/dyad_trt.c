@@ -12,7 +12,10 @@
  *    with j_p . i_k = -(j_k . i_p) = -d: it vanishes when the guides are parallel.
  * 2. Moment of link g about E (eq. 11), where R_mn drops out:
  *      M^R_gd = l_g i_g x R_gd - [(S_g - E) x F_g + M_g].
- * 3. Forces on link m (eq. 8): R_mn = -(R_mk + F_m).
+ * 3. Forces on link m (eq. 8): R_mn = -(R_mk + F_m), or equally on link n:
+ *    R_mn = R_np + F_n. The solver takes the sum with the smaller terms (see
+ *    dyad_smaller_sum): where link m is heavy and R_mn small, eq. 8 would lose
+ *    R_mn's digits to cancellation.
  */
 #include "dyad_internal.h"
 
@@ -40,7 +43,9 @@ dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
 
     result->r_mk = dyad_scale(result->n_mk, p.j_k);
     result->r_np = dyad_scale(result->n_np, p.j_p);
-    result->r_mn = dyad_neg(dyad_add(result->r_mk, m->f));
+    result->r_mn = dyad_smaller_sum(
+        dyad_neg(dyad_add(result->r_mk, m->f)), dyad_norm1(result->r_mk) + dyad_norm1(m->f),
+        dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
     result->m_np = n->l * dyad_cross(n->i, result->r_np) - dyad_load_moment_about_e(n);
     return dyad_finish(result);
