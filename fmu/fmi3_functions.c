@@ -190,7 +190,13 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     if (!scalar_counts(fmu, nValueReferences, nValues, "fmi3GetFloat64")) {
         return fmi3Error;
     }
-    if (nValueReferences > 0 && (valueReferences == NULL || values == NULL)) {
+    for (k = 0; valueReferences != NULL && k < nValueReferences; ++k) {
+        if (valueReferences[k] == TIME_VR) {
+            break;
+        }
+    }
+    if (valueReferences == NULL || values == NULL || k == nValueReferences) {
+        /* No time among them: one call, like FMI 2. */
         return to_fmi3(fmu_get_real(fmu, valueReferences, nValueReferences, values,
                                     "fmi3GetFloat64"));
     }

@@ -5,6 +5,9 @@
 #include "dyadfmu/dyad.h"
 #include "dyadfmu/vec2.h"
 
+#include <math.h>
+#include <stddef.h>
+
 /* A link ready for the formulas: its frame, length, centre of mass, and the
  * resultant F_g, M_g of active load, weight and inertia at the centre of mass. */
 typedef struct dyad_body {
@@ -14,7 +17,7 @@ typedef struct dyad_body {
     dyad_vec2 com; /* (x_S, y_S) in the link frame (m) */
     dyad_vec2 f;   /* F_g, global frame (N) */
     dyad_real m;   /* M_g (N m) */
-    dyad_real m_d; /* moment of F_g and M_g about D_g (N m), see link_resultant */
+    dyad_real m_d; /* moment of F_g and M_g about D_g (N m), see dyad_resultant */
 } dyad_body;
 
 typedef struct dyad_prepared {
@@ -24,25 +27,18 @@ typedef struct dyad_prepared {
     dyad_vec2 i_p, j_p; /* guide at D_n, where D_n is translational */
 } dyad_prepared;
 
-/* Validates the input for the type and fills prepared. On success the result's
- * outputs are zeroed (so the moments and normal forces of revolute pairs read 0)
- * and DYAD_STATUS_OK is returned; otherwise the result (if not NULL) reports the
- * invalid field with NaN outputs and DYAD_STATUS_INVALID_INPUT is returned. */
-dyad_status dyad_prepare(dyad_type type, const dyad_input* input, dyad_prepared* prepared,
-                         dyad_result* result);
 
-/* Records the conditioning figure. Returns DYAD_STATUS_OK if it is at or above
- * the threshold; otherwise marks the result singular with NaN outputs and
- * returns DYAD_STATUS_SINGULAR. */
-dyad_status dyad_accept_conditioning(dyad_real denominator, dyad_real conditioning,
-                                     dyad_real threshold, dyad_result* result);
+
+
 
 /* Marks the result with a failure status and field, outputs NaN; returns status. */
 dyad_status dyad_reject(dyad_result* result, dyad_status status, dyad_field field);
 
-/* Final check once a solver has written its outputs: any non-finite output
- * turns the result into DYAD_STATUS_OUT_OF_RANGE with NaN outputs. */
-dyad_status dyad_finish(dyad_result* result);
+/* The first input field out of its domain (non-finite included), in the order
+ * of dyad_field, or DYAD_FIELD_NONE: the slow path that names a bad input. */
+dyad_field dyad_first_bad_field(dyad_type type, const dyad_input* input);
+
+
 
 /* Moment about D_g of the link's resultant load: (S_g - D_g) x F_g + M_g. */
 static inline dyad_real dyad_load_moment_about_d(const dyad_body* b)
@@ -82,6 +78,191 @@ static inline dyad_vec2 dyad_smaller_sum(dyad_vec2 a, dyad_real a_terms, dyad_ve
                                          dyad_real b_terms)
 {
     return a_terms <= b_terms ? a : b;
+}
+
+/* ---- the shared first and last steps of every solver -------------------------
+ * Inline, so that each solver's copy is specialised for its constant type: the
+ * pair table lookups and unused guide checks fold away on the hot path. */
+
+static const dyad_pair_kind dyad_pair_table[DYAD_TYPE_COUNT][3] = {
+    /*            D_m                      E                        D_n */
+    [DYAD_RRR] = {DYAD_PAIR_REVOLUTE, DYAD_PAIR_REVOLUTE, DYAD_PAIR_REVOLUTE},
+    [DYAD_RRT] = {DYAD_PAIR_TRANSLATIONAL, DYAD_PAIR_REVOLUTE, DYAD_PAIR_REVOLUTE},
+    [DYAD_RTR] = {DYAD_PAIR_REVOLUTE, DYAD_PAIR_TRANSLATIONAL, DYAD_PAIR_REVOLUTE},
+    [DYAD_TRT] = {DYAD_PAIR_TRANSLATIONAL, DYAD_PAIR_REVOLUTE, DYAD_PAIR_TRANSLATIONAL},
+    [DYAD_RTT] = {DYAD_PAIR_TRANSLATIONAL, DYAD_PAIR_TRANSLATIONAL, DYAD_PAIR_REVOLUTE},
+};
+
+/* Which link lengths may be zero, as the paper states for each type: a link
+ * whose outer pair slides may have its pin on the guide (RRT l_m, TRT l_m and
+ * l_n), and so may the slider of an inner translational pair (RTR, RTT l_n).
+ * Every other length is a divisor or a lever that must exist. */
+static const int dyad_zero_length_table[DYAD_TYPE_COUNT][2] = {
+    /*            m  n */
+    [DYAD_RRR] = {0, 0},
+    [DYAD_RRT] = {1, 0},
+    [DYAD_RTR] = {0, 1},
+    [DYAD_TRT] = {1, 1},
+    [DYAD_RTT] = {0, 1},
+};
+
+static inline int dyad_is_unit(dyad_vec2 v)
+{
+    return dyad_abs(dyad_dot(v, v) - 1) <= DYAD_UNIT_TOLERANCE;
+}
+
+/* The unit vector of a direction that passed is_unit. One already unit to
+ * rounding, as cos/sin or a normalised difference give, is kept as it is. */
+static inline dyad_vec2 dyad_unit_of(dyad_vec2 v)
+{
+    const dyad_real norm2 = dyad_dot(v, v);
+    if (dyad_abs(norm2 - 1) <= 4 * DYAD_REAL_EPSILON) {
+        return v;
+    }
+    return dyad_scale(1 / dyad_length(v), v);
+}
+
+/* F_g and M_g for a link with frame (i, j): eq. (1) gives the acceleration of
+ * the centre of mass, a_S = a_D - omega^2 r + epsilon k0 x r with
+ * r = x_S i + y_S j; eq. (2) turns it into the inertia force -m a_S and
+ * moment -J epsilon, to which the active load and the weight m g are added.
+ * Also the moment of all that about D_g: the centripetal part m omega^2 r of
+ * the inertia force points along r and has no moment about D_g, so it is left
+ * out of that sum instead of being added and cancelled again; for a fast,
+ * heavy link it would otherwise swamp the moment in round-off. */
+static inline void dyad_resultant(const dyad_link* link, dyad_vec2 i, dyad_vec2 gravity,
+                           dyad_vec2* force, dyad_real* moment, dyad_real* moment_about_d)
+{
+    const dyad_vec2 j = dyad_perp(i);
+    const dyad_vec2 r = dyad_combine(link->com.x, i, link->com.y, j);
+    const dyad_vec2 tangential = dyad_add(link->accel_d, dyad_scale(link->epsilon, dyad_perp(r)));
+    const dyad_vec2 without_centripetal =
+        dyad_add(link->force, dyad_scale(link->mass, dyad_sub(gravity, tangential)));
+    *force = dyad_add(without_centripetal,
+                      dyad_scale(link->mass * link->omega * link->omega, r));
+    *moment = link->moment - link->inertia * link->epsilon;
+    *moment_about_d = *moment + dyad_cross(r, without_centripetal);
+}
+
+static inline int dyad_guide_used(dyad_type type, dyad_pair pair)
+{
+    return dyad_pair_table[type][pair] == DYAD_PAIR_TRANSLATIONAL;
+}
+
+static inline int dyad_link_in_domain(const dyad_link* link, int may_be_zero)
+{
+    /* length - length == 0 also rules out an infinite length, the one input
+     * that could vanish from the result (as a divisor) instead of spoiling it. */
+    return link->length - link->length == 0 && link->length >= 0 &&
+           (link->length > 0 || may_be_zero) && link->mass >= 0 && link->inertia >= 0 &&
+           dyad_is_unit(link->dir);
+}
+
+/* The fast check: domains, and the unit directions. It does not test every
+ * number for being finite: an infinite or NaN load, kinematic quantity, mass
+ * or inertia always reaches the reactions as inf or NaN (IEEE arithmetic keeps
+ * them through every sum and product, and no input but a length divides), so
+ * dyad_finish sees it and asks first_bad_field to name it. That keeps the
+ * common path to a handful of comparisons. */
+static inline dyad_field dyad_validate(dyad_type type, const dyad_input* in)
+{
+    const int in_domain = in->singular_threshold > 0 && in->singular_threshold < 1 &&
+                          dyad_link_in_domain(&in->m, dyad_zero_length_table[type][DYAD_LINK_M]) &&
+                          dyad_link_in_domain(&in->n, dyad_zero_length_table[type][DYAD_LINK_N]) &&
+                          (!dyad_guide_used(type, DYAD_PAIR_DM) || dyad_is_unit(in->guide_k)) &&
+                          (!dyad_guide_used(type, DYAD_PAIR_DN) || dyad_is_unit(in->guide_p));
+    return in_domain ? DYAD_FIELD_NONE : dyad_first_bad_field(type, in);
+}
+
+static inline void dyad_prepare_body(const dyad_link* link, dyad_vec2 gravity, dyad_body* body)
+{
+    body->i = dyad_unit_of(link->dir);
+    body->j = dyad_perp(body->i);
+    body->l = link->length;
+    body->com = link->com;
+    dyad_resultant(link, body->i, gravity, &body->f, &body->m, &body->m_d);
+}
+
+static inline void dyad_fill_outputs(dyad_result* result, dyad_real value)
+{
+    result->r_mk = dyad_vec2_make(value, value);
+    result->r_np = dyad_vec2_make(value, value);
+    result->r_mn = dyad_vec2_make(value, value);
+    result->n_mk = value;
+    result->n_np = value;
+    result->n_mn = value;
+    result->m_mk = value;
+    result->m_np = value;
+    result->m_mn = value;
+}
+
+static inline dyad_status dyad_prepare(dyad_type type, const dyad_input* input,
+                                       dyad_prepared* prepared, dyad_result* result)
+{
+    static const dyad_prepared nothing;
+    const dyad_field bad = result == NULL  ? DYAD_FIELD_NONE
+                           : input == NULL ? DYAD_FIELD_INPUT
+                                           : dyad_validate(type, input);
+    if (result == NULL || bad != DYAD_FIELD_NONE) {
+        /* Never read on this path; cleared so that no compiler has to prove it. */
+        *prepared = nothing;
+        if (result == NULL) {
+            return DYAD_STATUS_INVALID_INPUT;
+        }
+        result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
+        return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, bad);
+    }
+    dyad_prepare_body(&input->m, input->gravity, &prepared->m);
+    dyad_prepare_body(&input->n, input->gravity, &prepared->n);
+    prepared->i_k =
+        dyad_guide_used(type, DYAD_PAIR_DM) ? dyad_unit_of(input->guide_k) : dyad_vec2_make(0, 0);
+    prepared->j_k = dyad_perp(prepared->i_k);
+    prepared->i_p =
+        dyad_guide_used(type, DYAD_PAIR_DN) ? dyad_unit_of(input->guide_p) : dyad_vec2_make(0, 0);
+    prepared->j_p = dyad_perp(prepared->i_p);
+    dyad_fill_outputs(result, 0);
+    result->status = DYAD_STATUS_OK;
+    result->field = DYAD_FIELD_NONE;
+    return DYAD_STATUS_OK;
+}
+
+static inline dyad_status dyad_accept_conditioning(dyad_type type, const dyad_input* input,
+                                     dyad_real denominator, dyad_real conditioning,
+                                     dyad_result* result)
+{
+    result->denominator = denominator;
+    result->conditioning = conditioning;
+    result->amplification = 1 / conditioning;
+    if (!(conditioning >= input->singular_threshold)) {
+        /* A NaN anywhere can land here too: name it rather than call it singular. */
+        const dyad_field bad = dyad_first_bad_field(type, input);
+        if (bad != DYAD_FIELD_NONE) {
+            result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
+            return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, bad);
+        }
+        return dyad_reject(result, DYAD_STATUS_SINGULAR, DYAD_FIELD_NONE);
+    }
+    return DYAD_STATUS_OK;
+}
+
+static inline dyad_status dyad_finish(dyad_type type, const dyad_input* input, dyad_result* result)
+{
+    const dyad_result* r = result;
+    /* x - x is 0 for a finite x and NaN otherwise: one sum tests all outputs. */
+    const dyad_real nonfinite =
+        (r->r_mk.x - r->r_mk.x) + (r->r_mk.y - r->r_mk.y) + (r->r_np.x - r->r_np.x) +
+        (r->r_np.y - r->r_np.y) + (r->r_mn.x - r->r_mn.x) + (r->r_mn.y - r->r_mn.y) +
+        (r->n_mk - r->n_mk) + (r->n_np - r->n_np) + (r->n_mn - r->n_mn) +
+        (r->m_mk - r->m_mk) + (r->m_np - r->m_np) + (r->m_mn - r->m_mn);
+    if (nonfinite != 0) {
+        const dyad_field bad = dyad_first_bad_field(type, input);
+        if (bad != DYAD_FIELD_NONE) {
+            result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
+            return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, bad);
+        }
+        return dyad_reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
+    }
+    return DYAD_STATUS_OK;
 }
 
 #endif /* DYADFMU_INTERNAL_H */

@@ -27,14 +27,14 @@ dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
     dyad_status status = dyad_prepare(DYAD_RRR, input, &p, result);
     const dyad_body* m = &p.m;
     const dyad_body* n = &p.n;
-    dyad_real d, t_m, t_n, a, b;
+    dyad_real d, inv_d, t_m, t_n, a, b;
     dyad_vec2 f_sum;
 
     if (status != DYAD_STATUS_OK) {
         return status;
     }
     d = dyad_dot(m->i, n->j);
-    status = dyad_accept_conditioning(d, dyad_abs(d), input->singular_threshold, result);
+    status = dyad_accept_conditioning(DYAD_RRR, input, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
@@ -42,13 +42,14 @@ dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
     t_m = dyad_load_moment_about_e(m) / m->l;
     t_n = dyad_load_moment_about_e(n) / n->l;
     f_sum = dyad_add(m->f, n->f);
-    a = -(t_m * dyad_dot(m->j, n->j) + dyad_dot(f_sum, n->j) + t_n) / d;
-    b = (t_n * dyad_dot(n->j, m->j) + dyad_dot(f_sum, m->j) + t_m) / d;
+    inv_d = 1 / d;
+    a = -(t_m * dyad_dot(m->j, n->j) + dyad_dot(f_sum, n->j) + t_n) * inv_d;
+    b = (t_n * dyad_dot(n->j, m->j) + dyad_dot(f_sum, m->j) + t_m) * inv_d;
 
     result->r_mk = dyad_combine(a, m->i, t_m, m->j);
     result->r_np = dyad_combine(b, n->i, t_n, n->j);
     result->r_mn = dyad_smaller_sum(
         dyad_neg(dyad_add(result->r_mk, m->f)), dyad_norm1(result->r_mk) + dyad_norm1(m->f),
         dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
-    return dyad_finish(result);
+    return dyad_finish(DYAD_RRR, input, result);
 }

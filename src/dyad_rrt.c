@@ -36,7 +36,7 @@ dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
         return status;
     }
     d = dyad_dot(n->i, p.i_k);
-    status = dyad_accept_conditioning(d, dyad_abs(d), input->singular_threshold, result);
+    status = dyad_accept_conditioning(DYAD_RRT, input, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
@@ -52,5 +52,5 @@ dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
         dyad_neg(dyad_add(result->r_mk, m->f)), dyad_norm1(result->r_mk) + dyad_norm1(m->f),
         dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
-    return dyad_finish(result);
+    return dyad_finish(DYAD_RRT, input, result);
 }

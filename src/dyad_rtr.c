@@ -60,7 +60,7 @@ dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result)
     spread = dist / (m->l + n->l);
     d = dist > 0 ? dyad_dot(dm_dn, m->i) / dist : 0; /* i_beta . i_m */
     conditioning = dyad_abs(d) < spread ? dyad_abs(d) : spread;
-    status = dyad_accept_conditioning(d, conditioning, input->singular_threshold, result);
+    status = dyad_accept_conditioning(DYAD_RTR, input, d, conditioning, result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
@@ -80,5 +80,5 @@ dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result)
             n->l * dyad_norm1(result->r_np) + dyad_load_moment_size(n, n->com.x - n->l);
         result->m_mn = terms_m <= terms_n ? via_m : via_n;
     }
-    return dyad_finish(result);
+    return dyad_finish(DYAD_RTR, input, result);
 }

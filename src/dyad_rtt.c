@@ -36,7 +36,7 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
         return status;
     }
     d = dyad_dot(p.j_k, m->i);
-    status = dyad_accept_conditioning(d, dyad_abs(d), input->singular_threshold, result);
+    status = dyad_accept_conditioning(DYAD_RTT, input, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
@@ -50,5 +50,5 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
     result->m_mn = -n->l * dyad_cross(n->i, result->r_np) + dyad_load_moment_about_e(n);
     result->m_mk =
         m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m) - result->m_mn;
-    return dyad_finish(result);
+    return dyad_finish(DYAD_RTT, input, result);
 }

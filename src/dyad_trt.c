@@ -32,7 +32,7 @@ dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
         return status;
     }
     d = dyad_dot(p.j_k, p.i_p);
-    status = dyad_accept_conditioning(d, dyad_abs(d), input->singular_threshold, result);
+    status = dyad_accept_conditioning(DYAD_TRT, input, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
@@ -48,5 +48,5 @@ dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
         dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
     result->m_np = n->l * dyad_cross(n->i, result->r_np) - dyad_load_moment_about_e(n);
-    return dyad_finish(result);
+    return dyad_finish(DYAD_TRT, input, result);
 }
