@@ -21,6 +21,12 @@
  * 4. Moment of link m about E:
  *      -l_m i_m x R_mk + (S_m - E) x F_m + M_m + M^R_mk + M^R_mn = 0,
  *      M^R_mk = l_m i_m x R_mk - [(S_m - E) x F_m + M_m] - M^R_mn.
+ * Steps 2 to 4 each have a twin from the other link's equilibrium (R_np =
+ * R_mn - F_n; M^R_mn = M_Dn - l_n i_n x R_mn about D_n; M^R_mk = -M_Dm -
+ * l_m i_m x R_mn - M^R_mn about D_m, with M_Dg the moment of link g's load
+ * about D_g). Equal in exact arithmetic, they differ in round-off when one
+ * link's loads dwarf the other's: the solver takes the form summing smaller
+ * terms.
  */
 #include "dyad_internal.h"
 
@@ -46,9 +52,35 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
 
     result->r_mk = dyad_scale(result->n_mk, p.j_k);
     result->r_mn = dyad_scale(result->n_mn, m->j);
-    result->r_np = dyad_neg(dyad_add(dyad_add(result->r_mk, m->f), n->f));
-    result->m_mn = -n->l * dyad_cross(n->i, result->r_np) + dyad_load_moment_about_e(n);
-    result->m_mk =
-        m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m) - result->m_mn;
+    /* Where one link outweighs the other, the sums over the light one keep
+     * their digits; the two forms of each are equal in exact arithmetic. */
+    result->r_np = dyad_smaller_sum(
+        dyad_neg(dyad_add(dyad_add(result->r_mk, m->f), n->f)),
+        dyad_norm1(result->r_mk) + dyad_norm1(m->f) + dyad_norm1(n->f),
+        dyad_sub(result->r_mn, n->f), dyad_norm1(result->r_mn) + dyad_norm1(n->f));
+    {
+        /* M^R_mn from link n about E, or about D_n (where R_np drops out). */
+        const dyad_real about_e =
+            -n->l * dyad_cross(n->i, result->r_np) + dyad_load_moment_about_e(n);
+        const dyad_real about_d =
+            dyad_load_moment_about_d(n) - n->l * dyad_cross(n->i, result->r_mn);
+        const dyad_real terms_e =
+            n->l * dyad_norm1(result->r_np) + dyad_load_moment_size(n, n->com.x - n->l);
+        const dyad_real terms_d =
+            n->l * dyad_norm1(result->r_mn) + dyad_load_moment_size(n, n->com.x);
+        result->m_mn = terms_e <= terms_d ? about_e : about_d;
+    }
+    {
+        /* M^R_mk from link m about E (eq. 22), or about D_m (where R_mk drops out). */
+        const dyad_real about_e =
+            m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m) - result->m_mn;
+        const dyad_real about_d =
+            -dyad_load_moment_about_d(m) - m->l * dyad_cross(m->i, result->r_mn) - result->m_mn;
+        const dyad_real terms_e =
+            m->l * dyad_norm1(result->r_mk) + dyad_load_moment_size(m, m->com.x - m->l);
+        const dyad_real terms_d =
+            m->l * dyad_norm1(result->r_mn) + dyad_load_moment_size(m, m->com.x);
+        result->m_mk = terms_e <= terms_d ? about_e : about_d;
+    }
     return dyad_finish(DYAD_RTT, input, result);
 }
