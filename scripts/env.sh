@@ -17,6 +17,9 @@ dyadfmu_ensure_system() {
     if ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
         missing+=(python3-venv)
     fi
+    # GSL for the generic-solve baseline of the study; valgrind counts its instructions.
+    [ -f /usr/include/gsl/gsl_linalg.h ] || missing+=(libgsl-dev)
+    command -v valgrind >/dev/null 2>&1 || missing+=(valgrind)
     if [ ${#missing[@]} -eq 0 ]; then
         return 0
     fi

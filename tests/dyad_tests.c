@@ -851,6 +851,27 @@ static int test_singular(void)
     return fails;
 }
 
+/* A non-finite input is named even where the configuration is also singular
+ * (or overflows): invalid input takes precedence. */
+static int test_invalid_before_singular(void)
+{
+    int fails = 0;
+    int t;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        dyad_input in = near_singular(type, 0, 0);
+        in.n.force.y = (dyad_real)NAN;
+        fails += expect_invalid(type, &in, DYAD_FIELD_N_FORCE, "NaN force at a singular position");
+        in = near_singular(type, 0.3, 0);
+        in.m.omega = (dyad_real)INFINITY;
+        fails += expect_invalid(type, &in, DYAD_FIELD_M_OMEGA, "infinite omega");
+        in = near_singular(type, 0.3, 0);
+        in.n.length = (dyad_real)INFINITY;
+        fails += expect_invalid(type, &in, DYAD_FIELD_N_LENGTH, "infinite length");
+    }
+    return fails;
+}
+
 /* ---- runner --------------------------------------------------------------- */
 
 typedef struct named_test {
@@ -871,6 +892,7 @@ static const named_test tests[] = {
     {"invalid_domain", test_invalid_domain},
     {"out_of_range", test_out_of_range},
     {"singular", test_singular},
+    {"invalid_before_singular", test_invalid_before_singular},
 };
 
 int main(int argc, char** argv)
