@@ -158,7 +158,7 @@ typedef struct imbalance {
      * whole dyad (loads, weights, inertia, reactions): the backward error. */
     double dyad;
     /* Worst link, relative to the largest term acting on that link alone:
-     * stricter where one link's loads dwarf the other's. Reported only. */
+     * stricter where one link's loads dwarf the other's. */
     double link;
 } imbalance;
 
@@ -348,6 +348,8 @@ static int test_equilibrium_random(void)
                worst_link, worst_pair);
         CHECK(worst_imbalance < RESIDUAL_LIMIT, "%s: residual %.3e", dyad_type_name(type),
               worst_imbalance);
+        CHECK(worst_link < RESIDUAL_LIMIT, "%s: residual %.3e of a link's own terms",
+              dyad_type_name(type), worst_link);
         CHECK(worst_pair < RESIDUAL_LIMIT, "%s: pair violation %.3e", dyad_type_name(type),
               worst_pair);
     }
