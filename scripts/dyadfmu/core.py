@@ -65,6 +65,10 @@ class Core:
         self._lib.dyad_solve.argtypes = [ctypes.c_int, ctypes.POINTER(_Input),
                                          ctypes.POINTER(_Result)]
         self._lib.dyad_solve.restype = ctypes.c_int
+        self._lib.dyad_solve_tangent.argtypes = [ctypes.c_int, ctypes.POINTER(_Input),
+                                                 ctypes.POINTER(_Input), ctypes.POINTER(_Result),
+                                                 ctypes.POINTER(_Result)]
+        self._lib.dyad_solve_tangent.restype = ctypes.c_int
         self._lib.dyad_field_name.argtypes = [ctypes.c_int]
         self._lib.dyad_field_name.restype = ctypes.c_char_p
 
@@ -77,10 +81,7 @@ class Core:
             else:
                 setattr(dst, key, float(value))
 
-    def solve(self, dyad_type: str, m: dict, n: dict, guide_k=None, guide_p=None,
-              gravity=(0.0, 0.0), singular_threshold: float | None = None) -> dict:
-        if dyad_type not in TYPES:
-            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+    def _input(self, m, n, guide_k, guide_p, gravity, singular_threshold=None) -> _Input:
         inp = self._lib.dyad_input_default()
         self._fill_link(inp.m, m)
         self._fill_link(inp.n, n)
@@ -91,8 +92,9 @@ class Core:
         inp.gravity = _Vec2(float(gravity[0]), float(gravity[1]))
         if singular_threshold is not None:
             inp.singular_threshold = float(singular_threshold)
-        res = _Result()
-        self._lib.dyad_solve(TYPES.index(dyad_type), ctypes.byref(inp), ctypes.byref(res))
+        return inp
+
+    def _output(self, res: _Result) -> dict:
         out = {name: (getattr(res, name).x, getattr(res, name).y)
                for name in ("r_mk", "r_np", "r_mn")}
         for name in ("n_mk", "n_np", "n_mn", "m_mk", "m_np", "m_mn",
@@ -101,3 +103,30 @@ class Core:
         out["status"] = STATUS.get(res.status, "?")
         out["field"] = self._lib.dyad_field_name(res.field).decode()
         return out
+
+    def solve(self, dyad_type: str, m: dict, n: dict, guide_k=None, guide_p=None,
+              gravity=(0.0, 0.0), singular_threshold: float | None = None) -> dict:
+        if dyad_type not in TYPES:
+            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        inp = self._input(m, n, guide_k, guide_p, gravity, singular_threshold)
+        res = _Result()
+        self._lib.dyad_solve(TYPES.index(dyad_type), ctypes.byref(inp), ctypes.byref(res))
+        return self._output(res)
+
+    def solve_tangent(self, dyad_type: str, inputs: tuple, seeds: tuple,
+                      singular_threshold: float | None = None) -> tuple[dict, dict]:
+        """The reactions and their directional derivative. `inputs` and `seeds` are
+        (m, n, guide_k, guide_p, gravity) tuples of the same form as solve's
+        arguments; a seed direction is the derivative of the unit vector."""
+        if dyad_type not in TYPES:
+            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        zero = (0.0, 0.0)
+        inp = self._input(*inputs, singular_threshold=singular_threshold)
+        sm, sn, sk, sp, sg = seeds
+        seed = self._input(sm, sn, sk if sk is not None else zero, sp if sp is not None else zero,
+                           sg)
+        value, derivative = _Result(), _Result()
+        self._lib.dyad_solve_tangent(TYPES.index(dyad_type), ctypes.byref(inp),
+                                     ctypes.byref(seed), ctypes.byref(value),
+                                     ctypes.byref(derivative))
+        return self._output(value), self._output(derivative)

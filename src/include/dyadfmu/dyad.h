@@ -32,6 +32,17 @@ dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result);
 dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result);
 dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result);
 
+/** The reactions and their directional derivative along `seed`, exactly (one
+ *  more solve of the closed forms, no finite differences). `seed` has the layout
+ *  of the input and holds the rate of each field; a direction's rate is the
+ *  derivative of its unit vector, of which only the part normal to it counts
+ *  (for an angle rate w: w * (-dir.y, dir.x)). `value` gets the reactions as
+ *  dyad_solve gives them; `derivative` their rates in the same fields (N/s if
+ *  the seed is per second, and so on), including conditioning and
+ *  amplification. Status as dyad_solve's; outputs NaN unless ok. */
+dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dyad_input* seed,
+                               dyad_result* value, dyad_result* derivative);
+
 /** Resultant of link g's active load, weight and inertia (d'Alembert) at its
  *  centre of mass: force (N, global frame) and moment (N m). This is F_g, M_g
  *  of the paper. Inputs are not validated here. */
