@@ -206,14 +206,9 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         size_t nKnown, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[])
 {
-    (void)vUnknown_ref;
-    (void)nUnknown;
-    (void)vKnown_ref;
-    (void)nKnown;
-    (void)dvKnown;
-    (void)dvUnknown;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetDirectionalDerivative",
-                                   "providesDirectionalDerivative is false"));
+    return to_fmi2(fmu_directional_derivative((fmu_instance*)c, vUnknown_ref, nUnknown,
+                                              vKnown_ref, nKnown, dvKnown, dvUnknown,
+                                              "fmi2GetDirectionalDerivative"));
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],

@@ -540,15 +540,15 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueRe
                                         size_t nKnowns, const fmi3Float64 seed[], size_t nSeed,
                                         fmi3Float64 sensitivity[], size_t nSensitivity)
 {
-    (void)unknowns;
-    (void)nUnknowns;
-    (void)knowns;
-    (void)nKnowns;
-    (void)seed;
-    (void)nSeed;
-    (void)sensitivity;
-    (void)nSensitivity;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetDirectionalDerivative", "providesDirectionalDerivatives is false"));
+    fmu_instance* fmu = (fmu_instance*)instance;
+    if (fmu != NULL && (nSeed != nKnowns || nSensitivity != nUnknowns)) {
+        fmu_log(fmu, FMU_ERROR, "fmi3GetDirectionalDerivative: nSeed = %zu and nSensitivity = "
+                "%zu must equal nKnowns = %zu and nUnknowns = %zu (all variables are scalars)",
+                nSeed, nSensitivity, nKnowns, nUnknowns);
+        return fmi3Error;
+    }
+    return to_fmi3(fmu_directional_derivative(fmu, unknowns, nUnknowns, knowns, nKnowns, seed,
+                                              sensitivity, "fmi3GetDirectionalDerivative"));
 }
 
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[],

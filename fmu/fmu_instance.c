@@ -537,6 +537,68 @@ fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size
     return worst == FMU_ERROR ? FMU_ERROR : FMU_OK;
 }
 
+fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int unknowns[],
+                                      size_t n_unknowns, const unsigned int knowns[],
+                                      size_t n_knowns, const double seed[], double derivative[],
+                                      const char* function)
+{
+    static const dyad_input zero;
+    dyad_input input, rates = zero;
+    dyad_result value, rate;
+    size_t k;
+    fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
+    if (status != FMU_OK || check_arrays(instance, knowns, n_knowns, seed, function) != FMU_OK ||
+        check_arrays(instance, unknowns, n_unknowns, derivative, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    gather_input(instance, &input);
+    for (k = 0; k < n_knowns; ++k) {
+        const fmu_variable* v = lookup(instance, knowns[k], FMU_REAL, function);
+        char* member;
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        if (v->causality != FMU_INPUT) {
+            fmu_log(instance, FMU_ERROR, "%s: known %s is not an input", function, v->name);
+            return FMU_ERROR;
+        }
+        member = (char*)&rates + v->offset;
+        if (v->target == FMU_TARGET_INPUT_ANGLE) {
+            /* d(cos, sin)/d angle = (-sin, cos) */
+            const dyad_vec2 dir = *(const dyad_vec2*)(const void*)((const char*)&input + v->offset);
+            dyad_vec2* d = (dyad_vec2*)(void*)member;
+            d->x -= (dyad_real)(seed[k] * dir.y);
+            d->y += (dyad_real)(seed[k] * dir.x);
+        } else {
+            *(dyad_real*)(void*)member += (dyad_real)seed[k];
+        }
+    }
+    for (k = 0; k < n_unknowns; ++k) {
+        const fmu_variable* v = lookup(instance, unknowns[k], FMU_REAL, function);
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        if (v->causality != FMU_OUTPUT) {
+            fmu_log(instance, FMU_ERROR, "%s: unknown %s is not an output", function, v->name);
+            return FMU_ERROR;
+        }
+    }
+    if (dyad_solve_tangent_with(instance->model->solve, instance->model->type, &input, &rates,
+                                &value, &rate) != DYAD_STATUS_OK) {
+        fmu_log(instance, FMU_DISCARD, "%s: no derivative where the reactions are not defined "
+                "(%s)", function, dyad_status_name(value.status));
+        for (k = 0; k < n_unknowns; ++k) {
+            derivative[k] = NAN;
+        }
+        return FMU_DISCARD;
+    }
+    for (k = 0; k < n_unknowns; ++k) {
+        const fmu_variable* v = &instance->model->variables[instance->model->index_of_vr[unknowns[k]]];
+        derivative[k] = (double)*(const dyad_real*)(const void*)((const char*)&rate + v->offset);
+    }
+    return FMU_OK;
+}
+
 fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,
                                     const unsigned int vr[], size_t count,
                                     const char* function)

@@ -119,6 +119,13 @@ fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size
 fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
                            const int values[], const char* function);
 
+/* Exact directional derivative of Real outputs (unknowns) along a seed on Real
+ * inputs (knowns), at the current inputs (dyad_solve_tangent_with). */
+fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int unknowns[],
+                                      size_t n_unknowns, const unsigned int knowns[],
+                                      size_t n_knowns, const double seed[], double derivative[],
+                                      const char* function);
+
 /* For variable types the model has none of: accepts an empty list, rejects
  * any value reference by number. */
 fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,

@@ -53,7 +53,8 @@ typedef struct fmu_variable {
 typedef struct fmu_model {
     const char* identifier; /* modelIdentifier, e.g. "dyad_rrt" */
     const char* token;      /* instantiation token (FMI 3) / GUID (FMI 2) */
-    dyad_status (*solve)(const dyad_input* input, dyad_result* result);
+    dyad_type type;
+    dyad_solver solve;      /* this type's solver: the FMU links no other */
     const fmu_variable* variables;
     size_t variable_count;
     const short* index_of_vr; /* variable index for each vr < vr_limit, -1 where none */

@@ -624,7 +624,7 @@ def _element(indent: int, tag: str, attributes: list[tuple[str, object]], close=
 
 
 def source_files(table: Table, fmi_functions: str) -> list[str]:
-    return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "fmu_instance.c",
+    return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "dyad_tangent.c", "fmu_instance.c",
             fmi_functions, f"{table.identifier}_model.c"]
 
 
@@ -678,7 +678,7 @@ def fmi2_model_description(table: Table) -> str:
         ("canBeInstantiatedOnlyOncePerProcess", "false"),
         ("canGetAndSetFMUstate", "false"),
         ("canSerializeFMUstate", "false"),
-        ("providesDirectionalDerivative", "false")], close=False, wrap=True))
+        ("providesDirectionalDerivative", "true")], close=False, wrap=True))
     lines.append("    <SourceFiles>")
     lines += [_element(3, "File", [("name", f)]) for f in source_files(table, "fmi2_functions.c")]
     lines.append("    </SourceFiles>")
@@ -738,7 +738,7 @@ def fmi3_model_description(table: Table) -> str:
         ("canBeInstantiatedOnlyOncePerProcess", "false"),
         ("canGetAndSetFMUState", "false"),
         ("canSerializeFMUState", "false"),
-        ("providesDirectionalDerivatives", "false"),
+        ("providesDirectionalDerivatives", "true"),
         ("hasEventMode", "false"),
         ("canReturnEarlyAfterIntermediateUpdate", "false"),
         ("providesIntermediateUpdate", "false")], wrap=True))
@@ -857,7 +857,8 @@ def model_c(table: Table) -> str:
     lines.append("")
     lines.append(f"const fmu_model fmu_this_model = {{{_c_string(table.identifier)}, "
                  f"{_c_string(table.token)},")
-    lines.append(f"                                  dyad_solve_{table.type.lower()}, variables, "
+    lines.append(f"                                  DYAD_{table.type}, "
+                 f"dyad_solve_{table.type.lower()}, variables, "
                  f"{len(table.variables)}, index_of_vr, {vr_limit}}};")
     return "\n".join(lines) + "\n"
 

@@ -20,3 +20,21 @@ dyad_status dyad_solve(dyad_type type, const dyad_input* input, dyad_result* res
     result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
     return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_TYPE);
 }
+
+dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dyad_input* seed,
+                               dyad_result* value, dyad_result* derivative)
+{
+    static const dyad_solver solvers[DYAD_TYPE_COUNT] = {
+        dyad_solve_rrr, dyad_solve_rrt, dyad_solve_rtr, dyad_solve_trt, dyad_solve_rtt};
+    if ((unsigned)type >= DYAD_TYPE_COUNT) {
+        if (value != NULL) {
+            value->denominator = value->conditioning = value->amplification = (dyad_real)NAN;
+            dyad_reject(value, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_TYPE);
+        }
+        if (derivative != NULL && value != NULL) {
+            *derivative = *value;
+        }
+        return DYAD_STATUS_INVALID_INPUT;
+    }
+    return dyad_solve_tangent_with(solvers[type], type, input, seed, value, derivative);
+}

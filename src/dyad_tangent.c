@@ -62,18 +62,20 @@ static void resultant_rate(const dyad_link* k, const dyad_link* dk, dyad_vec2 i,
     *dmoment_d = dmoment + dyad_cross(dr, w) + dyad_cross(r, dw);
 }
 
-dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dyad_input* seed,
-                               dyad_result* value, dyad_result* derivative)
+dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dyad_input* input,
+                                    const dyad_input* seed, dyad_result* value,
+                                    dyad_result* derivative)
 {
     dyad_input loads;
     dyad_status status;
     dyad_vec2 i_m, i_n, i_k, i_p, df_m, df_n, dr_mn_turn;
     dyad_real dth_m, dth_n, dth_k, dth_p, dmd_m, dmd_n, dc;
 
-    if (derivative == NULL) {
+    if (value == NULL || derivative == NULL || solve == NULL ||
+        (unsigned)type >= DYAD_TYPE_COUNT) {
         return DYAD_STATUS_INVALID_INPUT;
     }
-    status = dyad_solve(type, input, value);
+    status = solve(input, value);
     if (status != DYAD_STATUS_OK) {
         *derivative = *value;
         return status;
@@ -129,7 +131,7 @@ dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dy
     loads.n.force = df_n;
     loads.m.moment = dmd_m;
     loads.n.moment = dmd_n;
-    status = dyad_solve(type, &loads, derivative);
+    status = solve(&loads, derivative);
     if (status != DYAD_STATUS_OK) {
         return status;
     }

@@ -381,7 +381,8 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
         (config,) = md.buildConfigurations
         assert config.modelIdentifier == ident
         assert config.sourceFileSets[0].sourceFiles == [
-            "dyad_common.c", f"dyad_{dyad_type.lower()}.c", "fmu_instance.c", shim,
+            "dyad_common.c", f"dyad_{dyad_type.lower()}.c", "dyad_tangent.c", "fmu_instance.c",
+            shim,
             f"{ident}_model.c"]
         units = {u.name: u.baseUnit for u in md.unitDefinitions}
         assert set(units) == set(BASE_UNITS)

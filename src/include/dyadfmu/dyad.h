@@ -18,6 +18,9 @@
 extern "C" {
 #endif
 
+/** A solver of one dyad type (dyad_solve_rrr, ...). */
+typedef dyad_status (*dyad_solver)(const dyad_input* input, dyad_result* result);
+
 /** Inputs with every field zero, except: directions i_m, i_n, i_k, i_p = (1, 0),
  *  lengths 1 m, singular threshold DYAD_DEFAULT_SINGULAR_THRESHOLD. */
 dyad_input dyad_input_default(void);
@@ -42,6 +45,12 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result);
  *  amplification. Status as dyad_solve's; outputs NaN unless ok. */
 dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dyad_input* seed,
                                dyad_result* value, dyad_result* derivative);
+
+/** The same with the type's solver given (dyad_solve_rrr for DYAD_RRR, ...), so
+ *  that a program that needs one type links only that type's solver. */
+dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dyad_input* input,
+                                    const dyad_input* seed, dyad_result* value,
+                                    dyad_result* derivative);
 
 /** Resultant of link g's active load, weight and inertia (d'Alembert) at its
  *  centre of mass: force (N, global frame) and moment (N m). This is F_g, M_g
