@@ -87,11 +87,28 @@ static void log_to(const fmu_logger* logger, fmu_status status, const char* form
     va_end(args);
 }
 
+/* Stores a value as set and where the solver reads it (an angle as its unit
+ * vector), so that a solve needs no pass over the variables. */
+static void store(fmu_instance* instance, size_t index, double value)
+{
+    const fmu_variable* v = &instance->model->variables[index];
+    char* member = (char*)&instance->input + v->offset;
+    instance->values[index] = value;
+    if (v->target == FMU_TARGET_INPUT_ANGLE) {
+        dyad_vec2* dir = (dyad_vec2*)(void*)member;
+        dir->x = (dyad_real)cos(value);
+        dir->y = (dyad_real)sin(value);
+    } else if (v->target == FMU_TARGET_INPUT_REAL) {
+        *(dyad_real*)(void*)member = (dyad_real)value;
+    }
+}
+
 static void load_start_values(fmu_instance* instance)
 {
     size_t k;
+    instance->input = dyad_input_default();
     for (k = 0; k < instance->model->variable_count; ++k) {
-        instance->values[k] = instance->model->variables[k].start;
+        store(instance, k, instance->model->variables[k].start);
     }
     instance->state = FMU_STATE_INSTANTIATED;
     instance->time = 0;
@@ -223,35 +240,14 @@ static const fmu_variable* variable_of_field(const fmu_model* model, dyad_field 
     return NULL;
 }
 
-/* The solver's input from the variable store, through the table's offsets. */
-static void gather_input(const fmu_instance* instance, dyad_input* input)
-{
-    const fmu_model* model = instance->model;
-    size_t k;
-    *input = dyad_input_default();
-    for (k = 0; k < model->variable_count; ++k) {
-        const fmu_variable* v = &model->variables[k];
-        char* member = (char*)input + v->offset;
-        if (v->target == FMU_TARGET_INPUT_ANGLE) {
-            dyad_vec2* dir = (dyad_vec2*)(void*)member;
-            dir->x = (dyad_real)cos(instance->values[k]);
-            dir->y = (dyad_real)sin(instance->values[k]);
-        } else if (v->target == FMU_TARGET_INPUT_REAL) {
-            *(dyad_real*)(void*)member = (dyad_real)instance->values[k];
-        }
-    }
-}
-
 /* Solves if an input changed since the last solve. Returns FMU_OK, FMU_ERROR
  * for inputs the solver rejects, or `not_solvable` for a singular or
  * overflowing configuration; each failure is logged once per solve. */
 static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const char* function)
 {
-    dyad_input input;
     const dyad_result* r = &instance->result;
     if (instance->dirty) {
-        gather_input(instance, &input);
-        instance->model->solve(&input, &instance->result);
+        instance->model->solve(&instance->input, &instance->result);
         instance->dirty = 0;
         switch (r->status) {
         case DYAD_STATUS_OK: break;
@@ -260,7 +256,7 @@ static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const c
                     "%s: singular configuration at t = %g s: conditioning %.3g is below "
                     "singular_threshold %.3g; the dyad cannot carry its load, reactions are NaN",
                     function, instance->time, (double)r->conditioning,
-                    (double)input.singular_threshold);
+                    (double)instance->input.singular_threshold);
             break;
         case DYAD_STATUS_OUT_OF_RANGE:
             fmu_log(instance, not_solvable,
@@ -463,7 +459,7 @@ static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], si
         }
     }
     for (k = 0; k < count; ++k) {
-        instance->values[instance->model->index_of_vr[vr[k]]] = value_at(values, type, k);
+        store(instance, (size_t)instance->model->index_of_vr[vr[k]], value_at(values, type, k));
     }
     if (count > 0) {
         instance->dirty = 1;
@@ -543,7 +539,8 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
                                       const char* function)
 {
     static const dyad_input zero;
-    dyad_input input, rates = zero;
+    const dyad_input* input = &instance->input;
+    dyad_input rates = zero;
     dyad_result value, rate;
     size_t k;
     fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
@@ -551,7 +548,6 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
         check_arrays(instance, unknowns, n_unknowns, derivative, function) != FMU_OK) {
         return FMU_ERROR;
     }
-    gather_input(instance, &input);
     for (k = 0; k < n_knowns; ++k) {
         const fmu_variable* v = lookup(instance, knowns[k], FMU_REAL, function);
         char* member;
@@ -565,7 +561,7 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
         member = (char*)&rates + v->offset;
         if (v->target == FMU_TARGET_INPUT_ANGLE) {
             /* d(cos, sin)/d angle = (-sin, cos) */
-            const dyad_vec2 dir = *(const dyad_vec2*)(const void*)((const char*)&input + v->offset);
+            const dyad_vec2 dir = *(const dyad_vec2*)(const void*)((const char*)input + v->offset);
             dyad_vec2* d = (dyad_vec2*)(void*)member;
             d->x -= (dyad_real)(seed[k] * dir.y);
             d->y += (dyad_real)(seed[k] * dir.x);
@@ -583,7 +579,7 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
             return FMU_ERROR;
         }
     }
-    if (dyad_solve_tangent_with(instance->model->solve, instance->model->type, &input, &rates,
+    if (dyad_solve_tangent_with(instance->model->solve, instance->model->type, input, &rates,
                                 &value, &rate) != DYAD_STATUS_OK) {
         fmu_log(instance, FMU_DISCARD, "%s: no derivative where the reactions are not defined "
                 "(%s)", function, dyad_status_name(value.status));

@@ -73,8 +73,9 @@ typedef struct fmu_instance {
     double last_successful_time;
     int terminate_requested; /* set when a step cannot be completed */
     int dirty;               /* inputs changed since the last solve */
+    dyad_input input;        /* the solver's input, kept up to date by every set */
     dyad_result result;
-    double* values;          /* one per variable; outputs unused */
+    double* values;          /* one per variable, as set; outputs unused */
 } fmu_instance;
 
 /* Log categories declared in the model descriptions, in bit order. */
