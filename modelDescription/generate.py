@@ -1029,6 +1029,15 @@ def documentation(table: Table) -> str:
              "reason.</li>")
     o.append("</ul>")
 
+    o.append("<h2>Directional derivatives</h2>")
+    o.append("<p><code>fmi2GetDirectionalDerivative</code> and "
+             "<code>fmi3GetDirectionalDerivative</code> give the exact derivative of every Real "
+             "output with respect to the inputs (knowns must be inputs, unknowns Real "
+             "outputs), at the current inputs: the equilibrium equations are differentiated "
+             "implicitly and the dyad is solved once more, with no finite-difference step. "
+             "Angles count in rad, so a derivative with respect to an angle is per rad. At a "
+             "singular configuration the call returns <code>Discard</code> and NaN.</p>")
+
     o.append("<h2>Identity</h2>")
     o.append(f"<p>Model identifier <code>{_h(table.identifier)}</code>, instantiation token "
              f"(FMI 2 GUID) <code>{_h(table.token)}</code>: a hash of the variable table "
