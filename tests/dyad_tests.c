@@ -17,6 +17,7 @@
 
 #include "dyadfmu/dyad.h"
 #include "dyadfmu/vec2.h"
+#include "named_tests.h"
 
 #ifdef DYAD_REAL_FLOAT
 #define REAL_NAME "float"
@@ -35,16 +36,6 @@
 #define RANDOM_CONFIGURATIONS 10000
 #define WELL_CONDITIONED 0.1
 #define PI 3.14159265358979323846
-
-#define CHECK(cond, ...)                                                                        \
-    do {                                                                                        \
-        if (!(cond)) {                                                                          \
-            printf("    FAIL %s:%d: ", __FILE__, __LINE__);                                     \
-            printf(__VA_ARGS__);                                                                \
-            printf("\n");                                                                       \
-            ++fails;                                                                            \
-        }                                                                                       \
-    } while (0)
 
 static const dyad_type all_types[DYAD_TYPE_COUNT] = {DYAD_RRR, DYAD_RRT, DYAD_RTR, DYAD_TRT,
                                                      DYAD_RTT};
@@ -876,11 +867,6 @@ static int test_invalid_before_singular(void)
 
 /* ---- runner --------------------------------------------------------------- */
 
-typedef struct named_test {
-    const char* name;
-    int (*run)(void);
-} named_test;
-
 static const named_test tests[] = {
     {"equilibrium_random", test_equilibrium_random},
     {"rrr_symmetric_truss", test_rrr_symmetric_truss},
@@ -899,26 +885,8 @@ static const named_test tests[] = {
 
 int main(int argc, char** argv)
 {
-    const size_t count = sizeof tests / sizeof tests[0];
-    int failed = 0, passed = 0;
-    size_t k;
-    int a;
-    for (k = 0; k < count; ++k) {
-        int selected = argc < 2;
-        for (a = 1; a < argc; ++a) {
-            selected |= strcmp(argv[a], tests[k].name) == 0;
-        }
-        if (!selected) {
-            continue;
-        }
-        printf("[%s] %s\n", REAL_NAME, tests[k].name);
-        if (tests[k].run() == 0) {
-            ++passed;
-        } else {
-            ++failed;
-            printf("    -> FAILED\n");
-        }
-    }
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed == 0 && passed > 0 ? 0 : 1;
+    return run_named_tests(tests, sizeof tests / sizeof tests[0], REAL_NAME, argv + 1,
+                           argc - 1) == 0
+               ? 0
+               : 1;
 }

@@ -17,16 +17,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 #include "fmu_model.h"
-
-#define CHECK(cond, ...)                                                                        \
-    do {                                                                                        \
-        if (!(cond)) {                                                                          \
-            printf("    FAIL %s:%d: ", __FILE__, __LINE__);                                     \
-            printf(__VA_ARGS__);                                                                \
-            printf("\n");                                                                       \
-            ++fails;                                                                            \
-        }                                                                                       \
-    } while (0)
+#include "named_tests.h"
 
 /* ---- the importer's side: a logger that keeps the last message ---------------- */
 
@@ -674,11 +665,6 @@ static int test_fmi3_state_machine(void)
 
 /* ---- runner --------------------------------------------------------------------- */
 
-typedef struct named_test {
-    const char* name;
-    int (*run)(void);
-} named_test;
-
 static const named_test tests[] = {
     {"fmi2_instances_independent", test_fmi2_instances_independent},
     {"fmi2_call_sequence", test_fmi2_call_sequence},
@@ -693,9 +679,7 @@ static const named_test tests[] = {
 
 int main(int argc, char** argv)
 {
-    const size_t count = sizeof tests / sizeof tests[0];
-    int failed = 0, passed = 0, a;
-    size_t k;
+    int failed;
     if (argc < 3) {
         printf("usage: fmu_api_tests FMI2_BINARY FMI3_BINARY [test-name ...]\n");
         return 2;
@@ -704,24 +688,9 @@ int main(int argc, char** argv)
         printf("0 passed, 1 failed\n");
         return 1;
     }
-    for (k = 0; k < count; ++k) {
-        int selected = argc < 4;
-        for (a = 3; a < argc; ++a) {
-            selected |= strcmp(argv[a], tests[k].name) == 0;
-        }
-        if (!selected) {
-            continue;
-        }
-        printf("[%s] %s\n", fmu_this_model.identifier, tests[k].name);
-        if (tests[k].run() == 0) {
-            ++passed;
-        } else {
-            ++failed;
-            printf("    -> FAILED\n");
-        }
-    }
+    failed = run_named_tests(tests, sizeof tests / sizeof tests[0], fmu_this_model.identifier,
+                             argv + 3, argc - 3);
     dlclose(api2.library);
     dlclose(api3.library);
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed == 0 && passed > 0 ? 0 : 1;
+    return failed == 0 ? 0 : 1;
 }
