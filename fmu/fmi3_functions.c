@@ -156,7 +156,8 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterEventMode", "hasEventMode is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterEventMode",
+                                   "hasEventMode is false"));
 }
 
 fmi3Status fmi3Terminate(fmi3Instance instance)
@@ -474,7 +475,8 @@ fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
 {
     (void)valueReference;
     (void)nDependencies;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfVariableDependencies", "the dependencies are declared in modelDescription.xml"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfVariableDependencies",
+                                   "the dependencies are declared in modelDescription.xml"));
 }
 
 fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent,
@@ -489,32 +491,37 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
     (void)elementIndicesOfIndependents;
     (void)dependencyKinds;
     (void)nDependencies;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetVariableDependencies", "the dependencies are declared in modelDescription.xml"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetVariableDependencies",
+                                   "the dependencies are declared in modelDescription.xml"));
 }
 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
 {
     (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetFMUState", "canGetAndSetFMUState is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetFMUState",
+                                   "canGetAndSetFMUState is false"));
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
 {
     (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetFMUState", "canGetAndSetFMUState is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetFMUState",
+                                   "canGetAndSetFMUState is false"));
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
 {
     (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3FreeFMUState", "canGetAndSetFMUState is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3FreeFMUState",
+                                   "canGetAndSetFMUState is false"));
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t* size)
 {
     (void)FMUState;
     (void)size;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializedFMUStateSize", "canGetAndSetFMUState is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializedFMUStateSize",
+                                   "canGetAndSetFMUState is false"));
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
@@ -523,7 +530,8 @@ fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
     (void)FMUState;
     (void)serializedState;
     (void)size;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializeFMUState", "canGetAndSetFMUState is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializeFMUState",
+                                   "canGetAndSetFMUState is false"));
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[],
@@ -532,7 +540,8 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
     (void)serializedState;
     (void)size;
     (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3DeserializeFMUState", "canGetAndSetFMUState is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3DeserializeFMUState",
+                                   "canGetAndSetFMUState is false"));
 }
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[],
@@ -564,17 +573,20 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueRefere
     (void)nSeed;
     (void)sensitivity;
     (void)nSensitivity;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetAdjointDerivative", "providesAdjointDerivatives is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetAdjointDerivative",
+                                   "providesAdjointDerivatives is false"));
 }
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterConfigurationMode", "the FMU has no structural parameters"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterConfigurationMode",
+                                   "the FMU has no structural parameters"));
 }
 
 fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3ExitConfigurationMode", "the FMU has no structural parameters"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3ExitConfigurationMode",
+                                   "the FMU has no structural parameters"));
 }
 
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -585,7 +597,8 @@ fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReferenc
     (void)nValueReferences;
     (void)intervals;
     (void)qualifiers;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetIntervalDecimal", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetIntervalDecimal",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3GetIntervalFraction(fmi3Instance instance,
@@ -598,7 +611,8 @@ fmi3Status fmi3GetIntervalFraction(fmi3Instance instance,
     (void)counters;
     (void)resolutions;
     (void)qualifiers;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetIntervalFraction", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetIntervalFraction",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -607,7 +621,8 @@ fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference v
     (void)valueReferences;
     (void)nValueReferences;
     (void)shifts;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftDecimal", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftDecimal",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -618,7 +633,8 @@ fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
     (void)nValueReferences;
     (void)counters;
     (void)resolutions;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftFraction", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftFraction",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -627,7 +643,8 @@ fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReferenc
     (void)valueReferences;
     (void)nValueReferences;
     (void)intervals;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetIntervalDecimal", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetIntervalDecimal",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3SetIntervalFraction(fmi3Instance instance,
@@ -639,7 +656,8 @@ fmi3Status fmi3SetIntervalFraction(fmi3Instance instance,
     (void)nValueReferences;
     (void)counters;
     (void)resolutions;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetIntervalFraction", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetIntervalFraction",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -648,7 +666,8 @@ fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference v
     (void)valueReferences;
     (void)nValueReferences;
     (void)shifts;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftDecimal", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftDecimal",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -659,12 +678,14 @@ fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
     (void)nValueReferences;
     (void)counters;
     (void)resolutions;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftFraction", "the FMU has no clocks"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftFraction",
+                                   "the FMU has no clocks"));
 }
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EvaluateDiscreteStates", "hasEventMode is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EvaluateDiscreteStates",
+                                   "hasEventMode is false"));
 }
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean* discreteStatesNeedUpdate,
@@ -679,12 +700,14 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean* discrete
     (void)valuesOfContinuousStatesChanged;
     (void)nextEventTimeDefined;
     (void)nextEventTime;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3UpdateDiscreteStates", "hasEventMode is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3UpdateDiscreteStates",
+                                   "hasEventMode is false"));
 }
 
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterContinuousTimeMode", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterContinuousTimeMode",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance,
@@ -695,13 +718,15 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance,
     (void)noSetFMUStatePriorToCurrentPoint;
     (void)enterEventMode;
     (void)terminateSimulation;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3CompletedIntegratorStep", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3CompletedIntegratorStep",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time)
 {
     (void)time;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetTime", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetTime",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[],
@@ -709,7 +734,8 @@ fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 cont
 {
     (void)continuousStates;
     (void)nContinuousStates;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetContinuousStates", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetContinuousStates",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[],
@@ -717,7 +743,8 @@ fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 
 {
     (void)derivatives;
     (void)nContinuousStates;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetContinuousStateDerivatives", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetContinuousStateDerivatives",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[],
@@ -725,7 +752,8 @@ fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndica
 {
     (void)eventIndicators;
     (void)nEventIndicators;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetEventIndicators", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetEventIndicators",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[],
@@ -733,7 +761,8 @@ fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuous
 {
     (void)continuousStates;
     (void)nContinuousStates;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetContinuousStates", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetContinuousStates",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[],
@@ -741,24 +770,28 @@ fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 
 {
     (void)nominals;
     (void)nContinuousStates;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNominalsOfContinuousStates", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNominalsOfContinuousStates",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t* nEventIndicators)
 {
     (void)nEventIndicators;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfEventIndicators", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfEventIndicators",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t* nContinuousStates)
 {
     (void)nContinuousStates;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfContinuousStates", "model exchange is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetNumberOfContinuousStates",
+                                   "model exchange is not supported"));
 }
 
 fmi3Status fmi3EnterStepMode(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterStepMode", "hasEventMode is false"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterStepMode",
+                                   "hasEventMode is false"));
 }
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance,
@@ -771,7 +804,8 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance,
     (void)orders;
     (void)values;
     (void)nValues;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetOutputDerivatives", "maxOutputDerivativeOrder is 0"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetOutputDerivatives",
+                                   "maxOutputDerivativeOrder is 0"));
 }
 
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint,
@@ -803,5 +837,6 @@ fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference 
 {
     (void)clockReference;
     (void)activationTime;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3ActivateModelPartition", "scheduled execution is not supported"));
+    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3ActivateModelPartition",
+                                   "scheduled execution is not supported"));
 }

@@ -30,7 +30,8 @@ enum { PARAMETER_STATES = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION };
 
 const char* const fmu_log_category_names[] = {"logStatusError", "logStatusWarning",
                                               "logStatusDiscard", "logCalls"};
-const size_t fmu_log_category_count = sizeof fmu_log_category_names / sizeof fmu_log_category_names[0];
+const size_t fmu_log_category_count =
+    sizeof fmu_log_category_names / sizeof fmu_log_category_names[0];
 enum { LOG_ERROR = 0, LOG_WARNING, LOG_DISCARD, LOG_CALLS };
 
 static const char* state_name(fmu_state state)
@@ -589,7 +590,8 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
         return FMU_DISCARD;
     }
     for (k = 0; k < n_unknowns; ++k) {
-        const fmu_variable* v = &instance->model->variables[instance->model->index_of_vr[unknowns[k]]];
+        const short index = instance->model->index_of_vr[unknowns[k]];
+        const fmu_variable* v = &instance->model->variables[index];
         derivative[k] = (double)*(const dyad_real*)(const void*)((const char*)&rate + v->offset);
     }
     return FMU_OK;

@@ -1,5 +1,6 @@
-/* dyadfmu: input validation, link resultants (paper eqs. 1 and 2), the pair
- * table, status handling and dispatch, shared by the five solvers. */
+/* dyadfmu: the public helpers (defaults, names, the pair table), the slow path
+ * that names a bad input field, and rejection. The steps every solver shares
+ * on its hot path are inline in dyad_internal.h; dispatch is in dyad_solve.c. */
 #include "dyad_internal.h"
 
 #include <stddef.h>

@@ -131,7 +131,8 @@ static inline dyad_vec2 dyad_unit_of(dyad_vec2 v)
  * out of that sum instead of being added and cancelled again; for a fast,
  * heavy link it would otherwise swamp the moment in round-off. */
 static inline void dyad_resultant(const dyad_link* link, dyad_vec2 i, dyad_vec2 gravity,
-                           dyad_vec2* force, dyad_real* moment, dyad_real* moment_about_d)
+                                  dyad_vec2* force, dyad_real* moment,
+                                  dyad_real* moment_about_d)
 {
     const dyad_vec2 j = dyad_perp(i);
     const dyad_vec2 r = dyad_combine(link->com.x, i, link->com.y, j);
@@ -227,8 +228,9 @@ static inline dyad_status dyad_prepare(dyad_type type, const dyad_input* input,
 }
 
 static inline dyad_status dyad_accept_conditioning(dyad_type type, const dyad_input* input,
-                                     dyad_real denominator, dyad_real conditioning,
-                                     dyad_result* result)
+                                                   dyad_real denominator,
+                                                   dyad_real conditioning,
+                                                   dyad_result* result)
 {
     result->denominator = denominator;
     result->conditioning = conditioning;
@@ -245,7 +247,8 @@ static inline dyad_status dyad_accept_conditioning(dyad_type type, const dyad_in
     return DYAD_STATUS_OK;
 }
 
-static inline dyad_status dyad_finish(dyad_type type, const dyad_input* input, dyad_result* result)
+static inline dyad_status dyad_finish(dyad_type type, const dyad_input* input,
+                                      dyad_result* result)
 {
     const dyad_result* r = result;
     /* x - x is 0 for a finite x and NaN otherwise: one sum tests all outputs. */

@@ -259,7 +259,8 @@ static int test_fmi2_instances_independent(void)
     log_book book_a = {0, 0, ""}, book_b = {0, 0, ""};
     fmi2Component a = new_fmi2(&book_a, "a");
     fmi2Component b = new_fmi2(&book_b, "b");
-    const unsigned set_a[3] = {vr_of("link_n.angle"), vr_of("link_m.force.x"), vr_of("link_n.omega")};
+    const unsigned set_a[3] = {vr_of("link_n.angle"), vr_of("link_m.force.x"),
+                               vr_of("link_n.omega")};
     const double val_a[3] = {0.3, -2500, 40};
     const double val_b[3] = {-0.5, 700, -15};
     unsigned outs[32];
