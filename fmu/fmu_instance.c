@@ -93,21 +93,27 @@ static void log_to(const fmu_logger* logger, fmu_status status, const char* form
 static void store(fmu_instance* instance, size_t index, double value)
 {
     const fmu_variable* v = &instance->model->variables[index];
-    char* member = (char*)&instance->input + v->offset;
+    double* member = (double*)(void*)((char*)instance->input + v->offset);
     instance->values[index] = value;
     if (v->target == FMU_TARGET_INPUT_ANGLE) {
-        dyad_vec2* dir = (dyad_vec2*)(void*)member;
-        dir->x = (dyad_real)cos(value);
-        dir->y = (dyad_real)sin(value);
+        member[0] = cos(value);
+        member[1] = sin(value);
     } else if (v->target == FMU_TARGET_INPUT_REAL) {
-        *(dyad_real*)(void*)member = (dyad_real)value;
+        member[0] = value;
     }
+}
+
+/* Sizes rounded up so that every block is aligned for any scalar. */
+static size_t round_up(size_t size)
+{
+    const size_t unit = 16;
+    return (size + unit - 1) / unit * unit;
 }
 
 static void load_start_values(fmu_instance* instance)
 {
     size_t k;
-    instance->input = dyad_input_default();
+    instance->model->behaviour->initialise(instance->model, instance->input);
     for (k = 0; k < instance->model->variable_count; ++k) {
         store(instance, k, instance->model->variables[k].start);
     }
@@ -123,8 +129,8 @@ fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
                               fmu_allocate allocate, fmu_release release)
 {
     fmu_instance* instance;
-    size_t values_size, name_size;
-    char* name;
+    size_t values_size, name_size, input_size, output_size;
+    char *block, *name;
 
     logger.instance_name = instance_name != NULL ? instance_name : "";
     if (instance_name == NULL || instance_name[0] == '\0') {
@@ -144,13 +150,24 @@ fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
     }
     values_size = model->variable_count * sizeof(double);
     name_size = strlen(instance_name) + 1;
-    instance = (fmu_instance*)allocate(1, sizeof(fmu_instance) + values_size + name_size);
+    input_size = round_up(model->behaviour->input_size);
+    output_size = round_up(model->behaviour->output_size);
+    instance = (fmu_instance*)allocate(1, round_up(sizeof(fmu_instance)) + values_size +
+                                              2 * input_size + 3 * output_size + name_size);
     if (instance == NULL) {
         log_to(&logger, FMU_ERROR, "instantiate: out of memory");
         return NULL;
     }
-    instance->values = (double*)(instance + 1);
-    name = (char*)(instance->values + model->variable_count);
+    block = (char*)instance + round_up(sizeof(fmu_instance));
+    instance->values = (double*)(void*)block;
+    block += values_size;
+    instance->input = block;
+    instance->seed = block + input_size;
+    block += 2 * input_size;
+    instance->output = block;
+    instance->value = block + output_size;
+    instance->rate = block + 2 * output_size;
+    name = block + 3 * output_size;
     memcpy(name, instance_name, name_size);
 
     instance->model = model;
@@ -230,55 +247,27 @@ fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time)
 
 /* ---- the solve ----------------------------------------------------------- */
 
-static const fmu_variable* variable_of_field(const fmu_model* model, dyad_field field)
-{
-    size_t k;
-    for (k = 0; k < model->variable_count; ++k) {
-        if (model->variables[k].causality != FMU_OUTPUT && model->variables[k].field == field) {
-            return &model->variables[k];
-        }
-    }
-    return NULL;
-}
-
-/* Solves if an input changed since the last solve. Returns FMU_OK, FMU_ERROR
- * for inputs the solver rejects, or `not_solvable` for a singular or
- * overflowing configuration; each failure is logged once per solve. */
+/* Evaluates if an input changed since the last evaluation. Returns FMU_OK,
+ * FMU_ERROR for inputs the model rejects, or `not_solvable` where the model has
+ * no answer (a singular dyad); each failure is logged once per evaluation. */
 static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const char* function)
 {
-    const dyad_result* r = &instance->result;
+    fmu_evaluation* e = &instance->evaluation;
     if (instance->dirty) {
-        instance->model->solve(&instance->input, &instance->result);
+        instance->model->behaviour->evaluate(instance->model, instance->input, instance->output,
+                                             e);
         instance->dirty = 0;
-        switch (r->status) {
-        case DYAD_STATUS_OK: break;
-        case DYAD_STATUS_SINGULAR:
-            fmu_log(instance, not_solvable,
-                    "%s: singular configuration at t = %g s: conditioning %.3g is below "
-                    "singular_threshold %.3g; the dyad cannot carry its load, reactions are NaN",
-                    function, instance->time, (double)r->conditioning,
-                    (double)instance->input.singular_threshold);
-            break;
-        case DYAD_STATUS_OUT_OF_RANGE:
-            fmu_log(instance, not_solvable,
-                    "%s: at t = %g s the loads or reactions overflow double; reactions are NaN",
-                    function, instance->time);
-            break;
-        case DYAD_STATUS_INVALID_INPUT: {
-            const fmu_variable* v = variable_of_field(instance->model, r->field);
-            fmu_log(instance, FMU_ERROR, "%s: %s = %g is not valid for this dyad (%s)", function,
-                    v != NULL ? v->name : dyad_field_name(r->field),
-                    v != NULL ? instance->values[v - instance->model->variables] : NAN,
-                    dyad_field_name(r->field));
-            break;
-        }
+        if (e->status == FMU_ERROR && e->bad_variable >= 0) {
+            fmu_log(instance, FMU_ERROR, "%s: %s = %g: %s", function,
+                    instance->model->variables[e->bad_variable].name,
+                    instance->values[e->bad_variable], e->reason);
+        } else if (e->status != FMU_OK) {
+            fmu_log(instance, e->status == FMU_ERROR ? FMU_ERROR : not_solvable,
+                    "%s: at t = %g s: %s", function, instance->time, e->reason);
         }
     }
-    switch (r->status) {
-    case DYAD_STATUS_OK: return FMU_OK;
-    case DYAD_STATUS_INVALID_INPUT: return FMU_ERROR;
-    case DYAD_STATUS_SINGULAR:
-    case DYAD_STATUS_OUT_OF_RANGE: break;
+    if (e->status == FMU_OK || e->status == FMU_ERROR) {
+        return e->status;
     }
     return not_solvable;
 }
@@ -473,7 +462,7 @@ static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], si
 static double read_variable(fmu_instance* instance, const fmu_variable* v, fmu_status* worst,
                             const char* function)
 {
-    const char* member = (const char*)&instance->result + v->offset;
+    const char* member = (const char*)instance->output + v->offset;
     fmu_status status;
     if (v->causality != FMU_OUTPUT) {
         return instance->values[v - instance->model->variables];
@@ -483,9 +472,9 @@ static double read_variable(fmu_instance* instance, const fmu_variable* v, fmu_s
         *worst = status;
     }
     if (v->target == FMU_TARGET_RESULT_STATUS) {
-        return (double)instance->result.status;
+        return (double)*(const int*)(const void*)member;
     }
-    return (double)*(const dyad_real*)(const void*)member;
+    return *(const double*)(const void*)member;
 }
 
 /* Returns the worst status of the solves behind the outputs read. */
@@ -539,19 +528,22 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
                                       size_t n_knowns, const double seed[], double derivative[],
                                       const char* function)
 {
-    static const dyad_input zero;
-    const dyad_input* input = &instance->input;
-    dyad_input rates = zero;
-    dyad_result value, rate;
+    const fmu_behaviour* behaviour;
+    fmu_evaluation evaluation;
     size_t k;
     fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
     if (status != FMU_OK || check_arrays(instance, knowns, n_knowns, seed, function) != FMU_OK ||
         check_arrays(instance, unknowns, n_unknowns, derivative, function) != FMU_OK) {
         return FMU_ERROR;
     }
+    behaviour = instance->model->behaviour;
+    if (behaviour->derivative == NULL) {
+        return fmu_unsupported(instance, function, "this model has no directional derivatives");
+    }
+    memset(instance->seed, 0, behaviour->input_size);
     for (k = 0; k < n_knowns; ++k) {
         const fmu_variable* v = lookup(instance, knowns[k], FMU_REAL, function);
-        char* member;
+        double* rate;
         if (v == NULL) {
             return FMU_ERROR;
         }
@@ -559,15 +551,15 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
             fmu_log(instance, FMU_ERROR, "%s: known %s is not an input", function, v->name);
             return FMU_ERROR;
         }
-        member = (char*)&rates + v->offset;
+        rate = (double*)(void*)((char*)instance->seed + v->offset);
         if (v->target == FMU_TARGET_INPUT_ANGLE) {
             /* d(cos, sin)/d angle = (-sin, cos) */
-            const dyad_vec2 dir = *(const dyad_vec2*)(const void*)((const char*)input + v->offset);
-            dyad_vec2* d = (dyad_vec2*)(void*)member;
-            d->x -= (dyad_real)(seed[k] * dir.y);
-            d->y += (dyad_real)(seed[k] * dir.x);
+            const double* dir = (const double*)(const void*)((const char*)instance->input +
+                                                             v->offset);
+            rate[0] -= seed[k] * dir[1];
+            rate[1] += seed[k] * dir[0];
         } else {
-            *(dyad_real*)(void*)member += (dyad_real)seed[k];
+            rate[0] += seed[k];
         }
     }
     for (k = 0; k < n_unknowns; ++k) {
@@ -580,10 +572,11 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
             return FMU_ERROR;
         }
     }
-    if (dyad_solve_tangent_with(instance->model->solve, instance->model->type, input, &rates,
-                                &value, &rate) != DYAD_STATUS_OK) {
-        fmu_log(instance, FMU_DISCARD, "%s: no derivative where the reactions are not defined "
-                "(%s)", function, dyad_status_name(value.status));
+    behaviour->derivative(instance->model, instance->input, instance->seed, instance->value,
+                          instance->rate, &evaluation);
+    if (evaluation.status != FMU_OK) {
+        fmu_log(instance, FMU_DISCARD, "%s: no derivative where the outputs are not defined: %s",
+                function, evaluation.reason);
         for (k = 0; k < n_unknowns; ++k) {
             derivative[k] = NAN;
         }
@@ -592,7 +585,7 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
     for (k = 0; k < n_unknowns; ++k) {
         const short index = instance->model->index_of_vr[unknowns[k]];
         const fmu_variable* v = &instance->model->variables[index];
-        derivative[k] = (double)*(const dyad_real*)(const void*)((const char*)&rate + v->offset);
+        derivative[k] = *(const double*)(const void*)((const char*)instance->rate + v->offset);
     }
     return FMU_OK;
 }

@@ -12,15 +12,6 @@
 
 #include "fmu_model.h"
 
-/* Same numbering as fmi2Status and fmi3Status. */
-typedef enum fmu_status {
-    FMU_OK = 0,
-    FMU_WARNING = 1,
-    FMU_DISCARD = 2,
-    FMU_ERROR = 3,
-    FMU_FATAL = 4
-} fmu_status;
-
 /* The states of the co-simulation state machine, as bits so that each entry
  * point can name the states it may be called in with one mask. */
 typedef enum fmu_state {
@@ -72,10 +63,17 @@ typedef struct fmu_instance {
     double time;             /* communication point reached (s) */
     double last_successful_time;
     int terminate_requested; /* set when a step cannot be completed */
-    int dirty;               /* inputs changed since the last solve */
-    dyad_input input;        /* the solver's input, kept up to date by every set */
-    dyad_result result;
+    int dirty;               /* inputs changed since the last evaluation */
+    fmu_evaluation evaluation; /* of the last evaluation */
     double* values;          /* one per variable, as set; outputs unused */
+    /* The model's blocks (see fmu_behaviour), in the instance's own memory:
+     * input kept up to date by every set, output of the last evaluation, and
+     * scratch for directional derivatives. */
+    void* input;
+    void* output;
+    void* seed;
+    void* rate;
+    void* value;
 } fmu_instance;
 
 /* Log categories declared in the model descriptions, in bit order. */

@@ -9,6 +9,15 @@
 
 #include "dyadfmu/dyad.h"
 
+/* Same numbering as fmi2Status and fmi3Status. */
+typedef enum fmu_status {
+    FMU_OK = 0,
+    FMU_WARNING = 1,
+    FMU_DISCARD = 2,
+    FMU_ERROR = 3,
+    FMU_FATAL = 4
+} fmu_status;
+
 typedef enum fmu_causality {
     FMU_PARAMETER = 0, /* fixed: settable until initialization ends */
     FMU_INPUT,         /* continuous input: settable at any time */
@@ -20,12 +29,14 @@ typedef enum fmu_value_type {
     FMU_INTEGER   /* fmi2Integer / fmi3Int32 */
 } fmu_value_type;
 
-/* Where a variable's value lives in the solver's structures. */
+/* Where a variable's value lives: in the model's input block (parameters and
+ * inputs) or its output block, both structs of the model's behaviour (for a
+ * dyad: dyad_input and dyad_result). */
 typedef enum fmu_target {
-    FMU_TARGET_INPUT_REAL = 0, /* the dyad_real at `offset` in dyad_input */
-    FMU_TARGET_INPUT_ANGLE,    /* the dyad_vec2 at `offset` in dyad_input, set to (cos, sin) */
-    FMU_TARGET_RESULT_REAL,    /* the dyad_real at `offset` in dyad_result */
-    FMU_TARGET_RESULT_STATUS   /* dyad_result.status, as an integer */
+    FMU_TARGET_INPUT_REAL = 0, /* the double at `offset` in the input block */
+    FMU_TARGET_INPUT_ANGLE,    /* the two doubles at `offset` in the input block: (cos, sin) */
+    FMU_TARGET_RESULT_REAL,    /* the double at `offset` in the output block */
+    FMU_TARGET_RESULT_STATUS   /* the int (enum) at `offset` in the output block */
 } fmu_target;
 
 /* Bits of fmu_variable.bounds. */
@@ -50,15 +61,41 @@ typedef struct fmu_variable {
     dyad_field field;       /* the core's input field it feeds (inputs, parameters) */
 } fmu_variable;
 
+struct fmu_model;
+
+/* How an evaluation went: FMU_OK; FMU_DISCARD where the model has no answer
+ * for these inputs (outputs NaN, e.g. a singular dyad); FMU_ERROR for an input
+ * the model rejects, naming the variable. `reason` is logged. */
+typedef struct fmu_evaluation {
+    fmu_status status;
+    int bad_variable;       /* index of the variable to blame, or -1 */
+    char reason[200];
+} fmu_evaluation;
+
+/* What a kind of model computes, on its own input and output blocks. */
+typedef struct fmu_behaviour {
+    size_t input_size;      /* bytes of the input block */
+    size_t output_size;     /* bytes of the output block */
+    /* The input block before any start value is applied. */
+    void (*initialise)(const struct fmu_model* model, void* input);
+    /* The outputs for the inputs. */
+    void (*evaluate)(const struct fmu_model* model, const void* input, void* output,
+                     fmu_evaluation* evaluation);
+    /* Exact directional derivative of the outputs along `seed` (an input block of
+     * rates; an angle's rate as the derivative of its (cos, sin)). NULL: none. */
+    void (*derivative)(const struct fmu_model* model, const void* input, const void* seed,
+                       void* output, void* rate, fmu_evaluation* evaluation);
+} fmu_behaviour;
+
 typedef struct fmu_model {
     const char* identifier; /* modelIdentifier, e.g. "dyad_rrt" */
     const char* token;      /* instantiation token (FMI 3) / GUID (FMI 2) */
-    dyad_type type;
-    dyad_solver solve;      /* this type's solver: the FMU links no other */
     const fmu_variable* variables;
     size_t variable_count;
     const short* index_of_vr; /* variable index for each vr < vr_limit, -1 where none */
     unsigned int vr_limit;
+    const fmu_behaviour* behaviour;
+    const void* data;       /* the behaviour's model data (a dyad: fmu_dyad_data) */
 } fmu_model;
 
 /* The model compiled into this FMU, defined by the generated <model>_model.c. */

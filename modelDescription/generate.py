@@ -624,7 +624,8 @@ def _element(indent: int, tag: str, attributes: list[tuple[str, object]], close=
 
 
 def source_files(table: Table, fmi_functions: str) -> list[str]:
-    return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "dyad_tangent.c", "fmu_instance.c",
+    return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
+            "fmu_instance.c",
             fmi_functions, f"{table.identifier}_model.c"]
 
 
@@ -827,7 +828,7 @@ def model_c(table: Table) -> str:
         " * generated from the same table, with the same instantiation token. */",
         "#include <stddef.h>",
         "",
-        '#include "fmu_model.h"',
+        '#include "fmu_dyad.h"',
         "",
         "static const fmu_variable variables[] = {",
         "    /* vr, name, unit, causality, type, target, offset,",
@@ -855,11 +856,13 @@ def model_c(table: Table) -> str:
         lines.append("    " + ", ".join(str(i) for i in index_of[start:start + 12]) + ",")
     lines.append("};")
     lines.append("")
+    lines.append(f"static const fmu_dyad_data dyad = {{DYAD_{table.type}, "
+                 f"dyad_solve_{table.type.lower()}}};")
+    lines.append("")
     lines.append(f"const fmu_model fmu_this_model = {{{_c_string(table.identifier)}, "
                  f"{_c_string(table.token)},")
-    lines.append(f"                                  DYAD_{table.type}, "
-                 f"dyad_solve_{table.type.lower()}, variables, "
-                 f"{len(table.variables)}, index_of_vr, {vr_limit}}};")
+    lines.append(f"                                  variables, {len(table.variables)}, "
+                 f"index_of_vr, {vr_limit}, &fmu_dyad_behaviour, &dyad}};")
     return "\n".join(lines) + "\n"
 
 

@@ -16,7 +16,7 @@
 
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
-#include "fmu_model.h"
+#include "fmu_dyad.h"
 #include "named_tests.h"
 
 /* ---- the importer's side: a logger that keeps the last message ---------------- */
@@ -199,7 +199,7 @@ static dyad_result core_result(const unsigned vrs[], const double values[], size
             *(double*)(void*)member = value;
         }
     }
-    fmu_this_model.solve(&in, &out);
+    ((const fmu_dyad_data*)fmu_this_model.data)->solve(&in, &out);
     return out;
 }
 

@@ -381,7 +381,8 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
         (config,) = md.buildConfigurations
         assert config.modelIdentifier == ident
         assert config.sourceFileSets[0].sourceFiles == [
-            "dyad_common.c", f"dyad_{dyad_type.lower()}.c", "dyad_tangent.c", "fmu_instance.c",
+            "dyad_common.c", f"dyad_{dyad_type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
+            "fmu_instance.c",
             shim,
             f"{ident}_model.c"]
         units = {u.name: u.baseUnit for u in md.unitDefinitions}
@@ -500,7 +501,7 @@ def test_c_table_matches_the_table(generated, dyad_type):
         if v["name"] == "status":
             assert (target, offset) == ("FMU_TARGET_RESULT_STATUS", "0")
     vr_limit = len(raw["variable"]) + 1
-    assert re.search(rf"index_of_vr, {vr_limit}\}};", c_text)
+    assert re.search(rf"index_of_vr, {vr_limit}, &fmu_dyad_behaviour, &dyad\}};", c_text)
     assert re.search(r"index_of_vr\[\d+\] = \{\s*-1, 0, 1, 2,", c_text)
 
 

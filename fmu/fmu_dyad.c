@@ -1,0 +1,74 @@
+/* dyadfmu FMU layer: a dyad as an FMU model (see fmu_dyad.h). */
+#include "fmu_dyad.h"
+
+#include <stdio.h>
+
+/* The variables' offsets address doubles: the FMUs use the double core. */
+typedef char fmu_dyad_real_is_double[sizeof(dyad_real) == sizeof(double) ? 1 : -1];
+
+static int variable_of_field(const fmu_model* model, dyad_field field)
+{
+    size_t k;
+    for (k = 0; k < model->variable_count; ++k) {
+        if (model->variables[k].causality != FMU_OUTPUT && model->variables[k].field == field) {
+            return (int)k;
+        }
+    }
+    return -1;
+}
+
+static void report(const fmu_model* model, const dyad_input* input, const dyad_result* result,
+                   fmu_evaluation* evaluation)
+{
+    evaluation->bad_variable = -1;
+    evaluation->reason[0] = '\0';
+    switch (result->status) {
+    case DYAD_STATUS_OK:
+        evaluation->status = FMU_OK;
+        break;
+    case DYAD_STATUS_SINGULAR:
+        evaluation->status = FMU_DISCARD;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "singular configuration: conditioning %.3g is below singular_threshold %.3g; "
+                 "the dyad cannot carry its load, reactions are NaN",
+                 (double)result->conditioning, (double)input->singular_threshold);
+        break;
+    case DYAD_STATUS_OUT_OF_RANGE:
+        evaluation->status = FMU_DISCARD;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "the loads or reactions overflow double; reactions are NaN");
+        break;
+    case DYAD_STATUS_INVALID_INPUT:
+        evaluation->status = FMU_ERROR;
+        evaluation->bad_variable = variable_of_field(model, result->field);
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "not valid for this dyad (%s)", dyad_field_name(result->field));
+        break;
+    }
+}
+
+static void initialise(const fmu_model* model, void* input)
+{
+    (void)model;
+    *(dyad_input*)input = dyad_input_default();
+}
+
+static void evaluate(const fmu_model* model, const void* input, void* output,
+                     fmu_evaluation* evaluation)
+{
+    const fmu_dyad_data* dyad = (const fmu_dyad_data*)model->data;
+    dyad->solve((const dyad_input*)input, (dyad_result*)output);
+    report(model, (const dyad_input*)input, (const dyad_result*)output, evaluation);
+}
+
+static void derivative(const fmu_model* model, const void* input, const void* seed, void* output,
+                       void* rate, fmu_evaluation* evaluation)
+{
+    const fmu_dyad_data* dyad = (const fmu_dyad_data*)model->data;
+    dyad_solve_tangent_with(dyad->solve, dyad->type, (const dyad_input*)input,
+                            (const dyad_input*)seed, (dyad_result*)output, (dyad_result*)rate);
+    report(model, (const dyad_input*)input, (const dyad_result*)output, evaluation);
+}
+
+const fmu_behaviour fmu_dyad_behaviour = {sizeof(dyad_input), sizeof(dyad_result), initialise,
+                                          evaluate, derivative};
