@@ -293,6 +293,10 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
     if (status != FMU_OK) {
         return status;
     }
+    if (instance->model->behaviour->start != NULL) {
+        instance->model->behaviour->start(instance->model, instance->input);
+        instance->dirty = 1;
+    }
     status = solve(instance, FMU_WARNING, "exitInitializationMode");
     if (status != FMU_ERROR) {
         instance->state = FMU_STATE_STEP;
@@ -315,6 +319,32 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
         return FMU_ERROR;
     }
     instance->time = current_time;
+    if (instance->model->behaviour->advance != NULL) {
+        /* A model with states: the outputs at the end of the step. */
+        status = solve(instance, FMU_DISCARD, function);
+        if (status == FMU_OK) {
+            fmu_evaluation* e = &instance->evaluation;
+            instance->model->behaviour->advance(instance->model, instance->input, step_size, e);
+            instance->dirty = 1;
+            if (e->status != FMU_OK) {
+                fmu_log(instance, FMU_DISCARD, "%s: at t = %g s: %s", function, current_time,
+                        e->reason);
+                instance->last_successful_time = current_time;
+                instance->terminate_requested = 1;
+                return FMU_DISCARD;
+            }
+            instance->time = current_time + step_size;
+            status = solve(instance, FMU_DISCARD, function);
+            if (status == FMU_OK) {
+                instance->last_successful_time = instance->time;
+                instance->terminate_requested = 0;
+                return FMU_OK;
+            }
+        }
+        instance->last_successful_time = current_time;
+        instance->terminate_requested = status == FMU_DISCARD;
+        return status;
+    }
     status = solve(instance, FMU_DISCARD, function);
     if (status == FMU_OK) {
         instance->time = current_time + step_size;

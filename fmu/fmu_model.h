@@ -81,6 +81,12 @@ typedef struct fmu_behaviour {
     /* The outputs for the inputs. */
     void (*evaluate)(const struct fmu_model* model, const void* input, void* output,
                      fmu_evaluation* evaluation);
+    /* A model with states: sets them from their start parameters when
+     * initialization ends, and advances them over a communication step of h
+     * seconds with the inputs held. NULL for an algebraic model. */
+    void (*start)(const struct fmu_model* model, void* input);
+    void (*advance)(const struct fmu_model* model, void* input, double h,
+                    fmu_evaluation* evaluation);
     /* Exact directional derivative of the outputs along `seed` (an input block of
      * rates; an angle's rate as the derivative of its (cos, sin)). NULL: none. */
     void (*derivative)(const struct fmu_model* model, const void* input, const void* seed,

@@ -1,0 +1,158 @@
+/* dyadfmu FMU layer: the crank drive (see fmu_drive.h).
+ *
+ * The crank turns about the fixed pivot O at angle phi and speed omega:
+ *
+ *     (J + J_load) eps = T_m(omega) + tau_load + (r_c x m_c g),
+ *     T_m(omega) = T_stall (1 - omega / omega_0),
+ *
+ * with J the rotor's and crank's inertia about O, r_c the crank's centre of
+ * mass turned by phi, tau_load the mechanism's torque on the crank at zero
+ * acceleration and J_load the inertia it adds (its torque is tau_load -
+ * J_load eps; a co-simulation master that knows the mechanism's sensitivity
+ * passes it so that the loop closes inside the step).
+ *
+ * Integrator: the classical 4th-order Runge-Kutta method, with the inputs held
+ * over the communication step and as many equal substeps as keep each below a
+ * fifth of the motor's mechanical time constant (J + J_load) omega_0 / T_stall
+ * and below 0.02 rad of crank turn. The state has two components and is smooth
+ * (gravity is a sine of phi), so an explicit method of high order is both
+ * accurate and cheap once the substep resolves the one stiff scale, the
+ * motor's damping; it needs no Newton iteration, and its result does not
+ * depend on anything but the step, which keeps co-simulation reproducible.
+ */
+#include "fmu_drive.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Variable indices are those of the generated table, found by name. */
+static int variable_named(const fmu_model* model, const char* name)
+{
+    size_t k;
+    for (k = 0; k < model->variable_count; ++k) {
+        if (strcmp(model->variables[k].name, name) == 0) {
+            return (int)k;
+        }
+    }
+    return -1;
+}
+
+static double total_inertia(const fmu_drive_input* in)
+{
+    return in->inertia + in->load_inertia;
+}
+
+static double motor_torque(const fmu_drive_input* in, double speed)
+{
+    return in->stall_torque * (1 - speed / in->no_load_speed);
+}
+
+static double acceleration(const fmu_drive_input* in, double angle, double speed)
+{
+    const double c = cos(angle), s = sin(angle);
+    const double rx = c * in->crank_com_x - s * in->crank_com_y;
+    const double ry = s * in->crank_com_x + c * in->crank_com_y;
+    const double gravity = in->crank_mass * (rx * in->gravity_y - ry * in->gravity_x);
+    return (motor_torque(in, speed) + in->load_torque + gravity) / total_inertia(in);
+}
+
+static void initialise(const fmu_model* model, void* input)
+{
+    static const fmu_drive_input zero;
+    (void)model;
+    *(fmu_drive_input*)input = zero;
+}
+
+static void start(const fmu_model* model, void* input)
+{
+    fmu_drive_input* in = (fmu_drive_input*)input;
+    (void)model;
+    in->angle = in->start_angle;
+    in->speed = in->start_speed;
+}
+
+/* The loaded inertia must stay positive: the parameters' bounds guarantee
+ * J > 0, but J_load is an input that a master computes. */
+static int check(const fmu_model* model, const fmu_drive_input* in, fmu_evaluation* e)
+{
+    if (!(total_inertia(in) > 0)) {
+        e->status = FMU_ERROR;
+        e->bad_variable = variable_named(model, "load.inertia");
+        snprintf(e->reason, sizeof e->reason,
+                 "inertia + load.inertia = %g kg.m2 must be positive", total_inertia(in));
+        return 0;
+    }
+    return 1;
+}
+
+static void evaluate(const fmu_model* model, const void* input, void* output,
+                     fmu_evaluation* evaluation)
+{
+    const fmu_drive_input* in = (const fmu_drive_input*)input;
+    fmu_drive_output* out = (fmu_drive_output*)output;
+    evaluation->status = FMU_OK;
+    evaluation->bad_variable = -1;
+    evaluation->reason[0] = '\0';
+    out->angle = in->angle;
+    out->speed = in->speed;
+    out->motor_torque = motor_torque(in, in->speed);
+    out->status = 0;
+    if (!check(model, in, evaluation)) {
+        out->acceleration = out->motor_torque = (double)NAN;
+        out->status = 2;
+        return;
+    }
+    out->acceleration = acceleration(in, in->angle, in->speed);
+}
+
+static void advance(const fmu_model* model, void* input, double h, fmu_evaluation* evaluation)
+{
+    fmu_drive_input* in = (fmu_drive_input*)input;
+    const double time_constant = total_inertia(in) * in->no_load_speed / in->stall_torque;
+    const double turn = fabs(in->speed) > 0 ? 0.02 / fabs(in->speed) : h;
+    double limit = 0.2 * time_constant < turn ? 0.2 * time_constant : turn;
+    double angle = in->angle, speed = in->speed, dt;
+    long substeps, k;
+
+    evaluation->status = FMU_OK;
+    evaluation->bad_variable = -1;
+    evaluation->reason[0] = '\0';
+    if (!check(model, in, evaluation)) {
+        return;
+    }
+    if (!(limit > 0) || limit > h) {
+        limit = h;
+    }
+    substeps = (long)ceil(h / limit);
+    if (substeps > 10000000L) {
+        evaluation->status = FMU_DISCARD;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "the step of %g s needs more than 1e7 substeps (speed %g rad/s)", h, speed);
+        return;
+    }
+    dt = h / (double)substeps;
+    for (k = 0; k < substeps; ++k) {
+        const double a1 = acceleration(in, angle, speed);
+        const double w2 = speed + 0.5 * dt * a1;
+        const double a2 = acceleration(in, angle + 0.5 * dt * speed, w2);
+        const double w3 = speed + 0.5 * dt * a2;
+        const double a3 = acceleration(in, angle + 0.5 * dt * w2, w3);
+        const double w4 = speed + dt * a3;
+        const double a4 = acceleration(in, angle + dt * w3, w4);
+        angle += dt / 6 * (speed + 2 * w2 + 2 * w3 + w4);
+        speed += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
+    }
+    if (!isfinite(angle) || !isfinite(speed)) {
+        evaluation->status = FMU_DISCARD;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "the crank's state is no longer finite (angle %g rad, speed %g rad/s)", angle,
+                 speed);
+        return;
+    }
+    in->angle = angle;
+    in->speed = speed;
+}
+
+const fmu_behaviour fmu_drive_behaviour = {sizeof(fmu_drive_input), sizeof(fmu_drive_output),
+                                           initialise, evaluate, start, advance, NULL};
