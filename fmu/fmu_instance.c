@@ -548,9 +548,23 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
 fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
                            int values[], const char* function)
 {
-    const fmu_status worst = get_values(instance, vr, count, values, FMU_INTEGER, function);
-    /* The status output itself reports a singular configuration: no warning. */
-    return worst == FMU_ERROR ? FMU_ERROR : FMU_OK;
+    fmu_status ignored = FMU_OK;
+    size_t k;
+    fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
+    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = lookup(instance, vr[k], FMU_INTEGER, function);
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        /* The status output is how the model reports a singular configuration or
+         * a rejected input (already logged when it was evaluated): reading it
+         * succeeds whatever it says. */
+        values[k] = (int)read_variable(instance, v, &ignored, function);
+    }
+    return FMU_OK;
 }
 
 fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int unknowns[],
