@@ -117,6 +117,9 @@ static void load_start_values(fmu_instance* instance)
     for (k = 0; k < instance->model->variable_count; ++k) {
         store(instance, k, instance->model->variables[k].start);
     }
+    if (instance->model->behaviour->start != NULL) {
+        instance->model->behaviour->start(instance->model, instance->input);
+    }
     instance->state = FMU_STATE_INSTANTIATED;
     instance->time = 0;
     instance->last_successful_time = 0;
@@ -292,10 +295,6 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
         fmu_check_call(instance, FMU_OP_EXIT_INITIALIZATION, "exitInitializationMode");
     if (status != FMU_OK) {
         return status;
-    }
-    if (instance->model->behaviour->start != NULL) {
-        instance->model->behaviour->start(instance->model, instance->input);
-        instance->dirty = 1;
     }
     status = solve(instance, FMU_WARNING, "exitInitializationMode");
     if (status != FMU_ERROR) {
@@ -483,6 +482,11 @@ static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], si
     }
     if (count > 0) {
         instance->dirty = 1;
+        /* Until initialization ends, the states follow their start parameters. */
+        if (instance->model->behaviour->start != NULL &&
+            ((unsigned)instance->state & PARAMETER_STATES)) {
+            instance->model->behaviour->start(instance->model, instance->input);
+        }
     }
     return FMU_OK;
 }

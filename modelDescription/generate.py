@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Generate everything an FMU of one dyad type needs from its variable table.
+"""Generate everything an FMU of one model needs from its variable table.
 
 The table ``modelDescription/<identifier>.toml`` is the single source of truth
-for the interface of one dyad FMU: names, value references, causalities, units,
-start values, bounds, descriptions, where each value lives in the solver's
+for the interface of one FMU: names, value references, causalities, units,
+start values, bounds, descriptions, where each value lives in the model's
 structures and which inputs each output depends on. From it this script writes
 
     DIR/fmi2/modelDescription.xml      the FMI 2.0 model description
@@ -19,6 +19,15 @@ Usage:
 
 The table is validated first; every problem is reported with the file and the
 variable it concerns, and nothing is written unless the table is valid.
+
+Two kinds of model (``kind`` in ``[model]``):
+
+    dyad    (the default) the kinetostatic solver of one Assur dyad, whose ``type``
+            (RRR, RRT, RTR, TRT, RTT) fixes its variables; it lives in dyad_input
+            and dyad_result (src/include/dyadfmu/types.h), behaviour fmu_dyad.c.
+    drive   the crank drive, a DC motor with states (crank angle and speed)
+            integrated inside doStep; no ``type``; it lives in fmu_drive_input and
+            fmu_drive_output (fmu/fmu_drive.h), behaviour fmu_drive.c.
 
 Value references start at 1: in FMI 3 the value reference 0 is the
 independent variable `time`, which the FMI 3 description declares and the FMI 3
@@ -46,7 +55,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 GOLDEN_DIR = HERE / "golden"
-TABLES = ("dyad_rrr.toml", "dyad_rrt.toml", "dyad_rtr.toml", "dyad_trt.toml", "dyad_rtt.toml")
+TABLES = ("dyad_rrr.toml", "dyad_rrt.toml", "dyad_rtr.toml", "dyad_trt.toml", "dyad_rtt.toml",
+          "drive.toml")
 GENERATION_TOOL = "dyadfmu generate.py"
 
 # ---------------------------------------------------------------------------
@@ -98,12 +108,23 @@ LOG_CATEGORIES = (
      "(reaction outputs NaN)"),
     ("logCalls", "Calls into the FMU"),
 )
+#: The same categories (fmu_instance.c knows them by name) as the drive uses them.
+DRIVE_LOG_CATEGORIES = (
+    ("logStatusError", "Errors: illegal call sequences, bad arguments, inputs the model "
+     "rejects (the offending variable is named, e.g. load.inertia when inertia + "
+     "load.inertia is not positive)"),
+    ("logStatusWarning", "Warnings"),
+    ("logStatusDiscard", "Discarded steps: a step that would need more than 1e7 integrator "
+     "substeps, or a crank state that is no longer finite (the state stays at the step's "
+     "start)"),
+    ("logCalls", "Calls into the FMU"),
+)
 
 CAUSALITIES = ("input", "parameter", "output")
 VALUE_TYPES = ("Real", "Integer")
 VARIABLE_KEYS = {"name", "vr", "causality", "type", "unit", "start", "min", "max",
                  "min_exclusive", "max_exclusive", "description", "lives", "depends"}
-MODEL_KEYS = {"type", "identifier", "description"}
+MODEL_KEYS = {"kind", "type", "identifier", "description"}
 
 # Member trees of dyad_input and dyad_result (types.h). Leaves: "real" (a
 # dyad_real), "dir" (a unit dyad_vec2 set from an angle), "status", "enum".
@@ -124,7 +145,46 @@ _LINK_FIELD = {"dir": "DIR", "length": "LENGTH", "omega": "OMEGA", "epsilon": "E
                "accel_d": "ACCEL_D", "com": "COM", "mass": "MASS", "inertia": "INERTIA",
                "force": "FORCE", "moment": "MOMENT"}
 
+# Members of fmu_drive_input and fmu_drive_output (fmu/fmu_drive.h), in declaration
+# order. Leaves: "real" (a double), "state" (a double the model integrates itself,
+# which no variable may set), "status" (the int status).
+DRIVE_INPUT_MEMBERS = {
+    "load_torque": "real", "load_inertia": "real", "stall_torque": "real",
+    "no_load_speed": "real", "inertia": "real", "crank_mass": "real",
+    "crank_com_x": "real", "crank_com_y": "real", "gravity_x": "real", "gravity_y": "real",
+    "start_angle": "real", "start_speed": "real", "angle": "state", "speed": "state",
+}
+DRIVE_OUTPUT_MEMBERS = {
+    "angle": "real", "speed": "real", "acceleration": "real", "motor_torque": "real",
+    "status": "status",
+}
+
+#: The start parameter of each state of the drive.
+_DRIVE_STATE_START = {"angle": "start.angle", "speed": "start.speed"}
+
 LIVES_RE = re.compile(r"^(input|result)\.([a-z_][a-z0-9_]*(?:\.[a-z_][a-z0-9_]*)*)(@angle)?$")
+
+
+class Kind:
+    """A kind of model: the C structs its variables live in and the behaviour
+    that computes on them (fmu/fmu_model.h)."""
+
+    def __init__(self, name, input_type, output_type, input_members, output_members,
+                 header, behaviour):
+        self.name = name
+        self.input_type = input_type            # C type of the input block
+        self.output_type = output_type          # C type of the output block
+        self.input_members = input_members
+        self.output_members = output_members
+        self.header = header                    # the header declaring both and the behaviour
+        self.behaviour = behaviour              # the fmu_behaviour object
+
+
+DYAD = Kind("dyad", "dyad_input", "dyad_result", INPUT_MEMBERS, RESULT_MEMBERS,
+            "fmu_dyad.h", "fmu_dyad_behaviour")
+DRIVE = Kind("drive", "fmu_drive_input", "fmu_drive_output", DRIVE_INPUT_MEMBERS,
+             DRIVE_OUTPUT_MEMBERS, "fmu_drive.h", "fmu_drive_behaviour")
+KINDS = {"dyad": DYAD, "drive": DRIVE}
 
 
 class TableError(Exception):
@@ -134,13 +194,17 @@ class TableError(Exception):
 class Entry:
     """One variable a dyad type has: where it lives and what it must look like."""
 
-    def __init__(self, lives, name, causality, unit, value_type="Real", domain=None):
+    def __init__(self, lives, name, causality, unit, value_type="Real", domain=None,
+                 depends=None):
         self.lives = lives
         self.name = name
         self.causality = causality
         self.unit = unit
         self.value_type = value_type
         self.domain = domain or {}  # min, max, min_exclusive, max_exclusive
+        # An output's true dependencies (input names) where the generator knows them
+        # (the drive); None where a test derives them (the dyads).
+        self.depends = depends
 
 
 def catalogue(dyad_type: str) -> dict[str, Entry]:
@@ -222,16 +286,56 @@ def _absence_reason(dyad_type: str, lives: str) -> str:
     return f"the {pairs} dyad FMU has no variable for '{lives}'"
 
 
+def drive_catalogue() -> dict[str, Entry]:
+    """Every variable of the crank drive, keyed by `lives`, in the canonical order.
+
+    The outputs' dependencies are exact: the angle and speed are states at the
+    communication point, the motor torque a function of the speed alone, the
+    acceleration (J + J_load) eps = T_m(omega) + tau_load + r_c x m_c g depends on
+    both load inputs, and the status (valid while J + J_load > 0) on load.inertia."""
+    positive = {"min": 0.0, "min_exclusive": True}
+    entries = [
+        Entry("input.load_torque", "load.torque", "input", "N.m"),
+        Entry("input.load_inertia", "load.inertia", "input", "kg.m2"),
+        Entry("input.stall_torque", "motor.stall_torque", "parameter", "N.m", domain=positive),
+        Entry("input.no_load_speed", "motor.no_load_speed", "parameter", "rad/s",
+              domain=positive),
+        Entry("input.inertia", "inertia", "parameter", "kg.m2", domain=positive),
+        Entry("input.crank_mass", "crank.mass", "parameter", "kg", domain={"min": 0.0}),
+        Entry("input.crank_com_x", "crank.com.x", "parameter", "m"),
+        Entry("input.crank_com_y", "crank.com.y", "parameter", "m"),
+        Entry("input.gravity_x", "gravity.x", "parameter", "m/s2"),
+        Entry("input.gravity_y", "gravity.y", "parameter", "m/s2"),
+        Entry("input.start_angle", "start.angle", "parameter", "rad"),
+        Entry("input.start_speed", "start.speed", "parameter", "rad/s"),
+        Entry("result.angle", "crank.angle", "output", "rad", depends=()),
+        Entry("result.speed", "crank.omega", "output", "rad/s", depends=()),
+        Entry("result.acceleration", "crank.epsilon", "output", "rad/s2",
+              depends=("load.torque", "load.inertia")),
+        Entry("result.motor_torque", "motor.torque", "output", "N.m", depends=()),
+        Entry("result.status", "status", "output", None, value_type="Integer",
+              depends=("load.inertia",)),
+    ]
+    return {entry.lives: entry for entry in entries}
+
+
+def _drive_absence_reason(lives: str) -> str:
+    """Why a well-formed `lives` is not a variable of the drive."""
+    return f"the drive FMU has no variable for '{lives}'"
+
+
 # ---------------------------------------------------------------------------
 # `lives` grammar
 # ---------------------------------------------------------------------------
 class Lives:
-    """A parsed `lives`: struct ("input" | "result"), member path, angle flag."""
+    """A parsed `lives`: struct ("input" | "result"), member path, angle flag, and
+    the kind of model whose structs it names."""
 
-    def __init__(self, struct, path, angle):
+    def __init__(self, struct, path, angle, kind=DYAD):
         self.struct = struct
         self.path = path
         self.angle = angle
+        self.kind = kind
 
     @property
     def target(self):
@@ -241,13 +345,16 @@ class Lives:
 
     @property
     def offset(self):
+        kind = self.kind
         if self.struct == "result":
-            return "0" if self.path == "status" else f"offsetof(dyad_result, {self.path})"
-        return f"offsetof(dyad_input, {self.path})"
+            if kind is DYAD and self.path == "status":
+                return "0"  # dyad_result.status is its first member
+            return f"offsetof({kind.output_type}, {self.path})"
+        return f"offsetof({kind.input_type}, {self.path})"
 
     @property
     def field(self):
-        if self.struct == "result":
+        if self.struct == "result" or self.kind is not DYAD:
             return "DYAD_FIELD_NONE"
         parts = self.path.split(".")
         if parts[0] in ("m", "n"):
@@ -255,14 +362,20 @@ class Lives:
         return f"DYAD_FIELD_{parts[0].upper()}"
 
 
-def parse_lives(text) -> Lives:
-    """Parse and resolve a `lives` string; raises ValueError with the reason."""
+def parse_lives(text, kind: Kind = DYAD) -> Lives:
+    """Parse and resolve a `lives` string of a model of the given kind; raises
+    ValueError with the reason."""
     if not isinstance(text, str):
         raise ValueError("must be a string")
     match = LIVES_RE.match(text)
     if not match:
-        raise ValueError("expected 'input.<member path>[@angle]' or 'result.<member path>'")
+        if kind is DYAD:
+            raise ValueError("expected 'input.<member path>[@angle]' or 'result.<member path>'")
+        raise ValueError(f"expected 'input.<member of {kind.input_type}>' or "
+                         f"'result.<member of {kind.output_type}>'")
     struct, path, angle = match.group(1), match.group(2), bool(match.group(3))
+    if kind is not DYAD:
+        return _parse_flat_lives(kind, struct, path, angle)
     node = INPUT_MEMBERS if struct == "input" else RESULT_MEMBERS
     type_name = "dyad_input" if struct == "input" else "dyad_result"
     walked = []
@@ -287,13 +400,31 @@ def parse_lives(text) -> Lives:
     return Lives(struct, path, angle)
 
 
+def _parse_flat_lives(kind: Kind, struct: str, path: str, angle: bool) -> Lives:
+    """`lives` of a model whose structs have only scalar members (the drive)."""
+    members = kind.input_members if struct == "input" else kind.output_members
+    type_name = kind.input_type if struct == "input" else kind.output_type
+    if path not in members:
+        raise ValueError(f"{type_name} has no member '{path}' (members: "
+                         f"{', '.join(members)})")
+    if angle:
+        raise ValueError(f"'@angle' applies only to the directions of a dyad; "
+                         f"{type_name}.{path} is a plain double")
+    if members[path] == "state":
+        raise ValueError(f"{type_name}.{path} is a state of the {kind.name}: it is set from "
+                         f"'{_DRIVE_STATE_START[path]}' when initialization ends and advanced "
+                         f"by doStep, so no variable may set it (read it through "
+                         f"{kind.output_type}.{path})")
+    return Lives(struct, path, angle, kind)
+
+
 # ---------------------------------------------------------------------------
 # Loading and validating a table
 # ---------------------------------------------------------------------------
 class Variable:
     """One validated row of the table, with its index in file order."""
 
-    def __init__(self, raw: dict, index: int):
+    def __init__(self, raw: dict, index: int, kind: Kind = DYAD):
         self.raw = raw
         self.index = index
         self.name = raw["name"]
@@ -307,7 +438,7 @@ class Variable:
         self.min_exclusive = raw.get("min_exclusive", False)
         self.max_exclusive = raw.get("max_exclusive", False)
         self.description = raw["description"]
-        self.lives = parse_lives(raw["lives"])
+        self.lives = parse_lives(raw["lives"], kind)
         self.depends = list(raw.get("depends", []))
 
 
@@ -316,7 +447,8 @@ class Table:
         self.path = path
         self.model = model
         self.variables = variables
-        self.type = model["type"]
+        self.kind = KINDS[model.get("kind", "dyad")]
+        self.type = model.get("type")  # the dyad type; None for other kinds
         self.identifier = model["identifier"]
         self.description = model["description"]
         self.by_name = {v.name: v for v in variables}
@@ -358,10 +490,28 @@ def load_table(path: Path) -> Table:
         raise TableError([f"{fname}: missing [model] table"])
     for key in sorted(set(model) - MODEL_KEYS):
         fail(f"[model]: unknown key '{key}'")
+    kind_name = model.get("kind", "dyad")
+    if not isinstance(kind_name, str) or kind_name not in KINDS:
+        raise TableError(problems + [f"{fname}: [model]: kind {kind_name!r} is not one of "
+                                     f"{', '.join(KINDS)}"])
+    kind = KINDS[kind_name]
     dyad_type = model.get("type")
-    if dyad_type not in PAIRS:
-        raise TableError(problems + [f"{fname}: [model]: type {dyad_type!r} is not one of "
-                                     f"{', '.join(PAIRS)}"])
+    if kind is DYAD:
+        if dyad_type not in PAIRS:
+            raise TableError(problems + [f"{fname}: [model]: type {dyad_type!r} is not one of "
+                                         f"{', '.join(PAIRS)}"])
+        known = catalogue(dyad_type)
+        owner = f"{dyad_type} dyad"
+
+        def absence_reason(lives):
+            return _absence_reason(dyad_type, lives)
+    else:
+        if "type" in model:
+            fail(f"[model]: type {dyad_type!r} given, but only a dyad has a type "
+                 f"(this table is of kind '{kind.name}')")
+        known = drive_catalogue()
+        owner = kind.name
+        absence_reason = _drive_absence_reason
     identifier = model.get("identifier")
     if not isinstance(identifier, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", identifier):
         fail(f"[model]: identifier {identifier!r} must be a C identifier")
@@ -373,7 +523,6 @@ def load_table(path: Path) -> Table:
     if not isinstance(rows, list) or not rows:
         raise TableError(problems + [f"{fname}: no [[variable]] entries"])
 
-    known = catalogue(dyad_type)
     variables: list[Variable] = []
     seen_names: dict[str, int] = {}
     seen_vrs: dict[int, str] = {}
@@ -448,7 +597,7 @@ def load_table(path: Path) -> Table:
         # lives, and the catalogue of the type
         entry = None
         try:
-            lives = parse_lives(raw["lives"])
+            lives = parse_lives(raw["lives"], kind)
         except ValueError as exc:
             bad(f"bad lives {raw['lives']!r}: {exc}")
             lives = None
@@ -456,7 +605,7 @@ def load_table(path: Path) -> Table:
             key = raw["lives"]
             entry = known.get(key)
             if entry is None:
-                bad(f"lives {key!r}: {_absence_reason(dyad_type, key)}")
+                bad(f"lives {key!r}: {absence_reason(key)}")
             elif key in seen_lives:
                 bad(f"lives {key!r} is also the home of '{seen_lives[key]}'")
                 entry = None
@@ -466,7 +615,7 @@ def load_table(path: Path) -> Table:
             if causality is not None and causality != entry.causality:
                 bad(f"causality '{causality}' but {entry.lives} is "
                     f"{'an' if entry.causality[0] in 'aeiou' else 'a'} {entry.causality} "
-                    f"of the {dyad_type} dyad")
+                    f"of the {owner}")
             if isinstance(name, str) and name != entry.name:
                 bad(f"name does not match lives {entry.lives!r}: expected '{entry.name}'")
             if value_type is not None and value_type != entry.value_type:
@@ -534,7 +683,7 @@ def load_table(path: Path) -> Table:
                 f"{'an' if causality[0] in 'aeiou' else 'a'} {causality})")
 
         if not problems[count_before:]:
-            variables.append(Variable(raw, k))
+            variables.append(Variable(raw, k, kind))
 
     # cross-variable checks
     if not problems:
@@ -554,10 +703,16 @@ def load_table(path: Path) -> Table:
                 elif other.causality != "input":
                     fail(f"{label}: depends on '{dep}', which is {'an' if other.causality[0] in 'aeiou' else 'a'} "
                          f"{other.causality}, not an input")
+            entry = known[v.raw["lives"]]
+            if entry.depends is not None and set(v.depends) != set(entry.depends):
+                fail(f"{label}: depends {sorted(set(v.depends))} differ from the true "
+                     f"dependencies of {entry.lives}: {sorted(entry.depends)} "
+                     f"(missing {sorted(set(entry.depends) - set(v.depends))}, "
+                     f"extra {sorted(set(v.depends) - set(entry.depends))})")
         for lives, entry in known.items():
             if lives not in seen_lives:
                 fail(f"missing variable '{entry.name}' ({entry.causality}, lives {lives!r}): "
-                     f"every {dyad_type} dyad FMU has it")
+                     f"every {owner} FMU has it")
     if problems:
         raise TableError(problems)
     return Table(path, model, variables)
@@ -624,9 +779,16 @@ def _element(indent: int, tag: str, attributes: list[tuple[str, object]], close=
 
 
 def source_files(table: Table, fmi_functions: str) -> list[str]:
+    if table.kind is DRIVE:
+        return ["fmu_drive.c", "fmu_instance.c", fmi_functions, f"{table.identifier}_model.c"]
     return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
             "fmu_instance.c",
             fmi_functions, f"{table.identifier}_model.c"]
+
+
+def _provides_directional_derivatives(table: Table) -> str:
+    """The dyads differentiate their solve exactly; the drive has no derivative."""
+    return "true" if table.kind is DYAD else "false"
 
 
 def _used_units(table: Table) -> list[str]:
@@ -646,8 +808,9 @@ def _unit_definitions(table: Table) -> list[str]:
 
 
 def _common_tail(table: Table) -> list[str]:
+    categories = LOG_CATEGORIES if table.kind is DYAD else DRIVE_LOG_CATEGORIES
     lines = ["  <LogCategories>"]
-    lines += [_element(2, "Category", [("name", n), ("description", d)]) for n, d in LOG_CATEGORIES]
+    lines += [_element(2, "Category", [("name", n), ("description", d)]) for n, d in categories]
     lines.append("  </LogCategories>")
     lines.append('  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>')
     return lines
@@ -679,7 +842,8 @@ def fmi2_model_description(table: Table) -> str:
         ("canBeInstantiatedOnlyOncePerProcess", "false"),
         ("canGetAndSetFMUstate", "false"),
         ("canSerializeFMUstate", "false"),
-        ("providesDirectionalDerivative", "true")], close=False, wrap=True))
+        ("providesDirectionalDerivative", _provides_directional_derivatives(table))],
+        close=False, wrap=True))
     lines.append("    <SourceFiles>")
     lines += [_element(3, "File", [("name", f)]) for f in source_files(table, "fmi2_functions.c")]
     lines.append("    </SourceFiles>")
@@ -739,7 +903,7 @@ def fmi3_model_description(table: Table) -> str:
         ("canBeInstantiatedOnlyOncePerProcess", "false"),
         ("canGetAndSetFMUState", "false"),
         ("canSerializeFMUState", "false"),
-        ("providesDirectionalDerivatives", "true"),
+        ("providesDirectionalDerivatives", _provides_directional_derivatives(table)),
         ("hasEventMode", "false"),
         ("canReturnEarlyAfterIntermediateUpdate", "false"),
         ("providesIntermediateUpdate", "false")], wrap=True))
@@ -821,14 +985,15 @@ def _bounds_flags(v: Variable) -> str:
 def model_c(table: Table) -> str:
     causality = {"input": "FMU_INPUT", "parameter": "FMU_PARAMETER", "output": "FMU_OUTPUT"}
     value_type = {"Real": "FMU_REAL", "Integer": "FMU_INTEGER"}
+    what = f"the {table.type} dyad FMU" if table.kind is DYAD else "the crank drive FMU"
     lines = [
-        f"/* {table.identifier}_model.c: the variable table of the {table.type} dyad FMU.",
+        f"/* {table.identifier}_model.c: the variable table of {what}.",
         f" * Generated by modelDescription/generate.py from modelDescription/{table.path.name};",
         " * do not edit: change the table and regenerate. The model descriptions are",
         " * generated from the same table, with the same instantiation token. */",
         "#include <stddef.h>",
         "",
-        '#include "fmu_dyad.h"',
+        f'#include "{table.kind.header}"',
         "",
         "static const fmu_variable variables[] = {",
         "    /* vr, name, unit, causality, type, target, offset,",
@@ -856,13 +1021,17 @@ def model_c(table: Table) -> str:
         lines.append("    " + ", ".join(str(i) for i in index_of[start:start + 12]) + ",")
     lines.append("};")
     lines.append("")
-    lines.append(f"static const fmu_dyad_data dyad = {{DYAD_{table.type}, "
-                 f"dyad_solve_{table.type.lower()}}};")
-    lines.append("")
+    if table.kind is DYAD:
+        lines.append(f"static const fmu_dyad_data dyad = {{DYAD_{table.type}, "
+                     f"dyad_solve_{table.type.lower()}}};")
+        lines.append("")
+        data = "&dyad"
+    else:
+        data = "NULL"  # the drive's behaviour needs no model data
     lines.append(f"const fmu_model fmu_this_model = {{{_c_string(table.identifier)}, "
                  f"{_c_string(table.token)},")
     lines.append(f"                                  variables, {len(table.variables)}, "
-                 f"index_of_vr, {vr_limit}, &fmu_dyad_behaviour, &dyad}};")
+                 f"index_of_vr, {vr_limit}, &{table.kind.behaviour}, {data}}};")
     return "\n".join(lines) + "\n"
 
 
@@ -893,6 +1062,8 @@ def _fmt_bounds(v: Variable) -> str:
 
 
 def documentation(table: Table) -> str:
+    if table.kind is DRIVE:
+        return drive_documentation(table)
     t = table.type
     d_m, e, d_n = PAIRS[t]
     conditioning, singular, typical = TYPE_NOTES[t]
@@ -1051,6 +1222,181 @@ def documentation(table: Table) -> str:
     return "\n".join(o) + "\n"
 
 
+def _variable_rows(table: Table) -> list[str]:
+    o = ["<table>",
+         "<tr><th>vr</th><th>name</th><th>causality</th><th>type</th><th>unit</th>"
+         "<th>start</th><th>range</th><th>description</th></tr>"]
+    for v in table.variables:
+        start = _num(v.start) if v.start is not None else ""
+        o.append(f"<tr><td class=\"num\">{v.vr}</td><td><code>{_h(v.name)}</code></td>"
+                 f"<td>{v.causality}</td><td>{v.type}</td><td>{_h(v.unit or '-')}</td>"
+                 f"<td class=\"num\">{start}</td><td class=\"num\">{_h(_fmt_bounds(v))}</td>"
+                 f"<td>{_h(v.description)}</td></tr>")
+    o.append("</table>")
+    return o
+
+
+def drive_documentation(table: Table) -> str:
+    """The documentation page of the crank drive (fmu/fmu_drive.c)."""
+    o = []
+    o.append("<!DOCTYPE html>")
+    o.append('<html lang="en">')
+    o.append("<head>")
+    o.append('<meta charset="utf-8">')
+    o.append(f"<title>{_h(table.identifier)}: a DC motor driving a crank</title>")
+    o.append(f"<style>\n{_CSS}\n</style>")
+    o.append("</head>")
+    o.append("<body>")
+    o.append(f"<h1>{_h(table.identifier)}: a DC motor driving a crank</h1>")
+    o.append(f"<p>{_h(table.description)}</p>")
+    o.append("<p>A co-simulation FMU (FMI 2.0 and FMI 3.0) of the drive of a mechanism: a DC "
+             "motor with a linear torque-speed characteristic turns, on a rigid shaft, a crank "
+             "about the fixed pivot O. Unlike the dyad FMUs of dyadfmu it has states, the "
+             "crank's angle and speed, which <code>doStep</code> integrates over each "
+             "communication step. The mechanism the crank drives (typically built from dyad "
+             "FMUs) acts on it through two inputs, <code>load.torque</code> and "
+             "<code>load.inertia</code>.</p>")
+
+    o.append("<h2>The model</h2>")
+    o.append("<p>The crank turns about O at the angle phi = <code>crank.angle</code>, the speed "
+             "omega = <code>crank.omega</code> and the acceleration eps = "
+             "<code>crank.epsilon</code>, which obeys</p>")
+    o.append("<pre>(inertia + load.inertia) eps = T_stall (1 - omega / omega_0) + load.torque "
+             "+ r_c x m_c g</pre>")
+    o.append("<ul>")
+    for item in (
+        "<code>inertia</code> is the inertia of the rotor and the crank about O, "
+        "<code>load.inertia</code> the inertia the driven mechanism adds at the crank "
+        "(see below); their sum must be positive.",
+        "T_m = T_stall (1 - omega / omega_0) is the motor torque (output "
+        "<code>motor.torque</code>), with T_stall = <code>motor.stall_torque</code> the torque "
+        "at standstill and omega_0 = <code>motor.no_load_speed</code> the speed at which it "
+        "vanishes. The characteristic is linear throughout: above omega_0 the motor brakes, "
+        "turned backwards it delivers more than T_stall.",
+        "<code>load.torque</code> is the torque of the driven mechanism on the crank about O "
+        "at zero crank acceleration; the mechanism's whole torque on the crank is "
+        "<code>load.torque - load.inertia * crank.epsilon</code>.",
+        "r_c x m_c g is the moment of the crank's weight about O: m_c = "
+        "<code>crank.mass</code>, g = (<code>gravity.x</code>, <code>gravity.y</code>), and "
+        "r_c = (com.x cos phi - com.y sin phi, com.x sin phi + com.y cos phi) is the crank's "
+        "centre of mass (<code>crank.com.x</code>, <code>crank.com.y</code> in the crank's "
+        "own frame) turned by phi; r_c x m_c g = m_c (r_c,x g_y - r_c,y g_x).",
+        "All angles, speeds, accelerations and torques are z components, positive "
+        "counter-clockwise; the crank angle is the direction of the crank frame's x axis from "
+        "the global x axis.",
+    ):
+        o.append(f"<li>{item}</li>")
+    o.append("</ul>")
+
+    o.append("<h2>States and the integrator</h2>")
+    o.append("<p>The state (phi, omega) starts from the parameters <code>start.angle</code> "
+             "and <code>start.speed</code> when initialization ends. "
+             "<code>doStep(t, h)</code> holds the inputs over the communication step and "
+             "integrates the state from t to t + h with the classical 4th-order Runge-Kutta "
+             "method (RK4) in n equal substeps, n = ceil(h / dt_max), where dt_max is the "
+             "smaller of a twentieth of the motor's mechanical time constant "
+             "tau = (inertia + load.inertia) omega_0 / T_stall and the time the crank takes "
+             "to turn 0.005 rad at the speed at the start of the step (no such limit at "
+             "standstill), and dt_max = h if the step is shorter.</p>")
+    o.append("<p>The state has two components and is smooth (gravity enters as a sine of "
+             "phi), so an explicit method of high order is accurate and cheap once the substep "
+             "resolves the one stiff scale, the motor's damping T_stall / omega_0: no Newton "
+             "iteration is needed, and the result depends on nothing but the state, the "
+             "inputs and the step, which keeps a co-simulation reproducible.</p>")
+    o.append("<p>After a step <code>crank.angle</code> and <code>crank.omega</code> are the "
+             "state at t + h, and <code>crank.epsilon</code> and <code>motor.torque</code> are "
+             "evaluated at that state with the current inputs. The angle, the speed and the "
+             "motor torque therefore do not depend on the inputs at a communication point (a "
+             "new input acts only over the next step); the acceleration depends on "
+             "<code>load.torque</code> and <code>load.inertia</code> at once, and "
+             "<code>status</code> on <code>load.inertia</code>.</p>")
+
+    o.append("<h2>Coupling with a mechanism</h2>")
+    o.append("<p>A co-simulation master reads <code>crank.angle</code>, "
+             "<code>crank.omega</code> and <code>crank.epsilon</code>, solves the mechanism's "
+             "kinematics, feeds its dyad FMUs, and returns the torque T_mech the mechanism "
+             "puts on the crank about O (for a crank that is link k of a dyad at its pair "
+             "D_m = A, the mechanism acts on the crank with -R_mk at A, so "
+             "T_mech = -(r_OA x R_mk)). At a given position and speed T_mech is affine in the "
+             "crank acceleration, T_mech = tau_0 - J_eff eps: the dyads' reactions are linear "
+             "in their accelerations, and these are affine in eps. J_eff is the mechanism's "
+             "effective inertia at the crank. The master passes T_mech in one of two "
+             "ways:</p>")
+    o.append("<ul>")
+    o.append("<li><b>Explicit:</b> <code>load.inertia</code> = 0 and <code>load.torque</code> "
+             "= T_mech evaluated with the crank acceleration of the last communication point. "
+             "Simple, but the mechanism's inertia then acts one step late, and the "
+             "acceleration of successive steps is amplified by -J_eff / inertia: the coupling "
+             "oscillates, and diverges unless the mechanism's effective inertia stays below "
+             "that of the rotor and crank.</li>")
+    o.append("<li><b>Stabilised:</b> <code>load.inertia</code> = J_eff and "
+             "<code>load.torque</code> = tau_0 = T_mech + J_eff eps, the mechanism's torque at "
+             "zero crank acceleration. J_eff comes from the dyad FMU's directional "
+             "derivatives (<code>fmi2GetDirectionalDerivative</code> / "
+             "<code>fmi3GetDirectionalDerivative</code>): seed its acceleration inputs "
+             "(<code>link_m.epsilon</code>, <code>link_n.epsilon</code>, "
+             "<code>link_m.accel_d</code>, <code>link_n.accel_d</code>) with their rates per "
+             "unit crank acceleration (the mechanism's velocity ratios; for the crank pin, "
+             "k x r_OA), take the derivative of the reaction at the crank's pin, and form "
+             "J_eff = -dT_mech / d eps. The mechanism's inertia then enters the drive's "
+             "equation of motion inside the step, as (inertia + load.inertia) eps, and no "
+             "longer lags a step behind; only its change with the crank angle over a step "
+             "does.</li>")
+    o.append("</ul>")
+
+    o.append("<h2>Variables</h2>")
+    o.append("<p>Value references as in the model descriptions (in FMI 3, value reference 0 "
+             "is the independent variable <code>time</code>). Inputs may change at every "
+             "communication point; parameters are fixed once initialization ends.</p>")
+    o += _variable_rows(table)
+    o.append("<p>A range in brackets is inclusive, in parentheses exclusive. Setting a "
+             "value outside its range, or a value that is not finite, is rejected with an "
+             "error that names the variable.</p>")
+
+    o.append("<h2>Status codes</h2>")
+    o.append("<table>")
+    o.append("<tr><th><code>status</code></th><th>meaning</th><th>outputs</th></tr>")
+    o.append("<tr><td class=\"num\">0</td><td>ok</td><td>finite</td></tr>")
+    o.append("<tr><td class=\"num\">2</td><td>invalid input: <code>inertia + "
+             "load.inertia</code> is not positive; <code>exitInitializationMode</code> and "
+             "<code>doStep</code> return <code>Error</code> and log <code>load.inertia</code> "
+             "and its value (category <code>logStatusError</code>), and the state is not "
+             "advanced</td><td><code>crank.epsilon</code> and <code>motor.torque</code> NaN; "
+             "<code>crank.angle</code> and <code>crank.omega</code> keep the state</td></tr>")
+    o.append("</table>")
+    o.append("<p>The codes are those of the dyad FMUs; 1 (singular) and 3 (out of range) do "
+             "not occur in the drive.</p>")
+    o.append("<ul>")
+    o.append("<li>A step the integrator cannot take, because it would need more than 1e7 "
+             "substeps (a communication step far longer than the time constant or a crank "
+             "turning very fast) or because the state is no longer finite: "
+             "<code>doStep</code> returns <code>Discard</code> and logs the reason (category "
+             "<code>logStatusDiscard</code>); the state stays at the start of the step.</li>")
+    o.append("<li>A value outside the range of its variable, or not finite, is rejected "
+             "already by the setter, which returns <code>Error</code> naming the variable: "
+             "<code>motor.stall_torque</code>, <code>motor.no_load_speed</code> and "
+             "<code>inertia</code> must be positive, <code>crank.mass</code> must not be "
+             "negative.</li>")
+    o.append("</ul>")
+
+    o.append("<h2>Directional derivatives</h2>")
+    o.append("<p>None: the model descriptions declare "
+             "<code>providesDirectionalDerivative(s)=\"false\"</code>, and "
+             "<code>fmi2GetDirectionalDerivative</code> and "
+             "<code>fmi3GetDirectionalDerivative</code> return <code>Error</code>. The one "
+             "output that depends on the inputs at a communication point, "
+             "<code>crank.epsilon</code>, is explicit in them (see the equation above).</p>")
+
+    o.append("<h2>Identity</h2>")
+    o.append(f"<p>Model identifier <code>{_h(table.identifier)}</code>, instantiation token "
+             f"(FMI 2 GUID) <code>{_h(table.token)}</code>: a hash of the variable table "
+             "<code>" + _h(table.path.name) + "</code>, from which this page, both model "
+             "descriptions and the FMU's C variable table are generated.</p>")
+    o.append("</body>")
+    o.append("</html>")
+    return "\n".join(o) + "\n"
+
+
 # ---------------------------------------------------------------------------
 # Command line
 # ---------------------------------------------------------------------------
@@ -1080,7 +1426,7 @@ def _shown(path: Path) -> str:
 
 
 def golden_files() -> dict[Path, str]:
-    """Golden path -> expected text for the five tables."""
+    """Golden path -> expected text for every table in TABLES."""
     result = {}
     for name in TABLES:
         table = load_table(HERE / name)
@@ -1092,12 +1438,12 @@ def golden_files() -> dict[Path, str]:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
         description="Generate the model descriptions, C variable table and documentation "
-                    "of a dyad FMU from its variable table.")
+                    "of a dyad or drive FMU from its variable table.")
     parser.add_argument("table", nargs="?", type=Path, help="the variable table (TOML)")
     parser.add_argument("--out", type=Path, help="directory to write the generated files to")
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--update-golden", action="store_true",
-                      help="rewrite modelDescription/golden/*.xml from the five tables")
+                      help="rewrite modelDescription/golden/*.xml from the tables")
     mode.add_argument("--check-golden", action="store_true",
                       help="exit 1 with a unified diff if a golden file differs")
     args = parser.parse_args(argv)

@@ -8,6 +8,11 @@
 (d) Malformed tables are refused with a message that names the variable.
 Also: the generated C tables compile, the start values give a well-conditioned
 solve, and the instantiation token follows the table.
+
+(e) The crank drive (drive.toml, a model with states; fmu/fmu_drive.h): golden
+    files, fmpy validation, its variables, units, causalities and dependencies
+    (including empty ones), its C table, its documentation, and malformed drive
+    tables. The dyad-only tests above stay parametrized over the five dyad types.
 """
 
 from __future__ import annotations
@@ -672,3 +677,461 @@ def test_unmodified_copy_is_accepted(tmp_path):
     write_toml(raw, table)
     proc = run_generator(table, "--out", tmp_path / "out")
     assert proc.returncode == 0, proc.stderr
+
+
+# ---------------------------------------------------------------------------
+# (e) the crank drive
+# ---------------------------------------------------------------------------
+DRIVE_TABLE = MD_DIR / "drive.toml"
+DRIVE_HEADER = ROOT / "fmu" / "fmu_drive.h"
+
+#: name -> (causality, unit, lives), in table order, written out from the specification.
+DRIVE_VARIABLES = {
+    "load.torque": ("input", "N.m", "input.load_torque"),
+    "load.inertia": ("input", "kg.m2", "input.load_inertia"),
+    "motor.stall_torque": ("parameter", "N.m", "input.stall_torque"),
+    "motor.no_load_speed": ("parameter", "rad/s", "input.no_load_speed"),
+    "inertia": ("parameter", "kg.m2", "input.inertia"),
+    "crank.mass": ("parameter", "kg", "input.crank_mass"),
+    "crank.com.x": ("parameter", "m", "input.crank_com_x"),
+    "crank.com.y": ("parameter", "m", "input.crank_com_y"),
+    "gravity.x": ("parameter", "m/s2", "input.gravity_x"),
+    "gravity.y": ("parameter", "m/s2", "input.gravity_y"),
+    "start.angle": ("parameter", "rad", "input.start_angle"),
+    "start.speed": ("parameter", "rad/s", "input.start_speed"),
+    "crank.angle": ("output", "rad", "result.angle"),
+    "crank.omega": ("output", "rad/s", "result.speed"),
+    "crank.epsilon": ("output", "rad/s2", "result.acceleration"),
+    "motor.torque": ("output", "N.m", "result.motor_torque"),
+    "status": ("output", None, "result.status"),
+}
+DRIVE_STARTS = {"load.torque": 0.0, "load.inertia": 0.0, "motor.stall_torque": 12.0,
+                "motor.no_load_speed": 36.0, "inertia": 2e-3, "crank.mass": 0.25,
+                "crank.com.x": 0.02, "crank.com.y": 0.003, "gravity.x": 0.0,
+                "gravity.y": -9.81, "start.angle": 0.0, "start.speed": 30.0}
+DRIVE_DEPENDS = {"crank.angle": set(), "crank.omega": set(),
+                 "crank.epsilon": {"load.torque", "load.inertia"}, "motor.torque": set(),
+                 "status": {"load.inertia"}}
+DRIVE_UNITS = {"rad", "rad/s", "rad/s2", "m", "m/s2", "N.m", "kg", "kg.m2"}  # no N
+
+
+def load_drive_raw():
+    with open(DRIVE_TABLE, "rb") as f:
+        return tomllib.load(f)
+
+
+@pytest.fixture(scope="module")
+def generated_drive(tmp_path_factory):
+    out = tmp_path_factory.mktemp("generated_drive")
+    proc = run_generator(DRIVE_TABLE, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def test_tables_are_the_five_dyads_and_the_drive():
+    """Every table in modelDescription is generated and golden-checked; only the dyad
+    tables go through the dyad-only tests (dependency derivation, reference solve)."""
+    on_disk = {p.name for p in MD_DIR.glob("*.toml")}
+    assert set(generate.TABLES) == on_disk
+    assert on_disk - {p.name for p in TABLE_OF.values()} == {"drive.toml"}
+    assert generate.load_table(DRIVE_TABLE).kind is generate.DRIVE
+    assert all(generate.load_table(p).kind is generate.DYAD for p in TABLE_OF.values())
+
+
+def test_drive_generator_writes_every_file(generated_drive):
+    for rel in ("fmi2/modelDescription.xml", "fmi3/modelDescription.xml",
+                "fmi3/buildDescription.xml", "drive_model.c", "documentation/index.html"):
+        assert (generated_drive / rel).is_file(), rel
+
+
+def test_drive_xml_equals_golden(generated_drive):
+    for version in ("fmi2", "fmi3"):
+        golden = MD_DIR / "golden" / f"drive_{version}.xml"
+        produced = generated_drive / version / "modelDescription.xml"
+        assert golden.is_file(), f"{golden} missing: run generate.py --update-golden"
+        assert produced.read_bytes() == golden.read_bytes(), (
+            f"drive {version} description differs from {golden.name}; review the change and "
+            "run modelDescription/generate.py --update-golden")
+
+
+def test_drive_output_is_deterministic(generated_drive, tmp_path):
+    assert run_generator(DRIVE_TABLE, "--out", tmp_path).returncode == 0
+    for path in generated_drive.rglob("*"):
+        if path.is_file():
+            rel = path.relative_to(generated_drive)
+            assert (tmp_path / rel).read_bytes() == path.read_bytes(), rel
+            assert b"\r" not in path.read_bytes()
+
+
+def test_drive_table_is_as_specified():
+    raw = load_drive_raw()
+    assert raw["model"] == {"kind": "drive", "identifier": "drive",
+                            "description": raw["model"]["description"]}
+    assert [v["name"] for v in raw["variable"]] == list(DRIVE_VARIABLES)
+    for k, v in enumerate(raw["variable"]):
+        causality, unit, lives = DRIVE_VARIABLES[v["name"]]
+        assert v["vr"] == k + 1
+        assert (v["causality"], v.get("unit"), v["lives"]) == (causality, unit, lives), v["name"]
+        assert "@angle" not in v["lives"]
+        if causality != "output":
+            assert float(v["start"]) == DRIVE_STARTS[v["name"]], v["name"]
+        else:
+            assert set(v["depends"]) == DRIVE_DEPENDS[v["name"]], v["name"]
+    bounds = {v["name"]: (v.get("min"), v.get("min_exclusive", False), v.get("max"))
+              for v in raw["variable"] if "min" in v or "max" in v}
+    assert bounds == {"motor.stall_torque": (0.0, True, None),
+                      "motor.no_load_speed": (0.0, True, None),
+                      "inertia": (0.0, True, None), "crank.mass": (0.0, False, None)}
+
+
+def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
+    md2 = read_fmi2(generated_drive / "fmi2" / "modelDescription.xml")
+    md3 = read_fmi3(generated_drive, tmp_path)
+    token = md2.guid
+    assert re.fullmatch(r"\{[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}\}", token)
+    assert md3.instantiationToken == token
+    assert token not in {generate.load_table(TABLE_OF[t]).token for t in TYPES}
+
+    for md, shim in ((md2, "fmi2_functions.c"), (md3, "fmi3_functions.c")):
+        assert md.coSimulation is not None and md.modelExchange is None
+        assert md.coSimulation.modelIdentifier == "drive"
+        assert md.variableNamingConvention == "structured"
+        description = md.description
+        assert "\n" not in description
+        assert "states" in description and "doStep" in description
+        assert "Runge-Kutta" in description and "RK4" in description
+        assert "substeps" in description
+        assert float(md.defaultExperiment.stopTime) == 1
+        assert float(md.defaultExperiment.stepSize) == 0.001
+        assert [c.name for c in md.logCategories] == [
+            "logStatusError", "logStatusWarning", "logStatusDiscard", "logCalls"]
+        (config,) = md.buildConfigurations
+        assert config.modelIdentifier == "drive"
+        assert config.sourceFileSets[0].sourceFiles == [
+            "fmu_drive.c", "fmu_instance.c", shim, "drive_model.c"]
+        units = {u.name: u.baseUnit for u in md.unitDefinitions}
+        assert set(units) == DRIVE_UNITS
+        for name in DRIVE_UNITS:
+            got = {k: getattr(units[name], k) for k in ("kg", "m", "s", "A", "K", "mol", "cd",
+                                                        "rad") if getattr(units[name], k)}
+            assert got == BASE_UNITS[name], name
+    assert md2.coSimulation.providesDirectionalDerivative is False
+
+    variables2 = md2.modelVariables
+    variables3 = [v for v in md3.modelVariables if v.causality != "independent"]
+    (time,) = [v for v in md3.modelVariables if v.causality == "independent"]
+    assert time.name == "time" and time.valueReference == 0
+    for variables in (variables2, variables3):
+        assert [v.name for v in variables] == list(DRIVE_VARIABLES)
+        assert [v.valueReference for v in variables] == list(range(1, len(DRIVE_VARIABLES) + 1))
+        for v in variables:
+            causality, unit, _ = DRIVE_VARIABLES[v.name]
+            assert (v.causality, v.unit) == (causality, unit), v.name
+            if causality == "input":
+                assert v.variability == "continuous" and float(v.start) == DRIVE_STARTS[v.name]
+            elif causality == "parameter":
+                assert (v.variability, v.initial) == ("fixed", "exact")
+                assert float(v.start) == DRIVE_STARTS[v.name]
+            else:
+                assert v.initial == "calculated" and v.start is None
+                assert v.variability == ("discrete" if v.name == "status" else "continuous")
+            want_type = ("Integer", "Int32") if v.name == "status" else ("Real", "Float64")
+            assert v.type in want_type, v.name
+    by_name = {v.name: v for v in variables3}
+    for name in ("motor.stall_torque", "motor.no_load_speed", "inertia", "crank.mass"):
+        assert float(by_name[name].min) == 0 and by_name[name].max is None, name
+    for name in ("load.torque", "load.inertia"):
+        assert by_name[name].min is None and by_name[name].max is None, name
+
+    # dependencies: an empty list (not "all"), read back as [] rather than None
+    for md in (md2, md3):
+        assert [u.variable.name for u in md.outputs] == list(DRIVE_DEPENDS)
+        for unknown in md.outputs:
+            assert unknown.dependencies is not None, unknown.variable.name
+            deps = {d.name for d in unknown.dependencies}
+            assert deps == DRIVE_DEPENDS[unknown.variable.name], unknown.variable.name
+        assert [u.variable.name for u in md.initialUnknowns] == list(DRIVE_DEPENDS)
+
+
+def test_drive_empty_dependencies_and_no_derivatives_in_the_xml(generated_drive):
+    text2 = (generated_drive / "fmi2" / "modelDescription.xml").read_text()
+    text3 = (generated_drive / "fmi3" / "modelDescription.xml").read_text()
+    for vr in (13, 14, 16):  # crank.angle, crank.omega, motor.torque: index = vr in FMI 2
+        assert f'<Unknown index="{vr}" dependencies=""/>' in text2
+        assert f'<Output valueReference="{vr}" dependencies=""/>' in text3
+    assert '<Unknown index="15" dependencies="1 2"/>' in text2
+    assert '<Output valueReference="15" dependencies="1 2"/>' in text3
+    assert '<Unknown index="17" dependencies="2"/>' in text2
+    assert '<Output valueReference="17" dependencies="2"/>' in text3
+    assert 'providesDirectionalDerivative="false"' in text2
+    assert 'providesDirectionalDerivatives="false"' in text3
+    assert '<Unit name="N">' not in text2 and '<Unit name="N">' not in text3
+
+
+def _struct_members(header_text, struct):
+    body = re.search(rf"typedef struct {struct} \{{(.*?)\}} {struct};", header_text, re.S)
+    assert body, f"{struct} not found in {DRIVE_HEADER.name}"
+    return re.findall(r"^\s*(?:double|int)\s+(\w+);", body.group(1), re.M)
+
+
+def test_drive_members_match_the_header():
+    """The generator's view of fmu_drive_input / fmu_drive_output is the header's."""
+    text = DRIVE_HEADER.read_text()
+    assert _struct_members(text, "fmu_drive_input") == list(generate.DRIVE_INPUT_MEMBERS)
+    assert _struct_members(text, "fmu_drive_output") == list(generate.DRIVE_OUTPUT_MEMBERS)
+    assert re.search(r"^\s*int status;", text, re.M)
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available")
+def test_drive_c_table_compiles(generated_drive, tmp_path):
+    proc = subprocess.run(
+        ["gcc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
+         f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'fmu'}", "-c",
+         str(generated_drive / "drive_model.c"), "-o", str(tmp_path / "drive_model.o")],
+        capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_drive_c_table_matches_the_table(generated_drive):
+    raw = load_drive_raw()
+    token = generate.load_table(DRIVE_TABLE).token
+    c_text = (generated_drive / "drive_model.c").read_text()
+    assert '#include "fmu_drive.h"' in c_text and "fmu_dyad" not in c_text
+    assert "dyad_solve" not in c_text
+    rows = re.findall(r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
+                      r'(offsetof\((\w+), ([\w.]+)\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+), (\w+)\}',
+                      c_text)
+    assert len(rows) == len(raw["variable"])
+    for row, v in zip(rows, raw["variable"]):
+        vr, name, unit, causality, value_type, target, _, struct, member, start = row[:10]
+        assert (int(vr), name, unit) == (v["vr"], v["name"], v.get("unit", ""))
+        assert causality == "FMU_" + v["causality"].upper()
+        assert float(start) == float(v.get("start", 0.0))
+        block, path = v["lives"].split(".")
+        assert struct == ("fmu_drive_input" if block == "input" else "fmu_drive_output")
+        assert member == path
+        assert row[13] == "DYAD_FIELD_NONE"
+        if v["name"] == "status":
+            assert (value_type, target) == ("FMU_INTEGER", "FMU_TARGET_RESULT_STATUS")
+            assert (struct, member) == ("fmu_drive_output", "status")
+        elif block == "input":
+            assert target == "FMU_TARGET_INPUT_REAL"
+        else:
+            assert target == "FMU_TARGET_RESULT_REAL"
+    assert "offsetof(fmu_drive_output, status)" in c_text
+    assert "FMU_TARGET_INPUT_ANGLE" not in c_text
+    assert re.search(r"FMU_HAS_MIN \| FMU_MIN_EXCLUSIVE, DYAD_FIELD_NONE", c_text)
+    vr_limit = len(raw["variable"]) + 1
+    assert (f'const fmu_model fmu_this_model = {{"drive", "{token}",\n'
+            f"                                  variables, {len(raw['variable'])}, "
+            f"index_of_vr, {vr_limit}, &fmu_drive_behaviour, NULL}};") in c_text
+
+
+def test_drive_documentation_is_complete(generated_drive):
+    page = (generated_drive / "documentation" / "index.html").read_text()
+    raw = load_drive_raw()
+    assert page.startswith("<!DOCTYPE html>") and "</html>" in page
+    assert "http" not in page
+    for v in raw["variable"]:
+        assert f"<code>{v['name']}</code>" in page
+    for phrase in ("(inertia + load.inertia) eps = T_stall (1 - omega / omega_0) + load.torque "
+                   "+ r_c x m_c g",
+                   "Runge-Kutta", "RK4", "substeps", "time constant", "0.005 rad",
+                   "Explicit", "Stabilised", "directional derivatives", "J_eff",
+                   "invalid input", "Discard", "Error", "NaN", "counter-clockwise",
+                   "providesDirectionalDerivative", generate.load_table(DRIVE_TABLE).token):
+        assert phrase in page, phrase
+    assert "dyad_solve" not in page
+
+
+# The drive's equations (fmu/fmu_drive.c), to check the declared dependencies by
+# perturbation as the dyad tables are checked against the reference solver.
+def drive_outputs(values, angle, speed):
+    total = values["inertia"] + values["load.inertia"]
+    motor = values["motor.stall_torque"] * (1 - speed / values["motor.no_load_speed"])
+    if not total > 0:
+        return {"crank.angle": angle, "crank.omega": speed, "crank.epsilon": math.nan,
+                "motor.torque": math.nan, "status": 2}
+    c, s = math.cos(angle), math.sin(angle)
+    rx = c * values["crank.com.x"] - s * values["crank.com.y"]
+    ry = s * values["crank.com.x"] + c * values["crank.com.y"]
+    gravity = values["crank.mass"] * (rx * values["gravity.y"] - ry * values["gravity.x"])
+    return {"crank.angle": angle, "crank.omega": speed,
+            "crank.epsilon": (motor + values["load.torque"] + gravity) / total,
+            "motor.torque": motor, "status": 0}
+
+
+def test_drive_declared_dependencies_are_the_true_ones():
+    """As for the dyads: among valid inputs, an output depends on an input if it changes
+    with it; `status` depends on what decides validity (inertia + load.inertia > 0)."""
+    rng = np.random.default_rng(7)
+    raw = load_drive_raw()
+    inputs = names_of(raw, "input")
+    derived = {name: set() for name in names_of(raw, "output")}
+    for _ in range(6):
+        values = {name: float(rng.uniform(0.5, 2.0)) for name in DRIVE_STARTS}
+        values["load.torque"] = float(rng.uniform(-5, 5))
+        values["load.inertia"] = float(rng.uniform(0, 0.1))
+        angle, speed = float(rng.uniform(0, 2 * math.pi)), float(rng.uniform(-40, 40))
+        base = drive_outputs(values, angle, speed)
+        for name in inputs:
+            trial = dict(values, **{name: values[name] + float(rng.uniform(0.01, 0.1))})
+            other = drive_outputs(trial, angle, speed)
+            assert other["status"] == 0
+            for out in derived:
+                if out != "status" and abs(other[out] - base[out]) > 1e-12 * (1 + abs(base[out])):
+                    derived[out].add(name)
+    derived["status"] = {"load.inertia"}  # validity: inertia (a parameter) + load.inertia > 0
+    assert drive_outputs(dict(DRIVE_STARTS, **{"load.inertia": -1.0}), 0.0, 0.0)["status"] == 2
+    declared = {v["name"]: set(v["depends"]) for v in raw["variable"]
+                if v["causality"] == "output"}
+    assert declared == derived == DRIVE_DEPENDS
+
+
+def test_drive_start_values_are_valid():
+    values = start_values(load_drive_raw())
+    out = drive_outputs(values, values["start.angle"], values["start.speed"])
+    assert out["status"] == 0 and all(math.isfinite(x) for x in out.values())
+    assert values["gravity.y"] == -9.81 and values["gravity.x"] == 0
+
+
+def test_drive_and_dyad_tokens_differ_and_follow_the_table():
+    raw = load_drive_raw()
+    token = generate.load_table(DRIVE_TABLE).token
+    assert token == generate.instantiation_token(raw["model"], raw["variable"])
+    changed = dict(raw["model"], description=raw["model"]["description"] + ".")
+    assert generate.instantiation_token(changed, raw["variable"]) != token
+
+
+def _drive_var(raw, name):
+    return next(v for v in raw["variable"] if v["name"] == name)
+
+
+def _drop_drive_variable(raw, name):
+    raw["variable"].remove(_drive_var(raw, name))
+    for k, v in enumerate(raw["variable"]):
+        v["vr"] = k + 1
+    for v in raw["variable"]:
+        if "depends" in v:
+            v["depends"] = [d for d in v["depends"] if d != name]
+
+
+MALFORMED_DRIVE = [
+    ("lives to no member",
+     lambda r: _drive_var(r, "load.torque").update(lives="input.load_torq"),
+     "load.torque", "fmu_drive_input has no member 'load_torq'"),
+    ("lives to no output member",
+     lambda r: _drive_var(r, "crank.omega").update(lives="result.omega"),
+     "crank.omega", "fmu_drive_output has no member 'omega'"),
+    ("lives to a dyad member",
+     lambda r: _drive_var(r, "gravity.x").update(lives="input.gravity.x"),
+     "gravity.x", "bad lives"),
+    ("lives to a state",
+     lambda r: _drive_var(r, "start.angle").update(lives="input.angle"),
+     "start.angle", "is a state of the drive"),
+    ("lives with @angle",
+     lambda r: _drive_var(r, "start.angle").update(lives="input.start_angle@angle"),
+     "start.angle", "@angle"),
+    ("lives of another variable",
+     lambda r: _drive_var(r, "motor.torque").update(lives="result.acceleration"),
+     "motor.torque", "also the home of"),
+    ("missing stall torque", lambda r: _drop_drive_variable(r, "motor.stall_torque"),
+     "motor.stall_torque", "missing variable"),
+    ("missing load inertia", lambda r: _drop_drive_variable(r, "load.inertia"),
+     "load.inertia", "missing variable"),
+    ("wrong name for lives",
+     lambda r: _drive_var(r, "crank.omega").update(name="crank.speed"),
+     "crank.speed", "expected 'crank.omega'"),
+    ("wrong unit", lambda r: _drive_var(r, "load.torque").update(unit="N"),
+     "load.torque", "unit"),
+    ("unknown unit", lambda r: _drive_var(r, "start.speed").update(unit="rpm"),
+     "start.speed", "unknown unit"),
+    ("input as a parameter", lambda r: _drive_var(r, "load.inertia").update(causality="parameter"),
+     "load.inertia", "is an input of the drive"),
+    ("start on the exclusive min", lambda r: _drive_var(r, "inertia").update(start=0.0),
+     "inertia", "below min"),
+    ("bounds off the domain", lambda r: _drive_var(r, "crank.mass").pop("min"),
+     "crank.mass", "domain"),
+    ("bounds on an unbounded input", lambda r: _drive_var(r, "load.inertia").update(min=0.0),
+     "load.inertia", "domain"),
+    ("start missing", lambda r: _drive_var(r, "start.speed").pop("start"),
+     "start.speed", "start is missing"),
+    ("vr out of order", lambda r: _drive_var(r, "inertia").update(vr=9),
+     "inertia", "not consecutive"),
+    ("parameter after an output",
+     lambda r: r["variable"].append(r["variable"].pop(r["variable"].index(
+         _drive_var(r, "start.speed")))) or [v.update(vr=k + 1) for k, v in
+                                              enumerate(r["variable"])],
+     "start.speed", "parameter after outputs"),
+    ("a dependency too few", lambda r: _drive_var(r, "crank.epsilon")["depends"].pop(),
+     "crank.epsilon", "true dependencies"),
+    ("a dependency too many", lambda r: _drive_var(r, "crank.angle")["depends"].append(
+        "load.torque"), "crank.angle", "true dependencies"),
+    ("depends missing", lambda r: _drive_var(r, "motor.torque").pop("depends"),
+     "motor.torque", "depends is missing"),
+    ("unknown key", lambda r: _drive_var(r, "inertia").update(colour="red"),
+     "inertia", "unknown key 'colour'"),
+]
+
+
+@pytest.mark.parametrize("mutation,name,fragment", [m[1:] for m in MALFORMED_DRIVE],
+                         ids=[m[0] for m in MALFORMED_DRIVE])
+def test_malformed_drive_table_is_refused(tmp_path, mutation, name, fragment):
+    raw = load_drive_raw()
+    mutation(raw)
+    table = tmp_path / "broken_drive.toml"
+    write_toml(raw, table)
+    proc = run_generator(table, "--out", tmp_path / "out")
+    assert proc.returncode != 0
+    assert not (tmp_path / "out").exists(), "nothing may be written from a bad table"
+    lines = [ln for ln in proc.stderr.splitlines() if fragment in ln]
+    assert lines, proc.stderr
+    assert any("broken_drive.toml" in ln and f"'{name}'" in ln for ln in lines), proc.stderr
+
+
+@pytest.mark.parametrize("model,fragment", [
+    ({"kind": "drive", "type": "RRT"}, "only a dyad has a type"),
+    ({"kind": "motor"}, "kind 'motor' is not one of dyad, drive"),
+    ({"kind": "dyad"}, "type None is not one of"),
+    ({"kind": "drive", "colour": "red"}, "[model]: unknown key 'colour'"),
+], ids=["drive with a type", "unknown kind", "dyad kind without a type", "unknown model key"])
+def test_malformed_drive_model_is_refused(tmp_path, model, fragment):
+    raw = load_drive_raw()
+    raw["model"] = dict({k: v for k, v in raw["model"].items() if k != "kind"}, **model)
+    table = tmp_path / "broken_drive.toml"
+    write_toml(raw, table)
+    proc = run_generator(table, "--out", tmp_path / "out")
+    assert proc.returncode != 0
+    assert not (tmp_path / "out").exists()
+    assert any("broken_drive.toml" in ln and fragment in ln
+               for ln in proc.stderr.splitlines()), proc.stderr
+
+
+def test_dyad_table_may_name_its_kind(tmp_path):
+    """kind = "dyad" is the default: saying it is accepted (with another token)."""
+    raw = load_raw("RRT")
+    raw["model"] = {"kind": "dyad", **raw["model"]}
+    table = tmp_path / "dyad_rrt.toml"
+    write_toml(raw, table)
+    proc = run_generator(table, "--out", tmp_path / "out")
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_drive_lives_must_not_name_dyad_structs():
+    with pytest.raises(ValueError, match="no member"):
+        generate.parse_lives("input.m.omega", generate.DRIVE)
+    with pytest.raises(ValueError, match="no member"):
+        generate.parse_lives("input.load_torque")  # a dyad's lives
+    lives = generate.parse_lives("result.status", generate.DRIVE)
+    assert (lives.target, lives.offset, lives.field) == (
+        "FMU_TARGET_RESULT_STATUS", "offsetof(fmu_drive_output, status)", "DYAD_FIELD_NONE")
+    assert generate.parse_lives("result.status").offset == "0"  # dyads: as they always were
+
+
+def test_unmodified_drive_copy_is_accepted(tmp_path):
+    raw = load_drive_raw()
+    table = tmp_path / "drive.toml"
+    write_toml(raw, table)
+    proc = run_generator(table, "--out", tmp_path / "out")
+    assert proc.returncode == 0, proc.stderr
+    assert generate.load_table(table).token == generate.load_table(DRIVE_TABLE).token

@@ -1,0 +1,133 @@
+"""The drive FMU (a DC motor turning a crank, with states) through fmpy: validation,
+its integration against SciPy's Radau at tight tolerances, independence of the
+communication step, and bad inputs."""
+
+import math
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+from fmpy.validation import validate_fmu
+from scipy.integrate import solve_ivp
+
+from dyadfmu.harness import build_dir
+
+VERSIONS = (2, 3)
+
+
+def drive_path(version):
+    path = build_dir() / "fmus" / f"drive_fmi{version}.fmu"
+    if not path.is_file():
+        pytest.fail(f"{path} is missing: build the FMUs first (scripts/run-tests does)")
+    return path
+
+
+PARAMS = {"motor.stall_torque": 12.0, "motor.no_load_speed": 36.0, "inertia": 2e-3,
+          "crank.mass": 0.25, "crank.com.x": 0.02, "crank.com.y": 0.003,
+          "gravity.x": 0.0, "gravity.y": -9.81, "start.angle": 0.3, "start.speed": 20.0}
+
+
+def reference(t_end, load_torque, load_inertia, t_eval):
+    """The same machine integrated by SciPy (Radau, rtol 1e-12)."""
+    p = PARAMS
+
+    def rhs(t, y):
+        phi, omega = y
+        c, s = math.cos(phi), math.sin(phi)
+        rx, ry = c * p["crank.com.x"] - s * p["crank.com.y"], s * p["crank.com.x"] + c * p["crank.com.y"]
+        gravity = p["crank.mass"] * (rx * p["gravity.y"] - ry * p["gravity.x"])
+        motor = p["motor.stall_torque"] * (1 - omega / p["motor.no_load_speed"])
+        return [omega, (motor + load_torque + gravity) / (p["inertia"] + load_inertia)]
+
+    sol = solve_ivp(rhs, (0, t_end), [p["start.angle"], p["start.speed"]], method="Radau",
+                    rtol=1e-12, atol=1e-12, t_eval=t_eval)
+    return sol.y
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_drive_validates(version):
+    assert validate_fmu(str(drive_path(version))) == []
+    md = read_model_description(str(drive_path(version)))
+    names = {v.name: v.causality for v in md.modelVariables}
+    assert names["load.torque"] == "input" and names["load.inertia"] == "input"
+    assert names["crank.omega"] == "output" and names["inertia"] == "parameter"
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+@pytest.mark.parametrize("step", (1e-2, 1e-3))
+def test_drive_integrates_like_radau(version, step):
+    t = np.linspace(0, 0.5, 51)
+    load = np.array(list(zip(t, -3 + 0 * t, 1e-3 + 0 * t)),
+                    dtype=[("time", float), ("load.torque", float), ("load.inertia", float)])
+    result = simulate_fmu(str(drive_path(version)), stop_time=0.5, step_size=step,
+                          output_interval=0.01, start_values=PARAMS, input=load,
+                          output=["crank.angle", "crank.omega", "crank.epsilon", "status"])
+    phi, omega = reference(0.5, -3.0, 1e-3, result["time"])
+    error_phi = np.max(np.abs(result["crank.angle"] - phi))
+    error_omega = np.max(np.abs(result["crank.omega"] - omega)) / np.max(np.abs(omega))
+    print(f"drive FMI {version}, step {step}: angle error {error_phi:.1e} rad, speed "
+          f"{error_omega:.1e} relative")
+    assert np.all(result["status"] == 0)
+    assert error_phi < 1e-7 and error_omega < 1e-7
+
+
+class Drive:
+    def __init__(self, version, tmp_path):
+        md = read_model_description(str(drive_path(version)))
+        self.version = version
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        unzipdir = tmp_path / f"drive{version}"
+        with zipfile.ZipFile(drive_path(version)) as archive:
+            archive.extractall(unzipdir)
+        cls = FMU2Slave if version == 2 else FMU3Slave
+        self.fmu = cls(guid=md.guid, unzipDirectory=str(unzipdir),
+                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="drive")
+        self.fmu.instantiate()
+
+    def set(self, name, value):
+        (self.fmu.setReal if self.version == 2 else self.fmu.setFloat64)([self.vr[name]], [value])
+
+    def get(self, name):
+        if name == "status":
+            return (self.fmu.getInteger if self.version == 2 else self.fmu.getInt32)(
+                [self.vr[name]])[0]
+        return (self.fmu.getReal if self.version == 2 else self.fmu.getFloat64)([self.vr[name]])[0]
+
+    def initialize(self):
+        if self.version == 2:
+            self.fmu.setupExperiment(startTime=0)
+        self.fmu.enterInitializationMode()
+        self.fmu.exitInitializationMode()
+
+    def step(self, t, h):
+        return self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_drive_states_bad_inertia_and_reset(version, tmp_path):
+    d = Drive(version, tmp_path)
+    for name, value in PARAMS.items():
+        d.set(name, value)
+    with pytest.raises(FMICallException):
+        d.set("inertia", 0.0)                     # must be positive
+    d.initialize()
+    assert d.get("crank.angle") == PARAMS["start.angle"]
+    assert d.get("crank.omega") == PARAMS["start.speed"]
+    d.step(0, 0.01)
+    moved = d.get("crank.angle")
+    assert moved > PARAMS["start.angle"]
+    d.set("load.inertia", -1.0)                   # loaded inertia no longer positive
+    with pytest.raises(FMICallException):
+        d.step(0.01, 0.01)
+    assert d.get("status") == 2
+    d.set("load.inertia", 0.0)                    # usable again
+    d.step(0.01, 0.01)
+    assert d.get("status") == 0 and d.get("crank.angle") > moved
+    d.fmu.reset()
+    d.initialize()
+    assert d.get("crank.angle") == 0.0            # the table's start value after reset
+    d.fmu.freeInstance()
