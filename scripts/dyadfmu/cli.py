@@ -73,6 +73,12 @@ def parser() -> argparse.ArgumentParser:
     study.add_argument("--build", type=Path, default=None,
                        help="CMake build directory with the benchmark and FMUs (default build/)")
     study.set_defaults(run=_study)
+
+    cosim = sub.add_parser(
+        "cosim", add_help=False,
+        help="the dyad FMU in a closed loop with the drive FMU: explicit and stabilised "
+             "coupling against a monolithic reference (see 'dyadfmu cosim --help')")
+    cosim.set_defaults(run=None)
     return top
 
 
@@ -135,6 +141,11 @@ def _run(args) -> int:
 
 
 def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["cosim"]:
+        from . import cosim_report  # its own options: --quick, --out, ...
+
+        return cosim_report.main(argv[1:])
     args = parser().parse_args(argv)
     return args.run(args)
 
