@@ -62,7 +62,6 @@ import shutil
 import tempfile
 import time as clock
 import zipfile
-from ctypes import byref
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -183,18 +182,21 @@ class FmuSlave:
             from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                                    fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
 
-            def logger(component, instance_name, status, category, message):
-                self._log(status, category, message)
+            from ctypes import CFUNCTYPE, c_char_p, c_int, c_void_p, cast
 
+            # The dyadfmu FMUs call the FMI 2 logger as (env, name, status, category,
+            # "%s", text): a callback that takes the text as a sixth argument reads
+            # the message without fmpy's logger proxy, whose single global target
+            # would dangle once this slave is gone.
+            def logger(component, instance_name, status, category, fmt, text):
+                self._log(status, category, text if text is not None else fmt)
+
+            self._logger = CFUNCTYPE(None, c_void_p, c_char_p, c_int, c_char_p, c_char_p,
+                                     c_char_p)(logger)
             callbacks = fmi2CallbackFunctions()
-            callbacks.logger = fmi2CallbackLoggerTYPE(logger)
+            callbacks.logger = cast(self._logger, fmi2CallbackLoggerTYPE)
             callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
             callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-            try:
-                from fmpy.logging import addLoggerProxy
-                addLoggerProxy(byref(callbacks))
-            except Exception:  # pragma: no cover - fmpy without its native proxy
-                pass
             self._callbacks = callbacks             # kept alive with the instance
             self.fmu.instantiate(callbacks=callbacks, loggingOn=False)
         else:
