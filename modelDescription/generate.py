@@ -1212,6 +1212,11 @@ def documentation(table: Table) -> str:
              "Angles count in rad, so a derivative with respect to an angle is per rad. At a "
              "singular configuration the call returns <code>Discard</code> and NaN.</p>")
 
+    return _closing(o, table)
+
+
+def _closing(o: list[str], table: Table) -> str:
+    """The identity section shared by every documentation page, and the end."""
     o.append("<h2>Identity</h2>")
     o.append(f"<p>Model identifier <code>{_h(table.identifier)}</code>, instantiation token "
              f"(FMI 2 GUID) <code>{_h(table.token)}</code>: a hash of the variable table "
@@ -1387,14 +1392,7 @@ def drive_documentation(table: Table) -> str:
              "output that depends on the inputs at a communication point, "
              "<code>crank.epsilon</code>, is explicit in them (see the equation above).</p>")
 
-    o.append("<h2>Identity</h2>")
-    o.append(f"<p>Model identifier <code>{_h(table.identifier)}</code>, instantiation token "
-             f"(FMI 2 GUID) <code>{_h(table.token)}</code>: a hash of the variable table "
-             "<code>" + _h(table.path.name) + "</code>, from which this page, both model "
-             "descriptions and the FMU's C variable table are generated.</p>")
-    o.append("</body>")
-    o.append("</html>")
-    return "\n".join(o) + "\n"
+    return _closing(o, table)
 
 
 # ---------------------------------------------------------------------------
