@@ -3,29 +3,16 @@
 #define DYADFMU_INTERNAL_H
 
 #include "dyadfmu/dyad.h"
+#include "dyadfmu/loaded.h"
 #include "dyadfmu/vec2.h"
 
 #include <math.h>
 #include <stddef.h>
 
-/* A link ready for the formulas: its frame, length, centre of mass, and the
- * resultant F_g, M_g of active load, weight and inertia at the centre of mass. */
-typedef struct dyad_body {
-    dyad_vec2 i;   /* i_g, normalised (-) */
-    dyad_vec2 j;   /* j_g = k0 x i_g (-) */
-    dyad_real l;   /* l_g (m) */
-    dyad_vec2 com; /* (x_S, y_S) in the link frame (m) */
-    dyad_vec2 f;   /* F_g, global frame (N) */
-    dyad_real m;   /* M_g (N m) */
-    dyad_real m_d; /* moment of F_g and M_g about D_g (N m), see dyad_resultant */
-} dyad_body;
-
-typedef struct dyad_prepared {
-    dyad_body m;
-    dyad_body n;
-    dyad_vec2 i_k, j_k; /* guide at D_m, where D_m is translational */
-    dyad_vec2 i_p, j_p; /* guide at D_n, where D_n is translational */
-} dyad_prepared;
+/* A link ready for the formulas, and the dyad: the public dyad_loaded of
+ * dyadfmu/loaded.h, under the names the formulas were written with. */
+typedef dyad_loaded_link dyad_body;
+typedef dyad_loaded dyad_prepared;
 
 
 
@@ -163,7 +150,7 @@ static inline int dyad_link_in_domain(const dyad_link* link, int may_be_zero)
  * number for being finite: an infinite or NaN load, kinematic quantity, mass
  * or inertia always reaches the reactions as inf or NaN (IEEE arithmetic keeps
  * them through every sum and product, and no input but a length divides), so
- * dyad_finish sees it and asks first_bad_field to name it. That keeps the
+ * dyad_name_failure sees it and asks first_bad_field to name it. That keeps the
  * common path to a handful of comparisons. */
 static inline dyad_field dyad_validate(dyad_type type, const dyad_input* in)
 {
@@ -221,34 +208,28 @@ static inline dyad_status dyad_prepare(dyad_type type, const dyad_input* input,
     prepared->i_p =
         dyad_guide_used(type, DYAD_PAIR_DN) ? dyad_unit_of(input->guide_p) : dyad_vec2_make(0, 0);
     prepared->j_p = dyad_perp(prepared->i_p);
+    prepared->singular_threshold = input->singular_threshold;
     dyad_fill_outputs(result, 0);
     result->status = DYAD_STATUS_OK;
     result->field = DYAD_FIELD_NONE;
     return DYAD_STATUS_OK;
 }
 
-static inline dyad_status dyad_accept_conditioning(dyad_type type, const dyad_input* input,
-                                                   dyad_real denominator,
-                                                   dyad_real conditioning,
-                                                   dyad_result* result)
+/* Stores the conditioning; below the threshold (or NaN) the dyad is singular. */
+static inline dyad_status dyad_accept_conditioning(dyad_real threshold, dyad_real denominator,
+                                                   dyad_real conditioning, dyad_result* result)
 {
     result->denominator = denominator;
     result->conditioning = conditioning;
     result->amplification = 1 / conditioning;
-    if (!(conditioning >= input->singular_threshold)) {
-        /* A NaN anywhere can land here too: name it rather than call it singular. */
-        const dyad_field bad = dyad_first_bad_field(type, input);
-        if (bad != DYAD_FIELD_NONE) {
-            result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
-            return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, bad);
-        }
+    if (!(conditioning >= threshold)) {
         return dyad_reject(result, DYAD_STATUS_SINGULAR, DYAD_FIELD_NONE);
     }
     return DYAD_STATUS_OK;
 }
 
-static inline dyad_status dyad_finish(dyad_type type, const dyad_input* input,
-                                      dyad_result* result)
+/* The last step of every type: a reaction that is not finite is out of range. */
+static inline dyad_status dyad_check_finite(dyad_result* result)
 {
     const dyad_result* r = result;
     /* x - x is 0 for a finite x and NaN otherwise: one sum tests all outputs. */
@@ -258,12 +239,39 @@ static inline dyad_status dyad_finish(dyad_type type, const dyad_input* input,
         (r->n_mk - r->n_mk) + (r->n_np - r->n_np) + (r->n_mn - r->n_mn) +
         (r->m_mk - r->m_mk) + (r->m_np - r->m_np) + (r->m_mn - r->m_mn);
     if (nonfinite != 0) {
+        return dyad_reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
+    }
+    return DYAD_STATUS_OK;
+}
+
+/* dyad_solve_<type>: a NaN or infinite input reaches the conditioning or the
+ * reactions (the fast validation lets non-finite loads through), so a failure
+ * of the closed forms is first blamed on the input field that caused it. */
+static inline dyad_status dyad_name_failure(dyad_type type, const dyad_input* input,
+                                            dyad_status status, dyad_result* result)
+{
+    if (status != DYAD_STATUS_OK) {
         const dyad_field bad = dyad_first_bad_field(type, input);
         if (bad != DYAD_FIELD_NONE) {
             result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
             return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, bad);
         }
-        return dyad_reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
+    }
+    return status;
+}
+
+/* dyad_react_<type>: the result starts ok with zero outputs. */
+static inline dyad_status dyad_begin(const dyad_loaded* dyad, dyad_result* result)
+{
+    if (result == NULL) {
+        return DYAD_STATUS_INVALID_INPUT;
+    }
+    dyad_fill_outputs(result, 0);
+    result->status = DYAD_STATUS_OK;
+    result->field = DYAD_FIELD_NONE;
+    if (dyad == NULL) {
+        result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
+        return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_INPUT);
     }
     return DYAD_STATUS_OK;
 }

@@ -32,19 +32,15 @@
  */
 #include "dyad_internal.h"
 
-dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
+static inline dyad_status rrr_reactions(const dyad_loaded* p, dyad_result* result)
 {
-    dyad_prepared p;
-    dyad_status status = dyad_prepare(DYAD_RRR, input, &p, result);
-    const dyad_body* m = &p.m;
-    const dyad_body* n = &p.n;
+    const dyad_body* m = &p->m;
+    const dyad_body* n = &p->n;
+    dyad_status status;
     dyad_real d, alpha, beta;
 
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
     d = dyad_dot(m->i, n->j);
-    status = dyad_accept_conditioning(DYAD_RRR, input, d, dyad_abs(d), result);
+    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
@@ -54,5 +50,21 @@ dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
     result->r_mn = dyad_combine(alpha, m->i, beta, m->j);
     result->r_mk = dyad_neg(dyad_add(result->r_mn, m->f));
     result->r_np = dyad_sub(result->r_mn, n->f);
-    return dyad_finish(DYAD_RRR, input, result);
+    return dyad_check_finite(result);
+}
+
+dyad_status dyad_react_rrr(const dyad_loaded* dyad, dyad_result* result)
+{
+    const dyad_status status = dyad_begin(dyad, result);
+    return status == DYAD_STATUS_OK ? rrr_reactions(dyad, result) : status;
+}
+
+dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    const dyad_status status = dyad_prepare(DYAD_RRR, input, &p, result);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    return dyad_name_failure(DYAD_RRR, input, rrr_reactions(&p, result), result);
 }

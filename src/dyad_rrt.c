@@ -31,29 +31,41 @@
  */
 #include "dyad_internal.h"
 
-dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
+static inline dyad_status rrt_reactions(const dyad_loaded* p, dyad_result* result)
 {
-    dyad_prepared p;
-    dyad_status status = dyad_prepare(DYAD_RRT, input, &p, result);
-    const dyad_body* m = &p.m;
-    const dyad_body* n = &p.n;
+    const dyad_body* m = &p->m;
+    const dyad_body* n = &p->n;
+    dyad_status status;
     dyad_real d, tau, gamma;
 
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-    d = dyad_dot(n->i, p.i_k);
-    status = dyad_accept_conditioning(DYAD_RRT, input, d, dyad_abs(d), result);
+    d = dyad_dot(n->i, p->i_k);
+    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
 
     tau = dyad_load_moment_about_d(n) / n->l;
-    gamma = -(dyad_dot(m->f, p.i_k) + tau * dyad_dot(n->j, p.i_k)) / d;
+    gamma = -(dyad_dot(m->f, p->i_k) + tau * dyad_dot(n->j, p->i_k)) / d;
     result->r_mn = dyad_combine(gamma, n->i, tau, n->j);
-    result->n_mk = -dyad_dot(dyad_add(m->f, result->r_mn), p.j_k);
-    result->r_mk = dyad_scale(result->n_mk, p.j_k);
+    result->n_mk = -dyad_dot(dyad_add(m->f, result->r_mn), p->j_k);
+    result->r_mk = dyad_scale(result->n_mk, p->j_k);
     result->r_np = dyad_sub(result->r_mn, n->f);
     result->m_mk = -dyad_load_moment_about_d(m) - m->l * dyad_cross(m->i, result->r_mn);
-    return dyad_finish(DYAD_RRT, input, result);
+    return dyad_check_finite(result);
+}
+
+dyad_status dyad_react_rrt(const dyad_loaded* dyad, dyad_result* result)
+{
+    const dyad_status status = dyad_begin(dyad, result);
+    return status == DYAD_STATUS_OK ? rrt_reactions(dyad, result) : status;
+}
+
+dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    const dyad_status status = dyad_prepare(DYAD_RRT, input, &p, result);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    return dyad_name_failure(DYAD_RRT, input, rrt_reactions(&p, result), result);
 }

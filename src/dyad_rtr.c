@@ -43,24 +43,20 @@
  */
 #include "dyad_internal.h"
 
-dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result)
+static inline dyad_status rtr_reactions(const dyad_loaded* p, dyad_result* result)
 {
-    dyad_prepared p;
-    dyad_status status = dyad_prepare(DYAD_RTR, input, &p, result);
-    const dyad_body* m = &p.m;
-    const dyad_body* n = &p.n;
+    const dyad_body* m = &p->m;
+    const dyad_body* n = &p->n;
+    dyad_status status;
     dyad_vec2 dm_dn;
     dyad_real dist, spread, d, conditioning, n_mn;
 
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
     dm_dn = dyad_combine(m->l, m->i, -n->l, n->i);
     dist = dyad_length(dm_dn);
     spread = dist / (m->l + n->l);
     d = dist > 0 ? dyad_dot(dm_dn, m->i) / dist : 0; /* i_beta . i_m */
     conditioning = dyad_abs(d) < spread ? dyad_abs(d) : spread;
-    status = dyad_accept_conditioning(DYAD_RTR, input, d, conditioning, result);
+    status = dyad_accept_conditioning(p->singular_threshold, d, conditioning, result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
@@ -80,5 +76,21 @@ dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result)
             n->l * dyad_norm1(result->r_np) + dyad_load_moment_size(n, n->com.x - n->l);
         result->m_mn = terms_m <= terms_n ? via_m : via_n;
     }
-    return dyad_finish(DYAD_RTR, input, result);
+    return dyad_check_finite(result);
+}
+
+dyad_status dyad_react_rtr(const dyad_loaded* dyad, dyad_result* result)
+{
+    const dyad_status status = dyad_begin(dyad, result);
+    return status == DYAD_STATUS_OK ? rtr_reactions(dyad, result) : status;
+}
+
+dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    const dyad_status status = dyad_prepare(DYAD_RTR, input, &p, result);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    return dyad_name_failure(DYAD_RTR, input, rtr_reactions(&p, result), result);
 }

@@ -30,27 +30,23 @@
  */
 #include "dyad_internal.h"
 
-dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
+static inline dyad_status rtt_reactions(const dyad_loaded* p, dyad_result* result)
 {
-    dyad_prepared p;
-    dyad_status status = dyad_prepare(DYAD_RTT, input, &p, result);
-    const dyad_body* m = &p.m;
-    const dyad_body* n = &p.n;
+    const dyad_body* m = &p->m;
+    const dyad_body* n = &p->n;
+    dyad_status status;
     dyad_real d;
 
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-    d = dyad_dot(p.j_k, m->i);
-    status = dyad_accept_conditioning(DYAD_RTT, input, d, dyad_abs(d), result);
+    d = dyad_dot(p->j_k, m->i);
+    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
 
     result->n_mk = -dyad_dot(m->f, m->i) / d;
-    result->n_mn = dyad_dot(m->f, p.i_k) / d;
+    result->n_mn = dyad_dot(m->f, p->i_k) / d;
 
-    result->r_mk = dyad_scale(result->n_mk, p.j_k);
+    result->r_mk = dyad_scale(result->n_mk, p->j_k);
     result->r_mn = dyad_scale(result->n_mn, m->j);
     /* Where one link outweighs the other, the sums over the light one keep
      * their digits; the two forms of each are equal in exact arithmetic. */
@@ -82,5 +78,21 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
             m->l * dyad_norm1(result->r_mn) + dyad_load_moment_size(m, m->com.x);
         result->m_mk = terms_e <= terms_d ? about_e : about_d;
     }
-    return dyad_finish(DYAD_RTT, input, result);
+    return dyad_check_finite(result);
+}
+
+dyad_status dyad_react_rtt(const dyad_loaded* dyad, dyad_result* result)
+{
+    const dyad_status status = dyad_begin(dyad, result);
+    return status == DYAD_STATUS_OK ? rtt_reactions(dyad, result) : status;
+}
+
+dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    const dyad_status status = dyad_prepare(DYAD_RTT, input, &p, result);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    return dyad_name_failure(DYAD_RTT, input, rtt_reactions(&p, result), result);
 }

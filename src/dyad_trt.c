@@ -19,34 +19,46 @@
  */
 #include "dyad_internal.h"
 
-dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
+static inline dyad_status trt_reactions(const dyad_loaded* p, dyad_result* result)
 {
-    dyad_prepared p;
-    dyad_status status = dyad_prepare(DYAD_TRT, input, &p, result);
-    const dyad_body* m = &p.m;
-    const dyad_body* n = &p.n;
+    const dyad_body* m = &p->m;
+    const dyad_body* n = &p->n;
+    dyad_status status;
     dyad_real d;
     dyad_vec2 f_sum;
 
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-    d = dyad_dot(p.j_k, p.i_p);
-    status = dyad_accept_conditioning(DYAD_TRT, input, d, dyad_abs(d), result);
+    d = dyad_dot(p->j_k, p->i_p);
+    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
 
     f_sum = dyad_add(m->f, n->f);
-    result->n_mk = -dyad_dot(f_sum, p.i_p) / d;
-    result->n_np = dyad_dot(f_sum, p.i_k) / d;
+    result->n_mk = -dyad_dot(f_sum, p->i_p) / d;
+    result->n_np = dyad_dot(f_sum, p->i_k) / d;
 
-    result->r_mk = dyad_scale(result->n_mk, p.j_k);
-    result->r_np = dyad_scale(result->n_np, p.j_p);
+    result->r_mk = dyad_scale(result->n_mk, p->j_k);
+    result->r_np = dyad_scale(result->n_np, p->j_p);
     result->r_mn = dyad_smaller_sum(
         dyad_neg(dyad_add(result->r_mk, m->f)), dyad_norm1(result->r_mk) + dyad_norm1(m->f),
         dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
     result->m_np = n->l * dyad_cross(n->i, result->r_np) - dyad_load_moment_about_e(n);
-    return dyad_finish(DYAD_TRT, input, result);
+    return dyad_check_finite(result);
+}
+
+dyad_status dyad_react_trt(const dyad_loaded* dyad, dyad_result* result)
+{
+    const dyad_status status = dyad_begin(dyad, result);
+    return status == DYAD_STATUS_OK ? trt_reactions(dyad, result) : status;
+}
+
+dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    const dyad_status status = dyad_prepare(DYAD_TRT, input, &p, result);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    return dyad_name_failure(DYAD_TRT, input, trt_reactions(&p, result), result);
 }

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "dyadfmu/dyad.h"
+#include "dyadfmu/loaded.h"
 #include "dyadfmu/vec2.h"
 #include "named_tests.h"
 
@@ -26,11 +27,15 @@
 #define RESIDUAL_LIMIT 1e-5
 #define HAND_LIMIT 1e-5
 #define HUGE_REAL 1e30f
+/* The test reduces the loads in double, the float core in float: the two
+ * roundings of terms up to 1e3 times the reactions differ by that much. */
+#define REACT_LIMIT 1e-4
 #else
 #define REAL_NAME "double"
 #define RESIDUAL_LIMIT 1e-12
 #define HAND_LIMIT 1e-12
 #define HUGE_REAL 1e300
+#define REACT_LIMIT 1e-12
 #endif
 
 #define RANDOM_CONFIGURATIONS 10000
@@ -867,6 +872,113 @@ static int test_invalid_before_singular(void)
 
 /* ---- runner --------------------------------------------------------------- */
 
+/* ---- the closed forms on reduced loads (dyadfmu/loaded.h) ---------------- */
+
+/* Link g reduced by hand: a_S = a_D + (i eps - omega^2) r in complex numbers,
+ * F = force + m (g - a_S), M = moment - J eps, and the moment about D. */
+static dyad_loaded_link loaded_link_of(const dyad_link* link, dyad_vec2 gravity)
+{
+    const double complex i_g = unit(link->dir);
+    const double complex r = ((double)link->com.x + I * (double)link->com.y) * i_g;
+    const double complex a_s = cvec(link->accel_d) +
+                               (I * (double)link->epsilon - (double)link->omega * link->omega) * r;
+    const double complex f = cvec(link->force) + (double)link->mass * (cvec(gravity) - a_s);
+    const double m = (double)link->moment - (double)link->inertia * link->epsilon;
+    dyad_loaded_link out;
+    out.i = vec(creal(i_g), cimag(i_g));
+    out.j = vec(-cimag(i_g), creal(i_g));
+    out.l = link->length;
+    out.com = link->com;
+    out.f = vec(creal(f), cimag(f));
+    out.m = (dyad_real)m;
+    out.m_d = (dyad_real)(m + creal(r) * cimag(f) - cimag(r) * creal(f));
+    return out;
+}
+
+static double result_distance(const dyad_result* a, const dyad_result* b)
+{
+    const double d[] = {a->r_mk.x - b->r_mk.x, a->r_mk.y - b->r_mk.y, a->r_np.x - b->r_np.x,
+                        a->r_np.y - b->r_np.y, a->r_mn.x - b->r_mn.x, a->r_mn.y - b->r_mn.y,
+                        a->n_mk - b->n_mk,     a->n_np - b->n_np,     a->n_mn - b->n_mn,
+                        a->m_mk - b->m_mk,     a->m_np - b->m_np,     a->m_mn - b->m_mn};
+    const double s[] = {a->r_mk.x, a->r_mk.y, a->r_np.x, a->r_np.y, a->r_mn.x, a->r_mn.y,
+                        a->n_mk,   a->n_np,   a->n_mn,   a->m_mk,   a->m_np,   a->m_mn};
+    double worst = 0, scale = 0;
+    size_t k;
+    for (k = 0; k < sizeof d / sizeof d[0]; ++k) {
+        worst = fabs(d[k]) > worst ? fabs(d[k]) : worst;
+        scale = fabs(s[k]) > scale ? fabs(s[k]) : scale;
+    }
+    return worst / (scale > 0 ? scale : 1);
+}
+
+static int test_react_loaded(void)
+{
+    static dyad_status (*const react[DYAD_TYPE_COUNT])(const dyad_loaded*, dyad_result*) = {
+        dyad_react_rrr, dyad_react_rrt, dyad_react_rtr, dyad_react_trt, dyad_react_rtt};
+    int fails = 0;
+    int t;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x10ADED00u + (uint64_t)t};
+        double worst = 0;
+        int solved = 0, singular = 0;
+        while (solved < 2000) {
+            const dyad_input in = random_input(&r, type);
+            dyad_loaded loaded;
+            dyad_result want, got;
+            loaded.m = loaded_link_of(&in.m, in.gravity);
+            loaded.n = loaded_link_of(&in.n, in.gravity);
+            loaded.i_k = in.guide_k;
+            loaded.j_k = vec(-in.guide_k.y, in.guide_k.x);
+            loaded.i_p = in.guide_p;
+            loaded.j_p = vec(-in.guide_p.y, in.guide_p.x);
+            loaded.singular_threshold = independent_conditioning(type, &in) < WELL_CONDITIONED
+                                            ? (dyad_real)0.99
+                                            : in.singular_threshold;
+            dyad_solve(type, &in, &want);
+            react[t](&loaded, &got);
+            if (loaded.singular_threshold > (dyad_real)0.9) {
+                /* a threshold no conditioning reaches: singular, NaN outputs */
+                ++singular;
+                CHECK(got.status == DYAD_STATUS_SINGULAR && all_outputs_nan(&got),
+                      "%s: status %s with a threshold of 0.99", dyad_type_name(type),
+                      dyad_status_name(got.status));
+                continue;
+            }
+            if (want.status != DYAD_STATUS_OK) {
+                continue;
+            }
+            ++solved;
+            CHECK(got.status == DYAD_STATUS_OK, "%s: status %s", dyad_type_name(type),
+                  dyad_status_name(got.status));
+            CHECK(fabs((double)got.conditioning - (double)want.conditioning) <=
+                      64 * DYAD_REAL_EPSILON,
+                  "%s: conditioning %.9g, dyad_solve %.9g", dyad_type_name(type),
+                  (double)got.conditioning, (double)want.conditioning);
+            {
+                /* the two reductions round differently; the closed forms amplify that */
+                const double distance = result_distance(&want, &got) / (double)want.amplification;
+                worst = distance > worst ? distance : worst;
+            }
+        }
+        printf("    %s %s: %d solved, %d singular; worst difference from dyad_solve %.3e of the "
+               "largest reaction times the amplification\n",
+               dyad_type_name(type), REAL_NAME, solved, singular, worst);
+        CHECK(worst < REACT_LIMIT, "%s: dyad_react differs from dyad_solve by %.3e",
+              dyad_type_name(type), worst);
+        {
+            dyad_result out;
+            CHECK(react[t](NULL, &out) == DYAD_STATUS_INVALID_INPUT &&
+                      out.field == DYAD_FIELD_INPUT && all_outputs_nan(&out),
+                  "%s: a NULL dyad is not rejected", dyad_type_name(type));
+            CHECK(react[t](NULL, NULL) == DYAD_STATUS_INVALID_INPUT, "%s: NULL result",
+                  dyad_type_name(type));
+        }
+    }
+    return fails;
+}
+
 static const named_test tests[] = {
     {"equilibrium_random", test_equilibrium_random},
     {"rrr_symmetric_truss", test_rrr_symmetric_truss},
@@ -881,6 +993,7 @@ static const named_test tests[] = {
     {"out_of_range", test_out_of_range},
     {"singular", test_singular},
     {"invalid_before_singular", test_invalid_before_singular},
+    {"react_loaded", test_react_loaded},
 };
 
 int main(int argc, char** argv)

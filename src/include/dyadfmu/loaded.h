@@ -1,0 +1,59 @@
+/* dyadfmu: the closed forms on a dyad whose loads are already reduced.
+ *
+ * dyad_solve_<type> validates a dyad_input, reduces each link's active load,
+ * weight and inertia to a resultant, and then applies the type's closed forms.
+ * The functions here are that last step alone. They serve a caller that forms
+ * the resultants itself: a mechanism of several dyads, where the reactions of
+ * a later dyad load the links of an earlier one, or generated code that knows
+ * at compile time which terms of the resultant exist (no inertia in a static
+ * scene, no weight without gravity) and so never computes the others.
+ *
+ * They do no input validation: the caller guarantees finite values, unit
+ * directions with j = k0 x i, and lengths in the type's domain
+ * (dyad_length_may_be_zero). The status is DYAD_STATUS_OK, DYAD_STATUS_SINGULAR
+ * (conditioning below the threshold) or DYAD_STATUS_OUT_OF_RANGE (a reaction is
+ * not finite); outputs are NaN unless ok, as with dyad_solve.
+ */
+#ifndef DYADFMU_LOADED_H
+#define DYADFMU_LOADED_H
+
+#include "dyadfmu/types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** One link of a dyad with the resultant of everything acting on it except the
+ *  reactions of its own three pairs. */
+typedef struct dyad_loaded_link {
+    dyad_vec2 i;    /**< i_g: unit vector from D_g towards E, global frame (-) */
+    dyad_vec2 j;    /**< j_g = k0 x i_g (-) */
+    dyad_real l;    /**< l_g = |D_g E| (m) */
+    /** (x_S, y_S) in the link frame (m). Only weighs the round-off of two
+     *  equivalent sums where a type offers both (RTR, RTT); zero is valid. */
+    dyad_vec2 com;
+    dyad_vec2 f;    /**< resultant force F_g, global frame (N) */
+    dyad_real m;    /**< resultant moment about the centre of mass S_g (N m) */
+    dyad_real m_d;  /**< moment of all those loads about D_g (N m) */
+} dyad_loaded_link;
+
+/** A dyad ready for its closed forms. */
+typedef struct dyad_loaded {
+    dyad_loaded_link m;           /**< link m, paired with k at D_m */
+    dyad_loaded_link n;           /**< link n, paired with p at D_n */
+    dyad_vec2 i_k, j_k;           /**< guide at D_m and its normal (-), where D_m slides */
+    dyad_vec2 i_p, j_p;           /**< guide at D_n and its normal (-), where D_n slides */
+    dyad_real singular_threshold; /**< as dyad_input.singular_threshold (-) */
+} dyad_loaded;
+
+dyad_status dyad_react_rrr(const dyad_loaded* dyad, dyad_result* result);
+dyad_status dyad_react_rrt(const dyad_loaded* dyad, dyad_result* result);
+dyad_status dyad_react_rtr(const dyad_loaded* dyad, dyad_result* result);
+dyad_status dyad_react_trt(const dyad_loaded* dyad, dyad_result* result);
+dyad_status dyad_react_rtt(const dyad_loaded* dyad, dyad_result* result);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DYADFMU_LOADED_H */
