@@ -55,8 +55,12 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 GOLDEN_DIR = HERE / "golden"
-TABLES = ("dyad_rrr.toml", "dyad_rrt.toml", "dyad_rtr.toml", "dyad_trt.toml", "dyad_rtt.toml",
-          "drive.toml")
+#: The variable tables written by hand; the dyad FMUs' tables come from their scenes.
+TABLES = ("drive.toml",)
+#: The scenes of the generic per-type dyad FMUs, whose model descriptions are golden.
+GOLDEN_SCENES = ("dyad_rrr.toml", "dyad_rrt.toml", "dyad_rtr.toml", "dyad_trt.toml",
+                 "dyad_rtt.toml")
+SCENES_DIR = HERE.parent / "scenes"
 GENERATION_TOOL = "dyadfmu generate.py"
 
 # ---------------------------------------------------------------------------
@@ -117,6 +121,16 @@ DRIVE_LOG_CATEGORIES = (
     ("logStatusDiscard", "Discarded steps: a step that would need more than 1e7 integrator "
      "substeps, or a crank state that is no longer finite (the state stays at the step's "
      "start)"),
+    ("logCalls", "Calls into the FMU"),
+)
+
+#: The same categories as a scene uses them.
+SCENE_LOG_CATEGORIES = (
+    ("logStatusError", "Errors: illegal call sequences, bad arguments, values outside a "
+     "variable's range (the variable is named)"),
+    ("logStatusWarning", "Warnings, e.g. a singular dyad at exitInitializationMode"),
+    ("logStatusDiscard", "Discarded steps: a singular dyad (named) or overflowing reactions "
+     "(outputs NaN)"),
     ("logCalls", "Calls into the FMU"),
 )
 
@@ -195,16 +209,16 @@ class Entry:
     """One variable a dyad type has: where it lives and what it must look like."""
 
     def __init__(self, lives, name, causality, unit, value_type="Real", domain=None,
-                 depends=None):
+                 depends=None, description=None):
         self.lives = lives
         self.name = name
         self.causality = causality
         self.unit = unit
         self.value_type = value_type
         self.domain = domain or {}  # min, max, min_exclusive, max_exclusive
-        # An output's true dependencies (input names) where the generator knows them
-        # (the drive); None where a test derives them (the dyads).
+        # An output's true dependencies (input names) where the generator knows them.
         self.depends = depends
+        self.description = description
 
 
 def catalogue(dyad_type: str) -> dict[str, Entry]:
@@ -267,7 +281,29 @@ def catalogue(dyad_type: str) -> dict[str, Entry]:
         Entry("result.amplification", "amplification", "output", None),
         Entry("result.status", "status", "output", None, value_type="Integer"),
     ]
+    interface = dyad_interface()
+    texts = dict(interface["description"])
+    texts.update(interface["description"].get(dyad_type, {}))
+    independent = interface["independent"][dyad_type]
+    inputs = [entry.name for entry in entries if entry.causality == "input"]
+    for entry in entries:
+        entry.description = texts[entry.lives]
+        if entry.causality == "output":
+            entry.depends = tuple(name for name in inputs
+                                  if name not in independent[entry.name])
     return {entry.lives: entry for entry in entries}
+
+
+_INTERFACE = {}
+
+
+def dyad_interface() -> dict:
+    """modelDescription/dyad_interface.toml: the descriptions of the generic dyad FMUs'
+    variables and the inputs each output does not depend on."""
+    if not _INTERFACE:
+        with open(HERE / "dyad_interface.toml", "rb") as f:
+            _INTERFACE.update(tomllib.load(f))
+    return _INTERFACE
 
 
 def _absence_reason(dyad_type: str, lives: str) -> str:
@@ -407,9 +443,12 @@ def _parse_flat_lives(kind: Kind, struct: str, path: str, angle: bool) -> Lives:
     if path not in members:
         raise ValueError(f"{type_name} has no member '{path}' (members: "
                          f"{', '.join(members)})")
-    if angle:
-        raise ValueError(f"'@angle' applies only to the directions of a dyad; "
+    if angle and members[path] != "dir":
+        raise ValueError(f"'@angle' applies only to a direction; "
                          f"{type_name}.{path} is a plain double")
+    if members[path] == "dir" and not angle:
+        raise ValueError(f"{type_name}.{path} is a unit direction; write "
+                         f"'{struct}.{path}@angle' to set it from an angle")
     if members[path] == "state":
         raise ValueError(f"{type_name}.{path} is a state of the {kind.name}: it is set from "
                          f"'{_DRIVE_STATE_START[path]}' when initialization ends and advanced "
@@ -477,7 +516,14 @@ def load_table(path: Path) -> Table:
         raise TableError([f"{fname}: cannot read: {exc.strerror}"]) from None
     except tomllib.TOMLDecodeError as exc:
         raise TableError([f"{fname}: invalid TOML: {exc}"]) from None
+    return table_from_data(data, path)
 
+
+def table_from_data(data: dict, path: Path) -> Table:
+    """Validate a table already read (a file's, or one a scene generates); `path` names
+    it in messages and in the generated files."""
+    path = Path(path)
+    fname = path.name
     problems: list[str] = []
 
     def fail(message):
@@ -779,6 +825,11 @@ def _element(indent: int, tag: str, attributes: list[tuple[str, object]], close=
 
 
 def source_files(table: Table, fmi_functions: str) -> list[str]:
+    if table.kind.name == "scene":
+        types = sorted({d.type.lower() for d in table.scene.dyads})
+        return (["dyad_common.c"] + [f"dyad_{t}.c" for t in types] +
+                [f"{table.identifier}_scene.c", "fmu_instance.c", fmi_functions,
+                 f"{table.identifier}_model.c"])
     if table.kind is DRIVE:
         return ["fmu_drive.c", "fmu_instance.c", fmi_functions, f"{table.identifier}_model.c"]
     return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
@@ -808,7 +859,8 @@ def _unit_definitions(table: Table) -> list[str]:
 
 
 def _common_tail(table: Table) -> list[str]:
-    categories = LOG_CATEGORIES if table.kind is DYAD else DRIVE_LOG_CATEGORIES
+    categories = (LOG_CATEGORIES if table.kind is DYAD else
+                  SCENE_LOG_CATEGORIES if table.kind.name == "scene" else DRIVE_LOG_CATEGORIES)
     lines = ["  <LogCategories>"]
     lines += [_element(2, "Category", [("name", n), ("description", d)]) for n, d in categories]
     lines.append("  </LogCategories>")
@@ -985,10 +1037,14 @@ def _bounds_flags(v: Variable) -> str:
 def model_c(table: Table) -> str:
     causality = {"input": "FMU_INPUT", "parameter": "FMU_PARAMETER", "output": "FMU_OUTPUT"}
     value_type = {"Real": "FMU_REAL", "Integer": "FMU_INTEGER"}
-    what = f"the {table.type} dyad FMU" if table.kind is DYAD else "the crank drive FMU"
+    what = (f"the {table.type} dyad FMU" if table.kind is DYAD else
+            f"the scene {table.identifier}" if table.kind.name == "scene" else
+            "the crank drive FMU")
+    source = (f"scene {table.path.name}" if table.kind.name == "scene" else
+              f"modelDescription/{table.path.name}")
     lines = [
         f"/* {table.identifier}_model.c: the variable table of {what}.",
-        f" * Generated by modelDescription/generate.py from modelDescription/{table.path.name};",
+        f" * Generated by modelDescription/generate.py from {source};",
         " * do not edit: change the table and regenerate. The model descriptions are",
         " * generated from the same table, with the same instantiation token. */",
         "#include <stddef.h>",
@@ -1424,10 +1480,16 @@ def _shown(path: Path) -> str:
 
 
 def golden_files() -> dict[Path, str]:
-    """Golden path -> expected text for every table in TABLES."""
+    """Golden path -> expected text for every table in TABLES and scene in GOLDEN_SCENES."""
+    # The scene generator builds on this module: let it find this very instance
+    # (when run as a script, this module is __main__, not generate).
+    sys.modules.setdefault("generate", sys.modules[__name__])
+    sys.path.insert(0, str(HERE))
+    import scene
     result = {}
-    for name in TABLES:
-        table = load_table(HERE / name)
+    tables = [load_table(HERE / name) for name in TABLES]
+    tables += [scene.build_table(scene.load_scene(SCENES_DIR / name)) for name in GOLDEN_SCENES]
+    for table in tables:
         result[GOLDEN_DIR / f"{table.identifier}_fmi2.xml"] = fmi2_model_description(table)
         result[GOLDEN_DIR / f"{table.identifier}_fmi3.xml"] = fmi3_model_description(table)
     return result

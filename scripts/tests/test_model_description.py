@@ -22,6 +22,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import tomllib
 from pathlib import Path
 
@@ -37,11 +38,15 @@ for _p in (str(MD_DIR), str(ROOT / "scripts")):
         sys.path.insert(0, _p)
 
 import generate  # noqa: E402
+import scene  # noqa: E402
 from dyadfmu import reference as ref  # noqa: E402
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}  # D_m, E, D_n
-TABLE_OF = {t: MD_DIR / f"dyad_{t.lower()}.toml" for t in TYPES}
+SCENES_DIR = ROOT / "scenes"
+#: The generic dyad FMUs' variable tables, as the scene generator makes them from
+#: scenes/dyad_<type>.toml, written to files (filled at the end of this module).
+TABLE_OF: dict = {}
 
 
 def load_raw(dyad_type):
@@ -728,14 +733,21 @@ def generated_drive(tmp_path_factory):
     return out
 
 
-def test_tables_are_the_five_dyads_and_the_drive():
-    """Every table in modelDescription is generated and golden-checked; only the dyad
-    tables go through the dyad-only tests (dependency derivation, reference solve)."""
+def test_tables_are_the_drive_and_the_scenes_of_the_five_dyads():
+    """The drive's table is the one written by hand; the dyads' tables come from their
+    scenes, and both are golden-checked. Only the dyad tables go through the dyad-only
+    tests (dependency derivation, reference solve)."""
     on_disk = {p.name for p in MD_DIR.glob("*.toml")}
-    assert set(generate.TABLES) == on_disk
-    assert on_disk - {p.name for p in TABLE_OF.values()} == {"drive.toml"}
+    assert on_disk == {"drive.toml", "dyad_interface.toml"}
+    assert generate.TABLES == ("drive.toml",)
+    assert {p.name for p in TABLE_OF.values()} == set(generate.GOLDEN_SCENES)
+    assert all((SCENES_DIR / name).is_file() for name in generate.GOLDEN_SCENES)
     assert generate.load_table(DRIVE_TABLE).kind is generate.DRIVE
     assert all(generate.load_table(p).kind is generate.DYAD for p in TABLE_OF.values())
+    for t in TYPES:
+        built = scene.build_table(scene.load_scene(SCENES_DIR / f"dyad_{t.lower()}.toml"))
+        assert built.kind is generate.DYAD and built.type == t
+        assert built.token == generate.load_table(TABLE_OF[t]).token
 
 
 def test_drive_generator_writes_every_file(generated_drive):
@@ -1135,3 +1147,14 @@ def test_unmodified_drive_copy_is_accepted(tmp_path):
     proc = run_generator(table, "--out", tmp_path / "out")
     assert proc.returncode == 0, proc.stderr
     assert generate.load_table(table).token == generate.load_table(DRIVE_TABLE).token
+
+
+def _write_generic_tables():
+    out = Path(tempfile.mkdtemp(prefix="dyadfmu_tables_"))
+    for t in TYPES:
+        path = out / f"dyad_{t.lower()}.toml"
+        write_toml(scene.generic_data(scene.load_scene(SCENES_DIR / path.name)), path)
+        TABLE_OF[t] = path
+
+
+_write_generic_tables()

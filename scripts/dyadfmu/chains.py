@@ -1,0 +1,870 @@
+"""Multi-dyad planar linkages ("chains"): a crank followed by several Assur dyads, with
+exact kinematics, active loads and a whole-mechanism Newton-Euler reference for their
+joint reactions.
+
+==========  ===============================================================================
+name        mechanism (scene file ``scenes/<name>.toml``)
+==========  ===============================================================================
+shaper      crank; dyad ``slot`` (RTR): slotted lever on the frame at O2 and a block on the
+            crank pin; dyad ``ram`` (RRT): ram on a horizontal frame guide, rod from the
+            lever's tip B to the ram's pin C. Cutting force on the ram.
+sixbar      Watt II: crank; dyad ``first`` (RRR): coupler A-B and rocker C-B; dyad
+            ``second`` (RRR): connector D-F from a point D of the rocker, output rocker G-F.
+            Resisting torque on the output rocker.
+==========  ===============================================================================
+
+The scene file gives the topology, lengths, mass properties, points of attachment on
+links and which links carry loads; ``chains.toml`` next to this module gives the rest
+(fixed pivots and guides, assembly branches, crank motion, load model constants).
+
+Conventions (those of the FMUs): global frame x, y, z out of the plane; angles
+counter-clockwise from +x; moments are z components. The crank turns about O = (0, 0),
+its frame is {O; i_c, j_c} with i_c = (cos phi, sin phi), j_c = k x i_c, its pin is
+A = O + r i_c. Link g of a dyad has the frame {D_g; i_g, j_g}, i_g from D_g towards E,
+E = D_m + l_m i_m = D_n + l_n i_n; all these frames are fixed in their links. Its centre
+of mass is S_g = D_g + com[0] i_g + com[1] j_g. ``<g>.accel_d`` is the acceleration of
+the material point of g at D_g. Pair kinds at (D_m, E, D_n): RRR (R, R, R), RRT (T on
+the guide of link k, R, R), RTR (R, T along i_m, R).
+
+Kinematics is exact: circle-circle intersection (RRR), circle-line intersection (RRT)
+and atan2 (RTR) for positions, and the loop equations differentiated once and twice in
+closed form and solved as 2 x 2 linear systems for velocities and accelerations.
+
+:meth:`Chain.reference` writes the Newton-Euler equations of every moving body (crank
+included), with weights, active loads and d'Alembert forces, and solves the square
+linear system for all pair reactions and the crank's driving torque at once.
+
+Example::
+
+    chain = load("shaper")
+    motion = chain.motion("constant", revolutions=1)
+    t = np.linspace(0, motion.duration, 361)
+    kin = chain.kinematics(t, motion)
+    out = chain.reference(kin)
+    assert chain.residuals(kin, out).max() < 1e-12
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+from importlib import resources
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
+    import tomli as tomllib
+
+from .mechanisms import CrankMotion, _rotating
+
+__all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
+
+#: The chain mechanisms.
+NAMES = ("shaper", "sixbar")
+
+#: Dyad types handled, with the pair kinds at (D_m, E, D_n).
+PAIR_KINDS = {"RRR": ("R", "R", "R"), "RRT": ("T", "R", "R"), "RTR": ("R", "T", "R")}
+
+#: Output tag of each pair: D_m joins m and k, E joins m and n, D_n joins n and p.
+_TAGS = (("D_m", "mk"), ("E", "mn"), ("D_n", "np"))
+
+
+# ---------------------------------------------------------------------------
+# vector helpers on arrays of shape (..., 2)
+# ---------------------------------------------------------------------------
+def _unit(angle):
+    angle = np.asarray(angle, dtype=float)
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def _rot90(v):
+    """k x v."""
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def _dot(a, b):
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+def _cross(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _col(x):
+    return np.asarray(x, dtype=float)[..., None]
+
+
+def _norm(v):
+    return np.hypot(v[..., 0], v[..., 1])
+
+
+def _angle(v):
+    return np.arctan2(v[..., 1], v[..., 0])
+
+
+def _solve2(c1, c2, rhs):
+    """x, y with x c1 + y c2 = rhs (Cramer's rule), batched over the leading axis."""
+    det = _cross(c1, c2)
+    return _cross(rhs, c2) / det, _cross(c1, rhs) / det
+
+
+# ---------------------------------------------------------------------------
+# data
+# ---------------------------------------------------------------------------
+def scene_path(name) -> Path:
+    """The scene file of mechanism ``name``: ``scenes/<name>.toml`` of the project."""
+    if name not in NAMES:
+        raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
+    return Path(__file__).resolve().parents[2] / "scenes" / f"{name}.toml"
+
+
+def default_data() -> dict:
+    """The packaged ``chains.toml`` as a dict (a fresh copy)."""
+    text = resources.files(__package__ or "dyadfmu").joinpath("chains.toml").read_text("utf-8")
+    return tomllib.loads(text)
+
+
+def _merge(base, over):
+    out = copy.deepcopy(base)
+    for key, value in over.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def _number(table, key, where, positive=False, nonnegative=False, default=None):
+    if key not in table:
+        if default is not None:
+            return float(default)
+        raise ValueError(f"{where}: missing key {key!r}")
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{where}.{key}: expected a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise ValueError(f"{where}.{key}: must be > 0, got {value!r}")
+    if nonnegative and value < 0:
+        raise ValueError(f"{where}.{key}: must be >= 0, got {value!r}")
+    return float(value)
+
+
+def _pair(table, key, where):
+    value = table.get(key)
+    if value is None:
+        raise ValueError(f"{where}: missing key {key!r}")
+    try:
+        x, y = (float(c) for c in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}.{key}: expected two numbers, got {value!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ValueError(f"{where}.{key}: expected finite numbers, got {value!r}")
+    return (x, y)
+
+
+def _sign(table, key, where):
+    value = _number(table, key, where)
+    if value not in (1.0, -1.0):
+        raise ValueError(f"{where}.{key}: expected +1 or -1, got {value!r}")
+    return value
+
+
+# ---------------------------------------------------------------------------
+# the chains
+# ---------------------------------------------------------------------------
+class Chain:
+    """A crank plus the dyads of a scene file, with the harness data of ``chains.toml``.
+
+    Attributes: ``name``; ``scene`` (the parsed scene file); ``data`` (this chain's table
+    of ``chains.toml``, after overrides); ``dyads`` (the scene's [[dyad]] tables, in
+    order); ``links`` (name -> the scene's [[link]] table, with ``length`` where it is
+    constant); ``crank`` (the scene's [crank] table); ``gravity`` (gx, gy) [m/s2];
+    ``effects`` {"inertia": bool, "gravity": bool}; ``plan`` (the dyads resolved: per
+    dyad its name, type, links m and n, the attachments k and p, lengths and branch);
+    ``pairs`` (every pair of the mechanism, crank pivot first, as used by
+    :meth:`reference`); ``bodies`` (the moving bodies: the crank, then the dyads' links).
+    """
+
+    def __init__(self, name: str, scene: Mapping, table: Mapping):
+        self.name = name
+        self.scene = copy.deepcopy(dict(scene))
+        self.data = copy.deepcopy(dict(table))
+        self.description = str(self.data.get("description", name))
+        where = f"scene {name}"
+
+        crank = self.scene.get("crank")
+        if not isinstance(crank, Mapping):
+            raise ValueError(f"{where}: missing table [crank]")
+        self.crank = dict(crank)
+        self.crank_name = str(crank.get("name", "crank"))
+        w = f"{where}.crank"
+        self._r = _number(crank, "length", w, positive=True)
+        self._crank_mass = _number(crank, "mass", w, nonnegative=True)
+        self._crank_inertia = _number(crank, "inertia", w, nonnegative=True)
+        self._crank_com = _pair(crank, "com", w)
+
+        grav = self.scene.get("gravity", {})
+        self.gravity = (_number(grav, "x", f"{where}.gravity"), _number(grav, "y", f"{where}.gravity"))
+        eff = self.scene.get("effects", {})
+        self.effects = {"inertia": bool(eff.get("inertia", True)), "gravity": bool(eff.get("gravity", True))}
+        #: gravity as it enters the dynamics and the potential energy
+        self._g = np.array(self.gravity if self.effects["gravity"] else (0.0, 0.0))
+
+        self.links = {}
+        for lt in self.scene.get("link", []):
+            lname = str(lt.get("name", ""))
+            if not lname or lname in self.links or lname in (self.crank_name, "frame"):
+                raise ValueError(f"{where}: bad or repeated link name {lname!r}")
+            wl = f"{where}.link[{lname}]"
+            link = dict(lt)
+            link["mass"] = _number(lt, "mass", wl, nonnegative=True)
+            link["inertia"] = _number(lt, "inertia", wl, nonnegative=True)
+            link["com"] = _pair(lt, "com", wl)
+            self.links[lname] = link
+        self.dyads = [dict(d) for d in self.scene.get("dyad", [])]
+        if not self.dyads:
+            raise ValueError(f"{where}: no [[dyad]]")
+
+        md = self.data.get("motion", {})
+        wm = f"{name}.motion"
+        self._w0 = _number(md, "omega", wm, positive=True)
+        self._variation = _number(md, "variation", wm, default=0.3)
+        if not 0.0 <= self._variation < 1.0:
+            raise ValueError(f"{wm}.variation: must be in [0, 1), got {self._variation!r}")
+        self._phi0 = _number(md, "phi0", wm, default=0.0)
+
+        self._resolve_dyads()
+        self._resolve_loads()
+        self.labels = {"O": "O", "A": "A"}
+        for key, value in (self.data.get("labels") or {}).items():
+            self.labels[str(key)] = str(value)
+        self._build_pairs()
+        self._frame_cache = None
+        # every dyad must assemble over a full crank turn
+        self._sweep()
+
+    # ---- resolution of the scene ------------------------------------------
+    def _attachment(self, spec, dyad, pair, done):
+        """The external link carrying pair ``pair`` ("D_m" or "D_n") of ``dyad``."""
+        where = f"scene {self.name}.dyad[{dyad}].{'k' if pair == 'D_m' else 'p'}"
+        frame = (self.data.get("frame") or {}).get(dyad, {}).get(pair)
+        if spec == "frame":
+            if not isinstance(frame, Mapping):
+                raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
+                                 f"(the scene puts {dyad}.{pair} on the frame)")
+            pos = _pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
+            return {"kind": "pivot", "body": None, "position": pos,
+                    "label": str(frame.get("label", f"{dyad}.{pair}"))}
+        if spec == "crank" or spec == self.crank_name:
+            return {"kind": "point", "body": self.crank_name, "at": (self._r, 0.0), "label": "A"}
+        if isinstance(spec, Mapping):
+            body = spec.get("link")
+            if body == "frame":
+                if "guide" not in spec:
+                    raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
+                angle = _number(spec, "guide", where)
+                if not isinstance(frame, Mapping):
+                    raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing guide height "
+                                     f"(the scene puts {dyad}.{pair} on a frame guide)")
+                h = _number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
+                return {"kind": "guide", "body": None, "angle": angle, "height": h,
+                        "label": str(frame.get("label", f"{dyad}.{pair}"))}
+            if body == "crank":
+                body = self.crank_name
+            if body != self.crank_name and body not in done:
+                raise ValueError(f"{where}: link {body!r} is not the crank nor a link of an "
+                                 f"earlier dyad")
+            return {"kind": "point", "body": body, "at": _pair(spec, "at", where),
+                    "label": f"{dyad}.{pair}"}
+        raise ValueError(f"{where}: expected 'frame', 'crank' or a table, got {spec!r}")
+
+    def _resolve_dyads(self):
+        done = set()
+        branches = self.data.get("branches") or {}
+        self.plan = []
+        for d in self.dyads:
+            dname = str(d.get("name", ""))
+            where = f"scene {self.name}.dyad[{dname}]"
+            if not dname or any(p["name"] == dname for p in self.plan) or dname == self.crank_name:
+                raise ValueError(f"{where}: bad or repeated dyad name")
+            kind = str(d.get("type", "")).upper()
+            if kind not in PAIR_KINDS:
+                raise ValueError(f"{where}.type: expected one of {sorted(PAIR_KINDS)}, got {kind!r}")
+            m, n = d.get("m"), d.get("n")
+            for g in (m, n):
+                if g not in self.links:
+                    raise ValueError(f"{where}: unknown link {g!r}")
+                if g in done:
+                    raise ValueError(f"{where}: link {g!r} belongs to an earlier dyad")
+            if m == n:
+                raise ValueError(f"{where}: links m and n must differ")
+            k = self._attachment(d.get("k"), dname, "D_m", done)
+            p = self._attachment(d.get("p"), dname, "D_n", done)
+            entry = {"name": dname, "type": kind, "m": m, "n": n, "k": k, "p": p}
+            lm_t, ln_t = self.links[m], self.links[n]
+            if kind == "RRR":
+                if k["kind"] == "guide" or p["kind"] == "guide":
+                    raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
+                entry["lm"] = _number(lm_t, "length", f"{where}.{m}", positive=True)
+                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
+                entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
+            elif kind == "RRT":
+                if k["kind"] != "guide":
+                    raise ValueError(f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }}")
+                if p["kind"] == "guide":
+                    raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
+                entry["lm"] = _number(lm_t, "length", f"{where}.{m}", nonnegative=True)
+                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
+                # the slider translates on the fixed guide: its angle is constant
+                entry["m_angle"] = _number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
+                entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
+            else:  # RTR
+                if k["kind"] == "guide" or p["kind"] == "guide":
+                    raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
+                if "length" in lm_t:
+                    raise ValueError(f"{where}.{m}: the slotted link's length |D_m E| varies; "
+                                     f"remove its 'length'")
+                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", nonnegative=True)
+                if entry["ln"] != 0.0:
+                    raise ValueError(f"{where}.{n}.length: only a block on the pin (length 0) "
+                                     f"is handled, got {entry['ln']!r}")
+            self.plan.append(entry)
+            done.update((m, n))
+        unused = set(self.links) - done
+        if unused:
+            raise ValueError(f"scene {self.name}: links {sorted(unused)} belong to no dyad")
+        # derived constant lengths
+        for entry in self.plan:
+            if "lm" in entry:
+                self.links[entry["m"]]["length"] = entry["lm"]
+            self.links[entry["n"]]["length"] = entry["ln"]
+        self.bodies = [self.crank_name] + [g for e in self.plan for g in (e["m"], e["n"])]
+
+    def _resolve_loads(self):
+        loads = self.scene.get("loads", {})
+        forces, moments = list(loads.get("force", [])), list(loads.get("moment", []))
+        models = self.data.get("load") or {}
+        self._loads = {}
+        for lname, model in models.items():
+            where = f"{self.name}.load.{lname}"
+            if lname not in self.links:
+                raise ValueError(f"{where}: unknown link {lname!r}")
+            kind = model.get("model")
+            if kind == "cutting":
+                if lname not in forces:
+                    raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
+                self._loads[lname] = {"model": kind, "F0": _number(model, "F0", where),
+                                      "v_ref": _number(model, "v_ref", where, positive=True),
+                                      "s": _sign(model, "s", where) if "s" in model else 1.0}
+            elif kind == "resisting-torque":
+                if lname not in moments:
+                    raise ValueError(f"{where}: the scene lists no moment on {lname!r} ([loads].moment)")
+                self._loads[lname] = {"model": kind, "T0": _number(model, "T0", where),
+                                      "w_ref": _number(model, "w_ref", where, positive=True),
+                                      "c": _number(model, "c", where)}
+            else:
+                raise ValueError(f"{where}.model: expected 'cutting' or 'resisting-torque', got {kind!r}")
+        for lname in forces + moments:
+            if lname not in self._loads:
+                raise ValueError(f"{self.name}.load: the scene loads link {lname!r} but "
+                                 f"chains.toml has no model for it")
+
+    def _build_pairs(self):
+        """Every pair: output key, kind, the body named first (it receives +R), the other
+        body (None: the frame), kin key of its point, and for a translational pair the
+        kin key of its guide's angle."""
+        c = self.crank_name
+        self.pairs = [{"key": f"{c}.R_O", "kind": "R", "first": c, "second": None,
+                       "point": "O", "guide": None, "dyad": None, "tag": "O"}]
+        for e in self.plan:
+            kinds = PAIR_KINDS[e["type"]]
+            others = {"D_m": e["k"]["body"], "E": e["n"], "D_n": e["p"]["body"]}
+            firsts = {"D_m": e["m"], "E": e["m"], "D_n": e["n"]}
+            for (point, tag), kind in zip(_TAGS, kinds):
+                guide = None
+                if kind == "T":
+                    # D_m: the guide of link k; E: the slot along i_m
+                    guide = f"{e['name']}.guide_k.angle" if point == "D_m" else f"{e['m']}.angle"
+                self.pairs.append({"key": f"{e['name']}.R_{tag}", "kind": kind,
+                                   "first": firsts[point], "second": others[point],
+                                   "point": f"{e['name']}.{point}", "guide": guide,
+                                   "dyad": e["name"], "tag": tag})
+
+    def output_names(self) -> list:
+        """The names of the outputs of :meth:`reference`, in the order of the unknowns."""
+        names = []
+        for pr in self.pairs:
+            names += [f"{pr['key']}.x", f"{pr['key']}.y"]
+            if pr["kind"] == "T":
+                names += [f"{pr['dyad']}.N_{pr['tag']}", f"{pr['dyad']}.M_{pr['tag']}"]
+        names.append(f"{self.crank_name}.torque")
+        return names
+
+    # ---- motion -----------------------------------------------------------
+    def motion(self, kind: str = "constant", revolutions: float = 2.0) -> CrankMotion:
+        """The crank's motion over ``revolutions`` full turns (counter-clockwise). kind
+        "constant": omega = w0; "varying": omega = w0 (1 + a sin(w0 t)), phi exact."""
+        if kind not in ("constant", "varying"):
+            raise ValueError(f"unknown motion kind {kind!r}; expected 'constant' or 'varying'")
+        revolutions = float(revolutions)
+        if not (revolutions > 0 and math.isfinite(revolutions)):
+            raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
+        return _rotating(kind, self._w0, self._variation, self._phi0, revolutions)
+
+    # ---- kinematics -------------------------------------------------------
+    def kinematics(self, t, motion: CrankMotion) -> dict:
+        """Positions, velocities, accelerations and active loads at the times ``t`` (N,).
+
+        Keys (arrays over the N samples; points and vectors (N, 2), scalars (N,)):
+        ``t``; ``crank.angle``, ``crank.omega``, ``crank.epsilon``; per link L of the
+        scene: ``L.angle``, ``L.omega``, ``L.epsilon``, ``L.accel_d`` (and ``.x``, ``.y``),
+        ``L.vel_d`` (velocity of the material point at D_L), ``L.length``,
+        ``L.length_rate``, ``L.length_accel``, ``L.force`` (and ``.x``, ``.y``),
+        ``L.moment``; points ``O``, ``A``, ``S_crank``, ``S_L``, ``<dyad>.D_m``,
+        ``<dyad>.E``, ``<dyad>.D_n``; velocities ``v_A``, ``v_S_crank``, ``v_S_L``;
+        accelerations ``a_A``, ``a_S_crank``, ``a_S_L``; ``<dyad>.conditioning``;
+        ``<dyad>.guide_k.angle`` for a guide on link k. Non-array entries: ``frame``
+        ({"pivots": {label: (x, y)}, "guides": {label: ((x0, y0), (x1, y1))}}) and
+        ``mechanism`` (the name).
+        """
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if t.ndim != 1:
+            raise ValueError(f"t: expected shape (N,), got {t.shape}")
+        phi = np.broadcast_to(motion.phi(t), t.shape).astype(float)
+        w = np.broadcast_to(motion.omega(t), t.shape).astype(float)
+        eps = np.broadcast_to(motion.epsilon(t), t.shape).astype(float)
+        kin = self._solve(t, phi, w, eps)
+        kin["frame"] = self._frame()
+        kin["mechanism"] = self.name
+        return kin
+
+    @staticmethod
+    def _material(state, at):
+        """Position, velocity, acceleration of the point fixed at ``at`` in a body's frame."""
+        i = _unit(state["angle"])
+        rel = at[0] * i + at[1] * _rot90(i)
+        w, e = _col(state["omega"]), _col(state["epsilon"])
+        return (state["D"] + rel, state["vD"] + w * _rot90(rel),
+                state["aD"] + e * _rot90(rel) - w * w * rel)
+
+    def _point(self, att, states, shape):
+        if att["kind"] == "pivot":
+            z = np.zeros(shape + (2,))
+            return z + np.asarray(att["position"]), z.copy(), z.copy()
+        return self._material(states[att["body"]], att["at"])
+
+    def _solve(self, t, phi, w, eps) -> dict:
+        shape = phi.shape
+        zero = np.zeros(shape)
+        z2 = np.zeros(shape + (2,))
+        c = self.crank_name
+        i_c = _unit(phi)
+        crank_state = {"angle": phi, "omega": w, "epsilon": eps, "D": z2, "vD": z2, "aD": z2}
+        A, vA, aA = self._material(crank_state, (self._r, 0.0))
+        kin = {"t": t, f"{c}.angle": phi, f"{c}.omega": w, f"{c}.epsilon": eps,
+               "O": z2.copy(), "A": A, "v_A": vA, "a_A": aA}
+        states = {c: crank_state}
+
+        for e in self.plan:
+            dn = e["name"]
+            P, vP, aP = self._point(e["p"], states, shape)      # D_n, on link p
+            if e["type"] == "RRR":
+                K, vK, aK = self._point(e["k"], states, shape)  # D_m, on link k
+                sm, sn, E = _rrr(K, vK, aK, P, vP, aP, e["lm"], e["ln"], e["branch"], dn)
+            elif e["type"] == "RRT":
+                sm, sn, E = _rrt(e["k"]["angle"], e["k"]["height"], e["lm"], e["m_angle"],
+                                 P, vP, aP, e["ln"], e["branch"], dn)
+                kin[f"{dn}.guide_k.angle"] = np.full(shape, e["k"]["angle"])
+            else:
+                K, vK, aK = self._point(e["k"], states, shape)
+                sm, sn, E = _rtr(K, vK, aK, P, vP, aP)
+            states[e["m"]], states[e["n"]] = sm, sn
+            kin[f"{dn}.D_m"], kin[f"{dn}.E"], kin[f"{dn}.D_n"] = sm["D"], E, sn["D"]
+            for g, st in ((e["m"], sm), (e["n"], sn)):
+                kin[f"{g}.angle"] = np.broadcast_to(st["angle"], shape).astype(float)
+                kin[f"{g}.omega"] = np.broadcast_to(st["omega"], shape).astype(float)
+                kin[f"{g}.epsilon"] = np.broadcast_to(st["epsilon"], shape).astype(float)
+                kin[f"{g}.accel_d"] = st["aD"]
+                kin[f"{g}.vel_d"] = st["vD"]
+                for key in ("length", "length_rate", "length_accel"):
+                    kin[f"{g}.{key}"] = np.broadcast_to(st[key], shape).astype(float)
+            kin[f"{dn}.conditioning"] = self._conditioning(e, kin)
+
+        # centres of mass (S = D + rel, rel fixed in the body)
+        for b in self.bodies:
+            st = states[b]
+            com = self._crank_com if b == c else self.links[b]["com"]
+            S, vS, aS = self._material(st, com)
+            kin[f"S_{b}"], kin[f"v_S_{b}"], kin[f"a_S_{b}"] = S, vS, aS
+
+        # active loads
+        for g in self.links:
+            force, moment = z2.copy(), zero.copy()
+            model = self._loads.get(g)
+            if model and model["model"] == "cutting":
+                v, s = kin[f"v_S_{g}"][:, 0], model["s"]
+                force[:, 0] = -s * model["F0"] * 0.5 * (1.0 + np.tanh(s * v / model["v_ref"]))
+            elif model and model["model"] == "resisting-torque":
+                om = kin[f"{g}.omega"]
+                moment = -model["T0"] * np.tanh(om / model["w_ref"]) - model["c"] * om
+            kin[f"{g}.force"], kin[f"{g}.moment"] = force, moment
+        # scalar views with the FMU input names
+        for g in self.links:
+            for key in ("accel_d", "force"):
+                kin[f"{g}.{key}.x"] = kin[f"{g}.{key}"][:, 0].copy()
+                kin[f"{g}.{key}.y"] = kin[f"{g}.{key}"][:, 1].copy()
+        return kin
+
+    def _conditioning(self, e, kin):
+        i_m, i_n = _unit(kin[f"{e['m']}.angle"]), _unit(kin[f"{e['n']}.angle"])
+        if e["type"] == "RRR":
+            return np.abs(_dot(i_m, _rot90(i_n)))
+        if e["type"] == "RRT":
+            return np.abs(_dot(i_n, _unit(e["k"]["angle"])))
+        lm, ln = kin[f"{e['m']}.length"], kin[f"{e['n']}.length"]
+        beta = _col(lm) * i_m - _col(ln) * i_n                  # D_n - D_m
+        dist = _norm(beta)
+        i_beta = beta / _col(np.where(dist > 0, dist, 1.0))
+        return np.minimum(np.abs(_dot(i_beta, i_m)), dist / (lm + ln))
+
+    def _sweep(self, count=720):
+        """Positions over one full crank turn (the motion does not matter for them)."""
+        phi = self._phi0 + np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
+        zero = np.zeros_like(phi)
+        try:
+            with np.errstate(invalid="raise", divide="raise"):
+                return self._solve(zero, phi, zero + self._w0, zero)
+        except FloatingPointError:  # pragma: no cover - _rrr/_rrt raise first
+            raise ValueError(f"{self.name}: a dyad does not assemble over a full crank turn")
+
+    def _frame(self) -> dict:
+        """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))}."""
+        if self._frame_cache is None:
+            pivots, guides = {"O": (0.0, 0.0)}, {}
+            sweep = None
+            for e in self.plan:
+                for att, pair in ((e["k"], "D_m"), (e["p"], "D_n")):
+                    if att["kind"] == "pivot":
+                        pivots[att["label"]] = tuple(att["position"])
+                    elif att["kind"] == "guide":
+                        sweep = self._sweep() if sweep is None else sweep
+                        pts = sweep[f"{e['name']}.{pair}"]
+                        i = np.array([math.cos(att["angle"]), math.sin(att["angle"])])
+                        s = pts @ i
+                        pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
+                        base = np.array([0.0, att["height"]])
+                        base = base - (base @ i) * i          # foot of O on the guide line
+                        x0, x1 = base + (s.min() - pad) * i, base + (s.max() + pad) * i
+                        guides[att["label"]] = (tuple(map(float, x0)), tuple(map(float, x1)))
+            self._frame_cache = {"pivots": pivots, "guides": guides}
+        return copy.deepcopy(self._frame_cache)
+
+    # ---- dynamics ---------------------------------------------------------
+    def _body_data(self, kin):
+        """Per body: mass, inertia, S (N, 2), a_S (N, 2) from accel_d, omega, epsilon and
+        the centre of mass, epsilon, omega, velocity of S."""
+        c = self.crank_name
+        out = {}
+        for b in self.bodies:
+            if b == c:
+                mass, inertia, com = self._crank_mass, self._crank_inertia, self._crank_com
+                a_d = np.zeros_like(kin["A"])                    # O is fixed
+            else:
+                link = self.links[b]
+                mass, inertia, com = link["mass"], link["inertia"], link["com"]
+                a_d = np.asarray(kin[f"{b}.accel_d"], dtype=float)
+            i = _unit(kin[f"{b}.angle"])
+            rel = com[0] * i + com[1] * _rot90(i)
+            w, e = np.asarray(kin[f"{b}.omega"], float), np.asarray(kin[f"{b}.epsilon"], float)
+            a_s = a_d + _col(e) * _rot90(rel) - _col(w * w) * rel
+            force = kin[f"{b}.force"] if b != c else np.zeros_like(a_d)
+            moment = kin[f"{b}.moment"] if b != c else np.zeros(len(w))
+            out[b] = {"mass": mass, "inertia": inertia, "S": np.asarray(kin[f"S_{b}"], float),
+                      "a_S": a_s, "epsilon": e, "force": force, "moment": moment}
+        return out
+
+    def _known(self, bd):
+        """The known terms of body bd: forces (at S) and moments: weight, active load,
+        d'Alembert force and moment."""
+        forces = [np.broadcast_to(bd["mass"] * self._g, bd["a_S"].shape), bd["force"]]
+        moments = [bd["moment"]]
+        if self.effects["inertia"]:
+            forces.append(-bd["mass"] * bd["a_S"])
+            moments.append(-bd["inertia"] * bd["epsilon"])
+        return forces, moments
+
+    def reference(self, kin) -> dict:
+        """Joint reactions and the crank's driving torque from the Newton-Euler equations
+        of all moving bodies, solved together (a square linear system per sample).
+
+        Unknowns: at each revolute pair the force's two components, at each translational
+        pair the normal force N (along j of its guide) and the reactive moment M (the
+        force is taken at the pair's named point), and the crank's driving torque.
+        Equations: per body, sum of forces = 0 and sum of moments about its centre of
+        mass = 0, with the weight, the active load and the d'Alembert force -m a_S and
+        moment -J epsilon. Returns output name -> (N,) array (see :meth:`output_names`;
+        for a translational pair also its force's x and y components).
+        """
+        bodies = self._body_data(kin)
+        row = {b: 3 * i for i, b in enumerate(self.bodies)}
+        n_eq = 3 * len(self.bodies)
+        count = len(np.atleast_1d(kin["t"]))
+        K = np.zeros((count, n_eq, n_eq))
+        rhs = np.zeros((count, n_eq))
+        ex = np.broadcast_to(np.array([1.0, 0.0]), (count, 2))
+        ey = np.broadcast_to(np.array([0.0, 1.0]), (count, 2))
+
+        def put(col, body, point, f, mu, sign):
+            """Unknown ``col`` acts on ``body`` as the force ``f`` at ``point`` plus the
+            couple ``mu`` (per unit value), with ``sign``."""
+            if body is None:
+                return
+            r = row[body]
+            K[:, r, col] += sign * f[:, 0]
+            K[:, r + 1, col] += sign * f[:, 1]
+            K[:, r + 2, col] += sign * (_cross(point - bodies[body]["S"], f) + mu)
+
+        col = 0
+        zero = np.zeros(count)
+        for pr in self.pairs:
+            P = np.asarray(kin[pr["point"]], dtype=float)
+            if pr["kind"] == "R":
+                columns = ((ex, zero), (ey, zero))
+            else:
+                j = _rot90(_unit(kin[pr["guide"]]))
+                columns = ((j, zero), (0.0 * j, zero + 1.0))
+            for f, mu in columns:
+                put(col, pr["first"], P, f, mu, 1.0)
+                put(col, pr["second"], P, f, mu, -1.0)
+                col += 1
+        c = self.crank_name
+        K[:, row[c] + 2, col] = 1.0                           # driving torque
+        col += 1
+        assert col == n_eq
+
+        for b, bd in bodies.items():
+            forces, moments = self._known(bd)
+            r = row[b]
+            rhs[:, r:r + 2] -= sum(forces)                    # all act at S: no moment about S
+            rhs[:, r + 2] -= sum(moments)
+        x = np.linalg.solve(K, rhs[..., None])[..., 0]
+
+        out, col = {}, 0
+        for pr in self.pairs:
+            if pr["kind"] == "R":
+                out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = x[:, col].copy(), x[:, col + 1].copy()
+            else:
+                j = _rot90(_unit(kin[pr["guide"]]))
+                N, M = x[:, col].copy(), x[:, col + 1].copy()
+                out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = N * j[:, 0], N * j[:, 1]
+                out[f"{pr['dyad']}.N_{pr['tag']}"], out[f"{pr['dyad']}.M_{pr['tag']}"] = N, M
+            col += 2
+        out[f"{c}.torque"] = x[:, col].copy()
+        return out
+
+    def residuals(self, kin, out) -> np.ndarray:
+        """Worst Newton-Euler residual per sample of the output set ``out`` (keys of
+        :meth:`reference`), over all bodies: |sum of forces| relative to the largest force
+        term of the sample and |sum of moments about S| relative to the largest moment
+        term. A translational pair's force must also lie along j of its guide and equal
+        N j (both relative to the largest force term)."""
+        bodies = self._body_data(kin)
+        count = len(np.atleast_1d(kin["t"]))
+        fsum = {b: np.zeros((count, 2)) for b in self.bodies}
+        msum = {b: np.zeros(count) for b in self.bodies}
+        fmax, mmax = np.zeros(count), np.zeros(count)
+        tangential = np.zeros(count)
+
+        def force(body, point, f):
+            nonlocal fmax, mmax
+            if body is None:
+                return
+            m = _cross(point - bodies[body]["S"], f)
+            fsum[body] += f
+            msum[body] += m
+            fmax = np.maximum(fmax, _norm(f))
+            mmax = np.maximum(mmax, np.abs(m))
+
+        def couple(body, mu):
+            nonlocal mmax
+            if body is None:
+                return
+            msum[body] += mu
+            mmax = np.maximum(mmax, np.abs(mu))
+
+        for b, bd in bodies.items():
+            forces, moments = self._known(bd)
+            for f in forces:
+                force(b, bd["S"], f)
+            for mu in moments:
+                couple(b, mu)
+        for pr in self.pairs:
+            P = np.asarray(kin[pr["point"]], dtype=float)
+            R = np.stack([np.asarray(out[f"{pr['key']}.x"], float),
+                          np.asarray(out[f"{pr['key']}.y"], float)], axis=-1)
+            force(pr["first"], P, R)
+            force(pr["second"], P, -R)
+            if pr["kind"] == "T":
+                i = _unit(kin[pr["guide"]])
+                N = np.asarray(out[f"{pr['dyad']}.N_{pr['tag']}"], float)
+                M = np.asarray(out[f"{pr['dyad']}.M_{pr['tag']}"], float)
+                couple(pr["first"], M)
+                couple(pr["second"], -M)
+                tangential = np.maximum(tangential, np.maximum(
+                    np.abs(_dot(R, i)), np.abs(N - _dot(R, _rot90(i)))))
+        couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
+
+        tiny = np.finfo(float).tiny
+        fscale, mscale = np.maximum(fmax, tiny), np.maximum(mmax, tiny)
+        worst = tangential / fscale
+        for b in self.bodies:
+            worst = np.maximum(worst, _norm(fsum[b]) / fscale)
+            worst = np.maximum(worst, np.abs(msum[b]) / mscale)
+        return worst
+
+    # ---- energy -----------------------------------------------------------
+    def _mass(self, b):
+        if b == self.crank_name:
+            return self._crank_mass, self._crank_inertia
+        return self.links[b]["mass"], self.links[b]["inertia"]
+
+    def kinetic_energy(self, kin) -> np.ndarray:
+        """Kinetic energy [J] of all moving bodies, crank included."""
+        total = 0.0
+        for b in self.bodies:
+            m, J = self._mass(b)
+            v = np.asarray(kin[f"v_S_{b}"], float)
+            w = np.asarray(kin[f"{b}.omega"], float)
+            total = total + 0.5 * m * _dot(v, v) + 0.5 * J * w * w
+        return np.asarray(total, dtype=float)
+
+    def potential_energy(self, kin) -> np.ndarray:
+        """Potential energy [J] of the weights of all moving bodies (crank included),
+        zero at the origin: -sum m g . S (zero when the scene turns gravity off)."""
+        total = 0.0
+        for b in self.bodies:
+            m, _ = self._mass(b)
+            total = total - m * (np.asarray(kin[f"S_{b}"], float) @ self._g)
+        return np.asarray(total, dtype=float)
+
+    def load_power(self, kin) -> np.ndarray:
+        """Power [W] of the active loads (weights excluded): sum F . v_S + M omega."""
+        total = 0.0
+        for g in self.links:
+            total = total + _dot(np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float))
+            total = total + np.asarray(kin[f"{g}.moment"], float) * np.asarray(kin[f"{g}.omega"], float)
+        return np.asarray(total, dtype=float)
+
+    def __repr__(self):
+        return f"<Chain {self.name}: " + ", ".join(f"{e['name']} ({e['type']})" for e in self.plan) + ">"
+
+
+# ---------------------------------------------------------------------------
+# the dyads
+# ---------------------------------------------------------------------------
+def _state(angle, omega, epsilon, D, vD, aD, length, rate=0.0, accel=0.0):
+    return {"angle": angle, "omega": omega, "epsilon": epsilon, "D": D, "vD": vD, "aD": aD,
+            "length": length, "length_rate": rate, "length_accel": accel}
+
+
+def _rrr(K, vK, aK, P, vP, aP, lm, ln, branch, name):
+    """RRR: link m pinned at D_m = K (on link k), link n at D_n = P (on link p), joined
+    at E. ``branch`` +1: E on the left of the directed line K -> P."""
+    d = P - K
+    dist = _norm(d)
+    u = d / _col(dist)
+    a = (lm * lm - ln * ln + dist * dist) / (2.0 * dist)        # along u from K to the chord
+    h2 = lm * lm - a * a
+    if np.any(~(h2 > 0.0)):
+        raise ValueError(f"dyad {name}: the circles about D_m ({lm} m) and D_n ({ln} m) do not "
+                         f"intersect at every crank angle (|D_m D_n| from {dist.min():.4g} to "
+                         f"{dist.max():.4g} m)")
+    E = K + _col(a) * u + branch * _col(np.sqrt(h2)) * _rot90(u)
+    i_m, i_n = (E - K) / lm, (E - P) / ln
+    j_m, j_n = _rot90(i_m), _rot90(i_n)
+    # vK + lm wm j_m = vP + ln wn j_n, differentiated once more for the accelerations
+    c1, c2 = lm * j_m, -ln * j_n
+    wm, wn = _solve2(c1, c2, vP - vK)
+    em, en = _solve2(c1, c2, aP - aK + _col(lm * wm * wm) * i_m - _col(ln * wn * wn) * i_n)
+    sm = _state(_angle(i_m), wm, em, K, vK, aK, lm)
+    sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
+    return sm, sn, E
+
+
+def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
+    """RRT: slider m on the fixed guide (direction ``guide``, through (0, height)), its
+    pin E = D_m + lm i_m; rod n from D_n = P (on link p) to E. ``branch`` +1: E ahead
+    of the foot of P on E's line along the guide direction."""
+    i_k = np.array([math.cos(guide), math.sin(guide)])
+    j_k = np.array([-i_k[1], i_k[0]])
+    i_m = np.array([math.cos(m_angle), math.sin(m_angle)])
+    base = np.array([0.0, height])
+    line = base + lm * i_m                                   # E = line + s i_k
+    d = P - line
+    along, across = d @ i_k, d @ j_k
+    root2 = ln * ln - across * across
+    if np.any(~(root2 > 0.0)):
+        raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
+                         f"crank angle (distance up to {np.abs(across).max():.4g} m)")
+    s = along + branch * np.sqrt(root2)
+    E = line + _col(s) * i_k
+    i_n = (E - P) / ln
+    j_n = _rot90(i_n)
+    # ds i_k = vP + ln wn j_n, and its derivative
+    ik = np.broadcast_to(i_k, P.shape)
+    ds, wn = _solve2(ik, -ln * j_n, vP)
+    dds, en = _solve2(ik, -ln * j_n, aP - _col(ln * wn * wn) * i_n)
+    zero = np.zeros(len(s))
+    Dm = base + _col(s) * i_k
+    sm = _state(zero + m_angle, zero, zero, Dm, _col(ds) * i_k, _col(dds) * i_k, lm)
+    sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
+    return sm, sn, E
+
+
+def _rtr(K, vK, aK, P, vP, aP):
+    """RTR with the block n on the pin D_n = P (l_n = 0, E = P): link m pinned at
+    D_m = K, its slot along i_m through P; l_m = |K P| varies. The block turns with m."""
+    d, vd, ad = P - K, vP - vK, aP - aK
+    L = _norm(d)
+    i_m = d / _col(L)
+    j_m = _rot90(i_m)
+    # d = L i_m: vd = L' i_m + L w j_m; ad = (L'' - L w^2) i_m + (L eps + 2 L' w) j_m
+    Ld = _dot(vd, i_m)
+    w = _dot(vd, j_m) / L
+    Ldd = _dot(ad, i_m) + L * w * w
+    e = (_dot(ad, j_m) - 2.0 * Ld * w) / L
+    angle = _angle(i_m)
+    sm = _state(angle, w, e, K, vK, aK, L, Ld, Ldd)
+    sn = _state(angle.copy(), w.copy(), e.copy(), P, vP, aP, 0.0)
+    return sm, sn, P.copy()
+
+
+# ---------------------------------------------------------------------------
+# loading
+# ---------------------------------------------------------------------------
+def load(name: str, data=None) -> Chain:
+    """The chain ``name`` (one of :data:`NAMES`): its scene file plus its table of the
+    packaged ``chains.toml``. ``data`` overrides that table key by key (nested tables
+    merged): a mapping, either the whole document (with a table ``name``) or the
+    mechanism's own table, or the path of a TOML file of the same form."""
+    if name not in NAMES:
+        raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
+    table = default_data()[name]
+    if data is not None:
+        if isinstance(data, (str, os.PathLike)):
+            with open(data, "rb") as f:
+                data = tomllib.load(f)
+        if not isinstance(data, Mapping):
+            raise ValueError(f"data: expected a mapping or a TOML path, got {type(data).__name__}")
+        over = data[name] if name in data else data
+        if not isinstance(over, Mapping):
+            raise ValueError(f"data[{name!r}]: expected a table")
+        table = _merge(table, over)
+    with open(scene_path(name), "rb") as f:
+        scene = tomllib.load(f)
+    return Chain(name, scene, table)
