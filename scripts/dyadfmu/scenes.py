@@ -1,0 +1,340 @@
+"""The tailored scene FMUs (scenes/*.toml) co-simulated with fmpy and checked output by
+output against independent references.
+
+Two kinds of scene:
+
+* the multi-dyad chains ``shaper`` and ``sixbar``: kinematics, loads and the reference
+  (one Newton-Euler system of the whole mechanism, crank included) come from
+  :mod:`dyadfmu.chains`;
+* the single-dyad scenes ``engine``, ``press`` and ``monitor``: kinematics and loads of the
+  slider-crank and four-bar of :mod:`dyadfmu.mechanisms`, the dyad's reactions from
+  :mod:`dyadfmu.reference` (its own 6x6 Newton-Euler solve) with the scene's effects (no
+  inertia in a static scene, no weight without gravity), and the crank's equilibrium
+  written out here.
+
+The FMU's inputs are taken by name from the kinematics; its outputs are compared by name
+with the reference. The driving torque of a chain is also checked against the energy
+balance of the whole mechanism: M omega + P_loads = d(T + V)/dt.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time as clock
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description, simulate_fmu
+
+from . import chains, mechanisms, reference
+from .harness import OutputError, _match_samples, _Progress
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENES_DIR = ROOT / "scenes"
+
+#: The tailored example scenes, in the order of the report.
+NAMES = ("press", "monitor", "engine", "shaper", "sixbar")
+
+#: Single-dyad scenes: the mechanism whose kinematics they take, and which scene link is
+#: the mechanism's link m and n.
+SINGLE = {
+    "engine": ("slider-crank", {"piston": "m", "rod": "n"}),
+    "press": ("slider-crank", {"ram": "m", "rod": "n"}),
+    "monitor": ("four-bar", {"rocker": "m", "coupler": "n"}),
+}
+
+#: The generic per-type FMUs a scene would need instead (one per dyad).
+FULL_OF = {"press": ("RRT",), "monitor": ("RRR",), "engine": ("RRT",),
+           "shaper": ("RTR", "RRT"), "sixbar": ("RRR", "RRR")}
+
+#: Speeds of the quasi-static press: slow enough that nothing dynamic matters, though the
+#: FMU takes no speeds at all.
+NEAR_SINGULAR = 1e-6
+
+
+def build_dir() -> Path:
+    return Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
+
+
+def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
+    path = (build or build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path} does not exist: build the FMUs first "
+                                "(scripts/run-scenes does, or cmake --build build)")
+    return path
+
+
+def scene_data(name: str) -> dict:
+    with open(SCENES_DIR / f"{name}.toml", "rb") as f:
+        return tomllib.load(f)
+
+
+def _unit(angle):
+    angle = np.asarray(angle, dtype=float)
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def _rot90(v):
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def _cross(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+# ---------------------------------------------------------------------------
+# A scene's kinematics, FMU inputs and reference
+# ---------------------------------------------------------------------------
+class Source:
+    """What drives one scene: its kinematics and its reference."""
+
+    def __init__(self, name: str):
+        self.name = name
+        self.scene = scene_data(name)
+        effects = self.scene.get("effects", {})
+        self.inertia = bool(effects.get("inertia", False))
+        self.gravity_on = bool(effects.get("gravity", False))
+        g = self.scene.get("gravity", {})
+        self.gravity = (float(g.get("x", 0.0)), float(g.get("y", 0.0))) if self.gravity_on \
+            else (0.0, 0.0)
+        self.crank_name = self.scene.get("crank", {}).get("name", "crank")
+        if name in SINGLE:
+            mech_name, self.roles = SINGLE[name]
+            self.mechanism = mechanisms.load(mech_name)
+            self.chain = None
+            self.dyad = self.scene["dyad"][0]
+        else:
+            self.chain = chains.load(name)
+            self.mechanism = None
+
+    def motion(self, kind: str, revolutions: float):
+        return (self.chain or self.mechanism).motion(kind, revolutions)
+
+    def kinematics(self, t, motion) -> dict:
+        if self.chain is not None:
+            return self.chain.kinematics(t, motion)
+        kin = self.mechanism.kinematics(t, motion)
+        out = dict(kin)
+        c = self.crank_name
+        for key in ("angle", "omega", "epsilon"):
+            out[f"{c}.{key}"] = kin[f"crank.{key}"]
+        for link, role in self.roles.items():
+            for key in ("angle", "omega", "epsilon", "length", "moment"):
+                out[f"{link}.{key}"] = kin[f"{role}.{key}"]
+            for key in ("accel_d", "force"):
+                out[f"{link}.{key}"] = kin[f"{role}.{key}"]
+                out[f"{link}.{key}.x"] = kin[f"{role}.{key}"][:, 0]
+                out[f"{link}.{key}.y"] = kin[f"{role}.{key}"][:, 1]
+        return out
+
+    def inputs(self, kin, names) -> dict:
+        """The FMU's input signals, by name."""
+        missing = [n for n in names if n not in kin]
+        if missing:
+            raise KeyError(f"scene {self.name}: no kinematics for input(s) {missing}")
+        return {n: np.asarray(kin[n], dtype=float).copy() for n in names}
+
+    def reference(self, kin) -> dict:
+        """Every output the scene can have, by FMU name."""
+        if self.chain is not None:
+            return self.chain.reference(kin)
+        return self._single_reference(kin)
+
+    def conditioning(self, kin) -> dict:
+        if self.chain is not None:
+            return {f"{d['name']}.conditioning": kin[f"{d['name']}.conditioning"]
+                    for d in self.scene["dyad"]}
+        return {f"{self.dyad['name']}.conditioning": self.mechanism.conditioning(kin)}
+
+    # ---- single dyad: reference.solve with the scene's effects, crank balance here
+    def _link_input(self, kin, link: str, table: dict) -> dict:
+        n = len(kin["t"])
+        zero, zero2 = np.zeros(n), np.zeros((n, 2))
+        dynamic = self.inertia
+        return {"dir": _unit(kin[f"{link}.angle"]),
+                "length": np.asarray(kin[f"{link}.length"], dtype=float),
+                "omega": kin[f"{link}.omega"] if dynamic else zero,
+                "epsilon": kin[f"{link}.epsilon"] if dynamic else zero,
+                "accel_d": kin[f"{link}.accel_d"] if dynamic else zero2,
+                "com": tuple(table.get("com", (0.0, 0.0))),
+                "mass": float(table.get("mass", 0.0)) if (self.inertia or self.gravity_on)
+                else 0.0,
+                "inertia": float(table.get("inertia", 0.0)) if self.inertia else 0.0,
+                "force": kin[f"{link}.force"] if link in self._loaded("force") else zero2,
+                "moment": kin[f"{link}.moment"] if link in self._loaded("moment") else zero}
+
+    def _loaded(self, key):
+        return set(self.scene.get("loads", {}).get(key, []))
+
+    def _single_reference(self, kin) -> dict:
+        d = self.dyad
+        links = {t["name"]: t for t in self.scene["link"]}
+        m = self._link_input(kin, d["m"], links[d["m"]])
+        n = self._link_input(kin, d["n"], links[d["n"]])
+        gk = _unit(kin["guide_k.angle"]) if "guide_k.angle" in kin else None
+        gp = _unit(kin["guide_p.angle"]) if "guide_p.angle" in kin else None
+        r = reference.solve(d["type"], m, n, gk, gp, self.gravity)
+        pre = f"{d['name']}."
+        out = {}
+        for pair in ("mk", "np", "mn"):
+            out[f"{pre}R_{pair}.x"] = r[f"r_{pair}"][:, 0]
+            out[f"{pre}R_{pair}.y"] = r[f"r_{pair}"][:, 1]
+            out[f"{pre}N_{pair}"] = r[f"n_{pair}"]
+            out[f"{pre}M_{pair}"] = r[f"m_{pair}"]
+        # the crank (link p of the dyad, at its pin A = D_n): equilibrium about O
+        crank = self.scene["crank"]
+        c = self.crank_name
+        phi, w, eps = kin[f"{c}.angle"], kin[f"{c}.omega"], kin[f"{c}.epsilon"]
+        i_c = _unit(phi)
+        j_c = _rot90(i_c)
+        pin = float(crank["length"]) * i_c
+        com = crank.get("com", (0.0, 0.0))
+        r_s = com[0] * i_c + com[1] * j_c
+        mass = float(crank.get("mass", 0.0)) if (self.inertia or self.gravity_on) else 0.0
+        inertia = float(crank.get("inertia", 0.0)) if self.inertia else 0.0
+        a_s = (eps[:, None] * _rot90(r_s) - (w * w)[:, None] * r_s) if self.inertia \
+            else np.zeros_like(r_s)
+        own = mass * (np.asarray(self.gravity) - a_s)
+        r_np = r["r_np"]
+        moments = _cross(pin, -r_np) + _cross(r_s, own) - inertia * (eps if self.inertia else 0.0)
+        out[f"{c}.torque"] = -moments
+        r_o = r_np - own
+        out[f"{c}.R_O.x"], out[f"{c}.R_O.y"] = r_o[:, 0], r_o[:, 1]
+        return out
+
+    # ---- energy of a chain
+    def energy(self, kin) -> np.ndarray:
+        return self.chain.kinetic_energy(kin) + self.chain.potential_energy(kin)
+
+
+# ---------------------------------------------------------------------------
+# Co-simulation
+# ---------------------------------------------------------------------------
+@dataclass
+class SceneRun:
+    name: str
+    fmi_version: int
+    source: Source
+    kin: dict
+    sample: np.ndarray
+    fmu: dict
+    ref: dict
+    valid: np.ndarray
+    errors: list
+    seconds_fmu: float
+    steps: int
+    units: dict = field(default_factory=dict)
+    energy_residual: float = math.nan     # worst |M w + P - dE/dt| / peak |M w|
+
+    @property
+    def worst_relative(self) -> float:
+        return max(e.relative for e in self.errors)
+
+
+def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
+        motion: str = "constant", build: Path | None = None, progress: bool = False) -> SceneRun:
+    """Co-simulate a scene's tailored FMU over `revolutions` crank turns at `steps`
+    communication steps per turn and compare every output with the reference."""
+    source = Source(name)
+    crank_motion = source.motion(motion, revolutions)
+    count = int(round(steps * revolutions))
+    t = np.linspace(0.0, crank_motion.duration, count + 1)
+    dt = t[1] - t[0]
+    kin = source.kinematics(t, crank_motion)
+
+    path = fmu_path(name, fmi_version, build)
+    md = read_model_description(str(path))
+    names = [v.name for v in md.modelVariables if v.causality == "input"]
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    units = {v.name: v.unit or "" for v in md.modelVariables}
+    inputs = source.inputs(kin, names)
+    signals = np.zeros(len(t), dtype=[("time", float)] + [(n, float) for n in names])
+    signals["time"] = t
+    for n in names:
+        signals[n] = inputs[n]
+
+    bar = _Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
+    started = clock.perf_counter()
+    recorded = simulate_fmu(str(path), start_time=0.0, stop_time=float(t[-1]), step_size=dt,
+                            output_interval=dt, input=signals, output=names + outputs,
+                            step_finished=bar)
+    seconds = clock.perf_counter() - started
+    bar.close()
+    fmu = {n: np.asarray(recorded[n]) for n in recorded.dtype.names}
+    sample = _match_samples(fmu, inputs, names, t)
+    rows = {k: (v[sample] if isinstance(v, np.ndarray) and v.shape[:1] == t.shape else v)
+            for k, v in kin.items()}
+    full_ref = source.reference(rows)
+    full_ref.update(source.conditioning(rows))
+    ref = {n: np.asarray(full_ref[n]) for n in outputs if n in full_ref}
+
+    cond = [fmu[n] for n in outputs if n.endswith("conditioning")]
+    valid = fmu["status"] == 0
+    for c in cond:
+        valid &= c >= NEAR_SINGULAR
+    errors = []
+    for out in outputs:
+        if out == "status" or out.endswith("amplification"):
+            continue
+        if out not in ref:
+            raise KeyError(f"scene {name}: the reference has no output {out}")
+        want, got = ref[out][valid], fmu[out][valid]
+        peak = float(np.max(np.abs(want))) if want.size else 0.0
+        max_abs = float(np.max(np.abs(got - want))) if want.size else math.nan
+        errors.append(OutputError(out, units.get(out, ""), peak, max_abs,
+                                  max_abs / peak if peak > 0 else max_abs))
+    result = SceneRun(name, fmi_version, source, rows, sample, fmu, ref, valid, errors, seconds,
+                      len(t) - 1, units)
+    torque = f"{source.crank_name}.torque"
+    if source.chain is not None and torque in fmu:
+        result.energy_residual = energy_balance(source, crank_motion, fmu["time"], fmu[torque],
+                                                t[sample])
+    return result
+
+
+def energy_balance(source: Source, motion, time, torque, t_samples) -> float:
+    """Worst |M omega + P_loads - d(T + V)/dt| over the run, relative to the peak driving
+    power; dE/dt by 4th-order central differences of the reference energies."""
+    w0 = float(np.max(np.abs(motion.omega(t_samples))))
+    h = 1e-3 / w0
+    energies = [source.energy(source.kinematics(t_samples + j * h, motion)) for j in (-2, -1, 1, 2)]
+    rate = (energies[0] - 8 * energies[1] + 8 * energies[2] - energies[3]) / (12 * h)
+    kin = source.kinematics(t_samples, motion)
+    power = torque * kin[f"{source.crank_name}.omega"]
+    loads = source.chain.load_power(kin)
+    residual = power + loads - rate
+    return float(np.max(np.abs(residual)) / np.max(np.abs(power)))
+
+
+# ---------------------------------------------------------------------------
+# Tables
+# ---------------------------------------------------------------------------
+def error_rows(result: SceneRun) -> list:
+    rows = [["output", "unit", "peak |reference|", "max |FMU - reference|", "relative to peak"]]
+    for e in result.errors:
+        rows.append([e.name, e.unit, f"{e.peak:.6g}", f"{e.max_abs:.3e}", f"{e.relative:.3e}"])
+    return rows
+
+
+def summary(result: SceneRun) -> str:
+    text = (f"{result.name}, FMI {result.fmi_version}: {result.steps} steps in "
+            f"{result.seconds_fmu:.3f} s; {len(result.errors)} outputs, worst relative error "
+            f"{result.worst_relative:.2e}")
+    torque = result.fmu.get(f"{result.source.crank_name}.torque")
+    if torque is not None:
+        t = torque[result.valid]
+        text += f"; driving torque {t.min():.4g} .. {t.max():.4g} N m"
+    if not math.isnan(result.energy_residual):
+        text += f"; energy balance {result.energy_residual:.1e} of the peak driving power"
+    left = int((~result.valid).sum())
+    if left:
+        text += f"; {left} near-singular rows left out"
+    return text
+
+
+def reactions_of(result: SceneRun) -> dict:
+    """The FMU's outputs, row by row as result.kin (for drawing)."""
+    return {k: v for k, v in result.fmu.items() if k != "time"}
