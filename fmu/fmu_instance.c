@@ -69,6 +69,10 @@ static void emit(const fmu_logger* logger, unsigned categories, fmu_status statu
 void fmu_log(const fmu_instance* instance, fmu_status status, const char* format, ...)
 {
     va_list args;
+    /* the common case, a call logged in no category: nothing to format */
+    if (status == FMU_OK && !(instance->log_categories & (1u << LOG_CALLS))) {
+        return;
+    }
     va_start(args, format);
     emit(&instance->logger, instance->log_categories, status, format, args);
     va_end(args);

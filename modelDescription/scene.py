@@ -293,7 +293,9 @@ def load_scene(path) -> Scene:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError([f"{path.name}: invalid TOML: {exc}"]) from None
+        line = re.search(r"at line (\d+)", str(exc))
+        where = f"{path.name}:{line.group(1)}" if line else path.name
+        raise SceneError([f"{where}: invalid TOML: {exc}"]) from None
     p = _Problems(path, Locator(text))
 
     for key in data:
@@ -407,8 +409,9 @@ def load_scene(path) -> Scene:
     for i, row in enumerate(rows):
         if not isinstance(row, dict):
             continue
-        _unknown_keys(p, row, LINK_KEYS, f"link #{i + 1}", "link", i)
         name = row.get("name")
+        _unknown_keys(p, row, LINK_KEYS,
+                      f"link '{name}'" if isinstance(name, str) else f"link #{i + 1}", "link", i)
         if not isinstance(name, str) or not NAME.match(name) or name in RESERVED:
             p.add(f"link #{i + 1}: name {name!r} must be a lower-case identifier and not one "
                   f"of {', '.join(sorted(RESERVED))}", "link", i, "name")
@@ -452,6 +455,9 @@ def load_scene(path) -> Scene:
         if dtype not in TYPES:
             p.add(f"{label}: unknown dyad type {dtype!r} (expected one of {', '.join(TYPES)})",
                   "dyad", i, "type")
+            for side in ("m", "n"):      # its links are not orphans
+                if isinstance(row.get(side), str):
+                    owner.setdefault(row[side], f"link {side} of {label}")
             continue
         dyad = Dyad(name, dtype, i, p.loc.line("dyad", i))
         d_m, e, d_n = generate.PAIRS[dtype]
@@ -547,13 +553,14 @@ def load_scene(path) -> Scene:
 
     if not p.items:
         _derive_inputs(scene)
+        candidates = {i.name for i in scene.inputs}
         _derive_outputs(p, scene, scene_t.get("outputs"))
         if not p.items:
             # only now is it known what the code computes, and so which inputs it reads;
             # the outputs' dependencies follow from those inputs
             _prune_inputs(scene)
             _derive_outputs(p, scene, scene_t.get("outputs"))
-            _apply_starts(p, scene, data.get("start", {}))
+            _apply_starts(p, scene, data.get("start", {}), candidates)
     if p.items:
         raise SceneError(p.items)
     return scene
@@ -763,14 +770,17 @@ def _derive_inputs(scene: Scene):
     scene.inputs = inputs
 
 
-def _apply_starts(p: _Problems, scene: Scene, starts):
-    """[start]: start values of inputs (default 0, and 1 m for a sliding length)."""
+def _apply_starts(p: _Problems, scene: Scene, starts, candidates: set):
+    """[start]: start values of inputs (default 0, and 1 m for a sliding length). A start
+    value of an input the scene's outputs turned out not to need is ignored."""
     if not isinstance(starts, dict):
         p.add("[start] must be a table of input names and values", "start", 0)
         return
     by_name = {i.name: i for i in scene.inputs}
     for name, value in starts.items():
         target = by_name.get(name)
+        if target is None and name in candidates:
+            continue
         if target is None:
             p.add(f"[start]: '{name}' is no input of this scene (inputs: "
                   f"{', '.join(by_name)})", "start", 0, name)
@@ -1151,8 +1161,10 @@ def scene_c(table: SceneTable) -> str:
                 code(f"const dyad_vec2 {c}_i = dyad_dir_from_angle({a.c()});")
             else:
                 code(f"const dyad_vec2 {c}_i = {_vec(_c_num(math.cos(a.value)), _c_num(math.sin(a.value)))};")
-        else:
+        elif has(g + ".angle"):
             code(f"const dyad_vec2 {c}_i = {inp(g + '.angle')};")
+        else:
+            continue   # a link the requested outputs do not involve
         code(f"const dyad_vec2 {c}_j = dyad_perp({c}_i);")
 
     def omega(g):

@@ -74,6 +74,35 @@ def parser() -> argparse.ArgumentParser:
                        help="CMake build directory with the benchmark and FMUs (default build/)")
     study.set_defaults(run=_study)
 
+    scene = sub.add_parser(
+        "scene", help="co-simulate tailored scene FMUs (scenes/*.toml) against their reference",
+        description="Co-simulate each scene's tailored FMU over the crank's motion, print the "
+                    "error of every output against the independent reference, and write "
+                    "tables (Markdown, CSV) and, for the multi-dyad chains, a drawing with "
+                    "every reaction. Scenes: " + ", ".join(scenes_names()) + ".")
+    scene.add_argument("scenes", nargs="*", metavar="SCENE", default=["shaper"],
+                       help="scene names (default shaper; 'all' for every example scene)")
+    scene.add_argument("--fmi", choices=("2", "3", "both"), default="both",
+                       help="FMI version of the FMU to run (default both)")
+    scene.add_argument("--revolutions", type=_positive_float, default=2.0,
+                       help="crank revolutions to simulate (default 2)")
+    scene.add_argument("--steps", type=_positive_int, default=360,
+                       help="communication steps per revolution (default 360)")
+    scene.add_argument("--motion", choices=("constant", "varying"), default="constant",
+                       help="crank speed: constant, or varying along the cycle (default constant)")
+    scene.add_argument("--out", type=Path, default=Path("out/scenes"),
+                       help="directory for tables and drawings (default ./out/scenes)")
+    scene.add_argument("--build", type=Path, default=None,
+                       help="CMake build directory holding fmus/ (default: build/ of the checkout)")
+    scene.add_argument("--no-plots", action="store_true", help="write tables only")
+    scene.set_defaults(run=_scene)
+
+    sub.add_parser(
+        "scenes", add_help=False,
+        help="every example scene against its reference, and the tailored FMUs against the "
+             "generic per-type FMUs: variables, binary size, callgrind instructions per doStep "
+             "(see 'dyadfmu scenes --help')").set_defaults(run=None)
+
     cosim = sub.add_parser(
         "cosim", add_help=False,
         help="the dyad FMU in a closed loop with the drive FMU: explicit and stabilised "
@@ -140,8 +169,64 @@ def _run(args) -> int:
     return 0
 
 
+def scenes_names():
+    from . import scenes
+
+    return scenes.NAMES
+
+
+def _scene(args) -> int:
+    import csv
+
+    from . import scenes
+
+    names = list(scenes.NAMES) if args.scenes == ["all"] else args.scenes
+    unknown = [n for n in names if n not in scenes.NAMES]
+    if unknown:
+        print(f"dyadfmu: unknown scene {', '.join(unknown)}; the example scenes are: "
+              f"{', '.join(scenes.NAMES)}", file=sys.stderr)
+        return 2
+    versions = (2, 3) if args.fmi == "both" else (int(args.fmi),)
+    args.out.mkdir(parents=True, exist_ok=True)
+    written, worst = [], 0.0
+    for name in names:
+        for version in versions:
+            try:
+                result = scenes.run(name, version, args.revolutions, args.steps, args.motion,
+                                    args.build, progress=True)
+            except FileNotFoundError as error:
+                print(f"dyadfmu: {error}", file=sys.stderr)
+                return 2
+            rows = scenes.error_rows(result)
+            print(scenes.summary(result))
+            print(harness.format_text(rows))
+            print()
+            worst = max(worst, result.worst_relative)
+            stem = args.out / f"{name}_fmi{version}"
+            Path(f"{stem}_errors.md").write_text(
+                f"# {scenes.summary(result)}\n\n{harness.format_markdown(rows)}\n")
+            with open(f"{stem}_errors.csv", "w", newline="") as handle:
+                csv.writer(handle).writerows(rows)
+            written += [Path(f"{stem}_errors.md"), Path(f"{stem}_errors.csv")]
+            if not args.no_plots and result.source.chain is not None:
+                from . import chain_drawing
+
+                written.append(chain_drawing.figure(
+                    result.source.chain, result.kin, scenes.reactions_of(result),
+                    scenes.drawing_indices(result), f"{stem}_reactions.png"))
+    print(f"worst relative error of any output: {worst:.2e}")
+    print("written:")
+    for path in written:
+        print(f"  {path}")
+    return 0
+
+
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["scenes"]:
+        from . import scene_report  # its own options: --quick, --out, ...
+
+        return scene_report.main(argv[1:])
     if argv[:1] == ["cosim"]:
         from . import cosim_report  # its own options: --quick, --out, ...
 

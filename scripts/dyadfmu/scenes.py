@@ -338,3 +338,13 @@ def summary(result: SceneRun) -> str:
 def reactions_of(result: SceneRun) -> dict:
     """The FMU's outputs, row by row as result.kin (for drawing)."""
     return {k: v for k, v in result.fmu.items() if k != "time"}
+
+
+def drawing_indices(result: SceneRun, angles_deg=(30.0, 120.0, 210.0, 300.0)) -> list:
+    """The rows nearest to the given crank angles (first occurrence), for drawings."""
+    phi = np.mod(np.asarray(result.kin[f"{result.source.crank_name}.angle"]), 2 * math.pi)
+    picks = []
+    for a in angles_deg:
+        gap = np.abs(np.angle(np.exp(1j * (phi - math.radians(a)))))
+        picks.append(int(np.argmin(gap)))
+    return picks

@@ -1,0 +1,259 @@
+"""What tailoring buys: for each example scene, its tailored FMU against the generic
+per-type FMUs it would otherwise take (one per dyad), in variables, binary size and work
+per doStep; and every tailored FMU co-simulated against its reference.
+
+Work per doStep is counted by ``valgrind --tool=callgrind`` around the stepping loop of
+``tests/bench/dyad_bench --method fmu`` (set the inputs, doStep, get the real outputs),
+and timed in one run of the same program (median of several passes). The generic FMUs are
+stepped through their own start values with smooth variations (as in the accuracy and
+speed study); the tailored ones through the scene's own kinematics. The generic route also
+leaves the master to carry the reactions from dyad to dyad and to balance the crank: that
+work is not counted, so the comparison favours the generic FMUs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+
+from . import scenes, study
+from .harness import format_markdown, format_text
+
+PLATFORM = {2: "linux64", 3: "x86_64-linux"}
+
+
+@dataclass
+class Footprint:
+    inputs: int
+    parameters: int
+    outputs: int
+    binary_bytes: int
+    text_bytes: int
+    instructions: float      # per doStep (set inputs, doStep, get outputs)
+    seconds: float           # per doStep, median of the passes
+
+    @property
+    def variables(self) -> int:
+        return self.inputs + self.parameters + self.outputs
+
+
+def _binary(build: Path, identifier: str, version: int) -> Path:
+    return (build / "fmus" / "stage" / f"{identifier}_fmi{version}" / "binaries" /
+            PLATFORM[version] / f"{identifier}.so")
+
+
+def _text_size(path: Path) -> int:
+    """Bytes of code (the .text section), from `size -A`; 0 if size is missing."""
+    if shutil.which("size") is None:
+        return 0
+    done = subprocess.run(["size", "-A", str(path)], capture_output=True, text=True)
+    match = re.search(r"^\.text\s+(\d+)", done.stdout, re.MULTILINE)
+    return int(match.group(1)) if match else 0
+
+
+def _step(build: Path, identifier: str, version: int, md, rows: np.ndarray, work: Path,
+          repeat: int) -> tuple[float, float]:
+    """(instructions, seconds) per doStep of an FMU binary over `rows` of its inputs."""
+    inputs = [v for v in md.modelVariables if v.causality == "input"]
+    outputs = [v for v in md.modelVariables if v.causality == "output" and
+               v.type in ("Real", "Float64")]
+    data = work / f"{identifier}_{version}.bin"
+    rows.astype("<f8").tofile(data)
+    args = ["--method", "fmu", "--fmu", str(_binary(build, identifier, version)),
+            "--fmi", str(version), "--token", md.guid, "--fmu-inputs", str(data),
+            "--in-vrs", ",".join(str(v.valueReference) for v in inputs),
+            "--out-vrs", ",".join(str(v.valueReference) for v in outputs)]
+    bench = study._bench_binary(build, "double")
+    info = study._run_bench(bench, args + ["--repeat", str(repeat)])
+    instructions = math.nan
+    if shutil.which("valgrind") is not None:
+        done = subprocess.run(
+            ["valgrind", "--tool=callgrind", "--toggle-collect=bench_loop_*",
+             f"--callgrind-out-file={work / 'callgrind.out'}", str(bench), *args,
+             "--repeat", "1"], capture_output=True, text=True)
+        match = re.search(r"Collected\s*:\s*(\d+)", done.stderr)
+        if match:
+            instructions = int(match.group(1)) / len(rows)
+    return instructions, float(info["seconds_per_config"])
+
+
+def _counts(md) -> tuple[int, int, int]:
+    causes = [v.causality for v in md.modelVariables]
+    return causes.count("input"), causes.count("parameter"), causes.count("output")
+
+
+def tailored(name: str, build: Path, version: int, work: Path, rows_count: int,
+             repeat: int) -> Footprint:
+    path = scenes.fmu_path(name, version, build)
+    md = read_model_description(str(path))
+    source = scenes.Source(name)
+    motion = source.motion("constant", 1.0)
+    t = (np.arange(rows_count) + 0.5) * motion.duration / rows_count
+    kin = source.kinematics(t, motion)
+    names = [v.name for v in md.modelVariables if v.causality == "input"]
+    inputs = source.inputs(kin, names)
+    rows = np.stack([inputs[n] for n in names], axis=1) if names else np.zeros((rows_count, 0))
+    instructions, seconds = _step(build, name, version, md, rows, work, repeat)
+    binary = _binary(build, name, version)
+    return Footprint(*_counts(md), binary.stat().st_size, _text_size(binary), instructions,
+                     seconds)
+
+
+def generic(dyad: str, build: Path, version: int, work: Path, rows_count: int,
+            repeat: int) -> Footprint:
+    identifier = f"dyad_{dyad.lower()}"
+    md, _, _, rows = study._fmu_rows(dyad, rows_count, seed=version)
+    if version != 2:
+        md = read_model_description(str(scenes.fmu_path(identifier, version, build)))
+    instructions, seconds = _step(build, identifier, version, md, rows, work, repeat)
+    binary = _binary(build, identifier, version)
+    return Footprint(*_counts(md), binary.stat().st_size, _text_size(binary), instructions,
+                     seconds)
+
+
+def measure(build: Path, version: int = 2, rows_count: int = 500, repeat: int = 21,
+            log=print) -> list:
+    """[(scene, tailored Footprint, [generic Footprint per dyad])]."""
+    results = []
+    with tempfile.TemporaryDirectory(prefix="dyadfmu_scenes_") as tmp:
+        work = Path(tmp)
+        cache = {}
+        for name in scenes.NAMES:
+            log(f"measuring {name} (FMI {version})")
+            mine = tailored(name, build, version, work, rows_count, repeat)
+            full = []
+            for dyad in scenes.FULL_OF[name]:
+                if dyad not in cache:
+                    cache[dyad] = generic(dyad, build, version, work, rows_count, repeat)
+                full.append(cache[dyad])
+            results.append((name, mine, full))
+    return results
+
+
+def footprint_rows(results) -> list:
+    rows = [["scene", "generic FMUs", "variables (in/par/out)", "generic variables",
+             "binary (bytes)", "generic binaries", ".text (bytes)", "generic .text",
+             "instr./doStep", "generic instr.", "ratio", "ns/doStep", "generic ns", "ratio"]]
+    for name, mine, full in results:
+        unique = {}
+        for dyad, f in zip(scenes.FULL_OF[name], full):
+            unique[dyad] = f
+        f_vars = sum(f.variables for f in full)
+        f_in = sum(f.inputs for f in full)
+        f_par = sum(f.parameters for f in full)
+        f_out = sum(f.outputs for f in full)
+        f_bytes = sum(f.binary_bytes for f in unique.values())
+        f_text = sum(f.text_bytes for f in unique.values())
+        f_instr = sum(f.instructions for f in full)
+        f_sec = sum(f.seconds for f in full)
+        rows.append([
+            name, " + ".join(f"dyad_{d.lower()}" for d in scenes.FULL_OF[name]),
+            f"{mine.variables} ({mine.inputs}/{mine.parameters}/{mine.outputs})",
+            f"{f_vars} ({f_in}/{f_par}/{f_out})",
+            f"{mine.binary_bytes}", f"{f_bytes}", f"{mine.text_bytes}", f"{f_text}",
+            f"{mine.instructions:.0f}", f"{f_instr:.0f}",
+            f"{mine.instructions / f_instr:.2f}" if f_instr else "-",
+            f"{1e9 * mine.seconds:.0f}", f"{1e9 * f_sec:.0f}",
+            f"{mine.seconds / f_sec:.2f}" if f_sec else "-"])
+    return rows
+
+
+def accuracy_rows(runs) -> list:
+    rows = [["scene", "FMI", "outputs", "steps", "worst relative error", "driving torque (N m)",
+             "energy balance", "run time (s)"]]
+    for r in runs:
+        torque = r.fmu.get(f"{r.source.crank_name}.torque")
+        rows.append([r.name, str(r.fmi_version), str(len(r.errors)), str(r.steps),
+                     f"{r.worst_relative:.2e}",
+                     f"{torque[r.valid].min():.4g} .. {torque[r.valid].max():.4g}"
+                     if torque is not None else "-",
+                     f"{r.energy_residual:.1e}" if not math.isnan(r.energy_residual) else "-",
+                     f"{r.seconds_fmu:.3f}"])
+    return rows
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="dyadfmu scenes",
+        description="Co-simulate every example scene's tailored FMU against its reference, "
+                    "draw the chains with their reactions, and measure each tailored FMU "
+                    "against the generic per-type FMUs it replaces (variables, binary size, "
+                    "callgrind instructions and time per doStep); writes report.md.")
+    parser.add_argument("--out", type=Path, default=Path("out/scenes"),
+                        help="directory for the report, tables and drawings "
+                             "(default ./out/scenes)")
+    parser.add_argument("--build", type=Path, default=None,
+                        help="CMake build directory with fmus/ and tests/bench (default build/)")
+    parser.add_argument("--quick", action="store_true",
+                        help="fewer steps and rows (for CI)")
+    args = parser.parse_args(argv)
+    build = args.build or scenes.build_dir()
+    out = args.out
+    out.mkdir(parents=True, exist_ok=True)
+
+    def log(text):
+        print(text, file=sys.stderr)
+
+    try:
+        runs = []
+        for name in scenes.NAMES:
+            for version in (2, 3):
+                result = scenes.run(name, version, revolutions=1.0 if args.quick else 2.0,
+                                    steps=180 if args.quick else 360, build=build)
+                runs.append(result)
+                log(scenes.summary(result))
+        drawings = []
+        from . import chain_drawing
+
+        for r in runs:
+            if r.source.chain is not None and r.fmi_version == 2:
+                drawings.append(chain_drawing.figure(r.source.chain, r.kin, scenes.reactions_of(r),
+                                                     scenes.drawing_indices(r),
+                                                     out / f"{r.name}_reactions.png"))
+        results = measure(build, 2, rows_count=200 if args.quick else 500,
+                          repeat=5 if args.quick else 21, log=log)
+    except FileNotFoundError as error:
+        print(f"dyadfmu: {error}", file=sys.stderr)
+        return 2
+
+    acc = accuracy_rows(runs)
+    foot = footprint_rows(results)
+    text = ["# Scenes: tailored FMUs against the generic per-type FMUs", "",
+            "Every example scene's tailored FMU, co-simulated with fmpy over "
+            f"{'one crank turn (180' if args.quick else 'two crank turns (360'} steps per "
+            "turn) and compared output by output with its independent reference (errors "
+            "relative to each output's peak; the chains' driving torque also against the "
+            "energy balance of the whole mechanism, relative to the peak driving power):", "",
+            format_markdown(acc), "",
+            "What tailoring buys (FMI 2 binaries; the generic route needs one dyad_<type> FMU "
+            "per dyad, binaries counted once per type; instructions by callgrind per doStep "
+            "including setting the inputs and getting the real outputs; times are medians "
+            "of one run, ratios in the same run):", "",
+            format_markdown(foot), "",
+            "The generic route also leaves the master to carry each dyad's reactions to the "
+            "links it is attached to and to balance the crank; that work is not counted "
+            "above.", ""]
+    if drawings:
+        text += ["Drawings with every reaction: " +
+                 ", ".join(f"`{p.name}`" for p in drawings), ""]
+    report = out / "report.md"
+    report.write_text("\n".join(text))
+    print(format_text(acc))
+    print()
+    print(format_text(foot))
+    print(f"\nreport: {report}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,292 @@
+"""Scenes: the generator on every example scene (valid and malformed), every tailored FMU
+validated by fmpy and compared with its independent reference in co-simulation, the
+chains' driving torque against the energy balance, the declared dependencies against the
+FMUs' behaviour, and the compile-time omission of what a scene leaves out."""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+from fmpy.validation import validate_fmu
+
+from dyadfmu import scenes
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
+SCENES_DIR = ROOT / "scenes"
+MALFORMED = sorted((SCENES_DIR / "malformed").glob("*.toml"))
+VERSIONS = (2, 3)
+GENERATED = scenes.build_dir() / "generated"
+
+
+def run_tool(*args):
+    return subprocess.run([sys.executable, str(SCENE_TOOL), *map(str, args)],
+                          capture_output=True, text=True)
+
+
+def variables(name, version=2):
+    md = read_model_description(str(scenes.fmu_path(name, version)))
+    return {c: [v.name for v in md.modelVariables if v.causality == c]
+            for c in ("input", "parameter", "output")}
+
+
+# ---------------------------------------------------------------------------
+# the generator
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("path", sorted(SCENES_DIR.glob("*.toml")), ids=lambda p: p.stem)
+def test_every_example_scene_is_accepted(path, tmp_path):
+    check = run_tool(path, "--check")
+    assert check.returncode == 0, check.stderr
+    out = tmp_path / path.stem
+    done = run_tool(path, "--out", out)
+    assert done.returncode == 0, done.stderr
+    for rel in ("fmi2/modelDescription.xml", "fmi3/modelDescription.xml",
+                "fmi3/buildDescription.xml", "documentation/index.html"):
+        assert (out / rel).is_file(), rel
+    # the same scene gives the same files, byte for byte
+    again = tmp_path / (path.stem + "_again")
+    assert run_tool(path, "--out", again).returncode == 0
+    for file in out.rglob("*"):
+        if file.is_file():
+            assert (again / file.relative_to(out)).read_bytes() == file.read_bytes()
+
+
+def test_malformed_examples_exist():
+    kinds = {p.stem for p in MALFORMED}
+    assert {"unknown_type", "link_twice", "output_no_pair_provides",
+            "missing_parameter"} <= kinds
+    assert len(kinds) >= 10
+
+
+@pytest.mark.parametrize("path", MALFORMED, ids=lambda p: p.stem)
+def test_malformed_scene_is_rejected_naming_line_and_problem(path, tmp_path):
+    expect = re.match(r"# expect: line (\d+): (.*)$", path.read_text().splitlines()[0])
+    assert expect, f"{path.name}: first line must be '# expect: line N: message'"
+    line, fragment = expect.group(1), expect.group(2)
+    out = tmp_path / "out"
+    done = run_tool(path, "--out", out)
+    assert done.returncode == 1
+    errors = [ln for ln in done.stderr.splitlines() if ln.startswith("error:")]
+    assert any(f"{path.name}:{line}:" in ln and fragment in ln for ln in errors), done.stderr
+    assert "nothing written" in done.stderr
+    assert not out.exists()                       # nothing built
+
+
+def test_cmake_stops_on_a_malformed_scene(tmp_path):
+    """One CMake call per scene; a malformed one stops the configuration with the
+    generator's message."""
+    build = tmp_path / "build"
+    done = subprocess.run(
+        ["cmake", "-S", str(ROOT), "-B", str(build), "-DDYADFMU_BUILD_TESTS=OFF",
+         "-DDYADFMU_BUILD_BENCH=OFF", f"-DPython3_EXECUTABLE={sys.executable}",
+         f"-DDYADFMU_SCENES={SCENES_DIR / 'malformed' / 'link_twice.toml'}"],
+        capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "link_twice.toml:42:" in done.stderr and "connected twice" in done.stderr
+
+
+# ---------------------------------------------------------------------------
+# what a scene leaves out
+# ---------------------------------------------------------------------------
+def test_static_press_takes_no_motion_and_computes_no_inertia_or_weight():
+    v = variables("press")
+    assert v["input"] == ["crank.angle", "ram.force.x", "ram.force.y", "rod.angle"]
+    assert v["parameter"] == []
+    assert v["output"] == ["press.N_mk", "press.R_np.x", "press.R_np.y", "crank.torque",
+                           "status"]
+    code = (GENERATED / "press" / "press_scene.c").read_text()
+    body = code[code.index("static void evaluate"):]
+    for absent in ("omega", "epsilon", "gravity", "accel", "crank_r_o"):
+        assert absent not in body, absent
+    # baked constants, not parameters: the rod length and the crank radius
+    assert "0.18" in body and "dyad_scale(0.05, crank_i)" in body
+
+
+def test_horizontal_monitor_has_no_weight_and_one_reaction():
+    v = variables("monitor")
+    assert v["output"] == ["agitator.R_mk.x", "agitator.R_mk.y", "status"]
+    assert v["parameter"] == ["rocker.mass"]
+    assert not any("gravity" in n for n in v["input"] + v["parameter"])
+    code = (GENERATED / "monitor" / "monitor_scene.c").read_text()
+    body = code[code.index("static void evaluate"):]
+    assert "gravity" not in body
+    assert "crank_torque" not in body and "crank_r_o" not in body   # no crank balance
+    assert "in->rocker_mass" in body
+
+
+def test_outputs_of_one_dyad_solve_only_what_loads_it(tmp_path):
+    """Asking the six-bar for the second dyad's reactions only solves that dyad."""
+    text = (SCENES_DIR / "sixbar.toml").read_text().replace(
+        'outputs = ["all"]', 'outputs = ["second.R_np"]')
+    scene = tmp_path / "sixbar_second.toml"
+    scene.write_text(text.replace('identifier = "sixbar"', 'identifier = "sixbar_second"'))
+    out = tmp_path / "gen"
+    assert run_tool(scene, "--out", out).returncode == 0
+    code = (out / "sixbar_second_scene.c").read_text()
+    assert "dyad_react_rrr(&load, &second)" in code
+    assert "&first)" not in code
+    md = (out / "fmi2" / "modelDescription.xml").read_text()
+    assert 'name="coupler.angle"' not in md     # the first dyad's links are not inputs
+    assert 'name="connector.angle"' in md
+
+
+def test_the_generic_scenes_are_the_per_type_fmus():
+    for t in ("rrr", "rrt", "rtr", "trt", "rtt"):
+        done = run_tool(SCENES_DIR / f"dyad_{t}.toml", "--cmake-info")
+        assert done.returncode == 0 and done.stdout.split(";")[:2] == [f"dyad_{t}", "generic"]
+    for name in scenes.NAMES:
+        done = run_tool(SCENES_DIR / f"{name}.toml", "--cmake-info")
+        assert done.stdout.split(";")[1] == "tailored"
+
+
+# ---------------------------------------------------------------------------
+# the tailored FMUs
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("name", scenes.NAMES)
+def test_tailored_fmus_validate(name):
+    for version in VERSIONS:
+        assert validate_fmu(str(scenes.fmu_path(name, version))) == []
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+@pytest.mark.parametrize("name", scenes.NAMES)
+def test_tailored_fmu_matches_the_reference(name, version):
+    result = scenes.run(name, version, revolutions=1.0, steps=120)
+    assert result.valid.all()
+    # each output to 1e-12 of the largest output of its unit (a reaction moment that is
+    # small beside the mechanism's moments is held to the moments' scale)
+    scale = {}
+    for e in result.errors:
+        scale[e.unit] = max(scale.get(e.unit, 0.0), e.peak)
+    for e in result.errors:
+        assert e.max_abs <= 1e-12 * max(scale[e.unit], 1e-300), (e.name, e.max_abs, e.peak)
+    assert {e.name for e in result.errors} == {
+        n for n in variables(name, version)["output"]
+        if n != "status" and not n.endswith("amplification")}
+
+
+@pytest.mark.parametrize("motion", ("constant", "varying"))
+@pytest.mark.parametrize("name", ("shaper", "sixbar"))
+def test_chain_driving_torque_against_the_energy_balance(name, motion):
+    result = scenes.run(name, 2, revolutions=1.0, steps=180, motion=motion)
+    assert result.energy_residual < 1e-9, result.energy_residual
+    torque = result.fmu["crank.torque"]
+    assert np.ptp(torque) > 0.1 * np.max(np.abs(torque))          # a varying load
+
+
+def test_energy_balance_detects_a_wrong_torque():
+    source = scenes.Source("shaper")
+    motion = source.motion("constant", 1.0)
+    t = (np.arange(90) + 0.5) * motion.duration / 90
+    kin = source.kinematics(t, motion)
+    torque = source.reference(kin)["crank.torque"]
+    good = scenes.energy_balance(source, motion, t, torque, t)
+    bad = scenes.energy_balance(source, motion, t, torque * (1 + 1e-6), t)
+    assert good < 1e-9 < bad
+
+
+class Slave:
+    def __init__(self, name, version, tmp_path):
+        path = scenes.fmu_path(name, version)
+        self.version = version
+        self.md = read_model_description(str(path))
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        unzipdir = tmp_path / f"{name}{version}"
+        with zipfile.ZipFile(path) as archive:
+            archive.extractall(unzipdir)
+        cls = FMU2Slave if version == 2 else FMU3Slave
+        self.fmu = cls(guid=self.md.guid, unzipDirectory=str(unzipdir),
+                       modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+        self.fmu.instantiate(loggingOn=False)
+        if version == 2:
+            self.fmu.setupExperiment(startTime=0)
+        self.fmu.enterInitializationMode()
+        self.fmu.exitInitializationMode()
+        self.t = 0.0
+
+    def set(self, values: dict):
+        vrs = [self.vr[n] for n in values]
+        (self.fmu.setReal if self.version == 2 else self.fmu.setFloat64)(vrs, list(values.values()))
+
+    def get(self, names):
+        return np.array((self.fmu.getReal if self.version == 2 else self.fmu.getFloat64)(
+            [self.vr[n] for n in names]))
+
+    def status(self):
+        vr = [self.vr["status"]]
+        return (self.fmu.getInteger if self.version == 2 else self.fmu.getInt32)(vr)[0]
+
+    def step(self):
+        self.fmu.doStep(currentCommunicationPoint=self.t, communicationStepSize=1e-3)
+        self.t += 1e-3
+
+
+@pytest.mark.parametrize("name", scenes.NAMES)
+def test_declared_dependencies_cover_every_true_one(name, tmp_path):
+    """Perturb each input: an output that changes must list it in its dependencies."""
+    md = read_model_description(str(scenes.fmu_path(name, 2)))
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    declared = {u.variable.name: {d.name for d in (u.dependencies or [])} for u in md.outputs}
+    source = scenes.Source(name)
+    motion = source.motion("varying", 1.0)
+    kin = source.kinematics(np.array([0.37 * motion.duration]), motion)
+    base = {n: float(np.asarray(kin[n])[0]) for n in inputs}
+    s = Slave(name, 2, tmp_path)
+    names = [v.name for v in outputs]
+    s.set(base)
+    s.step()
+    before = s.get(names)
+    for n in inputs:
+        s.set({**base, n: base[n] + 1e-3 * (abs(base[n]) + 1.0)})
+        s.step()
+        changed = [o for o, a, b in zip(names, before, s.get(names)) if a != b]
+        for o in changed:
+            assert n in declared[o], f"{o} changes with {n} but does not declare it"
+    s.set(base)
+    s.step()
+    assert np.array_equal(s.get(names), before)
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_a_singular_dyad_discards_and_names_itself(version, tmp_path):
+    s = Slave("sixbar", version, tmp_path)
+    source = scenes.Source("sixbar")
+    motion = source.motion("constant", 1.0)
+    kin = source.kinematics(np.array([0.1]), motion)
+    inputs = [v.name for v in s.md.modelVariables if v.causality == "input"]
+    base = {n: float(np.asarray(kin[n])[0]) for n in inputs}
+    s.set(base)
+    s.step()
+    assert s.status() == 0
+    s.set({"rocker.angle": base["coupler.angle"] + math.pi})   # coupler and rocker aligned
+    with pytest.raises(FMICallException) as error:
+        s.step()
+    assert error.value.status == 2                              # discard
+    assert s.status() == 1
+    assert all(math.isnan(x) for x in s.get(["first.R_mk.x", "crank.torque", "second.R_np.y"]))
+    s.set(base)
+    s.step()
+    assert s.status() == 0 and math.isfinite(s.get(["crank.torque"])[0])
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_tailored_fmu_rejects_a_bad_value_by_name(version, tmp_path):
+    s = Slave("shaper", version, tmp_path)
+    for name, value in (("slider.force.x", math.nan), ("lever.length", -0.1),
+                        ("lever.omega", math.inf)):
+        with pytest.raises(FMICallException):
+            s.set({name: value})
+    s.step()
+    assert s.status() == 0
