@@ -290,3 +290,17 @@ def test_tailored_fmu_rejects_a_bad_value_by_name(version, tmp_path):
             s.set({name: value})
     s.step()
     assert s.status() == 0
+
+
+def test_the_readme_scene_builds_as_described(tmp_path):
+    """The README's two-command example: the scene in it is valid and has the variables
+    the README says."""
+    readme = (ROOT / "README.md").read_text()
+    found = re.search(r"cat > my_press.toml <<'TOML'\n(.*?)\nTOML\n", readme, re.S)
+    assert found, "the README lost its scene example"
+    scene = tmp_path / "my_press.toml"
+    scene.write_text(found.group(1) + "\n")
+    done = run_tool(scene, "--check")
+    assert done.returncode == 0, done.stderr
+    assert "4 inputs, 0 parameters, 3 outputs" in done.stdout
+    assert "scripts/build-scene my_press.toml" in readme
