@@ -60,7 +60,7 @@ try:
 except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
     import tomli as tomllib
 
-from .mechanisms import CrankMotion, _rotating
+from .mechanisms import CrankMotion, _merge, _number, _pair, _rotating
 
 __all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
 
@@ -127,44 +127,6 @@ def default_data() -> dict:
     """The packaged ``chains.toml`` as a dict (a fresh copy)."""
     text = resources.files(__package__ or "dyadfmu").joinpath("chains.toml").read_text("utf-8")
     return tomllib.loads(text)
-
-
-def _merge(base, over):
-    out = copy.deepcopy(base)
-    for key, value in over.items():
-        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
-            out[key] = _merge(out[key], value)
-        else:
-            out[key] = copy.deepcopy(value)
-    return out
-
-
-def _number(table, key, where, positive=False, nonnegative=False, default=None):
-    if key not in table:
-        if default is not None:
-            return float(default)
-        raise ValueError(f"{where}: missing key {key!r}")
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"{where}.{key}: expected a finite number, got {value!r}")
-    if positive and value <= 0:
-        raise ValueError(f"{where}.{key}: must be > 0, got {value!r}")
-    if nonnegative and value < 0:
-        raise ValueError(f"{where}.{key}: must be >= 0, got {value!r}")
-    return float(value)
-
-
-def _pair(table, key, where):
-    value = table.get(key)
-    if value is None:
-        raise ValueError(f"{where}: missing key {key!r}")
-    try:
-        x, y = (float(c) for c in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{where}.{key}: expected two numbers, got {value!r}") from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise ValueError(f"{where}.{key}: expected finite numbers, got {value!r}")
-    return (x, y)
 
 
 def _sign(table, key, where):

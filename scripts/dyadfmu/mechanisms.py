@@ -206,8 +206,10 @@ def _merge(base, over):
     return out
 
 
-def _number(table, key, where, positive=False, nonnegative=False):
+def _number(table, key, where, positive=False, nonnegative=False, default=None):
     if key not in table:
+        if default is not None:
+            return float(default)
         raise ValueError(f"{where}: missing key {key!r}")
     value = table[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):

@@ -20,7 +20,6 @@ balance of the whole mechanism: M omega + P_loads = d(T + V)/dt.
 from __future__ import annotations
 
 import math
-import os
 import time as clock
 import tomllib
 from dataclasses import dataclass, field
@@ -30,7 +29,7 @@ import numpy as np
 from fmpy import read_model_description, simulate_fmu
 
 from . import chains, mechanisms, reference
-from .harness import OutputError, _match_samples, _Progress
+from .harness import OutputError, _match_samples, _Progress, build_dir
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES_DIR = ROOT / "scenes"
@@ -53,10 +52,6 @@ FULL_OF = {"press": ("RRT",), "monitor": ("RRR",), "engine": ("RRT",),
 #: Speeds of the quasi-static press: slow enough that nothing dynamic matters, though the
 #: FMU takes no speeds at all.
 NEAR_SINGULAR = 1e-6
-
-
-def build_dir() -> Path:
-    return Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
 
 
 def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
