@@ -197,7 +197,7 @@ class Scene:
     gravity_params: tuple | None   # (Param, Param)
     threshold: Param
     outputs: list = field(default_factory=list)      # Output
-    inputs: list = field(default_factory=list)       # (name, unit, description, member, start, domain)
+    inputs: list = field(default_factory=list)       # Input, in table order
 
     def parameters(self) -> list:
         """Every Param of the scene in table order."""
