@@ -210,7 +210,7 @@ class Scene:
             for a in (d.k, d.p):
                 if a.at:
                     out += a.at
-                if a.guide and a.kind == "frame":
+                if a.guide:
                     out.append(a.guide)
         if self.gravity_params:
             out += self.gravity_params
@@ -566,6 +566,11 @@ def load_scene(path) -> Scene:
     return scene
 
 
+def _finite_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and \
+        math.isfinite(value)
+
+
 def _attachment(p, spec, side, pair_kind, pair, label, i, crank, links, dyad):
     """Parse k or p of a dyad."""
     if spec is None:
@@ -584,72 +589,75 @@ def _attachment(p, spec, side, pair_kind, pair, label, i, crank, links, dyad):
             return None
     target = spec.get("link")
     prefix = dyad.prefix()
-    if pair_kind == "T":
-        if target not in ("frame", "external"):
-            p.add(f"{label}: {pair} is a translational pair; its guide must be on the frame "
-                  f"(or an external link), not on the moving link {target!r}", "dyad", i, side)
-            return None
-        if "at" in spec:
-            p.add(f"{label}: '{side}': a translational pair on the {target} takes no 'at'",
-                  "dyad", i, side)
-            return None
-        if target == "external":
-            if "guide" in spec:
-                p.add(f"{label}: '{side}': an external link's guide is an input; drop 'guide'",
-                      "dyad", i, side)
-                return None
-            return Attachment("external")
-        angle = spec.get("guide")
-        if isinstance(angle, bool) or not isinstance(angle, (int, float)) or \
-                not math.isfinite(angle):
-            p.add(f"{label}: {pair} slides on the frame: '{side}' needs guide = <angle in rad> "
-                  f"(e.g. {side} = {{ link = \"frame\", guide = 0.0 }})", "dyad", i, side)
-            return None
-        gname = f"{prefix}guide_{side}.angle"
-        return Attachment("frame", guide=Param(gname, float(angle), "rad",
-                                               f"Direction of the frame guide at {pair} "
-                                               f"(angle of i_{side} from x)"))
-    if "guide" in spec:
-        p.add(f"{label}: {pair} is a revolute pair and has no guide", "dyad", i, side)
+    sliding = pair_kind == "T"
+    moving = (crank is not None and target == crank.name) or target in links
+    if not isinstance(target, str):
+        p.add(f"{label}: '{side}' needs link = <name>", "dyad", i, side)
         return None
-    if target in ("frame", "external"):
-        if "at" in spec:
-            p.add(f"{label}: '{side}': a pair on the {target} takes no 'at'", "dyad", i, side)
-            return None
-        return Attachment(target)
-    if crank and target == crank.name:
-        at = spec.get("at")
-        if at is None:
-            at = (crank.params["length"].value if "length" in crank.params else 0.0, 0.0)
-            return Attachment("crank", crank.name)
-    elif target in links:
-        at = spec.get("at")
-        if at is None:
-            p.add(f"{label}: '{side}' on link '{target}' needs at = [x, y], the pair's point "
-                  f"in that link's frame (m)", "dyad", i, side)
-            return None
-    elif isinstance(target, str):
+    if target not in ("frame", "external") and not moving:
         later = f" (a link of a later dyad or of this one: dyads are listed from the crank " \
                 f"outwards)" if target else ""
         p.add(f"{label}: '{side}' names unknown link {target!r}{later}; expected 'frame', "
               f"'external'{', the crank' if crank else ''} or a link of an earlier dyad",
               "dyad", i, side)
         return None
-    else:
-        p.add(f"{label}: '{side}' needs link = <name>", "dyad", i, side)
+    if not sliding and "guide" in spec:
+        p.add(f"{label}: {pair} is a revolute pair and has no guide", "dyad", i, side)
         return None
-    if (not isinstance(at, list) or len(at) != 2 or
-            not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-                    for v in at)):
+    if target in ("frame", "external") and "at" in spec:
+        p.add(f"{label}: '{side}': a pair on the {target} takes no 'at'", "dyad", i, side)
+        return None
+    if target == "external":
+        if "guide" in spec:
+            p.add(f"{label}: '{side}': an external link's guide is an input; drop 'guide'",
+                  "dyad", i, side)
+            return None
+        return Attachment("external")
+    if target == "frame" and not sliding:
+        return Attachment("frame")
+    kind = "frame" if target == "frame" else "crank" if crank and target == crank.name \
+        else "link"
+
+    guide = None
+    if sliding:
+        angle = spec.get("guide")
+        if not _finite_number(angle):
+            on = "the frame" if kind == "frame" else f"'{target}'"
+            example = "0.0" if kind == "frame" else "0.0, at = [0.0, 0.0]"
+            p.add(f"{label}: {pair} slides on {on}: '{side}' needs guide = <angle in rad> "
+                  f"(e.g. {side} = {{ link = \"{target}\", guide = {example} }})",
+                  "dyad", i, side)
+            return None
+        text = (f"Direction of the frame guide at {pair} (angle of i_{side} from x)"
+                if kind == "frame" else
+                f"Direction of the guide at {pair} on {target}: angle of i_{side} from "
+                f"{target}'s i")
+        guide = Param(f"{prefix}guide_{side}.angle", float(angle), "rad", text)
+        if kind == "frame":
+            return Attachment("frame", guide=guide)
+
+    at = spec.get("at")
+    if at is None:
+        if sliding:
+            at = [0.0, 0.0]                  # the guide passes through the carrier's D (O)
+        elif kind == "crank":
+            return Attachment("crank", crank.name)       # the crank's pin
+        else:
+            p.add(f"{label}: '{side}' on link '{target}' needs at = [x, y], the pair's point "
+                  f"in that link's frame (m)", "dyad", i, side)
+            return None
+    if not isinstance(at, list) or len(at) != 2 or not all(_finite_number(v) for v in at):
         p.add(f"{label}: '{side}': at must be [x, y], two finite numbers (m)", "dyad", i, side)
         return None
-    pname = f"{prefix}{pair}"
     frame = f"{target}'s frame"
-    return Attachment("crank" if crank and target == crank.name else "link", target,
-                      (Param(f"{pname}.x", float(at[0]), "m", f"Pair {pair} on {target}: x in "
-                             f"the {frame}"),
-                       Param(f"{pname}.y", float(at[1]), "m", f"Pair {pair} on {target}: y in "
-                             f"the {frame}")))
+    if sliding:
+        pname, what = f"{prefix}guide_{side}.at", f"A point of the guide at {pair} on {target}"
+    else:
+        pname, what = f"{prefix}{pair}", f"Pair {pair} on {target}"
+    return Attachment(kind, target,
+                      (Param(f"{pname}.x", float(at[0]), "m", f"{what}: x in the {frame}"),
+                       Param(f"{pname}.y", float(at[1]), "m", f"{what}: y in the {frame}")),
+                      guide)
 
 
 def _link_params(p, link: Link, row: dict, i: int, inertia: bool, needs_mass: bool):
@@ -740,11 +748,12 @@ def _link_inputs(scene: Scene, link: Link) -> list:
 
 
 def _own_accel(scene: Scene, link: Link) -> bool:
-    """Whether the acceleration of D_g is an input: where D_g is on a frame guide (the link
-    slides) or on an external link. On a fixed pivot it is 0; on a point of the crank or of
-    an earlier link the generated code derives it from that link's motion."""
+    """Whether the acceleration of D_g is an input: where D_g slides on a guide (of the frame
+    or of a moving link) or sits on an external link. On a fixed pivot it is 0; on a point
+    of the crank or of an earlier link the generated code derives it from that link's
+    motion."""
     att = link.dyad.k if link.side == "m" else link.dyad.p
-    return att.kind == "external" or (att.kind == "frame" and att.guide is not None)
+    return att.kind == "external" or att.guide is not None
 
 
 def _derive_inputs(scene: Scene):
@@ -763,6 +772,12 @@ def _derive_inputs(scene: Scene):
             inputs += _link_inputs(scene, scene.links[g])
         for side, pair in (("k", "D_m"), ("p", "D_n")):
             att = getattr(d, side)
+            if att.kind in ("crank", "link") and att.guide is not None:
+                slider = d.m if side == "k" else d.n
+                inputs.append(Input(f"{d.prefix()}slide_{side}", "m",
+                                    f"Position of {pair} along the guide on {att.link}, from "
+                                    f"the guide's point 'at'", f"{_member(d.prefix())}slide_{side}",
+                                    owner=slider))
             if att.kind == "external" and d.pair_kind("mk" if side == "k" else "np") == "T":
                 inputs.append(Input(f"{d.prefix()}guide_{side}.angle", "rad",
                                     f"Direction of the guide of the external link at {pair}",
@@ -856,8 +871,12 @@ def _derive_outputs(p: _Problems, scene: Scene, wanted):
             involved |= _ancestors(scene, g)
         deps = _inputs_of_links(scene, involved) + [
             i.name for i in scene.inputs if i.owner == "" and i.name.startswith(d.prefix())]
+        # the conditioning: the dyad's own directions and lengths, and the direction of a
+        # guide it slides on (an input, or a moving carrier's angle)
+        carriers = {a.link for a in (d.k, d.p) if a.guide is not None and a.link}
         own_geometry = [n for n in deps if n in geometry_inputs and
-                        (n.split(".")[0] in (d.m, d.n) or n.startswith(d.prefix() + "guide"))]
+                        (n.split(".")[0] in {d.m, d.n} | carriers or
+                         n.startswith(d.prefix() + "guide"))]
         pre = d.prefix()
         for pair, idx in PAIR_NAMES:
             group = []
@@ -1189,6 +1208,7 @@ def scene_c(table: SceneTable) -> str:
         return crank.params if crank and g == crank.name else scene.links[g].params
 
     def attachment_point(att: Attachment):
+        """The pair's point (for a sliding pair: the guide's point) from the carrier's D."""
         if att.kind == "crank" and att.at is None:
             length = crank.params["length"]
             zero = Param("", 0.0, "m", "")
@@ -1312,6 +1332,17 @@ def scene_c(table: SceneTable) -> str:
             if d.pair_kind("mk" if side == "k" else "np") == "T":
                 if att.kind == "external":
                     guide = inp(f"{d.prefix()}guide_{side}.angle")
+                elif att.kind != "frame":
+                    carrier = _member(att.link)
+                    if att.guide.is_zero():
+                        guide = f"{carrier}_i"
+                    elif att.guide.tunable:
+                        guide = (f"dyad_combine(cos({att.guide.c()}), {carrier}_i, "
+                                 f"sin({att.guide.c()}), {carrier}_j)")
+                    else:
+                        guide = (f"dyad_combine({_c_num(math.cos(att.guide.value))}, "
+                                 f"{carrier}_i, {_c_num(math.sin(att.guide.value))}, "
+                                 f"{carrier}_j)")
                 elif att.guide.tunable:
                     guide = f"dyad_dir_from_angle({att.guide.c()})"
                 else:
@@ -1332,10 +1363,18 @@ def scene_c(table: SceneTable) -> str:
                 continue
             carrier = _member(att.link)
             r = attachment_point(att)
-            code(f"    /* on {att.link}: -{pair_force.upper()} at the pair */")
+            reactive = ""
+            if att.guide is not None:
+                # the pair point slides along the guide; the pair also carries a moment
+                slide = f"dyad_scale({inp(d.prefix() + 'slide_' + side)}, load.i_{side})"
+                r = slide if r is None else f"dyad_add({r}, {slide})"
+                reactive = f" - {dn}.m_{pair_force[2:]}"
+            code(f"    /* on {att.link}: -{pair_force.upper()} at the pair"
+                 f"{' and the reactive moment' if reactive else ''} */")
             code(f"    {carrier}_f = dyad_sub({carrier}_f, {dn}.{pair_force});")
             if r is not None:
-                code(f"    {{ const dyad_real moment = -dyad_cross({r}, {dn}.{pair_force});")
+                code(f"    {{ const dyad_real moment = -dyad_cross({r}, {dn}.{pair_force})"
+                     f"{reactive};")
                 code(f"      {carrier}_m_d += moment;")
                 com = holder(att.link)
                 if com.get("com.x") is not None and not (com["com.x"].is_zero() and
@@ -1513,6 +1552,9 @@ def _output_expr(scene: Scene, o: Output) -> str:
 def _attachment_text(att: Attachment, pair: str) -> str:
     if att.kind == "frame":
         return "the frame" + (f" (guide at {_h(_num(att.guide))} rad)" if att.guide else "")
+    if att.guide is not None:
+        return (f"a guide on <code>{_h(att.link)}</code> at {_h(_num(att.guide))} rad from its "
+                f"i, through ({_h(_num(att.at[0]))}, {_h(_num(att.at[1]))}) m in its frame")
     if att.kind == "external":
         return "an external link whose motion is an input"
     if att.at is None:

@@ -3,7 +3,8 @@ its joint reactions as arrows on one force scale.
 
 Symbols (those of :mod:`dyadfmu.drawing`): fixed pivots as triangles on hatched ground,
 fixed guides as hatched rails, the crank and the links as bars (a ternary link also as a
-shaded triangle, a slotted link with its groove), blocks and sliders as rectangles,
+shaded triangle, a slotted link with its groove, a link carrying a guide with a widened
+grooved part along the stretch the slider uses), blocks and sliders as rectangles,
 revolute pairs as white pins, centres of mass as dots, and labels for links and points.
 
 Reaction arrows: every pair force on the link named first in its output name, drawn from
@@ -88,6 +89,23 @@ def _point_labels(chain):
     return names
 
 
+def _link_guides(ax, frame, g, D, angle, colour):
+    """The guides carried by link ``g`` (origin D, angle ``angle`` at this sample): a wide
+    bar from the link's guide point to the stretch the slider uses, grooved along it."""
+    i_g = _u2(angle)
+    j_g = _r90(i_g)
+    for lg in (frame.get("link_guides") or {}).values():
+        if lg["link"] != g:
+            continue
+        Q = D + lg["at"][0] * i_g + lg["at"][1] * j_g
+        i_k = _u2(angle + lg["angle"])
+        s0, s1 = lg["range"]
+        if np.hypot(*(Q - D)) > 0.0:
+            _bar(ax, D, Q, colour, z=2.2)
+        _bar(ax, Q + min(s0, 0.0) * i_k, Q + max(s1, 0.0) * i_k, colour, width=_WIDTH * 1.6, z=2.5)
+        _slot(ax, Q + s0 * i_k, Q + s1 * i_k, z=2.6)
+
+
 def draw(ax, chain, kin, index, reactions=None, scale=None):
     """Draw ``chain`` at sample ``index`` of ``kin`` (from ``chain.kinematics``) on ``ax``
     to scale, with equal aspect.
@@ -131,6 +149,7 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
     O, A = at("O"), at("A")
     _bar(ax, O, A, _CRANK_COLOUR, z=2.0)
     i_c = _u2(float(at(f"{chain.crank_name}.angle")))
+    _link_guides(ax, frame, chain.crank_name, O, float(at(f"{chain.crank_name}.angle")), _CRANK_COLOUR)
     link_label_at[chain.crank_name] = 0.5 * (O + A) - 1.8 * u * _r90(i_c)
 
     # the links
@@ -155,6 +174,7 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
                         own.append(D + att["at"][0] * i_g + att["at"][1] * j_g)
             S = at(f"S_{g}")
             col = colours[g]
+            _link_guides(ax, frame, g, D, float(at(f"{g}.angle")), col)
             if e["type"] == "RTR" and g == n:             # block in the slot of m
                 _block(ax, E, i_g, 2.4 * u, 1.1 * u, col, z=4.5)
                 link_label_at[g] = E - 2.2 * u * j_g - 1.2 * u * i_g

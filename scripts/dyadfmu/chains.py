@@ -2,16 +2,20 @@
 exact kinematics, active loads and a whole-mechanism Newton-Euler reference for their
 joint reactions.
 
-==========  ===============================================================================
-name        mechanism (scene file ``scenes/<name>.toml``)
-==========  ===============================================================================
-shaper      crank; dyad ``slot`` (RTR): slotted lever on the frame at O2 and a block on the
-            crank pin; dyad ``ram`` (RRT): ram on a horizontal frame guide, rod from the
-            lever's tip B to the ram's pin C. Cutting force on the ram.
-sixbar      Watt II: crank; dyad ``first`` (RRR): coupler A-B and rocker C-B; dyad
-            ``second`` (RRR): connector D-F from a point D of the rocker, output rocker G-F.
-            Resisting torque on the output rocker.
-==========  ===============================================================================
+=============  ============================================================================
+name           mechanism (scene file ``scenes/<name>.toml``)
+=============  ============================================================================
+shaper         crank; dyad ``slot`` (RTR): slotted lever on the frame at O2 and a block on
+               the crank pin; dyad ``ram`` (RRT): ram on a horizontal frame guide, rod from
+               the lever's tip B to the ram's pin C. Cutting force on the ram.
+sixbar         Watt II: crank; dyad ``first`` (RRR): coupler A-B and rocker C-B; dyad
+               ``second`` (RRR): connector D-F from a point D of the rocker, output rocker
+               G-F. Resisting torque on the output rocker.
+rocker_slider  crank; dyad ``first`` (RRR) as in sixbar; dyad ``second`` (RRT): a slider on
+               a guide carried by the rocker (along the rocker, through its pivot C), held
+               by a rod from the frame pivot G. Resisting force on the slider along its
+               guide.
+=============  ============================================================================
 
 The scene file gives the topology, lengths, mass properties, points of attachment on
 links and which links carry loads; ``chains.toml`` next to this module gives the rest
@@ -25,6 +29,19 @@ E = D_m + l_m i_m = D_n + l_n i_n; all these frames are fixed in their links. It
 of mass is S_g = D_g + com[0] i_g + com[1] j_g. ``<g>.accel_d`` is the acceleration of
 the material point of g at D_g. Pair kinds at (D_m, E, D_n): RRR (R, R, R), RRT (T on
 the guide of link k, R, R), RTR (R, T along i_m, R).
+
+The guide of an RRT dyad lies on the frame or on a moving link k. A guide on link k
+(scene: ``k = { link = "<k>", guide = g, at = [x, y] }``) is the line fixed in k's frame
+through the point ``at`` of that frame, with direction i_k = i_(link k) rotated by g.
+The slider m then turns with k: its angle is k's angle + g (i_m = i_k), so its omega and
+epsilon are those of k. ``<dyad>.slide_k`` is the signed position of D_m along the guide
+from the point ``at``: D_m = D_k + x i_(link k) + y j_(link k) + slide_k i_k, with its
+first and second time derivatives ``<dyad>.slide_k_rate`` (the slider's velocity
+relative to k) and ``<dyad>.slide_k_accel``. The slider's ``accel_d`` is the absolute
+acceleration of its material point at D_m: that of k's point at D_m, plus the relative
+acceleration slide_k_accel i_k and the Coriolis term 2 omega_k x (slide_k_rate i_k).
+The pair's reaction on the slider is R_mk = N_mk j_k at D_m plus the couple M_mk; link k
+receives -R_mk at D_m and -M_mk.
 
 Kinematics is exact: circle-circle intersection (RRR), circle-line intersection (RRT)
 and atan2 (RTR) for positions, and the loop equations differentiated once and twice in
@@ -65,7 +82,7 @@ from .mechanisms import CrankMotion, _merge, _number, _pair, _rotating
 __all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
 
 #: The chain mechanisms.
-NAMES = ("shaper", "sixbar")
+NAMES = ("shaper", "sixbar", "rocker_slider")
 
 #: Dyad types handled, with the pair kinds at (D_m, E, D_n).
 PAIR_KINDS = {"RRR": ("R", "R", "R"), "RRT": ("T", "R", "R"), "RTR": ("R", "T", "R")}
@@ -241,6 +258,11 @@ class Chain:
             if body != self.crank_name and body not in done:
                 raise ValueError(f"{where}: link {body!r} is not the crank nor a link of an "
                                  f"earlier dyad")
+            if "guide" in spec:
+                # a guide fixed in the moving link: through ``at``, along i_body rotated
+                # by ``guide``
+                return {"kind": "link_guide", "body": body, "at": _pair(spec, "at", where),
+                        "angle": _number(spec, "guide", where), "label": f"{dyad}.guide_k"}
             return {"kind": "point", "body": body, "at": _pair(spec, "at", where),
                     "label": f"{dyad}.{pair}"}
         raise ValueError(f"{where}: expected 'frame', 'crank' or a table, got {spec!r}")
@@ -269,24 +291,31 @@ class Chain:
             p = self._attachment(d.get("p"), dname, "D_n", done)
             entry = {"name": dname, "type": kind, "m": m, "n": n, "k": k, "p": p}
             lm_t, ln_t = self.links[m], self.links[n]
+            guides = ("guide", "link_guide")
             if kind == "RRR":
-                if k["kind"] == "guide" or p["kind"] == "guide":
+                if k["kind"] in guides or p["kind"] in guides:
                     raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
                 entry["lm"] = _number(lm_t, "length", f"{where}.{m}", positive=True)
                 entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
                 entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
             elif kind == "RRT":
-                if k["kind"] != "guide":
-                    raise ValueError(f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }}")
-                if p["kind"] == "guide":
+                if k["kind"] not in guides:
+                    raise ValueError(f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }} "
+                                     f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}")
+                if p["kind"] in guides:
                     raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
                 entry["lm"] = _number(lm_t, "length", f"{where}.{m}", nonnegative=True)
                 entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
-                # the slider translates on the fixed guide: its angle is constant
-                entry["m_angle"] = _number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
+                if k["kind"] == "guide":
+                    # the slider translates on the fixed guide: its angle is constant
+                    entry["m_angle"] = _number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
+                elif "angle" in lm_t:
+                    raise ValueError(f"{where}.{m}.angle: the slider turns with link "
+                                     f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
+                                     f"remove its 'angle'")
                 entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
             else:  # RTR
-                if k["kind"] == "guide" or p["kind"] == "guide":
+                if k["kind"] in guides or p["kind"] in guides:
                     raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
                 if "length" in lm_t:
                     raise ValueError(f"{where}.{m}: the slotted link's length |D_m E| varies; "
@@ -329,8 +358,19 @@ class Chain:
                 self._loads[lname] = {"model": kind, "T0": _number(model, "T0", where),
                                       "w_ref": _number(model, "w_ref", where, positive=True),
                                       "c": _number(model, "c", where)}
+            elif kind == "resisting-force":
+                if lname not in forces:
+                    raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
+                dyad = next((e for e in self.plan if e["type"] == "RRT" and e["m"] == lname), None)
+                if dyad is None:
+                    raise ValueError(f"{where}: model 'resisting-force' needs a slider (link m "
+                                     f"of an RRT dyad); {lname!r} is none")
+                self._loads[lname] = {"model": kind, "F0": _number(model, "F0", where),
+                                      "v_ref": _number(model, "v_ref", where, positive=True),
+                                      "dyad": dyad["name"]}
             else:
-                raise ValueError(f"{where}.model: expected 'cutting' or 'resisting-torque', got {kind!r}")
+                raise ValueError(f"{where}.model: expected 'cutting', 'resisting-torque' or "
+                                 f"'resisting-force', got {kind!r}")
         for lname in forces + moments:
             if lname not in self._loads:
                 raise ValueError(f"{self.name}.load: the scene loads link {lname!r} but "
@@ -390,9 +430,11 @@ class Chain:
         ``L.moment``; points ``O``, ``A``, ``S_crank``, ``S_L``, ``<dyad>.D_m``,
         ``<dyad>.E``, ``<dyad>.D_n``; velocities ``v_A``, ``v_S_crank``, ``v_S_L``;
         accelerations ``a_A``, ``a_S_crank``, ``a_S_L``; ``<dyad>.conditioning``;
-        ``<dyad>.guide_k.angle`` for a guide on link k. Non-array entries: ``frame``
-        ({"pivots": {label: (x, y)}, "guides": {label: ((x0, y0), (x1, y1))}}) and
-        ``mechanism`` (the name).
+        ``<dyad>.guide_k.angle`` for a guide on link k; for a guide on a moving link also
+        ``<dyad>.slide_k``, ``<dyad>.slide_k_rate``, ``<dyad>.slide_k_accel``.
+        Non-array entries: ``frame`` ({"pivots": {label: (x, y)}, "guides": {label:
+        ((x0, y0), (x1, y1))}}, and "link_guides" with guides on moving links, see
+        :meth:`_frame`) and ``mechanism`` (the name).
         """
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if t.ndim != 1:
@@ -438,6 +480,12 @@ class Chain:
             if e["type"] == "RRR":
                 K, vK, aK = self._point(e["k"], states, shape)  # D_m, on link k
                 sm, sn, E = _rrr(K, vK, aK, P, vP, aP, e["lm"], e["ln"], e["branch"], dn)
+            elif e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
+                sm, sn, E, slide = _rrt_on_link(states[e["k"]["body"]], e["k"]["at"],
+                                                e["k"]["angle"], e["lm"], P, vP, aP, e["ln"],
+                                                e["branch"], dn)
+                kin[f"{dn}.guide_k.angle"] = sm["angle"].copy()
+                kin[f"{dn}.slide_k"], kin[f"{dn}.slide_k_rate"], kin[f"{dn}.slide_k_accel"] = slide
             elif e["type"] == "RRT":
                 sm, sn, E = _rrt(e["k"]["angle"], e["k"]["height"], e["lm"], e["m_angle"],
                                  P, vP, aP, e["ln"], e["branch"], dn)
@@ -474,6 +522,14 @@ class Chain:
             elif model and model["model"] == "resisting-torque":
                 om = kin[f"{g}.omega"]
                 moment = -model["T0"] * np.tanh(om / model["w_ref"]) - model["c"] * om
+            elif model and model["model"] == "resisting-force":
+                dn = model["dyad"]
+                i_k = _unit(kin[f"{dn}.guide_k.angle"])
+                if f"{dn}.slide_k_rate" in kin:                 # guide on a moving link
+                    v_rel = kin[f"{dn}.slide_k_rate"]
+                else:                                           # frame guide
+                    v_rel = _dot(kin[f"{g}.vel_d"], i_k)
+                force = _col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
             kin[f"{g}.force"], kin[f"{g}.moment"] = force, moment
         # scalar views with the FMU input names
         for g in self.links:
@@ -486,6 +542,8 @@ class Chain:
         i_m, i_n = _unit(kin[f"{e['m']}.angle"]), _unit(kin[f"{e['n']}.angle"])
         if e["type"] == "RRR":
             return np.abs(_dot(i_m, _rot90(i_n)))
+        if e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
+            return np.abs(_dot(i_n, _unit(kin[f"{e['name']}.guide_k.angle"])))
         if e["type"] == "RRT":
             return np.abs(_dot(i_n, _unit(e["k"]["angle"])))
         lm, ln = kin[f"{e['m']}.length"], kin[f"{e['n']}.length"]
@@ -505,9 +563,12 @@ class Chain:
             raise ValueError(f"{self.name}: a dyad does not assemble over a full crank turn")
 
     def _frame(self) -> dict:
-        """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))}."""
+        """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))};
+        with guides on moving links also ``link_guides`` {label: {"link": k, "at": (x, y),
+        "angle": guide, "range": (s0, s1)}}: the part s0 <= slide_k <= s1 of the guide
+        that the slider uses over a crank turn, with some margin."""
         if self._frame_cache is None:
-            pivots, guides = {"O": (0.0, 0.0)}, {}
+            pivots, guides, link_guides = {"O": (0.0, 0.0)}, {}, {}
             sweep = None
             for e in self.plan:
                 for att, pair in ((e["k"], "D_m"), (e["p"], "D_n")):
@@ -523,7 +584,16 @@ class Chain:
                         base = base - (base @ i) * i          # foot of O on the guide line
                         x0, x1 = base + (s.min() - pad) * i, base + (s.max() + pad) * i
                         guides[att["label"]] = (tuple(map(float, x0)), tuple(map(float, x1)))
+                    elif att["kind"] == "link_guide":
+                        sweep = self._sweep() if sweep is None else sweep
+                        s = sweep[f"{e['name']}.slide_k"]
+                        pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
+                        link_guides[att["label"]] = {
+                            "link": att["body"], "at": tuple(att["at"]), "angle": att["angle"],
+                            "range": (float(s.min() - pad), float(s.max() + pad + e["lm"]))}
             self._frame_cache = {"pivots": pivots, "guides": guides}
+            if link_guides:
+                self._frame_cache["link_guides"] = link_guides
         return copy.deepcopy(self._frame_cache)
 
     # ---- dynamics ---------------------------------------------------------
@@ -786,6 +856,42 @@ def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
     sm = _state(zero + m_angle, zero, zero, Dm, _col(ds) * i_k, _col(dds) * i_k, lm)
     sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
     return sm, sn, E
+
+
+def _rrt_on_link(ks, at, guide, lm, P, vP, aP, ln, branch, name):
+    """RRT with the guide on the moving link k (state ``ks``): the line through the point
+    ``at`` of k's frame, along i_k = i_(link k) rotated by ``guide``. The slider m turns
+    with k (i_m = i_k); D_m = Q + s i_k, Q the guide's point ``at``; E = D_m + lm i_k;
+    rod n from D_n = P (on link p) to E. ``branch`` +1: E ahead of the foot of P on the
+    guide line along i_k. Returns the states of m and n, E and (s, s', s'')."""
+    Q, vQ, aQ = Chain._material(ks, at)
+    angle = np.asarray(ks["angle"], dtype=float) + guide
+    w, e = np.asarray(ks["omega"], dtype=float), np.asarray(ks["epsilon"], dtype=float)
+    i_k = _unit(angle)
+    j_k = _rot90(i_k)
+    d = P - (Q + lm * i_k)                                   # E = Q + (s + lm) i_k
+    along, across = _dot(d, i_k), _dot(d, j_k)
+    root2 = ln * ln - across * across
+    if np.any(~(root2 > 0.0)):
+        raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
+                         f"crank angle (distance up to {np.abs(across).max():.4g} m)")
+    s = along + branch * np.sqrt(root2)
+    Dm = Q + _col(s) * i_k
+    E = Dm + lm * i_k
+    i_n = (E - P) / ln
+    j_n = _rot90(i_n)
+    q = s + lm                                               # E = Q + q i_k
+    # v_E = v_Q + s' i_k + q w j_k = v_P + ln wn j_n
+    ds, wn = _solve2(i_k, -ln * j_n, vP - vQ - _col(q * w) * j_k)
+    # a_E = a_Q + (s'' - q w^2) i_k + (q e + 2 s' w) j_k = a_P + ln en j_n - ln wn^2 i_n
+    rhs = aP - _col(ln * wn * wn) * i_n - aQ + _col(q * w * w) * i_k - _col(q * e + 2.0 * ds * w) * j_k
+    dds, en = _solve2(i_k, -ln * j_n, rhs)
+    # the slider's material point at D_m: k's point there, plus relative and Coriolis terms
+    vDm = vQ + _col(ds) * i_k + _col(s * w) * j_k
+    aDm = aQ + _col(dds - s * w * w) * i_k + _col(s * e + 2.0 * ds * w) * j_k
+    sm = _state(angle, w.copy(), e.copy(), Dm, vDm, aDm, lm)
+    sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
+    return sm, sn, E, (s, ds, dds)
 
 
 def _rtr(K, vK, aK, P, vP, aP):

@@ -3,7 +3,7 @@ output against independent references.
 
 Two kinds of scene:
 
-* the multi-dyad chains ``shaper`` and ``sixbar``: kinematics, loads and the reference
+* the multi-dyad chains ``shaper``, ``sixbar`` and ``rocker_slider``: kinematics, loads and the reference
   (one Newton-Euler system of the whole mechanism, crank included) come from
   :mod:`dyadfmu.chains`;
 * the single-dyad scenes ``engine``, ``press`` and ``monitor``: kinematics and loads of the
@@ -35,7 +35,7 @@ ROOT = Path(__file__).resolve().parents[2]
 SCENES_DIR = ROOT / "scenes"
 
 #: The tailored example scenes, in the order of the report.
-NAMES = ("press", "monitor", "engine", "shaper", "sixbar")
+NAMES = ("press", "monitor", "engine", "shaper", "sixbar", "rocker_slider")
 
 #: Single-dyad scenes: the mechanism whose kinematics they take, and which scene link is
 #: the mechanism's link m and n.
@@ -47,7 +47,8 @@ SINGLE = {
 
 #: The generic per-type FMUs a scene would need instead (one per dyad).
 FULL_OF = {"press": ("RRT",), "monitor": ("RRR",), "engine": ("RRT",),
-           "shaper": ("RTR", "RRT"), "sixbar": ("RRR", "RRR")}
+           "shaper": ("RTR", "RRT"), "sixbar": ("RRR", "RRR"),
+           "rocker_slider": ("RRR", "RRT")}
 
 #: Speeds of the quasi-static press: slow enough that nothing dynamic matters, though the
 #: FMU takes no speeds at all.

@@ -1,15 +1,18 @@
 """Tests of the chain mechanisms (scripts/dyadfmu/chains.py) and their drawing
 (scripts/dyadfmu/chain_drawing.py).
 
-For both mechanisms (shaper, sixbar) and both crank motions (constant, varying):
+For every mechanism (shaper, sixbar, rocker_slider) and both crank motions (constant,
+varying):
 - loop closure: every pair point computed from both of its links agrees, and the pairs'
   constraints hold (points on guides, blocks turning with their slotted links, sliders
-  translating); the geometry is rebuilt here from the scene file and chains.toml;
-- every velocity and acceleration (angles, lengths, centres of mass, ``accel_d`` of every
-  link as the acceleration of its material point at D_g) against 4th-order central finite
-  differences of positions;
+  translating on frame guides and turning with the link that carries their guide); the
+  geometry is rebuilt here from the scene file and chains.toml;
+- every velocity and acceleration (angles, lengths, positions along guides on moving
+  links, centres of mass, ``accel_d`` of every link as the acceleration of its material
+  point at D_g) against 4th-order central finite differences of positions;
 - the reference reactions satisfy every body's Newton-Euler equations (residuals), and
-  the residual check detects any perturbed output;
+  the residual check detects any perturbed output; for the rocker-slider the balances of
+  the rocker, slider and rod are also written out here term by term;
 - energy balance of the whole mechanism: driving power + load power = d/dt (kinetic +
   potential energy), the derivative by 4th-order finite differences;
 - every dyad stays well conditioned; loads follow their models;
@@ -18,6 +21,7 @@ For both mechanisms (shaper, sixbar) and both crank motions (constant, varying):
 
 from __future__ import annotations
 
+import copy
 import math
 import sys
 import tomllib
@@ -38,7 +42,7 @@ ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE.parent))
 from dyadfmu import chain_drawing, chains  # noqa: E402
 
-NAMES = ("shaper", "sixbar")
+NAMES = ("shaper", "sixbar", "rocker_slider")
 KINDS = ("constant", "varying")
 CASES = [(n, k) for n in NAMES for k in KINDS]
 
@@ -62,6 +66,10 @@ def col(x):
 
 def norm(v):
     return np.hypot(v[..., 0], v[..., 1])
+
+
+def cross(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 def d1(f, h):
@@ -143,6 +151,12 @@ def test_attributes(name):
     if name == "shaper":
         assert "length" not in ch.links["lever"]
         assert ch.links["rod"]["length"] == 0.16 and ch.links["block"]["length"] == 0.0
+    elif name == "rocker_slider":
+        assert ch.links["slider"]["length"] == 0.0
+        assert all(ch.links[g]["length"] > 0 for g in ch.links if g != "slider")
+        k = ch.plan[1]["k"]
+        assert (k["kind"], k["body"], k["at"], k["angle"]) == ("link_guide", "rocker", (0.0, 0.0), 0.0)
+        assert [pr["second"] for pr in ch.pairs if pr["key"] == "second.R_mk"] == ["rocker"]
     else:
         assert all(ch.links[g]["length"] > 0 for g in ch.links)
 
@@ -163,6 +177,44 @@ def test_overrides_and_bad_data():
         chains.load("shaper", {"motion": {"variation": 1.2}})
     with pytest.raises(ValueError, match="motion kind"):
         chain("shaper").motion("jerky")
+    with pytest.raises(ValueError, match="reach"):
+        chains.load("rocker_slider", {"frame": {"second": {"D_n": {"position": [0.4, -0.3]}}}})
+    with pytest.raises(ValueError, match="branches"):
+        chains.load("rocker_slider", {"branches": {"second": 2}})
+
+
+def test_bad_guides_on_links():
+    """A guide on a moving link: only at D_m of an RRT; its slider takes no angle; the
+    resisting force only on such a slider."""
+    sc, table = scene("rocker_slider"), harness("rocker_slider")
+
+    def build(edit_scene=None, edit_table=None):
+        s, t = copy.deepcopy(sc), copy.deepcopy(table)
+        if edit_scene:
+            edit_scene(s)
+        if edit_table:
+            edit_table(t)
+        return chains.Chain("rocker_slider", s, t)
+
+    build()                                           # as it is: fine
+    with pytest.raises(ValueError, match="turns with link 'rocker'"):
+        build(lambda s: s["link"][2].update(angle=0.0))
+    with pytest.raises(ValueError, match="revolute pair at D_n"):
+        build(lambda s: s["dyad"][1].update(p={"link": "rocker", "guide": 0.0, "at": [0.0, 0.0]}))
+    with pytest.raises(ValueError, match="RRR dyad has revolute pairs"):
+        build(lambda s: s["dyad"][1].update(type="RRR"))
+    with pytest.raises(ValueError, match="at"):
+        build(lambda s: s["dyad"][1].update(k={"link": "rocker", "guide": 0.0}))
+    with pytest.raises(ValueError, match="not the crank nor a link of an earlier dyad"):
+        build(lambda s: s["dyad"][1].update(k={"link": "rod", "guide": 0.0, "at": [0.0, 0.0]}))
+
+    def rod_loaded(t):
+        t["load"] = {"rod": dict(t["load"]["slider"])}
+
+    def scene_rod(s):
+        s["loads"]["force"] = ["rod"]
+    with pytest.raises(ValueError, match="needs a slider"):
+        build(scene_rod, rod_loaded)
 
 
 def test_output_names():
@@ -173,6 +225,9 @@ def test_output_names():
         "ram.R_mk.x", "ram.R_mk.y", "ram.N_mk", "ram.M_mk", "ram.R_mn.x", "ram.R_mn.y",
         "ram.R_np.x", "ram.R_np.y"}
     assert set(chain("sixbar").output_names()) == {"crank.R_O.x", "crank.R_O.y", "crank.torque"} | {
+        f"{d}.R_{t}.{c}" for d in ("first", "second") for t in ("mk", "mn", "np") for c in "xy"}
+    assert set(chain("rocker_slider").output_names()) == \
+        {"crank.R_O.x", "crank.R_O.y", "crank.torque", "second.N_mk", "second.M_mk"} | {
         f"{d}.R_{t}.{c}" for d in ("first", "second") for t in ("mk", "mn", "np") for c in "xy"}
 
 
@@ -195,7 +250,7 @@ def external_point(name, dyad, pair, spec, kin, origins):
         return np.broadcast_to(np.asarray(frame[dyad][pair]["position"], float), kin["A"].shape)
     if spec == "crank":
         return scene(name)["crank"]["length"] * unit(kin["crank.angle"])
-    if spec["link"] == "frame":
+    if spec["link"] == "frame" or "guide" in spec:
         return None
     g = spec["link"]
     i_g = unit(kin[f"{g}.angle"])
@@ -229,7 +284,20 @@ def test_loop_closure(name, kind):
         # D_m and D_n from the external links
         for pair, spec in (("D_m", d["k"]), ("D_n", d["p"])):
             P = external_point(name, dn, pair, spec, kin, origins)
-            if P is None:        # on a frame guide through (0, height)
+            if P is None and spec["link"] != "frame":
+                # on the guide of a moving link k: through Q (``at`` in k's frame), along
+                # i_k = i_(link k) rotated by the guide angle; D_m = Q + slide_k i_k
+                k = spec["link"]
+                i_g = unit(kin[f"{k}.angle"])
+                x, y = spec["at"]
+                Q = origins[k] + x * i_g + y * rot90(i_g)
+                i_k = unit(kin[f"{k}.angle"] + spec["guide"])
+                assert np.all(kin[f"{dn}.guide_k.angle"] == kin[f"{k}.angle"] + spec["guide"])
+                off = dot(kin[f"{dn}.{pair}"] - Q, rot90(i_k))
+                assert np.max(np.abs(off)) < tol, f"{dn}.{pair} on its guide"
+                want = Q + col(kin[f"{dn}.slide_k"]) * i_k
+                assert np.max(norm(want - kin[f"{dn}.{pair}"])) < tol, f"{dn}.slide_k"
+            elif P is None:      # on a frame guide through (0, height)
                 i_k = unit(spec["guide"])
                 foot = np.array([0.0, harness(name)["frame"][dn][pair]["height"]])
                 off = dot(kin[f"{dn}.{pair}"] - foot, rot90(i_k))
@@ -241,11 +309,16 @@ def test_loop_closure(name, kind):
             assert np.max(np.abs(np.sin(kin[f"{n}.angle"] - kin[f"{m}.angle"]))) < 1e-14
             assert np.max(np.abs(dot(kin[f"{dn}.D_n"] - kin[f"{dn}.D_m"], rot90(i_m)))) < tol
             assert np.min(lm) > 0
-        if d["type"] == "RRT":       # the slider translates
+        if d["type"] == "RRT" and d["k"]["link"] == "frame":       # the slider translates
             for key in ("omega", "epsilon"):
                 assert np.all(kin[f"{m}.{key}"] == 0.0)
             link = next(lt for lt in sc["link"] if lt["name"] == m)
             assert np.all(kin[f"{m}.angle"] == link.get("angle", d["k"]["guide"]))
+        elif d["type"] == "RRT":     # the slider turns with the link carrying its guide
+            k = d["k"]["link"]
+            assert np.all(kin[f"{m}.angle"] == kin[f"{k}.angle"] + d["k"]["guide"])
+            for key in ("omega", "epsilon"):
+                assert np.all(kin[f"{m}.{key}"] == kin[f"{k}.{key}"])
         # centres of mass
         for g, D, i_g in ((m, kin[f"{dn}.D_m"], i_m), (n, kin[f"{dn}.D_n"], i_n)):
             x, y = next(lt for lt in sc["link"] if lt["name"] == g)["com"]
@@ -265,6 +338,13 @@ def test_branches():
     kin = chain("sixbar").kinematics(np.linspace(0, 2, 200), chain("sixbar").motion())
     assert np.all(kin["first.E"][:, 1] > 0)                            # B above O C
     assert np.all(kin["second.E"][:, 0] > 0.12)                        # F right of G
+    kin = chain("rocker_slider").kinematics(np.linspace(0, 2, 200), chain("rocker_slider").motion())
+    assert np.all(kin["first.E"][:, 1] > 0)                            # B above O C
+    assert np.all(kin["second.slide_k"] < 0)                           # slider below C
+    G = np.asarray(harness("rocker_slider")["frame"]["second"]["D_n"]["position"])
+    i_k = unit(kin["second.guide_k.angle"])
+    assert np.all(dot(kin["second.E"] - G, i_k) > 0)                   # ahead of G's foot
+    assert np.ptp(kin["second.slide_k"]) > 0.02
 
 
 @pytest.mark.parametrize("name, kind", CASES)
@@ -289,6 +369,16 @@ def test_derivatives(name, kind):
         assert_close(d1(S, h), mid[f"v_S_{b}"], rel, f"v_S_{b}", floor=1e-3)
         v = np.array([k[f"v_S_{b}"] for k in kins])
         assert_close(d1(v, h), mid[f"a_S_{b}"], rel, f"a_S_{b}", floor=1e-3)
+    for d in scene(name)["dyad"]:
+        if d["type"] == "RRT" and d["k"]["link"] != "frame":
+            dn = d["name"]
+            s = np.array([k[f"{dn}.slide_k"] for k in kins])
+            assert_close(d1(s, h), mid[f"{dn}.slide_k_rate"], rel, f"{dn}.slide_k_rate", floor=1e-3)
+            assert_close(d2(s, h), mid[f"{dn}.slide_k_accel"], rel, f"{dn}.slide_k_accel", floor=1e-2)
+            sd = np.array([k[f"{dn}.slide_k_rate"] for k in kins])
+            assert_close(d1(sd, h), mid[f"{dn}.slide_k_accel"], rel, f"{dn}.slide_k_accel", floor=1e-2)
+            g = np.unwrap(np.array([k[f"{dn}.guide_k.angle"] for k in kins]), axis=0)
+            assert_close(d1(g, h), mid[f"{d['k']['link']}.omega"], rel, f"{dn}.guide_k.angle'")
     assert np.ptp(mid["lever.length"] if name == "shaper" else mid["rocker.angle"]) > 0.1
 
 
@@ -309,6 +399,20 @@ def test_accel_d(name, kind):
     if name == "shaper":
         assert np.all(mid["lever.accel_d"] == 0.0)
         assert np.max(norm(mid["slider.accel_d"])) > 1.0
+    if name == "rocker_slider":
+        # the slider's point at D_m: the rocker's point there (C fixed) plus the relative
+        # acceleration along the guide plus Coriolis 2 w x v_rel
+        w, e = mid["rocker.omega"], mid["rocker.epsilon"]
+        r = mid["second.D_m"] - np.asarray(harness(name)["frame"]["first"]["D_n"]["position"])
+        i_k = unit(mid["second.guide_k.angle"])
+        transport = col(e) * rot90(r) - col(w * w) * r
+        relative = col(mid["second.slide_k_accel"]) * i_k
+        coriolis = col(2.0 * w * mid["second.slide_k_rate"]) * rot90(i_k)
+        assert_close(transport + relative + coriolis, mid["slider.accel_d"], 1e-12, "slider.accel_d")
+        # no term is negligible
+        for term in (transport, relative, coriolis):
+            assert np.max(norm(term)) > 0.1 * np.max(norm(mid["slider.accel_d"]))
+        assert np.all(mid["rocker.accel_d"] == 0.0)
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -320,10 +424,12 @@ def test_conditioning(name):
         assert np.ptp(np.unwrap(kin["crank.angle"])) == pytest.approx(4 * math.pi)
         for d in scene(name)["dyad"]:
             c = kin[f"{d['name']}.conditioning"]
-            assert np.min(c) > 0.2, (d["name"], np.min(c))
+            assert np.min(c) > (0.3 if d["type"] == "RRT" else 0.2), (d["name"], np.min(c))
             i_m, i_n = unit(kin[f"{d['m']}.angle"]), unit(kin[f"{d['n']}.angle"])
             if d["type"] == "RRR":
                 want = np.abs(dot(i_m, rot90(i_n)))
+            elif d["type"] == "RRT" and d["k"]["link"] != "frame":
+                want = np.abs(dot(i_n, unit(kin[f"{d['k']['link']}.angle"] + d["k"]["guide"])))
             elif d["type"] == "RRT":
                 want = np.abs(dot(i_n, unit(d["k"]["guide"])))
             else:
@@ -339,7 +445,7 @@ def test_loads(name, kind):
     load = harness(name)["load"]
     loaded = {g for g in load}
     for g in ch.links:
-        if g not in loaded or load[g]["model"] != "cutting":
+        if g not in loaded or load[g]["model"] not in ("cutting", "resisting-force"):
             assert np.all(kin[f"{g}.force"] == 0.0)
         if g not in loaded or load[g]["model"] != "resisting-torque":
             assert np.all(kin[f"{g}.moment"] == 0.0)
@@ -352,6 +458,17 @@ def test_loads(name, kind):
         assert np.all(kin["slider.force.y"] == 0.0)
         assert np.max(np.abs(kin["slider.force.x"])) > 0.99 * ld["F0"]
         assert np.min(np.abs(kin["slider.force.x"])) < 1.0
+    elif name == "rocker_slider":
+        ld = load["slider"]
+        i_k = unit(kin["rocker.angle"])                  # guide = 0: along the rocker
+        # the velocity of D_m relative to the rocker: v_D - w k x (D_m - C)
+        C = np.asarray(harness(name)["frame"]["first"]["D_n"]["position"])
+        v_rel = dot(kin["slider.vel_d"] - col(kin["rocker.omega"]) * rot90(kin["second.D_m"] - C), i_k)
+        assert_close(v_rel, kin["second.slide_k_rate"], 1e-12, "v_rel")
+        want = col(-ld["F0"] * np.tanh(v_rel / ld["v_ref"])) * i_k
+        assert_close(kin["slider.force"], want, 1e-12, "resisting force")
+        assert np.all(dot(kin["slider.force"], i_k) * v_rel <= 0.0)
+        assert np.max(norm(kin["slider.force"])) > 0.9 * ld["F0"]
     else:
         ld = load["output"]
         w = kin["output.omega"]
@@ -412,7 +529,7 @@ def test_reactions_physics():
     assert_close(out["slot.N_mn"], dot(R, rot90(unit(kin["lever.angle"]))), 1e-14, "N_mn")
     # the ram's guide force is vertical
     assert np.max(np.abs(out["ram.R_mk.x"])) < 1e-9 * np.max(np.abs(out["ram.R_mk.y"]))
-    for c in (ch, chain("sixbar")):
+    for c in (ch, chain("sixbar"), chain("rocker_slider")):
         k = c.kinematics(times(c.motion(), 90), c.motion())
         o = c.reference(k)
         total = np.stack([o["crank.R_O.x"], o["crank.R_O.y"]], axis=-1)
@@ -426,6 +543,51 @@ def test_reactions_physics():
             if b != "crank":
                 total = total + k[f"{b}.force"]
         assert np.max(norm(total)) < 1e-10 * np.max(np.abs(o["crank.R_O.x"])), c.name
+
+
+def vec(out, key):
+    return np.stack([out[f"{key}.x"], out[f"{key}.y"]], axis=-1)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_rocker_slider_balances(kind):
+    """The rocker-slider's sliding pair on the moving rocker, written out by hand: R_mk
+    is normal to the guide (N_mk j_k) at D_m on the slider, with the couple M_mk; the
+    rocker takes -R_mk at D_m and -M_mk. Each of slider, rod and rocker balances, with
+    moments about a fixed point of the plane (the origin), so that the d'Alembert terms
+    are written here from a_S and epsilon."""
+    ch = chain("rocker_slider")
+    motion = ch.motion(kind, 1.0)
+    kin = ch.kinematics(times(motion, 90), motion)
+    out = ch.reference(kin)
+    g = np.array(ch.gravity)
+    i_k = unit(kin["rocker.angle"])
+    R_mk = vec(out, "second.R_mk")
+    assert_close(R_mk, col(out["second.N_mk"]) * rot90(i_k), 1e-13, "R_mk = N_mk j_k")
+    assert np.max(np.abs(out["second.N_mk"])) > 1.0 and np.max(np.abs(out["second.M_mk"])) > 1e-3
+
+    def inertial(b):
+        link = ch.links[b]
+        f = link["mass"] * g - link["mass"] * kin[f"a_S_{b}"] + kin[f"{b}.force"]
+        return f, cross(kin[f"S_{b}"], f) - link["inertia"] * kin[f"{b}.epsilon"] + kin[f"{b}.moment"]
+
+    def check(b, terms, couples):
+        F, M = inertial(b)
+        scale_f = max(np.max(norm(f)) for _, f in terms)
+        scale_m = max(np.max(np.abs(cross(p, f))) for p, f in terms)
+        for p, f in terms:
+            F, M = F + f, M + cross(p, f)
+        for mu in couples:
+            M = M + mu
+        assert np.max(norm(F)) < 1e-12 * scale_f, b
+        assert np.max(np.abs(M)) < 1e-12 * scale_m, b
+
+    D, E = kin["second.D_m"], kin["second.E"]
+    G, C, B = kin["second.D_n"], kin["first.D_n"], kin["first.E"]
+    check("slider", [(D, R_mk), (E, vec(out, "second.R_mn"))], [out["second.M_mk"]])
+    check("rod", [(E, -vec(out, "second.R_mn")), (G, vec(out, "second.R_np"))], [])
+    check("rocker", [(C, vec(out, "first.R_np")), (B, -vec(out, "first.R_mn")), (D, -R_mk)],
+          [-out["second.M_mk"]])
 
 
 @pytest.mark.parametrize("name, kind", CASES)
@@ -460,6 +622,11 @@ def test_energy_functions():
     assert ch.kinetic_energy(kin)[0] == pytest.approx(want_T, rel=1e-14)
     assert ch.potential_energy(kin)[0] == pytest.approx(want_V, rel=1e-14, abs=1e-15)
     assert ch.load_power(kin)[0] == pytest.approx(kin["output.moment"][0] * kin["output.omega"][0])
+    ch = chain("rocker_slider")
+    kin = ch.kinematics(np.array([0.1]), ch.motion())
+    want = dot(kin["slider.force"], kin["v_S_slider"])[0]
+    assert ch.load_power(kin)[0] == pytest.approx(want, rel=1e-14)
+    assert want < 0.0
 
 
 # ---------------------------------------------------------------------------
@@ -478,6 +645,9 @@ def test_drawing(name, tmp_path):
     assert len(arrows) == vectors == len(drawn["arrows"])
     assert drawn["scale"] > 0
     assert len(ax.get_legend().get_texts()) == vectors
+    if name == "rocker_slider":
+        texts = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert any(t.startswith("second.R_mk on slider at D:") for t in texts), texts
     plt.close(fig)
     fig, ax = plt.subplots()
     drawn = chain_drawing.draw(ax, ch, kin, 10)
@@ -487,3 +657,35 @@ def test_drawing(name, tmp_path):
     assert path.is_file() and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(ValueError):
         chain_drawing.figure(ch, kin, out, [0], tmp_path / "one.png")
+
+
+def test_guide_on_link_with_offset_pin():
+    """The rocker-slider with the slider's pin E off its guide point (l_slider = 0.03 m)
+    and the guide through a point off the rocker's axis at an angle: E from both links,
+    velocities and accelerations against finite differences, and the reference."""
+    sc = copy.deepcopy(scene("rocker_slider"))
+    sc["link"][2]["length"] = 0.03
+    sc["dyad"][1]["k"] = {"link": "rocker", "guide": -0.1, "at": [0.01, -0.02]}
+    ch = chains.Chain("rocker_slider", sc, harness("rocker_slider"))
+    motion = ch.motion("varying", 1.0)
+    h = 3e-3 / harness("rocker_slider")["motion"]["omega"]
+    t = times(motion, 40)
+    kins = [ch.kinematics(t + j * h, motion) for j in range(-2, 3)]
+    mid = kins[2]
+    i_m, i_n = unit(mid["slider.angle"]), unit(mid["rod.angle"])
+    assert np.max(norm(mid["second.D_m"] + 0.03 * i_m - mid["second.E"])) < 1e-12
+    assert np.max(norm(mid["second.D_n"] + 0.2 * i_n - mid["second.E"])) < 1e-12
+    assert np.all(mid["slider.angle"] == mid["rocker.angle"] - 0.1)
+    i_r = unit(mid["rocker.angle"])
+    Q = mid["first.D_n"] + 0.01 * i_r - 0.02 * rot90(i_r)
+    assert np.max(norm(Q + col(mid["second.slide_k"]) * i_m - mid["second.D_m"])) < 1e-12
+    s = np.array([k["second.slide_k"] for k in kins])
+    assert_close(d1(s, h), mid["second.slide_k_rate"], 1e-6, "slide_k_rate", floor=1e-3)
+    assert_close(d2(s, h), mid["second.slide_k_accel"], 1e-6, "slide_k_accel", floor=1e-2)
+    for g, pair in (("slider", "D_m"), ("rod", "D_n")):
+        P = np.array([k[f"second.{pair}"] for k in kins])
+        assert_close(d2(P, h), mid[f"{g}.accel_d"], 1e-6, f"{g}.accel_d", floor=1e-2)
+    a = np.unwrap(np.array([k["rod.angle"] for k in kins]), axis=0)
+    assert_close(d2(a, h), mid["rod.epsilon"], 1e-6, "rod.epsilon", floor=1e-3)
+    out = ch.reference(mid)
+    assert np.max(ch.residuals(mid, out)) < 1e-12

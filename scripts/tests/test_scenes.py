@@ -177,7 +177,7 @@ def test_tailored_fmu_matches_the_reference(name, version):
 
 
 @pytest.mark.parametrize("motion", ("constant", "varying"))
-@pytest.mark.parametrize("name", ("shaper", "sixbar"))
+@pytest.mark.parametrize("name", ("shaper", "sixbar", "rocker_slider"))
 def test_chain_driving_torque_against_the_energy_balance(name, motion):
     result = scenes.run(name, 2, revolutions=1.0, steps=180, motion=motion)
     assert result.energy_residual < 1e-9, result.energy_residual
