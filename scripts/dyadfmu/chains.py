@@ -77,7 +77,8 @@ try:
 except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
     import tomli as tomllib
 
-from .mechanisms import CrankMotion, _merge, _number, _pair, _rotating
+from .mechanisms import (CrankMotion, _col, _cross, _dot, _merge, _number, _pair, _rot90,
+                         _rotating, _unit)
 
 __all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
 
@@ -94,28 +95,6 @@ _TAGS = (("D_m", "mk"), ("E", "mn"), ("D_n", "np"))
 # ---------------------------------------------------------------------------
 # vector helpers on arrays of shape (..., 2)
 # ---------------------------------------------------------------------------
-def _unit(angle):
-    angle = np.asarray(angle, dtype=float)
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
-
-
-def _rot90(v):
-    """k x v."""
-    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
-
-
-def _dot(a, b):
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
-
-
-def _cross(a, b):
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
-def _col(x):
-    return np.asarray(x, dtype=float)[..., None]
-
-
 def _norm(v):
     return np.hypot(v[..., 0], v[..., 1])
 

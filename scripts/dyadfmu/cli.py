@@ -26,6 +26,25 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _cosimulation_options(command, out: Path, revolutions_help: str):
+    """The options of a command that co-simulates FMUs over the crank's motion."""
+    command.add_argument("--fmi", choices=("2", "3", "both"), default="both",
+                         help="FMI version of the FMU to run (default both)")
+    command.add_argument("--revolutions", type=_positive_float, default=2.0,
+                         help=revolutions_help)
+    command.add_argument("--steps", type=_positive_int, default=360,
+                         help="communication steps per revolution (default 360)")
+    command.add_argument("--motion", choices=("constant", "varying"), default="constant",
+                         help="crank speed: constant, or varying along the cycle "
+                              "(default constant)")
+    command.add_argument("--out", type=Path, default=out,
+                         help=f"directory for tables and plots (default ./{out})")
+    command.add_argument("--build", type=Path, default=None,
+                         help="CMake build directory holding fmus/ (default: build/ of the "
+                              "checkout)")
+    command.add_argument("--no-plots", action="store_true", help="write tables only")
+
+
 def parser() -> argparse.ArgumentParser:
     top = argparse.ArgumentParser(
         prog="dyadfmu",
@@ -43,21 +62,10 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("scenes", nargs="*", metavar="SCENE", default=[DEFAULT_SCENE],
                      help=f"scene names (default {DEFAULT_SCENE}; 'all' for every scene; "
                           f"see 'dyadfmu list')")
-    run.add_argument("--fmi", choices=("2", "3", "both"), default="both",
-                     help="FMI version of the FMU to run (default both)")
-    run.add_argument("--revolutions", type=_positive_float, default=2.0,
-                     help="crank revolutions (oscillations for trt-slot) to simulate (default 2)")
-    run.add_argument("--steps", type=_positive_int, default=360,
-                     help="communication steps per revolution (default 360)")
-    run.add_argument("--motion", choices=("constant", "varying"), default="constant",
-                     help="crank speed: constant, or varying along the cycle (default constant)")
+    _cosimulation_options(run, Path("out"),
+                          "crank revolutions (oscillations for trt-slot) to simulate (default 2)")
     run.add_argument("--angle", type=float, default=60.0,
                      help="crank angle in degrees at which the mechanism is drawn (default 60)")
-    run.add_argument("--out", type=Path, default=Path("out"),
-                     help="directory for tables and plots (default ./out)")
-    run.add_argument("--build", type=Path, default=None,
-                     help="CMake build directory holding fmus/ (default: build/ of the checkout)")
-    run.add_argument("--no-plots", action="store_true", help="write tables only")
     run.set_defaults(run=_run)
 
     study = sub.add_parser(
@@ -82,19 +90,7 @@ def parser() -> argparse.ArgumentParser:
                     "every reaction. Scenes: " + ", ".join(scenes_names()) + ".")
     scene.add_argument("scenes", nargs="*", metavar="SCENE", default=["shaper"],
                        help="scene names (default shaper; 'all' for every example scene)")
-    scene.add_argument("--fmi", choices=("2", "3", "both"), default="both",
-                       help="FMI version of the FMU to run (default both)")
-    scene.add_argument("--revolutions", type=_positive_float, default=2.0,
-                       help="crank revolutions to simulate (default 2)")
-    scene.add_argument("--steps", type=_positive_int, default=360,
-                       help="communication steps per revolution (default 360)")
-    scene.add_argument("--motion", choices=("constant", "varying"), default="constant",
-                       help="crank speed: constant, or varying along the cycle (default constant)")
-    scene.add_argument("--out", type=Path, default=Path("out/scenes"),
-                       help="directory for tables and drawings (default ./out/scenes)")
-    scene.add_argument("--build", type=Path, default=None,
-                       help="CMake build directory holding fmus/ (default: build/ of the checkout)")
-    scene.add_argument("--no-plots", action="store_true", help="write tables only")
+    _cosimulation_options(scene, Path("out/scenes"), "crank revolutions to simulate (default 2)")
     scene.set_defaults(run=_scene)
 
     sub.add_parser(

@@ -29,6 +29,7 @@ import numpy as np
 from fmpy import read_model_description, simulate_fmu
 
 from . import chains, mechanisms, reference
+from .mechanisms import _cross, _rot90, _unit
 from .harness import OutputError, _match_samples, _Progress, build_dir
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -66,19 +67,6 @@ def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
 def scene_data(name: str) -> dict:
     with open(SCENES_DIR / f"{name}.toml", "rb") as f:
         return tomllib.load(f)
-
-
-def _unit(angle):
-    angle = np.asarray(angle, dtype=float)
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
-
-
-def _rot90(v):
-    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
-
-
-def _cross(a, b):
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 # ---------------------------------------------------------------------------
