@@ -1240,8 +1240,11 @@ def documentation(table: Table) -> str:
     o.append(f"<p>The closed-form solution of the {t} dyad divides by one number that "
              f"vanishes at its singular position, where {_h(singular)}. The output "
              f"<code>conditioning</code> is <code>{_h(conditioning)}</code>, in [0, 1]; "
-             "<code>amplification</code> = 1 / conditioning is the factor by which the "
-             "reactions, and their round-off, grow against the loads. When the conditioning "
+             "<code>amplification</code> = data factor / conditioning bounds the round-off: "
+             "eps x amplification times the largest reaction of a unit (N or N.m) bounds the "
+             "error of every reaction of that unit, the data factor (1 to 1/eps) being how "
+             "much the load terms cancel as they are summed. Only the conditioning decides "
+             "the singular status. When the conditioning "
              "falls below the parameter <code>singular_threshold</code> (default "
              "sqrt(DBL_EPSILON) = 1.49e-8, where round-off still leaves half of the digits) "
              "the solve reports status 1.</p>")

@@ -58,6 +58,9 @@ TOP_KEYS = {"scene", "effects", "gravity", "crank", "dyad", "link", "loads", "st
 #: Per pair, the outputs a dyad offers: reactions always, normal force and
 #: reactive moment where the pair is translational.
 PAIR_NAMES = (("mk", 0), ("np", 2), ("mn", 1))   # (suffix, index into PAIRS[type])
+#: What a dyad's amplification output means (README, "Status, conditioning, amplification").
+AMPLIFICATION_TEXT = ("Data factor / conditioning: eps x amplification bounds the error of each "
+                      "reaction relative to the largest reaction of its unit (N or N.m)")
 
 
 class SceneError(Exception):
@@ -901,9 +904,8 @@ def _derive_outputs(p: _Problems, scene: Scene, wanted):
                       "[0, 1]; below singular_threshold the dyad is singular",
                       f"{_member(pre)}conditioning", depends=own_geometry,
                       source=str(d.index))
-        amp = Output(f"{pre}amplification", None, "1 / conditioning",
-                     f"{_member(pre)}amplification", depends=own_geometry,
-                     source=str(d.index))
+        amp = Output(f"{pre}amplification", None, AMPLIFICATION_TEXT,
+                     f"{_member(pre)}amplification", depends=deps, source=str(d.index))
         by_name[cond.name] = [cond]
         by_name[amp.name] = [amp]
         offered += [cond, amp]
@@ -1217,6 +1219,7 @@ def scene_c(table: SceneTable) -> str:
 
     # ---- accelerations of the outer pairs D
     accel: dict[str, str | None] = {}   # link -> C name of a_D or None for zero
+    accel_size: dict[str, str] = {}     # link -> C expression of the size of a_D's terms
     if scene.inertia:
         code()
         code("/* Accelerations of the pairs D: 0 on a fixed pivot, an input on a guide or an")
@@ -1229,25 +1232,32 @@ def scene_c(table: SceneTable) -> str:
                 if has(g + ".accel_d.x"):
                     code(f"const dyad_vec2 {c}_a_d = {_vec(inp(g + '.accel_d.x'), inp(g + '.accel_d.y'))};")
                     accel[g] = f"{c}_a_d"
+                    accel_size[g] = f"dyad_norm1({c}_a_d)"
                 elif att.kind in ("crank", "link"):
                     carrier = att.link
                     r = attachment_point(att)
                     terms = []
+                    sizes = []
                     if accel.get(carrier):
                         terms.append(accel[carrier])
+                        sizes.append(accel_size[carrier])
                     if r is not None:
                         code(f"const dyad_vec2 {c}_r_d = {r};")
                         w, e = omega(carrier), epsilon(carrier)
                         if e:
                             terms.append(f"dyad_scale({e}, dyad_perp({c}_r_d))")
+                            sizes.append(f"fabs({e}) * dyad_norm1({c}_r_d)")
                         if w:
                             terms.append(f"dyad_scale(-{w} * {w}, {c}_r_d)")
+                            sizes.append(f"{w} * {w} * dyad_norm1({c}_r_d)")
                     if terms:
                         expr = terms[0]
                         for t in terms[1:]:
                             expr = f"dyad_add({expr}, {t})"
                         code(f"const dyad_vec2 {c}_a_d = {expr};")
                         accel[g] = f"{c}_a_d"
+                        code(f"const double {c}_a_d_size = {' + '.join(sizes)};")
+                        accel_size[g] = f"{c}_a_d_size"
                     else:
                         accel[g] = None
                 else:
@@ -1269,21 +1279,27 @@ def scene_c(table: SceneTable) -> str:
         mass = params.get("mass")
         link = scene.links.get(g)
         force_terms = []
+        force_sizes = []   # the sizes of the terms (dyadfmu/loaded.h), as the core forms them
         if link is not None and link.force:
             force_terms.append(_vec(inp(g + ".force.x"), inp(g + ".force.y")))
+            force_sizes.append(f"dyad_norm1({force_terms[-1]})")
         massive = mass is not None and not mass.is_zero()
         if massive:
             inner = []
+            inner_sizes = []
             if scene.gravity:
                 gx, gy = scene.gravity_params
                 inner.append(_vec(gx.c(), gy.c()))
+                inner_sizes.append(f"dyad_norm1({inner[-1]})")
             if scene.inertia:
                 tang = []
                 if accel.get(g):
                     tang.append(accel[g])
+                    inner_sizes.append(accel_size[g])
                 e = epsilon(g)
                 if e and r is not None:
                     tang.append(f"dyad_scale({e}, dyad_perp({c}_r))")
+                    inner_sizes.append(f"fabs({e}) * dyad_norm1({c}_r)")
                 for t in tang:
                     inner.append(f"dyad_neg({t})")
             if inner:
@@ -1291,22 +1307,33 @@ def scene_c(table: SceneTable) -> str:
                 for t in inner[1:]:
                     expr = f"dyad_add({expr}, {t})"
                 force_terms.append(f"dyad_scale({mass.c()}, {expr})")
+                force_sizes.append(f"{mass.c()} * ({' + '.join(inner_sizes)})")
         code(f"dyad_vec2 {c}_f = {_sum(force_terms)};")
         moment_terms = []
+        moment_sizes = []
         if link is not None and link.moment:
             moment_terms.append(inp(g + ".moment"))
+            moment_sizes.append(f"fabs({moment_terms[-1]})")
         inert = params.get("inertia")
         if scene.inertia and inert is not None and not inert.is_zero() and epsilon(g):
             moment_terms.append(f"-{inert.c()} * {epsilon(g)}")
+            moment_sizes.append(f"{inert.c()} * fabs({epsilon(g)})")
         code(f"double {c}_m = {' + '.join(moment_terms) if moment_terms else '0.0'};")
         if r is not None and force_terms:
             code(f"double {c}_m_d = {c}_m + dyad_cross({c}_r, {c}_f);")
         else:
             code(f"double {c}_m_d = {c}_m;")
+        code(f"double {c}_f_size = {' + '.join(force_sizes) or '0.0'};")
+        if r is not None and force_terms:
+            moment_sizes.append(f"dyad_norm1({c}_r) * {c}_f_size")
+        code(f"double {c}_m_d_size = {' + '.join(moment_sizes) or '0.0'};")
         w = omega(g)
         if scene.inertia and massive and r is not None and w:
             code(f"{c}_f = dyad_add({c}_f, dyad_scale({mass.c()} * {w} * {w}, {c}_r));")
+            code(f"{c}_f_size += {mass.c()} * {w} * {w} * dyad_norm1({c}_r);")
         code(f"(void){c}_m;")
+        code(f"(void){c}_f_size;")
+        code(f"(void){c}_m_d_size;")
 
     # ---- the chain, from the last dyad back
     code()
@@ -1320,14 +1347,14 @@ def scene_c(table: SceneTable) -> str:
             c = _member(g)
             link = scene.links[g]
             length = inp(g + ".length") if link.sliding else link.params["length"].c()
-            com = (link.params.get("com.x"), link.params.get("com.y"))
             code(f"    load.{side}.i = {c}_i;")
             code(f"    load.{side}.j = {c}_j;")
             code(f"    load.{side}.l = {length};")
-            code(f"    load.{side}.com = {_vec(com[0].c(), com[1].c())};")
             code(f"    load.{side}.f = {c}_f;")
             code(f"    load.{side}.m = {c}_m;")
             code(f"    load.{side}.m_d = {c}_m_d;")
+            code(f"    load.{side}.f_size = {c}_f_size;")
+            code(f"    load.{side}.m_d_size = {c}_m_d_size;")
         for side, att in (("k", d.k), ("p", d.p)):
             if d.pair_kind("mk" if side == "k" else "np") == "T":
                 if att.kind == "external":
@@ -1372,10 +1399,13 @@ def scene_c(table: SceneTable) -> str:
             code(f"    /* on {att.link}: -{pair_force.upper()} at the pair"
                  f"{' and the reactive moment' if reactive else ''} */")
             code(f"    {carrier}_f = dyad_sub({carrier}_f, {dn}.{pair_force});")
+            code(f"    {carrier}_f_size += dyad_force_size(&{dn});")
             if r is not None:
                 code(f"    {{ const dyad_real moment = -dyad_cross({r}, {dn}.{pair_force})"
                      f"{reactive};")
                 code(f"      {carrier}_m_d += moment;")
+                code(f"      {carrier}_m_d_size += dyad_norm1({r}) * dyad_force_size(&{dn})"
+                     f"{f' + dyad_moment_size(&{dn})' if reactive else ''};")
                 com = holder(att.link)
                 if com.get("com.x") is not None and not (com["com.x"].is_zero() and
                                                           com["com.y"].is_zero()):

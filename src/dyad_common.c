@@ -118,8 +118,28 @@ const char* dyad_field_name(dyad_field field)
 void dyad_link_resultant(const dyad_link* link, dyad_vec2 gravity, dyad_vec2* force,
                          dyad_real* moment)
 {
-    dyad_real moment_about_d;
-    dyad_resultant(link, link->dir, gravity, force, moment, &moment_about_d);
+    dyad_body body;
+    dyad_resultant(link, link->dir, gravity, &body);
+    *force = body.f;
+    *moment = body.m;
+}
+
+dyad_real dyad_force_size(const dyad_result* result)
+{
+    const dyad_real mk = dyad_norm1(result->r_mk), np = dyad_norm1(result->r_np),
+                    mn = dyad_norm1(result->r_mn);
+    const dyad_real largest = mk > np ? (mk > mn ? mk : mn) : (np > mn ? np : mn);
+    return result->status == DYAD_STATUS_OK ? result->amplification * largest
+                                            : (dyad_real)NAN;
+}
+
+dyad_real dyad_moment_size(const dyad_result* result)
+{
+    const dyad_real mk = dyad_abs(result->m_mk), np = dyad_abs(result->m_np),
+                    mn = dyad_abs(result->m_mn);
+    const dyad_real largest = mk > np ? (mk > mn ? mk : mn) : (np > mn ? np : mn);
+    return result->status == DYAD_STATUS_OK ? result->amplification * largest
+                                            : (dyad_real)NAN;
 }
 
 /* The first field of a link that is out of its domain, or DYAD_FIELD_NONE.

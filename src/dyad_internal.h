@@ -5,6 +5,7 @@
 #include "dyadfmu/dyad.h"
 #include "dyadfmu/loaded.h"
 #include "dyadfmu/vec2.h"
+#include "dyad_amplification.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -13,6 +14,15 @@
  * dyadfmu/loaded.h, under the names the formulas were written with. */
 typedef dyad_loaded_link dyad_body;
 typedef dyad_loaded dyad_prepared;
+
+/* A solver's closed forms, inlined into both dyad_solve_<type> and
+ * dyad_react_<type> even where the compiler's size heuristics would not: the
+ * validating path is the hot one and a call would cost it a tenth. */
+#if defined(__GNUC__) || defined(__clang__)
+#define DYAD_CLOSED_FORM static inline __attribute__((always_inline))
+#else
+#define DYAD_CLOSED_FORM static inline
+#endif
 
 
 
@@ -43,18 +53,6 @@ static inline dyad_real dyad_load_moment_about_e(const dyad_body* b)
 static inline dyad_real dyad_abs(dyad_real a)
 {
     return a < 0 ? -a : a;
-}
-
-static inline dyad_real dyad_norm1(dyad_vec2 a)
-{
-    return dyad_abs(a.x) + dyad_abs(a.y);
-}
-
-/* Size of the terms summed in dyad_load_moment_about_d / _about_e: the round-off
- * of those sums is a few eps times this. */
-static inline dyad_real dyad_load_moment_size(const dyad_body* b, dyad_real lever_x)
-{
-    return (dyad_abs(lever_x) + dyad_abs(b->com.y)) * dyad_norm1(b->f) + dyad_abs(b->m);
 }
 
 /* Where two sums are equal in exact arithmetic (a force or moment closing one
@@ -116,20 +114,25 @@ static inline dyad_vec2 dyad_unit_of(dyad_vec2 v)
  * Also the moment of all that about D_g: the centripetal part m omega^2 r of
  * the inertia force points along r and has no moment about D_g, so it is left
  * out of that sum instead of being added and cancelled again; for a fast,
- * heavy link it would otherwise swamp the moment in round-off. */
+ * heavy link it would otherwise swamp the moment in round-off. And the sizes
+ * of both sums (dyad_amplification.h), for the amplification. */
 static inline void dyad_resultant(const dyad_link* link, dyad_vec2 i, dyad_vec2 gravity,
-                                  dyad_vec2* force, dyad_real* moment,
-                                  dyad_real* moment_about_d)
+                                  dyad_body* body)
 {
+    static const dyad_link no_rate;
+    const dyad_vec2 zero = dyad_vec2_make(0, 0);
     const dyad_vec2 j = dyad_perp(i);
     const dyad_vec2 r = dyad_combine(link->com.x, i, link->com.y, j);
     const dyad_vec2 tangential = dyad_add(link->accel_d, dyad_scale(link->epsilon, dyad_perp(r)));
     const dyad_vec2 without_centripetal =
         dyad_add(link->force, dyad_scale(link->mass, dyad_sub(gravity, tangential)));
-    *force = dyad_add(without_centripetal,
-                      dyad_scale(link->mass * link->omega * link->omega, r));
-    *moment = link->moment - link->inertia * link->epsilon;
-    *moment_about_d = *moment + dyad_cross(r, without_centripetal);
+    const dyad_link_sizes sizes = dyad_link_sizes_of(link, &no_rate, r, zero, gravity, zero);
+    body->f = dyad_add(without_centripetal,
+                       dyad_scale(link->mass * link->omega * link->omega, r));
+    body->m = link->moment - link->inertia * link->epsilon;
+    body->m_d = body->m + dyad_cross(r, without_centripetal);
+    body->f_size = sizes.f.v;
+    body->m_d_size = sizes.m_d.v;
 }
 
 static inline int dyad_guide_used(dyad_type type, dyad_pair pair)
@@ -167,8 +170,7 @@ static inline void dyad_prepare_body(const dyad_link* link, dyad_vec2 gravity, d
     body->i = dyad_unit_of(link->dir);
     body->j = dyad_perp(body->i);
     body->l = link->length;
-    body->com = link->com;
-    dyad_resultant(link, body->i, gravity, &body->f, &body->m, &body->m_d);
+    dyad_resultant(link, body->i, gravity, body);
 }
 
 static inline void dyad_fill_outputs(dyad_result* result, dyad_real value)
@@ -215,7 +217,9 @@ static inline dyad_status dyad_prepare(dyad_type type, const dyad_input* input,
     return DYAD_STATUS_OK;
 }
 
-/* Stores the conditioning; below the threshold (or NaN) the dyad is singular. */
+/* Stores the conditioning; below the threshold (or NaN) the dyad is singular.
+ * The amplification is 1 / conditioning until dyad_finish adds the data factor:
+ * what a singular or out-of-range result reports. */
 static inline dyad_status dyad_accept_conditioning(dyad_real threshold, dyad_real denominator,
                                                    dyad_real conditioning, dyad_result* result)
 {
@@ -226,6 +230,21 @@ static inline dyad_status dyad_accept_conditioning(dyad_real threshold, dyad_rea
         return dyad_reject(result, DYAD_STATUS_SINGULAR, DYAD_FIELD_NONE);
     }
     return DYAD_STATUS_OK;
+}
+
+/* The sizes of the loads of a prepared dyad, for dyad_sizes_<type>; inv is the
+ * inverse of the type's divisor (dyad_amplification.h). */
+static inline dyad_size_terms dyad_size_terms_of(const dyad_loaded* p, dyad_real inv)
+{
+    dyad_size_terms t;
+    t.f_m = dyad_dual_const(p->m.f_size);
+    t.m_m = dyad_dual_const(p->m.m_d_size);
+    t.f_n = dyad_dual_const(p->n.f_size);
+    t.m_n = dyad_dual_const(p->n.m_d_size);
+    t.l_m = dyad_dual_const(p->m.l);
+    t.l_n = dyad_dual_const(p->n.l);
+    t.inv = dyad_dual_const(inv);
+    return t;
 }
 
 /* The last step of every type: a reaction that is not finite is out of range. */
@@ -242,6 +261,25 @@ static inline dyad_status dyad_check_finite(dyad_result* result)
         return dyad_reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
     }
     return DYAD_STATUS_OK;
+}
+
+/* The last step of every type: out of range unless finite; then the
+ * amplification from the output sizes (the rates are never read here). */
+static inline dyad_status dyad_finish(dyad_type type, dyad_output_sizes sizes,
+                                      dyad_result* result)
+{
+    const dyad_status status = dyad_check_finite(result);
+    if (status == DYAD_STATUS_OK) {
+        result->amplification =
+            dyad_amplification_of(sizes, dyad_largest_force(result, result),
+                                  dyad_largest_moment(result, result,
+                                                      dyad_guide_used(type, DYAD_PAIR_DM),
+                                                      dyad_guide_used(type, DYAD_PAIR_E),
+                                                      dyad_guide_used(type, DYAD_PAIR_DN)),
+                                  dyad_dual_const(result->conditioning))
+                .v;
+    }
+    return status;
 }
 
 /* dyad_solve_<type>: a NaN or infinite input reaches the conditioning or the

@@ -32,7 +32,7 @@
  */
 #include "dyad_internal.h"
 
-static inline dyad_status rrr_reactions(const dyad_loaded* p, dyad_result* result)
+DYAD_CLOSED_FORM dyad_status rrr_reactions(const dyad_loaded* p, dyad_result* result)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
@@ -50,7 +50,10 @@ static inline dyad_status rrr_reactions(const dyad_loaded* p, dyad_result* resul
     result->r_mn = dyad_combine(alpha, m->i, beta, m->j);
     result->r_mk = dyad_neg(dyad_add(result->r_mn, m->f));
     result->r_np = dyad_sub(result->r_mn, n->f);
-    return dyad_check_finite(result);
+    {
+        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(d));
+        return dyad_finish(DYAD_RRR, dyad_sizes_rrr(&terms), result);
+    }
 }
 
 dyad_status dyad_react_rrr(const dyad_loaded* dyad, dyad_result* result)

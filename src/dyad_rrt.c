@@ -31,7 +31,7 @@
  */
 #include "dyad_internal.h"
 
-static inline dyad_status rrt_reactions(const dyad_loaded* p, dyad_result* result)
+DYAD_CLOSED_FORM dyad_status rrt_reactions(const dyad_loaded* p, dyad_result* result)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
@@ -51,7 +51,10 @@ static inline dyad_status rrt_reactions(const dyad_loaded* p, dyad_result* resul
     result->r_mk = dyad_scale(result->n_mk, p->j_k);
     result->r_np = dyad_sub(result->r_mn, n->f);
     result->m_mk = -dyad_load_moment_about_d(m) - m->l * dyad_cross(m->i, result->r_mn);
-    return dyad_check_finite(result);
+    {
+        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(d));
+        return dyad_finish(DYAD_RRT, dyad_sizes_rrt(&terms), result);
+    }
 }
 
 dyad_status dyad_react_rrt(const dyad_loaded* dyad, dyad_result* result)

@@ -33,10 +33,11 @@ static dyad_real turn_rate(dyad_vec2 d, dyad_vec2 dd)
 }
 
 /* Derivative of a link's resultant force F and moment about D, M_D, along the
- * seed dk, for the link frame i (already unit) turning at dtheta. */
+ * seed dk, for the link frame i (already unit) turning at dtheta; and the sizes
+ * of both sums with their rates, for the amplification. */
 static void resultant_rate(const dyad_link* k, const dyad_link* dk, dyad_vec2 i, dyad_real dtheta,
                            dyad_vec2 gravity, dyad_vec2 dgravity, dyad_vec2* dforce,
-                           dyad_real* dmoment_d)
+                           dyad_real* dmoment_d, dyad_link_sizes* sizes)
 {
     const dyad_vec2 j = dyad_perp(i);
     const dyad_vec2 r = dyad_combine(k->com.x, i, k->com.y, j);
@@ -60,6 +61,40 @@ static void resultant_rate(const dyad_link* k, const dyad_link* dk, dyad_vec2 i,
     const dyad_real dmoment = dk->moment - dk->inertia * k->epsilon - k->inertia * dk->epsilon;
     *dforce = dyad_add(dw, dcentripetal);
     *dmoment_d = dmoment + dyad_cross(dr, w) + dyad_cross(r, dw);
+    *sizes = dyad_link_sizes_of(k, dk, r, dr, gravity, dgravity);
+}
+
+/* The rate of the amplification (dyad_amplification.h): the same formulas as
+ * the solvers', on dual numbers. inv: the inverse of the type's divisor with
+ * its rate. */
+static dyad_real amplification_rate(dyad_type type, const dyad_input* input, const dyad_input* seed,
+                                    const dyad_link_sizes* m, const dyad_link_sizes* n,
+                                    dyad_dual inv, const dyad_result* value,
+                                    const dyad_result* derivative)
+{
+    dyad_size_terms t;
+    dyad_output_sizes sizes;
+    t.f_m = m->f;
+    t.m_m = m->m_d;
+    t.f_n = n->f;
+    t.m_n = n->m_d;
+    t.l_m = dyad_dual_make(input->m.length, seed->m.length);
+    t.l_n = dyad_dual_make(input->n.length, seed->n.length);
+    t.inv = inv;
+    switch (type) {
+    case DYAD_RRR: sizes = dyad_sizes_rrr(&t); break;
+    case DYAD_RRT: sizes = dyad_sizes_rrt(&t); break;
+    case DYAD_RTR: sizes = dyad_sizes_rtr(&t); break;
+    case DYAD_TRT: sizes = dyad_sizes_trt(&t); break;
+    default: sizes = dyad_sizes_rtt(&t); break;
+    }
+    return dyad_amplification_of(
+               sizes, dyad_largest_force(value, derivative),
+               dyad_largest_moment(value, derivative, dyad_guide_used(type, DYAD_PAIR_DM),
+                                   dyad_guide_used(type, DYAD_PAIR_E),
+                                   dyad_guide_used(type, DYAD_PAIR_DN)),
+               dyad_dual_make(value->conditioning, derivative->conditioning))
+        .d;
 }
 
 dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dyad_input* input,
@@ -69,7 +104,10 @@ dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dya
     dyad_input loads;
     dyad_status status;
     dyad_vec2 i_m, i_n, i_k, i_p, df_m, df_n, dr_mn_turn;
-    dyad_real dth_m, dth_n, dth_k, dth_p, dmd_m, dmd_n, dc;
+    dyad_real dth_m, dth_n, dth_k, dth_p, dmd_m, dmd_n, dc = 0;
+    dyad_link_sizes sizes_m, sizes_n;
+    /* the type's divisor |d| (RTR: |D_m D_n| |d|) and its rate */
+    dyad_dual divisor = dyad_dual_const(1);
 
     if (value == NULL || derivative == NULL || solve == NULL ||
         (unsigned)type >= DYAD_TYPE_COUNT) {
@@ -94,8 +132,10 @@ dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dya
     dth_k = dyad_guide_used(type, DYAD_PAIR_DM) ? turn_rate(i_k, seed->guide_k) : 0;
     dth_p = dyad_guide_used(type, DYAD_PAIR_DN) ? turn_rate(i_p, seed->guide_p) : 0;
 
-    resultant_rate(&input->m, &seed->m, i_m, dth_m, input->gravity, seed->gravity, &df_m, &dmd_m);
-    resultant_rate(&input->n, &seed->n, i_n, dth_n, input->gravity, seed->gravity, &df_n, &dmd_n);
+    resultant_rate(&input->m, &seed->m, i_m, dth_m, input->gravity, seed->gravity, &df_m, &dmd_m,
+                   &sizes_m);
+    resultant_rate(&input->n, &seed->n, i_n, dth_n, input->gravity, seed->gravity, &df_n, &dmd_n,
+                   &sizes_n);
 
     /* Reactions held, geometry moving: a turning guide turns its normal force
      * (d(N j) = -N i dtheta), and R_mn's lever l_g i_g about D_g changes. */
@@ -158,7 +198,7 @@ dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dya
     case DYAD_RTT: /* d = j_k . i_m */
         dc = -dth_k * dyad_dot(i_k, i_m) + dth_m * dyad_dot(dyad_perp(i_k), dyad_perp(i_m));
         break;
-    default: { /* RTR: the smaller of |i_beta . i_m| and |D_m D_n| / (l_m + l_n) */
+    case DYAD_RTR: { /* the smaller of |i_beta . i_m| and |D_m D_n| / (l_m + l_n) */
         const dyad_vec2 v = dyad_combine(input->m.length, i_m, -input->n.length, i_n);
         const dyad_vec2 dv = dyad_add(
             dyad_combine(seed->m.length, i_m, input->m.length * dth_m, dyad_perp(i_m)),
@@ -169,21 +209,24 @@ dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dya
         const dyad_real slant = dyad_dot(v, i_m) / dist;
         const dyad_real dslant =
             (dyad_dot(dv, i_m) + dth_m * dyad_dot(v, dyad_perp(i_m))) / dist - slant * ddist / dist;
-        if (dyad_abs(slant) > spread) {
-            derivative->denominator = dslant;
-            derivative->conditioning = (ddist - spread * (seed->m.length + seed->n.length)) /
-                                       (input->m.length + input->n.length);
-            derivative->amplification =
-                -derivative->conditioning / (value->conditioning * value->conditioning);
-            return DYAD_STATUS_OK;
-        }
-        dc = dslant;
+        divisor = dyad_dual_mul(dyad_dual_make(dist, ddist), dyad_dual_abs(slant, dslant));
+        derivative->denominator = dslant;
+        derivative->conditioning =
+            dyad_abs(slant) > spread
+                ? (ddist - spread * (seed->m.length + seed->n.length)) /
+                      (input->m.length + input->n.length)
+                : (slant < 0 ? -dslant : dslant);
         break;
     }
+    case DYAD_TYPE_COUNT: break;
     }
-    derivative->denominator = dc;
-    derivative->conditioning = value->denominator < 0 ? -dc : dc;
+    if (type != DYAD_RTR) {
+        divisor = dyad_dual_abs(value->denominator, dc);
+        derivative->denominator = dc;
+        derivative->conditioning = value->denominator < 0 ? -dc : dc;
+    }
     derivative->amplification =
-        -derivative->conditioning / (value->conditioning * value->conditioning);
+        amplification_rate(type, input, seed, &sizes_m, &sizes_n,
+                           dyad_dual_div(dyad_dual_const(1), divisor), value, derivative);
     return DYAD_STATUS_OK;
 }

@@ -19,7 +19,7 @@
  */
 #include "dyad_internal.h"
 
-static inline dyad_status trt_reactions(const dyad_loaded* p, dyad_result* result)
+DYAD_CLOSED_FORM dyad_status trt_reactions(const dyad_loaded* p, dyad_result* result)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
@@ -44,7 +44,10 @@ static inline dyad_status trt_reactions(const dyad_loaded* p, dyad_result* resul
         dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
     result->m_np = n->l * dyad_cross(n->i, result->r_np) - dyad_load_moment_about_e(n);
-    return dyad_check_finite(result);
+    {
+        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(d));
+        return dyad_finish(DYAD_TRT, dyad_sizes_trt(&terms), result);
+    }
 }
 
 dyad_status dyad_react_trt(const dyad_loaded* dyad, dyad_result* result)

@@ -817,12 +817,19 @@ static int test_singular(void)
                 dyad_status status;
                 in = near_singular(type, delta, variant);
                 status = dyad_solve(type, &in, &out);
-                /* Strictly growing while delta is resolved in the scalar type. */
-                CHECK(out.amplification > previous ||
-                          (delta < 1e3 * DYAD_REAL_EPSILON && out.amplification >= previous),
-                      "%s/%d: amplification %.3g not growing at %.0e", dyad_type_name(type),
-                      variant, (double)out.amplification, delta);
-                previous = out.amplification;
+                /* 1 / conditioning, the geometric part of the amplification (all
+                 * of it once singular), strictly growing while delta is resolved
+                 * in the scalar type; the data factor on top is at least 1. */
+                CHECK(1 / out.conditioning > previous ||
+                          (delta < 1e3 * DYAD_REAL_EPSILON && 1 / out.conditioning >= previous),
+                      "%s/%d: 1 / conditioning %.3g not growing at %.0e", dyad_type_name(type),
+                      variant, 1 / (double)out.conditioning, delta);
+                CHECK(status == DYAD_STATUS_OK ? out.amplification >= 1 / out.conditioning
+                                               : out.amplification == 1 / out.conditioning,
+                      "%s/%d: amplification %.3g, 1 / conditioning %.3g at %.0e",
+                      dyad_type_name(type), variant, (double)out.amplification,
+                      1 / (double)out.conditioning, delta);
+                previous = 1 / out.conditioning;
                 if (out.conditioning >= in.singular_threshold) {
                     CHECK(status == DYAD_STATUS_OK && !switched,
                           "%s/%d: status %s above threshold at %.0e", dyad_type_name(type),
@@ -874,8 +881,15 @@ static int test_invalid_before_singular(void)
 
 /* ---- the closed forms on reduced loads (dyadfmu/loaded.h) ---------------- */
 
+/* |x| + |y| of a complex number. */
+static double cnorm1(double complex z)
+{
+    return fabs(creal(z)) + fabs(cimag(z));
+}
+
 /* Link g reduced by hand: a_S = a_D + (i eps - omega^2) r in complex numbers,
- * F = force + m (g - a_S), M = moment - J eps, and the moment about D. */
+ * F = force + m (g - a_S), M = moment - J eps, and the moment about D; and the
+ * sizes of those sums as loaded.h defines them (the magnitudes of their terms). */
 static dyad_loaded_link loaded_link_of(const dyad_link* link, dyad_vec2 gravity)
 {
     const double complex i_g = unit(link->dir);
@@ -888,10 +902,20 @@ static dyad_loaded_link loaded_link_of(const dyad_link* link, dyad_vec2 gravity)
     out.i = vec(creal(i_g), cimag(i_g));
     out.j = vec(-cimag(i_g), creal(i_g));
     out.l = link->length;
-    out.com = link->com;
     out.f = vec(creal(f), cimag(f));
     out.m = (dyad_real)m;
     out.m_d = (dyad_real)(m + creal(r) * cimag(f) - cimag(r) * creal(f));
+    {
+        /* every term but the centripetal one, which has no moment about D */
+        const double lever = cnorm1(r);
+        const double straight =
+            cnorm1(cvec(link->force)) +
+            link->mass * (cnorm1(cvec(gravity)) + cnorm1(cvec(link->accel_d)) +
+                          fabs((double)link->epsilon) * lever);
+        out.f_size = (dyad_real)(straight + link->mass * link->omega * link->omega * lever);
+        out.m_d_size = (dyad_real)(fabs((double)link->moment) +
+                                   link->inertia * fabs((double)link->epsilon) + lever * straight);
+    }
     return out;
 }
 
@@ -958,9 +982,16 @@ static int test_react_loaded(void)
                   (double)got.conditioning, (double)want.conditioning);
             {
                 /* the two reductions round differently; the closed forms amplify that */
-                const double distance = result_distance(&want, &got) / (double)want.amplification;
+                const double distance = result_distance(&want, &got) * (double)want.conditioning;
                 worst = distance > worst ? distance : worst;
             }
+            /* the same loads and sizes give the same amplification, to the
+             * difference of the largest outputs the two reductions give */
+            CHECK(fabs((double)got.amplification - (double)want.amplification) <=
+                      sqrt(DYAD_REAL_EPSILON) * (double)want.amplification &&
+                      got.amplification >= 1 / got.conditioning,
+                  "%s: amplification %.17g, dyad_solve %.17g", dyad_type_name(type),
+                  (double)got.amplification, (double)want.amplification);
         }
         printf("    %s %s: %d solved, %d singular; worst difference from dyad_solve %.3e of the "
                "largest reaction times the amplification\n",

@@ -72,8 +72,8 @@ def parser() -> argparse.ArgumentParser:
         "study", help="accuracy and speed of every method; writes the report",
         description="Time the C core (double, float), GSL LU and SVD 6x6 solves, NumPy's "
                     "batched solve and the FMUs (from C and fmpy) on the same inputs; measure "
-                    "their errors against mpmath ground truth on random, near-singular and "
-                    "extreme configurations; write report.md, CSVs and plots.")
+                    "their errors against mpmath ground truth on random, near-singular, "
+                    "extreme and cancelling configurations; write report.md, CSVs and plots.")
     study.add_argument("--quick", action="store_true",
                        help="small input sets (for CI: under a minute)")
     study.add_argument("--out", type=Path, default=Path("out/study"),

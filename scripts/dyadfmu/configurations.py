@@ -3,7 +3,8 @@ the benchmark's row layout (35 float64 per configuration, see COLUMNS).
 
 - ``random``: well-conditioned random configurations (conditioning >= 0.1);
 - ``sweep``: configurations whose type denominator runs from 1e-1 down to 1e-16;
-- ``extreme``: extreme scales and stiff mixtures in one dyad.
+- ``extreme``: extreme scales and stiff mixtures in one dyad;
+- ``cancelling``: loads that nearly cancel as they are summed.
 
 Every direction is a unit vector to double precision. Generation is
 deterministic for a given seed.
@@ -102,66 +103,26 @@ def conditioning(dyad: str, rows: np.ndarray) -> np.ndarray:
     return np.minimum(np.nan_to_num(slant), dist / (l_m + l_n))
 
 
-def exact_amplification(dyad: str, row: np.ndarray) -> float:
-    """1 / conditioning of one configuration, computed exactly (mpmath) from its
-    double inputs: the amplification the problem itself has."""
-    with mpmath.workdps(60):
-        v = {name: mpmath.mpf(float(row[k])) for name, k in COL.items()}
-        i_m, i_n = (v["m.dir.x"], v["m.dir.y"]), (v["n.dir.x"], v["n.dir.y"])
-        i_k, i_p = (v["guide_k.x"], v["guide_k.y"]), (v["guide_p.x"], v["guide_p.y"])
-
-        def unit(a):
-            norm = mpmath.sqrt(a[0] ** 2 + a[1] ** 2)
-            return (a[0] / norm, a[1] / norm)
-
-        i_m, i_n, i_k, i_p = unit(i_m), unit(i_n), unit(i_k), unit(i_p)
-        perp = (lambda a: (-a[1], a[0]))
-        dot = (lambda a, b: a[0] * b[0] + a[1] * b[1])
-        if dyad == "RRR":
-            c = abs(dot(i_m, perp(i_n)))
-        elif dyad == "RRT":
-            c = abs(dot(i_n, i_k))
-        elif dyad == "TRT":
-            c = abs(dot(perp(i_k), i_p))
-        elif dyad == "RTT":
-            c = abs(dot(perp(i_k), i_m))
-        else:
-            l_m, l_n = v["m.length"], v["n.length"]
-            d = (l_m * i_m[0] - l_n * i_n[0], l_m * i_m[1] - l_n * i_n[1])
-            dist = mpmath.sqrt(d[0] ** 2 + d[1] ** 2)
-            c = min(abs(dot((d[0] / dist, d[1] / dist), i_m)) if dist > 0 else 0,
-                    dist / (l_m + l_n))
-        return float(1 / c) if c > 0 else math.inf
+#: Output columns by unit: the forces (N) and the reactive moments (N m).
+UNITS = (slice(0, 9), slice(9, 12))
 
 
-def data_factor(rows: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    """How much larger the load terms a solver must sum are than the reactions
-    they produce: the sum of the magnitudes of every term of the links'
-    resultant forces (active load, weight, and each part of the inertia force)
-    over the largest force reaction, and likewise for moments (levers up to
-    |com| + length) over the largest reactive moment; at least 1. Round-off in
-    those sums is a few eps of the terms whatever the method, so an error of
-    eps x (1/conditioning) x data_factor is the best any double solve can do."""
-    forces, moments = np.zeros(len(rows)), np.zeros(len(rows))
-    gravity = np.hypot(rows[:, COL["gravity.x"]], rows[:, COL["gravity.y"]])
-    for g in ("m", "n"):
-        lever = np.hypot(rows[:, COL[f"{g}.com.x"]], rows[:, COL[f"{g}.com.y"]])
-        mass = rows[:, COL[f"{g}.mass"]]
-        terms = (np.hypot(rows[:, COL[f"{g}.force.x"]], rows[:, COL[f"{g}.force.y"]])
-                 + mass * gravity
-                 + mass * np.hypot(rows[:, COL[f"{g}.accel_d.x"]], rows[:, COL[f"{g}.accel_d.y"]])
-                 + mass * (rows[:, COL[f"{g}.omega"]] ** 2
-                           + np.abs(rows[:, COL[f"{g}.epsilon"]])) * lever)
-        forces += terms
-        moments += (np.abs(rows[:, COL[f"{g}.moment"]])
-                    + rows[:, COL[f"{g}.inertia"]] * np.abs(rows[:, COL[f"{g}.epsilon"]])
-                    + (lever + rows[:, COL[f"{g}.length"]]) * terms)
+def contract_ratio(values: np.ndarray, truth: np.ndarray, amplification: np.ndarray,
+                   eps: float) -> np.ndarray:
+    """The contract of the core's ``amplification`` output (src/dyad_amplification.h),
+    per configuration: the worst |value - truth| of an output over eps x amplification
+    x the largest reported |output| of its unit. With status ok it is at most a small
+    constant (test_accuracy.py: 16). 0 where eps x amplification >= 1, which promises
+    no digit; inf where a unit reports only zeros and is wrong."""
+    ratio = np.zeros(len(values))
+    promised = eps * amplification < 1
     with np.errstate(invalid="ignore", divide="ignore"):
-        peak_force = np.max(np.abs(truth[:, :9]), axis=1)
-        peak_moment = np.max(np.abs(truth[:, 9:12]), axis=1)
-        kappa_f = np.where(peak_force > 0, forces / peak_force, 1.0)
-        kappa_m = np.where(peak_moment > 0, moments / peak_moment, 1.0)
-    return np.nan_to_num(np.maximum(1.0, np.maximum(kappa_f, kappa_m)), nan=1.0, posinf=1.0)
+        for unit in UNITS:
+            error = np.max(np.abs(values[:, unit] - truth[:, unit]), axis=1)
+            bound = eps * amplification * np.max(np.abs(values[:, unit]), axis=1)
+            unit_ratio = np.where(error > 0, error / bound, 0.0)
+            ratio = np.fmax(ratio, np.where(promised, unit_ratio, 0.0))
+    return ratio
 
 
 def random_set(dyad: str, count: int, seed: int) -> np.ndarray:
@@ -256,6 +217,32 @@ def extreme_set(dyad: str, count: int, seed: int) -> np.ndarray:
         rows[tiny, COL[f"{g}.force.y"]] *= 1e-12
         rows[tiny, COL[f"{g}.moment"]] *= 1e-12
         rows[tiny, COL[f"{g}.omega"]] = 1e4
+    return rows
+
+
+def cancelling_set(dyad: str, count: int, seed: int) -> np.ndarray:
+    """Loads that cancel as they are summed, well-conditioned geometrically: on one
+    link an active force and moment that balance its weight and inertia force and
+    moment but for a residue of 1e-3 to 1e-12 of them, the other link's loads that
+    much smaller. The reactions are then the residue of terms 1e3 to 1e12 times
+    larger, and so is their round-off: the data factor of the amplification."""
+    rows = random_set(dyad, count, seed)
+    rng = np.random.default_rng(seed + 1)
+    for row in rows:
+        residue = 10.0 ** rng.uniform(-12, -3)
+        g, other = ("m", "n") if rng.random() < 0.5 else ("n", "m")
+        i = row[[COL[f"{g}.dir.x"], COL[f"{g}.dir.y"]]]
+        j = np.array([-i[1], i[0]])
+        r = row[COL[f"{g}.com.x"]] * i + row[COL[f"{g}.com.y"]] * j
+        mass, omega, epsilon = (row[COL[f"{g}.{k}"]] for k in ("mass", "omega", "epsilon"))
+        gravity = row[[COL["gravity.x"], COL["gravity.y"]]]
+        accel_d = row[[COL[f"{g}.accel_d.x"], COL[f"{g}.accel_d.y"]]]
+        # weight and inertia force: m (g - a_D - epsilon k0 x r + omega^2 r)
+        passive = mass * (gravity - accel_d - epsilon * np.array([-r[1], r[0]]) + omega ** 2 * r)
+        row[[COL[f"{g}.force.x"], COL[f"{g}.force.y"]]] = -passive * (1 - residue)
+        row[COL[f"{g}.moment"]] = row[COL[f"{g}.inertia"]] * epsilon * (1 - residue)
+        for k in ("mass", "inertia", "force.x", "force.y", "moment"):
+            row[COL[f"{other}.{k}"]] *= residue
     return rows
 
 

@@ -31,7 +31,7 @@ OUTPUTS = {"R_mk.x": ("r_mk", 0), "R_mk.y": ("r_mk", 1), "R_np.x": ("r_np", 0),
            "M_mk": ("m_mk", None), "M_np": ("m_np", None), "M_mn": ("m_mn", None)}
 
 #: Below this conditioning a sample counts as near-singular and is left out of
-#: the error figures (its amplification exceeds 1e6).
+#: the error figures (its amplification exceeds 1e6, 1 / conditioning).
 NEAR_SINGULAR = 1e-6
 
 

@@ -1,7 +1,8 @@
 """The variable tables of the dyad FMUs and what modelDescription/generate.py makes of them.
 
 (a) The `depends` lists of every table are the true output dependencies, derived
-    here afresh with the independent NumPy reference by perturbing each input.
+    here afresh with the independent NumPy reference by perturbing each input (the
+    amplification, which the reference does not compute, with the C core).
 (b) The generated model descriptions equal the golden files byte for byte.
 (c) fmpy validates every generated description, and units, causalities, counts
     and the model structure are what the dyad type calls for.
@@ -108,8 +109,23 @@ def reference_args(values):
     return links["m"], links["n"], gk, gp, (values["gravity.x"], values["gravity.y"])
 
 
+_CORE = []
+
+
+def core_amplification(dyad_type, m, n, gk, gp, gravity, threshold):
+    """The C core's amplification output, NaN where the core is not built."""
+    from dyadfmu.core import Core, library_path
+    if not _CORE:
+        _CORE.append(Core() if library_path().is_file() else None)
+    if _CORE[0] is None:
+        return math.nan
+    return _CORE[0].solve(dyad_type, m, n, gk, gp, gravity,
+                          singular_threshold=threshold)["amplification"]
+
+
 def evaluate(dyad_type, values):
-    """Every FMU output (by name) for the given inputs and parameters, by the reference."""
+    """Every FMU output (by name) for the given inputs and parameters, by the reference;
+    the amplification (data factor / conditioning, src/dyad_amplification.h) by the core."""
     m, n, gk, gp, gravity = reference_args(values)
     out = ref.solve(dyad_type, m, n, gk, gp, gravity)
     result = {}
@@ -120,7 +136,8 @@ def evaluate(dyad_type, values):
         result[f"M_{pair}"] = float(out[f"m_{pair}"][0])
     cond = conditioning(dyad_type, m, n, gk, gp)
     result["conditioning"] = cond
-    result["amplification"] = 1 / cond if cond > 0 else math.inf
+    result["amplification"] = core_amplification(dyad_type, m, n, gk, gp, gravity,
+                                                 values["singular_threshold"])
     result["status"] = 0 if cond >= values["singular_threshold"] else 1
     return result
 
@@ -211,6 +228,9 @@ def test_declared_dependencies_are_the_true_ones(dyad_type):
     for v in raw["variable"]:
         if v["causality"] != "output":
             continue
+        if v["name"] == "amplification" and math.isnan(evaluate(dyad_type, start_values(raw))
+                                                       ["amplification"]):
+            continue   # the C core is not built: nothing to derive it with
         declared = set(v["depends"])
         want = derived[v["name"]]
         if declared != want:
@@ -221,10 +241,16 @@ def test_declared_dependencies_are_the_true_ones(dyad_type):
 
 @pytest.mark.parametrize("dyad_type", TYPES)
 def test_dependencies_do_not_depend_on_the_sample(dyad_type):
-    """Another seed gives the same dependencies: the derivation is not luck."""
+    """Another seed gives the same dependencies: the derivation is not luck. Not for
+    the amplification: the larger of two units' data factors, it moves with an input
+    only where that input's unit has the larger one, which six configurations show
+    (test (a)) and three may not."""
     raw = load_raw(dyad_type)
-    assert derive_dependencies(dyad_type, raw, configurations=3, seed=1000) == \
-        derive_dependencies(dyad_type, raw, configurations=3, seed=2000)
+    first = derive_dependencies(dyad_type, raw, configurations=3, seed=1000)
+    second = derive_dependencies(dyad_type, raw, configurations=3, seed=2000)
+    first.pop("amplification")
+    second.pop("amplification")
+    assert first == second
 
 
 # ---------------------------------------------------------------------------

@@ -149,3 +149,53 @@ def test_conditioning_rate(core, dyad):
 
         central = (conditioning(step) - conditioning(-step)) / (2 * step)
         assert derivative["conditioning"] == pytest.approx(central, rel=1e-5, abs=1e-7)
+
+
+def _amplification_rates(core, dyad, row, seed):
+    """The core's rate of the amplification along the seed and the central difference
+    of its values, or None where the one-sided differences disagree (a max, a clamp or
+    a choice of form switches within the step: no derivative there)."""
+    value, derivative = core.solve_tangent(dyad, cfg.reference_args(dyad, row),
+                                           _core_seed(dyad, row, seed))
+    step = 1e-7 * value["amplification"] / max(1.0, abs(derivative["amplification"]))
+
+    def amplification(h):
+        return core.solve(dyad, *_perturbed(dyad, row, seed, h))["amplification"]
+
+    left, right = amplification(-step), amplification(step)
+    central = (right - left) / (2 * step)
+    right_slope = (right - value["amplification"]) / step
+    left_slope = (value["amplification"] - left) / step
+    if abs(right_slope - left_slope) > 1e-3 * abs(central) + 1e-9:
+        return None
+    return derivative["amplification"], central
+
+
+@pytest.mark.parametrize("dyad", cfg.TYPES)
+def test_amplification_rate(core, dyad):
+    """The amplification depends on every input, the loads too (the data factor sums
+    the magnitude of every load term); its rate is exact where it is smooth, which is
+    almost everywhere: against central differences of the core, along random seeds
+    and along seeds that move only the loads and motion."""
+    rng = np.random.default_rng(11)
+    rows = cfg.random_set(dyad, 25, seed=950 + cfg.TYPES.index(dyad))
+    for g, floor in (("m", 0.05), ("n", 0.07)):   # a length of 0 may not move down; and
+        # l_m = l_n would put RTR on the kink of its conditioning (both forms equal)
+        rows[:, cfg.COL[f"{g}.length"]] = np.maximum(rows[:, cfg.COL[f"{g}.length"]], floor)
+    checked = moved_by_loads = 0
+    for row in rows:
+        seed = _random_seed(rng, dyad)
+        for g, link in zip("mn", seed[:2]):   # quantities >= 0 move relative to their size
+            for key in ("length", "mass", "inertia"):
+                link[key] *= row[cfg.COL[f"{g}.{key}"]]
+        loads_only = (dict(seed[0], angle=0.0, length=0.0), dict(seed[1], angle=0.0, length=0.0),
+                      0.0, 0.0, (0.0, 0.0))
+        for s, counts in ((seed, False), (loads_only, True)):
+            rates = _amplification_rates(core, dyad, row, s)
+            if rates is None:
+                continue
+            checked += 1
+            assert rates[0] == pytest.approx(rates[1], rel=1e-5, abs=1e-9), row
+            moved_by_loads += counts and rates[0] != 0
+    assert checked >= 40
+    assert moved_by_loads >= 15

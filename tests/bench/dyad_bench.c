@@ -52,7 +52,7 @@
 enum {
     IN_LINK_COLS = 14, /* columns per link in the inputs file */
     IN_COLS = 35,      /* 2 links, guide_k, guide_p, gravity, singular_threshold */
-    OUT_COLS = 15
+    OUT_COLS = 16
 };
 
 typedef enum bench_method { METHOD_CORE, METHOD_GSL_LU, METHOD_GSL_SVD, METHOD_FMU } bench_method;
@@ -102,10 +102,11 @@ static void usage(FILE* out)
         "                accel_d.x, accel_d.y, com.x, com.y, mass, inertia, force.x,\n"
         "                force.y, moment; then guide_k.x/y, guide_p.x/y, gravity.x/y,\n"
         "                singular_threshold\n"
-        "  --outputs     N x 15: r_mk.x, r_mk.y, r_np.x, r_np.y, r_mn.x, r_mn.y, n_mk,\n"
+        "  --outputs     N x 16: r_mk.x, r_mk.y, r_np.x, r_np.y, r_mn.x, r_mn.y, n_mk,\n"
         "                n_np, n_mn, m_mk, m_np, m_mn, status (0 ok, 1 singular, 2 invalid,\n"
         "                3 out of range), conditioning (core; else NaN), cond2 (gsl_svd:\n"
-        "                s_max/s_min of the 6x6 matrix; else NaN).\n"
+        "                s_max/s_min of the 6x6 matrix; else NaN), amplification (core;\n"
+        "                else NaN).\n"
         "                For fmu: N x (number of out-vrs), the values read back.\n"
         "  --fmu-inputs  N x (number of in-vrs), in the FMU's units\n"
         "\n"
@@ -393,6 +394,7 @@ static void row_from_result(const dyad_result* r, double cond2, double* row)
     row[12] = (double)r->status;
     row[13] = (double)r->conditioning;
     row[14] = cond2;
+    row[15] = (double)r->amplification;
 }
 
 /* ---- timing ------------------------------------------------------------------- */

@@ -29,12 +29,18 @@ typedef struct dyad_loaded_link {
     dyad_vec2 i;    /**< i_g: unit vector from D_g towards E, global frame (-) */
     dyad_vec2 j;    /**< j_g = k0 x i_g (-) */
     dyad_real l;    /**< l_g = |D_g E| (m) */
-    /** (x_S, y_S) in the link frame (m). Only weighs the round-off of two
-     *  equivalent sums where a type offers both (RTR, RTT); zero is valid. */
-    dyad_vec2 com;
     dyad_vec2 f;    /**< resultant force F_g, global frame (N) */
     dyad_real m;    /**< resultant moment about the centre of mass S_g (N m) */
     dyad_real m_d;  /**< moment of all those loads about D_g (N m) */
+    /** Size of f (N): the sum of |x| + |y| over every term summed into f (a
+     *  term's own error bound where it carries one, see dyad_force_size). The
+     *  caller's round-off of f must be a few eps times it; it is at least
+     *  |f.x| + |f.y|. It makes result.amplification cover the cancellation of
+     *  the load terms; |f.x| + |f.y| claims that f has no round-off. */
+    dyad_real f_size;
+    /** Size of m_d (N m), likewise: the sum of the magnitudes of its terms,
+     *  |r x v| counted as (|r.x| + |r.y|)(|v.x| + |v.y|). */
+    dyad_real m_d_size;
 } dyad_loaded_link;
 
 /** A dyad ready for its closed forms. */
@@ -51,6 +57,17 @@ dyad_status dyad_react_rrt(const dyad_loaded* dyad, dyad_result* result);
 dyad_status dyad_react_rtr(const dyad_loaded* dyad, dyad_result* result);
 dyad_status dyad_react_trt(const dyad_loaded* dyad, dyad_result* result);
 dyad_status dyad_react_rtt(const dyad_loaded* dyad, dyad_result* result);
+
+/** The size of a solved dyad's reaction forces as a term of another link's
+ *  load (N): amplification x the largest |x| + |y| of R_mk, R_np, R_mn. It
+ *  bounds each of them, and a few eps times it bounds their error; a chain
+ *  adds it to the f_size of the link a reaction loads. NaN unless the status
+ *  is ok. */
+dyad_real dyad_force_size(const dyad_result* result);
+
+/** The same for the reactive moments (N m): amplification x the largest
+ *  |m_mk|, |m_np|, |m_mn|. */
+dyad_real dyad_moment_size(const dyad_result* result);
 
 #ifdef __cplusplus
 }

@@ -51,6 +51,17 @@ static inline dyad_real dyad_cross(dyad_vec2 a, dyad_vec2 b)
     return a.x * b.y - a.y * b.x;
 }
 
+/** |a.x| + |a.y|: how the sizes behind the amplification measure a vector
+ *  term (dyadfmu/loaded.h). */
+static inline dyad_real dyad_norm1(dyad_vec2 a)
+{
+#ifdef DYAD_REAL_FLOAT
+    return fabsf(a.x) + fabsf(a.y);
+#else
+    return fabs(a.x) + fabs(a.y);
+#endif
+}
+
 /** k0 x a: a turned by +90 degrees. */
 static inline dyad_vec2 dyad_perp(dyad_vec2 a)
 {
