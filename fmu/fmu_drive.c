@@ -20,12 +20,30 @@
  * accurate and cheap once the substep resolves the one stiff scale, the
  * motor's damping; it needs no Newton iteration, and its result does not
  * depend on anything but the step, which keeps co-simulation reproducible.
+ * A step that needs more than FMU_DRIVE_MAX_SUBSTEPS substeps is refused before
+ * any of them is taken: the count is compared as a double, since h / limit
+ * may exceed every integer type.
+ *
+ * No output is ever infinite: an input such as load.torque = -DBL_MAX passes
+ * the setters but overflows the acceleration, which is then NaN with status 3,
+ * as a dyad reports a load that overflows. crank.epsilon is NaN whenever status
+ * is not 0; motor.torque only where it overflows itself, since it depends on the
+ * state alone (its declared dependencies stay empty); crank.angle and
+ * crank.omega are the states.
  */
 #include "fmu_drive.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+
+/* At 0.005 rad a substep this is over 5000 rad of crank turn, or 50000 of the
+ * motor's time constants, in one communication step: a step that long is a
+ * mistake, and it would take about a tenth of a second. */
+#define FMU_DRIVE_MAX_SUBSTEPS 1e6
+
+/* Values of the status output. */
+enum { FMU_DRIVE_OK = 0, FMU_DRIVE_INVALID_INPUT = 2, FMU_DRIVE_OUT_OF_RANGE = 3 };
 
 /* Variable indices are those of the generated table, found by name. */
 static int variable_named(const fmu_model* model, const char* name)
@@ -98,13 +116,25 @@ static void evaluate(const fmu_model* model, const void* input, void* output,
     out->angle = in->angle;
     out->speed = in->speed;
     out->motor_torque = motor_torque(in, in->speed);
-    out->status = 0;
+    out->acceleration = (double)NAN;
+    out->status = FMU_DRIVE_INVALID_INPUT;
     if (!check(model, in, evaluation)) {
-        out->acceleration = out->motor_torque = (double)NAN;
-        out->status = 2;
         return;
     }
     out->acceleration = acceleration(in, in->angle, in->speed);
+    out->status = FMU_DRIVE_OK;
+    if (!isfinite(out->motor_torque) || !isfinite(out->acceleration)) {
+        evaluation->status = FMU_DISCARD;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "the motor torque (%g N.m) or the crank's acceleration (%g rad/s2) overflows "
+                 "double; it is NaN",
+                 out->motor_torque, out->acceleration);
+        out->status = FMU_DRIVE_OUT_OF_RANGE;
+        out->acceleration = (double)NAN;
+        if (!isfinite(out->motor_torque)) {
+            out->motor_torque = (double)NAN;
+        }
+    }
 }
 
 static void advance(const fmu_model* model, void* input, double h, fmu_evaluation* evaluation)
@@ -113,7 +143,7 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
     const double time_constant = total_inertia(in) * in->no_load_speed / in->stall_torque;
     const double turn = fabs(in->speed) > 0 ? 0.005 / fabs(in->speed) : h;
     double limit = 0.05 * time_constant < turn ? 0.05 * time_constant : turn;
-    double angle = in->angle, speed = in->speed, dt;
+    double angle = in->angle, speed = in->speed, needed, dt;
     long substeps, k;
 
     evaluation->status = FMU_OK;
@@ -125,14 +155,17 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
     if (!(limit > 0) || limit > h) {
         limit = h;
     }
-    substeps = (long)ceil(h / limit);
-    if (substeps > 10000000L) {
-        evaluation->status = FMU_DISCARD;
+    needed = ceil(h / limit);
+    if (!(needed <= FMU_DRIVE_MAX_SUBSTEPS)) {
+        evaluation->status = FMU_ERROR;
         snprintf(evaluation->reason, sizeof evaluation->reason,
-                 "the step of %g s needs more than 1e7 substeps (speed %g rad/s)", h, speed);
+                 "communicationStepSize = %g s needs %.3g substeps of %.3g s (speed %.3g "
+                 "rad/s, time constant %.3g s), over the %g allowed: take shorter steps",
+                 h, needed, limit, speed, time_constant, FMU_DRIVE_MAX_SUBSTEPS);
         return;
     }
-    dt = h / (double)substeps;
+    substeps = (long)needed;
+    dt = h / needed;
     for (k = 0; k < substeps; ++k) {
         const double a1 = acceleration(in, angle, speed);
         const double w2 = speed + 0.5 * dt * a1;

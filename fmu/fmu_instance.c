@@ -334,6 +334,16 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
                 function, current_time, step_size);
         return FMU_ERROR;
     }
+    /* The end of the step must be a later finite time: a sum that overflows would
+     * leave the instance at an infinite time, one below the resolution of double
+     * at current_time would advance the states but not the time. */
+    if (!isfinite(current_time + step_size) || !(current_time + step_size > current_time)) {
+        fmu_log(instance, FMU_ERROR,
+                "%s: currentCommunicationPoint = %.17g s + communicationStepSize = %.17g s "
+                "= %.17g s is not a finite time after the current one",
+                function, current_time, step_size, current_time + step_size);
+        return FMU_ERROR;
+    }
     instance->time = current_time;
     if (instance->model->behaviour->advance != NULL) {
         /* A model with states: the outputs at the end of the step. */
@@ -342,6 +352,12 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
             fmu_evaluation* e = &instance->evaluation;
             instance->model->behaviour->advance(instance->model, instance->input, step_size, e);
             instance->dirty = 1;
+            if (e->status == FMU_ERROR) {
+                /* A step the model refuses (it left its states as they were). */
+                fmu_log(instance, FMU_ERROR, "%s: at t = %g s: %s", function, current_time,
+                        e->reason);
+                return FMU_ERROR;
+            }
             if (e->status != FMU_OK) {
                 fmu_log(instance, FMU_DISCARD, "%s: at t = %g s: %s", function, current_time,
                         e->reason);

@@ -83,7 +83,9 @@ typedef struct fmu_behaviour {
                      fmu_evaluation* evaluation);
     /* A model with states: sets them from their start parameters when
      * initialization ends, and advances them over a communication step of h
-     * seconds with the inputs held. NULL for an algebraic model. */
+     * seconds with the inputs held; FMU_ERROR refuses the step and FMU_DISCARD
+     * reports one that failed, both with the states left as they were. NULL for
+     * an algebraic model. */
     void (*start)(const struct fmu_model* model, void* input);
     void (*advance)(const struct fmu_model* model, void* input, double h,
                     fmu_evaluation* evaluation);

@@ -328,7 +328,8 @@ def drive_catalogue() -> dict[str, Entry]:
     The outputs' dependencies are exact: the angle and speed are states at the
     communication point, the motor torque a function of the speed alone, the
     acceleration (J + J_load) eps = T_m(omega) + tau_load + r_c x m_c g depends on
-    both load inputs, and the status (valid while J + J_load > 0) on load.inertia."""
+    both load inputs, and so does the status (2 unless J + J_load > 0, 3 where the
+    acceleration overflows)."""
     positive = {"min": 0.0, "min_exclusive": True}
     entries = [
         Entry("input.load_torque", "load.torque", "input", "N.m"),
@@ -350,7 +351,7 @@ def drive_catalogue() -> dict[str, Entry]:
               depends=("load.torque", "load.inertia")),
         Entry("result.motor_torque", "motor.torque", "output", "N.m", depends=()),
         Entry("result.status", "status", "output", None, value_type="Integer",
-              depends=("load.inertia",)),
+              depends=("load.torque", "load.inertia")),
     ]
     return {entry.lives: entry for entry in entries}
 

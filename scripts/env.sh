@@ -75,3 +75,57 @@ dyadfmu_build_tsan() {
     cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" --target "${targets[@]}" >/dev/null
 }
 # ---- end of the probes' block ----
+
+# ---- the second FMI importer (scripts/tests/test_importers.py) ----------------------
+# fmi-sim, a Rust FMI 2 / FMI 3 importer independent of fmpy, at the version
+# scripts/dyadfmu/importers.py pins (FMI_SIM_VERSION). `cargo install` builds it once into
+# the cargo install root (~/.cargo/bin unless CARGO_INSTALL_ROOT or CARGO_HOME say
+# otherwise; about 12 CPU minutes); a later run finds the pinned version there and skips.
+# The build needs cargo (PATH or ~/.cargo/bin, else Debian's cargo-web, since bookworm's
+# cargo / rustc 1.63 is older than fmi-sim's dependencies allow) and libclang (Debian's
+# libclang-dev). Exports DYADFMU_FMI_SIM for the tests. fmutool comes with the venv
+# (scripts/pyproject.toml, test extras). Where fmi-sim cannot be installed, the tests
+# skip it, except under CI (CI=true), where this returns non-zero.
+dyadfmu_fmi_sim_pin() {
+    sed -n 's/^FMI_SIM_VERSION = "\([0-9.]*\)"$/\1/p' "$DYADFMU_ROOT/scripts/dyadfmu/importers.py"
+}
+
+dyadfmu_fmi_sim_installed() {   # the version of the fmi-sim at $1, or nothing
+    [ -x "$1" ] || return 0
+    RUST_BACKTRACE=0 "$1" --version 2>&1 | sed -n 's/.*fmi-sim \([0-9][0-9.]*\).*/\1/p' | head -n 1
+}
+
+dyadfmu_ensure_fmi_sim() {
+    local want root bin cargo missing=()
+    want=$(dyadfmu_fmi_sim_pin)
+    root=${CARGO_INSTALL_ROOT:-${CARGO_HOME:-$HOME/.cargo}}
+    bin="$root/bin/fmi-sim"
+    if [ -n "$want" ] && [ "$(dyadfmu_fmi_sim_installed "$bin")" = "$want" ]; then
+        export DYADFMU_FMI_SIM="$bin"
+        return 0
+    fi
+    cargo=$(command -v cargo 2>/dev/null || true)
+    if [ -z "$cargo" ] && [ -x "${CARGO_HOME:-$HOME/.cargo}/bin/cargo" ]; then
+        cargo="${CARGO_HOME:-$HOME/.cargo}/bin/cargo"
+    fi
+    [ -n "$cargo" ] || missing+=(cargo-web)
+    dpkg-query -W -f='${Status}' libclang-dev 2>/dev/null | grep -q 'ok installed' \
+        || missing+=(libclang-dev)
+    if [ ${#missing[@]} -gt 0 ]; then
+        if [ "$(id -u)" -ne 0 ]; then
+            dyadfmu_log "fmi-sim $want not installed: it needs ${missing[*]} (run as root, or apt-get install ${missing[*]})"
+            [ "${CI:-}" != "true" ]
+            return
+        fi
+        dyadfmu_log "installing system packages for fmi-sim: ${missing[*]}"
+        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+        cargo=${cargo:-$(command -v cargo)}
+    fi
+    dyadfmu_log "building fmi-sim $want with $("$cargo" --version) into $root (once)"
+    if ! "$cargo" install --quiet --locked --root "$root" fmi-sim --version "$want"; then
+        dyadfmu_log "cargo install fmi-sim $want failed"
+        [ "${CI:-}" != "true" ]
+        return
+    fi
+    export DYADFMU_FMI_SIM="$bin"
+}

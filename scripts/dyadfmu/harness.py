@@ -164,6 +164,70 @@ def _match_samples(recorded: dict, inputs: dict, names, t: np.ndarray) -> np.nda
     return index
 
 
+@dataclass
+class CoSimSetup:
+    """What one co-simulation feeds an FMU, the same for every importer: the input
+    signals on the communication grid, the parameters' start values, what it records."""
+    path: Path
+    time: np.ndarray                # communication points (s), evenly spaced from 0
+    inputs: dict                    # input name -> values at `time`
+    start_values: dict              # parameter name -> value
+    outputs: list                   # output names, in model-description order
+    units: dict                     # variable name -> unit ("" where none)
+
+    @property
+    def step(self) -> float:
+        return float(self.time[1] - self.time[0])
+
+    @property
+    def stop(self) -> float:
+        return float(self.time[-1])
+
+    def signals(self) -> np.ndarray:
+        """Time and every input as a structured array, the form fmpy's simulate_fmu takes."""
+        rows = np.zeros(len(self.time), dtype=[("time", float)] + [(n, float) for n in self.inputs])
+        rows["time"] = self.time
+        for n, values in self.inputs.items():
+            rows[n] = values
+        return rows
+
+
+def communication_grid(duration: float, revolutions: float, steps: int) -> np.ndarray:
+    """`steps` communication points per revolution over `revolutions`, from 0 to `duration`."""
+    return np.linspace(0.0, duration, int(round(steps * revolutions)) + 1)
+
+
+def setup_for(path: Path, time: np.ndarray, inputs: dict, start_values: dict | None = None
+              ) -> CoSimSetup:
+    md = read_model_description(str(path))
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    units = {v.name: v.unit or "" for v in md.modelVariables}
+    return CoSimSetup(path, time, inputs, dict(start_values or {}), outputs, units)
+
+
+def simulate(setup: CoSimSetup, step_finished=None) -> dict:
+    """Co-simulate with fmpy over the setup's grid; every input and output recorded after
+    each step (name -> array, with "time")."""
+    recorded = simulate_fmu(str(setup.path), start_time=0.0, stop_time=setup.stop,
+                            step_size=setup.step, output_interval=setup.step,
+                            input=setup.signals(), output=list(setup.inputs) + setup.outputs,
+                            start_values=dict(setup.start_values), step_finished=step_finished)
+    return {n: np.asarray(recorded[n]) for n in recorded.dtype.names}
+
+
+def scene_setup(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
+                motion: str = "constant", build: Path | None = None):
+    """The co-simulation of one mechanism's dyad FMU: (setup, mechanism, crank motion,
+    kinematics on the grid)."""
+    mech = mechanisms.load(name)
+    crank_motion = mech.motion(motion, revolutions)
+    t = communication_grid(crank_motion.duration, revolutions, steps)
+    kin = mech.kinematics(t, crank_motion)
+    setup = setup_for(fmu_path(mech.dyad, fmi_version, build), t, mech.fmu_inputs(kin),
+                      mech.fmu_parameters())
+    return setup, mech, crank_motion, kin
+
+
 def run_scene(name: str, fmi_version: int = 2, revolutions: float = 2.0,
               steps: int = 360, motion: str = "constant", build: Path | None = None,
               progress: bool = False) -> SceneResult:
@@ -171,33 +235,16 @@ def run_scene(name: str, fmi_version: int = 2, revolutions: float = 2.0,
 
     steps: communication steps per crank revolution (or oscillation).
     """
-    mech = mechanisms.load(name)
-    crank_motion = mech.motion(motion, revolutions)
-    count = int(round(steps * revolutions))
-    t = np.linspace(0.0, crank_motion.duration, count + 1)
-    dt = t[1] - t[0]
-    kin = mech.kinematics(t, crank_motion)
-    inputs = mech.fmu_inputs(kin)
-    params = mech.fmu_parameters()
-
-    path = fmu_path(mech.dyad, fmi_version, build)
-    md = read_model_description(str(path))
-    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
-    units = {v.name: v.unit or "" for v in md.modelVariables}
-    names = list(inputs)
-    signals = np.zeros(len(t), dtype=[("time", float)] + [(n, float) for n in names])
-    signals["time"] = t
-    for n in names:
-        signals[n] = inputs[n]
+    setup, mech, crank_motion, kin = scene_setup(name, fmi_version, revolutions, steps, motion,
+                                                 build)
+    t, inputs, params = setup.time, setup.inputs, setup.start_values
+    outputs, units, names = setup.outputs, setup.units, list(setup.inputs)
 
     bar = _Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
     started = clock.perf_counter()
-    recorded = simulate_fmu(str(path), start_time=0.0, stop_time=float(t[-1]), step_size=dt,
-                            output_interval=dt, input=signals, output=names + outputs,
-                            start_values=params, step_finished=bar)
+    fmu = simulate(setup, step_finished=bar)
     seconds_fmu = clock.perf_counter() - started
     bar.close()
-    fmu = {n: np.asarray(recorded[n]) for n in recorded.dtype.names}
     sample = _match_samples(fmu, inputs, names, t)
 
     started = clock.perf_counter()

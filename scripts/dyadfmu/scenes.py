@@ -26,11 +26,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from fmpy import read_model_description, simulate_fmu
+from fmpy import read_model_description
 
 from . import chains, mechanisms, reference
 from .mechanisms import _cross, _rot90, _unit
-from .harness import OutputError, _match_samples, _Progress, build_dir
+from .harness import (OutputError, _match_samples, _Progress, build_dir, communication_grid,
+                      setup_for, simulate)
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES_DIR = ROOT / "scenes"
@@ -218,36 +219,32 @@ class SceneRun:
         return max(e.relative for e in self.errors)
 
 
+def setup(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
+          motion: str = "constant", build: Path | None = None):
+    """The co-simulation of a scene's tailored FMU: (setup, source, crank motion,
+    kinematics on the grid); its inputs are taken by name from the kinematics."""
+    source = Source(name)
+    crank_motion = source.motion(motion, revolutions)
+    t = communication_grid(crank_motion.duration, revolutions, steps)
+    kin = source.kinematics(t, crank_motion)
+    path = fmu_path(name, fmi_version, build)
+    md = read_model_description(str(path))
+    names = [v.name for v in md.modelVariables if v.causality == "input"]
+    return setup_for(path, t, source.inputs(kin, names)), source, crank_motion, kin
+
+
 def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
         motion: str = "constant", build: Path | None = None, progress: bool = False) -> SceneRun:
     """Co-simulate a scene's tailored FMU over `revolutions` crank turns at `steps`
     communication steps per turn and compare every output with the reference."""
-    source = Source(name)
-    crank_motion = source.motion(motion, revolutions)
-    count = int(round(steps * revolutions))
-    t = np.linspace(0.0, crank_motion.duration, count + 1)
-    dt = t[1] - t[0]
-    kin = source.kinematics(t, crank_motion)
-
-    path = fmu_path(name, fmi_version, build)
-    md = read_model_description(str(path))
-    names = [v.name for v in md.modelVariables if v.causality == "input"]
-    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
-    units = {v.name: v.unit or "" for v in md.modelVariables}
-    inputs = source.inputs(kin, names)
-    signals = np.zeros(len(t), dtype=[("time", float)] + [(n, float) for n in names])
-    signals["time"] = t
-    for n in names:
-        signals[n] = inputs[n]
+    co, source, crank_motion, kin = setup(name, fmi_version, revolutions, steps, motion, build)
+    t, inputs, outputs, units, names = co.time, co.inputs, co.outputs, co.units, list(co.inputs)
 
     bar = _Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
     started = clock.perf_counter()
-    recorded = simulate_fmu(str(path), start_time=0.0, stop_time=float(t[-1]), step_size=dt,
-                            output_interval=dt, input=signals, output=names + outputs,
-                            step_finished=bar)
+    fmu = simulate(co, step_finished=bar)
     seconds = clock.perf_counter() - started
     bar.close()
-    fmu = {n: np.asarray(recorded[n]) for n in recorded.dtype.names}
     sample = _match_samples(fmu, inputs, names, t)
     rows = {k: (v[sample] if isinstance(v, np.ndarray) and v.shape[:1] == t.shape else v)
             for k, v in kin.items()}

@@ -131,3 +131,71 @@ def test_drive_states_bad_inertia_and_reset(version, tmp_path):
     d.initialize()
     assert d.get("crank.angle") == 0.0            # the table's start value after reset
     d.fmu.freeInstance()
+
+
+def _state(d):
+    return d.get("crank.angle"), d.get("crank.omega")
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+@pytest.mark.parametrize("inertia, step, next_step", ((2e-3, 1e16, 1e-3), (1e-12, 1.0, 1e-8),
+                                                      (1e-300, 1.0, None), (2e-3, 1e3, 1e-3)))
+def test_drive_refuses_a_step_beyond_the_substep_cap(version, tmp_path, inertia, step,
+                                                     next_step):
+    """A step that needs more than a million substeps (here up to 7e300, beyond every
+    integer type) is refused with Error before any substep: the state stays where it
+    was, and a step short enough then goes on from it."""
+    d = Drive(version, tmp_path)
+    d.set("inertia", inertia)
+    d.initialize()
+    before = _state(d)
+    with pytest.raises(FMICallException) as error:
+        d.step(0, step)
+    assert error.value.status == 3
+    assert _state(d) == before
+    if next_step is not None:
+        d.step(0, next_step)
+        assert d.get("status") == 0
+        assert d.get("crank.angle") != before[0]
+    d.fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+@pytest.mark.parametrize("name, value", (("load.torque", -1.7976931348623157e308),
+                                         ("load.torque", 1.7976931348623157e308),
+                                         ("motor.stall_torque", 1.7976931348623157e308)))
+def test_drive_reports_an_overflow_as_out_of_range(version, tmp_path, name, value):
+    """Accepted values whose acceleration or motor torque overflow double give status 3
+    and NaN for them, never status 0 beside an infinite output; the step is discarded
+    and the state kept."""
+    d = Drive(version, tmp_path)
+    parameter = name.startswith("motor.")
+    if parameter:
+        d.set(name, value)
+    d.initialize()
+    before = _state(d)
+    if not parameter:
+        d.set(name, value)
+    assert d.get("status") == 3
+    assert math.isnan(d.get("crank.epsilon")) and not math.isinf(d.get("motor.torque"))
+    with pytest.raises(FMICallException):
+        d.step(0, 0.01)
+    assert _state(d) == before and all(math.isfinite(x) for x in before)
+    d.fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+@pytest.mark.parametrize("t, h", ((1.7976931348623157e308, 1e300), (1e300, 1e-300),
+                                  (1e9, 1e-9)))
+def test_drive_refuses_a_step_whose_end_is_not_a_later_finite_time(version, tmp_path, t, h):
+    """t + h overflowing, or rounding back to t, is refused with Error, and the
+    instance steps on normally afterwards."""
+    d = Drive(version, tmp_path)
+    d.initialize()
+    before = _state(d)
+    with pytest.raises(FMICallException):
+        d.step(t, h)
+    assert _state(d) == before
+    d.step(0, 0.01)
+    assert d.get("status") == 0 and d.get("crank.angle") != before[0]
+    d.fmu.freeInstance()

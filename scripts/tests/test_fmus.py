@@ -183,6 +183,21 @@ def test_wrong_call_order_is_an_error(tmp_path, version):
 
 
 @pytest.mark.parametrize("version", VERSIONS)
+@pytest.mark.parametrize("t, h", ((1.7976931348623157e308, 1e300), (1e300, 1e-300),
+                                  (1e9, 1e-9)))
+def test_step_must_end_at_a_later_finite_time(tmp_path, version, t, h):
+    """t + h that overflows (or rounds back to t) is an Error, and the instance steps on."""
+    s = Slave("rrt", version, tmp_path)
+    s.initialize()
+    with pytest.raises(FMICallException) as error:
+        s.step(t, h)
+    assert error.value.status == 3
+    s.step(0)
+    assert s.get("status") == 0 and math.isfinite(s.get("R_np.x"))
+    s.close()
+
+
+@pytest.mark.parametrize("version", VERSIONS)
 def test_bad_inputs_and_parameters_are_rejected(tmp_path, version):
     s = Slave("rrr", version, tmp_path)
     for name, value in (("link_m.force.x", math.nan), ("link_n.omega", math.inf),

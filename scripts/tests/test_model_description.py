@@ -716,7 +716,7 @@ DRIVE_STARTS = {"load.torque": 0.0, "load.inertia": 0.0, "motor.stall_torque": 1
                 "gravity.y": -9.81, "start.angle": 0.0, "start.speed": 30.0}
 DRIVE_DEPENDS = {"crank.angle": set(), "crank.omega": set(),
                  "crank.epsilon": {"load.torque", "load.inertia"}, "motor.torque": set(),
-                 "status": {"load.inertia"}}
+                 "status": {"load.torque", "load.inertia"}}
 DRIVE_UNITS = {"rad", "rad/s", "rad/s2", "m", "m/s2", "N.m", "kg", "kg.m2"}  # no N
 
 
@@ -873,8 +873,8 @@ def test_drive_empty_dependencies_and_no_derivatives_in_the_xml(generated_drive)
         assert f'<Output valueReference="{vr}" dependencies=""/>' in text3
     assert '<Unknown index="15" dependencies="1 2"/>' in text2
     assert '<Output valueReference="15" dependencies="1 2"/>' in text3
-    assert '<Unknown index="17" dependencies="2"/>' in text2
-    assert '<Output valueReference="17" dependencies="2"/>' in text3
+    assert '<Unknown index="17" dependencies="1 2"/>' in text2
+    assert '<Output valueReference="17" dependencies="1 2"/>' in text3
     assert 'providesDirectionalDerivative="false"' in text2
     assert 'providesDirectionalDerivatives="false"' in text3
     assert '<Unit name="N">' not in text2 and '<Unit name="N">' not in text3
@@ -968,14 +968,18 @@ def drive_outputs(values, angle, speed):
     rx = c * values["crank.com.x"] - s * values["crank.com.y"]
     ry = s * values["crank.com.x"] + c * values["crank.com.y"]
     gravity = values["crank.mass"] * (rx * values["gravity.y"] - ry * values["gravity.x"])
-    return {"crank.angle": angle, "crank.omega": speed,
-            "crank.epsilon": (motor + values["load.torque"] + gravity) / total,
+    epsilon = (motor + values["load.torque"] + gravity) / total
+    if not (math.isfinite(epsilon) and math.isfinite(motor)):
+        return {"crank.angle": angle, "crank.omega": speed, "crank.epsilon": math.nan,
+                "motor.torque": motor if math.isfinite(motor) else math.nan, "status": 3}
+    return {"crank.angle": angle, "crank.omega": speed, "crank.epsilon": epsilon,
             "motor.torque": motor, "status": 0}
 
 
 def test_drive_declared_dependencies_are_the_true_ones():
     """As for the dyads: among valid inputs, an output depends on an input if it changes
-    with it; `status` depends on what decides validity (inertia + load.inertia > 0)."""
+    with it; `status` depends on what decides validity (inertia + load.inertia > 0) and
+    on what can overflow the acceleration (load.torque)."""
     rng = np.random.default_rng(7)
     raw = load_drive_raw()
     inputs = names_of(raw, "input")
@@ -993,8 +997,11 @@ def test_drive_declared_dependencies_are_the_true_ones():
             for out in derived:
                 if out != "status" and abs(other[out] - base[out]) > 1e-12 * (1 + abs(base[out])):
                     derived[out].add(name)
-    derived["status"] = {"load.inertia"}  # validity: inertia (a parameter) + load.inertia > 0
+    # validity: inertia (a parameter) + load.inertia > 0, and a finite acceleration
+    derived["status"] = {"load.inertia", "load.torque"}
     assert drive_outputs(dict(DRIVE_STARTS, **{"load.inertia": -1.0}), 0.0, 0.0)["status"] == 2
+    assert drive_outputs(dict(DRIVE_STARTS, **{"load.torque": -1.7976931348623157e308}),
+                         0.0, 0.0)["status"] == 3
     declared = {v["name"]: set(v["depends"]) for v in raw["variable"]
                 if v["causality"] == "output"}
     assert declared == derived == DRIVE_DEPENDS
