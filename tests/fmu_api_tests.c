@@ -15,8 +15,7 @@
  * For the RRT FMUs the outputs are also compared with the C core on the same
  * inputs (the variable table of the same generated file the FMUs are built from).
  *
- * Usage: fmu_api_tests FMI2_FMU_DIR FMI3_FMU_DIR [--strict] [test-name ...]
- * (--strict also runs the cases of known findings that are skipped today).
+ * Usage: fmu_api_tests FMI2_FMU_DIR FMI3_FMU_DIR [test-name ...]
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -1690,21 +1689,17 @@ static int test_exports_only_fmi(void)
     return fails;
 }
 
-/* Run with --strict: checks that a known finding of issue 12, being fixed in
- * fmu/ on another branch, still skips (remove its `known` mark once merged). */
-static int strict;
-
 typedef struct bad_step {
-    double t, h;
-    int known; /* the finding of issue 12 that makes this case fail today, or 0 */
+    double t, h; /* s */
 } bad_step;
 
 /* Communication points and step sizes doStep must refuse with Error and a
- * message, changing nothing. */
+ * message, changing nothing: among them end times t + h that overflow or round
+ * back to t (issue 12, finding 7). */
 static const bad_step bad_steps[] = {
-    {0, 0, 0},          {0, -0.0, 0},       {0, -1e-3, 0},      {0, NAN, 0},
-    {0, INFINITY, 0},   {0, -INFINITY, 0},  {NAN, 1e-3, 0},     {INFINITY, 1e-3, 0},
-    {-INFINITY, 1e-3, 0}, {DBL_MAX, 1e300, 7}, {DBL_MAX, DBL_MAX, 7}, {-DBL_MAX, -1e-3, 0},
+    {0, 0},          {0, -0.0},        {0, -1e-3},     {0, NAN},         {0, INFINITY},
+    {0, -INFINITY},  {NAN, 1e-3},      {INFINITY, 1e-3}, {-INFINITY, 1e-3}, {DBL_MAX, 1e300},
+    {DBL_MAX, DBL_MAX}, {-DBL_MAX, -1e-3}, {1e300, 1e-3},
 };
 
 static void free_either(int version, void* c)
@@ -1727,12 +1722,6 @@ static int test_bad_steps(void)
             values_read before, after;
             void* c = version == 2 ? new_fmi2(&book, "steps") : new_fmi3(&book, "steps");
             int status, read;
-            if (b->known != 0 && !strict) {
-                printf("    FMI %d doStep(%g, %g): skipped, known finding %d of issue 12\n",
-                       version, b->t, b->h, b->known);
-                free_either(version, c);
-                continue;
-            }
             if (version == 2) {
                 read = initialise_fmi2(c) && fmi2_read_all(c, &before);
                 status = api2.DoStep(c, b->t, b->h, fmi2True);
@@ -1801,8 +1790,129 @@ static int test_drive_errors_logged_every_time(void)
     return fails;
 }
 
+/* Sets one Real variable by name before initialization; 1 if accepted. */
+static int set_named(int version, void* c, const char* name, double value)
+{
+    const probe_variable* v = probe_variable_named(version == 2 ? &md2 : &md3, name);
+    if (v == NULL) {
+        return 0;
+    }
+    return version == 2 ? api2.SetReal(c, &v->vr, 1, &value) == fmi2OK
+                        : api3.SetFloat64(c, &v->vr, 1, &value, 1) == fmi3OK;
+}
+
+static double get_named(int version, void* c, const char* name)
+{
+    const probe_variable* v = probe_variable_named(version == 2 ? &md2 : &md3, name);
+    double value = -12345.678;
+    if (v != NULL) {
+        (void)(version == 2 ? (int)api2.GetReal(c, &v->vr, 1, &value)
+                            : (int)api3.GetFloat64(c, &v->vr, 1, &value, 1));
+    }
+    return value;
+}
+
+static int get_status_output(int version, void* c)
+{
+    const probe_variable* v = probe_variable_named(version == 2 ? &md2 : &md3, "status");
+    int value = -1;
+    if (v != NULL) {
+        (void)(version == 2 ? (int)api2.GetInteger(c, &v->vr, 1, &value)
+                            : (int)api3.GetInt32(c, &v->vr, 1, &value, 1));
+    }
+    return value;
+}
+
+static int enter_initialization(int version, void* c)
+{
+    return version == 2 ? api2.SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0) == fmi2OK &&
+                              api2.EnterInitializationMode(c) == fmi2OK
+                        : api3.EnterInitializationMode(c, fmi3False, 0, 0, fmi3False, 0) == fmi3OK;
+}
+
+/* A step that needs more substeps than the drive's cap (1e6; h = 1e16 s with
+ * the start values, issue 12 finding 5) is refused with Error and a message,
+ * and the state stays where it was; a step within the cap moves it. */
+static int test_drive_step_beyond_cap(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        probe_log_book book;
+        void* c = version == 2 ? new_fmi2(&book, "cap") : new_fmi3(&book, "cap");
+        const int ready = version == 2 ? initialise_fmi2(c) : initialise_fmi3(c);
+        const double angle = get_named(version, c, "crank.angle");
+        const double omega = get_named(version, c, "crank.omega");
+        const long count = book.count;
+        const int status = version == 2 ? (int)api2.DoStep(c, 0, 1e16, fmi2True)
+                                        : (int)step3(c, 0, 1e16);
+        CHECK(ready && status == 3 && logged_error(&book, count) &&
+                  strstr(book.last, "substeps") != NULL &&
+                  probe_bits(get_named(version, c, "crank.angle")) == probe_bits(angle) &&
+                  probe_bits(get_named(version, c, "crank.omega")) == probe_bits(omega),
+              "FMI %d: doStep(0, 1e16): status %d, message '%s'", version, status, book.last);
+        free_either(version, c);
+        c = version == 2 ? new_fmi2(&book, "cap") : new_fmi3(&book, "cap");
+        CHECK((version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)) &&
+                  (version == 2 ? (int)api2.DoStep(c, 0, 1, fmi2True) : (int)step3(c, 0, 1)) == 0 &&
+                  get_named(version, c, "crank.angle") != angle,
+              "FMI %d: doStep(0, 1) within the cap: '%s'", version, book.last);
+        free_either(version, c);
+    }
+    return fails;
+}
+
+/* No drive output is ever infinite: a load torque of -DBL_MAX passes the
+ * setter and overflows the acceleration (issue 12 finding 6): status 3,
+ * crank.epsilon NaN; a motor torque that overflows itself is NaN even when the
+ * inertia check fails first (status 2); crank.angle and crank.omega are the
+ * states, finite whatever the status. */
+static int test_drive_outputs_never_infinite(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        probe_log_book book;
+        void* c = version == 2 ? new_fmi2(&book, "finite") : new_fmi3(&book, "finite");
+        double epsilon, torque;
+        int status;
+        CHECK(set_named(version, c, "load.torque", -DBL_MAX) && enter_initialization(version, c),
+              "FMI %d: set load.torque = -DBL_MAX", version);
+        (void)(version == 2 ? (int)api2.ExitInitializationMode(c)
+                            : (int)api3.ExitInitializationMode(c));
+        epsilon = get_named(version, c, "crank.epsilon");
+        status = get_status_output(version, c);
+        CHECK(status == 3 && isnan(epsilon) && isfinite(get_named(version, c, "crank.angle")) &&
+                  isfinite(get_named(version, c, "crank.omega")),
+              "FMI %d: load.torque = -DBL_MAX: status %d, crank.epsilon %g", version, status,
+              epsilon);
+        free_either(version, c);
+
+        c = version == 2 ? new_fmi2(&book, "finite") : new_fmi3(&book, "finite");
+        /* speed / no_load_speed = 30 / DBL_MIN overflows the motor torque */
+        CHECK(set_named(version, c, "motor.no_load_speed", DBL_MIN) &&
+                  set_named(version, c, "load.inertia", -1) && enter_initialization(version, c),
+              "FMI %d: set no_load_speed = DBL_MIN, load.inertia = -1", version);
+        torque = get_named(version, c, "motor.torque");
+        status = get_status_output(version, c);
+        CHECK(status == 2 && isnan(torque) && isnan(get_named(version, c, "crank.epsilon")) &&
+                  isfinite(get_named(version, c, "crank.angle")) &&
+                  isfinite(get_named(version, c, "crank.omega")),
+              "FMI %d: an overflowing motor torque with an invalid inertia: status %d, "
+              "motor.torque %g",
+              version, status, torque);
+        CHECK(set_named(version, c, "load.inertia", 0) &&
+                  isnan(get_named(version, c, "motor.torque")) &&
+                  get_status_output(version, c) == 3,
+              "FMI %d: the same with a valid inertia: status %d", version,
+              get_status_output(version, c));
+        free_either(version, c);
+    }
+    return fails;
+}
+
 static const named_test drive_tests[] = {
     {"drive_errors_logged_every_time", test_drive_errors_logged_every_time},
+    {"drive_step_beyond_cap", test_drive_step_beyond_cap},
+    {"drive_outputs_never_infinite", test_drive_outputs_never_infinite},
 };
 
 /* ---- runner ----------------------------------------------------------------------------------- */
@@ -1839,14 +1949,11 @@ static const named_test rrt_tests[] = {
 int main(int argc, char** argv)
 {
     char error[512];
-    int failed, more = 0, first_name = 3;
+    int failed, more = 0;
+    const int first_name = 3;
     if (argc < 3) {
-        printf("usage: fmu_api_tests FMI2_FMU_DIR FMI3_FMU_DIR [--strict] [test-name ...]\n");
+        printf("usage: fmu_api_tests FMI2_FMU_DIR FMI3_FMU_DIR [test-name ...]\n");
         return 2;
-    }
-    if (argc > 3 && strcmp(argv[3], "--strict") == 0) {
-        strict = 1;
-        first_name = 4;
     }
     if (!probe_read_model(argv[1], &md2, error, sizeof error) ||
         !probe_read_model(argv[2], &md3, error, sizeof error) ||

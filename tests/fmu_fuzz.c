@@ -12,9 +12,11 @@
  *   - a rejected setter (or any call that returns Error) logged a message, and
  *     changed nothing: every variable, output and status reads as before;
  *   - the status output is 0 exactly when the getter says OK, and then every
- *     output is finite; otherwise every output is NaN (except those the model
- *     description keeps defined: a dyad's conditioning and amplification, the
- *     drive's state), and doStep is not OK;
+ *     output is finite; otherwise every output is NaN, except those the model
+ *     descriptions keep defined (a dyad's conditioning and amplification; the
+ *     drive's motor.torque, NaN only where it overflows itself), and doStep is
+ *     not OK; the drive's crank.angle and crank.omega are its states and are
+ *     finite whatever the status;
  *   - an OK doStep had finite t, h > 0 and t + h, reports t + h as the last
  *     successful time, and moved a model's state if the step should have;
  *     an algebraic model's outputs do not depend on the step;
@@ -24,7 +26,7 @@
  * Each episode has its own seed, printed on a failure; --replay SEED --verbose
  * reruns that episode alone and prints every call.
  *
- * Usage: fmu_fuzz [--steps N] [--seed S] [--strict] [--replay SEED] [--verbose] FMU_DIR
+ * Usage: fmu_fuzz [--steps N] [--seed S] [--replay SEED] [--verbose] FMU_DIR
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -40,38 +42,26 @@
 
 #include "fmu_probe.h"
 
-/* ---- the known findings ---------------------------------------------------------- */
-
-/* What a violated invariant was, for matching the known findings. */
-typedef enum fuzz_kind {
-    FUZZ_OTHER = 0,
-    FUZZ_NONFINITE_WITH_OK,  /* status ok (or doStep OK) next to an inf or NaN output */
-    FUZZ_END_TIME_OVERFLOW,  /* doStep OK although t + h is not finite */
-    FUZZ_STATE_FROZEN        /* doStep OK but the state did not move */
-} fuzz_kind;
-
-typedef struct fuzz_known_finding {
-    int number;             /* in issue 12 */
-    const char* model;      /* modelIdentifier it applies to, NULL for every FMU */
-    fuzz_kind kind;
-    const char* what;
-} fuzz_known_finding;
-
-/* Findings 5, 6 and 7 of issue 12 are fixed in fmu/ on another branch. Until
- * that fix is merged, a violation they explain is counted and ends its episode
- * instead of failing the run. Remove an entry once its fix is in; --strict
- * ignores this list (and so fails on them today). */
-static const fuzz_known_finding fuzz_known_findings[] = {
-    {5, "drive", FUZZ_STATE_FROZEN,
-     "the drive converts ceil(h / limit) to long out of range; RK4 runs zero times and "
-     "doStep returns OK with the state frozen"},
-    {6, "drive", FUZZ_NONFINITE_WITH_OK,
-     "the drive never checks that its outputs are finite: status ok with crank.epsilon inf"},
-    {7, NULL, FUZZ_END_TIME_OVERFLOW, "doStep checks t and h but not t + h"},
-};
-enum { FUZZ_KNOWN_COUNT = sizeof fuzz_known_findings / sizeof fuzz_known_findings[0] };
-
 /* ---- the FMU, either version --------------------------------------------------------- */
+
+/* What an output may be when the status output is not 0, as the model
+ * descriptions say; every output is finite when it is 0. */
+typedef enum fuzz_rule {
+    FUZZ_NAN_WHEN_FAILED = 0, /* NaN unless status 0 (the reactions, crank.epsilon) */
+    FUZZ_ANY_WHEN_FAILED,     /* explains the failure: a dyad's conditioning, amplification */
+    FUZZ_FINITE_OR_NAN,       /* NaN only where it overflows itself: the drive's motor.torque */
+    FUZZ_ALWAYS_FINITE        /* a state, kept whatever the status: crank.angle, crank.omega */
+} fuzz_rule;
+
+typedef struct fuzz_named_rule {
+    const char* name;
+    fuzz_rule rule;
+} fuzz_named_rule;
+
+static const fuzz_named_rule fuzz_rules[] = {
+    {"conditioning", FUZZ_ANY_WHEN_FAILED}, {"amplification", FUZZ_ANY_WHEN_FAILED},
+    {"motor.torque", FUZZ_FINITE_OR_NAN},   {"crank.angle", FUZZ_ALWAYS_FINITE},
+    {"crank.omega", FUZZ_ALWAYS_FINITE}};
 
 typedef struct fuzz_fmu {
     probe_model model;
@@ -88,15 +78,8 @@ typedef struct fuzz_fmu {
     size_t settable_count;
     int status_index;   /* the Integer output `status`, -1 if none */
     int angle, omega, epsilon; /* a state: outputs crank.angle, .omega, .epsilon; -1 if none */
-    int* defined_when_failed;  /* per variable: keeps a value when status is not 0 */
+    fuzz_rule* rule;    /* per variable: what an output may be when status is not 0 */
 } fuzz_fmu;
-
-/* Outputs that stay defined when the status is not 0, as the model descriptions
- * say: a generic dyad's conditioning and amplification explain a singular
- * position ("reaction outputs NaN unless 0"); the drive's state is kept (its
- * status: "crank.epsilon and motor.torque NaN"). */
-static const char* const fuzz_defined_when_failed[] = {"conditioning", "amplification",
-                                                       "crank.angle", "crank.omega"};
 
 static int fuzz_prepare(fuzz_fmu* f, const char* directory)
 {
@@ -118,9 +101,9 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
     f->integers = (size_t*)calloc(n + 1, sizeof *f->integers);
     f->integer_vrs = (unsigned*)calloc(n + 1, sizeof *f->integer_vrs);
     f->settable = (size_t*)calloc(n + 1, sizeof *f->settable);
-    f->defined_when_failed = (int*)calloc(n + 1, sizeof *f->defined_when_failed);
+    f->rule = (fuzz_rule*)calloc(n + 1, sizeof *f->rule);
     if (f->reals == NULL || f->real_vrs == NULL || f->integers == NULL ||
-        f->integer_vrs == NULL || f->settable == NULL || f->defined_when_failed == NULL) {
+        f->integer_vrs == NULL || f->settable == NULL || f->rule == NULL) {
         printf("out of memory\n");
         return 0;
     }
@@ -152,9 +135,10 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
             } else if (strcmp(v->name, "crank.epsilon") == 0) {
                 f->epsilon = (int)k;
             }
-            for (j = 0; j < sizeof fuzz_defined_when_failed / sizeof fuzz_defined_when_failed[0];
-                 ++j) {
-                f->defined_when_failed[k] |= strcmp(v->name, fuzz_defined_when_failed[j]) == 0;
+            for (j = 0; j < sizeof fuzz_rules / sizeof fuzz_rules[0]; ++j) {
+                if (strcmp(v->name, fuzz_rules[j].name) == 0) {
+                    f->rule[k] = fuzz_rules[j].rule;
+                }
             }
         }
     }
@@ -172,7 +156,7 @@ static void fuzz_release(fuzz_fmu* f)
     free(f->integers);
     free(f->integer_vrs);
     free(f->settable);
-    free(f->defined_when_failed);
+    free(f->rule);
     probe_free_model(&f->model);
 }
 
@@ -199,7 +183,6 @@ typedef struct fuzz_snapshot {
 typedef struct fuzz_counts {
     long episodes, instances, steps, steps_ok, steps_discard, steps_error;
     long sets, sets_rejected, gets, illegal_calls, replays;
-    long known[FUZZ_KNOWN_COUNT];
 } fuzz_counts;
 
 typedef struct fuzz_episode {
@@ -214,9 +197,8 @@ typedef struct fuzz_episode {
     fuzz_snapshot before, after;
     long call;            /* index of the current call, for the report */
     long step_quota;
-    int strict, verbose;
-    int failed;           /* an invariant broke (not a known finding) */
-    int known;            /* index+1 of the known finding that ended the episode */
+    int verbose;
+    int failed;           /* an invariant broke */
     fuzz_counts* counts;
     char failure[1200];
 } fuzz_episode;
@@ -239,38 +221,28 @@ static void note(fuzz_episode* e, const char* format, ...)
     va_end(args);
 }
 
-/* Records a broken invariant of `kind`; a known finding ends the episode quietly. */
-static void violation(fuzz_episode* e, fuzz_kind kind, const char* format, ...)
+/* Records the first broken invariant of the episode, which ends it. */
+static void violation(fuzz_episode* e, const char* format, ...)
 #if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
+    __attribute__((format(printf, 2, 3)))
 #endif
     ;
-static void violation(fuzz_episode* e, fuzz_kind kind, const char* format, ...)
+static void violation(fuzz_episode* e, const char* format, ...)
 {
     va_list args;
-    size_t k;
-    if (e->failed || e->known) {
+    if (e->failed) {
         return;
     }
     va_start(args, format);
     vsnprintf(e->failure, sizeof e->failure, format, args);
     va_end(args);
-    for (k = 0; !e->strict && k < FUZZ_KNOWN_COUNT; ++k) {
-        const fuzz_known_finding* known = &fuzz_known_findings[k];
-        if (known->kind == kind &&
-            (known->model == NULL || strcmp(known->model, e->fmu->model.identifier) == 0)) {
-            e->known = (int)k + 1;
-            note(e, "known finding %d: %s", known->number, e->failure);
-            return;
-        }
-    }
     e->failed = 1;
     note(e, "VIOLATION: %s", e->failure);
 }
 
 static int stopped(const fuzz_episode* e)
 {
-    return e->failed || e->known;
+    return e->failed;
 }
 
 static const char* name_of(const fuzz_episode* e, size_t index)
@@ -297,7 +269,7 @@ static void trace_double(fuzz_episode* e, double x)
 static void expect_message(fuzz_episode* e, int status, long count_before, const char* call)
 {
     if (status >= 3 && (e->book.count == count_before || e->book.last_status < 3)) {
-        violation(e, FUZZ_OTHER, "%s returned %d without logging an error", call, status);
+        violation(e, "%s returned %d without logging an error", call, status);
     }
 }
 
@@ -375,12 +347,12 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
         trace(e, (uint64_t)(unsigned)s->integers[k]);
     }
     if (integer_status != 0) {
-        violation(e, FUZZ_OTHER, "getting the Integer variables in %s returned %d",
+        violation(e, "getting the Integer variables in %s returned %d",
                   fuzz_state_names[e->state], integer_status);
         return;
     }
     if (s->get_status > 3) {
-        violation(e, FUZZ_OTHER, "getting the Real variables returned %d", s->get_status);
+        violation(e, "getting the Real variables returned %d", s->get_status);
         return;
     }
     s->valid = 1;
@@ -389,7 +361,7 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
         const size_t index = f->reals[k];
         if (f->model.variables[index].causality != PROBE_OUTPUT &&
             probe_bits(s->reals[k]) != probe_bits(e->shadow[index])) {
-            violation(e, FUZZ_OTHER, "%s reads %.17g, but the last accepted value was %.17g",
+            violation(e, "%s reads %.17g, but the last accepted value was %.17g",
                       name_of(e, index), s->reals[k], e->shadow[index]);
             return;
         }
@@ -404,7 +376,7 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
         status = s->get_status == 0 ? 0 : -1;
     }
     if ((status == 0) != (s->get_status == 0)) {
-        violation(e, FUZZ_OTHER, "status output %d but the getter returned %d", status,
+        violation(e, "status output %d but the getter returned %d", status,
                   s->get_status);
         return;
     }
@@ -414,12 +386,17 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
         if (f->model.variables[index].causality != PROBE_OUTPUT) {
             continue;
         }
-        if (status == 0 && !is_finite(x)) {
-            violation(e, FUZZ_NONFINITE_WITH_OK, "status 0 but %s = %g", name_of(e, index), x);
+        const fuzz_rule rule = f->rule[index];
+        if ((status == 0 || rule == FUZZ_ALWAYS_FINITE) && !is_finite(x)) {
+            violation(e, "status %d but %s = %g", status, name_of(e, index), x);
             return;
         }
-        if (status != 0 && !isnan(x) && !f->defined_when_failed[index]) {
-            violation(e, FUZZ_OTHER, "status %d but %s = %.17g, not NaN", status,
+        if (status != 0 && rule == FUZZ_NAN_WHEN_FAILED && !isnan(x)) {
+            violation(e, "status %d but %s = %.17g, not NaN", status, name_of(e, index), x);
+            return;
+        }
+        if (status != 0 && rule == FUZZ_FINITE_OR_NAN && isinf(x)) {
+            violation(e, "status %d but %s = %g, neither finite nor NaN", status,
                       name_of(e, index), x);
             return;
         }
@@ -451,20 +428,20 @@ static void compare_with_before(fuzz_episode* e, const char* call)
     const fuzz_fmu* f = e->fmu;
     size_t k;
     if (e->after.get_status != e->before.get_status) {
-        violation(e, FUZZ_OTHER, "%s changed the getter's status from %d to %d", call,
+        violation(e, "%s changed the getter's status from %d to %d", call,
                   e->before.get_status, e->after.get_status);
         return;
     }
     for (k = 0; k < f->real_count; ++k) {
         if (probe_bits(e->after.reals[k]) != probe_bits(e->before.reals[k])) {
-            violation(e, FUZZ_OTHER, "%s changed %s from %.17g to %.17g", call,
+            violation(e, "%s changed %s from %.17g to %.17g", call,
                       name_of(e, f->reals[k]), e->before.reals[k], e->after.reals[k]);
             return;
         }
     }
     for (k = 0; k < f->integer_count; ++k) {
         if (e->after.integers[k] != e->before.integers[k]) {
-            violation(e, FUZZ_OTHER, "%s changed %s from %d to %d", call,
+            violation(e, "%s changed %s from %d to %d", call,
                       name_of(e, f->integers[k]), e->before.integers[k], e->after.integers[k]);
             return;
         }
@@ -677,7 +654,7 @@ static void judge_set(fuzz_episode* e, const unsigned* vrs, size_t n, const doub
     ++e->counts->sets;
     if (status == 0) {
         if (reason != NULL) {
-            violation(e, FUZZ_OTHER, "%s accepted value reference %u = %.17g (%s) in %s", call,
+            violation(e, "%s accepted value reference %u = %.17g (%s) in %s", call,
                       vrs[bad], values[bad], reason, fuzz_state_names[e->state]);
             return;
         }
@@ -692,7 +669,7 @@ static void judge_set(fuzz_episode* e, const unsigned* vrs, size_t n, const doub
     }
     ++e->counts->sets_rejected;
     if (status != 3) {
-        violation(e, FUZZ_OTHER, "%s returned %d: a setter accepts (0) or refuses (3)", call,
+        violation(e, "%s returned %d: a setter accepts (0) or refuses (3)", call,
                   status);
         return;
     }
@@ -704,7 +681,7 @@ static void judge_set(fuzz_episode* e, const unsigned* vrs, size_t n, const doub
         sprintf(number, "%u", vrs[0]);
         if (!(v != NULL && strstr(e->book.last, v->name) != NULL) &&
             strstr(e->book.last, number) == NULL) {
-            violation(e, FUZZ_OTHER, "%s refused %s without naming it: %s", call,
+            violation(e, "%s refused %s without naming it: %s", call,
                       v != NULL ? v->name : number, e->book.last);
         }
     }
@@ -799,7 +776,7 @@ static void fmi2_step_status(fuzz_episode* e, double* last, int* terminate)
     const int a = (int)e->fmu->f2.GetRealStatus(e->instance, fmi2LastSuccessfulTime, &time);
     const int b = (int)e->fmu->f2.GetBooleanStatus(e->instance, fmi2Terminated, &flag);
     if (a != 0 || b != 0) {
-        violation(e, FUZZ_OTHER, "fmi2GetRealStatus / fmi2GetBooleanStatus in Step: %d, %d", a, b);
+        violation(e, "fmi2GetRealStatus / fmi2GetBooleanStatus in Step: %d, %d", a, b);
     }
     *last = time;
     *terminate = flag != fmi2False;
@@ -821,17 +798,16 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
 {
     const double end = t + h;
     if (!is_finite(t) || !is_finite(h) || !(h > 0)) {
-        violation(e, FUZZ_OTHER, "doStep(%g, %g) returned OK", t, h);
+        violation(e, "doStep(%g, %g) returned OK", t, h);
         return;
     }
     if (!is_finite(end)) {
-        violation(e, FUZZ_END_TIME_OVERFLOW, "doStep(%.17g, %.17g) returned OK: t + h = %g", t,
+        violation(e, "doStep(%.17g, %.17g) returned OK: t + h = %g", t,
                   h, end);
         return;
     }
     if (probe_bits(last) != probe_bits(end) || terminate) {
-        violation(e, FUZZ_OTHER,
-                  "doStep(%.17g, %.17g) OK but last successful time %.17g, terminate %d", t, h,
+        violation(e, "doStep(%.17g, %.17g) OK but last successful time %.17g, terminate %d", t, h,
                   last, terminate);
         return;
     }
@@ -840,7 +816,7 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
         return;
     }
     if (!e->after.valid || e->after.get_status != 0) {
-        violation(e, FUZZ_NONFINITE_WITH_OK, "doStep returned OK, the getter then %d",
+        violation(e, "doStep returned OK, the getter then %d",
                   e->after.get_status);
         return;
     }
@@ -850,7 +826,7 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
         const int status = (int)e->fmu->f3.GetFloat64(e->instance, &time_vr, 1, &time, 1);
         trace_double(e, time);
         if (status != 0 || probe_bits(time) != probe_bits(end)) {
-            violation(e, FUZZ_OTHER, "after doStep(%.17g, %.17g) OK, time reads %.17g (%d)", t,
+            violation(e, "after doStep(%.17g, %.17g) OK, time reads %.17g (%d)", t,
                       h, time, status);
             return;
         }
@@ -866,8 +842,7 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
                    probe_bits(snapshot_real(e, &e->before, e->fmu->angle)) &&
                probe_bits(snapshot_real(e, &e->after, e->fmu->omega)) ==
                    probe_bits(snapshot_real(e, &e->before, e->fmu->omega))) {
-        violation(e, FUZZ_STATE_FROZEN,
-                  "doStep(%.17g, %.17g) OK but the state (angle %.17g, speed %.17g, "
+        violation(e, "doStep(%.17g, %.17g) OK but the state (angle %.17g, speed %.17g, "
                   "acceleration %.17g) did not move",
                   t, h, snapshot_real(e, &e->before, e->fmu->angle),
                   snapshot_real(e, &e->before, e->fmu->omega),
@@ -898,7 +873,7 @@ static void op_do_step(fuzz_episode* e)
                                         &last);
         terminate = flag != fmi3False;
         if (event != fmi3False || early != fmi3False) {
-            violation(e, FUZZ_OTHER, "doStep asks for event handling or returned early");
+            violation(e, "doStep asks for event handling or returned early");
         }
     }
     note(e, "doStep(%.17g, %.17g) -> %d (last %.17g, terminate %d)", t, h, status, last,
@@ -917,14 +892,13 @@ static void op_do_step(fuzz_episode* e)
     if (status == 2) {
         ++e->counts->steps_discard;
         if ((probe_bits(last) != probe_bits(t) || !terminate) && !stopped(e)) {
-            violation(e, FUZZ_OTHER,
-                      "doStep(%.17g, %.17g) discarded: last successful time %.17g, terminate %d",
+            violation(e, "doStep(%.17g, %.17g) discarded: last successful time %.17g, terminate %d",
                       t, h, last, terminate);
         }
     } else if (status == 3) {
         ++e->counts->steps_error;
     } else {
-        violation(e, FUZZ_OTHER, "doStep returned %d", status);
+        violation(e, "doStep returned %d", status);
     }
     /* a step that is not OK takes the state nowhere and leaves every output */
     expect_unchanged(e, "a doStep that is not OK");
@@ -978,7 +952,7 @@ static void op_illegal(fuzz_episode* e)
     note(e, "illegal %s in %s -> %d", call, fuzz_state_names[e->state], status);
     trace(e, (uint64_t)status);
     if (status != 3) {
-        violation(e, FUZZ_OTHER, "%s in %s returned %d, not Error", call,
+        violation(e, "%s in %s returned %d, not Error", call,
                   fuzz_state_names[e->state], status);
         return;
     }
@@ -1002,7 +976,7 @@ static void op_enter_initialization(fuzz_episode* e)
     trace(e, (uint64_t)a);
     trace(e, (uint64_t)b);
     if (a != 0 || b != 0) {
-        violation(e, FUZZ_OTHER, "entering initialization from Instantiated: %d, %d", a, b);
+        violation(e, "entering initialization from Instantiated: %d, %d", a, b);
         return;
     }
     e->state = S_INITIALIZATION;
@@ -1022,11 +996,11 @@ static void op_exit_initialization(fuzz_episode* e)
         e->state = S_STEP;
         snapshot(e, &e->before);
         if (e->before.valid && (e->before.get_status == 0) != (status == 0)) {
-            violation(e, FUZZ_OTHER, "exitInitializationMode returned %d, the getter then %d",
+            violation(e, "exitInitializationMode returned %d, the getter then %d",
                       status, e->before.get_status);
         }
     } else if (status != 3) {
-        violation(e, FUZZ_OTHER, "exitInitializationMode returned %d", status);
+        violation(e, "exitInitializationMode returned %d", status);
     } else {
         /* refused inputs: still in Initialization Mode */
         e->before.valid = 0;
@@ -1051,7 +1025,7 @@ static void op_terminate(fuzz_episode* e)
     note(e, "terminate -> %d", status);
     trace(e, (uint64_t)status);
     if (status != 0) {
-        violation(e, FUZZ_OTHER, "terminate in Step returned %d", status);
+        violation(e, "terminate in Step returned %d", status);
         return;
     }
     e->state = S_TERMINATED;
@@ -1065,7 +1039,7 @@ static void op_reset(fuzz_episode* e)
     note(e, "reset -> %d", status);
     trace(e, (uint64_t)status);
     if (status != 0) {
-        violation(e, FUZZ_OTHER, "reset in %s returned %d", fuzz_state_names[e->state], status);
+        violation(e, "reset in %s returned %d", fuzz_state_names[e->state], status);
         return;
     }
     load_start_values(e);
@@ -1088,7 +1062,7 @@ static void op_debug_logging(fuzz_episode* e)
     note(e, "setDebugLogging(%d, %s) -> %d", on, one != NULL ? one : "all", status);
     trace(e, (uint64_t)status);
     if (status != (pick == 4 ? 3 : 0)) {
-        violation(e, FUZZ_OTHER, "setDebugLogging(%s) returned %d", one != NULL ? one : "all",
+        violation(e, "setDebugLogging(%s) returned %d", one != NULL ? one : "all",
                   status);
     }
     expect_message(e, status, log_count, "setDebugLogging");
@@ -1201,13 +1175,13 @@ static uint64_t run_episode(fuzz_episode* e, uint64_t seed)
     probe_rng_seed(&e->rng, seed);
     probe_log_book_clear(&e->book);
     e->trace = PROBE_HASH_START;
-    e->failed = e->known = 0;
+    e->failed = 0;
     e->call = 0;
     e->step_quota = 1 + (long)probe_rng_below(&e->rng, 200);
     e->time = 0;
     e->instance = instantiate(e);
     if (e->instance == NULL) {
-        violation(e, FUZZ_OTHER, "instantiation failed: %s", e->book.last);
+        violation(e, "instantiation failed: %s", e->book.last);
         return e->trace;
     }
     load_start_values(e);
@@ -1225,7 +1199,7 @@ static uint64_t run_episode(fuzz_episode* e, uint64_t seed)
 typedef struct fuzz_options {
     long steps;
     uint64_t seed;
-    int strict, verbose, replay;
+    int verbose, replay;
     uint64_t replay_seed;
     const char* directory;
 } fuzz_options;
@@ -1251,10 +1225,8 @@ static int episode_and_replay(fuzz_episode* e, uint64_t seed, const char* direct
 {
     const fuzz_fmu* f = e->fmu;
     uint64_t first, second;
-    int known;
     ++e->counts->episodes;
     first = run_episode(e, seed);
-    known = e->known;
     if (e->failed) {
         printf("FAIL %s fmi%d: episode seed 0x%016" PRIx64 ", call %ld: %s\n"
                "     replay: fmu_fuzz --replay 0x%016" PRIx64 " --verbose %s\n",
@@ -1268,10 +1240,7 @@ static int episode_and_replay(fuzz_episode* e, uint64_t seed, const char* direct
     e->verbose = 0; /* the replay prints nothing new */
     second = run_episode(e, seed);
     ++e->counts->replays;
-    if (known) {
-        ++e->counts->known[known - 1];
-    }
-    if (first != second || e->failed || e->known != known) {
+    if (first != second || e->failed) {
         printf("FAIL %s fmi%d: episode seed 0x%016" PRIx64 " replayed on a fresh instance "
                "differs (trace %016" PRIx64 " then %016" PRIx64 ")%s%s\n"
                "     replay: fmu_fuzz --replay 0x%016" PRIx64 " --verbose %s\n",
@@ -1296,8 +1265,6 @@ static int parse_options(int argc, char** argv, fuzz_options* o)
         } else if (strcmp(argv[a], "--replay") == 0 && a + 1 < argc) {
             o->replay = 1;
             o->replay_seed = strtoull(argv[++a], NULL, 0);
-        } else if (strcmp(argv[a], "--strict") == 0) {
-            o->strict = 1;
         } else if (strcmp(argv[a], "--verbose") == 0) {
             o->verbose = 1;
         } else if (argv[a][0] != '-' && o->directory == NULL) {
@@ -1317,11 +1284,9 @@ int main(int argc, char** argv)
     fuzz_counts counts;
     long episode;
     int failed = 0;
-    size_t k;
     struct timespec started, ended;
     if (!parse_options(argc, argv, &options)) {
-        printf("usage: fmu_fuzz [--steps N] [--seed S] [--strict] [--replay SEED] [--verbose] "
-               "FMU_DIR\n");
+        printf("usage: fmu_fuzz [--steps N] [--seed S] [--replay SEED] [--verbose] FMU_DIR\n");
         return 2;
     }
     if (!fuzz_prepare(&fmu, options.directory)) {
@@ -1331,7 +1296,6 @@ int main(int argc, char** argv)
     memset(&counts, 0, sizeof counts);
     e.fmu = &fmu;
     e.counts = &counts;
-    e.strict = options.strict;
     e.shadow = (double*)calloc(fmu.model.variable_count + 1, sizeof *e.shadow);
     if (e.shadow == NULL || !alloc_snapshot(&e.before, &fmu) || !alloc_snapshot(&e.after, &fmu)) {
         printf("out of memory\n");
@@ -1358,12 +1322,6 @@ int main(int argc, char** argv)
            counts.steps_discard, counts.steps_error, counts.sets, counts.sets_rejected,
            counts.gets, counts.illegal_calls, counts.episodes, counts.instances, counts.replays,
            (double)(ended.tv_sec - started.tv_sec) + 1e-9 * (double)(ended.tv_nsec - started.tv_nsec));
-    for (k = 0; k < FUZZ_KNOWN_COUNT; ++k) {
-        if (counts.known[k] > 0) {
-            printf("  known finding %d hit in %ld episodes (ended there; --strict fails): %s\n",
-                   fuzz_known_findings[k].number, counts.known[k], fuzz_known_findings[k].what);
-        }
-    }
     free(e.shadow);
     free(e.before.reals);
     free(e.before.integers);
