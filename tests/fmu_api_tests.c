@@ -31,6 +31,21 @@
 #include "fmu_probe.h"
 #include "named_tests.h"
 
+/* Every entry of the matrix is one CHECK; counted so that a run says how many
+ * it checked. */
+static long checks_run;
+#undef CHECK
+#define CHECK(cond, ...)                                                                        \
+    do {                                                                                        \
+        ++checks_run;                                                                           \
+        if (!(cond)) {                                                                          \
+            printf("    FAIL %s:%d: ", __FILE__, __LINE__);                                     \
+            printf(__VA_ARGS__);                                                                \
+            printf("\n");                                                                       \
+            ++fails;                                                                            \
+        }                                                                                       \
+    } while (0)
+
 static probe_model md2, md3;
 static probe_fmi2 api2;
 static probe_fmi3 api3;
@@ -1978,6 +1993,7 @@ int main(int argc, char** argv)
                                argv + first_name, argc - first_name);
         failed = failed < 0 ? more : more < 0 ? failed : failed + more;
     }
+    printf("misuse %s: %ld checks\n", md2.identifier, checks_run);
     probe_unload(api2.library);
     probe_unload(api3.library);
     probe_free_model(&md2);

@@ -801,9 +801,10 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
         violation(e, "doStep(%g, %g) returned OK", t, h);
         return;
     }
-    if (!is_finite(end)) {
-        violation(e, "doStep(%.17g, %.17g) returned OK: t + h = %g", t,
-                  h, end);
+    if (!is_finite(end) || !(end > t)) {
+        /* an end time that overflows, or that rounds back to t */
+        violation(e, "doStep(%.17g, %.17g) returned OK: t + h = %.17g is not a later finite time",
+                  t, h, end);
         return;
     }
     if (probe_bits(last) != probe_bits(end) || terminate) {
