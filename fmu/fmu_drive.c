@@ -184,6 +184,17 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
                  speed);
         return;
     }
+    /* A step is taken only if the outputs at its end are finite: one that ends
+     * where the motor torque or the acceleration overflows is discarded with
+     * the state kept, as the importer is told (last successful time = t). */
+    if (!isfinite(motor_torque(in, speed)) || !isfinite(acceleration(in, angle, speed))) {
+        evaluation->status = FMU_DISCARD;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "the step would end where the motor torque (%g N.m) or the crank's "
+                 "acceleration (%g rad/s2) overflows double (angle %g rad, speed %g rad/s)",
+                 motor_torque(in, speed), acceleration(in, angle, speed), angle, speed);
+        return;
+    }
     in->angle = angle;
     in->speed = speed;
 }

@@ -1924,10 +1924,46 @@ static int test_drive_outputs_never_infinite(void)
     return fails;
 }
 
+/* A step whose end state is finite but whose outputs there overflow (a crank's
+ * centre of mass 1e308 m out, turned by the step into the direction gravity
+ * acts on) is discarded, and the state is kept, as the last successful time
+ * says: the next step starts where this one did. */
+static int test_drive_discard_keeps_state(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        probe_log_book book;
+        void* c = version == 2 ? new_fmi2(&book, "keep") : new_fmi3(&book, "keep");
+        double angle, omega;
+        int status;
+        CHECK(set_named(version, c, "motor.stall_torque", 1.6361668717536812e-76) &&
+                  set_named(version, c, "crank.mass", 1.132571408184845) &&
+                  set_named(version, c, "crank.com.y", 1e308) &&
+                  set_named(version, c, "load.inertia", 0.99527050589162336) &&
+                  set_named(version, c, "start.speed", 1e-300) &&
+                  (version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)) &&
+                  get_status_output(version, c) == 0,
+              "FMI %d: set up", version);
+        angle = get_named(version, c, "crank.angle");
+        omega = get_named(version, c, "crank.omega");
+        status = version == 2 ? (int)api2.DoStep(c, 0, 0.0022494449308296154, fmi2True)
+                              : (int)step3(c, 0, 0.0022494449308296154);
+        CHECK(status == 2 && probe_bits(get_named(version, c, "crank.angle")) == probe_bits(angle) &&
+                  probe_bits(get_named(version, c, "crank.omega")) == probe_bits(omega) &&
+                  get_status_output(version, c) == 0,
+              "FMI %d: doStep: status %d, state (%g, %g) from (%g, %g), status output %d", version,
+              status, get_named(version, c, "crank.angle"), get_named(version, c, "crank.omega"),
+              angle, omega, get_status_output(version, c));
+        free_either(version, c);
+    }
+    return fails;
+}
+
 static const named_test drive_tests[] = {
     {"drive_errors_logged_every_time", test_drive_errors_logged_every_time},
     {"drive_step_beyond_cap", test_drive_step_beyond_cap},
     {"drive_outputs_never_infinite", test_drive_outputs_never_infinite},
+    {"drive_discard_keeps_state", test_drive_discard_keeps_state},
 };
 
 /* ---- runner ----------------------------------------------------------------------------------- */

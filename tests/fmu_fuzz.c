@@ -782,16 +782,38 @@ static void fmi2_step_status(fuzz_episode* e, double* last, int* terminate)
     *terminate = flag != fmi2False;
 }
 
-/* Whether a step of h from the state in `before` must move it: by more than a
- * billionth of its size (and beyond underflow) in angle or in speed. */
+/* The value of the drive's variable `name` in `before` (NaN if it has none). */
+static double before_named(const fuzz_episode* e, const char* name)
+{
+    const probe_variable* v = probe_variable_named(&e->fmu->model, name);
+    return v != NULL ? snapshot_real(e, &e->before, (int)(v - e->fmu->model.variables)) : NAN;
+}
+
+/* Whether a step of h s from the state in `before` must move it, by more than
+ * a billionth of its size (and beyond underflow): in angle, if the crank
+ * turns; in speed, if its acceleration is more than the round-off of the
+ * torque balance it comes from (1e-9 of the torques summed: at a standstill
+ * held by gravity the acceleration is that round-off, and the state rightly
+ * stays). A subnormal step is too short to resolve either. */
 static int state_must_move(const fuzz_episode* e, double h)
 {
     const double angle = snapshot_real(e, &e->before, e->fmu->angle);
     const double omega = snapshot_real(e, &e->before, e->fmu->omega);
     const double epsilon = snapshot_real(e, &e->before, e->fmu->epsilon);
+    const double inertia = before_named(e, "inertia") + before_named(e, "load.inertia");
+    const double gravity =
+        fabs(before_named(e, "crank.mass")) *
+        hypot(before_named(e, "crank.com.x"), before_named(e, "crank.com.y")) *
+        hypot(before_named(e, "gravity.x"), before_named(e, "gravity.y"));
+    const double torques = fabs(before_named(e, "motor.torque")) +
+                           fabs(before_named(e, "load.torque")) + gravity; /* N.m */
     const double turn = fabs(h * omega), spin = fabs(h * epsilon);
+    if (!(h >= DBL_MIN)) {
+        return 0;
+    }
     return (turn > 1e-250 && turn > 1e-9 * fabs(angle)) ||
-           (spin > 1e-250 && spin > 1e-9 * fabs(omega));
+           (spin > 1e-250 && spin > 1e-9 * fabs(omega) &&
+            fabs(epsilon) * inertia > 1e-9 * torques);
 }
 
 static void check_step_ok(fuzz_episode* e, double t, double h, double last, int terminate)
