@@ -110,12 +110,15 @@ static void evaluate(const fmu_model* model, const void* input, void* output,
 {
     const fmu_drive_input* in = (const fmu_drive_input*)input;
     fmu_drive_output* out = (fmu_drive_output*)output;
+    /* N.m; depends on the state alone, so it is NaN where it overflows whether
+     * or not the inertia check below passes */
+    const double torque = motor_torque(in, in->speed);
     evaluation->status = FMU_OK;
     evaluation->bad_variable = -1;
     evaluation->reason[0] = '\0';
     out->angle = in->angle;
     out->speed = in->speed;
-    out->motor_torque = motor_torque(in, in->speed);
+    out->motor_torque = isfinite(torque) ? torque : (double)NAN;
     out->acceleration = (double)NAN;
     out->status = FMU_DRIVE_INVALID_INPUT;
     if (!check(model, in, evaluation)) {
@@ -123,17 +126,14 @@ static void evaluate(const fmu_model* model, const void* input, void* output,
     }
     out->acceleration = acceleration(in, in->angle, in->speed);
     out->status = FMU_DRIVE_OK;
-    if (!isfinite(out->motor_torque) || !isfinite(out->acceleration)) {
+    if (!isfinite(torque) || !isfinite(out->acceleration)) {
         evaluation->status = FMU_DISCARD;
         snprintf(evaluation->reason, sizeof evaluation->reason,
                  "the motor torque (%g N.m) or the crank's acceleration (%g rad/s2) overflows "
                  "double; it is NaN",
-                 out->motor_torque, out->acceleration);
+                 torque, out->acceleration);
         out->status = FMU_DRIVE_OUT_OF_RANGE;
         out->acceleration = (double)NAN;
-        if (!isfinite(out->motor_torque)) {
-            out->motor_torque = (double)NAN;
-        }
     }
 }
 
@@ -182,6 +182,17 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
         snprintf(evaluation->reason, sizeof evaluation->reason,
                  "the crank's state is no longer finite (angle %g rad, speed %g rad/s)", angle,
                  speed);
+        return;
+    }
+    /* A step is taken only if the outputs at its end are finite: one that ends
+     * where the motor torque or the acceleration overflows is discarded with
+     * the state kept, as the importer is told (last successful time = t). */
+    if (!isfinite(motor_torque(in, speed)) || !isfinite(acceleration(in, angle, speed))) {
+        evaluation->status = FMU_DISCARD;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "the step would end where the motor torque (%g N.m) or the crank's "
+                 "acceleration (%g rad/s2) overflows double (angle %g rad, speed %g rad/s)",
+                 motor_torque(in, speed), acceleration(in, angle, speed), angle, speed);
         return;
     }
     in->angle = angle;

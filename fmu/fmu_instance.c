@@ -254,24 +254,37 @@ fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time)
 
 /* ---- the solve ----------------------------------------------------------- */
 
+/* Logs why the last evaluation failed. */
+static void log_failure(fmu_instance* instance, fmu_status not_solvable, const char* function)
+{
+    const fmu_evaluation* e = &instance->evaluation;
+    if (e->status == FMU_ERROR && e->bad_variable >= 0) {
+        fmu_log(instance, FMU_ERROR, "%s: %s = %g: %s", function,
+                instance->model->variables[e->bad_variable].name,
+                instance->values[e->bad_variable], e->reason);
+    } else if (e->status != FMU_OK) {
+        fmu_log(instance, e->status == FMU_ERROR ? FMU_ERROR : not_solvable,
+                "%s: at t = %g s: %s", function, instance->time, e->reason);
+    }
+}
+
 /* Evaluates if an input changed since the last evaluation. Returns FMU_OK,
  * FMU_ERROR for inputs the model rejects, or `not_solvable` where the model has
- * no answer (a singular dyad); each failure is logged once per evaluation. */
-static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const char* function)
+ * no answer (a singular dyad). A failure is logged when it is found; an Error
+ * is logged again by every call that returns it (`each_error`), since a call
+ * that returns Error must say why, while a getter that reports a failure in
+ * its status alone (fmi*GetInteger of `status`) passes 0. */
+static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const char* function,
+                        int each_error)
 {
     fmu_evaluation* e = &instance->evaluation;
     if (instance->dirty) {
         instance->model->behaviour->evaluate(instance->model, instance->input, instance->output,
                                              e);
         instance->dirty = 0;
-        if (e->status == FMU_ERROR && e->bad_variable >= 0) {
-            fmu_log(instance, FMU_ERROR, "%s: %s = %g: %s", function,
-                    instance->model->variables[e->bad_variable].name,
-                    instance->values[e->bad_variable], e->reason);
-        } else if (e->status != FMU_OK) {
-            fmu_log(instance, e->status == FMU_ERROR ? FMU_ERROR : not_solvable,
-                    "%s: at t = %g s: %s", function, instance->time, e->reason);
-        }
+        log_failure(instance, not_solvable, function);
+    } else if (e->status == FMU_ERROR && each_error) {
+        log_failure(instance, not_solvable, function);
     }
     if (e->status == FMU_OK || e->status == FMU_ERROR) {
         return e->status;
@@ -300,7 +313,7 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
     if (status != FMU_OK) {
         return status;
     }
-    status = solve(instance, FMU_WARNING, "exitInitializationMode");
+    status = solve(instance, FMU_WARNING, "exitInitializationMode", 1);
     if (status != FMU_ERROR) {
         instance->state = FMU_STATE_STEP;
     }
@@ -334,7 +347,7 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
     instance->time = current_time;
     if (instance->model->behaviour->advance != NULL) {
         /* A model with states: the outputs at the end of the step. */
-        status = solve(instance, FMU_DISCARD, function);
+        status = solve(instance, FMU_DISCARD, function, 1);
         if (status == FMU_OK) {
             fmu_evaluation* e = &instance->evaluation;
             instance->model->behaviour->advance(instance->model, instance->input, step_size, e);
@@ -353,7 +366,7 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
                 return FMU_DISCARD;
             }
             instance->time = current_time + step_size;
-            status = solve(instance, FMU_DISCARD, function);
+            status = solve(instance, FMU_DISCARD, function, 1);
             if (status == FMU_OK) {
                 instance->last_successful_time = instance->time;
                 instance->terminate_requested = 0;
@@ -364,7 +377,7 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
         instance->terminate_requested = status == FMU_DISCARD;
         return status;
     }
-    status = solve(instance, FMU_DISCARD, function);
+    status = solve(instance, FMU_DISCARD, function, 1);
     if (status == FMU_OK) {
         instance->time = current_time + step_size;
         instance->last_successful_time = instance->time;
@@ -511,19 +524,12 @@ static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], si
     return FMU_OK;
 }
 
-/* The value of a variable as a double, solving first if it is an output.
- * `worst` collects the status of the solve. */
-static double read_variable(fmu_instance* instance, const fmu_variable* v, fmu_status* worst,
-                            const char* function)
+/* The value of a variable as a double; an output as of the last evaluation. */
+static double read_variable(const fmu_instance* instance, const fmu_variable* v)
 {
     const char* member = (const char*)instance->output + v->offset;
-    fmu_status status;
     if (v->causality != FMU_OUTPUT) {
         return instance->values[v - instance->model->variables];
-    }
-    status = solve(instance, FMU_WARNING, function);
-    if (status > *worst) {
-        *worst = status;
     }
     if (v->target == FMU_TARGET_RESULT_STATUS) {
         return (double)*(const int*)(const void*)member;
@@ -531,11 +537,15 @@ static double read_variable(fmu_instance* instance, const fmu_variable* v, fmu_s
     return *(const double*)(const void*)member;
 }
 
-/* Returns the worst status of the solves behind the outputs read. */
+/* Reads the values, solving once before the first output. Returns FMU_ERROR
+ * for a value reference that is not of `type`; otherwise, if `solve_counts`,
+ * the status of that solve (a failed one as FMU_WARNING), else FMU_OK. */
 static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], size_t count,
-                             void* values, fmu_value_type type, const char* function)
+                             void* values, fmu_value_type type, int solve_counts,
+                             const char* function)
 {
     fmu_status worst = FMU_OK;
+    int solved = 0;
     size_t k;
     fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
     if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
@@ -546,7 +556,12 @@ static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], si
         if (v == NULL) {
             return FMU_ERROR;
         }
-        store_at(values, type, k, read_variable(instance, v, &worst, function));
+        if (v->causality == FMU_OUTPUT && !solved) {
+            const fmu_status solved_status = solve(instance, FMU_WARNING, function, solve_counts);
+            worst = solve_counts ? solved_status : FMU_OK;
+            solved = 1;
+        }
+        store_at(values, type, k, read_variable(instance, v));
     }
     return worst;
 }
@@ -566,29 +581,16 @@ fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size
 fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         double values[], const char* function)
 {
-    return get_values(instance, vr, count, values, FMU_REAL, function);
+    return get_values(instance, vr, count, values, FMU_REAL, 1, function);
 }
 
 fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
                            int values[], const char* function)
 {
-    fmu_status ignored = FMU_OK;
-    size_t k;
-    fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
-    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
-        return FMU_ERROR;
-    }
-    for (k = 0; k < count; ++k) {
-        const fmu_variable* v = lookup(instance, vr[k], FMU_INTEGER, function);
-        if (v == NULL) {
-            return FMU_ERROR;
-        }
-        /* The status output is how the model reports a singular configuration or
-         * a rejected input (already logged when it was evaluated): reading it
-         * succeeds whatever it says. */
-        values[k] = (int)read_variable(instance, v, &ignored, function);
-    }
-    return FMU_OK;
+    /* The status output is how the model reports a singular configuration or
+     * a rejected input (logged when it was evaluated): reading it succeeds
+     * whatever it says. */
+    return get_values(instance, vr, count, values, FMU_INTEGER, 0, function);
 }
 
 fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int unknowns[],

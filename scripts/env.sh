@@ -56,6 +56,26 @@ dyadfmu_build() {
     cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
 }
 
+# ---- probes of the FMU binaries (tests/fmu_fuzz.c, fmu_api_tests.c, fmu_threads.c) ----
+# The FMUs the ThreadSanitizer build makes: one of each kind (a generic dyad, a
+# tailored multi-dyad scene, the drive), enough for the thread test and no more.
+DYADFMU_TSAN_FMUS=${DYADFMU_TSAN_FMUS:-"dyad_rrt;sixbar;drive"}
+
+# dyadfmu_build_tsan DIR: the thread test and the FMUs of DYADFMU_TSAN_FMUS,
+# all built with -fsanitize=thread; nothing else of the project.
+dyadfmu_build_tsan() {
+    local dir=$1 targets=(fmu_threads) id
+    dyadfmu_log "building in $dir (ThreadSanitizer: $DYADFMU_TSAN_FMUS)"
+    cmake -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDYADFMU_TSAN=ON \
+        -DDYADFMU_BUILD_BENCH=OFF -DDYADFMU_PROBE_FMUS="$DYADFMU_TSAN_FMUS" \
+        -DPython3_EXECUTABLE="$DYADFMU_VENV/bin/python" >/dev/null
+    for id in ${DYADFMU_TSAN_FMUS//;/ }; do
+        targets+=("${id}_fmi2_package" "${id}_fmi3_package")
+    done
+    cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" --target "${targets[@]}" >/dev/null
+}
+# ---- end of the probes' block ----
+
 # ---- the second FMI importer (scripts/tests/test_importers.py) ----------------------
 # fmi-sim, a Rust FMI 2 / FMI 3 importer independent of fmpy, at the version
 # scripts/dyadfmu/importers.py pins (FMI_SIM_VERSION). `cargo install` builds it once into
