@@ -60,6 +60,9 @@ RESERVED = {"frame", "external", "gravity", "singular_threshold", "status", "tim
 #: Prefixes of the core's, the FMU layer's and the FMI standard's C names: no name may
 #: start with one (nor be the prefix without its underscore, 'dyad' or 'fmu').
 RESERVED_PREFIXES = ("dyad_", "fmu_", "fmi2", "fmi3")
+_PREFIX_RULE = ("no name is " + " or ".join(p[:-1] for p in RESERVED_PREFIXES if p.endswith("_"))
+                + " or starts with " + ", ".join(RESERVED_PREFIXES[:-1])
+                + f" or {RESERVED_PREFIXES[-1]}")
 
 SCENE_KEYS = {"identifier", "description", "outputs", "tunable", "singular_threshold"}
 EFFECT_KEYS = {"inertia", "gravity"}
@@ -82,35 +85,105 @@ class SceneError(Exception):
 # Where things are in the file
 # ---------------------------------------------------------------------------
 class Locator:
-    """Line numbers of tables and keys in a TOML text, for messages."""
+    """Line numbers of tables and keys in a TOML text, for messages. The text is read as
+    TOML reads it: strings (basic, literal, multi-line) and comments are skipped, so that a
+    '[' or '#' inside a string moves nothing, and quoted keys and headers are decoded."""
 
-    HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\"-]+)\s*\]\]?")
-    KEY = re.compile(r"^\s*(\"[^\"]*\"|[A-Za-z0-9_-]+)\s*=")
+    BARE = re.compile(r"[A-Za-z0-9_-]+")
+    STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'')
 
     def __init__(self, text: str):
         self.tables: dict[tuple[str, int], int] = {}
         self.keys: dict[tuple[str, int, str], int] = {}
-        counts: dict[str, int] = {}
-        section, index = "", 0
-        depth = 0  # inside a multi-line array
-        for number, line in enumerate(text.splitlines(), start=1):
-            stripped = line.split("#", 1)[0]
-            if depth == 0:
-                header = self.HEADER.match(stripped)
-                if header:
-                    section = header.group(2)
-                    if header.group(1) == "[[":
-                        index = counts.get(section, -1) + 1
-                        counts[section] = index
-                    else:
-                        index = 0
-                    self.tables.setdefault((section, index), number)
+        self._counts: dict[str, int] = {}
+        self._section, self._index = "", 0
+        depth = 0              # inside a multi-line array or inline table
+        closing = None         # the closing quotes of an open multi-line string
+        # TOML ends lines at LF only (str.splitlines would split at U+2028 and others too)
+        for number, line in enumerate(text.split("\n"), start=1):
+            line = line.removesuffix("\r")
+            pos = 0
+            if closing:
+                end = line.find(closing)
+                if end < 0:
                     continue
-                key = self.KEY.match(stripped)
-                if key:
-                    self.keys.setdefault((section, index, key.group(1).strip('"')), number)
-            depth += stripped.count("[") - stripped.count("]")
-            depth = max(depth, 0)
+                pos, closing = end + 3, None
+            if depth == 0 and pos == 0:
+                pos = self._statement(line, number)
+            depth, closing = self._scan(line, pos, depth)
+
+    def _key(self, line: str, pos: int) -> tuple[list[str], int]:
+        """The parts of the (dotted) key at `pos`, and where it ends; no parts if none."""
+        parts = []
+        while True:
+            while pos < len(line) and line[pos] in " \t":
+                pos += 1
+            bare = self.BARE.match(line, pos)
+            quoted = self.STRING.match(line, pos)
+            if quoted:
+                try:
+                    parts.append(next(iter(tomllib.loads(quoted.group(0) + " = 0"))))
+                except tomllib.TOMLDecodeError:
+                    return [], pos
+                pos = quoted.end()
+            elif bare:
+                parts.append(bare.group(0))
+                pos = bare.end()
+            else:
+                return [], pos
+            while pos < len(line) and line[pos] in " \t":
+                pos += 1
+            if not line.startswith(".", pos):
+                return parts, pos
+            pos += 1
+
+    def _statement(self, line: str, number: int) -> int:
+        """Record a table header or a key that starts `line`; where the value starts."""
+        pos = len(line) - len(line.lstrip(" \t"))
+        if line.startswith("[", pos):
+            array = line.startswith("[[", pos)
+            parts, end = self._key(line, pos + (2 if array else 1))
+            if parts:
+                section = ".".join(parts)
+                if array:
+                    self._index = self._counts.get(section, -1) + 1
+                    self._counts[section] = self._index
+                else:
+                    self._index = 0
+                self._section = section
+                self.tables.setdefault((section, self._index), number)
+            return len(line)
+        parts, end = self._key(line, pos)
+        if parts and line.startswith("=", end):
+            self.keys.setdefault((self._section, self._index, parts[0]), number)
+            return end + 1
+        return len(line)
+
+    @staticmethod
+    def _scan(line: str, pos: int, depth: int) -> tuple[int, str | None]:
+        """The bracket depth after a line's value from `pos`, and the closing quotes of a
+        multi-line string the line leaves open."""
+        while pos < len(line):
+            ch = line[pos]
+            if ch == "#":
+                break
+            if ch in "\"'":
+                triple = ch * 3
+                if line.startswith(triple, pos):
+                    end = line.find(triple, pos + 3)
+                    if end < 0:
+                        return depth, triple
+                    pos = end + 3
+                    continue
+                pos += 1
+                while pos < len(line) and line[pos] != ch:
+                    pos += 2 if ch == '"' and line[pos] == "\\" else 1
+            elif ch in "[{":
+                depth += 1
+            elif ch in "]}":
+                depth = max(depth - 1, 0)
+            pos += 1
+        return depth, None
 
     def line(self, section: str, index: int = 0, key: str | None = None) -> int | None:
         if key is not None and (section, index, key) in self.keys:
@@ -253,9 +326,13 @@ class _Problems:
         self.items: list[str] = []
 
     def where(self, section: str = "", index: int = 0, key: str | None = None) -> str:
-        line = self.loc.line(section, index, key) if section else None
-        name = textsafe.plain(self.path.name)
-        return f"{name}:{line}" if line else name
+        """file:line of a table or key; a table written as a plain key (scene = 1) is
+        found as that key, and what has no line of its own (a table that is missing)
+        is placed on line 1."""
+        line = self.loc.line(section, index, key) if section else self.loc.line("", 0, key)
+        if line is None and section:
+            line = self.loc.line("", 0, section.split(".")[0])
+        return f"{textsafe.plain(self.path.name)}:{line or 1}"
 
     def add(self, message: str, section: str = "", index: int = 0, key: str | None = None):
         self.items.append(f"{self.where(section, index, key)}: {textsafe.plain(message)}")
@@ -339,8 +416,7 @@ def _name_problem(name) -> str | None:
     for prefix in RESERVED_PREFIXES:
         if (name + "_").startswith(prefix):
             return (f"'{name}' starts with '{prefix}', which is reserved for the C names of "
-                    "the core, the FMU layer and FMI (reserved prefixes: "
-                    f"{', '.join(RESERVED_PREFIXES)})")
+                    f"the core, the FMU layer and FMI ({_PREFIX_RULE})")
     return None
 
 
@@ -438,11 +514,17 @@ def _c_name_clashes(p: _Problems, objects: list):
     names = c_names()
     taken: dict[tuple[str, str], str] = {}
     for kind, name, label, where in objects:
+        # an identifier itself too: 'EOF' or 'main' would name the FMU, its library and
+        # files after a name of C (a dyad's name is a C name as it is: see the patterns)
+        if kind == "identifier" and name in names.reserved:
+            p.add(f"{label}: its name is already a name of C, its standard headers, the core "
+                  f"or the generated code ('{name}'); choose another name", *where)
+            continue
         for scope, cname in names.derived(kind, name):
             if scope == "code" and cname in names.reserved:
                 what = "its name" if cname == name else f"the C name '{cname}' it leads to"
-                p.add(f"{label}: {what} is a name the generated C code or the core already "
-                      f"uses ('{cname}'); choose another name", *where)
+                p.add(f"{label}: {what} is already a name of C, its standard headers, the "
+                      f"core or the generated code ('{cname}'); choose another name", *where)
                 break
             other = taken.setdefault((scope, cname), label)
             if other != label:
@@ -480,8 +562,8 @@ def load_scene(path, *, check_c_names: bool = True) -> Scene:
             p.add(f"unknown table '{key}' (expected {', '.join(sorted(TOP_KEYS))})", key, 0)
     scene_t = data.get("scene")
     if not isinstance(scene_t, dict):
-        raise SceneError([f"{path.name}: missing [scene] table (identifier, description, "
-                          "outputs)"])
+        p.add("missing [scene] table (identifier, description, outputs)", "scene", 0)
+        raise SceneError(p.items)
     _unknown_keys(p, scene_t, SCENE_KEYS, "[scene]", "scene", 0)
     identifier = scene_t.get("identifier")
     problem = _identifier_problem(identifier)
@@ -777,10 +859,10 @@ def _attachment(p, spec, side, pair_kind, pair, label, i, crank, links, dyad):
     target = spec.get("link")
     prefix = dyad.prefix()
     sliding = pair_kind == "T"
-    moving = (crank is not None and target == crank.name) or target in links
     if not isinstance(target, str):
         p.add(f"{label}: '{side}' needs link = <name>", "dyad", i, side)
         return None
+    moving = (crank is not None and target == crank.name) or target in links
     if target not in ("frame", "external") and not moving:
         later = f" (a link of a later dyad or of this one: dyads are listed from the crank " \
                 f"outwards)" if target else ""

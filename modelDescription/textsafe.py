@@ -67,8 +67,8 @@ def description_problem(text) -> str | None:
                     "a control character" if unicodedata.category(ch) == "Cc" else
                     "a bidi or format character" if unicodedata.category(ch) == "Cf" else
                     "not printable text")
-            return (f"character {position}, {_char_name(ch)}, is {what}; a description is one "
-                    "line of printable text")
+            return (f"has {what}, {_char_name(ch)}, at character {position}; a description is "
+                    "one line of printable text")
     if "*/" in text:
         return ("must not contain '*/' (it is copied into a C comment, which '*/' would "
                 "end)")
