@@ -32,6 +32,7 @@ Python 3.11 standard library only.
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import re
 import sys
@@ -39,13 +40,29 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import cnames
 import generate
+import textsafe
 from generate import Variable
 
 TYPES = tuple(generate.PAIRS)          # RRR, RRT, RTR, TRT, RTT
-IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
-NAME = re.compile(r"^[a-z_][a-z0-9_]*$")
+#: The scene's identifier (it names the FMU, its files and C types) and the names of the
+#: crank, the dyads and the links (they name variables and C names); matched whole.
+IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+NAME = re.compile(r"[a-z][a-z0-9_]*")
+#: The longest identifier or name. The generated C appends at most 16 characters to a
+#: name (the member 'DYAD_guide_k_at_x') and 16 to the identifier ('DYADFMU_SCENE_..._H'),
+#: which keeps every generated C name within the 63 characters that C99 guarantees to
+#: be significant, and every file name (<identifier>_fmi3.fmu) far below 255 bytes.
+MAX_NAME = 40
+#: Names with a meaning in a scene: they cannot name a crank, dyad or link.
 RESERVED = {"frame", "external", "gravity", "singular_threshold", "status", "time"}
+#: Prefixes of the core's, the FMU layer's and the FMI standard's C names: no name may
+#: start with one (nor be the prefix without its underscore, 'dyad' or 'fmu').
+RESERVED_PREFIXES = ("dyad_", "fmu_", "fmi2", "fmi3")
+_PREFIX_RULE = ("no name is " + " or ".join(p[:-1] for p in RESERVED_PREFIXES if p.endswith("_"))
+                + " or starts with " + ", ".join(RESERVED_PREFIXES[:-1])
+                + f" or {RESERVED_PREFIXES[-1]}")
 
 SCENE_KEYS = {"identifier", "description", "outputs", "tunable", "singular_threshold"}
 EFFECT_KEYS = {"inertia", "gravity"}
@@ -71,35 +88,105 @@ class SceneError(Exception):
 # Where things are in the file
 # ---------------------------------------------------------------------------
 class Locator:
-    """Line numbers of tables and keys in a TOML text, for messages."""
+    """Line numbers of tables and keys in a TOML text, for messages. The text is read as
+    TOML reads it: strings (basic, literal, multi-line) and comments are skipped, so that a
+    '[' or '#' inside a string moves nothing, and quoted keys and headers are decoded."""
 
-    HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\"-]+)\s*\]\]?")
-    KEY = re.compile(r"^\s*(\"[^\"]*\"|[A-Za-z0-9_-]+)\s*=")
+    BARE = re.compile(r"[A-Za-z0-9_-]+")
+    STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'')
 
     def __init__(self, text: str):
         self.tables: dict[tuple[str, int], int] = {}
         self.keys: dict[tuple[str, int, str], int] = {}
-        counts: dict[str, int] = {}
-        section, index = "", 0
-        depth = 0  # inside a multi-line array
-        for number, line in enumerate(text.splitlines(), start=1):
-            stripped = line.split("#", 1)[0]
-            if depth == 0:
-                header = self.HEADER.match(stripped)
-                if header:
-                    section = header.group(2)
-                    if header.group(1) == "[[":
-                        index = counts.get(section, -1) + 1
-                        counts[section] = index
-                    else:
-                        index = 0
-                    self.tables.setdefault((section, index), number)
+        self._counts: dict[str, int] = {}
+        self._section, self._index = "", 0
+        depth = 0              # inside a multi-line array or inline table
+        closing = None         # the closing quotes of an open multi-line string
+        # TOML ends lines at LF only (str.splitlines would split at U+2028 and others too)
+        for number, line in enumerate(text.split("\n"), start=1):
+            line = line.removesuffix("\r")
+            pos = 0
+            if closing:
+                end = line.find(closing)
+                if end < 0:
                     continue
-                key = self.KEY.match(stripped)
-                if key:
-                    self.keys.setdefault((section, index, key.group(1).strip('"')), number)
-            depth += stripped.count("[") - stripped.count("]")
-            depth = max(depth, 0)
+                pos, closing = end + 3, None
+            if depth == 0 and pos == 0:
+                pos = self._statement(line, number)
+            depth, closing = self._scan(line, pos, depth)
+
+    def _key(self, line: str, pos: int) -> tuple[list[str], int]:
+        """The parts of the (dotted) key at `pos`, and where it ends; no parts if none."""
+        parts = []
+        while True:
+            while pos < len(line) and line[pos] in " \t":
+                pos += 1
+            bare = self.BARE.match(line, pos)
+            quoted = self.STRING.match(line, pos)
+            if quoted:
+                try:
+                    parts.append(next(iter(tomllib.loads(quoted.group(0) + " = 0"))))
+                except tomllib.TOMLDecodeError:
+                    return [], pos
+                pos = quoted.end()
+            elif bare:
+                parts.append(bare.group(0))
+                pos = bare.end()
+            else:
+                return [], pos
+            while pos < len(line) and line[pos] in " \t":
+                pos += 1
+            if not line.startswith(".", pos):
+                return parts, pos
+            pos += 1
+
+    def _statement(self, line: str, number: int) -> int:
+        """Record a table header or a key that starts `line`; where the value starts."""
+        pos = len(line) - len(line.lstrip(" \t"))
+        if line.startswith("[", pos):
+            array = line.startswith("[[", pos)
+            parts, end = self._key(line, pos + (2 if array else 1))
+            if parts:
+                section = ".".join(parts)
+                if array:
+                    self._index = self._counts.get(section, -1) + 1
+                    self._counts[section] = self._index
+                else:
+                    self._index = 0
+                self._section = section
+                self.tables.setdefault((section, self._index), number)
+            return len(line)
+        parts, end = self._key(line, pos)
+        if parts and line.startswith("=", end):
+            self.keys.setdefault((self._section, self._index, parts[0]), number)
+            return end + 1
+        return len(line)
+
+    @staticmethod
+    def _scan(line: str, pos: int, depth: int) -> tuple[int, str | None]:
+        """The bracket depth after a line's value from `pos`, and the closing quotes of a
+        multi-line string the line leaves open."""
+        while pos < len(line):
+            ch = line[pos]
+            if ch == "#":
+                break
+            if ch in "\"'":
+                triple = ch * 3
+                if line.startswith(triple, pos):
+                    end = line.find(triple, pos + 3)
+                    if end < 0:
+                        return depth, triple
+                    pos = end + 3
+                    continue
+                pos += 1
+                while pos < len(line) and line[pos] != ch:
+                    pos += 2 if ch == '"' and line[pos] == "\\" else 1
+            elif ch in "[{":
+                depth += 1
+            elif ch in "]}":
+                depth = max(depth - 1, 0)
+            pos += 1
+        return depth, None
 
     def line(self, section: str, index: int = 0, key: str | None = None) -> int | None:
         if key is not None and (section, index, key) in self.keys:
@@ -138,7 +225,7 @@ class Attachment:
     guide: Param | None = None     # guide angle on the frame, for a translational pair
 
 
-@dataclass
+@dataclass(eq=False)
 class Link:
     name: str
     dyad: "Dyad"
@@ -151,7 +238,7 @@ class Link:
     moment: bool = False
 
 
-@dataclass
+@dataclass(eq=False)
 class Dyad:
     name: str
     type: str
@@ -176,7 +263,7 @@ class Crank:
     params: dict = field(default_factory=dict)
 
 
-@dataclass
+@dataclass(eq=False)
 class Output:
     name: str
     unit: str | None
@@ -201,6 +288,8 @@ class Scene:
     threshold: Param
     outputs: list = field(default_factory=list)      # Output
     inputs: list = field(default_factory=list)       # Input, in table order
+    #: dyad index -> the dyads that load it (see _loaders), computed once
+    loaders: dict = field(default_factory=dict, repr=False)
 
     def parameters(self) -> list:
         """Every Param of the scene in table order."""
@@ -239,10 +328,36 @@ class _Problems:
         self.loc = locator
         self.items: list[str] = []
 
+    def where(self, section: str = "", index: int = 0, key: str | None = None) -> str:
+        """file:line of a table or key; a table written as a plain key (scene = 1) is
+        found as that key, and what has no line of its own (a table that is missing)
+        is placed on line 1."""
+        line = self.loc.line(section, index, key) if section else self.loc.line("", 0, key)
+        if line is None and section:
+            line = self.loc.line("", 0, section.split(".")[0])
+        return f"{textsafe.plain(self.path.name)}:{line or 1}"
+
     def add(self, message: str, section: str = "", index: int = 0, key: str | None = None):
-        line = self.loc.line(section, index, key) if section else None
-        where = f"{self.path.name}:{line}" if line else self.path.name
-        self.items.append(f"{where}: {message}")
+        self.items.append(f"{self.where(section, index, key)}: {textsafe.plain(message)}")
+
+
+def _real(value) -> float | None:
+    """A TOML number as a finite double, or None: not a number (a bool is none), not
+    finite, or an integer beyond the range of a double."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:
+        return None
+    return x if math.isfinite(x) else None
+
+
+def _shown(value) -> str:
+    """A value of the scene for a message, shortened (an integer of 400 digits stays
+    readable)."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:40] + f"... ({len(text)} characters)"
 
 
 def _number(p: _Problems, table: dict, key: str, where: str, sec, idx, *, positive=False,
@@ -251,17 +366,18 @@ def _number(p: _Problems, table: dict, key: str, where: str, sec, idx, *, positi
         if required:
             p.add(f"{where}: missing parameter '{key}'", sec, idx)
         return None
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        p.add(f"{where}: '{key}' must be a finite number, not {value!r}", sec, idx, key)
+    value = _real(table[key])
+    if value is None:
+        p.add(f"{where}: '{key}' must be a finite number (within the range of a double), "
+              f"not {_shown(table[key])}", sec, idx, key)
         return None
     if positive and not value > 0:
-        p.add(f"{where}: '{key}' must be positive, not {value!r}", sec, idx, key)
+        p.add(f"{where}: '{key}' must be positive, not {_shown(table[key])}", sec, idx, key)
         return None
     if nonnegative and not value >= 0:
-        p.add(f"{where}: '{key}' must not be negative, not {value!r}", sec, idx, key)
+        p.add(f"{where}: '{key}' must not be negative, not {_shown(table[key])}", sec, idx, key)
         return None
-    return float(value)
+    return value
 
 
 def _pair_of_numbers(p: _Problems, table: dict, key: str, where: str, sec, idx, required=True):
@@ -271,12 +387,11 @@ def _pair_of_numbers(p: _Problems, table: dict, key: str, where: str, sec, idx, 
         return None
     value = table[key]
     if (not isinstance(value, list) or len(value) != 2 or
-            not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-                    for v in value)):
-        p.add(f"{where}: '{key}' must be [x, y], two finite numbers (m), not {value!r}",
+            any(_real(v) is None for v in value)):
+        p.add(f"{where}: '{key}' must be [x, y], two finite numbers (m), not {_shown(value)}",
               sec, idx, key)
         return None
-    return float(value[0]), float(value[1])
+    return _real(value[0]), _real(value[1])
 
 
 def _unknown_keys(p: _Problems, table: dict, allowed: set, where: str, sec, idx):
@@ -286,19 +401,163 @@ def _unknown_keys(p: _Problems, table: dict, allowed: set, where: str, sec, idx)
                   sec, idx, key)
 
 
-def load_scene(path) -> Scene:
-    """Read and validate a scene; raises SceneError listing every problem."""
+def _name_problem(name) -> str | None:
+    """Why `name` cannot name a crank, dyad or link (the message goes on "name ..."), or
+    None. The C names it leads to are checked once every name is known (_c_name_clashes)."""
+    if not isinstance(name, str):
+        return f"must be a string, not {_shown(name)}"
+    if not NAME.fullmatch(name):
+        return (f"{_shown(name)} must be a lower-case identifier: a letter a-z, then letters "
+                "a-z, digits 0-9 and '_'")
+    if len(name) > MAX_NAME:
+        return f"'{name[:20]}...' has {len(name)} characters; a name has at most {MAX_NAME}"
+    if name in RESERVED:
+        return (f"'{name}' is a word of the scene format (reserved: "
+                f"{', '.join(sorted(RESERVED))})")
+    if name in cnames.C_KEYWORDS:
+        return f"'{name}' is a C keyword"
+    for prefix in RESERVED_PREFIXES:
+        if (name + "_").startswith(prefix):
+            return (f"'{name}' starts with '{prefix}', which is reserved for the C names of "
+                    f"the core, the FMU layer and FMI ({_PREFIX_RULE})")
+    return None
+
+
+def _identifier_problem(identifier) -> str | None:
+    """Why `identifier` cannot name the FMU, or None."""
+    if not isinstance(identifier, str):
+        return f"must be a string (a C identifier that names the FMU), not {_shown(identifier)}"
+    if not IDENT.fullmatch(identifier):
+        return (f"{_shown(identifier)} must be a C identifier (it names the FMU): a letter, "
+                "then letters, digits and '_'")
+    if len(identifier) > MAX_NAME:
+        return (f"'{identifier[:20]}...' has {len(identifier)} characters; an identifier has "
+                f"at most {MAX_NAME}")
+    if identifier in cnames.C_KEYWORDS:
+        return f"'{identifier}' is a C keyword"
+    return None
+
+
+# ---------------------------------------------------------------------------
+# C names
+# ---------------------------------------------------------------------------
+HERE = Path(__file__).resolve().parent
+#: A scene with every feature of the generated code; see the file.
+C_NAMES_PROBE = HERE / "c_names_probe.toml"
+#: Where the headers the generated code includes are found.
+HEADER_DIRS = (HERE.parent / "src" / "include", HERE.parent / "src", HERE.parent / "fmu")
+_PROBE_NAME = re.compile(r"zq[a-z]{2}", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class CNames:
+    """What the generated C makes of a scene's names, learnt from the generated code of
+    the probe scene: `reserved`, every identifier that code and the headers it includes
+    use (C's keywords, the standard headers' names, the core's and the FMU layer's,
+    the generated code's own: in, out, load, cos, ...); `patterns`, per kind of name
+    (identifier, crank, dyad, link), the C names derived from a name as (scope, prefix,
+    suffix, upper case): scope "code" for the names of the generated code's functions
+    and files, "member" for the members of the scene's input and output blocks."""
+    reserved: frozenset
+    patterns: dict
+
+    def derived(self, kind: str, name: str) -> list[tuple[str, str]]:
+        """(scope, C name) of every C name derived from `name`, a name of `kind`."""
+        return sorted((scope, prefix + (name.upper() if upper else name) + suffix)
+                      for scope, prefix, suffix, upper in self.patterns[kind])
+
+
+_C_NAMES: list = []
+
+
+def c_names() -> CNames:
+    """The C names of generated code (computed once per process from the probe scene)."""
+    if not _C_NAMES:
+        _C_NAMES.append(_learn_c_names())
+    return _C_NAMES[0]
+
+
+def _learn_c_names() -> CNames:
+    probe = load_scene(C_NAMES_PROBE, check_c_names=False)
+    table = scene_table(probe)
+    header = f"{probe.identifier}_scene.h"
+    files = {"scene.c": scene_c(table), "scene.h": scene_header(table),
+             "model.c": generate.model_c(table)}
+    kind_of = {probe.identifier: "identifier", probe.crank.name: "crank"}
+    kind_of.update({d.name: "dyad" for d in probe.dyads})
+    kind_of.update({g: "link" for g in probe.links})
+    reserved = set(cnames.C_KEYWORDS) | cnames.COMMON_MACROS
+    reserved |= cnames.headers_names("\n".join(files.values()), list(HEADER_DIRS),
+                                     {header: files["scene.h"]})
+    patterns: dict[str, set] = {kind: set() for kind in ("identifier", "crank", "dyad", "link")}
+    for file, code in files.items():
+        for t in cnames.identifiers(code):
+            found = _PROBE_NAME.search(t.text)
+            if found is None:
+                # the header's own names came with headers_names (its struct members,
+                # which no local can hide, do not count)
+                if not t.member and file != "scene.h":
+                    reserved.add(t.text)
+                continue
+            kind = kind_of[found.group().lower()]
+            # a link's, dyad's or crank's name in the header or the variable table is a
+            # member of the input or output block; in the code, after '.' or '->'
+            member = t.member or (kind != "identifier" and file != "scene.c")
+            patterns[kind].add(("member" if member else "code", t.text[:found.start()],
+                                t.text[found.end():], found.group().isupper()))
+    reserved = {n for n in reserved if not _PROBE_NAME.search(n)}
+    return CNames(frozenset(reserved), {k: frozenset(v) for k, v in patterns.items()})
+
+
+def _c_name_clashes(p: _Problems, objects: list):
+    """Every clash of the C names the scene's names lead to: a name the generated code,
+    the core or C already uses (a dyad 'in', 'load' or 'cos'), or one C name derived
+    from two names (a dyad 'rod_f' beside the resultant force rod_f of a link 'rod').
+    `objects`: (kind, name, label, (section, index, key)) in file order."""
+    names = c_names()
+    taken: dict[tuple[str, str], str] = {}
+    for kind, name, label, where in objects:
+        # an identifier itself too: 'EOF' or 'main' would name the FMU, its library and
+        # files after a name of C (a dyad's name is a C name as it is: see the patterns)
+        if kind == "identifier" and name in names.reserved:
+            p.add(f"{label}: its name is already a name of C, its standard headers, the core "
+                  f"or the generated code ('{name}'); choose another name", *where)
+            continue
+        for scope, cname in names.derived(kind, name):
+            if scope == "code" and cname in names.reserved:
+                what = "its name" if cname == name else f"the C name '{cname}' it leads to"
+                p.add(f"{label}: {what} is already a name of C, its standard headers, the "
+                      f"core or the generated code ('{cname}'); choose another name", *where)
+                break
+            other = taken.setdefault((scope, cname), label)
+            if other != label:
+                p.add(f"{label}: the generated C code would use the name '{cname}' both for "
+                      f"{other} and for {label}; rename one of them", *where)
+                break
+
+
+def load_scene(path, *, check_c_names: bool = True) -> Scene:
+    """Read and validate a scene; raises SceneError listing every problem.
+    `check_c_names`: refuse names whose C names clash (off only for the C names
+    probe, from which the clashes are learnt)."""
     path = Path(path)
+    shown_name = textsafe.plain(path.name)
     try:
-        text = path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except OSError as exc:
-        raise SceneError([f"{path.name}: cannot read: {exc.strerror}"]) from None
+        raise SceneError([f"{shown_name}: cannot read: {exc.strerror}"]) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise SceneError([f"{shown_name}:{line}: not UTF-8 text (byte {exc.start + 1})"]) \
+            from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         line = re.search(r"at line (\d+)", str(exc))
-        where = f"{path.name}:{line.group(1)}" if line else path.name
-        raise SceneError([f"{where}: invalid TOML: {exc}"]) from None
+        where = f"{shown_name}:{line.group(1)}" if line else shown_name
+        raise SceneError([f"{where}: invalid TOML: {textsafe.plain(exc)}"]) from None
     p = _Problems(path, Locator(text))
 
     for key in data:
@@ -306,17 +565,18 @@ def load_scene(path) -> Scene:
             p.add(f"unknown table '{key}' (expected {', '.join(sorted(TOP_KEYS))})", key, 0)
     scene_t = data.get("scene")
     if not isinstance(scene_t, dict):
-        raise SceneError([f"{path.name}: missing [scene] table (identifier, description, "
-                          "outputs)"])
+        p.add("missing [scene] table (identifier, description, outputs)", "scene", 0)
+        raise SceneError(p.items)
     _unknown_keys(p, scene_t, SCENE_KEYS, "[scene]", "scene", 0)
     identifier = scene_t.get("identifier")
-    if not isinstance(identifier, str) or not IDENT.match(identifier):
-        p.add(f"[scene]: identifier {identifier!r} must be a C identifier (it names the FMU)",
-              "scene", 0, "identifier")
+    problem = _identifier_problem(identifier)
+    if problem:
+        p.add(f"[scene]: identifier {problem}", "scene", 0, "identifier")
         identifier = "scene"
     description = scene_t.get("description")
-    if not isinstance(description, str) or not description.strip() or "\n" in description:
-        p.add("[scene]: description must be one non-empty line", "scene", 0, "description")
+    problem = textsafe.description_problem(description)
+    if problem:
+        p.add(f"[scene]: description {problem}", "scene", 0, "description")
         description = ""
 
     effects_t = data.get("effects", {})
@@ -352,13 +612,12 @@ def load_scene(path) -> Scene:
         p.add("[gravity] is given, but [effects] gravity is not true: set it or remove the "
               "table", "gravity", 0)
 
-    threshold_value = scene_t.get("singular_threshold", 1.4901161193847656e-8)
-    if (isinstance(threshold_value, bool) or not isinstance(threshold_value, (int, float))
-            or not 0 < threshold_value < 1):
-        p.add(f"[scene]: singular_threshold must be in (0, 1), not {threshold_value!r}",
-              "scene", 0, "singular_threshold")
+    threshold_value = _real(scene_t.get("singular_threshold", 1.4901161193847656e-8))
+    if threshold_value is None or not 0 < threshold_value < 1:
+        p.add(f"[scene]: singular_threshold must be in (0, 1), not "
+              f"{_shown(scene_t.get('singular_threshold'))}", "scene", 0, "singular_threshold")
         threshold_value = 1.4901161193847656e-8
-    threshold = Param("singular_threshold", float(threshold_value), None,
+    threshold = Param("singular_threshold", threshold_value, None,
                       "Conditioning below which a dyad is reported singular (default "
                       "sqrt(eps) = 1.49e-8)",
                       {"min": 0.0, "max": 1.0, "min_exclusive": True, "max_exclusive": True})
@@ -372,9 +631,9 @@ def load_scene(path) -> Scene:
         else:
             _unknown_keys(p, crank_t, CRANK_KEYS, "[crank]", "crank", 0)
             cname = crank_t.get("name", "crank")
-            if not isinstance(cname, str) or not NAME.match(cname) or cname in RESERVED:
-                p.add(f"[crank]: name {cname!r} must be a lower-case identifier and not one of "
-                      f"{', '.join(sorted(RESERVED))}", "crank", 0, "name")
+            problem = _name_problem(cname)
+            if problem:
+                p.add(f"[crank]: name {problem}", "crank", 0, "name")
                 cname = "crank"
             crank = Crank(cname, p.loc.line("crank"))
             where = f"crank '{cname}'"
@@ -415,9 +674,9 @@ def load_scene(path) -> Scene:
         name = row.get("name")
         _unknown_keys(p, row, LINK_KEYS,
                       f"link '{name}'" if isinstance(name, str) else f"link #{i + 1}", "link", i)
-        if not isinstance(name, str) or not NAME.match(name) or name in RESERVED:
-            p.add(f"link #{i + 1}: name {name!r} must be a lower-case identifier and not one "
-                  f"of {', '.join(sorted(RESERVED))}", "link", i, "name")
+        problem = _name_problem(name)
+        if problem:
+            p.add(f"link #{i + 1}: name {problem}", "link", i, "name")
             continue
         if name in link_tables:
             p.add(f"link '{name}' is described twice (also line "
@@ -445,10 +704,8 @@ def load_scene(path) -> Scene:
         name = row.get("name", "")
         if name == "" and len(rows) > 1:
             p.add(f"dyad #{i + 1}: a scene with several dyads must name each one", "dyad", i)
-        elif name != "" and (not isinstance(name, str) or not NAME.match(name) or
-                             name in RESERVED):
-            p.add(f"dyad #{i + 1}: name {name!r} must be a lower-case identifier", "dyad", i,
-                  "name")
+        elif name != "" and _name_problem(name):
+            p.add(f"dyad #{i + 1}: name {_name_problem(name)}", "dyad", i, "name")
             name = f"dyad{i + 1}"
         elif name in names_seen:
             p.add(f"dyad '{name}' is named twice", "dyad", i, "name")
@@ -513,6 +770,19 @@ def load_scene(path) -> Scene:
             continue
         _link_params(p, links[lname], row, i, inertia, needs_mass)
 
+    if check_c_names:
+        objects = []
+        if not _identifier_problem(identifier):
+            objects.append(("identifier", identifier, f"[scene]: identifier '{identifier}'",
+                            ("scene", 0, "identifier")))
+        if crank:
+            objects.append(("crank", crank.name, f"crank '{crank.name}'", ("crank", 0, "name")))
+        objects += [("dyad", d.name, f"dyad '{d.name}'", ("dyad", d.index, "name"))
+                    for d in dyads if d.name]
+        objects += [("link", g, f"link '{g}'", ("link", i, "name"))
+                    for g, (row, i) in link_tables.items()]
+        _c_name_clashes(p, objects)
+
     # ---- loads
     loads_t = data.get("loads", {})
     if not isinstance(loads_t, dict):
@@ -570,8 +840,7 @@ def load_scene(path) -> Scene:
 
 
 def _finite_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and \
-        math.isfinite(value)
+    return _real(value) is not None
 
 
 def _attachment(p, spec, side, pair_kind, pair, label, i, crank, links, dyad):
@@ -593,10 +862,10 @@ def _attachment(p, spec, side, pair_kind, pair, label, i, crank, links, dyad):
     target = spec.get("link")
     prefix = dyad.prefix()
     sliding = pair_kind == "T"
-    moving = (crank is not None and target == crank.name) or target in links
     if not isinstance(target, str):
         p.add(f"{label}: '{side}' needs link = <name>", "dyad", i, side)
         return None
+    moving = (crank is not None and target == crank.name) or target in links
     if target not in ("frame", "external") and not moving:
         later = f" (a link of a later dyad or of this one: dyads are listed from the crank " \
                 f"outwards)" if target else ""
@@ -635,7 +904,7 @@ def _attachment(p, spec, side, pair_kind, pair, label, i, crank, links, dyad):
                 if kind == "frame" else
                 f"Direction of the guide at {pair} on {target}: angle of i_{side} from "
                 f"{target}'s i")
-        guide = Param(f"{prefix}guide_{side}.angle", float(angle), "rad", text)
+        guide = Param(f"{prefix}guide_{side}.angle", _real(angle), "rad", text)
         if kind == "frame":
             return Attachment("frame", guide=guide)
 
@@ -658,8 +927,8 @@ def _attachment(p, spec, side, pair_kind, pair, label, i, crank, links, dyad):
     else:
         pname, what = f"{prefix}{pair}", f"Pair {pair} on {target}"
     return Attachment(kind, target,
-                      (Param(f"{pname}.x", float(at[0]), "m", f"{what}: x in the {frame}"),
-                       Param(f"{pname}.y", float(at[1]), "m", f"{what}: y in the {frame}")),
+                      (Param(f"{pname}.x", _real(at[0]), "m", f"{what}: x in the {frame}"),
+                       Param(f"{pname}.y", _real(at[1]), "m", f"{what}: y in the {frame}")),
                       guide)
 
 
@@ -803,14 +1072,15 @@ def _apply_starts(p: _Problems, scene: Scene, starts, candidates: set):
             p.add(f"[start]: '{name}' is no input of this scene (inputs: "
                   f"{', '.join(by_name)})", "start", 0, name)
             continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-                not math.isfinite(value):
-            p.add(f"[start]: '{name}' must be a finite number, not {value!r}", "start", 0, name)
+        number = _real(value)
+        if number is None:
+            p.add(f"[start]: '{name}' must be a finite number (within the range of a double), "
+                  f"not {_shown(value)}", "start", 0, name)
             continue
-        if "min" in target.domain and not value > target.domain["min"]:
-            p.add(f"[start]: '{name}' must be positive, not {value!r}", "start", 0, name)
+        if "min" in target.domain and not number > target.domain["min"]:
+            p.add(f"[start]: '{name}' must be positive, not {_shown(value)}", "start", 0, name)
             continue
-        target.start = float(value)
+        target.start = number
 
 
 def _prune_inputs(scene: Scene):
@@ -822,32 +1092,49 @@ def _prune_inputs(scene: Scene):
     scene.inputs = [i for i in scene.inputs if i.member in used]
 
 
-def _ancestors(scene: Scene, name: str, seen=None) -> set:
-    """The moving links whose motion the acceleration of link `name`'s D derives from."""
-    seen = set() if seen is None else seen
-    if scene.crank and name == scene.crank.name:
-        return seen
-    link = scene.links[name]
-    att = link.dyad.k if link.side == "m" else link.dyad.p
-    if att.kind in ("crank", "link") and att.link not in seen:
-        seen.add(att.link)
-        _ancestors(scene, att.link, seen)
-    return seen
+def _carriers(scene: Scene) -> dict:
+    """Link name -> the moving link (crank or dyad link) its pair D sits on, or None."""
+    out = {}
+    for name, link in scene.links.items():
+        att = link.dyad.k if link.side == "m" else link.dyad.p
+        out[name] = att.link if att.kind in ("crank", "link") else None
+    if scene.crank:
+        out[scene.crank.name] = None
+    return out
+
+
+def _ancestors(carrier_of: dict, names) -> set:
+    """The moving links whose motion the accelerations of the links `names`' pairs D
+    derive from: their carriers, the carriers' carriers, and so on (`carrier_of` from
+    _carriers). Each link is visited once."""
+    found: set = set()
+    for name in names:
+        carrier = carrier_of[name]
+        while carrier is not None and carrier not in found:
+            found.add(carrier)
+            carrier = carrier_of[carrier]
+    return found
 
 
 def _loaders(scene: Scene, dyad: Dyad) -> list:
     """Dyads whose reactions load this dyad's links, directly or through others."""
-    found, frontier = [], [dyad]
-    while frontier:
-        current = frontier.pop()
-        mine = {current.m, current.n}
+    if not scene.loaders:
+        # a dyad hangs only on links of earlier dyads: from the last dyad back, each one's
+        # loaders are the dyads on its links and their loaders
+        on_link: dict[str, list] = {}
         for d in scene.dyads:
-            if d in found or d is dyad:
-                continue
-            if any(a.kind == "link" and a.link in mine for a in (d.k, d.p)):
-                found.append(d)
-                frontier.append(d)
-    return found
+            for a in (d.k, d.p):
+                if a.kind == "link":
+                    on_link.setdefault(a.link, []).append(d)
+        for d in reversed(scene.dyads):
+            found: dict[int, Dyad] = {}
+            for g in (d.m, d.n):
+                for child in on_link.get(g, []):
+                    found[child.index] = child
+                    found.update((o.index, o) for o in scene.loaders[child.index])
+            found.pop(d.index, None)
+            scene.loaders[d.index] = list(found.values())
+    return scene.loaders[dyad.index]
 
 
 def _inputs_of_links(scene: Scene, names: set) -> list:
@@ -866,20 +1153,22 @@ def _derive_outputs(p: _Problems, scene: Scene, wanted):
     by_name: dict[str, list[Output]] = {}
     geometry_inputs = {i.name for i in scene.inputs
                        if i.unit in ("rad", "m") and not i.name.endswith(".moment")}
+    owner_of = {i.name: i.owner for i in scene.inputs}
+    # the inputs of no link: the guides of external links, DYAD.guide_k.angle
+    unowned = [i.name for i in scene.inputs if i.owner == ""]
+    carrier_of = _carriers(scene)
     for d in scene.dyads:
         involved = {d.m, d.n}
         for other in _loaders(scene, d):
             involved |= {other.m, other.n}
-        for g in list(involved):
-            involved |= _ancestors(scene, g)
-        deps = _inputs_of_links(scene, involved) + [
-            i.name for i in scene.inputs if i.owner == "" and i.name.startswith(d.prefix())]
+        involved |= _ancestors(carrier_of, involved)
+        guides = [n for n in unowned if n.startswith(d.prefix())]
+        deps = _inputs_of_links(scene, involved) + guides
         # the conditioning: the dyad's own directions and lengths, and the direction of a
         # guide it slides on (an input, or a moving carrier's angle)
-        carriers = {a.link for a in (d.k, d.p) if a.guide is not None and a.link}
+        own = {d.m, d.n} | {a.link for a in (d.k, d.p) if a.guide is not None and a.link}
         own_geometry = [n for n in deps if n in geometry_inputs and
-                        (n.split(".")[0] in {d.m, d.n} | carriers or
-                         n.startswith(d.prefix() + "guide"))]
+                        (owner_of[n] in own or n in guides)]
         pre = d.prefix()
         for pair, idx in PAIR_NAMES:
             group = []
@@ -922,6 +1211,7 @@ def _derive_outputs(p: _Problems, scene: Scene, wanted):
         by_name[f"{c}.R_O"] = r_o
         offered += [torque] + r_o
     chosen: list[Output] = []
+    picked: set[int] = set()
     for w in wanted:
         if w == "all":
             group = offered
@@ -936,9 +1226,11 @@ def _derive_outputs(p: _Problems, scene: Scene, wanted):
                 p.add(f"[scene]: output '{w}': {_why_not(scene, w)}", "scene", 0, "outputs")
                 continue
         for o in group:
-            if o not in chosen:
+            if id(o) not in picked:
+                picked.add(id(o))
                 chosen.append(o)
-    chosen.sort(key=offered.index)
+    position = {id(o): k for k, o in enumerate(offered)}
+    chosen.sort(key=lambda o: position[id(o)])
     status = Output("status", None, "0 ok, 1 a dyad is singular, 3 a reaction overflows",
                     "status", integer=True, depends=[i.name for i in scene.inputs])
     scene.outputs = chosen + [status]
@@ -1001,7 +1293,13 @@ class SceneTable(generate.Table):
         self.description = scene.description
         self.variables = [Variable(raw, k, kind) for k, raw in enumerate(rows)]
         self.by_name = {v.name: v for v in self.variables}
-        self.token = generate.instantiation_token(self.model, rows)
+        self.rows = rows
+
+    @functools.cached_property
+    def token(self) -> str:
+        """The instantiation token, a hash of the whole table (computed when first asked
+        for: the tables of the C names probe and of input pruning never need it)."""
+        return generate.instantiation_token(self.model, self.rows)
 
 
 def _bounds(raw: dict, domain: dict):
@@ -1111,7 +1409,8 @@ def scene_header(table: SceneTable) -> str:
     ident = scene.identifier
     guard = f"DYADFMU_SCENE_{ident.upper()}_H"
     lines = [f"/* {ident}_scene.h: the input and output blocks of the scene {ident}.",
-             f" * Generated by modelDescription/scene.py from {scene.path.name}; do not edit. */",
+             f" * Generated by modelDescription/scene.py from "
+             f"{textsafe.c_comment(scene.path.name)}; do not edit. */",
              f"#ifndef {guard}", f"#define {guard}", "", '#include "fmu_model.h"', "",
              "/* Inputs and tunable parameters; an angle is kept as its unit vector. */",
              f"typedef struct {ident}_input {{"]
@@ -1381,8 +1680,8 @@ def scene_c(table: SceneTable) -> str:
             code(f"    load.j_{side} = dyad_perp(load.i_{side});")
         code(f"    load.singular_threshold = {scene.threshold.c()};")
         code(f"    if (dyad_react_{d.type.lower()}(&load, &{dn}) != DYAD_STATUS_OK) {{")
-        code(f"        fail(out, &{dn}, \"{d.name or d.type}\", {scene.threshold.c()}, "
-             "evaluation);")
+        code(f"        fail(out, &{dn}, {textsafe.c_string(d.name or d.type)}, "
+             f"{scene.threshold.c()}, evaluation);")
         code("        return;")
         code("    }")
         for side, att, pair_force in (("k", d.k, "r_mk"), ("p", d.p, "r_np")):
@@ -1428,9 +1727,10 @@ def scene_c(table: SceneTable) -> str:
     # ---- outputs
     code()
     code("/* Outputs */")
+    exprs = _output_exprs(scene)
     for o in scene.outputs:
         if not o.integer:
-            code(f"out->{o.member} = {_output_expr(scene, o)};")
+            code(f"out->{o.member} = {exprs[o.member]};")
     code("out->status = 0;")
     code("check(out, evaluation);")
 
@@ -1446,10 +1746,10 @@ def scene_c(table: SceneTable) -> str:
     check_terms = " + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0"
     nan_lines = "\n".join(f"    out->{m} = NAN;" for m in reals)
     header = f'''/* {ident}_scene.c: the computation of the scene {ident}.
- * Generated by modelDescription/scene.py from {scene.path.name}; do not edit: change the
- * scene and regenerate.
+ * Generated by modelDescription/scene.py from {textsafe.c_comment(scene.path.name)}; do not
+ * edit: change the scene and regenerate.
  *
- * {scene.description}
+ * {textsafe.c_comment(scene.description)}
  *
  * Effects: inertia {"on" if scene.inertia else "off"}, gravity {"on" if scene.gravity else "off"}.
  * Every parameter the scene does not list as tunable is a constant here, and a term
@@ -1532,17 +1832,32 @@ const fmu_behaviour {ident}_behaviour = {{sizeof({ident}_input), sizeof({ident}_
 
 def _drop_unused_constants(lines: list) -> list:
     """Remove `const ... name = ...;` lines whose name nothing else reads (a frame vector j
-    that no term of the scene needs, say), until none is left."""
+    that no term of the scene needs, say), until none is left. Each identifier's uses are
+    counted once; removing a line takes its uses off the counts, which may free the
+    constants it read in turn."""
     declaration = re.compile(r"^\s*const [A-Za-z0-9_]+ ([A-Za-z0-9_]+) = .*;$")
-    while True:
-        text = "\n".join(lines)
-        for k, line in enumerate(lines):
-            m = declaration.match(line)
-            if m and len(re.findall(rf"\b{m.group(1)}\b", text)) == 1:
-                del lines[k]
-                break
-        else:
-            return lines
+    word = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+    uses: dict[str, int] = {}
+    declared: dict[str, int] = {}          # constant -> its line
+    for k, line in enumerate(lines):
+        for w in word.findall(line):
+            uses[w] = uses.get(w, 0) + 1
+        m = declaration.match(line)
+        if m:
+            declared[m.group(1)] = k
+    removed: set[int] = set()
+    pending = [name for name in declared if uses[name] == 1]
+    while pending:
+        name = pending.pop()
+        k = declared[name]
+        if k in removed or uses[name] != 1:
+            continue
+        removed.add(k)
+        for w in word.findall(lines[k]):
+            uses[w] -= 1
+            if w != name and w in declared and uses[w] == 1:
+                pending.append(w)
+    return [line for k, line in enumerate(lines) if k not in removed]
 
 
 def _sum(terms: list) -> str:
@@ -1554,25 +1869,25 @@ def _sum(terms: list) -> str:
     return expr
 
 
-def _output_expr(scene: Scene, o: Output) -> str:
+def _output_exprs(scene: Scene) -> dict[str, str]:
+    """The C expression of every output's value, by output member."""
+    exprs = {}
     if scene.crank:
         c = _member(scene.crank.name)
-        if o.member == f"{c}_torque":
-            return f"{c}_torque"
-        if o.member.startswith(f"{c}_r_o_"):
-            return f"{c}_r_o.{o.member[-1]}"
+        exprs[f"{c}_torque"] = f"{c}_torque"
+        exprs[f"{c}_r_o_x"] = f"{c}_r_o.x"
+        exprs[f"{c}_r_o_y"] = f"{c}_r_o.y"
     for d in scene.dyads:
         pre = _member(d.prefix())
         dn = _member(d.name or "dyad")
-        if not o.member.startswith(pre):
-            continue
-        rest = o.member[len(pre):]
-        m = re.fullmatch(r"r_(mk|np|mn)_(x|y)", rest)
-        if m:
-            return f"{dn}.r_{m.group(1)}.{m.group(2)}"
-        if rest in ("conditioning", "amplification") or re.fullmatch(r"[nm]_(mk|np|mn)", rest):
-            return f"{dn}.{rest}"
-    raise AssertionError(o.name)
+        for pair in ("mk", "np", "mn"):
+            for c in "xy":
+                exprs[f"{pre}r_{pair}_{c}"] = f"{dn}.r_{pair}.{c}"
+            for kind in "nm":
+                exprs[f"{pre}{kind}_{pair}"] = f"{dn}.{kind}_{pair}"
+        for rest in ("conditioning", "amplification"):
+            exprs[f"{pre}{rest}"] = f"{dn}.{rest}"
+    return exprs
 
 
 
@@ -1598,7 +1913,7 @@ def _num(prm: Param) -> str:
 
 
 def _h(text) -> str:
-    return generate._h(text)
+    return textsafe.html(text)
 
 
 def scene_documentation(table: SceneTable) -> str:

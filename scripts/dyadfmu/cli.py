@@ -104,6 +104,11 @@ def parser() -> argparse.ArgumentParser:
         help="the dyad FMU in a closed loop with the drive FMU: explicit and stabilised "
              "coupling against a monolithic reference (see 'dyadfmu cosim --help')")
     cosim.set_defaults(run=None)
+
+    sub.add_parser(
+        "scene-bench", add_help=False,
+        help="time the scene generator (--check and --out) on chains of 25 to 200 dyads "
+             "(see 'dyadfmu scene-bench --help')").set_defaults(run=None)
     return top
 
 
@@ -227,6 +232,10 @@ def main(argv=None) -> int:
         from . import cosim_report  # its own options: --quick, --out, ...
 
         return cosim_report.main(argv[1:])
+    if argv[:1] == ["scene-bench"]:
+        from . import long_chain  # its own options: --sizes, --generator, --write
+
+        return long_chain.main(argv[1:])
     args = parser().parse_args(argv)
     return args.run(args)
 

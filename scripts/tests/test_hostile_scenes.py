@@ -1,0 +1,617 @@
+"""Scenes as untrusted input: the scene generator (modelDescription/scene.py) on hostile
+and careless scenes.
+
+* Each malformed hostile scene (scenes/malformed/hostile_*.toml) is refused with exactly
+  the message its first line names: descriptions that would end a C comment or carry
+  control or bidi characters, numbers beyond a double, names with a trailing newline,
+  names too long, names that clash with C, the core or the generated code.
+* Every name the generated code, the core or C uses is refused as a dyad's name; the
+  refused set covers every identifier of the generated code of every example scene.
+* Accepted scenes with awkward descriptions and file names put no scene text into the
+  generated C outside comments and string literals, compile with -std=c99 -Werror, and
+  give model descriptions that the FMI 2 and FMI 3 schemas accept.
+* A description that tries to plant a constructor, with the description check bypassed,
+  still compiles to an FMU with the same symbols and constructors as a plain one.
+* A tunable pair point (tunable = ["DYAD.D_m"], or ["all"]) works as documented.
+* Mutated scenes give file:line messages, never a traceback.
+* Checking a long chain grows linearly: counted in function calls, not timed.
+"""
+
+from __future__ import annotations
+
+import collections
+import json
+import math
+import random
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+MD_DIR = ROOT / "modelDescription"
+for _p in (str(MD_DIR), str(ROOT / "scripts")):
+    if _p not in sys.path:
+        sys.path.insert(0, _p)
+
+import cnames  # noqa: E402
+import scene  # noqa: E402
+import textsafe  # noqa: E402
+from dyadfmu import long_chain, scenes  # noqa: E402
+
+SCENE_TOOL = MD_DIR / "scene.py"
+SCENES_DIR = ROOT / "scenes"
+HOSTILE = sorted((SCENES_DIR / "malformed").glob("hostile_*.toml"))
+SIXBAR = SCENES_DIR / "sixbar.toml"
+GCC = shutil.which("gcc")
+needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc not available")
+#: As the FMUs are compiled (CMakeLists.txt), in strict ISO mode so that trigraphs count.
+C_FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror"]
+
+
+def run_tool(*args):
+    return subprocess.run([sys.executable, str(SCENE_TOOL), *map(str, args)],
+                          capture_output=True, text=True)
+
+
+def sixbar_with(tmp_path, name="sixbar.toml", **scene_keys) -> Path:
+    """The six-bar scene with keys of its [scene] table replaced, written to tmp_path."""
+    text = SIXBAR.read_text(encoding="utf-8")
+    for key, value in scene_keys.items():
+        text, count = re.subn(rf"(?m)^{key} = .*$", lambda _: f"{key} = {value}", text)
+        assert count == 1, key
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def toml_string(text: str) -> str:
+    """A TOML basic string (JSON's escapes are TOML's)."""
+    return json.dumps(text, ensure_ascii=False)
+
+
+def include_flags(generated: Path) -> list[str]:
+    from fmpy import __file__ as fmpy_init
+    return [f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'src'}", f"-I{ROOT / 'fmu'}",
+            f"-I{generated}", f"-I{Path(fmpy_init).parent / 'c-code'}"]
+
+
+# ---------------------------------------------------------------------------
+# the hostile malformed scenes, each with its exact message
+# ---------------------------------------------------------------------------
+def test_the_hostile_examples_cover_the_findings():
+    kinds = {p.stem for p in HOSTILE}
+    assert {"hostile_description_comment_end", "hostile_description_control",
+            "hostile_description_bidi", "hostile_number_beyond_double",
+            "hostile_name_trailing_newline", "hostile_identifier_too_long", "hostile_dyad_in",
+            "hostile_dyad_keyword", "hostile_dyad_crank_torque",
+            "hostile_dyad_core_name"} <= kinds
+
+
+@pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
+def test_hostile_scene_is_refused_with_its_exact_message(path, tmp_path):
+    expect = re.fullmatch(r"# expect: line (\d+): (.*)", path.read_text().splitlines()[0])
+    assert expect, f"{path.name}: first line must be '# expect: line N: message'"
+    done = run_tool(path, "--out", tmp_path / "out")
+    assert done.returncode == 1, done.stdout
+    assert "Traceback" not in done.stderr
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error:")]
+    assert f"error: {path.name}:{expect.group(1)}: {expect.group(2)}" in errors, done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_file_that_is_not_utf8_is_refused_with_its_line(tmp_path):
+    path = tmp_path / "latin1.toml"
+    path.write_bytes(b'[scene]\nidentifier = "x"\ndescription = "Pr\xe9sse"\n')
+    with pytest.raises(scene.SceneError) as error:
+        scene.load_scene(path)
+    assert error.value.args[0] == ["latin1.toml:3: not UTF-8 text (byte 43)"]
+
+
+# ---------------------------------------------------------------------------
+# names: C keywords, the names of C's headers, the core and the generated code
+# ---------------------------------------------------------------------------
+def _refusal(tmp_path, text: str) -> list[str]:
+    path = tmp_path / "named.toml"
+    path.write_text(text, encoding="utf-8")
+    try:
+        scene.load_scene(path)
+    except scene.SceneError as error:
+        return error.args[0]
+    return []
+
+
+def test_every_name_the_generated_code_uses_is_refused_as_a_dyad_name(tmp_path):
+    """A dyad's name is a local variable of the generated code; every identifier that C,
+    the headers the code includes, the core and the generated code use is refused, with
+    the dyad's line."""
+    names = scene.c_names()
+    base = SIXBAR.read_text()
+    line = base.splitlines().index('name = "second"') + 1
+    candidates = sorted(n for n in names.reserved if scene.NAME.fullmatch(n))
+    # the examples of the issue, and the macros a C program must leave alone
+    assert {"in", "out", "load", "check", "model", "evaluation", "cos", "snprintf", "memset",
+            "errno", "int", "double"} <= set(candidates)
+    assert {"NULL", "EOF", "INFINITY", "NAN", "errno"} <= names.reserved
+    assert len(candidates) > 300                      # C, math.h, stdio.h, string.h, ...
+    for name in candidates + ["crank_torque", "dyad_cross", "fmu_instance", "dyad"]:
+        problems = _refusal(tmp_path, base.replace('name = "second"', f'name = "{name}"'))
+        assert any(p.startswith(f"named.toml:{line}: dyad ") and f"'{name}'" in p
+                   for p in problems), (name, problems)
+
+
+@pytest.mark.parametrize("name", ("NULL", "EOF", "INFINITY", "NAN", "errno", "main", "int",
+                                  "dyad"))
+def test_an_identifier_named_after_c_or_the_core_is_refused(name, tmp_path):
+    problems = _refusal(tmp_path, SIXBAR.read_text().replace('identifier = "sixbar"',
+                                                             f'identifier = "{name}"'))
+    assert any(p.startswith("named.toml:") and "identifier" in p and f"'{name}" in p
+               for p in problems), problems
+
+
+@pytest.mark.parametrize("keyword", sorted(k for k in cnames.C_KEYWORDS
+                                           if scene.NAME.fullmatch(k)))
+def test_a_c_keyword_is_refused_as_a_link_name(keyword, tmp_path):
+    text = SIXBAR.read_text().replace('"connector"', f'"{keyword}"')
+    line = text.splitlines().index(f'name = "{keyword}"') + 1
+    assert f"named.toml:{line}: link #3: name '{keyword}' is a C keyword" in \
+        _refusal(tmp_path, text)
+
+
+def _scene_objects(sc) -> list[tuple[str, str]]:
+    objects = [("identifier", sc.identifier)]
+    if sc.crank:
+        objects.append(("crank", sc.crank.name))
+    objects += [("dyad", d.name) for d in sc.dyads if d.name]
+    objects += [("link", g) for g in sc.links]
+    return objects
+
+
+SCENE_FILES = sorted(SCENES_DIR.glob("*.toml")) + sorted((ROOT / "tests" / "scenes").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", SCENE_FILES, ids=lambda p: p.stem)
+def test_the_refused_names_cover_the_generated_code(path):
+    """Every identifier of a scene's generated C is a name the generator refuses (C's, the
+    headers', the core's, the generated code's own), or one it derives from a name of
+    the scene, or a member: the probe the refused names are learnt from has every
+    feature of the examples."""
+    names = scene.c_names()
+    sc = scene.load_scene(path)
+    table = scene.build_table(sc)
+    if not isinstance(table, scene.SceneTable):
+        pytest.skip("a generic dyad: no generated code")
+    derived = {c for kind, name in _scene_objects(sc) for _, c in names.derived(kind, name)}
+    code = [t.text for t in cnames.identifiers(scene.scene_c(table)) if not t.member]
+    declared = sorted(cnames.declared_names(scene.scene_header(table)))
+    for name in code + declared:
+        assert name in names.reserved or name in derived, (path.name, name)
+
+
+def test_generated_names_stay_within_c99_significance():
+    """MAX_NAME keeps every derived C name within the 63 characters C99 guarantees."""
+    names = scene.c_names()
+    longest = max(len(c) for kind in names.patterns
+                  for _, c in names.derived(kind, "x" * scene.MAX_NAME))
+    assert longest <= 63
+
+
+# ---------------------------------------------------------------------------
+# scene text in the generated files
+# ---------------------------------------------------------------------------
+AWKWARD_DESCRIPTIONS = (
+    "leakmark opens a comment /* here",
+    'leakmark has a " quote',
+    "leakmark ends in a backslash \\",
+    "leakmark ends in a trigraph ??/",
+    "leakmark %s %n %d",
+    "Presse à vilebrequin — ünïcode ✓ leakmark",
+    '<b>leakmark</b> & "x" -- y -->',
+    "leakmark // a line comment, / * apart, ??= and ??( trigraphs",
+)
+AWKWARD_FILE_NAMES = ("my--press.toml", "leak-->mark.toml", "leak*mark.toml",
+                      "leak\\mark.toml", "leak??=mark.toml", "-leakmark-.toml",
+                      "leak--.toml", "leak\u202emark.toml",
+                      "leak\x07mark.toml")
+
+
+def _generate(tmp_path, description="A six-bar", file_name="sixbar.toml") -> Path:
+    path = sixbar_with(tmp_path, file_name, description=toml_string(description))
+    out = tmp_path / "generated"
+    done = run_tool(path, "--out", out)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+def _no_scene_text_in_code(out: Path, marker: str):
+    for source in sorted(out.glob("*.[ch]")):
+        for t in cnames.tokens(source.read_text(encoding="utf-8")):
+            if t.kind not in ("comment", "string", "header"):
+                assert marker not in t.text.lower(), (source.name, t)
+
+
+def _compiles(out: Path, tmp_path):
+    for source in sorted(out.glob("*.c")):
+        done = subprocess.run([GCC, *C_FLAGS, "-fsyntax-only", *include_flags(out),
+                               str(source)], capture_output=True, text=True)
+        assert done.returncode == 0, (source.name, done.stderr)
+
+
+def _valid_model_descriptions(out: Path, tmp_path, description: str):
+    from fmpy import read_model_description
+    layout = tmp_path / "fmu3"
+    (layout / "sources").mkdir(parents=True)
+    shutil.copy(out / "fmi3" / "modelDescription.xml", layout / "modelDescription.xml")
+    shutil.copy(out / "fmi3" / "buildDescription.xml",
+                layout / "sources" / "buildDescription.xml")
+    for where in (out / "fmi2" / "modelDescription.xml", layout):
+        md = read_model_description(str(where), validate=True, validate_variable_names=True,
+                                    validate_model_structure=True)
+        assert md.description == description
+        assert len(md.modelVariables) > 30
+
+
+@needs_gcc
+@pytest.mark.parametrize("description", AWKWARD_DESCRIPTIONS)
+def test_an_awkward_description_stays_in_comments_and_strings(description, tmp_path):
+    assert textsafe.description_problem(description) is None
+    out = _generate(tmp_path, description)
+    _no_scene_text_in_code(out, "leakmark")
+    assert textsafe.c_comment(description) in (out / "sixbar_scene.c").read_text()
+    _compiles(out, tmp_path)
+    _valid_model_descriptions(out, tmp_path, description)
+    page = (out / "documentation" / "index.html").read_text()
+    assert f"<p>{textsafe.html(description)}</p>" in page
+
+
+@needs_gcc
+@pytest.mark.parametrize("file_name", AWKWARD_FILE_NAMES)
+def test_an_awkward_file_name_stays_in_comments(file_name, tmp_path):
+    out = _generate(tmp_path, file_name=file_name)
+    _no_scene_text_in_code(out, "leak")
+    _compiles(out, tmp_path)
+    _valid_model_descriptions(out, tmp_path, "A six-bar")
+    for xml in out.glob("fmi*/*.xml"):
+        comment = re.search(r"<!--(.*?)-->", xml.read_text(), re.S).group(1)
+        assert "--" not in comment and textsafe.xml_comment(file_name) in comment
+
+
+def test_escaping_functions_close_every_way_out():
+    """Random text through each escaping function: nothing that ends or nests a C comment
+    or joins its line, no '--' in an XML comment, a C string that reads back."""
+    rng = random.Random(12)
+    alphabet = "*/\\?=-<>&\"' \n\ta\u202e\u0000\u00e9\U0001f600"
+    for _ in range(3000):
+        text = "".join(rng.choice(alphabet) for _ in range(rng.randint(0, 12)))
+        comment = textsafe.c_comment(text)
+        assert "*/" not in comment and "/*" not in comment and "\\" not in comment
+        assert "??/" not in comment and "\n" not in comment and "\u202e" not in comment
+        xml = textsafe.xml_comment(text)
+        assert "--" not in xml and not xml.endswith("-") and not xml.startswith("-")
+        literal = textsafe.c_string(text)
+        assert literal.isascii() and "??" not in literal
+        assert _read_c_string(literal) == text.encode("utf-8")
+        assert "<" not in textsafe.html(text) and "\u202e" not in textsafe.plain(text)
+
+
+def _read_c_string(literal: str) -> bytes:
+    tokens = cnames.tokens(literal)
+    assert [t.kind for t in tokens] == ["string"]
+    body, out, k = literal[1:-1], bytearray(), 0
+    while k < len(body):
+        if body[k] == "\\":
+            if body[k + 1] in "01234567":
+                out.append(int(body[k + 1:k + 4], 8))
+                k += 4
+            else:
+                out += body[k + 1].encode()
+                k += 2
+        else:
+            out += body[k].encode()
+            k += 1
+    return bytes(out)
+
+
+# ---------------------------------------------------------------------------
+# a constructor planted in the description
+# ---------------------------------------------------------------------------
+#: A constructor with a side effect (gcc drops an empty one), and a global it sets.
+PLANT = ("x */ volatile int dyadfmu_planted_flag; __attribute__((constructor)) static void "
+         "dyadfmu_planted(void) { dyadfmu_planted_flag = 1; } /* y")
+
+
+def test_a_planted_constructor_is_refused(tmp_path):
+    path = sixbar_with(tmp_path, description=toml_string(PLANT))
+    line = path.read_text().splitlines().index(f"description = {toml_string(PLANT)}") + 1
+    done = run_tool(path, "--check")
+    assert done.returncode == 1
+    assert (f"error: sixbar.toml:{line}: [scene]: description must not contain '*/' (it is "
+            "copied into a C comment, which '*/' would end)") in done.stderr.splitlines()
+
+
+def _build_fmu(table, tmp_path, name) -> Path:
+    """The FMI 2 FMU of a tailored table, compiled as CMake compiles it (hidden
+    visibility, the FMI functions exported and nothing else, unused sections dropped)."""
+    gen = tmp_path / name
+    for rel, text in scene.outputs_of(table).items():
+        (gen / rel).parent.mkdir(parents=True, exist_ok=True)
+        (gen / rel).write_text(text, encoding="utf-8")
+    ident = table.identifier
+    library = gen / "binaries" / "linux64" / f"{ident}.so"
+    library.parent.mkdir(parents=True)
+    types = sorted({d.type.lower() for d in table.scene.dyads})
+    sources = ([ROOT / "src" / "dyad_common.c"] + [ROOT / "src" / f"dyad_{t}.c" for t in types]
+               + [gen / f"{ident}_scene.c", ROOT / "fmu" / "fmu_instance.c",
+                  ROOT / "fmu" / "fmi2_functions.c", gen / f"{ident}_model.c"])
+    done = subprocess.run(
+        [GCC, *C_FLAGS, "-O1", "-fPIC", "-shared", "-fvisibility=hidden",
+         "-ffunction-sections", "-fdata-sections", "-Wl,--gc-sections",
+         f"-Wl,--version-script={ROOT / 'fmu' / 'exports.map'}", *include_flags(gen),
+         *map(str, sources), "-o", str(library), "-lm"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    fmu = tmp_path / f"{name}.fmu"
+    with zipfile.ZipFile(fmu, "w") as archive:
+        archive.write(gen / "fmi2" / "modelDescription.xml", "modelDescription.xml")
+        archive.write(library, f"binaries/linux64/{ident}.so")
+    return fmu
+
+
+def _symbols_and_constructors(fmu: Path, tmp_path) -> tuple[list, int]:
+    with zipfile.ZipFile(fmu) as archive:
+        name = next(n for n in archive.namelist() if n.endswith(".so"))
+        library = tmp_path / "inspect" / fmu.stem / Path(name).name
+        library.parent.mkdir(parents=True)
+        library.write_bytes(archive.read(name))
+    nm = subprocess.run(["nm", "--defined-only", str(library)], capture_output=True, text=True)
+    symbols = sorted(line.split()[-1] for line in nm.stdout.splitlines())
+    sections = subprocess.run(["objdump", "-h", str(library)], capture_output=True,
+                              text=True).stdout
+    init = re.search(r"\.init_array\s+([0-9a-f]+)", sections)
+    return symbols, int(init.group(1), 16) if init else 0
+
+
+@needs_gcc
+@pytest.mark.skipif(shutil.which("nm") is None or shutil.which("objdump") is None,
+                    reason="binutils not available")
+def test_a_planted_constructor_stays_a_comment_even_past_the_check(tmp_path):
+    """With the description check bypassed, the escaping of the C comment alone keeps the
+    planted code out: the FMU has the same symbols and constructors as with a plain
+    description, and fmpy validates and runs it."""
+    from fmpy import simulate_fmu
+    from fmpy.validation import validate_fmu
+    plain = scene.build_table(scene.load_scene(SIXBAR))
+    planted_scene = scene.load_scene(SIXBAR)
+    planted_scene.description = PLANT
+    planted = scene.build_table(planted_scene)
+    assert textsafe.html(PLANT) in scene.outputs_of(planted)["documentation/index.html"]
+    plain_fmu = _build_fmu(plain, tmp_path, "plain")
+    planted_fmu = _build_fmu(planted, tmp_path, "planted")
+    want = _symbols_and_constructors(plain_fmu, tmp_path)
+    got = _symbols_and_constructors(planted_fmu, tmp_path)
+    assert not any("planted" in s for s in got[0])
+    assert got == want
+    assert validate_fmu(str(planted_fmu)) == []
+    result = simulate_fmu(str(planted_fmu), stop_time=0.01, step_size=0.005,
+                          output=["status"])
+    assert len(result) >= 2
+
+
+# ---------------------------------------------------------------------------
+# a tunable pair point
+# ---------------------------------------------------------------------------
+class _Slave:
+    def __init__(self, fmu: Path, tmp_path, tag):
+        from fmpy import read_model_description
+        from fmpy.fmi2 import FMU2Slave
+        self.md = read_model_description(str(fmu))
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        unzipped = tmp_path / f"unzipped_{tag}"
+        with zipfile.ZipFile(fmu) as archive:
+            archive.extractall(unzipped)
+        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=str(unzipped),
+                             modelIdentifier=self.md.coSimulation.modelIdentifier,
+                             instanceName=tag)
+        self.fmu.instantiate(loggingOn=False)
+        self.fmu.setupExperiment(startTime=0)
+        self.fmu.enterInitializationMode()
+
+    def start(self, parameters: dict):
+        if parameters:
+            self.fmu.setReal([self.vr[n] for n in parameters], list(parameters.values()))
+        self.fmu.exitInitializationMode()
+
+    def outputs(self, inputs: dict, names):
+        self.fmu.setReal([self.vr[n] for n in inputs], list(inputs.values()))
+        self.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+        return np.array(self.fmu.getReal([self.vr[n] for n in names]))
+
+
+@needs_gcc
+@pytest.mark.parametrize("tunable", ('["second.D_m"]', '["all"]'))
+def test_a_tunable_pair_point_is_a_parameter_that_works(tunable, tmp_path):
+    """scenes/README.md lists DYAD.D_m.x (a pair point `at`) among the tunable parameters:
+    with it tunable, the FMU gives the outputs of the baked scene at the same value, and
+    other outputs at another value."""
+    path = sixbar_with(tmp_path, "tunable.toml", tunable=tunable)
+    assert run_tool(path, "--check").returncode == 0
+    tuned = scene.build_table(scene.load_scene(path))
+    params = [v.name for v in tuned.variables if v.causality == "parameter"]
+    assert {"second.D_m.x", "second.D_m.y"} <= set(params)
+    baked = scene.build_table(scene.load_scene(SIXBAR))
+    source = scenes.Source("sixbar")
+    motion = source.motion("varying", 1.0)
+    kin = source.kinematics(np.array([0.37 * motion.duration]), motion)
+    inputs = {v.name: float(np.asarray(kin[v.name])[0])
+              for v in baked.variables if v.causality == "input"}
+    names = [v.name for v in baked.variables if v.causality == "output" and v.type == "Real"]
+    want = _Slave(_build_fmu(baked, tmp_path, "baked"), tmp_path, "baked")
+    want.start({})
+    expected = want.outputs(inputs, names)
+    same = _Slave(_build_fmu(tuned, tmp_path, "tuned"), tmp_path, "same")
+    same.start({})
+    assert np.array_equal(same.outputs(inputs, names), expected)
+    moved = _Slave(tmp_path / "tuned.fmu", tmp_path, "moved")
+    start = {v.name: v.start for v in tuned.variables if v.name == "second.D_m.x"}
+    moved.start({"second.D_m.x": start["second.D_m.x"] + 0.01})
+    assert not np.array_equal(moved.outputs(inputs, names), expected)
+
+
+# ---------------------------------------------------------------------------
+# every failure a message
+# ---------------------------------------------------------------------------
+_NASTY = [10 ** 400, -10 ** 400, math.nan, math.inf, 0, -1, 1e308, True, "", "x", "\u202e",
+          "a*/b", "in", "load", "dyad_x", "crank", "frame", "external", "all", [], [1, 2],
+          [10 ** 400, 0], ["all"], {}, {"link": "frame"}, {"link": {"name": "crank"}},
+          {"link": "crank", "at": [0.0, 0.0]}, {"link": "crank", "guide": 0.1}, "RRR", "RTT",
+          "TRT", "a" * 41, "rocker", "coupler", "first", "link_m", [[1]], 0.5, {"x": 1},
+          "status", "first.D_m", "crank.torque", "int", "rod_f", "crank_torque", "x\n"]
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float) and not math.isfinite(v):
+        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return toml_string(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(map(_toml_value, v)) + "]"
+    return "{ " + ", ".join(f"{toml_string(k)} = {_toml_value(x)}" for k, x in v.items()) + " }"
+
+
+def _toml(data: dict) -> str:
+    lines = []
+    for key, value in data.items():
+        rows = value if isinstance(value, list) and value and \
+            all(isinstance(r, dict) for r in value) else None
+        if isinstance(value, dict):
+            rows = [value]
+        if rows is None:
+            lines.insert(0, f"{toml_string(key)} = {_toml_value(value)}")
+            continue
+        for row in rows:
+            lines.append(f"[{toml_string(key)}]" if isinstance(value, dict) else
+                         f"[[{toml_string(key)}]]")
+            lines += [f"{toml_string(k)} = {_toml_value(v)}" for k, v in row.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _mutate(rng, node, depth=0):
+    if isinstance(node, dict) and node:
+        key = rng.choice(list(node))
+        r = rng.random()
+        if r < 0.4 or depth > 3:
+            node[key] = rng.choice(_NASTY)
+        elif r < 0.5:
+            del node[key]
+        elif r < 0.6:
+            node[rng.choice(["name", "at", "guide", "link", "k", "p", "type", "x"])] = \
+                rng.choice(_NASTY)
+        else:
+            _mutate(rng, node[key], depth + 1)
+    elif isinstance(node, list) and node:
+        k = rng.randrange(len(node))
+        r = rng.random()
+        if r < 0.3 and not isinstance(node[k], dict):
+            node[k] = rng.choice(_NASTY)
+        elif r < 0.4:
+            node.append(json.loads(json.dumps(node[k])))
+        elif r < 0.5:
+            del node[k]
+        else:
+            _mutate(rng, node[k], depth + 1)
+
+
+def test_mutated_scenes_give_messages_never_tracebacks(tmp_path):
+    """Values of the example scenes replaced by numbers beyond a double, NaN, wrong types,
+    names that clash, tables where strings belong: the generator accepts the scene and
+    generates it, or refuses it with file:line messages; nothing else escapes."""
+    sources = [(p, tomllib.loads(p.read_text())) for p in sorted(SCENES_DIR.glob("*.toml"))]
+    rng = random.Random(2024)
+    outcomes = collections.Counter()
+    for trial in range(600):
+        path, data = rng.choice(sources)
+        data = json.loads(json.dumps(data))
+        for _ in range(rng.randint(1, 3)):
+            _mutate(rng, data)
+        target = tmp_path / path.name
+        try:
+            target.write_text(_toml(data), encoding="utf-8")
+            tomllib.loads(target.read_text())
+        except (ValueError, TypeError, tomllib.TOMLDecodeError):
+            continue
+        try:
+            scene.outputs_of(scene.build_table(scene.load_scene(target)))
+            outcomes["accepted"] += 1
+        except scene.SceneError as error:
+            outcomes["refused"] += 1
+            for message in error.args[0]:
+                assert re.match(rf"{re.escape(path.name)}:\d+: \S", message), (trial, message)
+    assert outcomes["refused"] > 300 and outcomes["accepted"] > 20, outcomes
+
+
+# ---------------------------------------------------------------------------
+# long chains
+# ---------------------------------------------------------------------------
+def _calls_to_check(path: Path) -> int:
+    """Python and C function calls made while checking a scene (as --check does)."""
+    count = 0
+
+    def profile(frame, event, arg):
+        nonlocal count
+        if event in ("call", "c_call"):
+            count += 1
+
+    sys.setprofile(profile)
+    try:
+        scene.build_table(scene.load_scene(path))
+    finally:
+        sys.setprofile(None)
+    return count
+
+
+def test_checking_a_chain_grows_linearly_with_its_dyads(tmp_path):
+    """Function calls, not time: twice the dyads may cost a little more than twice the
+    calls (the dependency lists are longer), not four or eight times."""
+    scene.c_names()                                   # learnt once per process
+    small = _calls_to_check(long_chain.write_chain(50, tmp_path))
+    large = _calls_to_check(long_chain.write_chain(100, tmp_path))
+    print(f"calls to check 50 dyads: {small}, 100 dyads: {large} ({large / small:.2f} x)")
+    assert large < 2.3 * small
+
+
+@needs_gcc
+def test_a_chain_of_200_dyads_is_checked_generated_and_compiles(tmp_path):
+    path = long_chain.write_chain(200, tmp_path)
+    done = run_tool(path, "--check")
+    assert done.returncode == 0, done.stderr
+    assert "chain200 (tailored): 1803 inputs, 3 parameters, 1604 outputs" in done.stdout
+    out = tmp_path / "generated"
+    assert run_tool(path, "--out", out).returncode == 0
+    source = out / "chain200_scene.c"
+    assert source.read_text().count("dyad_react_rrr(&load, &d") == 200
+    _compiles(out, tmp_path)
+
+
+# ---------------------------------------------------------------------------
+# CMake
+# ---------------------------------------------------------------------------
+def test_cmake_stops_on_a_planted_description(tmp_path):
+    bad = SCENES_DIR / "malformed" / "hostile_description_comment_end.toml"
+    done = subprocess.run(
+        ["cmake", "-S", str(ROOT), "-B", str(tmp_path / "build"), "-DDYADFMU_BUILD_TESTS=OFF",
+         "-DDYADFMU_BUILD_BENCH=OFF", f"-DPython3_EXECUTABLE={sys.executable}",
+         f"-DDYADFMU_SCENES={bad}"], capture_output=True, text=True)
+    assert done.returncode != 0
+    message = " ".join(done.stderr.split())           # CMake wraps long lines
+    assert "hostile_description_comment_end.toml:4: [scene]: description must not contain" \
+        in message, done.stderr
