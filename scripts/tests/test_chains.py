@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import copy
 import math
-import sys
 import tomllib
 from functools import lru_cache
 from pathlib import Path
@@ -39,7 +38,6 @@ from matplotlib.patches import FancyArrow  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-sys.path.insert(0, str(HERE.parent))
 from dyadfmu import chain_drawing, chains  # noqa: E402
 
 NAMES = ("shaper", "sixbar", "rocker_slider")

@@ -30,14 +30,12 @@ import csv
 import functools
 import math
 import os
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent))
 from dyadfmu import cosim, cosim_report, machine, mechanisms, reference  # noqa: E402
 
 ROOT = HERE.parents[1]

@@ -37,9 +37,6 @@ import pytest
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 MD_DIR = ROOT / "modelDescription"
-for _p in (str(MD_DIR), str(ROOT / "scripts")):
-    if _p not in sys.path:
-        sys.path.insert(0, _p)
 
 import cnames  # noqa: E402
 import scene  # noqa: E402

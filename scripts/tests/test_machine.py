@@ -17,15 +17,11 @@
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent))
-from dyadfmu import crank, machine, mechanisms  # noqa: E402
+from dyadfmu import crank, machine, mechanisms
 
 NAMES = mechanisms.NAMES
 RATIOS = (0.1, 1.0, 10.0, 100.0)

@@ -19,7 +19,6 @@ For every mechanism and both crank motions:
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +31,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-sys.path.insert(0, str(HERE.parent))
 from dyadfmu import drawing, mechanisms, reference  # noqa: E402
 
 NAMES = mechanisms.NAMES
@@ -460,7 +458,6 @@ def test_quick_return_strokes():
 # ---------------------------------------------------------------------------
 def toml_names(dyad, causality):
     """The generic dyad FMU's variables, as the scene generator makes them."""
-    sys.path.insert(0, str(ROOT / "modelDescription"))
     import scene
 
     table = scene.build_table(scene.load_scene(ROOT / "scenes" / f"dyad_{dyad.lower()}.toml"))

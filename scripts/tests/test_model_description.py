@@ -34,9 +34,6 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 MD_DIR = ROOT / "modelDescription"
 GENERATOR = MD_DIR / "generate.py"
-for _p in (str(MD_DIR), str(ROOT / "scripts")):
-    if _p not in sys.path:
-        sys.path.insert(0, _p)
 
 import generate  # noqa: E402
 import scene  # noqa: E402

@@ -1,14 +1,11 @@
 """Tests of the independent Newton-Euler dyad reference (scripts/dyadfmu/reference.py)."""
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from dyadfmu import reference as ref  # noqa: E402
+from dyadfmu import reference as ref
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 # pair kinds (D_m, E, D_n) written out independently of ref.PAIRS
