@@ -827,17 +827,22 @@ def _element(indent: int, tag: str, attributes: list[tuple[str, object]], close=
     return f"{pad}<{tag}{text}{'/>' if close else '>'}"
 
 
-def source_files(table: Table, fmi_functions: str) -> list[str]:
+#: The FMI shim's C files per FMI version (fmu/).
+SHIM_FILES = {2: ["fmi2_functions.c"], 3: ["fmi3_functions.c", "fmi3_unsupported.c"]}
+
+
+def source_files(table: Table, version: int) -> list[str]:
+    """The C files an importer compiles to rebuild the FMI `version` binary."""
+    shim = SHIM_FILES[version]
     if table.kind.name == "scene":
         types = sorted({d.type.lower() for d in table.scene.dyads})
         return (["dyad_common.c"] + [f"dyad_{t}.c" for t in types] +
-                [f"{table.identifier}_scene.c", "fmu_instance.c", fmi_functions,
+                [f"{table.identifier}_scene.c", "fmu_instance.c", *shim,
                  f"{table.identifier}_model.c"])
     if table.kind is DRIVE:
-        return ["fmu_drive.c", "fmu_instance.c", fmi_functions, f"{table.identifier}_model.c"]
+        return ["fmu_drive.c", "fmu_instance.c", *shim, f"{table.identifier}_model.c"]
     return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
-            "fmu_instance.c",
-            fmi_functions, f"{table.identifier}_model.c"]
+            "fmu_instance.c", *shim, f"{table.identifier}_model.c"]
 
 
 def _provides_directional_derivatives(table: Table) -> str:
@@ -900,7 +905,7 @@ def fmi2_model_description(table: Table) -> str:
         ("providesDirectionalDerivative", _provides_directional_derivatives(table))],
         close=False, wrap=True))
     lines.append("    <SourceFiles>")
-    lines += [_element(3, "File", [("name", f)]) for f in source_files(table, "fmi2_functions.c")]
+    lines += [_element(3, "File", [("name", f)]) for f in source_files(table, 2)]
     lines.append("    </SourceFiles>")
     lines.append("  </CoSimulation>")
     lines += _unit_definitions(table)
@@ -1005,7 +1010,7 @@ def fmi3_build_description(table: Table) -> str:
                           close=False))
     lines.append('    <SourceFileSet language="C99">')
     lines += [_element(3, "SourceFile", [("name", f)])
-              for f in source_files(table, "fmi3_functions.c")]
+              for f in source_files(table, 3)]
     lines.append("    </SourceFileSet>")
     lines.append("  </BuildConfiguration>")
     lines.append("</fmiBuildDescription>")

@@ -404,7 +404,8 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
     assert f'"{ident}"' in c_text and f"dyad_solve_{dyad_type.lower()}" in c_text
 
     # co-simulation interface and sources
-    for md, shim in ((md2, "fmi2_functions.c"), (md3, "fmi3_functions.c")):
+    for md, shim in ((md2, ["fmi2_functions.c"]),
+                     (md3, ["fmi3_functions.c", "fmi3_unsupported.c"])):
         assert md.coSimulation is not None and md.modelExchange is None
         assert md.coSimulation.modelIdentifier == ident
         assert md.variableNamingConvention == "structured"
@@ -416,7 +417,7 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
         assert config.sourceFileSets[0].sourceFiles == [
             "dyad_common.c", f"dyad_{dyad_type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
             "fmu_instance.c",
-            shim,
+            *shim,
             f"{ident}_model.c"]
         units = {u.name: u.baseUnit for u in md.unitDefinitions}
         assert set(units) == set(BASE_UNITS)
@@ -828,7 +829,8 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
     assert md3.instantiationToken == token
     assert token not in {generate.load_table(TABLE_OF[t]).token for t in TYPES}
 
-    for md, shim in ((md2, "fmi2_functions.c"), (md3, "fmi3_functions.c")):
+    for md, shim in ((md2, ["fmi2_functions.c"]),
+                     (md3, ["fmi3_functions.c", "fmi3_unsupported.c"])):
         assert md.coSimulation is not None and md.modelExchange is None
         assert md.coSimulation.modelIdentifier == "drive"
         assert md.variableNamingConvention == "structured"
@@ -844,7 +846,7 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
         (config,) = md.buildConfigurations
         assert config.modelIdentifier == "drive"
         assert config.sourceFileSets[0].sourceFiles == [
-            "fmu_drive.c", "fmu_instance.c", shim, "drive_model.c"]
+            "fmu_drive.c", "fmu_instance.c", *shim, "drive_model.c"]
         units = {u.name: u.baseUnit for u in md.unitDefinitions}
         assert set(units) == DRIVE_UNITS
         for name in DRIVE_UNITS:
