@@ -124,22 +124,25 @@ void dyad_link_resultant(const dyad_link* link, dyad_vec2 gravity, dyad_vec2* fo
     *moment = body.m;
 }
 
-dyad_real dyad_force_size(const dyad_result* result)
+/* amplification x the largest of three output magnitudes, NaN unless ok. */
+static dyad_real dyad_error_scale(const dyad_result* result, dyad_real mk, dyad_real np,
+                                  dyad_real mn)
 {
-    const dyad_real mk = dyad_norm1(result->r_mk), np = dyad_norm1(result->r_np),
-                    mn = dyad_norm1(result->r_mn);
     const dyad_real largest = mk > np ? (mk > mn ? mk : mn) : (np > mn ? np : mn);
     return result->status == DYAD_STATUS_OK ? result->amplification * largest
                                             : (dyad_real)NAN;
 }
 
+dyad_real dyad_force_size(const dyad_result* result)
+{
+    return dyad_error_scale(result, dyad_norm1(result->r_mk), dyad_norm1(result->r_np),
+                            dyad_norm1(result->r_mn));
+}
+
 dyad_real dyad_moment_size(const dyad_result* result)
 {
-    const dyad_real mk = dyad_abs(result->m_mk), np = dyad_abs(result->m_np),
-                    mn = dyad_abs(result->m_mn);
-    const dyad_real largest = mk > np ? (mk > mn ? mk : mn) : (np > mn ? np : mn);
-    return result->status == DYAD_STATUS_OK ? result->amplification * largest
-                                            : (dyad_real)NAN;
+    return dyad_error_scale(result, dyad_abs(result->m_mk), dyad_abs(result->m_np),
+                            dyad_abs(result->m_mn));
 }
 
 /* The first field of a link that is out of its domain, or DYAD_FIELD_NONE.

@@ -251,41 +251,48 @@ static int parse_number(const char* text, double* value)
     return stop != text && *stop == '\0';
 }
 
-static int parse_causality(const char* text, probe_causality* causality)
+/* An enumerated attribute: the index of `text` in `names`, or `fallback` when
+ * the attribute is absent (its default in both standards); 0 when unknown. */
+static int parse_enum(const char* text, const char* const names[], size_t count, int fallback,
+                      int* index)
 {
-    static const char* const names[] = {"parameter", "calculatedParameter",
-                                        "structuralParameter", "input", "output", "local",
-                                        "independent"};
     size_t k;
     if (text == NULL) {
-        *causality = PROBE_LOCAL; /* the default of both standards */
+        *index = fallback;
         return 1;
     }
-    for (k = 0; k < sizeof names / sizeof names[0]; ++k) {
+    for (k = 0; k < count; ++k) {
         if (strcmp(text, names[k]) == 0) {
-            *causality = (probe_causality)k;
+            *index = (int)k;
             return 1;
         }
     }
     return 0;
 }
 
+static int parse_causality(const char* text, probe_causality* causality)
+{
+    static const char* const names[] = {"parameter", "calculatedParameter",
+                                        "structuralParameter", "input", "output", "local",
+                                        "independent"};
+    int k;
+    if (!parse_enum(text, names, sizeof names / sizeof names[0], PROBE_LOCAL, &k)) {
+        return 0;
+    }
+    *causality = (probe_causality)k;
+    return 1;
+}
+
 static int parse_variability(const char* text, probe_variability* variability)
 {
     static const char* const names[] = {"constant", "fixed", "tunable", "discrete",
                                         "continuous"};
-    size_t k;
-    if (text == NULL) {
-        *variability = PROBE_CONTINUOUS;
-        return 1;
+    int k;
+    if (!parse_enum(text, names, sizeof names / sizeof names[0], PROBE_CONTINUOUS, &k)) {
+        return 0;
     }
-    for (k = 0; k < sizeof names / sizeof names[0]; ++k) {
-        if (strcmp(text, names[k]) == 0) {
-            *variability = (probe_variability)k;
-            return 1;
-        }
-    }
-    return 0;
+    *variability = (probe_variability)k;
+    return 1;
 }
 
 /* Element names of variable types: FMI 2 (child of <ScalarVariable>), FMI 3. */

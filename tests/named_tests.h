@@ -7,8 +7,15 @@
 #include <stdio.h>
 #include <string.h>
 
+/* A test file that counts its checks defines NAMED_TESTS_ON_CHECK() before
+ * including this header. */
+#ifndef NAMED_TESTS_ON_CHECK
+#define NAMED_TESTS_ON_CHECK() ((void)0)
+#endif
+
 #define CHECK(cond, ...)                                                                        \
     do {                                                                                        \
+        NAMED_TESTS_ON_CHECK();                                                                 \
         if (!(cond)) {                                                                          \
             printf("    FAIL %s:%d: ", __FILE__, __LINE__);                                     \
             printf(__VA_ARGS__);                                                                \
