@@ -119,7 +119,7 @@ fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size
                            const int values[], const char* function);
 
 /* Exact directional derivative of Real outputs (unknowns) along a seed on Real
- * inputs (knowns), at the current inputs (dyad_solve_tangent_with). */
+ * inputs (knowns), at the current inputs (dyad_solve_tangent_of). */
 fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int unknowns[],
                                       size_t n_unknowns, const unsigned int knowns[],
                                       size_t n_knowns, const double seed[], double derivative[],

@@ -1,13 +1,11 @@
-/* dyadfmu FMU layer: the description of one dyad model as the FMU layer sees
- * it. The table of variables is generated from modelDescription/<model>.toml
- * (by modelDescription/generate.py) together with both model descriptions, so
- * the C side and the XML cannot drift apart. */
+/* dyadfmu FMU layer: the description of one model as the FMU layer sees it.
+ * The table of variables is generated from modelDescription/<model>.toml (by
+ * modelDescription/generate.py) together with both model descriptions, so the C
+ * side and the XML cannot drift apart. */
 #ifndef DYADFMU_FMU_MODEL_H
 #define DYADFMU_FMU_MODEL_H
 
 #include <stddef.h>
-
-#include "dyadfmu/dyad.h"
 
 /* Same numbering as fmi2Status and fmi3Status. */
 typedef enum fmu_status {
@@ -58,7 +56,6 @@ typedef struct fmu_variable {
     double start;           /* start value (inputs and parameters) */
     double min, max;        /* bounds, valid where `bounds` says so */
     unsigned bounds;        /* FMU_HAS_MIN | FMU_HAS_MAX | ..._EXCLUSIVE */
-    dyad_field field;       /* the core's input field it feeds (inputs, parameters) */
 } fmu_variable;
 
 struct fmu_model;

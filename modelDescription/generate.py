@@ -1053,7 +1053,7 @@ def model_c(table: Table) -> str:
         "",
         "static const fmu_variable variables[] = {",
         "    /* vr, name, unit, causality, type, target, offset,",
-        "       start, min, max, bounds, field */",
+        "       start, min, max, bounds */",
     ]
     for v in table.variables:
         lines.append(
@@ -1062,8 +1062,7 @@ def model_c(table: Table) -> str:
             f"{v.lives.offset},\n"
             f"     {_num(v.start if v.start is not None else 0.0)}, "
             f"{_num(v.min if v.min is not None else 0.0)}, "
-            f"{_num(v.max if v.max is not None else 0.0)}, {_bounds_flags(v)}, "
-            f"{v.lives.field}}},")
+            f"{_num(v.max if v.max is not None else 0.0)}, {_bounds_flags(v)}}},")
     lines.append("};")
     lines.append("")
     vr_limit = max(v.vr for v in table.variables) + 1
@@ -1078,8 +1077,16 @@ def model_c(table: Table) -> str:
     lines.append("};")
     lines.append("")
     if table.kind is DYAD:
-        lines.append(f"static const fmu_dyad_data dyad = {{DYAD_{table.type}, "
-                     f"dyad_solve_{table.type.lower()}}};")
+        feeds = [(v.lives.field, v.index) for v in table.variables
+                 if v.causality != "output" and v.lives.field != "DYAD_FIELD_NONE"]
+        lines.append("/* The variable that feeds each input field of the core, for errors. */")
+        lines.append("static const fmu_dyad_feed feeds[] = {")
+        lines += [f"    {{{field}, {index}}}," for field, index in feeds]
+        lines.append("};")
+        lines.append("")
+        t = table.type.lower()
+        lines.append(f"static const fmu_dyad_data dyad = {{dyad_solve_{t}, &dyad_tangent_{t}, "
+                     f"feeds, {len(feeds)}}};")
         lines.append("")
         data = "&dyad"
     else:

@@ -24,8 +24,9 @@ dyad_status dyad_solve(dyad_type type, const dyad_input* input, dyad_result* res
 dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dyad_input* seed,
                                dyad_result* value, dyad_result* derivative)
 {
-    static const dyad_solver solvers[DYAD_TYPE_COUNT] = {
-        dyad_solve_rrr, dyad_solve_rrt, dyad_solve_rtr, dyad_solve_trt, dyad_solve_rtt};
+    static const dyad_tangent_type* const kinds[DYAD_TYPE_COUNT] = {
+        &dyad_tangent_rrr, &dyad_tangent_rrt, &dyad_tangent_rtr, &dyad_tangent_trt,
+        &dyad_tangent_rtt};
     if ((unsigned)type >= DYAD_TYPE_COUNT) {
         if (value != NULL) {
             value->denominator = value->conditioning = value->amplification = (dyad_real)NAN;
@@ -36,5 +37,5 @@ dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dy
         }
         return DYAD_STATUS_INVALID_INPUT;
     }
-    return dyad_solve_tangent_with(solvers[type], type, input, seed, value, derivative);
+    return dyad_solve_tangent_of(kinds[type], input, seed, value, derivative);
 }

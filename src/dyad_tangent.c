@@ -24,7 +24,7 @@
  * normal to the direction counts (the angle rate dtheta = dir x ddir), as a
  * unit vector can only turn.
  */
-#include "dyad_internal.h"
+#include "dyad_tangent.h"
 
 /* Angle rate of a unit direction d under the seed dd. */
 static dyad_real turn_rate(dyad_vec2 d, dyad_vec2 dd)
@@ -67,13 +67,13 @@ static void resultant_rate(const dyad_link* k, const dyad_link* dk, dyad_vec2 i,
 /* The rate of the amplification (dyad_amplification.h): the same formulas as
  * the solvers', on dual numbers. inv: the inverse of the type's divisor with
  * its rate. */
-static dyad_real amplification_rate(dyad_type type, const dyad_input* input, const dyad_input* seed,
-                                    const dyad_link_sizes* m, const dyad_link_sizes* n,
-                                    dyad_dual inv, const dyad_result* value,
-                                    const dyad_result* derivative)
+static dyad_real amplification_rate(const dyad_tangent_type* kind, const dyad_input* input,
+                                    const dyad_input* seed, const dyad_link_sizes* m,
+                                    const dyad_link_sizes* n, dyad_dual inv,
+                                    const dyad_result* value, const dyad_result* derivative)
 {
+    const dyad_type type = kind->type;
     dyad_size_terms t;
-    dyad_output_sizes sizes;
     t.f_m = m->f;
     t.m_m = m->m_d;
     t.f_n = n->f;
@@ -81,15 +81,8 @@ static dyad_real amplification_rate(dyad_type type, const dyad_input* input, con
     t.l_m = dyad_dual_make(input->m.length, seed->m.length);
     t.l_n = dyad_dual_make(input->n.length, seed->n.length);
     t.inv = inv;
-    switch (type) {
-    case DYAD_RRR: sizes = dyad_sizes_rrr(&t); break;
-    case DYAD_RRT: sizes = dyad_sizes_rrt(&t); break;
-    case DYAD_RTR: sizes = dyad_sizes_rtr(&t); break;
-    case DYAD_TRT: sizes = dyad_sizes_trt(&t); break;
-    default: sizes = dyad_sizes_rtt(&t); break;
-    }
     return dyad_amplification_of(
-               sizes, dyad_largest_force(value, derivative),
+               kind->sizes(&t), dyad_largest_force(value, derivative),
                dyad_largest_moment(value, derivative, dyad_guide_used(type, DYAD_PAIR_DM),
                                    dyad_guide_used(type, DYAD_PAIR_E),
                                    dyad_guide_used(type, DYAD_PAIR_DN)),
@@ -97,23 +90,87 @@ static dyad_real amplification_rate(dyad_type type, const dyad_input* input, con
         .d;
 }
 
-dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dyad_input* input,
-                                    const dyad_input* seed, dyad_result* value,
-                                    dyad_result* derivative)
+/* How the dyad's frames turn along the seed; a guide the type has not stays. */
+static dyad_turning turning_of(dyad_type type, const dyad_input* input, const dyad_input* seed)
 {
-    dyad_input loads;
-    dyad_status status;
-    dyad_vec2 i_m, i_n, i_k, i_p, df_m, df_n, dr_mn_turn;
-    dyad_real dth_m, dth_n, dth_k, dth_p, dmd_m, dmd_n, dc = 0;
-    dyad_link_sizes sizes_m, sizes_n;
-    /* the type's divisor |d| (RTR: |D_m D_n| |d|) and its rate */
-    dyad_dual divisor = dyad_dual_const(1);
+    dyad_turning t;
+    t.i_m = dyad_unit_of(input->m.dir);
+    t.i_n = dyad_unit_of(input->n.dir);
+    t.i_k = dyad_unit_of(input->guide_k);
+    t.i_p = dyad_unit_of(input->guide_p);
+    t.dth_m = turn_rate(t.i_m, seed->m.dir);
+    t.dth_n = turn_rate(t.i_n, seed->n.dir);
+    t.dth_k = dyad_guide_used(type, DYAD_PAIR_DM) ? turn_rate(t.i_k, seed->guide_k) : 0;
+    t.dth_p = dyad_guide_used(type, DYAD_PAIR_DN) ? turn_rate(t.i_p, seed->guide_p) : 0;
+    return t;
+}
 
-    if (value == NULL || derivative == NULL || solve == NULL ||
-        (unsigned)type >= DYAD_TYPE_COUNT) {
+/* The loads of the derivative's solve: the change of each link's equilibrium
+ * sums when the inputs move along the seed and the reactions are held, applied
+ * at D_g (com at the origin, no mass). dr_mn_turn: how R_mn turns with a
+ * translational pair E. Also the sizes of the links' sums with their rates. */
+static dyad_input held_reaction_loads(dyad_type type, const dyad_input* input,
+                                      const dyad_input* seed, const dyad_turning* t,
+                                      const dyad_result* value, dyad_vec2 dr_mn_turn,
+                                      dyad_link_sizes* sizes_m, dyad_link_sizes* sizes_n)
+{
+    dyad_input loads = *input;
+    dyad_vec2 df_m, df_n;
+    dyad_real dmd_m, dmd_n;
+    resultant_rate(&input->m, &seed->m, t->i_m, t->dth_m, input->gravity, seed->gravity, &df_m,
+                   &dmd_m, sizes_m);
+    resultant_rate(&input->n, &seed->n, t->i_n, t->dth_n, input->gravity, seed->gravity, &df_n,
+                   &dmd_n, sizes_n);
+
+    /* A turning guide turns its normal force (d(N j) = -N i dtheta), and R_mn's
+     * lever l_g i_g about D_g changes. */
+    if (dyad_guide_used(type, DYAD_PAIR_DM)) {
+        df_m = dyad_add(df_m, dyad_scale(-value->n_mk * t->dth_k, t->i_k));
+    }
+    if (dyad_guide_used(type, DYAD_PAIR_DN)) {
+        df_n = dyad_add(df_n, dyad_scale(-value->n_np * t->dth_p, t->i_p));
+    }
+    df_m = dyad_add(df_m, dr_mn_turn);
+    df_n = dyad_sub(df_n, dr_mn_turn);
+    {
+        const dyad_vec2 lever_m = dyad_scale(input->m.length, t->i_m);
+        const dyad_vec2 lever_n = dyad_scale(input->n.length, t->i_n);
+        const dyad_vec2 dlever_m = dyad_combine(seed->m.length, t->i_m, input->m.length * t->dth_m,
+                                                dyad_perp(t->i_m));
+        const dyad_vec2 dlever_n = dyad_combine(seed->n.length, t->i_n, input->n.length * t->dth_n,
+                                                dyad_perp(t->i_n));
+        dmd_m += dyad_cross(dlever_m, value->r_mn) + dyad_cross(lever_m, dr_mn_turn);
+        dmd_n -= dyad_cross(dlever_n, value->r_mn) + dyad_cross(lever_n, dr_mn_turn);
+    }
+
+    loads.m.com = loads.n.com = dyad_vec2_make(0, 0);
+    loads.m.mass = loads.n.mass = loads.m.inertia = loads.n.inertia = 0;
+    loads.m.omega = loads.n.omega = loads.m.epsilon = loads.n.epsilon = 0;
+    loads.m.accel_d = loads.n.accel_d = loads.gravity = dyad_vec2_make(0, 0);
+    loads.m.force = df_m;
+    loads.n.force = df_n;
+    loads.m.moment = dmd_m;
+    loads.n.moment = dmd_n;
+    return loads;
+}
+
+dyad_status dyad_solve_tangent_of(const dyad_tangent_type* kind, const dyad_input* input,
+                                  const dyad_input* seed, dyad_result* value,
+                                  dyad_result* derivative)
+{
+    dyad_type type;
+    dyad_status status;
+    dyad_turning t;
+    dyad_input loads;
+    dyad_vec2 dr_mn_turn;
+    dyad_link_sizes sizes_m, sizes_n;
+    dyad_dual divisor; /* the type's divisor |d| (RTR: |D_m D_n| |d|) and its rate */
+
+    if (kind == NULL || value == NULL || derivative == NULL) {
         return DYAD_STATUS_INVALID_INPUT;
     }
-    status = solve(input, value);
+    type = kind->type;
+    status = kind->solve(input, value);
     if (status != DYAD_STATUS_OK) {
         *derivative = *value;
         return status;
@@ -123,110 +180,28 @@ dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dya
         return dyad_reject(derivative, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_INPUT);
     }
 
-    i_m = dyad_unit_of(input->m.dir);
-    i_n = dyad_unit_of(input->n.dir);
-    i_k = dyad_unit_of(input->guide_k);
-    i_p = dyad_unit_of(input->guide_p);
-    dth_m = turn_rate(i_m, seed->m.dir);
-    dth_n = turn_rate(i_n, seed->n.dir);
-    dth_k = dyad_guide_used(type, DYAD_PAIR_DM) ? turn_rate(i_k, seed->guide_k) : 0;
-    dth_p = dyad_guide_used(type, DYAD_PAIR_DN) ? turn_rate(i_p, seed->guide_p) : 0;
-
-    resultant_rate(&input->m, &seed->m, i_m, dth_m, input->gravity, seed->gravity, &df_m, &dmd_m,
-                   &sizes_m);
-    resultant_rate(&input->n, &seed->n, i_n, dth_n, input->gravity, seed->gravity, &df_n, &dmd_n,
-                   &sizes_n);
-
-    /* Reactions held, geometry moving: a turning guide turns its normal force
-     * (d(N j) = -N i dtheta), and R_mn's lever l_g i_g about D_g changes. */
-    if (dyad_guide_used(type, DYAD_PAIR_DM)) {
-        df_m = dyad_add(df_m, dyad_scale(-value->n_mk * dth_k, i_k));
-    }
-    if (dyad_guide_used(type, DYAD_PAIR_DN)) {
-        df_n = dyad_add(df_n, dyad_scale(-value->n_np * dth_p, i_p));
-    }
+    t = turning_of(type, input, seed);
     dr_mn_turn = dyad_pair_kind_of(type, DYAD_PAIR_E) == DYAD_PAIR_TRANSLATIONAL
-                     ? dyad_scale(-value->n_mn * dth_m, i_m)
+                     ? dyad_scale(-value->n_mn * t.dth_m, t.i_m)
                      : dyad_vec2_make(0, 0);
-    df_m = dyad_add(df_m, dr_mn_turn);
-    df_n = dyad_sub(df_n, dr_mn_turn);
-    {
-        const dyad_vec2 lever_m = dyad_scale(input->m.length, i_m);
-        const dyad_vec2 lever_n = dyad_scale(input->n.length, i_n);
-        const dyad_vec2 dlever_m = dyad_combine(seed->m.length, i_m, input->m.length * dth_m,
-                                                dyad_perp(i_m));
-        const dyad_vec2 dlever_n = dyad_combine(seed->n.length, i_n, input->n.length * dth_n,
-                                                dyad_perp(i_n));
-        dmd_m += dyad_cross(dlever_m, value->r_mn) + dyad_cross(lever_m, dr_mn_turn);
-        dmd_n -= dyad_cross(dlever_n, value->r_mn) + dyad_cross(lever_n, dr_mn_turn);
-    }
-
-    /* The same dyad under those loads, applied at D_g (com at the origin). */
-    loads = *input;
-    loads.m.com = loads.n.com = dyad_vec2_make(0, 0);
-    loads.m.mass = loads.n.mass = loads.m.inertia = loads.n.inertia = 0;
-    loads.m.omega = loads.n.omega = loads.m.epsilon = loads.n.epsilon = 0;
-    loads.m.accel_d = loads.n.accel_d = loads.gravity = dyad_vec2_make(0, 0);
-    loads.m.force = df_m;
-    loads.n.force = df_n;
-    loads.m.moment = dmd_m;
-    loads.n.moment = dmd_n;
-    status = solve(&loads, derivative);
+    loads = held_reaction_loads(type, input, seed, &t, value, dr_mn_turn, &sizes_m, &sizes_n);
+    status = kind->solve(&loads, derivative);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
     /* A translational pair's force N j turns with its guide. */
     if (dyad_guide_used(type, DYAD_PAIR_DM)) {
-        derivative->r_mk = dyad_add(derivative->r_mk, dyad_scale(-value->n_mk * dth_k, i_k));
+        derivative->r_mk = dyad_add(derivative->r_mk, dyad_scale(-value->n_mk * t.dth_k, t.i_k));
     }
     if (dyad_guide_used(type, DYAD_PAIR_DN)) {
-        derivative->r_np = dyad_add(derivative->r_np, dyad_scale(-value->n_np * dth_p, i_p));
+        derivative->r_np = dyad_add(derivative->r_np, dyad_scale(-value->n_np * t.dth_p, t.i_p));
     }
     derivative->r_mn = dyad_add(derivative->r_mn, dr_mn_turn);
 
-    /* The conditioning's own rate, from its definition per type. */
-    switch (type) {
-    case DYAD_RRR: /* d = i_m . j_n */
-        dc = dth_m * dyad_dot(dyad_perp(i_m), dyad_perp(i_n)) - dth_n * dyad_dot(i_m, i_n);
-        break;
-    case DYAD_RRT: /* d = i_n . i_k */
-        dc = dth_n * dyad_dot(dyad_perp(i_n), i_k) + dth_k * dyad_dot(i_n, dyad_perp(i_k));
-        break;
-    case DYAD_TRT: /* d = j_k . i_p */
-        dc = -dth_k * dyad_dot(i_k, i_p) + dth_p * dyad_dot(dyad_perp(i_k), dyad_perp(i_p));
-        break;
-    case DYAD_RTT: /* d = j_k . i_m */
-        dc = -dth_k * dyad_dot(i_k, i_m) + dth_m * dyad_dot(dyad_perp(i_k), dyad_perp(i_m));
-        break;
-    case DYAD_RTR: { /* the smaller of |i_beta . i_m| and |D_m D_n| / (l_m + l_n) */
-        const dyad_vec2 v = dyad_combine(input->m.length, i_m, -input->n.length, i_n);
-        const dyad_vec2 dv = dyad_add(
-            dyad_combine(seed->m.length, i_m, input->m.length * dth_m, dyad_perp(i_m)),
-            dyad_combine(-seed->n.length, i_n, -input->n.length * dth_n, dyad_perp(i_n)));
-        const dyad_real dist = dyad_length(v);
-        const dyad_real ddist = dyad_dot(v, dv) / dist;
-        const dyad_real spread = dist / (input->m.length + input->n.length);
-        const dyad_real slant = dyad_dot(v, i_m) / dist;
-        const dyad_real dslant =
-            (dyad_dot(dv, i_m) + dth_m * dyad_dot(v, dyad_perp(i_m))) / dist - slant * ddist / dist;
-        divisor = dyad_dual_mul(dyad_dual_make(dist, ddist), dyad_dual_abs(slant, dslant));
-        derivative->denominator = dslant;
-        derivative->conditioning =
-            dyad_abs(slant) > spread
-                ? (ddist - spread * (seed->m.length + seed->n.length)) /
-                      (input->m.length + input->n.length)
-                : (slant < 0 ? -dslant : dslant);
-        break;
-    }
-    case DYAD_TYPE_COUNT: break;
-    }
-    if (type != DYAD_RTR) {
-        divisor = dyad_dual_abs(value->denominator, dc);
-        derivative->denominator = dc;
-        derivative->conditioning = value->denominator < 0 ? -dc : dc;
-    }
+    /* The conditioning's own rate, from its definition in the type's file. */
+    divisor = kind->conditioning_rate(input, seed, &t, value, derivative);
     derivative->amplification =
-        amplification_rate(type, input, seed, &sizes_m, &sizes_n,
+        amplification_rate(kind, input, seed, &sizes_m, &sizes_n,
                            dyad_dual_div(dyad_dual_const(1), divisor), value, derivative);
     return DYAD_STATUS_OK;
 }

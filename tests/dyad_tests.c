@@ -1010,6 +1010,43 @@ static int test_react_loaded(void)
     return fails;
 }
 
+/* The tangent of one type (dyad_solve_tangent_of, what a one-type program
+ * links) gives what dyad_solve_tangent gives for that type, bit for bit, and a
+ * missing type is refused. */
+static int test_tangent_of_each_type(void)
+{
+    static const dyad_tangent_type* const kinds[DYAD_TYPE_COUNT] = {
+        &dyad_tangent_rrr, &dyad_tangent_rrt, &dyad_tangent_rtr, &dyad_tangent_trt,
+        &dyad_tangent_rtt};
+    int fails = 0;
+    int t, k;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x7A4E0000u + (uint64_t)t};
+        int ok = 0;
+        for (k = 0; k < 200; ++k) {
+            const dyad_input in = random_input(&r, type);
+            const dyad_input seed = random_input(&r, type);
+            dyad_result value_a, rate_a, value_b, rate_b;
+            const dyad_status a = dyad_solve_tangent(type, &in, &seed, &value_a, &rate_a);
+            const dyad_status b = dyad_solve_tangent_of(kinds[t], &in, &seed, &value_b, &rate_b);
+            ok += a == DYAD_STATUS_OK;
+            CHECK(a == b && memcmp(&value_a, &value_b, sizeof value_a) == 0 &&
+                      memcmp(&rate_a, &rate_b, sizeof rate_a) == 0,
+                  "%s: dyad_solve_tangent_of differs from dyad_solve_tangent (sample %d)",
+                  dyad_type_name(type), k);
+        }
+        CHECK(ok > 100, "%s: only %d of 200 samples solved", dyad_type_name(type), ok);
+    }
+    {
+        const dyad_input in = dyad_input_default();
+        dyad_result value, rate;
+        CHECK(dyad_solve_tangent_of(NULL, &in, &in, &value, &rate) == DYAD_STATUS_INVALID_INPUT,
+              "a NULL type is not refused");
+    }
+    return fails;
+}
+
 static const named_test tests[] = {
     {"equilibrium_random", test_equilibrium_random},
     {"rrr_symmetric_truss", test_rrr_symmetric_truss},
@@ -1025,6 +1062,7 @@ static const named_test tests[] = {
     {"singular", test_singular},
     {"invalid_before_singular", test_invalid_before_singular},
     {"react_loaded", test_react_loaded},
+    {"tangent_of_each_type", test_tangent_of_each_type},
 };
 
 int main(int argc, char** argv)

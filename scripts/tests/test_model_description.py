@@ -510,7 +510,8 @@ def test_c_table_compiles(generated, dyad_type, tmp_path):
     source = generated[dyad_type] / f"{identifier(dyad_type)}_model.c"
     proc = subprocess.run(
         ["gcc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
-         f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'fmu'}", "-c", str(source),
+         f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'fmu'}", f"-I{ROOT / 'fmu' / 'models'}",
+         "-c", str(source),
          "-o", str(tmp_path / "model.o")], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
 
@@ -520,10 +521,12 @@ def test_c_table_matches_the_table(generated, dyad_type):
     raw = load_raw(dyad_type)
     c_text = (generated[dyad_type] / f"{identifier(dyad_type)}_model.c").read_text()
     rows = re.findall(r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
-                      r'(offsetof\(\w+, [\w.]+\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+), (\w+)\}',
+                      r'(offsetof\(\w+, [\w.]+\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+)\}',
                       c_text)
+    feeds = {int(index): field
+             for field, index in re.findall(r"\{(DYAD_FIELD_\w+), (\d+)\}", c_text)}
     assert len(rows) == len(raw["variable"])
-    for row, v in zip(rows, raw["variable"]):
+    for index, (row, v) in enumerate(zip(rows, raw["variable"])):
         vr, name, unit, causality, _, target, offset, start = row[:8]
         assert (int(vr), name, unit) == (v["vr"], v["name"], v.get("unit", ""))
         assert causality == "FMU_" + v["causality"].upper()
@@ -531,7 +534,10 @@ def test_c_table_matches_the_table(generated, dyad_type):
         if v["name"].endswith("angle"):
             assert target == "FMU_TARGET_INPUT_ANGLE"
         if v["name"] == "link_m.accel_d.x":
-            assert offset == "offsetof(dyad_input, m.accel_d.x)" and row[11] == "DYAD_FIELD_M_ACCEL_D"
+            assert offset == "offsetof(dyad_input, m.accel_d.x)"
+            assert feeds[index] == "DYAD_FIELD_M_ACCEL_D"
+        if v["causality"] == "output":
+            assert index not in feeds
         if v["name"] == "status":
             assert (target, offset) == ("FMU_TARGET_RESULT_STATUS", "0")
     vr_limit = len(raw["variable"]) + 1
@@ -712,7 +718,7 @@ def test_unmodified_copy_is_accepted(tmp_path):
 # (e) the crank drive
 # ---------------------------------------------------------------------------
 DRIVE_TABLE = MD_DIR / "drive.toml"
-DRIVE_HEADER = ROOT / "fmu" / "fmu_drive.h"
+DRIVE_HEADER = ROOT / "fmu" / "models" / "fmu_drive.h"
 
 #: name -> (causality, unit, lives), in table order, written out from the specification.
 DRIVE_VARIABLES = {
@@ -924,7 +930,7 @@ def test_drive_members_match_the_header():
 def test_drive_c_table_compiles(generated_drive, tmp_path):
     proc = subprocess.run(
         ["gcc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
-         f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'fmu'}", "-c",
+         f"-I{ROOT / 'fmu'}", f"-I{ROOT / 'fmu' / 'models'}", "-c",
          str(generated_drive / "drive_model.c"), "-o", str(tmp_path / "drive_model.o")],
         capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
@@ -935,9 +941,9 @@ def test_drive_c_table_matches_the_table(generated_drive):
     token = generate.load_table(DRIVE_TABLE).token
     c_text = (generated_drive / "drive_model.c").read_text()
     assert '#include "fmu_drive.h"' in c_text and "fmu_dyad" not in c_text
-    assert "dyad_solve" not in c_text
+    assert "dyad_solve" not in c_text and "DYAD_FIELD" not in c_text
     rows = re.findall(r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
-                      r'(offsetof\((\w+), ([\w.]+)\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+), (\w+)\}',
+                      r'(offsetof\((\w+), ([\w.]+)\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+)\}',
                       c_text)
     assert len(rows) == len(raw["variable"])
     for row, v in zip(rows, raw["variable"]):
@@ -948,7 +954,6 @@ def test_drive_c_table_matches_the_table(generated_drive):
         block, path = v["lives"].split(".")
         assert struct == ("fmu_drive_input" if block == "input" else "fmu_drive_output")
         assert member == path
-        assert row[13] == "DYAD_FIELD_NONE"
         if v["name"] == "status":
             assert (value_type, target) == ("FMU_INTEGER", "FMU_TARGET_RESULT_STATUS")
             assert (struct, member) == ("fmu_drive_output", "status")
@@ -958,7 +963,7 @@ def test_drive_c_table_matches_the_table(generated_drive):
             assert target == "FMU_TARGET_RESULT_REAL"
     assert "offsetof(fmu_drive_output, status)" in c_text
     assert "FMU_TARGET_INPUT_ANGLE" not in c_text
-    assert re.search(r"FMU_HAS_MIN \| FMU_MIN_EXCLUSIVE, DYAD_FIELD_NONE", c_text)
+    assert re.search(r"FMU_HAS_MIN \| FMU_MIN_EXCLUSIVE\}", c_text)
     vr_limit = len(raw["variable"]) + 1
     assert (f'const fmu_model fmu_this_model = {{"drive", "{token}",\n'
             f"                                  variables, {len(raw['variable'])}, "

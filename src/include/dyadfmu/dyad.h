@@ -46,11 +46,21 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result);
 dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dyad_input* seed,
                                dyad_result* value, dyad_result* derivative);
 
-/** The same with the type's solver given (dyad_solve_rrr for DYAD_RRR, ...), so
- *  that a program that needs one type links only that type's solver. */
-dyad_status dyad_solve_tangent_with(dyad_solver solve, dyad_type type, const dyad_input* input,
-                                    const dyad_input* seed, dyad_result* value,
-                                    dyad_result* derivative);
+/** What the directional derivative needs of one dyad type (its solver, the
+ *  sizes of its outputs, the rate of its conditioning), defined in the type's
+ *  own source file: passing dyad_tangent_rrt to dyad_solve_tangent_of links
+ *  only the RRT solver. */
+typedef struct dyad_tangent_type dyad_tangent_type;
+extern const dyad_tangent_type dyad_tangent_rrr;
+extern const dyad_tangent_type dyad_tangent_rrt;
+extern const dyad_tangent_type dyad_tangent_rtr;
+extern const dyad_tangent_type dyad_tangent_trt;
+extern const dyad_tangent_type dyad_tangent_rtt;
+
+/** dyad_solve_tangent for the type `kind` (&dyad_tangent_rrr, ...). */
+dyad_status dyad_solve_tangent_of(const dyad_tangent_type* kind, const dyad_input* input,
+                                  const dyad_input* seed, dyad_result* value,
+                                  dyad_result* derivative);
 
 /** Resultant of link g's active load, weight and inertia (d'Alembert) at its
  *  centre of mass: force (N, global frame) and moment (N m). This is F_g, M_g

@@ -8,10 +8,11 @@ typedef char fmu_dyad_real_is_double[sizeof(dyad_real) == sizeof(double) ? 1 : -
 
 static int variable_of_field(const fmu_model* model, dyad_field field)
 {
+    const fmu_dyad_data* dyad = (const fmu_dyad_data*)model->data;
     size_t k;
-    for (k = 0; k < model->variable_count; ++k) {
-        if (model->variables[k].causality != FMU_OUTPUT && model->variables[k].field == field) {
-            return (int)k;
+    for (k = 0; k < dyad->feed_count; ++k) {
+        if (dyad->feeds[k].field == field) {
+            return dyad->feeds[k].variable;
         }
     }
     return -1;
@@ -65,8 +66,8 @@ static void derivative(const fmu_model* model, const void* input, const void* se
                        void* rate, fmu_evaluation* evaluation)
 {
     const fmu_dyad_data* dyad = (const fmu_dyad_data*)model->data;
-    dyad_solve_tangent_with(dyad->solve, dyad->type, (const dyad_input*)input,
-                            (const dyad_input*)seed, (dyad_result*)output, (dyad_result*)rate);
+    dyad_solve_tangent_of(dyad->tangent, (const dyad_input*)input, (const dyad_input*)seed,
+                          (dyad_result*)output, (dyad_result*)rate);
     report(model, (const dyad_input*)input, (const dyad_result*)output, evaluation);
 }
 
