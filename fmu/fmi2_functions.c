@@ -68,9 +68,8 @@ void fmi2FreeInstance(fmi2Component c)
     fmu_free((fmu_instance*)c);
 }
 
-fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined,
-                               fmi2Real tolerance, fmi2Real startTime,
-                               fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime)
 {
     (void)toleranceDefined;
     (void)tolerance;
@@ -100,8 +99,7 @@ fmi2Status fmi2Reset(fmi2Component c)
     return to_fmi2(fmu_reset((fmu_instance*)c));
 }
 
-fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
-                       fmi2Real value[])
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
 {
     return to_fmi2(fmu_get_real((fmu_instance*)c, vr, nvr, value, "fmi2GetReal"));
 }
@@ -116,16 +114,16 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
                           fmi2Boolean value[])
 {
     (void)value;
-    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_GET, vr, nvr,
-                                            "fmi2GetBoolean"));
+    return to_fmi2(
+        fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_GET, vr, nvr, "fmi2GetBoolean"));
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                          fmi2String value[])
 {
     (void)value;
-    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_GET, vr, nvr,
-                                            "fmi2GetString"));
+    return to_fmi2(
+        fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_GET, vr, nvr, "fmi2GetString"));
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -144,16 +142,16 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
                           const fmi2Boolean value[])
 {
     (void)value;
-    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_SET, vr, nvr,
-                                            "fmi2SetBoolean"));
+    return to_fmi2(
+        fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_SET, vr, nvr, "fmi2SetBoolean"));
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                          const fmi2String value[])
 {
     (void)value;
-    return to_fmi2(fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_SET, vr, nvr,
-                                            "fmi2SetString"));
+    return to_fmi2(
+        fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_SET, vr, nvr, "fmi2SetString"));
 }
 
 static const char no_state[] = "canGetAndSetFMUstate is false";
@@ -192,8 +190,8 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
     return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SerializeFMUstate", no_state));
 }
 
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[],
-                                   size_t size, fmi2FMUstate* FMUstate)
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate* FMUstate)
 {
     (void)serializedState;
     (void)size;
@@ -206,14 +204,13 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         size_t nKnown, const fmi2Real dvKnown[],
                                         fmi2Real dvUnknown[])
 {
-    return to_fmi2(fmu_directional_derivative((fmu_instance*)c, vUnknown_ref, nUnknown,
-                                              vKnown_ref, nKnown, dvKnown, dvUnknown,
+    return to_fmi2(fmu_directional_derivative((fmu_instance*)c, vUnknown_ref, nUnknown, vKnown_ref,
+                                              nKnown, dvKnown, dvUnknown,
                                               "fmi2GetDirectionalDerivative"));
 }
 
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
-                                       size_t nvr, const fmi2Integer order[],
-                                       const fmi2Real value[])
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[])
 {
     (void)vr;
     (void)nvr;
@@ -223,8 +220,8 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
                                    "canInterpolateInputs is false"));
 }
 
-fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
-                                        size_t nvr, const fmi2Integer order[], fmi2Real value[])
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[])
 {
     (void)vr;
     (void)nvr;
@@ -238,8 +235,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
 {
     (void)noSetFMUStatePriorToCurrentPoint;
-    return to_fmi2(fmu_do_step((fmu_instance*)c, currentCommunicationPoint,
-                               communicationStepSize, "fmi2DoStep"));
+    return to_fmi2(fmu_do_step((fmu_instance*)c, currentCommunicationPoint, communicationStepSize,
+                               "fmi2DoStep"));
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)
@@ -252,8 +249,8 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* va
 {
     (void)s;
     (void)value;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetStatus",
-                                   "fmi2DoStep never returns fmi2Pending"));
+    return to_fmi2(
+        fmu_unsupported((fmu_instance*)c, "fmi2GetStatus", "fmi2DoStep never returns fmi2Pending"));
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value)
@@ -275,8 +272,8 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 {
     (void)s;
     (void)value;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetIntegerStatus",
-                                   "there is no Integer status"));
+    return to_fmi2(
+        fmu_unsupported((fmu_instance*)c, "fmi2GetIntegerStatus", "there is no Integer status"));
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value)
@@ -298,6 +295,6 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
 {
     (void)s;
     (void)value;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetStringStatus",
-                                   "there is no String status"));
+    return to_fmi2(
+        fmu_unsupported((fmu_instance*)c, "fmi2GetStringStatus", "there is no String status"));
 }

@@ -47,8 +47,10 @@ static int scalar_counts(fmu_instance* instance, size_t n_value_references, size
                          const char* function)
 {
     if (instance != NULL && n_values != n_value_references) {
-        fmu_log(instance, FMU_ERROR, "%s: nValues = %zu but nValueReferences = %zu (all "
-                "variables are scalars)", function, n_values, n_value_references);
+        fmu_log(instance, FMU_ERROR,
+                "%s: nValues = %zu but nValueReferences = %zu (all "
+                "variables are scalars)",
+                function, n_values, n_value_references);
         return 0;
     }
     return 1;
@@ -62,8 +64,8 @@ const char* fmi3GetVersion(void)
 fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
                                const fmi3String categories[])
 {
-    return to_fmi3(fmu_set_debug_logging((fmu_instance*)instance, loggingOn, nCategories,
-                                         categories));
+    return to_fmi3(
+        fmu_set_debug_logging((fmu_instance*)instance, loggingOn, nCategories, categories));
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
@@ -189,8 +191,8 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     }
     if (valueReferences == NULL || values == NULL || k == nValueReferences) {
         /* No time among them: one call, like FMI 2. */
-        return to_fmi3(fmu_get_real(fmu, valueReferences, nValueReferences, values,
-                                    "fmi3GetFloat64"));
+        return to_fmi3(
+            fmu_get_real(fmu, valueReferences, nValueReferences, values, "fmi3GetFloat64"));
     }
     for (k = 0; k < nValueReferences; ++k) {
         fmu_status status;
@@ -341,13 +343,13 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     }
     for (k = 0; fmu != NULL && valueReferences != NULL && k < nValueReferences; ++k) {
         if (valueReferences[k] == TIME_VR) {
-            fmu_log(fmu, FMU_ERROR, "fmi3SetFloat64: time (value reference 0) is the "
+            fmu_log(fmu, FMU_ERROR,
+                    "fmi3SetFloat64: time (value reference 0) is the "
                     "independent variable and cannot be set");
             return fmi3Error;
         }
     }
-    return to_fmi3(fmu_set_real(fmu, valueReferences, nValueReferences, values,
-                                "fmi3SetFloat64"));
+    return to_fmi3(fmu_set_real(fmu, valueReferences, nValueReferences, values, "fmi3SetFloat64"));
 }
 
 fmi3Status fmi3SetInt8(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -467,7 +469,8 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueRe
 {
     fmu_instance* fmu = (fmu_instance*)instance;
     if (fmu != NULL && (nSeed != nKnowns || nSensitivity != nUnknowns)) {
-        fmu_log(fmu, FMU_ERROR, "fmi3GetDirectionalDerivative: nSeed = %zu and nSensitivity = "
+        fmu_log(fmu, FMU_ERROR,
+                "fmi3GetDirectionalDerivative: nSeed = %zu and nSensitivity = "
                 "%zu must equal nKnowns = %zu and nUnknowns = %zu (all variables are scalars)",
                 nSeed, nSensitivity, nKnowns, nUnknowns);
         return fmi3Error;
@@ -499,4 +502,3 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     }
     return to_fmi3(status);
 }
-

@@ -8,8 +8,8 @@
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterEventMode",
-                                   "hasEventMode is false"));
+    return to_fmi3(
+        fmu_unsupported((fmu_instance*)instance, "fmi3EnterEventMode", "hasEventMode is false"));
 }
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
@@ -148,8 +148,8 @@ fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference v
     (void)valueReferences;
     (void)nValueReferences;
     (void)shifts;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftDecimal",
-                                   "the FMU has no clocks"));
+    return to_fmi3(
+        fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftDecimal", "the FMU has no clocks"));
 }
 
 fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -160,8 +160,8 @@ fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
     (void)nValueReferences;
     (void)counters;
     (void)resolutions;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftFraction",
-                                   "the FMU has no clocks"));
+    return to_fmi3(
+        fmu_unsupported((fmu_instance*)instance, "fmi3GetShiftFraction", "the FMU has no clocks"));
 }
 
 fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -193,8 +193,8 @@ fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference v
     (void)valueReferences;
     (void)nValueReferences;
     (void)shifts;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftDecimal",
-                                   "the FMU has no clocks"));
+    return to_fmi3(
+        fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftDecimal", "the FMU has no clocks"));
 }
 
 fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -205,8 +205,8 @@ fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
     (void)nValueReferences;
     (void)counters;
     (void)resolutions;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftFraction",
-                                   "the FMU has no clocks"));
+    return to_fmi3(
+        fmu_unsupported((fmu_instance*)instance, "fmi3SetShiftFraction", "the FMU has no clocks"));
 }
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance)
@@ -252,8 +252,8 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance,
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time)
 {
     (void)time;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetTime",
-                                   "model exchange is not supported"));
+    return to_fmi3(
+        fmu_unsupported((fmu_instance*)instance, "fmi3SetTime", "model exchange is not supported"));
 }
 
 fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[],
@@ -317,8 +317,8 @@ fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t* nConti
 
 fmi3Status fmi3EnterStepMode(fmi3Instance instance)
 {
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3EnterStepMode",
-                                   "hasEventMode is false"));
+    return to_fmi3(
+        fmu_unsupported((fmu_instance*)instance, "fmi3EnterStepMode", "hasEventMode is false"));
 }
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance,

@@ -7,8 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { ALL_STATES = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION | FMU_STATE_STEP |
-                    FMU_STATE_TERMINATED };
+enum {
+    ALL_STATES = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION | FMU_STATE_STEP |
+    FMU_STATE_TERMINATED
+};
 
 /* Where each operation may be called. One table instead of a test per entry point. */
 static const unsigned legal_states[FMU_OP_COUNT] = {
@@ -131,9 +133,9 @@ static void load_start_values(fmu_instance* instance)
     instance->dirty = 1;
 }
 
-fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
-                              const char* token, fmu_logger logger, int logging_on,
-                              fmu_allocate allocate, fmu_release release)
+fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name, const char* token,
+                              fmu_logger logger, int logging_on, fmu_allocate allocate,
+                              fmu_release release)
 {
     fmu_instance* instance;
     size_t values_size, name_size, input_size, output_size;
@@ -237,8 +239,8 @@ fmu_status fmu_set_debug_logging(fmu_instance* instance, int logging_on, size_t 
     if (count == 0) {
         bits = ~0u;
     }
-    instance->log_categories = logging_on ? (instance->log_categories | bits)
-                                          : (instance->log_categories & ~bits);
+    instance->log_categories =
+        logging_on ? (instance->log_categories | bits) : (instance->log_categories & ~bits);
     return FMU_OK;
 }
 
@@ -252,7 +254,7 @@ fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time)
     return status;
 }
 
-/* ---- the solve ----------------------------------------------------------- */
+/* ---- the solve ------------------------------------------------------------------------------ */
 
 /* Logs why the last evaluation failed. */
 static void log_failure(fmu_instance* instance, fmu_status not_solvable, const char* function)
@@ -260,11 +262,11 @@ static void log_failure(fmu_instance* instance, fmu_status not_solvable, const c
     const fmu_evaluation* e = &instance->evaluation;
     if (e->status == FMU_ERROR && e->bad_variable >= 0) {
         fmu_log(instance, FMU_ERROR, "%s: %s = %g: %s", function,
-                instance->model->variables[e->bad_variable].name,
-                instance->values[e->bad_variable], e->reason);
+                instance->model->variables[e->bad_variable].name, instance->values[e->bad_variable],
+                e->reason);
     } else if (e->status != FMU_OK) {
-        fmu_log(instance, e->status == FMU_ERROR ? FMU_ERROR : not_solvable,
-                "%s: at t = %g s: %s", function, instance->time, e->reason);
+        fmu_log(instance, e->status == FMU_ERROR ? FMU_ERROR : not_solvable, "%s: at t = %g s: %s",
+                function, instance->time, e->reason);
     }
 }
 
@@ -279,8 +281,7 @@ static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const c
 {
     fmu_evaluation* e = &instance->evaluation;
     if (instance->dirty) {
-        instance->model->behaviour->evaluate(instance->model, instance->input, instance->output,
-                                             e);
+        instance->model->behaviour->evaluate(instance->model, instance->input, instance->output, e);
         instance->dirty = 0;
         log_failure(instance, not_solvable, function);
     } else if (e->status == FMU_ERROR && each_error) {
@@ -292,7 +293,7 @@ static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const c
     return not_solvable;
 }
 
-/* ---- the state machine ---------------------------------------------------- */
+/* ---- the state machine ---------------------------------------------------------------------- */
 
 fmu_status fmu_enter_initialization(fmu_instance* instance, double start_time)
 {
@@ -320,13 +321,13 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
     return status;
 }
 
-fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
-                       const char* function)
+/* Refuses a step whose size is not positive or whose end is not a later finite
+ * time: a sum that overflows would leave the instance at an infinite time, one
+ * below the resolution of double at current_time would advance the states but
+ * not the time. */
+static fmu_status check_step(fmu_instance* instance, double current_time, double step_size,
+                             const char* function)
 {
-    fmu_status status = fmu_check_call(instance, FMU_OP_DO_STEP, function);
-    if (status != FMU_OK) {
-        return status;
-    }
     if (!isfinite(current_time) || !isfinite(step_size) || !(step_size > 0)) {
         fmu_log(instance, FMU_ERROR,
                 "%s: currentCommunicationPoint = %g s and communicationStepSize = %g s: the "
@@ -334,9 +335,6 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
                 function, current_time, step_size);
         return FMU_ERROR;
     }
-    /* The end of the step must be a later finite time: a sum that overflows would
-     * leave the instance at an infinite time, one below the resolution of double
-     * at current_time would advance the states but not the time. */
     if (!isfinite(current_time + step_size) || !(current_time + step_size > current_time)) {
         fmu_log(instance, FMU_ERROR,
                 "%s: currentCommunicationPoint = %.17g s + communicationStepSize = %.17g s "
@@ -344,38 +342,57 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
                 function, current_time, step_size, current_time + step_size);
         return FMU_ERROR;
     }
-    instance->time = current_time;
-    if (instance->model->behaviour->advance != NULL) {
-        /* A model with states: the outputs at the end of the step. */
+    return FMU_OK;
+}
+
+/* A step of a model with states: the outputs at its start, the states
+ * advanced, the outputs at its end. */
+static fmu_status advance_states(fmu_instance* instance, double current_time, double step_size,
+                                 const char* function)
+{
+    fmu_status status = solve(instance, FMU_DISCARD, function, 1);
+    if (status == FMU_OK) {
+        fmu_evaluation* e = &instance->evaluation;
+        instance->model->behaviour->advance(instance->model, instance->input, step_size, e);
+        instance->dirty = 1;
+        if (e->status == FMU_ERROR) {
+            /* A step the model refuses (it left its states as they were). */
+            fmu_log(instance, FMU_ERROR, "%s: at t = %g s: %s", function, current_time, e->reason);
+            return FMU_ERROR;
+        }
+        if (e->status != FMU_OK) {
+            fmu_log(instance, FMU_DISCARD, "%s: at t = %g s: %s", function, current_time,
+                    e->reason);
+            instance->last_successful_time = current_time;
+            instance->terminate_requested = 1;
+            return FMU_DISCARD;
+        }
+        instance->time = current_time + step_size;
         status = solve(instance, FMU_DISCARD, function, 1);
         if (status == FMU_OK) {
-            fmu_evaluation* e = &instance->evaluation;
-            instance->model->behaviour->advance(instance->model, instance->input, step_size, e);
-            instance->dirty = 1;
-            if (e->status == FMU_ERROR) {
-                /* A step the model refuses (it left its states as they were). */
-                fmu_log(instance, FMU_ERROR, "%s: at t = %g s: %s", function, current_time,
-                        e->reason);
-                return FMU_ERROR;
-            }
-            if (e->status != FMU_OK) {
-                fmu_log(instance, FMU_DISCARD, "%s: at t = %g s: %s", function, current_time,
-                        e->reason);
-                instance->last_successful_time = current_time;
-                instance->terminate_requested = 1;
-                return FMU_DISCARD;
-            }
-            instance->time = current_time + step_size;
-            status = solve(instance, FMU_DISCARD, function, 1);
-            if (status == FMU_OK) {
-                instance->last_successful_time = instance->time;
-                instance->terminate_requested = 0;
-                return FMU_OK;
-            }
+            instance->last_successful_time = instance->time;
+            instance->terminate_requested = 0;
+            return FMU_OK;
         }
-        instance->last_successful_time = current_time;
-        instance->terminate_requested = status == FMU_DISCARD;
+    }
+    instance->last_successful_time = current_time;
+    instance->terminate_requested = status == FMU_DISCARD;
+    return status;
+}
+
+fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
+                       const char* function)
+{
+    fmu_status status = fmu_check_call(instance, FMU_OP_DO_STEP, function);
+    if (status != FMU_OK) {
         return status;
+    }
+    if (check_step(instance, current_time, step_size, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    instance->time = current_time;
+    if (instance->model->behaviour->advance != NULL) {
+        return advance_states(instance, current_time, step_size, function);
     }
     status = solve(instance, FMU_DISCARD, function, 1);
     if (status == FMU_OK) {
@@ -407,7 +424,7 @@ fmu_status fmu_reset(fmu_instance* instance)
     return status;
 }
 
-/* ---- get and set ------------------------------------------------------------ */
+/* ---- get and set ---------------------------------------------------------------------------- */
 
 static const char* type_name(fmu_value_type type)
 {
@@ -426,8 +443,8 @@ static const fmu_variable* lookup(const fmu_instance* instance, unsigned int vr,
     }
     v = &model->variables[model->index_of_vr[vr]];
     if (v->type != type) {
-        fmu_log(instance, FMU_ERROR, "%s: value reference %u (%s) is of type %s, not %s",
-                function, vr, v->name, type_name(v->type), type_name(type));
+        fmu_log(instance, FMU_ERROR, "%s: value reference %u (%s) is of type %s, not %s", function,
+                vr, v->name, type_name(v->type), type_name(type));
         return NULL;
     }
     return v;
@@ -445,8 +462,8 @@ static fmu_status check_arrays(const fmu_instance* instance, const void* vr, siz
 }
 
 /* Whether a value may be stored in v now; logs the reason if not. */
-static fmu_status check_settable(const fmu_instance* instance, const fmu_variable* v,
-                                 double value, const char* function)
+static fmu_status check_settable(const fmu_instance* instance, const fmu_variable* v, double value,
+                                 const char* function)
 {
     if (v->causality == FMU_OUTPUT) {
         fmu_log(instance, FMU_ERROR, "%s: %s is an output and cannot be set", function, v->name);
@@ -593,6 +610,55 @@ fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size
     return get_values(instance, vr, count, values, FMU_INTEGER, 0, function);
 }
 
+/* The seed block from the knowns' rates: an angle's rate as the derivative of
+ * its (cos, sin). FMU_ERROR where a known is not an input. */
+static fmu_status seed_knowns(fmu_instance* instance, const unsigned int knowns[], size_t n_knowns,
+                              const double seed[], const char* function)
+{
+    size_t k;
+    memset(instance->seed, 0, instance->model->behaviour->input_size);
+    for (k = 0; k < n_knowns; ++k) {
+        const fmu_variable* v = lookup(instance, knowns[k], FMU_REAL, function);
+        double* rate;
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        if (v->causality != FMU_INPUT) {
+            fmu_log(instance, FMU_ERROR, "%s: known %s is not an input", function, v->name);
+            return FMU_ERROR;
+        }
+        rate = (double*)(void*)((char*)instance->seed + v->offset);
+        if (v->target == FMU_TARGET_INPUT_ANGLE) {
+            /* d(cos, sin)/d angle = (-sin, cos) */
+            const double* dir =
+                (const double*)(const void*)((const char*)instance->input + v->offset);
+            rate[0] -= seed[k] * dir[1];
+            rate[1] += seed[k] * dir[0];
+        } else {
+            rate[0] += seed[k];
+        }
+    }
+    return FMU_OK;
+}
+
+/* FMU_ERROR unless every unknown is an output. */
+static fmu_status check_unknowns(fmu_instance* instance, const unsigned int unknowns[],
+                                 size_t n_unknowns, const char* function)
+{
+    size_t k;
+    for (k = 0; k < n_unknowns; ++k) {
+        const fmu_variable* v = lookup(instance, unknowns[k], FMU_REAL, function);
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        if (v->causality != FMU_OUTPUT) {
+            fmu_log(instance, FMU_ERROR, "%s: unknown %s is not an output", function, v->name);
+            return FMU_ERROR;
+        }
+    }
+    return FMU_OK;
+}
+
 fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int unknowns[],
                                       size_t n_unknowns, const unsigned int knowns[],
                                       size_t n_knowns, const double seed[], double derivative[],
@@ -610,37 +676,9 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
     if (behaviour->derivative == NULL) {
         return fmu_unsupported(instance, function, "this model has no directional derivatives");
     }
-    memset(instance->seed, 0, behaviour->input_size);
-    for (k = 0; k < n_knowns; ++k) {
-        const fmu_variable* v = lookup(instance, knowns[k], FMU_REAL, function);
-        double* rate;
-        if (v == NULL) {
-            return FMU_ERROR;
-        }
-        if (v->causality != FMU_INPUT) {
-            fmu_log(instance, FMU_ERROR, "%s: known %s is not an input", function, v->name);
-            return FMU_ERROR;
-        }
-        rate = (double*)(void*)((char*)instance->seed + v->offset);
-        if (v->target == FMU_TARGET_INPUT_ANGLE) {
-            /* d(cos, sin)/d angle = (-sin, cos) */
-            const double* dir = (const double*)(const void*)((const char*)instance->input +
-                                                             v->offset);
-            rate[0] -= seed[k] * dir[1];
-            rate[1] += seed[k] * dir[0];
-        } else {
-            rate[0] += seed[k];
-        }
-    }
-    for (k = 0; k < n_unknowns; ++k) {
-        const fmu_variable* v = lookup(instance, unknowns[k], FMU_REAL, function);
-        if (v == NULL) {
-            return FMU_ERROR;
-        }
-        if (v->causality != FMU_OUTPUT) {
-            fmu_log(instance, FMU_ERROR, "%s: unknown %s is not an output", function, v->name);
-            return FMU_ERROR;
-        }
+    if (seed_knowns(instance, knowns, n_knowns, seed, function) != FMU_OK ||
+        check_unknowns(instance, unknowns, n_unknowns, function) != FMU_OK) {
+        return FMU_ERROR;
     }
     behaviour->derivative(instance->model, instance->input, instance->seed, instance->value,
                           instance->rate, &evaluation);
@@ -661,16 +699,17 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
 }
 
 fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,
-                                    const unsigned int vr[], size_t count,
-                                    const char* function)
+                                    const unsigned int vr[], size_t count, const char* function)
 {
     fmu_status status = fmu_check_call(instance, operation, function);
     if (status != FMU_OK) {
         return status;
     }
     if (count > 0) {
-        fmu_log(instance, FMU_ERROR, "%s: unknown value reference %u (this FMU has no variables "
-                "of this type)", function, vr != NULL ? vr[0] : 0u);
+        fmu_log(instance, FMU_ERROR,
+                "%s: unknown value reference %u (this FMU has no variables "
+                "of this type)",
+                function, vr != NULL ? vr[0] : 0u);
         return FMU_ERROR;
     }
     return FMU_OK;

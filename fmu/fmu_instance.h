@@ -45,9 +45,9 @@ typedef void (*fmu_log_sink)(const struct fmu_logger* logger, fmu_status status,
                              const char* category, const char* message);
 
 typedef struct fmu_logger {
-    fmu_log_sink sink;       /* NULL: messages are dropped */
-    void (*callback)(void);  /* the importer's logger, cast back by the sink */
-    void* environment;       /* the importer's environment pointer */
+    fmu_log_sink sink;      /* NULL: messages are dropped */
+    void (*callback)(void); /* the importer's logger, cast back by the sink */
+    void* environment;      /* the importer's environment pointer */
     const char* instance_name;
 } fmu_logger;
 
@@ -60,12 +60,12 @@ typedef struct fmu_instance {
     fmu_release release;
     unsigned log_categories; /* bit k: category k of fmu_log_category_names is on */
     fmu_state state;
-    double time;             /* communication point reached (s) */
+    double time; /* communication point reached (s) */
     double last_successful_time;
-    int terminate_requested; /* set when a step cannot be completed */
-    int dirty;               /* inputs changed since the last evaluation */
+    int terminate_requested;   /* set when a step cannot be completed */
+    int dirty;                 /* inputs changed since the last evaluation */
     fmu_evaluation evaluation; /* of the last evaluation */
-    double* values;          /* one per variable, as set; outputs unused */
+    double* values;            /* one per variable, as set; outputs unused */
     /* The model's blocks (see fmu_behaviour), in the instance's own memory:
      * input kept up to date by every set, output of the last evaluation, and
      * scratch for directional derivatives. */
@@ -81,9 +81,9 @@ extern const char* const fmu_log_category_names[];
 extern const size_t fmu_log_category_count;
 
 /* Creates an instance with start values, or logs why not and returns NULL. */
-fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
-                              const char* token, fmu_logger logger, int logging_on,
-                              fmu_allocate allocate, fmu_release release);
+fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name, const char* token,
+                              fmu_logger logger, int logging_on, fmu_allocate allocate,
+                              fmu_release release);
 void fmu_free(fmu_instance* instance);
 
 /* Error, with a logged reason, unless `operation` is legal in the current state. */
@@ -128,8 +128,7 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
 /* For variable types the model has none of: accepts an empty list, rejects
  * any value reference by number. */
 fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,
-                                    const unsigned int vr[], size_t count,
-                                    const char* function);
+                                    const unsigned int vr[], size_t count, const char* function);
 
 /* Error with a logged "not supported" for an entry point this FMU does not offer. */
 fmu_status fmu_unsupported(fmu_instance* instance, const char* function, const char* why);

@@ -46,16 +46,16 @@ enum {
 };
 
 typedef struct fmu_variable {
-    unsigned int vr;        /* value reference */
-    const char* name;       /* structured name, e.g. "link_m.mass" */
-    const char* unit;       /* SI unit, "" if dimensionless */
+    unsigned int vr;  /* value reference */
+    const char* name; /* structured name, e.g. "link_m.mass" */
+    const char* unit; /* SI unit, "" if dimensionless */
     fmu_causality causality;
     fmu_value_type type;
     fmu_target target;
-    size_t offset;          /* into dyad_input or dyad_result, see target */
-    double start;           /* start value (inputs and parameters) */
-    double min, max;        /* bounds, valid where `bounds` says so */
-    unsigned bounds;        /* FMU_HAS_MIN | FMU_HAS_MAX | ..._EXCLUSIVE */
+    size_t offset;   /* into dyad_input or dyad_result, see target */
+    double start;    /* start value (inputs and parameters) */
+    double min, max; /* bounds, valid where `bounds` says so */
+    unsigned bounds; /* FMU_HAS_MIN | FMU_HAS_MAX | ..._EXCLUSIVE */
 } fmu_variable;
 
 struct fmu_model;
@@ -65,14 +65,14 @@ struct fmu_model;
  * the model rejects, naming the variable. `reason` is logged. */
 typedef struct fmu_evaluation {
     fmu_status status;
-    int bad_variable;       /* index of the variable to blame, or -1 */
+    int bad_variable; /* index of the variable to blame, or -1 */
     char reason[200];
 } fmu_evaluation;
 
 /* What a kind of model computes, on its own input and output blocks. */
 typedef struct fmu_behaviour {
-    size_t input_size;      /* bytes of the input block */
-    size_t output_size;     /* bytes of the output block */
+    size_t input_size;  /* bytes of the input block */
+    size_t output_size; /* bytes of the output block */
     /* The input block before any start value is applied. */
     void (*initialise)(const struct fmu_model* model, void* input);
     /* The outputs for the inputs. */
@@ -100,7 +100,7 @@ typedef struct fmu_model {
     const short* index_of_vr; /* variable index for each vr < vr_limit, -1 where none */
     unsigned int vr_limit;
     const fmu_behaviour* behaviour;
-    const void* data;       /* the behaviour's model data (a dyad: fmu_dyad_data) */
+    const void* data; /* the behaviour's model data (a dyad: fmu_dyad_data) */
 } fmu_model;
 
 /* The model compiled into this FMU, defined by the generated <model>_model.c. */

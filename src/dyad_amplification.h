@@ -137,14 +137,14 @@ static inline dyad_link_sizes dyad_link_sizes_of(const dyad_link* link, const dy
     const dyad_dual omega = dyad_dual_make(link->omega, rate->omega);
     const dyad_dual lever = dyad_dual_norm1(r, dr);
     const dyad_dual turn = dyad_dual_abs(link->epsilon, rate->epsilon);
-    const dyad_dual accel = dyad_dual_add(
-        dyad_dual_add(dyad_dual_norm1(gravity, dgravity),
-                      dyad_dual_norm1(link->accel_d, rate->accel_d)),
-        dyad_dual_mul(turn, lever));
-    const dyad_dual without_centripetal = dyad_dual_add(
-        dyad_dual_norm1(link->force, rate->force), dyad_dual_mul(mass, accel));
-    const dyad_dual centripetal = dyad_dual_mul(dyad_dual_mul(dyad_dual_mul(mass, omega), omega),
-                                                lever);
+    const dyad_dual accel =
+        dyad_dual_add(dyad_dual_add(dyad_dual_norm1(gravity, dgravity),
+                                    dyad_dual_norm1(link->accel_d, rate->accel_d)),
+                      dyad_dual_mul(turn, lever));
+    const dyad_dual without_centripetal =
+        dyad_dual_add(dyad_dual_norm1(link->force, rate->force), dyad_dual_mul(mass, accel));
+    const dyad_dual centripetal =
+        dyad_dual_mul(dyad_dual_mul(dyad_dual_mul(mass, omega), omega), lever);
     dyad_link_sizes s;
     s.f = dyad_dual_add(without_centripetal, centripetal); /* m omega^2 |r| >= 0 */
     s.m_d = dyad_dual_add(
@@ -176,7 +176,8 @@ typedef struct dyad_size_terms {
 static inline dyad_output_sizes dyad_sizes_rrr(const dyad_size_terms* t)
 {
     const dyad_dual beta = dyad_dual_div(t->m_m, t->l_m);
-    const dyad_dual alpha = dyad_dual_mul(dyad_dual_add(dyad_dual_div(t->m_n, t->l_n), beta), t->inv);
+    const dyad_dual alpha =
+        dyad_dual_mul(dyad_dual_add(dyad_dual_div(t->m_n, t->l_n), beta), t->inv);
     dyad_output_sizes s;
     s.force = dyad_dual_add(dyad_dual_add(alpha, beta), dyad_dual_add(t->f_m, t->f_n));
     s.moment = dyad_dual_const(0);
@@ -221,9 +222,9 @@ static inline dyad_output_sizes dyad_sizes_trt(const dyad_size_terms* t)
     const dyad_dual normal = dyad_dual_mul(dyad_dual_add(t->f_m, t->f_n), t->inv);
     dyad_output_sizes s;
     s.force = dyad_dual_add(normal, dyad_dual_add(t->f_m, t->f_n));
-    s.moment = dyad_dual_max(
-        dyad_dual_add(dyad_dual_mul(t->l_m, dyad_dual_add(normal, t->f_m)), t->m_m),
-        dyad_dual_add(dyad_dual_mul(t->l_n, dyad_dual_add(normal, t->f_n)), t->m_n));
+    s.moment =
+        dyad_dual_max(dyad_dual_add(dyad_dual_mul(t->l_m, dyad_dual_add(normal, t->f_m)), t->m_m),
+                      dyad_dual_add(dyad_dual_mul(t->l_n, dyad_dual_add(normal, t->f_n)), t->m_n));
     s.first_form = 1;
     return s;
 }
@@ -242,7 +243,7 @@ static inline dyad_output_sizes dyad_sizes_rtt(const dyad_size_terms* t)
     return s;
 }
 
-/* ---- from sizes to the amplification ------------------------------------- */
+/* ---- from sizes to the amplification -------------------------------------------------------- */
 
 /* Largest |component| of the reaction forces R_mk, R_np, R_mn, with its rate.
  * The normal forces are projections of these (|N| <= sqrt(2) x this), so the

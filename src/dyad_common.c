@@ -129,8 +129,7 @@ static dyad_real dyad_error_scale(const dyad_result* result, dyad_real mk, dyad_
                                   dyad_real mn)
 {
     const dyad_real largest = mk > np ? (mk > mn ? mk : mn) : (np > mn ? np : mn);
-    return result->status == DYAD_STATUS_OK ? result->amplification * largest
-                                            : (dyad_real)NAN;
+    return result->status == DYAD_STATUS_OK ? result->amplification * largest : (dyad_real)NAN;
 }
 
 dyad_real dyad_force_size(const dyad_result* result)
@@ -219,4 +218,3 @@ dyad_status dyad_reject(dyad_result* result, dyad_status status, dyad_field fiel
     result->field = field;
     return status;
 }
-

@@ -24,18 +24,12 @@ typedef dyad_loaded dyad_prepared;
 #define DYAD_CLOSED_FORM static inline
 #endif
 
-
-
-
-
 /* Marks the result with a failure status and field, outputs NaN; returns status. */
 dyad_status dyad_reject(dyad_result* result, dyad_status status, dyad_field field);
 
 /* The first input field out of its domain (non-finite included), in the order
  * of dyad_field, or DYAD_FIELD_NONE: the slow path that names a bad input. */
 dyad_field dyad_first_bad_field(dyad_type type, const dyad_input* input);
-
-
 
 /* Moment about D_g of the link's resultant load: (S_g - D_g) x F_g + M_g. */
 static inline dyad_real dyad_load_moment_about_d(const dyad_body* b)
@@ -83,12 +77,14 @@ static const dyad_pair_kind dyad_pair_table[DYAD_TYPE_COUNT][3] = {
  * l_n), and so may the slider of an inner translational pair (RTR, RTT l_n).
  * Every other length is a divisor or a lever that must exist. */
 static const int dyad_zero_length_table[DYAD_TYPE_COUNT][2] = {
+    /* clang-format off */
     /*            m  n */
     [DYAD_RRR] = {0, 0},
     [DYAD_RRT] = {1, 0},
     [DYAD_RTR] = {0, 1},
     [DYAD_TRT] = {1, 1},
     [DYAD_RTT] = {0, 1},
+    /* clang-format on */
 };
 
 static inline int dyad_is_unit(dyad_vec2 v)
@@ -127,8 +123,7 @@ static inline void dyad_resultant(const dyad_link* link, dyad_vec2 i, dyad_vec2 
     const dyad_vec2 without_centripetal =
         dyad_add(link->force, dyad_scale(link->mass, dyad_sub(gravity, tangential)));
     const dyad_link_sizes sizes = dyad_link_sizes_of(link, &no_rate, r, zero, gravity, zero);
-    body->f = dyad_add(without_centripetal,
-                       dyad_scale(link->mass * link->omega * link->omega, r));
+    body->f = dyad_add(without_centripetal, dyad_scale(link->mass * link->omega * link->omega, r));
     body->m = link->moment - link->inertia * link->epsilon;
     body->m_d = body->m + dyad_cross(r, without_centripetal);
     body->f_size = sizes.f.v;
@@ -252,11 +247,11 @@ static inline dyad_status dyad_check_finite(dyad_result* result)
 {
     const dyad_result* r = result;
     /* x - x is 0 for a finite x and NaN otherwise: one sum tests all outputs. */
-    const dyad_real nonfinite =
-        (r->r_mk.x - r->r_mk.x) + (r->r_mk.y - r->r_mk.y) + (r->r_np.x - r->r_np.x) +
-        (r->r_np.y - r->r_np.y) + (r->r_mn.x - r->r_mn.x) + (r->r_mn.y - r->r_mn.y) +
-        (r->n_mk - r->n_mk) + (r->n_np - r->n_np) + (r->n_mn - r->n_mn) +
-        (r->m_mk - r->m_mk) + (r->m_np - r->m_np) + (r->m_mn - r->m_mn);
+    const dyad_real nonfinite = (r->r_mk.x - r->r_mk.x) + (r->r_mk.y - r->r_mk.y) +
+                                (r->r_np.x - r->r_np.x) + (r->r_np.y - r->r_np.y) +
+                                (r->r_mn.x - r->r_mn.x) + (r->r_mn.y - r->r_mn.y) +
+                                (r->n_mk - r->n_mk) + (r->n_np - r->n_np) + (r->n_mn - r->n_mn) +
+                                (r->m_mk - r->m_mk) + (r->m_np - r->m_np) + (r->m_mn - r->m_mn);
     if (nonfinite != 0) {
         return dyad_reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
     }
@@ -265,8 +260,7 @@ static inline dyad_status dyad_check_finite(dyad_result* result)
 
 /* The last step of every type: out of range unless finite; then the
  * amplification from the output sizes (the rates are never read here). */
-static inline dyad_status dyad_finish(dyad_type type, dyad_output_sizes sizes,
-                                      dyad_result* result)
+static inline dyad_status dyad_finish(dyad_type type, dyad_output_sizes sizes, dyad_result* result)
 {
     const dyad_status status = dyad_check_finite(result);
     if (status == DYAD_STATUS_OK) {

@@ -74,15 +74,15 @@ dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
 
 /* The rate of the conditioning d = i_m . j_n as the directions turn. */
 static dyad_dual rrr_conditioning_rate(const dyad_input* input, const dyad_input* seed,
-                                      const dyad_turning* t, const dyad_result* value,
-                                      dyad_result* derivative)
+                                       const dyad_turning* t, const dyad_result* value,
+                                       dyad_result* derivative)
 {
-    const dyad_real dc =
-        t->dth_m * dyad_dot(dyad_perp(t->i_m), dyad_perp(t->i_n)) - t->dth_n * dyad_dot(t->i_m, t->i_n);
+    const dyad_real dc = t->dth_m * dyad_dot(dyad_perp(t->i_m), dyad_perp(t->i_n)) -
+                         t->dth_n * dyad_dot(t->i_m, t->i_n);
     (void)input;
     (void)seed;
     return dyad_denominator_rate(value, dc, derivative);
 }
 
 const dyad_tangent_type dyad_tangent_rrr = {DYAD_RRR, dyad_solve_rrr, dyad_sizes_rrr,
-                                             rrr_conditioning_rate};
+                                            rrr_conditioning_rate};

@@ -75,15 +75,15 @@ dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
 
 /* The rate of the conditioning d = i_n . i_k as the directions turn. */
 static dyad_dual rrt_conditioning_rate(const dyad_input* input, const dyad_input* seed,
-                                      const dyad_turning* t, const dyad_result* value,
-                                      dyad_result* derivative)
+                                       const dyad_turning* t, const dyad_result* value,
+                                       dyad_result* derivative)
 {
-    const dyad_real dc =
-        t->dth_n * dyad_dot(dyad_perp(t->i_n), t->i_k) + t->dth_k * dyad_dot(t->i_n, dyad_perp(t->i_k));
+    const dyad_real dc = t->dth_n * dyad_dot(dyad_perp(t->i_n), t->i_k) +
+                         t->dth_k * dyad_dot(t->i_n, dyad_perp(t->i_k));
     (void)input;
     (void)seed;
     return dyad_denominator_rate(value, dc, derivative);
 }
 
 const dyad_tangent_type dyad_tangent_rrt = {DYAD_RRT, dyad_solve_rrt, dyad_sizes_rrt,
-                                             rrt_conditioning_rate};
+                                            rrt_conditioning_rate};

@@ -106,16 +106,16 @@ static dyad_dual rtr_conditioning_rate(const dyad_input* input, const dyad_input
 {
     const dyad_real reach = input->m.length + input->n.length;
     const dyad_vec2 v = dyad_combine(input->m.length, t->i_m, -input->n.length, t->i_n);
-    const dyad_vec2 dv =
-        dyad_add(dyad_combine(seed->m.length, t->i_m, input->m.length * t->dth_m, dyad_perp(t->i_m)),
-                 dyad_combine(-seed->n.length, t->i_n, -input->n.length * t->dth_n,
-                              dyad_perp(t->i_n)));
+    const dyad_vec2 dv = dyad_add(
+        dyad_combine(seed->m.length, t->i_m, input->m.length * t->dth_m, dyad_perp(t->i_m)),
+        dyad_combine(-seed->n.length, t->i_n, -input->n.length * t->dth_n, dyad_perp(t->i_n)));
     const dyad_real dist = dyad_length(v);
     const dyad_real ddist = dyad_dot(v, dv) / dist;
     const dyad_real spread = dist / reach;
     const dyad_real slant = dyad_dot(v, t->i_m) / dist;
     const dyad_real dslant =
-        (dyad_dot(dv, t->i_m) + t->dth_m * dyad_dot(v, dyad_perp(t->i_m))) / dist - slant * ddist / dist;
+        (dyad_dot(dv, t->i_m) + t->dth_m * dyad_dot(v, dyad_perp(t->i_m))) / dist -
+        slant * ddist / dist;
     (void)value;
     derivative->denominator = dslant;
     derivative->conditioning = dyad_abs(slant) > spread
@@ -125,4 +125,4 @@ static dyad_dual rtr_conditioning_rate(const dyad_input* input, const dyad_input
 }
 
 const dyad_tangent_type dyad_tangent_rtr = {DYAD_RTR, dyad_solve_rtr, dyad_sizes_rtr,
-                                             rtr_conditioning_rate};
+                                            rtr_conditioning_rate};

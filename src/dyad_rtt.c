@@ -54,10 +54,10 @@ DYAD_CLOSED_FORM dyad_status rtt_reactions(const dyad_loaded* p, dyad_result* re
     result->r_mn = dyad_scale(result->n_mn, m->j);
     /* Where one link outweighs the other, the sums over the light one keep
      * their digits; the two forms of each are equal in exact arithmetic. */
-    result->r_np = dyad_smaller_sum(
-        dyad_neg(dyad_add(dyad_add(result->r_mk, m->f), n->f)),
-        dyad_norm1(result->r_mk) + dyad_norm1(m->f) + dyad_norm1(n->f),
-        dyad_sub(result->r_mn, n->f), dyad_norm1(result->r_mn) + dyad_norm1(n->f));
+    result->r_np =
+        dyad_smaller_sum(dyad_neg(dyad_add(dyad_add(result->r_mk, m->f), n->f)),
+                         dyad_norm1(result->r_mk) + dyad_norm1(m->f) + dyad_norm1(n->f),
+                         dyad_sub(result->r_mn, n->f), dyad_norm1(result->r_mn) + dyad_norm1(n->f));
     /* The moments about the outer pairs, where R_np and R_mk drop out. */
     result->m_mn = dyad_load_moment_about_d(n) - n->l * dyad_cross(n->i, result->r_mn);
     result->m_mk =
@@ -86,15 +86,15 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
 
 /* The rate of the conditioning d = j_k . i_m as the directions turn. */
 static dyad_dual rtt_conditioning_rate(const dyad_input* input, const dyad_input* seed,
-                                      const dyad_turning* t, const dyad_result* value,
-                                      dyad_result* derivative)
+                                       const dyad_turning* t, const dyad_result* value,
+                                       dyad_result* derivative)
 {
-    const dyad_real dc =
-        -t->dth_k * dyad_dot(t->i_k, t->i_m) + t->dth_m * dyad_dot(dyad_perp(t->i_k), dyad_perp(t->i_m));
+    const dyad_real dc = -t->dth_k * dyad_dot(t->i_k, t->i_m) +
+                         t->dth_m * dyad_dot(dyad_perp(t->i_k), dyad_perp(t->i_m));
     (void)input;
     (void)seed;
     return dyad_denominator_rate(value, dc, derivative);
 }
 
 const dyad_tangent_type dyad_tangent_rtt = {DYAD_RTT, dyad_solve_rtt, dyad_sizes_rtt,
-                                             rtt_conditioning_rate};
+                                            rtt_conditioning_rate};

@@ -42,17 +42,20 @@ static void resultant_rate(const dyad_link* k, const dyad_link* dk, dyad_vec2 i,
     const dyad_vec2 j = dyad_perp(i);
     const dyad_vec2 r = dyad_combine(k->com.x, i, k->com.y, j);
     /* r turns with the link and moves with com. */
-    const dyad_vec2 dr = dyad_add(dyad_combine(dk->com.x, i, dk->com.y, j),
-                                  dyad_scale(dtheta, dyad_perp(r)));
-    const dyad_vec2 w = dyad_add(k->force, dyad_scale(k->mass, dyad_sub(gravity,
-                          dyad_add(k->accel_d, dyad_scale(k->epsilon, dyad_perp(r))))));
-    const dyad_vec2 dtangential = dyad_add(
-        dyad_add(dk->accel_d, dyad_scale(dk->epsilon, dyad_perp(r))),
-        dyad_scale(k->epsilon, dyad_perp(dr)));
+    const dyad_vec2 dr =
+        dyad_add(dyad_combine(dk->com.x, i, dk->com.y, j), dyad_scale(dtheta, dyad_perp(r)));
+    const dyad_vec2 w = dyad_add(
+        k->force,
+        dyad_scale(k->mass,
+                   dyad_sub(gravity, dyad_add(k->accel_d, dyad_scale(k->epsilon, dyad_perp(r))))));
+    const dyad_vec2 dtangential =
+        dyad_add(dyad_add(dk->accel_d, dyad_scale(dk->epsilon, dyad_perp(r))),
+                 dyad_scale(k->epsilon, dyad_perp(dr)));
     const dyad_vec2 dw = dyad_add(
         dyad_add(dk->force,
-                 dyad_scale(dk->mass, dyad_sub(gravity, dyad_add(k->accel_d,
-                                               dyad_scale(k->epsilon, dyad_perp(r)))))),
+                 dyad_scale(dk->mass,
+                            dyad_sub(gravity,
+                                     dyad_add(k->accel_d, dyad_scale(k->epsilon, dyad_perp(r)))))),
         dyad_scale(k->mass, dyad_sub(dgravity, dtangential)));
     const dyad_real w2 = k->omega * k->omega;
     const dyad_vec2 dcentripetal =
@@ -81,12 +84,12 @@ static dyad_real amplification_rate(const dyad_tangent_type* kind, const dyad_in
     t.l_m = dyad_dual_make(input->m.length, seed->m.length);
     t.l_n = dyad_dual_make(input->n.length, seed->n.length);
     t.inv = inv;
-    return dyad_amplification_of(
-               kind->sizes(&t), dyad_largest_force(value, derivative),
-               dyad_largest_moment(value, derivative, dyad_guide_used(type, DYAD_PAIR_DM),
-                                   dyad_guide_used(type, DYAD_PAIR_E),
-                                   dyad_guide_used(type, DYAD_PAIR_DN)),
-               dyad_dual_make(value->conditioning, derivative->conditioning))
+    return dyad_amplification_of(kind->sizes(&t), dyad_largest_force(value, derivative),
+                                 dyad_largest_moment(value, derivative,
+                                                     dyad_guide_used(type, DYAD_PAIR_DM),
+                                                     dyad_guide_used(type, DYAD_PAIR_E),
+                                                     dyad_guide_used(type, DYAD_PAIR_DN)),
+                                 dyad_dual_make(value->conditioning, derivative->conditioning))
         .d;
 }
 
@@ -135,10 +138,10 @@ static dyad_input held_reaction_loads(dyad_type type, const dyad_input* input,
     {
         const dyad_vec2 lever_m = dyad_scale(input->m.length, t->i_m);
         const dyad_vec2 lever_n = dyad_scale(input->n.length, t->i_n);
-        const dyad_vec2 dlever_m = dyad_combine(seed->m.length, t->i_m, input->m.length * t->dth_m,
-                                                dyad_perp(t->i_m));
-        const dyad_vec2 dlever_n = dyad_combine(seed->n.length, t->i_n, input->n.length * t->dth_n,
-                                                dyad_perp(t->i_n));
+        const dyad_vec2 dlever_m =
+            dyad_combine(seed->m.length, t->i_m, input->m.length * t->dth_m, dyad_perp(t->i_m));
+        const dyad_vec2 dlever_n =
+            dyad_combine(seed->n.length, t->i_n, input->n.length * t->dth_n, dyad_perp(t->i_n));
         dmd_m += dyad_cross(dlever_m, value->r_mn) + dyad_cross(lever_m, dr_mn_turn);
         dmd_n -= dyad_cross(dlever_n, value->r_mn) + dyad_cross(lever_n, dr_mn_turn);
     }

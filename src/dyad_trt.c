@@ -68,15 +68,15 @@ dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
 
 /* The rate of the conditioning d = j_k . i_p as the directions turn. */
 static dyad_dual trt_conditioning_rate(const dyad_input* input, const dyad_input* seed,
-                                      const dyad_turning* t, const dyad_result* value,
-                                      dyad_result* derivative)
+                                       const dyad_turning* t, const dyad_result* value,
+                                       dyad_result* derivative)
 {
-    const dyad_real dc =
-        -t->dth_k * dyad_dot(t->i_k, t->i_p) + t->dth_p * dyad_dot(dyad_perp(t->i_k), dyad_perp(t->i_p));
+    const dyad_real dc = -t->dth_k * dyad_dot(t->i_k, t->i_p) +
+                         t->dth_p * dyad_dot(dyad_perp(t->i_k), dyad_perp(t->i_p));
     (void)input;
     (void)seed;
     return dyad_denominator_rate(value, dc, derivative);
 }
 
 const dyad_tangent_type dyad_tangent_trt = {DYAD_TRT, dyad_solve_trt, dyad_sizes_trt,
-                                             trt_conditioning_rate};
+                                            trt_conditioning_rate};

@@ -25,27 +25,27 @@
 /* float carries 24 bits; with amplification up to 10 in the random set a few
  * units of 6e-8 per term are expected. */
 #define RESIDUAL_LIMIT 1e-5
-#define HAND_LIMIT 1e-5
-#define HUGE_REAL 1e30f
+#define HAND_LIMIT     1e-5
+#define HUGE_REAL      1e30f
 /* The test reduces the loads in double, the float core in float: the two
  * roundings of terms up to 1e3 times the reactions differ by that much. */
 #define REACT_LIMIT 1e-4
 #else
-#define REAL_NAME "double"
+#define REAL_NAME      "double"
 #define RESIDUAL_LIMIT 1e-12
-#define HAND_LIMIT 1e-12
-#define HUGE_REAL 1e300
-#define REACT_LIMIT 1e-12
+#define HAND_LIMIT     1e-12
+#define HUGE_REAL      1e300
+#define REACT_LIMIT    1e-12
 #endif
 
 #define RANDOM_CONFIGURATIONS 10000
-#define WELL_CONDITIONED 0.1
-#define PI 3.14159265358979323846
+#define WELL_CONDITIONED      0.1
+#define PI                    3.14159265358979323846
 
 static const dyad_type all_types[DYAD_TYPE_COUNT] = {DYAD_RRR, DYAD_RRT, DYAD_RTR, DYAD_TRT,
                                                      DYAD_RTT};
 
-/* ---- random numbers: splitmix64 ---------------------------------------- */
+/* ---- random numbers: splitmix64 ------------------------------------------------------------- */
 
 typedef struct rng {
     uint64_t state;
@@ -80,12 +80,12 @@ static dyad_vec2 polar(double magnitude, double angle)
     return vec(magnitude * cos(angle), magnitude * sin(angle));
 }
 
-/* ---- equilibrium, summed independently of the solver ------------------- */
+/* ---- equilibrium, summed independently of the solver ---------------------------------------- */
 
 typedef struct balance {
-    double fx, fy, mz;   /* sums of forces (N) and of moments about P (N m) */
-    double f_scale;      /* largest force term (N) */
-    double m_scale;      /* largest moment term (N m) */
+    double fx, fy, mz; /* sums of forces (N) and of moments about P (N m) */
+    double f_scale;    /* largest force term (N) */
+    double m_scale;    /* largest moment term (N m) */
 } balance;
 
 static void add_force(balance* b, double complex at, double complex force, double complex p)
@@ -133,8 +133,8 @@ static double complex unit(dyad_vec2 v)
 
 /* Adds a link's active load, weight and d'Alembert inertia. The acceleration
  * of S is a_D + r (i epsilon - omega^2), r = S - D as a complex number. */
-static void add_link_loads(balance* b, const dyad_link* link, double complex d,
-                           dyad_vec2 gravity, double complex p)
+static void add_link_loads(balance* b, const dyad_link* link, double complex d, dyad_vec2 gravity,
+                           double complex p)
 {
     const double complex i = unit(link->dir);
     const double complex r = i * ((double)link->com.x + I * (double)link->com.y);
@@ -240,7 +240,7 @@ static int all_outputs_nan(const dyad_result* r)
     return 1;
 }
 
-/* ---- random configurations ---------------------------------------------- */
+/* ---- random configurations ------------------------------------------------------------------ */
 
 /* Conditioning of a configuration from its angles, not from the solver. */
 static double independent_conditioning(dyad_type type, const dyad_input* in)
@@ -267,8 +267,7 @@ static double independent_conditioning(dyad_type type, const dyad_input* in)
 
 static void random_link(rng* r, dyad_link* link, int may_be_zero)
 {
-    const double length =
-        (may_be_zero && uniform(r, 0, 1) < 0.1) ? 0 : log_uniform(r, 1e-3, 1e3);
+    const double length = (may_be_zero && uniform(r, 0, 1) < 0.1) ? 0 : log_uniform(r, 1e-3, 1e3);
     const double size = length > 0 ? length : log_uniform(r, 1e-3, 1);
     const double mass = uniform(r, 0, 1) < 0.05 ? 0 : log_uniform(r, 1e-3, 1e3);
     const double radius = size * uniform(r, 0.05, 0.6);
@@ -352,7 +351,7 @@ static int test_equilibrium_random(void)
     return fails;
 }
 
-/* ---- hand-checkable cases ------------------------------------------------ */
+/* ---- hand-checkable cases ------------------------------------------------------------------- */
 
 /* The hand cases carry loads of about 1e3 N (and moments of about 1e2 N m): a
  * component that should vanish is met to HAND_LIMIT of that scale. */
@@ -363,10 +362,12 @@ static int close_to(double got, double want)
     return fabs(got - want) <= HAND_LIMIT * (HAND_SCALE + fabs(want));
 }
 
-#define CHECK_VEC(v, wx, wy)                                                                   \
-    CHECK(close_to((v).x, (wx)) && close_to((v).y, (wy)), "%s = (%.12g, %.12g), expected "    \
-          "(%.12g, %.12g)", #v, (double)(v).x, (double)(v).y, (double)(wx), (double)(wy))
-#define CHECK_REAL(v, w)                                                                       \
+#define CHECK_VEC(v, wx, wy)                              \
+    CHECK(close_to((v).x, (wx)) && close_to((v).y, (wy)), \
+          "%s = (%.12g, %.12g), expected "                \
+          "(%.12g, %.12g)",                               \
+          #v, (double)(v).x, (double)(v).y, (double)(wx), (double)(wy))
+#define CHECK_REAL(v, w) \
     CHECK(close_to((v), (w)), "%s = %.12g, expected %.12g", #v, (double)(v), (double)(w))
 
 /* A massless link whose load sits at E: the symmetric RRR truss. */
@@ -533,7 +534,7 @@ static int test_rrr_centripetal(void)
     return fails;
 }
 
-/* ---- invalid input --------------------------------------------------------- */
+/* ---- invalid input -------------------------------------------------------------------------- */
 
 /* A valid configuration of every type: a generic one from the random set. */
 static dyad_input valid_input(dyad_type type)
@@ -597,8 +598,7 @@ static dyad_real* field_at(dyad_input* in, size_t offset)
     return (dyad_real*)((char*)in + offset);
 }
 
-static int expect_invalid(dyad_type type, const dyad_input* in, dyad_field field,
-                          const char* what)
+static int expect_invalid(dyad_type type, const dyad_input* in, dyad_field field, const char* what)
 {
     int fails = 0;
     dyad_result out;
@@ -625,10 +625,10 @@ static int test_invalid_nonfinite(void)
         for (f = 0; f < sizeof real_fields / sizeof real_fields[0]; ++f) {
             const real_field* rf = &real_fields[f];
             const int read = rf->guide == 0 ||
-                             (rf->guide == 1 && dyad_pair_kind_of(type, DYAD_PAIR_DM) ==
-                                                    DYAD_PAIR_TRANSLATIONAL) ||
-                             (rf->guide == 2 && dyad_pair_kind_of(type, DYAD_PAIR_DN) ==
-                                                    DYAD_PAIR_TRANSLATIONAL);
+                             (rf->guide == 1 &&
+                              dyad_pair_kind_of(type, DYAD_PAIR_DM) == DYAD_PAIR_TRANSLATIONAL) ||
+                             (rf->guide == 2 &&
+                              dyad_pair_kind_of(type, DYAD_PAIR_DN) == DYAD_PAIR_TRANSLATIONAL);
             for (v = 0; v < 3; ++v) {
                 dyad_input in = base;
                 *field_at(&in, rf->offset) = bad_values[v];
@@ -743,7 +743,7 @@ static int test_out_of_range(void)
     return fails;
 }
 
-/* ---- singular positions -------------------------------------------------- */
+/* ---- singular positions --------------------------------------------------------------------- */
 
 /* A configuration of the type at distance delta (rad or relative length) from
  * its singular position, with loads that the singular dyad cannot carry. */
@@ -764,9 +764,7 @@ static dyad_input near_singular(dyad_type type, double delta, int variant)
     in.m.dir = polar(1, base);
     in.guide_k = polar(1, base - 0.4);
     switch (type) {
-    case DYAD_RRR: /* links aligned */
-        in.n.dir = polar(1, base + delta);
-        break;
+    case DYAD_RRR: /* links aligned */ in.n.dir = polar(1, base + delta); break;
     case DYAD_RRT: /* rod normal to the guide */
         in.n.dir = polar(1, base - 0.4 + PI / 2 - delta);
         break;
@@ -832,16 +830,16 @@ static int test_singular(void)
                 previous = 1 / out.conditioning;
                 if (out.conditioning >= in.singular_threshold) {
                     CHECK(status == DYAD_STATUS_OK && !switched,
-                          "%s/%d: status %s above threshold at %.0e", dyad_type_name(type),
-                          variant, dyad_status_name(status), delta);
+                          "%s/%d: status %s above threshold at %.0e", dyad_type_name(type), variant,
+                          dyad_status_name(status), delta);
                     CHECK(dyad_imbalance(&in, &out, 0, 1 + I).dyad <
                               RESIDUAL_LIMIT * 100 * (double)out.amplification,
                           "%s/%d: residual at %.0e", dyad_type_name(type), variant, delta);
                 } else {
                     switched = 1;
                     CHECK(status == DYAD_STATUS_SINGULAR && all_outputs_nan(&out),
-                          "%s/%d: status %s below threshold at %.0e", dyad_type_name(type),
-                          variant, dyad_status_name(status), delta);
+                          "%s/%d: status %s below threshold at %.0e", dyad_type_name(type), variant,
+                          dyad_status_name(status), delta);
                 }
             }
             CHECK(switched, "%s/%d: never reported singular down to 1e-12", dyad_type_name(type),
@@ -877,9 +875,9 @@ static int test_invalid_before_singular(void)
     return fails;
 }
 
-/* ---- runner --------------------------------------------------------------- */
+/* ---- runner --------------------------------------------------------------------------------- */
 
-/* ---- the closed forms on reduced loads (dyadfmu/loaded.h) ---------------- */
+/* ---- the closed forms on reduced loads (dyadfmu/loaded.h) ----------------------------------- */
 
 /* |x| + |y| of a complex number. */
 static double cnorm1(double complex z)
@@ -894,8 +892,8 @@ static dyad_loaded_link loaded_link_of(const dyad_link* link, dyad_vec2 gravity)
 {
     const double complex i_g = unit(link->dir);
     const double complex r = ((double)link->com.x + I * (double)link->com.y) * i_g;
-    const double complex a_s = cvec(link->accel_d) +
-                               (I * (double)link->epsilon - (double)link->omega * link->omega) * r;
+    const double complex a_s =
+        cvec(link->accel_d) + (I * (double)link->epsilon - (double)link->omega * link->omega) * r;
     const double complex f = cvec(link->force) + (double)link->mass * (cvec(gravity) - a_s);
     const double m = (double)link->moment - (double)link->inertia * link->epsilon;
     dyad_loaded_link out;
@@ -908,10 +906,9 @@ static dyad_loaded_link loaded_link_of(const dyad_link* link, dyad_vec2 gravity)
     {
         /* every term but the centripetal one, which has no moment about D */
         const double lever = cnorm1(r);
-        const double straight =
-            cnorm1(cvec(link->force)) +
-            link->mass * (cnorm1(cvec(gravity)) + cnorm1(cvec(link->accel_d)) +
-                          fabs((double)link->epsilon) * lever);
+        const double straight = cnorm1(cvec(link->force)) +
+                                link->mass * (cnorm1(cvec(gravity)) + cnorm1(cvec(link->accel_d)) +
+                                              fabs((double)link->epsilon) * lever);
         out.f_size = (dyad_real)(straight + link->mass * link->omega * link->omega * lever);
         out.m_d_size = (dyad_real)(fabs((double)link->moment) +
                                    link->inertia * fabs((double)link->epsilon) + lever * straight);
@@ -988,7 +985,7 @@ static int test_react_loaded(void)
             /* the same loads and sizes give the same amplification, to the
              * difference of the largest outputs the two reductions give */
             CHECK(fabs((double)got.amplification - (double)want.amplification) <=
-                      sqrt(DYAD_REAL_EPSILON) * (double)want.amplification &&
+                          sqrt(DYAD_REAL_EPSILON) * (double)want.amplification &&
                       got.amplification >= 1 / got.conditioning,
                   "%s: amplification %.17g, dyad_solve %.17g", dyad_type_name(type),
                   (double)got.amplification, (double)want.amplification);
@@ -1067,8 +1064,8 @@ static const named_test tests[] = {
 
 int main(int argc, char** argv)
 {
-    return run_named_tests(tests, sizeof tests / sizeof tests[0], REAL_NAME, argv + 1,
-                           argc - 1) == 0
+    return run_named_tests(tests, sizeof tests / sizeof tests[0], REAL_NAME, argv + 1, argc - 1) ==
+                   0
                ? 0
                : 1;
 }

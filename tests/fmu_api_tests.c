@@ -40,7 +40,7 @@ static probe_model md2, md3;
 static probe_fmi2 api2;
 static probe_fmi3 api3;
 
-/* ---- what each test needs of a model ------------------------------------------------- */
+/* ---- what each test needs of a model -------------------------------------------------------- */
 
 /* A variable of each role the calls below need; NULL where the model has none. */
 typedef struct picks {
@@ -88,10 +88,11 @@ static int logged_error(const probe_log_book* book, long count_before)
 
 static int is_real_setting(const probe_variable* v)
 {
-    return v->type == PROBE_REAL && (v->causality == PROBE_INPUT || v->causality == PROBE_PARAMETER);
+    return v->type == PROBE_REAL &&
+           (v->causality == PROBE_INPUT || v->causality == PROBE_PARAMETER);
 }
 
-/* ---- FMI 2 -------------------------------------------------------------------------------- */
+/* ---- FMI 2 ---------------------------------------------------------------------------------- */
 
 static fmi2Component new_fmi2(probe_log_book* book, const char* name)
 {
@@ -111,9 +112,9 @@ static int initialise_fmi2(fmi2Component c)
  * stepFailed after a doStep that returned Discard, error after one that
  * returned Error (a step size of -1). */
 enum { S_INSTANTIATED, S_INITIALIZATION, S_STEP, S_FAILED, S_ERROR, S_TERMINATED, STATE_COUNT };
-static const char* const state_names[STATE_COUNT] = {
-    "Instantiated", "Initialization", "StepComplete", "StepFailed/Discarded", "Error",
-    "Terminated"};
+static const char* const state_names[STATE_COUNT] = {"Instantiated", "Initialization",
+                                                     "StepComplete", "StepFailed/Discarded",
+                                                     "Error",        "Terminated"};
 
 /* Inputs all at one extreme value: a doStep that the model cannot complete
  * (the reactions or the state overflow) and must discard. Returns 1 if found. */
@@ -242,8 +243,7 @@ static int fmi2_call(fmi2Component c, size_t rule, const picks* p)
     case 6: return api2.Reset(c);
     case 7: return api2.GetReal(c, &out, 1, &value);
     case 8: return p->input != NULL ? (int)api2.GetReal(c, &in, 1, &value) : -1;
-    case 9:
-        return p->status != NULL ? (int)api2.GetInteger(c, &p->status->vr, 1, &integer) : -1;
+    case 9: return p->status != NULL ? (int)api2.GetInteger(c, &p->status->vr, 1, &integer) : -1;
     case 10: return api2.GetBoolean(c, NULL, 0, NULL);
     case 11: return api2.GetString(c, NULL, 0, NULL);
     case 12: return p->input != NULL ? (int)api2.SetReal(c, &in, 1, &value) : -1;
@@ -263,9 +263,9 @@ static int fmi2_call(fmi2Component c, size_t rule, const picks* p)
     case 21: return api2.SerializeFMUstate(c, state, bytes, sizeof bytes);
     case 22: return api2.DeSerializeFMUstate(c, bytes, sizeof bytes, &state);
     case 23:
-        return p->input != NULL ? (int)api2.GetDirectionalDerivative(c, &out, 1, &in, 1, &seed,
-                                                                     &rate)
-                                : -1;
+        return p->input != NULL
+                   ? (int)api2.GetDirectionalDerivative(c, &out, 1, &in, 1, &seed, &rate)
+                   : -1;
     case 24: return api2.SetRealInputDerivatives(c, &in, 1, &order, &rate);
     case 25: return api2.GetRealOutputDerivatives(c, &out, 1, &order, &rate);
     case 26: return api2.CancelStep(c);
@@ -340,8 +340,8 @@ static int test_fmi2_state_machine(void)
             }
             if (status >= 0) {
                 ++calls;
-                fails += judge(fmi2_rules[rule].name, state_names[state], expect, status, &book,
-                               0, rule == 13 ? p.parameter->name : NULL);
+                fails += judge(fmi2_rules[rule].name, state_names[state], expect, status, &book, 0,
+                               rule == 13 ? p.parameter->name : NULL);
             }
             api2.FreeInstance(c);
         }
@@ -391,8 +391,7 @@ static int test_fmi2_null_instance(void)
     CHECK(api2.CancelStep(NULL) == fmi2Error, "CancelStep");
     CHECK(api2.GetStatus(NULL, fmi2DoStepStatus, &s) == fmi2Error, "GetStatus");
     CHECK(api2.GetRealStatus(NULL, fmi2LastSuccessfulTime, &r) == fmi2Error, "GetRealStatus");
-    CHECK(api2.GetIntegerStatus(NULL, fmi2LastSuccessfulTime, &i) == fmi2Error,
-          "GetIntegerStatus");
+    CHECK(api2.GetIntegerStatus(NULL, fmi2LastSuccessfulTime, &i) == fmi2Error, "GetIntegerStatus");
     CHECK(api2.GetBooleanStatus(NULL, fmi2Terminated, &b) == fmi2Error, "GetBooleanStatus");
     CHECK(api2.GetStringStatus(NULL, fmi2PendingStatus, &str) == fmi2Error, "GetStringStatus");
     return fails;
@@ -441,8 +440,8 @@ static int test_fmi2_null_arguments(void)
         CHECK(api2.GetDirectionalDerivative(c, NULL, 0, NULL, 0, NULL, NULL) == fmi2OK,
               "GetDirectionalDerivative of nothing");
         count = book.count;
-        CHECK(api2.GetDirectionalDerivative(c, &p.output->vr, 1, &p.input->vr, 1, NULL,
-                                            &value) == fmi2Error &&
+        CHECK(api2.GetDirectionalDerivative(c, &p.output->vr, 1, &p.input->vr, 1, NULL, &value) ==
+                      fmi2Error &&
                   logged_error(&book, count),
               "GetDirectionalDerivative with a NULL seed");
     }
@@ -466,8 +465,7 @@ static int test_fmi2_null_arguments(void)
               logged_error(&book, count),
           "GetRealStatus into NULL");
     count = book.count;
-    CHECK(api2.GetBooleanStatus(c, fmi2Terminated, NULL) == fmi2Error &&
-              logged_error(&book, count),
+    CHECK(api2.GetBooleanStatus(c, fmi2Terminated, NULL) == fmi2Error && logged_error(&book, count),
           "GetBooleanStatus into NULL");
     api2.FreeInstance(c);
     return fails;
@@ -697,7 +695,7 @@ static int test_fmi2_instantiate_refusals(void)
     return fails;
 }
 
-/* ---- FMI 3 ------------------------------------------------------------------------------------ */
+/* ---- FMI 3 ---------------------------------------------------------------------------------- */
 
 static fmi3Instance new_fmi3(probe_log_book* book, const char* name)
 {
@@ -907,8 +905,7 @@ static int fmi3_call(fmi3Instance c, size_t rule, const picks* p)
     case 35: return api3.SetBinary(c, NULL, 0, NULL, NULL, 0);
     case 36: return api3.SetClock(c, NULL, 0, NULL);
     case 37: return api3.GetNumberOfVariableDependencies(c, out, &size);
-    case 38:
-        return api3.GetVariableDependencies(c, out, &element, &dependent, &element, &kind, 1);
+    case 38: return api3.GetVariableDependencies(c, out, &element, &dependent, &element, &kind, 1);
     case 39: return api3.GetFMUState(c, &state);
     case 40: return api3.SetFMUState(c, state);
     case 41: return api3.FreeFMUState(c, &state);
@@ -916,9 +913,9 @@ static int fmi3_call(fmi3Instance c, size_t rule, const picks* p)
     case 43: return api3.SerializeFMUState(c, state, bytes, sizeof bytes);
     case 44: return api3.DeserializeFMUState(c, bytes, sizeof bytes, &state);
     case 45:
-        return p->input != NULL ? (int)api3.GetDirectionalDerivative(c, &out, 1, &in, 1, &seed, 1,
-                                                                     &rate, 1)
-                                : -1;
+        return p->input != NULL
+                   ? (int)api3.GetDirectionalDerivative(c, &out, 1, &in, 1, &seed, 1, &rate, 1)
+                   : -1;
     case 46: return api3.GetAdjointDerivative(c, &out, 1, &in, 1, &seed, 1, &rate, 1);
     case 47: return api3.EnterConfigurationMode(c);
     case 48: return api3.ExitConfigurationMode(c);
@@ -979,8 +976,8 @@ static int test_fmi3_state_machine(void)
             }
             if (status >= 0) {
                 ++calls;
-                fails += judge(fmi3_rules[rule].name, state_names[state], expect, status, &book,
-                               0, rule == 23 ? p.parameter->name : NULL);
+                fails += judge(fmi3_rules[rule].name, state_names[state], expect, status, &book, 0,
+                               rule == 23 ? p.parameter->name : NULL);
             }
             api3.FreeInstance(c);
         }
@@ -1066,8 +1063,7 @@ static int test_fmi3_null_arguments(void)
     CHECK(api3.GetFloat64(c, NULL, 1, &value, 1) == fmi3Error && logged_error(&book, count),
           "GetFloat64 with NULL value references");
     count = book.count;
-    CHECK(api3.GetFloat64(c, &p.output->vr, 1, NULL, 1) == fmi3Error &&
-              logged_error(&book, count),
+    CHECK(api3.GetFloat64(c, &p.output->vr, 1, NULL, 1) == fmi3Error && logged_error(&book, count),
           "GetFloat64 with a NULL value array");
     count = book.count;
     CHECK(p.input == NULL || (api3.SetFloat64(c, &p.input->vr, 1, NULL, 1) == fmi3Error &&
@@ -1123,8 +1119,12 @@ static int fmi3_wrong_type_calls(fmi3Instance c, const probe_variable* v, probe_
         int status = 0;
         memset(&any, 0, sizeof any);
         switch (k) {
-        case 0: status = v->type == PROBE_REAL ? -1 : (int)api3.GetFloat64(c, &vr, 1, &any.f64, 1); break;
-        case 1: status = v->type == PROBE_INTEGER ? -1 : (int)api3.GetInt32(c, &vr, 1, &any.i32, 1); break;
+        case 0:
+            status = v->type == PROBE_REAL ? -1 : (int)api3.GetFloat64(c, &vr, 1, &any.f64, 1);
+            break;
+        case 1:
+            status = v->type == PROBE_INTEGER ? -1 : (int)api3.GetInt32(c, &vr, 1, &any.i32, 1);
+            break;
         case 2: status = api3.GetFloat32(c, &vr, 1, &any.f32, 1); break;
         case 3: status = api3.GetInt8(c, &vr, 1, (fmi3Int8*)&any, 1); break;
         case 4: status = api3.GetUInt8(c, &vr, 1, (fmi3UInt8*)&any, 1); break;
@@ -1138,8 +1138,16 @@ static int fmi3_wrong_type_calls(fmi3Instance c, const probe_variable* v, probe_
         case 12: status = api3.GetBinary(c, &vr, 1, &size, &any.b, 1); break;
         case 13: status = api3.GetClock(c, &vr, 1, &any.clock); break;
         /* a setter of the variable's own type is wrong only for an output or time */
-        case 14: status = v->type == PROBE_REAL && settable ? -1 : (int)api3.SetFloat64(c, &vr, 1, &any.f64, 1); break;
-        case 15: status = v->type == PROBE_INTEGER && settable ? -1 : (int)api3.SetInt32(c, &vr, 1, &any.i32, 1); break;
+        case 14:
+            status = v->type == PROBE_REAL && settable
+                         ? -1
+                         : (int)api3.SetFloat64(c, &vr, 1, &any.f64, 1);
+            break;
+        case 15:
+            status = v->type == PROBE_INTEGER && settable
+                         ? -1
+                         : (int)api3.SetInt32(c, &vr, 1, &any.i32, 1);
+            break;
         case 16: status = api3.SetFloat32(c, &vr, 1, &any.f32, 1); break;
         case 17: status = api3.SetInt8(c, &vr, 1, (fmi3Int8*)&any, 1); break;
         case 18: status = api3.SetUInt8(c, &vr, 1, (fmi3UInt8*)&any, 1); break;
@@ -1149,7 +1157,10 @@ static int fmi3_wrong_type_calls(fmi3Instance c, const probe_variable* v, probe_
         case 22: status = api3.SetInt64(c, &vr, 1, &any.i64, 1); break;
         case 23: status = api3.SetUInt64(c, &vr, 1, &any.u64, 1); break;
         case 24: status = api3.SetBoolean(c, &vr, 1, (fmi3Boolean*)&any, 1); break;
-        case 25: any.s = "x"; status = api3.SetString(c, &vr, 1, &any.s, 1); break;
+        case 25:
+            any.s = "x";
+            status = api3.SetString(c, &vr, 1, &any.s, 1);
+            break;
         }
         if (status >= 0) {
             CHECK(status == fmi3Error && logged_error(book, count),
@@ -1395,7 +1406,7 @@ static int test_fmi3_instantiate_refusals(void)
     return fails;
 }
 
-/* ---- both: instances are independent ------------------------------------------------------ */
+/* ---- both: instances are independent -------------------------------------------------------- */
 
 /* Steps instances with their own inputs, interleaved, and again each alone: the
  * outputs agree bit for bit. */
@@ -1471,7 +1482,7 @@ static int test_instances_independent(void)
     return fails;
 }
 
-/* ---- the RRT FMUs against the C core ------------------------------------------------------- */
+/* ---- the RRT FMUs against the C core -------------------------------------------------------- */
 
 static const fmu_variable* variable(const char* name)
 {
@@ -1601,8 +1612,7 @@ static int test_rrt_fmi2_singular(void)
     CHECK(api2.DoStep(c, 0.01, 0.01, fmi2True) == fmi2Discard, "singular step discarded");
     CHECK(book.last_status == fmi2Discard && strstr(book.last, "singular") != NULL,
           "logged reason: %s", book.last);
-    CHECK(api2.GetRealStatus(c, fmi2LastSuccessfulTime, &last_time) == fmi2OK &&
-              last_time == 0.01,
+    CHECK(api2.GetRealStatus(c, fmi2LastSuccessfulTime, &last_time) == fmi2OK && last_time == 0.01,
           "last successful time %g", last_time);
     CHECK(api2.GetBooleanStatus(c, fmi2Terminated, &terminated) == fmi2OK && terminated,
           "asks to terminate");
@@ -1610,8 +1620,7 @@ static int test_rrt_fmi2_singular(void)
     for (k = 0; k < 6; ++k) {
         CHECK(isnan(got[k]), "reaction %zu = %g, expected NaN", k, got[k]);
     }
-    CHECK(api2.GetInteger(c, &status_vr, 1, &status) == fmi2OK && status == 1, "status %d",
-          status);
+    CHECK(api2.GetInteger(c, &status_vr, 1, &status) == fmi2OK && status == 1, "status %d", status);
     CHECK(api2.SetReal(c, &rod, 1, &fine) == fmi2OK &&
               api2.DoStep(c, 0.01, 0.01, fmi2True) == fmi2OK,
           "usable again once the input is fixed");
@@ -1681,10 +1690,10 @@ static int test_rrt_fmi3_singular(void)
 static int test_exports_only_fmi(void)
 {
     static const char* const internal[] = {
-        "fmu_instantiate", "fmu_this_model", "fmu_log",        "fmu_do_step",
-        "fmu_dyad_behaviour", "fmu_drive_behaviour", "dyad_solve_rrr", "dyad_solve_rrt",
-        "dyad_solve_rtr",  "dyad_solve_trt", "dyad_solve_rtt", "dyad_react_rrr",
-        "dyad_react_rrt",  "dyad_field_name", "dyad_input_default"};
+        "fmu_instantiate",    "fmu_this_model",      "fmu_log",           "fmu_do_step",
+        "fmu_dyad_behaviour", "fmu_drive_behaviour", "dyad_solve_rrr",    "dyad_solve_rrt",
+        "dyad_solve_rtr",     "dyad_solve_trt",      "dyad_solve_rtt",    "dyad_react_rrr",
+        "dyad_react_rrt",     "dyad_field_name",     "dyad_input_default"};
     int fails = 0;
     size_t k;
     for (k = 0; k < sizeof internal / sizeof internal[0]; ++k) {
@@ -1702,9 +1711,11 @@ typedef struct bad_step {
  * message, changing nothing: among them end times t + h that overflow or round
  * back to t (issue 12, finding 7). */
 static const bad_step bad_steps[] = {
-    {0, 0},          {0, -0.0},        {0, -1e-3},     {0, NAN},         {0, INFINITY},
-    {0, -INFINITY},  {NAN, 1e-3},      {INFINITY, 1e-3}, {-INFINITY, 1e-3}, {DBL_MAX, 1e300},
-    {DBL_MAX, DBL_MAX}, {-DBL_MAX, -1e-3}, {1e300, 1e-3},
+    {0, 0},           {0, -0.0},          {0, -1e-3},
+    {0, NAN},         {0, INFINITY},      {0, -INFINITY},
+    {NAN, 1e-3},      {INFINITY, 1e-3},   {-INFINITY, 1e-3},
+    {DBL_MAX, 1e300}, {DBL_MAX, DBL_MAX}, {-DBL_MAX, -1e-3},
+    {1e300, 1e-3},
 };
 
 static void free_either(int version, void* c)
@@ -1745,7 +1756,7 @@ static int test_bad_steps(void)
     return fails;
 }
 
-/* ---- the drive ----------------------------------------------------------------------------- */
+/* ---- the drive ------------------------------------------------------------------------------ */
 
 /* Inputs the drive refuses only when it evaluates them (inertia + load.inertia
  * must be positive): every call that returns Error says why, not only the
@@ -1848,8 +1859,8 @@ static int test_drive_step_beyond_cap(void)
         const double angle = get_named(version, c, "crank.angle");
         const double omega = get_named(version, c, "crank.omega");
         const long count = book.count;
-        const int status = version == 2 ? (int)api2.DoStep(c, 0, 1e16, fmi2True)
-                                        : (int)step3(c, 0, 1e16);
+        const int status =
+            version == 2 ? (int)api2.DoStep(c, 0, 1e16, fmi2True) : (int)step3(c, 0, 1e16);
         CHECK(ready && status == 3 && logged_error(&book, count) &&
                   strstr(book.last, "substeps") != NULL &&
                   probe_bits(get_named(version, c, "crank.angle")) == probe_bits(angle) &&
@@ -1938,7 +1949,8 @@ static int test_drive_discard_keeps_state(void)
         omega = get_named(version, c, "crank.omega");
         status = version == 2 ? (int)api2.DoStep(c, 0, 0.0022494449308296154, fmi2True)
                               : (int)step3(c, 0, 0.0022494449308296154);
-        CHECK(status == 2 && probe_bits(get_named(version, c, "crank.angle")) == probe_bits(angle) &&
+        CHECK(status == 2 &&
+                  probe_bits(get_named(version, c, "crank.angle")) == probe_bits(angle) &&
                   probe_bits(get_named(version, c, "crank.omega")) == probe_bits(omega) &&
                   get_status_output(version, c) == 0,
               "FMI %d: doStep: status %d, state (%g, %g) from (%g, %g), status output %d", version,
@@ -1956,7 +1968,7 @@ static const named_test drive_tests[] = {
     {"drive_discard_keeps_state", test_drive_discard_keeps_state},
 };
 
-/* ---- runner ----------------------------------------------------------------------------------- */
+/* ---- runner --------------------------------------------------------------------------------- */
 
 static const named_test generic_tests[] = {
     {"fmi2_state_machine", test_fmi2_state_machine},
@@ -2003,7 +2015,8 @@ int main(int argc, char** argv)
         printf("%s\n0 passed, 1 failed\n", error);
         return 1;
     }
-    if (md2.fmi_version != 2 || md3.fmi_version != 3 || strcmp(md2.identifier, md3.identifier) != 0) {
+    if (md2.fmi_version != 2 || md3.fmi_version != 3 ||
+        strcmp(md2.identifier, md3.identifier) != 0) {
         printf("expected the FMI 2 and FMI 3 FMU of one model\n0 passed, 1 failed\n");
         return 1;
     }

@@ -42,7 +42,7 @@
 
 #include "fmu_probe.h"
 
-/* ---- the FMU, either version --------------------------------------------------------- */
+/* ---- the FMU, either version ---------------------------------------------------------------- */
 
 /* What an output may be when the status output is not 0, as the model
  * descriptions say; every output is finite when it is 0. */
@@ -58,27 +58,28 @@ typedef struct fuzz_named_rule {
     fuzz_rule rule;
 } fuzz_named_rule;
 
-static const fuzz_named_rule fuzz_rules[] = {
-    {"conditioning", FUZZ_ANY_WHEN_FAILED}, {"amplification", FUZZ_ANY_WHEN_FAILED},
-    {"motor.torque", FUZZ_FINITE_OR_NAN},   {"crank.angle", FUZZ_ALWAYS_FINITE},
-    {"crank.omega", FUZZ_ALWAYS_FINITE}};
+static const fuzz_named_rule fuzz_rules[] = {{"conditioning", FUZZ_ANY_WHEN_FAILED},
+                                             {"amplification", FUZZ_ANY_WHEN_FAILED},
+                                             {"motor.torque", FUZZ_FINITE_OR_NAN},
+                                             {"crank.angle", FUZZ_ALWAYS_FINITE},
+                                             {"crank.omega", FUZZ_ALWAYS_FINITE}};
 
 typedef struct fuzz_fmu {
     probe_model model;
     probe_fmi2 f2;
     probe_fmi3 f3;
     /* Indices into model.variables, and value references in the same order. */
-    size_t* reals;      /* every Real variable but FMI 3's time */
+    size_t* reals; /* every Real variable but FMI 3's time */
     unsigned* real_vrs;
     size_t real_count;
     size_t* integers;
     unsigned* integer_vrs;
     size_t integer_count;
-    size_t* settable;   /* inputs and parameters */
+    size_t* settable; /* inputs and parameters */
     size_t settable_count;
-    int status_index;   /* the Integer output `status`, -1 if none */
+    int status_index;          /* the Integer output `status`, -1 if none */
     int angle, omega, epsilon; /* a state: outputs crank.angle, .omega, .epsilon; -1 if none */
-    fuzz_rule* rule;    /* per variable: what an output may be when status is not 0 */
+    fuzz_rule* rule;           /* per variable: what an output may be when status is not 0 */
 } fuzz_fmu;
 
 static int fuzz_prepare(fuzz_fmu* f, const char* directory)
@@ -102,8 +103,8 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
     f->integer_vrs = (unsigned*)calloc(n + 1, sizeof *f->integer_vrs);
     f->settable = (size_t*)calloc(n + 1, sizeof *f->settable);
     f->rule = (fuzz_rule*)calloc(n + 1, sizeof *f->rule);
-    if (f->reals == NULL || f->real_vrs == NULL || f->integers == NULL ||
-        f->integer_vrs == NULL || f->settable == NULL || f->rule == NULL) {
+    if (f->reals == NULL || f->real_vrs == NULL || f->integers == NULL || f->integer_vrs == NULL ||
+        f->settable == NULL || f->rule == NULL) {
         printf("out of memory\n");
         return 0;
     }
@@ -165,7 +166,7 @@ static int has_state(const fuzz_fmu* f)
     return f->angle >= 0;
 }
 
-/* ---- an episode -------------------------------------------------------------------------- */
+/* ---- an episode ----------------------------------------------------------------------------- */
 
 typedef enum fuzz_state { S_INSTANTIATED, S_INITIALIZATION, S_STEP, S_TERMINATED } fuzz_state;
 static const char* const fuzz_state_names[] = {"Instantiated", "Initialization", "Step",
@@ -191,14 +192,14 @@ typedef struct fuzz_episode {
     void* instance;
     probe_log_book book;
     fuzz_state state;
-    double* shadow;       /* per variable: the value the last accepted set stored */
-    double time;          /* the communication point an importer would use next */
+    double* shadow; /* per variable: the value the last accepted set stored */
+    double time;    /* the communication point an importer would use next */
     uint64_t trace;
     fuzz_snapshot before, after;
-    long call;            /* index of the current call, for the report */
+    long call; /* index of the current call, for the report */
     long step_quota;
     int verbose;
-    int failed;           /* an invariant broke */
+    int failed; /* an invariant broke */
     fuzz_counts* counts;
     char failure[1200];
 } fuzz_episode;
@@ -273,7 +274,7 @@ static void expect_message(fuzz_episode* e, int status, long count_before, const
     }
 }
 
-/* ---- the calls, either version ------------------------------------------------------------- */
+/* ---- the calls, either version -------------------------------------------------------------- */
 
 static int call_set_real(fuzz_episode* e, const unsigned* vrs, size_t n, const double* values)
 {
@@ -347,8 +348,8 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
         trace(e, (uint64_t)(unsigned)s->integers[k]);
     }
     if (integer_status != 0) {
-        violation(e, "getting the Integer variables in %s returned %d",
-                  fuzz_state_names[e->state], integer_status);
+        violation(e, "getting the Integer variables in %s returned %d", fuzz_state_names[e->state],
+                  integer_status);
         return;
     }
     if (s->get_status > 3) {
@@ -361,8 +362,8 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
         const size_t index = f->reals[k];
         if (f->model.variables[index].causality != PROBE_OUTPUT &&
             probe_bits(s->reals[k]) != probe_bits(e->shadow[index])) {
-            violation(e, "%s reads %.17g, but the last accepted value was %.17g",
-                      name_of(e, index), s->reals[k], e->shadow[index]);
+            violation(e, "%s reads %.17g, but the last accepted value was %.17g", name_of(e, index),
+                      s->reals[k], e->shadow[index]);
             return;
         }
     }
@@ -376,8 +377,7 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
         status = s->get_status == 0 ? 0 : -1;
     }
     if ((status == 0) != (s->get_status == 0)) {
-        violation(e, "status output %d but the getter returned %d", status,
-                  s->get_status);
+        violation(e, "status output %d but the getter returned %d", status, s->get_status);
         return;
     }
     for (k = 0; k < f->real_count; ++k) {
@@ -396,8 +396,8 @@ static void snapshot(fuzz_episode* e, fuzz_snapshot* s)
             return;
         }
         if (status != 0 && rule == FUZZ_FINITE_OR_NAN && isinf(x)) {
-            violation(e, "status %d but %s = %g, neither finite nor NaN", status,
-                      name_of(e, index), x);
+            violation(e, "status %d but %s = %g, neither finite nor NaN", status, name_of(e, index),
+                      x);
             return;
         }
     }
@@ -428,21 +428,21 @@ static void compare_with_before(fuzz_episode* e, const char* call)
     const fuzz_fmu* f = e->fmu;
     size_t k;
     if (e->after.get_status != e->before.get_status) {
-        violation(e, "%s changed the getter's status from %d to %d", call,
-                  e->before.get_status, e->after.get_status);
+        violation(e, "%s changed the getter's status from %d to %d", call, e->before.get_status,
+                  e->after.get_status);
         return;
     }
     for (k = 0; k < f->real_count; ++k) {
         if (probe_bits(e->after.reals[k]) != probe_bits(e->before.reals[k])) {
-            violation(e, "%s changed %s from %.17g to %.17g", call,
-                      name_of(e, f->reals[k]), e->before.reals[k], e->after.reals[k]);
+            violation(e, "%s changed %s from %.17g to %.17g", call, name_of(e, f->reals[k]),
+                      e->before.reals[k], e->after.reals[k]);
             return;
         }
     }
     for (k = 0; k < f->integer_count; ++k) {
         if (e->after.integers[k] != e->before.integers[k]) {
-            violation(e, "%s changed %s from %d to %d", call,
-                      name_of(e, f->integers[k]), e->before.integers[k], e->after.integers[k]);
+            violation(e, "%s changed %s from %d to %d", call, name_of(e, f->integers[k]),
+                      e->before.integers[k], e->after.integers[k]);
             return;
         }
     }
@@ -469,7 +469,7 @@ static void swap_snapshots(fuzz_episode* e)
     e->after.valid = 0;
 }
 
-/* ---- nasty values -------------------------------------------------------------------------- */
+/* ---- nasty values --------------------------------------------------------------------------- */
 
 static double from_bits(uint64_t bits)
 {
@@ -480,14 +480,40 @@ static double from_bits(uint64_t bits)
 
 static double special_value(probe_rng* rng)
 {
-    const double specials[] = {
-        NAN, -(double)NAN, INFINITY, -INFINITY, DBL_MAX, -DBL_MAX, DBL_MIN, -DBL_MIN,
-        4.9406564584124654e-324, -4.9406564584124654e-324, /* smallest denormals */
-        2.2250738585072009e-308, -2.2250738585072009e-308, /* largest denormals */
-        0.0, -0.0, 1e308, -1e308, 1e300, -1e300, 1e154, -1e154, /* squares overflow */
-        1e-154, -1e-160, 1e-300, 9007199254740992.0, 9.2233720368547758e18, -9.3e18,
-        1e16, -1e16, 1.5707963267948966, -1.5707963267948966, 3.141592653589793, 1.0, -1.0,
-        from_bits(0x7FF0000000000001ULL) /* a signalling NaN */};
+    const double specials[] = {NAN,
+                               -(double)NAN,
+                               INFINITY,
+                               -INFINITY,
+                               DBL_MAX,
+                               -DBL_MAX,
+                               DBL_MIN,
+                               -DBL_MIN,
+                               4.9406564584124654e-324,
+                               -4.9406564584124654e-324, /* smallest denormals */
+                               2.2250738585072009e-308,
+                               -2.2250738585072009e-308, /* largest denormals */
+                               0.0,
+                               -0.0,
+                               1e308,
+                               -1e308,
+                               1e300,
+                               -1e300,
+                               1e154,
+                               -1e154, /* squares overflow */
+                               1e-154,
+                               -1e-160,
+                               1e-300,
+                               9007199254740992.0,
+                               9.2233720368547758e18,
+                               -9.3e18,
+                               1e16,
+                               -1e16,
+                               1.5707963267948966,
+                               -1.5707963267948966,
+                               3.141592653589793,
+                               1.0,
+                               -1.0,
+                               from_bits(0x7FF0000000000001ULL) /* a signalling NaN */};
     return specials[probe_rng_below(rng, sizeof specials / sizeof specials[0])];
 }
 
@@ -565,9 +591,9 @@ static double nasty_value(probe_rng* rng, const probe_variable* v)
 
 static double nasty_step(probe_rng* rng)
 {
-    static const double steps[] = {0.0,    -0.0,   -1e-3,   NAN,     INFINITY, -INFINITY,
-                                   DBL_MIN, 4.9406564584124654e-324, 1e-300,  DBL_MAX,
-                                   1e300,  1e16,   1e6,     1.0,     -DBL_MAX};
+    static const double steps[] = {
+        0.0,    -0.0,    -1e-3, NAN,  INFINITY, -INFINITY, DBL_MIN, 4.9406564584124654e-324,
+        1e-300, DBL_MAX, 1e300, 1e16, 1e6,      1.0,       -DBL_MAX};
     const uint64_t pick = probe_rng_below(rng, 100);
     if (pick < 70) {
         return pow(10.0, -4.0 + 3.0 * probe_rng_uniform(rng));
@@ -591,7 +617,7 @@ static double nasty_time(probe_rng* rng, double tracked)
     return log_uniform(rng);
 }
 
-/* ---- operations ------------------------------------------------------------------------------ */
+/* ---- operations ----------------------------------------------------------------------------- */
 
 /* Why a set of this variable and value must be refused now, or NULL. */
 static const char* must_refuse(const fuzz_episode* e, const probe_variable* v, double value,
@@ -654,8 +680,8 @@ static void judge_set(fuzz_episode* e, const unsigned* vrs, size_t n, const doub
     ++e->counts->sets;
     if (status == 0) {
         if (reason != NULL) {
-            violation(e, "%s accepted value reference %u = %.17g (%s) in %s", call,
-                      vrs[bad], values[bad], reason, fuzz_state_names[e->state]);
+            violation(e, "%s accepted value reference %u = %.17g (%s) in %s", call, vrs[bad],
+                      values[bad], reason, fuzz_state_names[e->state]);
             return;
         }
         for (k = 0; k < n; ++k) {
@@ -669,8 +695,7 @@ static void judge_set(fuzz_episode* e, const unsigned* vrs, size_t n, const doub
     }
     ++e->counts->sets_rejected;
     if (status != 3) {
-        violation(e, "%s returned %d: a setter accepts (0) or refuses (3)", call,
-                  status);
+        violation(e, "%s returned %d: a setter accepts (0) or refuses (3)", call, status);
         return;
     }
     expect_message(e, status, log_count, call);
@@ -681,8 +706,8 @@ static void judge_set(fuzz_episode* e, const unsigned* vrs, size_t n, const doub
         sprintf(number, "%u", vrs[0]);
         if (!(v != NULL && strstr(e->book.last, v->name) != NULL) &&
             strstr(e->book.last, number) == NULL) {
-            violation(e, "%s refused %s without naming it: %s", call,
-                      v != NULL ? v->name : number, e->book.last);
+            violation(e, "%s refused %s without naming it: %s", call, v != NULL ? v->name : number,
+                      e->book.last);
         }
     }
     expect_unchanged(e, call);
@@ -700,8 +725,7 @@ static void op_set_real(fuzz_episode* e)
     for (k = 0; k < n; ++k) {
         const probe_variable* v;
         /* now and then the same variable twice: the last value counts */
-        vrs[k] = k > 0 && probe_rng_below(&e->rng, 10) == 0 ? vrs[k - 1]
-                                                            : random_vr(e, PROBE_REAL);
+        vrs[k] = k > 0 && probe_rng_below(&e->rng, 10) == 0 ? vrs[k - 1] : random_vr(e, PROBE_REAL);
         v = probe_variable_of_vr(&e->fmu->model, vrs[k]);
         values[k] = v != NULL ? nasty_value(&e->rng, v) : special_value(&e->rng);
         trace(e, vrs[k]);
@@ -801,10 +825,9 @@ static int state_must_move(const fuzz_episode* e, double h)
     const double omega = snapshot_real(e, &e->before, e->fmu->omega);
     const double epsilon = snapshot_real(e, &e->before, e->fmu->epsilon);
     const double inertia = before_named(e, "inertia") + before_named(e, "load.inertia");
-    const double gravity =
-        fabs(before_named(e, "crank.mass")) *
-        hypot(before_named(e, "crank.com.x"), before_named(e, "crank.com.y")) *
-        hypot(before_named(e, "gravity.x"), before_named(e, "gravity.y"));
+    const double gravity = fabs(before_named(e, "crank.mass")) *
+                           hypot(before_named(e, "crank.com.x"), before_named(e, "crank.com.y")) *
+                           hypot(before_named(e, "gravity.x"), before_named(e, "gravity.y"));
     const double torques = fabs(before_named(e, "motor.torque")) +
                            fabs(before_named(e, "load.torque")) + gravity; /* N.m */
     const double turn = fabs(h * omega), spin = fabs(h * epsilon);
@@ -812,8 +835,7 @@ static int state_must_move(const fuzz_episode* e, double h)
         return 0;
     }
     return (turn > 1e-250 && turn > 1e-9 * fabs(angle)) ||
-           (spin > 1e-250 && spin > 1e-9 * fabs(omega) &&
-            fabs(epsilon) * inertia > 1e-9 * torques);
+           (spin > 1e-250 && spin > 1e-9 * fabs(omega) && fabs(epsilon) * inertia > 1e-9 * torques);
 }
 
 static void check_step_ok(fuzz_episode* e, double t, double h, double last, int terminate)
@@ -839,8 +861,7 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
         return;
     }
     if (!e->after.valid || e->after.get_status != 0) {
-        violation(e, "doStep returned OK, the getter then %d",
-                  e->after.get_status);
+        violation(e, "doStep returned OK, the getter then %d", e->after.get_status);
         return;
     }
     if (!fmi2(e)) {
@@ -849,8 +870,8 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
         const int status = (int)e->fmu->f3.GetFloat64(e->instance, &time_vr, 1, &time, 1);
         trace_double(e, time);
         if (status != 0 || probe_bits(time) != probe_bits(end)) {
-            violation(e, "after doStep(%.17g, %.17g) OK, time reads %.17g (%d)", t,
-                      h, time, status);
+            violation(e, "after doStep(%.17g, %.17g) OK, time reads %.17g (%d)", t, h, time,
+                      status);
             return;
         }
     }
@@ -865,7 +886,8 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
                    probe_bits(snapshot_real(e, &e->before, e->fmu->angle)) &&
                probe_bits(snapshot_real(e, &e->after, e->fmu->omega)) ==
                    probe_bits(snapshot_real(e, &e->before, e->fmu->omega))) {
-        violation(e, "doStep(%.17g, %.17g) OK but the state (angle %.17g, speed %.17g, "
+        violation(e,
+                  "doStep(%.17g, %.17g) OK but the state (angle %.17g, speed %.17g, "
                   "acceleration %.17g) did not move",
                   t, h, snapshot_real(e, &e->before, e->fmu->angle),
                   snapshot_real(e, &e->before, e->fmu->omega),
@@ -892,15 +914,13 @@ static void op_do_step(fuzz_episode* e)
         }
     } else {
         fmi3Boolean event = fmi3False, flag = fmi3False, early = fmi3False;
-        status = (int)e->fmu->f3.DoStep(e->instance, t, h, fmi3True, &event, &flag, &early,
-                                        &last);
+        status = (int)e->fmu->f3.DoStep(e->instance, t, h, fmi3True, &event, &flag, &early, &last);
         terminate = flag != fmi3False;
         if (event != fmi3False || early != fmi3False) {
             violation(e, "doStep asks for event handling or returned early");
         }
     }
-    note(e, "doStep(%.17g, %.17g) -> %d (last %.17g, terminate %d)", t, h, status, last,
-         terminate);
+    note(e, "doStep(%.17g, %.17g) -> %d (last %.17g, terminate %d)", t, h, status, last, terminate);
     trace(e, (uint64_t)status);
     trace_double(e, last);
     trace(e, (uint64_t)terminate);
@@ -945,10 +965,10 @@ static void op_illegal(fuzz_episode* e)
     log_count = e->book.count;
     if (pick == 0 && e->state != S_STEP) {
         call = "doStep";
-        status = fmi2(e) ? (int)f->f2.DoStep(e->instance, e->time, 1e-3, fmi2True)
-                         : (int)f->f3.DoStep(e->instance, e->time, 1e-3, fmi3True,
-                                             &(fmi3Boolean){0}, &(fmi3Boolean){0},
-                                             &(fmi3Boolean){0}, &(fmi3Float64){0});
+        status = fmi2(e)
+                     ? (int)f->f2.DoStep(e->instance, e->time, 1e-3, fmi2True)
+                     : (int)f->f3.DoStep(e->instance, e->time, 1e-3, fmi3True, &(fmi3Boolean){0},
+                                         &(fmi3Boolean){0}, &(fmi3Boolean){0}, &(fmi3Float64){0});
     } else if (pick == 1 && e->state != S_INITIALIZATION) {
         call = "exitInitializationMode";
         status = fmi2(e) ? (int)f->f2.ExitInitializationMode(e->instance)
@@ -975,8 +995,7 @@ static void op_illegal(fuzz_episode* e)
     note(e, "illegal %s in %s -> %d", call, fuzz_state_names[e->state], status);
     trace(e, (uint64_t)status);
     if (status != 3) {
-        violation(e, "%s in %s returned %d, not Error", call,
-                  fuzz_state_names[e->state], status);
+        violation(e, "%s in %s returned %d, not Error", call, fuzz_state_names[e->state], status);
         return;
     }
     expect_message(e, status, log_count, call);
@@ -992,8 +1011,7 @@ static void op_enter_initialization(fuzz_episode* e)
         a = (int)e->fmu->f2.SetupExperiment(e->instance, fmi2False, 0, start, fmi2False, 0);
         b = (int)e->fmu->f2.EnterInitializationMode(e->instance);
     } else {
-        b = (int)e->fmu->f3.EnterInitializationMode(e->instance, fmi3False, 0, start, fmi3False,
-                                                    0);
+        b = (int)e->fmu->f3.EnterInitializationMode(e->instance, fmi3False, 0, start, fmi3False, 0);
     }
     note(e, "enter initialization at %g -> %d %d", start, a, b);
     trace(e, (uint64_t)a);
@@ -1019,8 +1037,8 @@ static void op_exit_initialization(fuzz_episode* e)
         e->state = S_STEP;
         snapshot(e, &e->before);
         if (e->before.valid && (e->before.get_status == 0) != (status == 0)) {
-            violation(e, "exitInitializationMode returned %d, the getter then %d",
-                      status, e->before.get_status);
+            violation(e, "exitInitializationMode returned %d, the getter then %d", status,
+                      e->before.get_status);
         }
     } else if (status != 3) {
         violation(e, "exitInitializationMode returned %d", status);
@@ -1043,8 +1061,8 @@ static void load_start_values(fuzz_episode* e)
 
 static void op_terminate(fuzz_episode* e)
 {
-    const int status = fmi2(e) ? (int)e->fmu->f2.Terminate(e->instance)
-                               : (int)e->fmu->f3.Terminate(e->instance);
+    const int status =
+        fmi2(e) ? (int)e->fmu->f2.Terminate(e->instance) : (int)e->fmu->f3.Terminate(e->instance);
     note(e, "terminate -> %d", status);
     trace(e, (uint64_t)status);
     if (status != 0) {
@@ -1057,8 +1075,8 @@ static void op_terminate(fuzz_episode* e)
 
 static void op_reset(fuzz_episode* e)
 {
-    const int status = fmi2(e) ? (int)e->fmu->f2.Reset(e->instance)
-                               : (int)e->fmu->f3.Reset(e->instance);
+    const int status =
+        fmi2(e) ? (int)e->fmu->f2.Reset(e->instance) : (int)e->fmu->f3.Reset(e->instance);
     note(e, "reset -> %d", status);
     trace(e, (uint64_t)status);
     if (status != 0) {
@@ -1078,22 +1096,25 @@ static void op_debug_logging(fuzz_episode* e)
     long log_count = e->book.count;
     int status;
     if (fmi2(e)) {
-        status = (int)e->fmu->f2.SetDebugLogging(e->instance, on, one != NULL, one != NULL ? &one : NULL);
+        status = (int)e->fmu->f2.SetDebugLogging(e->instance, on, one != NULL,
+                                                 one != NULL ? &one : NULL);
     } else {
-        status = (int)e->fmu->f3.SetDebugLogging(e->instance, on, one != NULL, one != NULL ? &one : NULL);
+        status = (int)e->fmu->f3.SetDebugLogging(e->instance, on, one != NULL,
+                                                 one != NULL ? &one : NULL);
     }
     note(e, "setDebugLogging(%d, %s) -> %d", on, one != NULL ? one : "all", status);
     trace(e, (uint64_t)status);
     if (status != (pick == 4 ? 3 : 0)) {
-        violation(e, "setDebugLogging(%s) returned %d", one != NULL ? one : "all",
-                  status);
+        violation(e, "setDebugLogging(%s) returned %d", one != NULL ? one : "all", status);
     }
     expect_message(e, status, log_count, "setDebugLogging");
 }
 
 static void* instantiate(fuzz_episode* e)
 {
-    static const char* const names[] = {"fuzz", "100% %s %n %p", "\xc3\xbcnic\xc3\xb8" "de",
+    static const char* const names[] = {"fuzz", "100% %s %n %p",
+                                        "\xc3\xbcnic\xc3\xb8"
+                                        "de",
                                         "a-name-of-sixty-four-characters-so-that-messages-must-"
                                         "be-clipped-at-the-end-of-their-buffer-........"};
     const char* name = names[probe_rng_below(&e->rng, sizeof names / sizeof names[0])];
@@ -1217,7 +1238,7 @@ static uint64_t run_episode(fuzz_episode* e, uint64_t seed)
     return probe_hash_u64(e->trace, e->book.hash);
 }
 
-/* ---- the run ---------------------------------------------------------------------------------- */
+/* ---- the run -------------------------------------------------------------------------------- */
 
 typedef struct fuzz_options {
     long steps;
@@ -1342,9 +1363,10 @@ int main(int argc, char** argv)
            "refused), %ld reads, %ld illegal calls, %ld episodes on %ld instances, %ld replays "
            "identical; %.1f s\n",
            fmu.model.identifier, fmu.model.fmi_version, counts.steps, counts.steps_ok,
-           counts.steps_discard, counts.steps_error, counts.sets, counts.sets_rejected,
-           counts.gets, counts.illegal_calls, counts.episodes, counts.instances, counts.replays,
-           (double)(ended.tv_sec - started.tv_sec) + 1e-9 * (double)(ended.tv_nsec - started.tv_nsec));
+           counts.steps_discard, counts.steps_error, counts.sets, counts.sets_rejected, counts.gets,
+           counts.illegal_calls, counts.episodes, counts.instances, counts.replays,
+           (double)(ended.tv_sec - started.tv_sec) +
+               1e-9 * (double)(ended.tv_nsec - started.tv_nsec));
     free(e.shadow);
     free(e.before.reals);
     free(e.before.integers);

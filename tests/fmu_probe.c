@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- a minimal XML reader ------------------------------------------------------ */
+/* ---- a minimal XML reader ------------------------------------------------------------------- */
 
 /* One start tag and its attributes, values with the five entities and
  * character references resolved. Attribute storage is owned by the tag. */
@@ -230,7 +230,7 @@ static int next_tag(const char** cursor, xml_tag* tag)
     }
 }
 
-/* ---- the model description ------------------------------------------------------ */
+/* ---- the model description ------------------------------------------------------------------ */
 
 static char* copy_string(const char* s)
 {
@@ -272,9 +272,9 @@ static int parse_enum(const char* text, const char* const names[], size_t count,
 
 static int parse_causality(const char* text, probe_causality* causality)
 {
-    static const char* const names[] = {"parameter", "calculatedParameter",
-                                        "structuralParameter", "input", "output", "local",
-                                        "independent"};
+    static const char* const names[] = {
+        "parameter", "calculatedParameter", "structuralParameter", "input", "output",
+        "local",     "independent"};
     int k;
     if (!parse_enum(text, names, sizeof names / sizeof names[0], PROBE_LOCAL, &k)) {
         return 0;
@@ -285,8 +285,7 @@ static int parse_causality(const char* text, probe_causality* causality)
 
 static int parse_variability(const char* text, probe_variability* variability)
 {
-    static const char* const names[] = {"constant", "fixed", "tunable", "discrete",
-                                        "continuous"};
+    static const char* const names[] = {"constant", "fixed", "tunable", "discrete", "continuous"};
     int k;
     if (!parse_enum(text, names, sizeof names / sizeof names[0], PROBE_CONTINUOUS, &k)) {
         return 0;
@@ -299,10 +298,9 @@ static int parse_variability(const char* text, probe_variability* variability)
 static int type_of_element(int fmi_version, const char* name, probe_type* type)
 {
     static const char* const fmi2_others[] = {"Boolean", "String", "Enumeration"};
-    static const char* const fmi3_others[] = {"Float32", "Int8",    "UInt8",   "Int16",
-                                              "UInt16",  "UInt32",  "Int64",   "UInt64",
-                                              "Boolean", "String",  "Binary",  "Clock",
-                                              "Enumeration"};
+    static const char* const fmi3_others[] = {"Float32", "Int8",  "UInt8",      "Int16",   "UInt16",
+                                              "UInt32",  "Int64", "UInt64",     "Boolean", "String",
+                                              "Binary",  "Clock", "Enumeration"};
     const char* const* others = fmi_version == 2 ? fmi2_others : fmi3_others;
     const size_t count = fmi_version == 2 ? sizeof fmi2_others / sizeof fmi2_others[0]
                                           : sizeof fmi3_others / sizeof fmi3_others[0];
@@ -431,7 +429,8 @@ static int read_variables(const char* text, probe_model* model, char* error, siz
                 token = tag_attribute(&tag, "instantiationToken");
             }
             if (version == NULL || token == NULL || (version[0] != '2' && version[0] != '3')) {
-                ok = fail(error, error_size, "fmiModelDescription: no fmiVersion 2 or 3, or no token");
+                ok = fail(error, error_size,
+                          "fmiModelDescription: no fmiVersion 2 or 3, or no token");
                 break;
             }
             model->fmi_version = version[0] - '0';
@@ -586,7 +585,7 @@ unsigned probe_unused_vr(const probe_model* model)
     return highest + 1;
 }
 
-/* ---- loading ---------------------------------------------------------------------- */
+/* ---- loading -------------------------------------------------------------------------------- */
 
 static int resolve(void* library, const char* name, void* function_pointer, char* error,
                    size_t error_size)
@@ -610,9 +609,9 @@ static void* open_library(const probe_model* model, char* error, size_t error_si
     return library;
 }
 
-#define PROBE_RESOLVE2(name)                                                                  \
+#define PROBE_RESOLVE2(name) \
     ok = ok && resolve(api->library, "fmi2" #name, &api->name, error, error_size);
-#define PROBE_RESOLVE3(name)                                                                  \
+#define PROBE_RESOLVE3(name) \
     ok = ok && resolve(api->library, "fmi3" #name, &api->name, error, error_size);
 
 int probe_load_fmi2(const probe_model* model, probe_fmi2* api, char* error, size_t error_size)
@@ -652,7 +651,7 @@ void probe_unload(void* library)
     }
 }
 
-/* ---- the logger ---------------------------------------------------------------------- */
+/* ---- the logger ----------------------------------------------------------------------------- */
 
 void probe_log_book_clear(probe_log_book* book)
 {
@@ -685,8 +684,8 @@ void probe_fmi2_logger(fmi2ComponentEnvironment environment, fmi2String instance
     record(book, (int)status, book->last);
 }
 
-void probe_fmi3_logger(fmi3InstanceEnvironment environment, fmi3Status status,
-                       fmi3String category, fmi3String message)
+void probe_fmi3_logger(fmi3InstanceEnvironment environment, fmi3Status status, fmi3String category,
+                       fmi3String message)
 {
     probe_log_book* book = (probe_log_book*)environment;
     (void)category;
@@ -708,7 +707,7 @@ fmi2CallbackFunctions probe_fmi2_callbacks(probe_log_book* book)
     return callbacks;
 }
 
-/* ---- random numbers and hashing ---------------------------------------------------------- */
+/* ---- random numbers and hashing ------------------------------------------------------------- */
 
 uint64_t probe_splitmix64(uint64_t* state)
 {

@@ -47,13 +47,13 @@ typedef struct probe_variable {
     probe_causality causality;
     probe_variability variability;
     probe_type type;
-    int is_array;  /* an FMI 3 variable with <Dimension> */
+    int is_array; /* an FMI 3 variable with <Dimension> */
     int has_start, has_min, has_max;
     double start, min, max; /* as declared (min and max are inclusive in FMI) */
 } probe_variable;
 
 typedef struct probe_model {
-    int fmi_version; /* 2 or 3 */
+    int fmi_version;  /* 2 or 3 */
     char* identifier; /* modelIdentifier of <CoSimulation> */
     char* token;      /* guid (FMI 2) or instantiationToken (FMI 3) */
     int provides_directional_derivatives;
@@ -78,6 +78,8 @@ unsigned probe_unused_vr(const probe_model* model);
 
 /* ---- the entry points --------------------------------------------------------- */
 
+/* The entry points, packed: one X each. */
+/* clang-format off */
 #define PROBE_FMI2_FUNCTIONS(X)                                                               \
     X(GetTypesPlatform) X(GetVersion) X(SetDebugLogging) X(Instantiate) X(FreeInstance)       \
     X(SetupExperiment) X(EnterInitializationMode) X(ExitInitializationMode) X(Terminate)      \
@@ -108,6 +110,7 @@ unsigned probe_unused_vr(const probe_model* model);
     X(GetNominalsOfContinuousStates) X(GetNumberOfEventIndicators)                          \
     X(GetNumberOfContinuousStates) X(EnterStepMode) X(GetOutputDerivatives) X(DoStep)       \
     X(ActivateModelPartition)
+/* clang-format on */
 
 #define PROBE_FMI2_MEMBER(name) fmi2##name##TYPE* name;
 #define PROBE_FMI3_MEMBER(name) fmi3##name##TYPE* name;
@@ -142,8 +145,8 @@ typedef struct probe_log_book {
 void probe_log_book_clear(probe_log_book* book);
 void probe_fmi2_logger(fmi2ComponentEnvironment environment, fmi2String instance_name,
                        fmi2Status status, fmi2String category, fmi2String message, ...);
-void probe_fmi3_logger(fmi3InstanceEnvironment environment, fmi3Status status,
-                       fmi3String category, fmi3String message);
+void probe_fmi3_logger(fmi3InstanceEnvironment environment, fmi3Status status, fmi3String category,
+                       fmi3String message);
 /* Callbacks for fmi2Instantiate that log into `book`. */
 fmi2CallbackFunctions probe_fmi2_callbacks(probe_log_book* book);
 

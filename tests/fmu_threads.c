@@ -57,8 +57,8 @@ static const int runs_per_thread = 2;
 
 static double some_value(probe_rng* rng, const probe_variable* v)
 {
-    static const double nasty[] = {NAN, INFINITY, -INFINITY, DBL_MAX, -DBL_MAX, 1e300, -0.0,
-                                   4.9406564584124654e-324};
+    static const double nasty[] = {NAN,      INFINITY, -INFINITY, DBL_MAX,
+                                   -DBL_MAX, 1e300,    -0.0,      4.9406564584124654e-324};
     const double start = v->has_start ? v->start : 0.0;
     if (probe_rng_below(rng, 10) == 0) {
         return nasty[probe_rng_below(rng, sizeof nasty / sizeof nasty[0])];
@@ -150,8 +150,8 @@ static int run_program(const thread_program* p, int index, uint64_t* trace)
                               fmi2True);
     } else {
         c = p->f3.InstantiateCoSimulation(name, p->model.token, NULL, fmi3False, fmi3True,
-                                          fmi3False, fmi3False, NULL, 0, &book,
-                                          probe_fmi3_logger, NULL);
+                                          fmi3False, fmi3False, NULL, 0, &book, probe_fmi3_logger,
+                                          NULL);
     }
     if (c == NULL) {
         free(reals);
@@ -173,8 +173,8 @@ static int run_program(const thread_program* p, int index, uint64_t* trace)
                           : (int)p->f3.EnterInitializationMode(c, fmi3False, 0, 0, fmi3False, 0);
             break;
         case OP_EXIT:
-            status = fmi2 ? (int)p->f2.ExitInitializationMode(c)
-                          : (int)p->f3.ExitInitializationMode(c);
+            status =
+                fmi2 ? (int)p->f2.ExitInitializationMode(c) : (int)p->f3.ExitInitializationMode(c);
             break;
         case OP_STEP:
             if (fmi2) {
@@ -182,17 +182,17 @@ static int run_program(const thread_program* p, int index, uint64_t* trace)
             } else {
                 fmi3Boolean event, terminate, early;
                 fmi3Float64 last;
-                status = (int)p->f3.DoStep(c, op->t, op->h, fmi3True, &event, &terminate, &early,
-                                           &last);
+                status =
+                    (int)p->f3.DoStep(c, op->t, op->h, fmi3True, &event, &terminate, &early, &last);
                 h = probe_hash_double(probe_hash_u64(h, (uint64_t)terminate), last);
             }
             h = probe_hash_u64(h, fmi2 ? (uint64_t)p->f2.GetReal(c, p->real_vrs, p->n_reals, reals)
                                        : (uint64_t)p->f3.GetFloat64(c, p->real_vrs, p->n_reals,
                                                                     reals, p->n_reals));
-            h = probe_hash_u64(h, fmi2 ? (uint64_t)p->f2.GetInteger(c, p->integer_vrs,
-                                                                    p->n_integers, integers)
-                                       : (uint64_t)p->f3.GetInt32(c, p->integer_vrs, p->n_integers,
-                                                                  integers, p->n_integers));
+            h = probe_hash_u64(
+                h, fmi2 ? (uint64_t)p->f2.GetInteger(c, p->integer_vrs, p->n_integers, integers)
+                        : (uint64_t)p->f3.GetInt32(c, p->integer_vrs, p->n_integers, integers,
+                                                   p->n_integers));
             for (j = 0; j < p->n_reals; ++j) {
                 h = probe_hash_double(h, reals[j]);
             }

@@ -13,15 +13,15 @@
 #define NAMED_TESTS_ON_CHECK() ((void)0)
 #endif
 
-#define CHECK(cond, ...)                                                                        \
-    do {                                                                                        \
-        NAMED_TESTS_ON_CHECK();                                                                 \
-        if (!(cond)) {                                                                          \
-            printf("    FAIL %s:%d: ", __FILE__, __LINE__);                                     \
-            printf(__VA_ARGS__);                                                                \
-            printf("\n");                                                                       \
-            ++fails;                                                                            \
-        }                                                                                       \
+#define CHECK(cond, ...)                                    \
+    do {                                                    \
+        NAMED_TESTS_ON_CHECK();                             \
+        if (!(cond)) {                                      \
+            printf("    FAIL %s:%d: ", __FILE__, __LINE__); \
+            printf(__VA_ARGS__);                            \
+            printf("\n");                                   \
+            ++fails;                                        \
+        }                                                   \
     } while (0)
 
 typedef struct named_test {

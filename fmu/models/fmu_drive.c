@@ -15,11 +15,10 @@
  * over the communication step and as many equal substeps as keep each below a
  * twentieth of the motor's mechanical time constant (J + J_load) omega_0 /
  * T_stall and below 0.005 rad of crank turn (which holds the integration
- * error near 1e-9 of the speed, below the co-simulation's own). The state has two components and is smooth
- * (gravity is a sine of phi), so an explicit method of high order is both
- * accurate and cheap once the substep resolves the one stiff scale, the
- * motor's damping; it needs no Newton iteration, and its result does not
- * depend on anything but the step, which keeps co-simulation reproducible.
+ * error near 1e-9 of the speed, below the co-simulation's own). The state has two components and is
+ * smooth (gravity is a sine of phi), so an explicit method of high order is both accurate and cheap
+ * once the substep resolves the one stiff scale, the motor's damping; it needs no Newton iteration,
+ * and its result does not depend on anything but the step, which keeps co-simulation reproducible.
  * A step that needs more than FMU_DRIVE_MAX_SUBSTEPS substeps is refused before
  * any of them is taken: the count is compared as a double, since h / limit
  * may exceed every integer type.
@@ -98,8 +97,8 @@ static int check(const fmu_model* model, const fmu_drive_input* in, fmu_evaluati
     if (!(total_inertia(in) > 0)) {
         e->status = FMU_ERROR;
         e->bad_variable = variable_named(model, "load.inertia");
-        snprintf(e->reason, sizeof e->reason,
-                 "inertia + load.inertia = %g kg.m2 must be positive", total_inertia(in));
+        snprintf(e->reason, sizeof e->reason, "inertia + load.inertia = %g kg.m2 must be positive",
+                 total_inertia(in));
         return 0;
     }
     return 1;
@@ -137,14 +136,34 @@ static void evaluate(const fmu_model* model, const void* input, void* output,
     }
 }
 
+/* The state after `substeps` classical Runge-Kutta steps of dt seconds. */
+static void integrate(const fmu_drive_input* in, double dt, long substeps, double* angle,
+                      double* speed)
+{
+    double q = *angle, w = *speed;
+    long k;
+    for (k = 0; k < substeps; ++k) {
+        const double a1 = acceleration(in, q, w);
+        const double w2 = w + 0.5 * dt * a1;
+        const double a2 = acceleration(in, q + 0.5 * dt * w, w2);
+        const double w3 = w + 0.5 * dt * a2;
+        const double a3 = acceleration(in, q + 0.5 * dt * w2, w3);
+        const double w4 = w + dt * a3;
+        const double a4 = acceleration(in, q + dt * w3, w4);
+        q += dt / 6 * (w + 2 * w2 + 2 * w3 + w4);
+        w += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
+    }
+    *angle = q;
+    *speed = w;
+}
+
 static void advance(const fmu_model* model, void* input, double h, fmu_evaluation* evaluation)
 {
     fmu_drive_input* in = (fmu_drive_input*)input;
     const double time_constant = total_inertia(in) * in->no_load_speed / in->stall_torque;
     const double turn = fabs(in->speed) > 0 ? 0.005 / fabs(in->speed) : h;
     double limit = 0.05 * time_constant < turn ? 0.05 * time_constant : turn;
-    double angle = in->angle, speed = in->speed, needed, dt;
-    long substeps, k;
+    double angle = in->angle, speed = in->speed, needed;
 
     evaluation->status = FMU_OK;
     evaluation->bad_variable = -1;
@@ -164,19 +183,7 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
                  h, needed, limit, speed, time_constant, FMU_DRIVE_MAX_SUBSTEPS);
         return;
     }
-    substeps = (long)needed;
-    dt = h / needed;
-    for (k = 0; k < substeps; ++k) {
-        const double a1 = acceleration(in, angle, speed);
-        const double w2 = speed + 0.5 * dt * a1;
-        const double a2 = acceleration(in, angle + 0.5 * dt * speed, w2);
-        const double w3 = speed + 0.5 * dt * a2;
-        const double a3 = acceleration(in, angle + 0.5 * dt * w2, w3);
-        const double w4 = speed + dt * a3;
-        const double a4 = acceleration(in, angle + dt * w3, w4);
-        angle += dt / 6 * (speed + 2 * w2 + 2 * w3 + w4);
-        speed += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
-    }
+    integrate(in, h / needed, (long)needed, &angle, &speed);
     if (!isfinite(angle) || !isfinite(speed)) {
         evaluation->status = FMU_DISCARD;
         snprintf(evaluation->reason, sizeof evaluation->reason,
@@ -199,5 +206,5 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
     in->speed = speed;
 }
 
-const fmu_behaviour fmu_drive_behaviour = {sizeof(fmu_drive_input), sizeof(fmu_drive_output),
-                                           initialise, evaluate, start, advance, NULL};
+const fmu_behaviour fmu_drive_behaviour = {
+    sizeof(fmu_drive_input), sizeof(fmu_drive_output), initialise, evaluate, start, advance, NULL};

@@ -7,9 +7,9 @@
 
 /* The input block: inputs, parameters and the states. */
 typedef struct fmu_drive_input {
-    double load_torque;   /* N m: torque of the driven mechanism on the crank at zero acceleration */
-    double load_inertia;  /* kg m^2: inertia the mechanism adds at the crank */
-    double stall_torque;  /* N m: motor torque at standstill */
+    double load_torque;  /* N m: torque of the driven mechanism on the crank at zero acceleration */
+    double load_inertia; /* kg m^2: inertia the mechanism adds at the crank */
+    double stall_torque; /* N m: motor torque at standstill */
     double no_load_speed; /* rad/s: speed where the motor torque vanishes */
     double inertia;       /* kg m^2: rotor and crank about the crank pivot O */
     double crank_mass;    /* kg */

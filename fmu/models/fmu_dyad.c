@@ -24,9 +24,7 @@ static void report(const fmu_model* model, const dyad_input* input, const dyad_r
     evaluation->bad_variable = -1;
     evaluation->reason[0] = '\0';
     switch (result->status) {
-    case DYAD_STATUS_OK:
-        evaluation->status = FMU_OK;
-        break;
+    case DYAD_STATUS_OK: evaluation->status = FMU_OK; break;
     case DYAD_STATUS_SINGULAR:
         evaluation->status = FMU_DISCARD;
         snprintf(evaluation->reason, sizeof evaluation->reason,
@@ -42,8 +40,8 @@ static void report(const fmu_model* model, const dyad_input* input, const dyad_r
     case DYAD_STATUS_INVALID_INPUT:
         evaluation->status = FMU_ERROR;
         evaluation->bad_variable = variable_of_field(model, result->field);
-        snprintf(evaluation->reason, sizeof evaluation->reason,
-                 "not valid for this dyad (%s)", dyad_field_name(result->field));
+        snprintf(evaluation->reason, sizeof evaluation->reason, "not valid for this dyad (%s)",
+                 dyad_field_name(result->field));
         break;
     }
 }
@@ -71,5 +69,5 @@ static void derivative(const fmu_model* model, const void* input, const void* se
     report(model, (const dyad_input*)input, (const dyad_result*)output, evaluation);
 }
 
-const fmu_behaviour fmu_dyad_behaviour = {sizeof(dyad_input), sizeof(dyad_result), initialise,
-                                          evaluate, NULL, NULL, derivative};
+const fmu_behaviour fmu_dyad_behaviour = {
+    sizeof(dyad_input), sizeof(dyad_result), initialise, evaluate, NULL, NULL, derivative};

@@ -17,27 +17,26 @@
 #define PI 3.14159265358979323846
 
 typedef struct slider_crank {
-    double crank;        /* r (m) */
-    double rod;          /* L (m) */
-    double offset;       /* e (m) */
-    double rod_mass;     /* kg */
-    double rod_inertia;  /* about its centre of mass, kg m^2 */
-    double slider_mass;  /* kg */
-    double peak_gas;     /* peak gas force on the slider (N) */
+    double crank;       /* r (m) */
+    double rod;         /* L (m) */
+    double offset;      /* e (m) */
+    double rod_mass;    /* kg */
+    double rod_inertia; /* about its centre of mass, kg m^2 */
+    double slider_mass; /* kg */
+    double peak_gas;    /* peak gas force on the slider (N) */
 } slider_crank;
 
 static void usage(FILE* to)
 {
-    fprintf(to,
-            "usage: slider_crank [--steps N] [--rpm RPM] [--help]\n"
-            "Prints the joint reactions of an offset slider-crank (r = 0.05 m, L = 0.2 m,\n"
-            "e = 0.01 m) over one revolution at constant crank speed, solved as an RRT dyad.\n"
-            "  --steps N   crank positions per revolution (default 24, 1..100000)\n"
-            "  --rpm RPM   crank speed in rev/min (default 3000, 0..100000)\n"
-            "Columns: crank angle (deg); R_np, the force of the crank pin on the rod (N);\n"
-            "R_mn, the force of the rod on the slider (N); N_mk, the guide's normal force on\n"
-            "the slider (N); M_mk, the guide's reactive moment on the slider (N m);\n"
-            "conditioning |i_n . i_k| (-).\n");
+    fprintf(to, "usage: slider_crank [--steps N] [--rpm RPM] [--help]\n"
+                "Prints the joint reactions of an offset slider-crank (r = 0.05 m, L = 0.2 m,\n"
+                "e = 0.01 m) over one revolution at constant crank speed, solved as an RRT dyad.\n"
+                "  --steps N   crank positions per revolution (default 24, 1..100000)\n"
+                "  --rpm RPM   crank speed in rev/min (default 3000, 0..100000)\n"
+                "Columns: crank angle (deg); R_np, the force of the crank pin on the rod (N);\n"
+                "R_mn, the force of the rod on the slider (N); N_mk, the guide's normal force on\n"
+                "the slider (N); M_mk, the guide's reactive moment on the slider (N m);\n"
+                "conditioning |i_n . i_k| (-).\n");
 }
 
 static int parse_number(const char* text, double lo, double hi, double* value)
@@ -59,12 +58,12 @@ static dyad_input dyad_at(const slider_crank* sc, double phi, double w)
     const double sin_t = (sc->offset - r * sin(phi)) / L;
     const double cos_t = sqrt(1 - sin_t * sin_t);
     const double theta_dot = -r * cos(phi) * w / (L * cos_t);
-    const double theta_ddot = (r * sin(phi) * w * w + L * sin_t * theta_dot * theta_dot) /
-                              (L * cos_t);
+    const double theta_ddot =
+        (r * sin(phi) * w * w + L * sin_t * theta_dot * theta_dot) / (L * cos_t);
     const double accel_pin_x = -r * cos(phi) * w * w;
     const double accel_pin_y = -r * sin(phi) * w * w;
-    const double accel_slider = -r * cos(phi) * w * w - L * cos_t * theta_dot * theta_dot -
-                                L * sin_t * theta_ddot;
+    const double accel_slider =
+        -r * cos(phi) * w * w - L * cos_t * theta_dot * theta_dot - L * sin_t * theta_ddot;
     dyad_input in = dyad_input_default();
 
     in.gravity = dyad_vec2_make(0, (dyad_real)-9.81);
@@ -99,8 +98,10 @@ int main(int argc, char** argv)
             return 0;
         } else if (strcmp(argv[a], "--steps") == 0 && a + 1 < argc) {
             if (!parse_number(argv[++a], 1, 100000, &steps) || steps != floor(steps)) {
-                fprintf(stderr, "slider_crank: --steps wants a whole number from 1 to 100000, "
-                                "got '%s'\n", argv[a]);
+                fprintf(stderr,
+                        "slider_crank: --steps wants a whole number from 1 to 100000, "
+                        "got '%s'\n",
+                        argv[a]);
                 return 2;
             }
         } else if (strcmp(argv[a], "--rpm") == 0 && a + 1 < argc) {

@@ -54,13 +54,13 @@
 #include "dyadfmu/vec2.h"
 
 struct dense_gsl {
-    gsl_matrix* a;          /* A, overwritten by LU or by U of the SVD */
-    gsl_vector* b;          /* right-hand side */
-    gsl_vector* x;          /* the unknowns u */
-    gsl_permutation* perm;  /* LU row permutation */
-    gsl_matrix* v;          /* SVD: V */
-    gsl_vector* s;          /* SVD: singular values, descending */
-    gsl_vector* work;       /* SVD work space */
+    gsl_matrix* a;         /* A, overwritten by LU or by U of the SVD */
+    gsl_vector* b;         /* right-hand side */
+    gsl_vector* x;         /* the unknowns u */
+    gsl_permutation* perm; /* LU row permutation */
+    gsl_matrix* v;         /* SVD: V */
+    gsl_vector* s;         /* SVD: singular values, descending */
+    gsl_vector* work;      /* SVD work space */
 };
 
 dense_gsl* dense_gsl_alloc(void)
@@ -77,8 +77,8 @@ dense_gsl* dense_gsl_alloc(void)
     ws->v = gsl_matrix_alloc(DENSE_DIM, DENSE_DIM);
     ws->s = gsl_vector_alloc(DENSE_DIM);
     ws->work = gsl_vector_alloc(DENSE_DIM);
-    if (ws->a == NULL || ws->b == NULL || ws->x == NULL || ws->perm == NULL ||
-        ws->v == NULL || ws->s == NULL || ws->work == NULL) {
+    if (ws->a == NULL || ws->b == NULL || ws->x == NULL || ws->perm == NULL || ws->v == NULL ||
+        ws->s == NULL || ws->work == NULL) {
         dense_gsl_free(ws);
         return NULL;
     }
@@ -90,35 +90,42 @@ void dense_gsl_free(dense_gsl* ws)
     if (ws == NULL) {
         return;
     }
-    if (ws->a != NULL) gsl_matrix_free(ws->a);
-    if (ws->b != NULL) gsl_vector_free(ws->b);
-    if (ws->x != NULL) gsl_vector_free(ws->x);
-    if (ws->perm != NULL) gsl_permutation_free(ws->perm);
-    if (ws->v != NULL) gsl_matrix_free(ws->v);
-    if (ws->s != NULL) gsl_vector_free(ws->s);
-    if (ws->work != NULL) gsl_vector_free(ws->work);
+    if (ws->a != NULL)
+        gsl_matrix_free(ws->a);
+    if (ws->b != NULL)
+        gsl_vector_free(ws->b);
+    if (ws->x != NULL)
+        gsl_vector_free(ws->x);
+    if (ws->perm != NULL)
+        gsl_permutation_free(ws->perm);
+    if (ws->v != NULL)
+        gsl_matrix_free(ws->v);
+    if (ws->s != NULL)
+        gsl_vector_free(ws->s);
+    if (ws->work != NULL)
+        gsl_vector_free(ws->work);
     free(ws);
 }
 
 /* Adds the columns of the pair whose unknowns start at column col, acting with
  * sign s on the link whose equations start at row row0, at arm a from its D.
  * j is the normal of the pair's guide (read for a translational pair only). */
-static void add_pair(double* a, size_t tda, dyad_pair_kind kind, size_t col, size_t row0,
-                     double s, dyad_vec2 arm, dyad_vec2 j)
+static void add_pair(double* a, size_t tda, dyad_pair_kind kind, size_t col, size_t row0, double s,
+                     dyad_vec2 arm, dyad_vec2 j)
 {
     double* fx = a + row0 * tda;
     double* fy = fx + tda;
     double* mo = fy + tda;
     if (kind == DYAD_PAIR_REVOLUTE) {
-        fx[col] += s;                 /* unit force (1, 0) */
+        fx[col] += s; /* unit force (1, 0) */
         mo[col] += -s * arm.y;
-        fy[col + 1] += s;             /* unit force (0, 1) */
+        fy[col + 1] += s; /* unit force (0, 1) */
         mo[col + 1] += s * arm.x;
     } else {
-        fx[col] += s * j.x;           /* unit normal force j */
+        fx[col] += s * j.x; /* unit normal force j */
         fy[col] += s * j.y;
         mo[col] += s * dyad_cross(arm, j);
-        mo[col + 1] += s;             /* unit reactive moment */
+        mo[col + 1] += s; /* unit reactive moment */
     }
 }
 
@@ -149,10 +156,8 @@ void dense_assemble(dyad_type type, const dyad_input* in, double* a, size_t tda,
             a[r * tda + c] = 0;
         }
     }
-    add_pair(a, tda, dyad_pair_kind_of(type, DYAD_PAIR_DM), 0, 0, 1, zero,
-             dyad_perp(in->guide_k));
-    add_pair(a, tda, dyad_pair_kind_of(type, DYAD_PAIR_DN), 2, 3, 1, zero,
-             dyad_perp(in->guide_p));
+    add_pair(a, tda, dyad_pair_kind_of(type, DYAD_PAIR_DM), 0, 0, 1, zero, dyad_perp(in->guide_k));
+    add_pair(a, tda, dyad_pair_kind_of(type, DYAD_PAIR_DN), 2, 3, 1, zero, dyad_perp(in->guide_p));
     add_pair(a, tda, kind_e, 4, 0, 1, arm_m, j_m);
     add_pair(a, tda, kind_e, 4, 3, -1, arm_n, j_m);
 
@@ -197,8 +202,8 @@ static dyad_status finish(dyad_type type, const dyad_input* in, const double* u,
         return result->status;
     }
     result->status = DYAD_STATUS_OK;
-    unpack_pair(dyad_pair_kind_of(type, DYAD_PAIR_DM), u, in->guide_k, &result->r_mk,
-                &result->n_mk, &result->m_mk);
+    unpack_pair(dyad_pair_kind_of(type, DYAD_PAIR_DM), u, in->guide_k, &result->r_mk, &result->n_mk,
+                &result->m_mk);
     unpack_pair(dyad_pair_kind_of(type, DYAD_PAIR_DN), u + 2, in->guide_p, &result->r_np,
                 &result->n_np, &result->m_np);
     unpack_pair(dyad_pair_kind_of(type, DYAD_PAIR_E), u + 4, in->m.dir, &result->r_mn,

@@ -30,10 +30,10 @@
 #ifndef DYAD_REAL_FLOAT
 #include "dense_gsl.h"
 #define BENCH_REAL_NAME "double"
-#define BENCH_PROGRAM "dyad_bench"
+#define BENCH_PROGRAM   "dyad_bench"
 #else
 #define BENCH_REAL_NAME "float"
-#define BENCH_PROGRAM "dyad_bench_float"
+#define BENCH_PROGRAM   "dyad_bench_float"
 #endif
 
 /* The fmu method needs the FMI headers (CMake defines DYADFMU_BENCH_FMI when it
@@ -79,47 +79,47 @@ typedef struct options {
 static void usage(FILE* out)
 {
     fprintf(out,
-        "usage: %s --type RRR|RRT|RTR|TRT|RTT --method core|gsl_lu|gsl_svd|fmu\n"
-        "           --inputs FILE [--outputs FILE] [--count N] [--repeat R]\n"
-        "       %s --method fmu --fmu BINARY.so --fmi 2|3 --token TOKEN\n"
-        "           --fmu-inputs FILE --in-vrs VR,VR,... --out-vrs VR,VR,...\n"
-        "           [--outputs FILE] [--count N] [--repeat R]\n"
-        "\n"
-        "Times the solve of every configuration (row) of the inputs file, R times\n"
-        "(default 5), and prints one JSON line: method, real, type, count, repeat,\n"
-        "seconds_per_config (the median over the R runs) and seconds_all (the time\n"
-        "per configuration of each run).\n"
-        "\n"
-        "methods:\n"
-        "  core     dyad_solve of the C core (%s)\n"
-        "  gsl_lu   the dyad's 6x6 Newton-Euler system, GSL LU (double binary only)\n"
-        "  gsl_svd  the same, GSL SVD (double binary only)\n"
-        "  fmu      the FMU binary stepped from C, one doStep (h = 1e-3 s) per row\n"
-        "           (double binary only)\n"
-        "\n"
-        "files (raw little-endian float64, row-major):\n"
-        "  --inputs      N x 35: per link m then n: dir.x, dir.y, length, omega, epsilon,\n"
-        "                accel_d.x, accel_d.y, com.x, com.y, mass, inertia, force.x,\n"
-        "                force.y, moment; then guide_k.x/y, guide_p.x/y, gravity.x/y,\n"
-        "                singular_threshold\n"
-        "  --outputs     N x 16: r_mk.x, r_mk.y, r_np.x, r_np.y, r_mn.x, r_mn.y, n_mk,\n"
-        "                n_np, n_mn, m_mk, m_np, m_mn, status (0 ok, 1 singular, 2 invalid,\n"
-        "                3 out of range), conditioning (core; else NaN), cond2 (gsl_svd:\n"
-        "                s_max/s_min of the 6x6 matrix; else NaN), amplification (core;\n"
-        "                else NaN).\n"
-        "                For fmu: N x (number of out-vrs), the values read back.\n"
-        "  --fmu-inputs  N x (number of in-vrs), in the FMU's units\n"
-        "\n"
-        "options:\n"
-        "  --count N     use the first N rows (default: all)\n"
-        "  --repeat R    run the timed loop R times (default 5)\n"
-        "  --fmi 2|3     FMI version of the binary; --token is its guid (FMI 2) or\n"
-        "                instantiationToken (FMI 3); --in-vrs/--out-vrs are value\n"
-        "                references of Real (FMI 2) / Float64 (FMI 3) variables\n"
-        "  --help        this text\n"
-        "\n"
-        "exit status: 0 done, 1 an FMU call did not return OK, 2 bad arguments or files\n",
-        BENCH_PROGRAM, BENCH_PROGRAM, BENCH_REAL_NAME);
+            "usage: %s --type RRR|RRT|RTR|TRT|RTT --method core|gsl_lu|gsl_svd|fmu\n"
+            "           --inputs FILE [--outputs FILE] [--count N] [--repeat R]\n"
+            "       %s --method fmu --fmu BINARY.so --fmi 2|3 --token TOKEN\n"
+            "           --fmu-inputs FILE --in-vrs VR,VR,... --out-vrs VR,VR,...\n"
+            "           [--outputs FILE] [--count N] [--repeat R]\n"
+            "\n"
+            "Times the solve of every configuration (row) of the inputs file, R times\n"
+            "(default 5), and prints one JSON line: method, real, type, count, repeat,\n"
+            "seconds_per_config (the median over the R runs) and seconds_all (the time\n"
+            "per configuration of each run).\n"
+            "\n"
+            "methods:\n"
+            "  core     dyad_solve of the C core (%s)\n"
+            "  gsl_lu   the dyad's 6x6 Newton-Euler system, GSL LU (double binary only)\n"
+            "  gsl_svd  the same, GSL SVD (double binary only)\n"
+            "  fmu      the FMU binary stepped from C, one doStep (h = 1e-3 s) per row\n"
+            "           (double binary only)\n"
+            "\n"
+            "files (raw little-endian float64, row-major):\n"
+            "  --inputs      N x 35: per link m then n: dir.x, dir.y, length, omega, epsilon,\n"
+            "                accel_d.x, accel_d.y, com.x, com.y, mass, inertia, force.x,\n"
+            "                force.y, moment; then guide_k.x/y, guide_p.x/y, gravity.x/y,\n"
+            "                singular_threshold\n"
+            "  --outputs     N x 16: r_mk.x, r_mk.y, r_np.x, r_np.y, r_mn.x, r_mn.y, n_mk,\n"
+            "                n_np, n_mn, m_mk, m_np, m_mn, status (0 ok, 1 singular, 2 invalid,\n"
+            "                3 out of range), conditioning (core; else NaN), cond2 (gsl_svd:\n"
+            "                s_max/s_min of the 6x6 matrix; else NaN), amplification (core;\n"
+            "                else NaN).\n"
+            "                For fmu: N x (number of out-vrs), the values read back.\n"
+            "  --fmu-inputs  N x (number of in-vrs), in the FMU's units\n"
+            "\n"
+            "options:\n"
+            "  --count N     use the first N rows (default: all)\n"
+            "  --repeat R    run the timed loop R times (default 5)\n"
+            "  --fmi 2|3     FMI version of the binary; --token is its guid (FMI 2) or\n"
+            "                instantiationToken (FMI 3); --in-vrs/--out-vrs are value\n"
+            "                references of Real (FMI 2) / Float64 (FMI 3) variables\n"
+            "  --help        this text\n"
+            "\n"
+            "exit status: 0 done, 1 an FMU call did not return OK, 2 bad arguments or files\n",
+            BENCH_PROGRAM, BENCH_PROGRAM, BENCH_REAL_NAME);
 }
 
 static void fail_usage(const char* what, const char* detail)
@@ -129,15 +129,18 @@ static void fail_usage(const char* what, const char* detail)
     exit(EXIT_USAGE);
 }
 
-/* ---- arguments ---------------------------------------------------------------- */
+/* ---- arguments ------------------------------------------------------------------------------ */
 
 static int same_ignoring_case(const char* a, const char* b)
 {
     for (; *a != '\0' && *b != '\0'; ++a, ++b) {
         char x = *a, y = *b;
-        if (x >= 'a' && x <= 'z') x = (char)(x - 'a' + 'A');
-        if (y >= 'a' && y <= 'z') y = (char)(y - 'a' + 'A');
-        if (x != y) return 0;
+        if (x >= 'a' && x <= 'z')
+            x = (char)(x - 'a' + 'A');
+        if (y >= 'a' && y <= 'z')
+            y = (char)(y - 'a' + 'A');
+        if (x != y)
+            return 0;
     }
     return *a == *b;
 }
@@ -149,8 +152,7 @@ static long parse_positive(const char* option, const char* text)
     errno = 0;
     value = strtol(text, &end, 10);
     if (errno != 0 || end == text || *end != '\0' || value <= 0) {
-        fprintf(stderr, "%s: %s needs a positive integer, not '%s'\n", BENCH_PROGRAM, option,
-                text);
+        fprintf(stderr, "%s: %s needs a positive integer, not '%s'\n", BENCH_PROGRAM, option, text);
         exit(EXIT_USAGE);
     }
     return value;
@@ -255,7 +257,7 @@ static void parse_args(int argc, char** argv, options* opt)
     }
 }
 
-/* ---- files -------------------------------------------------------------------- */
+/* ---- files ---------------------------------------------------------------------------------- */
 
 static int host_is_little_endian(void)
 {
@@ -324,8 +326,8 @@ static size_t rows_to_use(const options* opt, size_t rows, const char* path)
         return rows;
     }
     if ((unsigned long)opt->count > rows) {
-        fprintf(stderr, "%s: --count %ld, but %s holds only %lu rows\n", BENCH_PROGRAM,
-                opt->count, path, (unsigned long)rows);
+        fprintf(stderr, "%s: --count %ld, but %s holds only %lu rows\n", BENCH_PROGRAM, opt->count,
+                path, (unsigned long)rows);
         exit(EXIT_USAGE);
     }
     return (size_t)opt->count;
@@ -341,7 +343,7 @@ static void* xmalloc(size_t count, size_t size)
     return p;
 }
 
-/* ---- rows to inputs, results to rows ------------------------------------------- */
+/* ---- rows to inputs, results to rows -------------------------------------------------------- */
 
 static dyad_vec2 vec_at(const double* c)
 {
@@ -397,7 +399,7 @@ static void row_from_result(const dyad_result* r, double cond2, double* row)
     row[15] = (double)r->amplification;
 }
 
-/* ---- timing ------------------------------------------------------------------- */
+/* ---- timing --------------------------------------------------------------------------------- */
 
 static double now_seconds(void)
 {
@@ -440,7 +442,7 @@ static void print_json(const options* opt, size_t count, const double* per_confi
     printf("]}\n");
 }
 
-/* ---- the timed loops ------------------------------------------------------------ */
+/* ---- the timed loops ------------------------------------------------------------------------ */
 
 /* External linkage and noinline: each loop keeps its own symbol for callgrind's
  * --toggle-collect, and the solves cannot be folded into main. */
@@ -518,19 +520,12 @@ static void run_solver(const options* opt)
     for (rep = 0; rep < opt->repeat; ++rep) {
         const double start = now_seconds();
         switch (opt->method) {
-        case METHOD_CORE:
-            bench_loop_core(opt->type, in, out, count);
-            break;
+        case METHOD_CORE: bench_loop_core(opt->type, in, out, count); break;
 #ifndef DYAD_REAL_FLOAT
-        case METHOD_GSL_LU:
-            bench_loop_gsl_lu(ws, opt->type, in, out, count);
-            break;
-        case METHOD_GSL_SVD:
-            bench_loop_gsl_svd(ws, opt->type, in, out, cond2, count);
-            break;
+        case METHOD_GSL_LU: bench_loop_gsl_lu(ws, opt->type, in, out, count); break;
+        case METHOD_GSL_SVD: bench_loop_gsl_svd(ws, opt->type, in, out, cond2, count); break;
 #endif
-        default:
-            break; /* refused in main */
+        default: break; /* refused in main */
         }
         per_config[rep] = (now_seconds() - start) / (double)count;
     }
@@ -554,7 +549,7 @@ static void run_solver(const options* opt)
     free(per_config);
 }
 
-/* ---- fmu ---------------------------------------------------------------------- */
+/* ---- fmu ------------------------------------------------------------------------------------ */
 
 #ifdef BENCH_HAVE_FMU
 
@@ -626,10 +621,10 @@ static void* symbol(void* library, const char* path, const char* name)
 
 /* dlsym returns an object pointer; ISO C has no conversion to a function
  * pointer, so the address is copied bytewise (as POSIX permits). */
-#define RESOLVE(target, name)                                                                   \
-    do {                                                                                        \
-        void* address_ = symbol(s->library, opt->fmu_path, name);                               \
-        memcpy(&(target), &address_, sizeof address_);                                         \
+#define RESOLVE(target, name)                                     \
+    do {                                                          \
+        void* address_ = symbol(s->library, opt->fmu_path, name); \
+        memcpy(&(target), &address_, sizeof address_);            \
     } while (0)
 
 static void fmu_check(int status, int ok, const char* call)
@@ -675,8 +670,7 @@ static void fmu_open(const options* opt, fmu_session* s)
             fprintf(stderr, "%s: fmi2Instantiate failed\n", BENCH_PROGRAM);
             exit(EXIT_FAILURE);
         }
-        fmu_check(setup(s->instance, fmi2False, 0, 0, fmi2False, 0), fmi2OK,
-                  "fmi2SetupExperiment");
+        fmu_check(setup(s->instance, fmi2False, 0, 0, fmi2False, 0), fmi2OK, "fmi2SetupExperiment");
         fmu_check(enter(s->instance), fmi2OK, "fmi2EnterInitializationMode");
         fmu_check(leave(s->instance), fmi2OK, "fmi2ExitInitializationMode");
     } else {
@@ -715,9 +709,9 @@ static void fmu_close(fmu_session* s)
     dlclose(s->library);
 }
 
-__attribute__((noinline)) size_t bench_loop_fmu(const fmu_session* s, const double* in,
-                                                double* out, size_t count,
-                                                unsigned long* steps, fmu_failure* failure);
+__attribute__((noinline)) size_t bench_loop_fmu(const fmu_session* s, const double* in, double* out,
+                                                size_t count, unsigned long* steps,
+                                                fmu_failure* failure);
 
 /* Set, doStep, get for every row; the communication time runs on across
  * repeats. Returns the number of rows done: count, or the failing row. */
@@ -729,26 +723,50 @@ size_t bench_loop_fmu(const fmu_session* s, const double* in, double* out, size_
         for (i = 0; i < count; ++i) {
             const double t = (double)(*steps)++ * FMU_STEP_SIZE;
             fmi2Status st = s->set2(s->instance, s->in_vrs, s->in_count, in + i * s->in_count);
-            if (st != fmi2OK) { failure->call = "fmi2SetReal"; failure->status = st; return i; }
+            if (st != fmi2OK) {
+                failure->call = "fmi2SetReal";
+                failure->status = st;
+                return i;
+            }
             st = s->step2(s->instance, t, FMU_STEP_SIZE, fmi2True);
-            if (st != fmi2OK) { failure->call = "fmi2DoStep"; failure->status = st; return i; }
+            if (st != fmi2OK) {
+                failure->call = "fmi2DoStep";
+                failure->status = st;
+                return i;
+            }
             st = s->get2(s->instance, s->out_vrs, s->out_count, out + i * s->out_count);
-            if (st != fmi2OK) { failure->call = "fmi2GetReal"; failure->status = st; return i; }
+            if (st != fmi2OK) {
+                failure->call = "fmi2GetReal";
+                failure->status = st;
+                return i;
+            }
         }
     } else {
         for (i = 0; i < count; ++i) {
             const double t = (double)(*steps)++ * FMU_STEP_SIZE;
             fmi3Boolean event, terminate, early;
             fmi3Float64 last;
-            fmi3Status st = s->set3(s->instance, s->in_vrs, s->in_count,
-                                    in + i * s->in_count, s->in_count);
-            if (st != fmi3OK) { failure->call = "fmi3SetFloat64"; failure->status = st; return i; }
+            fmi3Status st =
+                s->set3(s->instance, s->in_vrs, s->in_count, in + i * s->in_count, s->in_count);
+            if (st != fmi3OK) {
+                failure->call = "fmi3SetFloat64";
+                failure->status = st;
+                return i;
+            }
             st = s->step3(s->instance, t, FMU_STEP_SIZE, fmi3True, &event, &terminate, &early,
                           &last);
-            if (st != fmi3OK) { failure->call = "fmi3DoStep"; failure->status = st; return i; }
+            if (st != fmi3OK) {
+                failure->call = "fmi3DoStep";
+                failure->status = st;
+                return i;
+            }
             st = s->get3(s->instance, s->out_vrs, s->out_count, out + i * s->out_count,
                          s->out_count);
-            if (st != fmi3OK) { failure->call = "fmi3GetFloat64"; failure->status = st; return i; }
+            if (st != fmi3OK) {
+                failure->call = "fmi3GetFloat64";
+                failure->status = st;
+                return i;
+            }
         }
     }
     return count;
@@ -842,8 +860,10 @@ int main(int argc, char** argv)
     }
 #ifdef DYAD_REAL_FLOAT
     if (opt.method != METHOD_CORE) {
-        fprintf(stderr, "%s: method %s is not available in the float build (only core); "
-                        "use dyad_bench\n", BENCH_PROGRAM, method_names[opt.method]);
+        fprintf(stderr,
+                "%s: method %s is not available in the float build (only core); "
+                "use dyad_bench\n",
+                BENCH_PROGRAM, method_names[opt.method]);
         return EXIT_USAGE;
     }
 #endif
@@ -851,8 +871,10 @@ int main(int argc, char** argv)
 #ifdef BENCH_HAVE_FMU
         run_fmu(&opt);
 #else
-        fprintf(stderr, "%s: method fmu is not available: built without the FMI headers "
-                        "(configure with DYADFMU_BUILD_FMUS=ON)\n", BENCH_PROGRAM);
+        fprintf(stderr,
+                "%s: method fmu is not available: built without the FMI headers "
+                "(configure with DYADFMU_BUILD_FMUS=ON)\n",
+                BENCH_PROGRAM);
         return EXIT_USAGE;
 #endif
     } else {

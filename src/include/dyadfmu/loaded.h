@@ -26,12 +26,12 @@ extern "C" {
 /** One link of a dyad with the resultant of everything acting on it except the
  *  reactions of its own three pairs. */
 typedef struct dyad_loaded_link {
-    dyad_vec2 i;    /**< i_g: unit vector from D_g towards E, global frame (-) */
-    dyad_vec2 j;    /**< j_g = k0 x i_g (-) */
-    dyad_real l;    /**< l_g = |D_g E| (m) */
-    dyad_vec2 f;    /**< resultant force F_g, global frame (N) */
-    dyad_real m;    /**< resultant moment about the centre of mass S_g (N m) */
-    dyad_real m_d;  /**< moment of all those loads about D_g (N m) */
+    dyad_vec2 i;   /**< i_g: unit vector from D_g towards E, global frame (-) */
+    dyad_vec2 j;   /**< j_g = k0 x i_g (-) */
+    dyad_real l;   /**< l_g = |D_g E| (m) */
+    dyad_vec2 f;   /**< resultant force F_g, global frame (N) */
+    dyad_real m;   /**< resultant moment about the centre of mass S_g (N m) */
+    dyad_real m_d; /**< moment of all those loads about D_g (N m) */
     /** Size of f (N): the sum of |x| + |y| over every term summed into f (a
      *  term's own error bound where it carries one, see dyad_force_size). The
      *  caller's round-off of f must be a few eps times it; it is at least

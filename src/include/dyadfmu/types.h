@@ -19,13 +19,13 @@
 #ifdef DYAD_REAL_FLOAT
 typedef float dyad_real;
 #define DYAD_REAL_EPSILON FLT_EPSILON
-#define DYAD_REAL_MAX FLT_MAX
+#define DYAD_REAL_MAX     FLT_MAX
 /** Default singular threshold: sqrt(FLT_EPSILON) = 2^-11.5. */
 #define DYAD_DEFAULT_SINGULAR_THRESHOLD 3.4526698e-4f
 #else
 typedef double dyad_real;
-#define DYAD_REAL_EPSILON DBL_EPSILON
-#define DYAD_REAL_MAX DBL_MAX
+#define DYAD_REAL_EPSILON               DBL_EPSILON
+#define DYAD_REAL_MAX                   DBL_MAX
 /** Default singular threshold: sqrt(DBL_EPSILON) = 2^-26. At this conditioning
  *  the round-off bound eps * amplification is sqrt(eps): half the digits survive. */
 #define DYAD_DEFAULT_SINGULAR_THRESHOLD 1.4901161193847656e-8
