@@ -11,6 +11,8 @@ import ctypes
 import os
 from pathlib import Path
 
+from .paths import ROOT
+
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 STATUS = {0: "ok", 1: "singular", 2: "invalid input", 3: "out of range"}
 LINK_KEYS = ("dir", "length", "omega", "epsilon", "accel_d", "com",
@@ -47,7 +49,7 @@ def library_path() -> Path:
     env = os.environ.get("DYADFMU_LIB")
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[2] / "build" / "libdyadfmu.so"
+    return ROOT / "build" / "libdyadfmu.so"
 
 
 class Core:

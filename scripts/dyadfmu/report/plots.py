@@ -1,4 +1,4 @@
-"""Plots of a scene run: reactions over the crank angle (FMU and reference, with
+"""Plots of a mechanism run: reactions over the crank angle (FMU and reference, with
 the error underneath), the driving torque, and the mechanism drawn to scale
 with its reaction vectors."""
 
@@ -13,10 +13,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from . import drawing  # noqa: E402
-from .harness import SceneResult  # noqa: E402
+from ..cosim.harness import MechanismResult  # noqa: E402
 
 
-def _abscissa(result: SceneResult):
+def _abscissa(result: MechanismResult):
     """Crank angle in degrees, unwrapped, for the recorded rows; time where the
     crank oscillates (its angle would fold the curves)."""
     rows = result.extra["rows_kin"]
@@ -26,7 +26,7 @@ def _abscissa(result: SceneResult):
     return rows["t"], "time (s)"
 
 
-def plot_reactions(result: SceneResult, path: Path) -> Path:
+def plot_reactions(result: MechanismResult, path: Path) -> Path:
     """Each output: FMU and reference over the crank angle, the error below."""
     x, label = _abscissa(result)
     order = np.argsort(x, kind="stable")
@@ -63,7 +63,7 @@ def plot_reactions(result: SceneResult, path: Path) -> Path:
     return path
 
 
-def plot_mechanism(result: SceneResult, angle_deg: float, path: Path) -> Path:
+def plot_mechanism(result: MechanismResult, angle_deg: float, path: Path) -> Path:
     """The mechanism at the recorded row nearest to the crank angle, to scale, with
     the reactions of the dyad and the frame's reaction on the crank."""
     rows = result.extra["rows_kin"]

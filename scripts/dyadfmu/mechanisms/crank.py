@@ -17,9 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-
-def _cross(a, b):
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+from .geometry import cross
 
 
 def balance(mechanism, kin: dict, r_np: np.ndarray, m_np: np.ndarray | None = None) -> dict:
@@ -35,8 +33,8 @@ def balance(mechanism, kin: dict, r_np: np.ndarray, m_np: np.ndarray | None = No
     crank = mechanism.crank
     weight_and_inertia = crank["mass"] * (np.asarray(mechanism.gravity) - kin["a_S_c"])
     r_o = r_np - weight_and_inertia
-    torque = -(_cross(kin["D_n"] - kin["O"], -r_np) - m_np
-               + _cross(kin["S_c"] - kin["O"], weight_and_inertia)
+    torque = -(cross(kin["D_n"] - kin["O"], -r_np) - m_np
+               + cross(kin["S_c"] - kin["O"], weight_and_inertia)
                - crank["inertia"] * kin["crank.epsilon"])
     return {"torque": torque, "R_O": r_o}
 

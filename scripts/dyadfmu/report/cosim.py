@@ -17,7 +17,7 @@ import sys
 import time as clock
 from pathlib import Path
 
-from . import cosim
+from ..cosim import master as cosim
 
 #: Inertia ratios (mean J over a revolution, crank included, / rotor inertia).
 RATIOS = (0.1, 1.0, 10.0, 100.0)

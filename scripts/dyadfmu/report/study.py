@@ -12,8 +12,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .configurations import TYPES  # noqa: E402
-from .study import EPS, LABELS, SETS  # noqa: E402
+from ..study.accuracy import EPS, LABELS, SETS, Results  # noqa: E402
+from ..study.configurations import TYPES  # noqa: E402
 
 MARKERS = {"core": "o", "core_float": "v", "gsl_lu": "s", "gsl_svd": "D", "numpy": "^",
            "fmu_c2": "P", "fmu_c3": "X", "fmu_fmpy2": "*", "fmu_fmpy3": "h"}
@@ -200,3 +200,10 @@ def markdown(out: Path, summary, contract, silent, sizes, quick, elapsed, figure
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def write(out: Path, results: Results) -> Path:
+    """The plots and report.md of the study's results in `out`; returns the report's path."""
+    figures = plots(out, results.points, results.summary)
+    return markdown(out, results.summary, results.contract, results.silent, results.sizes,
+                    results.quick, results.elapsed, figures)

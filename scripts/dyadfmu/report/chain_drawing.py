@@ -23,7 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .drawing import _bar, _block, _ground_pivot, _hatch, _label, _pin, _slot  # noqa: E402
+from . import sketch  # noqa: E402
 
 __all__ = ["draw", "figure", "reaction_vectors", "chain_size"]
 
@@ -101,9 +101,9 @@ def _link_guides(ax, frame, g, D, angle, colour):
         i_k = _u2(angle + lg["angle"])
         s0, s1 = lg["range"]
         if np.hypot(*(Q - D)) > 0.0:
-            _bar(ax, D, Q, colour, z=2.2)
-        _bar(ax, Q + min(s0, 0.0) * i_k, Q + max(s1, 0.0) * i_k, colour, width=_WIDTH * 1.6, z=2.5)
-        _slot(ax, Q + s0 * i_k, Q + s1 * i_k, z=2.6)
+            sketch.bar(ax, D, Q, colour, z=2.2)
+        sketch.bar(ax, Q + min(s0, 0.0) * i_k, Q + max(s1, 0.0) * i_k, colour, width=_WIDTH * 1.6, z=2.5)
+        sketch.slot(ax, Q + s0 * i_k, Q + s1 * i_k, z=2.6)
 
 
 def draw(ax, chain, kin, index, reactions=None, scale=None):
@@ -135,19 +135,19 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
     # the frame
     frame = kin.get("frame") or chain._frame()
     for p in frame["pivots"].values():
-        _ground_pivot(ax, p, u)
+        sketch.ground_pivot(ax, p, u)
     hs = 1.0 * u                                     # half height of a slider on a guide
     for label, (p0, p1) in frame["guides"].items():
         p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
         n = _r90((p1 - p0) / np.hypot(*(p1 - p0)))
         ax.plot([p0[0], p1[0]], [p0[1], p1[1]], color="0.35", lw=0.8, ls="-.", zorder=1)
-        _hatch(ax, p0 - hs * n, p1 - hs * n, -n, u)
-        _hatch(ax, p0 + hs * n, p1 + hs * n, n, u)
-        _label(ax, p1 + 2.5 * u * n, label, (0.0, 0.0), colour="0.3", size=8, box=False)
+        sketch.hatch(ax, p0 - hs * n, p1 - hs * n, -n, u)
+        sketch.hatch(ax, p0 + hs * n, p1 + hs * n, n, u)
+        sketch.label(ax, p1 + 2.5 * u * n, label, (0.0, 0.0), colour="0.3", size=8, box=False)
 
     # the crank
     O, A = at("O"), at("A")
-    _bar(ax, O, A, _CRANK_COLOUR, z=2.0)
+    sketch.bar(ax, O, A, _CRANK_COLOUR, z=2.0)
     i_c = _u2(float(at(f"{chain.crank_name}.angle")))
     _link_guides(ax, frame, chain.crank_name, O, float(at(f"{chain.crank_name}.angle")), _CRANK_COLOUR)
     link_label_at[chain.crank_name] = 0.5 * (O + A) - 1.8 * u * _r90(i_c)
@@ -176,7 +176,7 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
             col = colours[g]
             _link_guides(ax, frame, g, D, float(at(f"{g}.angle")), col)
             if e["type"] == "RTR" and g == n:             # block in the slot of m
-                _block(ax, E, i_g, 2.4 * u, 1.1 * u, col, z=4.5)
+                sketch.block(ax, E, i_g, 2.4 * u, 1.1 * u, col, z=4.5)
                 link_label_at[g] = E - 2.2 * u * j_g - 1.2 * u * i_g
             elif e["type"] == "RRT" and g == m:           # slider on the guide
                 rel = [p - D for p in own + [S]]
@@ -185,14 +185,14 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
                 x0, x1 = min(xs) - 1.5 * u, max(xs) + 1.5 * u
                 y0, y1 = min(min(ys), -hs), max(max(ys), hs)
                 centre = D + 0.5 * (x0 + x1) * i_g + 0.5 * (y0 + y1) * j_g
-                _block(ax, centre, i_g, x1 - x0, y1 - y0, col, z=3.0)
+                sketch.block(ax, centre, i_g, x1 - x0, y1 - y0, col, z=3.0)
                 link_label_at[g] = D + 0.5 * (x0 + x1) * i_g + (y1 + 1.6 * u) * j_g
             elif e["type"] == "RTR" and g == m:           # slotted link
                 lengths = np.asarray(kin[f"{g}.length"], dtype=float)
                 reach = max([float(lengths.max())] + [float((p - D) @ i_g) for p in own]) + 1.2 * u
                 tip = D + reach * i_g
-                _bar(ax, D, tip, col, width=_WIDTH * 1.6, z=2.5)
-                _slot(ax, D + (lengths.min() - 1.0 * u) * i_g, D + (lengths.max() + 1.0 * u) * i_g,
+                sketch.bar(ax, D, tip, col, width=_WIDTH * 1.6, z=2.5)
+                sketch.slot(ax, D + (lengths.min() - 1.0 * u) * i_g, D + (lengths.max() + 1.0 * u) * i_g,
                       z=2.6)
                 link_label_at[g] = D + 0.3 * reach * i_g + 2.0 * u * j_g
             else:                                         # bar (or ternary plate)
@@ -200,12 +200,12 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
                     ax.add_patch(plt.Polygon([tuple(p) for p in own], closed=True, facecolor=col,
                                              edgecolor="none", alpha=0.25, zorder=1.8))
                 for p in own[1:]:
-                    _bar(ax, D, p, col, z=2.2)
+                    sketch.bar(ax, D, p, col, z=2.2)
                 far = max(own[1:], key=lambda p: np.hypot(*(p - D))) if len(own) > 1 else D + u * i_g
                 side = _r90((far - D) / max(np.hypot(*(far - D)), 1e-300))
                 link_label_at[g] = 0.5 * (D + far) + 1.8 * u * side
     for p in pins:
-        _pin(ax, p, u)
+        sketch.pin(ax, p, u)
 
     # centres of mass
     for b in chain.bodies:
@@ -234,11 +234,11 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
                 shown[b] = group[0]
         d = pts[a] - centre
         d = d / np.hypot(*d) if np.hypot(*d) > 1e-12 else np.array([-1.0, 1.0]) / math.sqrt(2)
-        _label(ax, pts[a], " = ".join(group), tuple(11.0 * d), size=9)
+        sketch.label(ax, pts[a], " = ".join(group), tuple(11.0 * d), size=9)
 
     # link labels
     for b, p in link_label_at.items():
-        _label(ax, p, b, (0.0, 0.0), colour=colours[b], size=9, weight="bold", box=False)
+        sketch.label(ax, p, b, (0.0, 0.0), colour=colours[b], size=9, weight="bold", box=False)
 
     # reactions
     if scale is not None:

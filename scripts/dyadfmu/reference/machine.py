@@ -45,9 +45,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import crank as _crank
-from . import reference as _reference
-from .mechanisms import CrankMotion, Mechanism
+from ..mechanisms import crank as _crank
+from ..mechanisms.builtin import Mechanism
+from ..mechanisms.motion import CrankMotion
+from . import newton_euler as _reference
 
 __all__ = ["Motor", "MOTORS", "default_motor", "state_kinematics", "reduced_inertia",
            "generalized_load", "crank_torque_from_kinetostatics", "phi_range",

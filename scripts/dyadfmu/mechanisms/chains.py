@@ -72,13 +72,12 @@ from typing import Mapping
 
 import numpy as np
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
-    import tomli as tomllib
+import tomllib
 
-from .mechanisms import (CrankMotion, _col, _cross, _dot, _merge, _number, _pair, _rot90,
-                         _rotating, _unit)
+from ..paths import SCENES_DIR
+from . import geometry as geo
+from . import motion as motion_
+from .motion import CrankMotion
 
 __all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
 
@@ -105,8 +104,8 @@ def _angle(v):
 
 def _solve2(c1, c2, rhs):
     """x, y with x c1 + y c2 = rhs (Cramer's rule), batched over the leading axis."""
-    det = _cross(c1, c2)
-    return _cross(rhs, c2) / det, _cross(c1, rhs) / det
+    det = geo.cross(c1, c2)
+    return geo.cross(rhs, c2) / det, geo.cross(c1, rhs) / det
 
 
 # ---------------------------------------------------------------------------
@@ -116,7 +115,7 @@ def scene_path(name) -> Path:
     """The scene file of mechanism ``name``: ``scenes/<name>.toml`` of the project."""
     if name not in NAMES:
         raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
-    return Path(__file__).resolve().parents[2] / "scenes" / f"{name}.toml"
+    return SCENES_DIR / f"{name}.toml"
 
 
 def default_data() -> dict:
@@ -126,7 +125,7 @@ def default_data() -> dict:
 
 
 def _sign(table, key, where):
-    value = _number(table, key, where)
+    value = geo.number(table, key, where)
     if value not in (1.0, -1.0):
         raise ValueError(f"{where}.{key}: expected +1 or -1, got {value!r}")
     return value
@@ -161,13 +160,13 @@ class Chain:
         self.crank = dict(crank)
         self.crank_name = str(crank.get("name", "crank"))
         w = f"{where}.crank"
-        self._r = _number(crank, "length", w, positive=True)
-        self._crank_mass = _number(crank, "mass", w, nonnegative=True)
-        self._crank_inertia = _number(crank, "inertia", w, nonnegative=True)
-        self._crank_com = _pair(crank, "com", w)
+        self._r = geo.number(crank, "length", w, positive=True)
+        self._crank_mass = geo.number(crank, "mass", w, nonnegative=True)
+        self._crank_inertia = geo.number(crank, "inertia", w, nonnegative=True)
+        self._crank_com = geo.pair(crank, "com", w)
 
         grav = self.scene.get("gravity", {})
-        self.gravity = (_number(grav, "x", f"{where}.gravity"), _number(grav, "y", f"{where}.gravity"))
+        self.gravity = (geo.number(grav, "x", f"{where}.gravity"), geo.number(grav, "y", f"{where}.gravity"))
         eff = self.scene.get("effects", {})
         self.effects = {"inertia": bool(eff.get("inertia", True)), "gravity": bool(eff.get("gravity", True))}
         #: gravity as it enters the dynamics and the potential energy
@@ -180,9 +179,9 @@ class Chain:
                 raise ValueError(f"{where}: bad or repeated link name {lname!r}")
             wl = f"{where}.link[{lname}]"
             link = dict(lt)
-            link["mass"] = _number(lt, "mass", wl, nonnegative=True)
-            link["inertia"] = _number(lt, "inertia", wl, nonnegative=True)
-            link["com"] = _pair(lt, "com", wl)
+            link["mass"] = geo.number(lt, "mass", wl, nonnegative=True)
+            link["inertia"] = geo.number(lt, "inertia", wl, nonnegative=True)
+            link["com"] = geo.pair(lt, "com", wl)
             self.links[lname] = link
         self.dyads = [dict(d) for d in self.scene.get("dyad", [])]
         if not self.dyads:
@@ -190,11 +189,11 @@ class Chain:
 
         md = self.data.get("motion", {})
         wm = f"{name}.motion"
-        self._w0 = _number(md, "omega", wm, positive=True)
-        self._variation = _number(md, "variation", wm, default=0.3)
+        self._w0 = geo.number(md, "omega", wm, positive=True)
+        self._variation = geo.number(md, "variation", wm, default=0.3)
         if not 0.0 <= self._variation < 1.0:
             raise ValueError(f"{wm}.variation: must be in [0, 1), got {self._variation!r}")
-        self._phi0 = _number(md, "phi0", wm, default=0.0)
+        self._phi0 = geo.number(md, "phi0", wm, default=0.0)
 
         self._resolve_dyads()
         self._resolve_loads()
@@ -215,7 +214,7 @@ class Chain:
             if not isinstance(frame, Mapping):
                 raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
                                  f"(the scene puts {dyad}.{pair} on the frame)")
-            pos = _pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
+            pos = geo.pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
             return {"kind": "pivot", "body": None, "position": pos,
                     "label": str(frame.get("label", f"{dyad}.{pair}"))}
         if spec == "crank" or spec == self.crank_name:
@@ -225,11 +224,11 @@ class Chain:
             if body == "frame":
                 if "guide" not in spec:
                     raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
-                angle = _number(spec, "guide", where)
+                angle = geo.number(spec, "guide", where)
                 if not isinstance(frame, Mapping):
                     raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing guide height "
                                      f"(the scene puts {dyad}.{pair} on a frame guide)")
-                h = _number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
+                h = geo.number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
                 return {"kind": "guide", "body": None, "angle": angle, "height": h,
                         "label": str(frame.get("label", f"{dyad}.{pair}"))}
             if body == "crank":
@@ -240,9 +239,9 @@ class Chain:
             if "guide" in spec:
                 # a guide fixed in the moving link: through ``at``, along i_body rotated
                 # by ``guide``
-                return {"kind": "link_guide", "body": body, "at": _pair(spec, "at", where),
-                        "angle": _number(spec, "guide", where), "label": f"{dyad}.guide_k"}
-            return {"kind": "point", "body": body, "at": _pair(spec, "at", where),
+                return {"kind": "link_guide", "body": body, "at": geo.pair(spec, "at", where),
+                        "angle": geo.number(spec, "guide", where), "label": f"{dyad}.guide_k"}
+            return {"kind": "point", "body": body, "at": geo.pair(spec, "at", where),
                     "label": f"{dyad}.{pair}"}
         raise ValueError(f"{where}: expected 'frame', 'crank' or a table, got {spec!r}")
 
@@ -274,8 +273,8 @@ class Chain:
             if kind == "RRR":
                 if k["kind"] in guides or p["kind"] in guides:
                     raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
-                entry["lm"] = _number(lm_t, "length", f"{where}.{m}", positive=True)
-                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
+                entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", positive=True)
+                entry["ln"] = geo.number(ln_t, "length", f"{where}.{n}", positive=True)
                 entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
             elif kind == "RRT":
                 if k["kind"] not in guides:
@@ -283,11 +282,11 @@ class Chain:
                                      f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}")
                 if p["kind"] in guides:
                     raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
-                entry["lm"] = _number(lm_t, "length", f"{where}.{m}", nonnegative=True)
-                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
+                entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", nonnegative=True)
+                entry["ln"] = geo.number(ln_t, "length", f"{where}.{n}", positive=True)
                 if k["kind"] == "guide":
                     # the slider translates on the fixed guide: its angle is constant
-                    entry["m_angle"] = _number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
+                    entry["m_angle"] = geo.number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
                 elif "angle" in lm_t:
                     raise ValueError(f"{where}.{m}.angle: the slider turns with link "
                                      f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
@@ -299,7 +298,7 @@ class Chain:
                 if "length" in lm_t:
                     raise ValueError(f"{where}.{m}: the slotted link's length |D_m E| varies; "
                                      f"remove its 'length'")
-                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", nonnegative=True)
+                entry["ln"] = geo.number(ln_t, "length", f"{where}.{n}", nonnegative=True)
                 if entry["ln"] != 0.0:
                     raise ValueError(f"{where}.{n}.length: only a block on the pin (length 0) "
                                      f"is handled, got {entry['ln']!r}")
@@ -328,15 +327,15 @@ class Chain:
             if kind == "cutting":
                 if lname not in forces:
                     raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
-                self._loads[lname] = {"model": kind, "F0": _number(model, "F0", where),
-                                      "v_ref": _number(model, "v_ref", where, positive=True),
+                self._loads[lname] = {"model": kind, "F0": geo.number(model, "F0", where),
+                                      "v_ref": geo.number(model, "v_ref", where, positive=True),
                                       "s": _sign(model, "s", where) if "s" in model else 1.0}
             elif kind == "resisting-torque":
                 if lname not in moments:
                     raise ValueError(f"{where}: the scene lists no moment on {lname!r} ([loads].moment)")
-                self._loads[lname] = {"model": kind, "T0": _number(model, "T0", where),
-                                      "w_ref": _number(model, "w_ref", where, positive=True),
-                                      "c": _number(model, "c", where)}
+                self._loads[lname] = {"model": kind, "T0": geo.number(model, "T0", where),
+                                      "w_ref": geo.number(model, "w_ref", where, positive=True),
+                                      "c": geo.number(model, "c", where)}
             elif kind == "resisting-force":
                 if lname not in forces:
                     raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
@@ -344,8 +343,8 @@ class Chain:
                 if dyad is None:
                     raise ValueError(f"{where}: model 'resisting-force' needs a slider (link m "
                                      f"of an RRT dyad); {lname!r} is none")
-                self._loads[lname] = {"model": kind, "F0": _number(model, "F0", where),
-                                      "v_ref": _number(model, "v_ref", where, positive=True),
+                self._loads[lname] = {"model": kind, "F0": geo.number(model, "F0", where),
+                                      "v_ref": geo.number(model, "v_ref", where, positive=True),
                                       "dyad": dyad["name"]}
             else:
                 raise ValueError(f"{where}.model: expected 'cutting', 'resisting-torque' or "
@@ -395,7 +394,7 @@ class Chain:
         revolutions = float(revolutions)
         if not (revolutions > 0 and math.isfinite(revolutions)):
             raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
-        return _rotating(kind, self._w0, self._variation, self._phi0, revolutions)
+        return motion_.rotating(kind, self._w0, self._variation, self._phi0, revolutions)
 
     # ---- kinematics -------------------------------------------------------
     def kinematics(self, t, motion: CrankMotion) -> dict:
@@ -429,11 +428,11 @@ class Chain:
     @staticmethod
     def _material(state, at):
         """Position, velocity, acceleration of the point fixed at ``at`` in a body's frame."""
-        i = _unit(state["angle"])
-        rel = at[0] * i + at[1] * _rot90(i)
-        w, e = _col(state["omega"]), _col(state["epsilon"])
-        return (state["D"] + rel, state["vD"] + w * _rot90(rel),
-                state["aD"] + e * _rot90(rel) - w * w * rel)
+        i = geo.unit(state["angle"])
+        rel = at[0] * i + at[1] * geo.rot90(i)
+        w, e = geo.col(state["omega"]), geo.col(state["epsilon"])
+        return (state["D"] + rel, state["vD"] + w * geo.rot90(rel),
+                state["aD"] + e * geo.rot90(rel) - w * w * rel)
 
     def _point(self, att, states, shape):
         if att["kind"] == "pivot":
@@ -446,7 +445,7 @@ class Chain:
         zero = np.zeros(shape)
         z2 = np.zeros(shape + (2,))
         c = self.crank_name
-        i_c = _unit(phi)
+        i_c = geo.unit(phi)
         crank_state = {"angle": phi, "omega": w, "epsilon": eps, "D": z2, "vD": z2, "aD": z2}
         A, vA, aA = self._material(crank_state, (self._r, 0.0))
         kin = {"t": t, f"{c}.angle": phi, f"{c}.omega": w, f"{c}.epsilon": eps,
@@ -503,12 +502,12 @@ class Chain:
                 moment = -model["T0"] * np.tanh(om / model["w_ref"]) - model["c"] * om
             elif model and model["model"] == "resisting-force":
                 dn = model["dyad"]
-                i_k = _unit(kin[f"{dn}.guide_k.angle"])
+                i_k = geo.unit(kin[f"{dn}.guide_k.angle"])
                 if f"{dn}.slide_k_rate" in kin:                 # guide on a moving link
                     v_rel = kin[f"{dn}.slide_k_rate"]
                 else:                                           # frame guide
-                    v_rel = _dot(kin[f"{g}.vel_d"], i_k)
-                force = _col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
+                    v_rel = geo.dot(kin[f"{g}.vel_d"], i_k)
+                force = geo.col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
             kin[f"{g}.force"], kin[f"{g}.moment"] = force, moment
         # scalar views with the FMU input names
         for g in self.links:
@@ -518,18 +517,18 @@ class Chain:
         return kin
 
     def _conditioning(self, e, kin):
-        i_m, i_n = _unit(kin[f"{e['m']}.angle"]), _unit(kin[f"{e['n']}.angle"])
+        i_m, i_n = geo.unit(kin[f"{e['m']}.angle"]), geo.unit(kin[f"{e['n']}.angle"])
         if e["type"] == "RRR":
-            return np.abs(_dot(i_m, _rot90(i_n)))
+            return np.abs(geo.dot(i_m, geo.rot90(i_n)))
         if e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
-            return np.abs(_dot(i_n, _unit(kin[f"{e['name']}.guide_k.angle"])))
+            return np.abs(geo.dot(i_n, geo.unit(kin[f"{e['name']}.guide_k.angle"])))
         if e["type"] == "RRT":
-            return np.abs(_dot(i_n, _unit(e["k"]["angle"])))
+            return np.abs(geo.dot(i_n, geo.unit(e["k"]["angle"])))
         lm, ln = kin[f"{e['m']}.length"], kin[f"{e['n']}.length"]
-        beta = _col(lm) * i_m - _col(ln) * i_n                  # D_n - D_m
+        beta = geo.col(lm) * i_m - geo.col(ln) * i_n                  # D_n - D_m
         dist = _norm(beta)
-        i_beta = beta / _col(np.where(dist > 0, dist, 1.0))
-        return np.minimum(np.abs(_dot(i_beta, i_m)), dist / (lm + ln))
+        i_beta = beta / geo.col(np.where(dist > 0, dist, 1.0))
+        return np.minimum(np.abs(geo.dot(i_beta, i_m)), dist / (lm + ln))
 
     def _sweep(self, count=720):
         """Positions over one full crank turn (the motion does not matter for them)."""
@@ -589,10 +588,10 @@ class Chain:
                 link = self.links[b]
                 mass, inertia, com = link["mass"], link["inertia"], link["com"]
                 a_d = np.asarray(kin[f"{b}.accel_d"], dtype=float)
-            i = _unit(kin[f"{b}.angle"])
-            rel = com[0] * i + com[1] * _rot90(i)
+            i = geo.unit(kin[f"{b}.angle"])
+            rel = com[0] * i + com[1] * geo.rot90(i)
             w, e = np.asarray(kin[f"{b}.omega"], float), np.asarray(kin[f"{b}.epsilon"], float)
-            a_s = a_d + _col(e) * _rot90(rel) - _col(w * w) * rel
+            a_s = a_d + geo.col(e) * geo.rot90(rel) - geo.col(w * w) * rel
             force = kin[f"{b}.force"] if b != c else np.zeros_like(a_d)
             moment = kin[f"{b}.moment"] if b != c else np.zeros(len(w))
             out[b] = {"mass": mass, "inertia": inertia, "S": np.asarray(kin[f"S_{b}"], float),
@@ -638,7 +637,7 @@ class Chain:
             r = row[body]
             K[:, r, col] += sign * f[:, 0]
             K[:, r + 1, col] += sign * f[:, 1]
-            K[:, r + 2, col] += sign * (_cross(point - bodies[body]["S"], f) + mu)
+            K[:, r + 2, col] += sign * (geo.cross(point - bodies[body]["S"], f) + mu)
 
         col = 0
         zero = np.zeros(count)
@@ -647,7 +646,7 @@ class Chain:
             if pr["kind"] == "R":
                 columns = ((ex, zero), (ey, zero))
             else:
-                j = _rot90(_unit(kin[pr["guide"]]))
+                j = geo.rot90(geo.unit(kin[pr["guide"]]))
                 columns = ((j, zero), (0.0 * j, zero + 1.0))
             for f, mu in columns:
                 put(col, pr["first"], P, f, mu, 1.0)
@@ -670,7 +669,7 @@ class Chain:
             if pr["kind"] == "R":
                 out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = x[:, col].copy(), x[:, col + 1].copy()
             else:
-                j = _rot90(_unit(kin[pr["guide"]]))
+                j = geo.rot90(geo.unit(kin[pr["guide"]]))
                 N, M = x[:, col].copy(), x[:, col + 1].copy()
                 out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = N * j[:, 0], N * j[:, 1]
                 out[f"{pr['dyad']}.N_{pr['tag']}"], out[f"{pr['dyad']}.M_{pr['tag']}"] = N, M
@@ -695,7 +694,7 @@ class Chain:
             nonlocal fmax, mmax
             if body is None:
                 return
-            m = _cross(point - bodies[body]["S"], f)
+            m = geo.cross(point - bodies[body]["S"], f)
             fsum[body] += f
             msum[body] += m
             fmax = np.maximum(fmax, _norm(f))
@@ -721,13 +720,13 @@ class Chain:
             force(pr["first"], P, R)
             force(pr["second"], P, -R)
             if pr["kind"] == "T":
-                i = _unit(kin[pr["guide"]])
+                i = geo.unit(kin[pr["guide"]])
                 N = np.asarray(out[f"{pr['dyad']}.N_{pr['tag']}"], float)
                 M = np.asarray(out[f"{pr['dyad']}.M_{pr['tag']}"], float)
                 couple(pr["first"], M)
                 couple(pr["second"], -M)
                 tangential = np.maximum(tangential, np.maximum(
-                    np.abs(_dot(R, i)), np.abs(N - _dot(R, _rot90(i)))))
+                    np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))))
         couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
 
         tiny = np.finfo(float).tiny
@@ -751,7 +750,7 @@ class Chain:
             m, J = self._mass(b)
             v = np.asarray(kin[f"v_S_{b}"], float)
             w = np.asarray(kin[f"{b}.omega"], float)
-            total = total + 0.5 * m * _dot(v, v) + 0.5 * J * w * w
+            total = total + 0.5 * m * geo.dot(v, v) + 0.5 * J * w * w
         return np.asarray(total, dtype=float)
 
     def potential_energy(self, kin) -> np.ndarray:
@@ -767,7 +766,7 @@ class Chain:
         """Power [W] of the active loads (weights excluded): sum F . v_S + M omega."""
         total = 0.0
         for g in self.links:
-            total = total + _dot(np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float))
+            total = total + geo.dot(np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float))
             total = total + np.asarray(kin[f"{g}.moment"], float) * np.asarray(kin[f"{g}.omega"], float)
         return np.asarray(total, dtype=float)
 
@@ -788,20 +787,20 @@ def _rrr(K, vK, aK, P, vP, aP, lm, ln, branch, name):
     at E. ``branch`` +1: E on the left of the directed line K -> P."""
     d = P - K
     dist = _norm(d)
-    u = d / _col(dist)
+    u = d / geo.col(dist)
     a = (lm * lm - ln * ln + dist * dist) / (2.0 * dist)        # along u from K to the chord
     h2 = lm * lm - a * a
     if np.any(~(h2 > 0.0)):
         raise ValueError(f"dyad {name}: the circles about D_m ({lm} m) and D_n ({ln} m) do not "
                          f"intersect at every crank angle (|D_m D_n| from {dist.min():.4g} to "
                          f"{dist.max():.4g} m)")
-    E = K + _col(a) * u + branch * _col(np.sqrt(h2)) * _rot90(u)
+    E = K + geo.col(a) * u + branch * geo.col(np.sqrt(h2)) * geo.rot90(u)
     i_m, i_n = (E - K) / lm, (E - P) / ln
-    j_m, j_n = _rot90(i_m), _rot90(i_n)
+    j_m, j_n = geo.rot90(i_m), geo.rot90(i_n)
     # vK + lm wm j_m = vP + ln wn j_n, differentiated once more for the accelerations
     c1, c2 = lm * j_m, -ln * j_n
     wm, wn = _solve2(c1, c2, vP - vK)
-    em, en = _solve2(c1, c2, aP - aK + _col(lm * wm * wm) * i_m - _col(ln * wn * wn) * i_n)
+    em, en = _solve2(c1, c2, aP - aK + geo.col(lm * wm * wm) * i_m - geo.col(ln * wn * wn) * i_n)
     sm = _state(_angle(i_m), wm, em, K, vK, aK, lm)
     sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
     return sm, sn, E
@@ -823,16 +822,16 @@ def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
         raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
                          f"crank angle (distance up to {np.abs(across).max():.4g} m)")
     s = along + branch * np.sqrt(root2)
-    E = line + _col(s) * i_k
+    E = line + geo.col(s) * i_k
     i_n = (E - P) / ln
-    j_n = _rot90(i_n)
+    j_n = geo.rot90(i_n)
     # ds i_k = vP + ln wn j_n, and its derivative
     ik = np.broadcast_to(i_k, P.shape)
     ds, wn = _solve2(ik, -ln * j_n, vP)
-    dds, en = _solve2(ik, -ln * j_n, aP - _col(ln * wn * wn) * i_n)
+    dds, en = _solve2(ik, -ln * j_n, aP - geo.col(ln * wn * wn) * i_n)
     zero = np.zeros(len(s))
-    Dm = base + _col(s) * i_k
-    sm = _state(zero + m_angle, zero, zero, Dm, _col(ds) * i_k, _col(dds) * i_k, lm)
+    Dm = base + geo.col(s) * i_k
+    sm = _state(zero + m_angle, zero, zero, Dm, geo.col(ds) * i_k, geo.col(dds) * i_k, lm)
     sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
     return sm, sn, E
 
@@ -846,28 +845,28 @@ def _rrt_on_link(ks, at, guide, lm, P, vP, aP, ln, branch, name):
     Q, vQ, aQ = Chain._material(ks, at)
     angle = np.asarray(ks["angle"], dtype=float) + guide
     w, e = np.asarray(ks["omega"], dtype=float), np.asarray(ks["epsilon"], dtype=float)
-    i_k = _unit(angle)
-    j_k = _rot90(i_k)
+    i_k = geo.unit(angle)
+    j_k = geo.rot90(i_k)
     d = P - (Q + lm * i_k)                                   # E = Q + (s + lm) i_k
-    along, across = _dot(d, i_k), _dot(d, j_k)
+    along, across = geo.dot(d, i_k), geo.dot(d, j_k)
     root2 = ln * ln - across * across
     if np.any(~(root2 > 0.0)):
         raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
                          f"crank angle (distance up to {np.abs(across).max():.4g} m)")
     s = along + branch * np.sqrt(root2)
-    Dm = Q + _col(s) * i_k
+    Dm = Q + geo.col(s) * i_k
     E = Dm + lm * i_k
     i_n = (E - P) / ln
-    j_n = _rot90(i_n)
+    j_n = geo.rot90(i_n)
     q = s + lm                                               # E = Q + q i_k
     # v_E = v_Q + s' i_k + q w j_k = v_P + ln wn j_n
-    ds, wn = _solve2(i_k, -ln * j_n, vP - vQ - _col(q * w) * j_k)
+    ds, wn = _solve2(i_k, -ln * j_n, vP - vQ - geo.col(q * w) * j_k)
     # a_E = a_Q + (s'' - q w^2) i_k + (q e + 2 s' w) j_k = a_P + ln en j_n - ln wn^2 i_n
-    rhs = aP - _col(ln * wn * wn) * i_n - aQ + _col(q * w * w) * i_k - _col(q * e + 2.0 * ds * w) * j_k
+    rhs = aP - geo.col(ln * wn * wn) * i_n - aQ + geo.col(q * w * w) * i_k - geo.col(q * e + 2.0 * ds * w) * j_k
     dds, en = _solve2(i_k, -ln * j_n, rhs)
     # the slider's material point at D_m: k's point there, plus relative and Coriolis terms
-    vDm = vQ + _col(ds) * i_k + _col(s * w) * j_k
-    aDm = aQ + _col(dds - s * w * w) * i_k + _col(s * e + 2.0 * ds * w) * j_k
+    vDm = vQ + geo.col(ds) * i_k + geo.col(s * w) * j_k
+    aDm = aQ + geo.col(dds - s * w * w) * i_k + geo.col(s * e + 2.0 * ds * w) * j_k
     sm = _state(angle, w.copy(), e.copy(), Dm, vDm, aDm, lm)
     sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
     return sm, sn, E, (s, ds, dds)
@@ -878,13 +877,13 @@ def _rtr(K, vK, aK, P, vP, aP):
     D_m = K, its slot along i_m through P; l_m = |K P| varies. The block turns with m."""
     d, vd, ad = P - K, vP - vK, aP - aK
     L = _norm(d)
-    i_m = d / _col(L)
-    j_m = _rot90(i_m)
+    i_m = d / geo.col(L)
+    j_m = geo.rot90(i_m)
     # d = L i_m: vd = L' i_m + L w j_m; ad = (L'' - L w^2) i_m + (L eps + 2 L' w) j_m
-    Ld = _dot(vd, i_m)
-    w = _dot(vd, j_m) / L
-    Ldd = _dot(ad, i_m) + L * w * w
-    e = (_dot(ad, j_m) - 2.0 * Ld * w) / L
+    Ld = geo.dot(vd, i_m)
+    w = geo.dot(vd, j_m) / L
+    Ldd = geo.dot(ad, i_m) + L * w * w
+    e = (geo.dot(ad, j_m) - 2.0 * Ld * w) / L
     angle = _angle(i_m)
     sm = _state(angle, w, e, K, vK, aK, L, Ld, Ldd)
     sn = _state(angle.copy(), w.copy(), e.copy(), P, vP, aP, 0.0)
@@ -911,7 +910,7 @@ def load(name: str, data=None) -> Chain:
         over = data[name] if name in data else data
         if not isinstance(over, Mapping):
             raise ValueError(f"data[{name!r}]: expected a table")
-        table = _merge(table, over)
+        table = geo.merge(table, over)
     with open(scene_path(name), "rb") as f:
         scene = tomllib.load(f)
     return Chain(name, scene, table)

@@ -1,6 +1,6 @@
 """A co-simulation master for a motor-driven mechanism: the drive FMU (motor, rotor and
 crank, with states) coupled to the mechanism's dyad FMU (kinetostatic, no states)
-through the crank's closed-form kinematics -- the machine of :mod:`dyadfmu.machine`
+through the crank's closed-form kinematics -- the machine of :mod:`dyadfmu.reference.machine`
 split into two FMUs and stepped with fmpy's low-level classes (FMI 2 and FMI 3).
 
 The coupling
@@ -11,18 +11,18 @@ The drive FMU integrates
 
 with ``inertia`` = J_r + J_cO: the rotor plus the crank about its pivot O
 (J_cO = crank inertia about its centre of mass + crank mass |com|^2, the crank's share of
-J(phi) in :mod:`dyadfmu.machine`). The crank is the drive's; the dyad FMU brings only
+J(phi) in :mod:`dyadfmu.reference.machine`). The crank is the drive's; the dyad FMU brings only
 the links m and n. Its reaction on the crank is -R_np at D_n (and -M_np where D_n slides
 on the crank), so the dyad's torque on the crank about O is
 
     tau = (D_n - O) x (-R_np) - M_np.
 
 The dyad's inputs (link angles, speeds, accelerations, loads) follow from the crank state
-(phi, omega, eps) by :func:`dyadfmu.machine.state_kinematics` and
+(phi, omega, eps) by :func:`dyadfmu.reference.machine.state_kinematics` and
 ``Mechanism.fmu_inputs``; they are affine in eps, hence so is tau:
 tau(eps) = tau0 + tau1 eps, with -tau1 = J(phi) - J_cO the links' share of the reduced
 inertia. Summing the two FMUs gives (J_r + J(phi)) eps + ... = T_motor + Q: the machine
-that :func:`dyadfmu.machine.monolithic` integrates as one ODE.
+that :func:`dyadfmu.reference.machine.monolithic` integrates as one ODE.
 
 Two schemes per communication step [t, t + h]:
 
@@ -43,36 +43,35 @@ Divergence (a run stops, is flagged, never raises): crank speed not finite or be
 :data:`DIVERGENCE_SPEED_FACTOR` x the motor's no-load speed, a dyad status other than 0
 (singular, invalid input, out of range), or an FMU call that fails (error or discard).
 
-The monolithic reference (:func:`reference`) is :func:`dyadfmu.machine.monolithic` with
+The monolithic reference (:func:`reference`) is :func:`dyadfmu.reference.machine.monolithic` with
 the same motor, rotor inertia and start state, evaluated at the communication points,
-with the reactions of :func:`dyadfmu.reference.solve` at its states.
+with the reactions of :func:`dyadfmu.reference.newton_euler.solve` at its states.
 
 API: :func:`run` (-> :class:`CosimRun`), :func:`run_setup`, :func:`reference`
 (-> :class:`Reference`), :func:`reference_for`, :func:`errors`, :func:`setup`
 (-> :class:`Setup`), :func:`drive_parameters`,
-:func:`crank_inertia_about_pivot`, :func:`explicit_lag_factor`, :func:`drive_fmu_path`,
-:class:`FmuSlave`, :class:`SlaveError`.
+:func:`crank_inertia_about_pivot`, :func:`explicit_lag_factor`, :func:`drive_fmu_path`;
+the FMUs run through :class:`dyadfmu.fmi.slave.Slave`.
 """
 
 from __future__ import annotations
 
-import atexit
 import math
-import shutil
-import tempfile
 import time as clock
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
-from . import harness, machine, mechanisms
-from . import reference as _reference
+from .. import paths
+from ..fmi.slave import Slave, SlaveError
+from ..mechanisms import builtin
+from ..reference import machine, newton_euler
+from . import harness
 
 __all__ = ["SCHEMES", "STUDY_MECHANISMS", "DURATIONS", "START_ANGLE", "DIVERGENCE_SPEED_FACTOR",
-           "SlaveError", "FmuSlave", "drive_fmu_path", "drive_available",
+           "drive_fmu_path", "drive_available",
            "crank_inertia_about_pivot", "drive_parameters", "explicit_lag_factor", "Setup",
            "setup", "CosimRun", "run", "run_setup", "Reference", "reference", "reference_for",
            "errors"]
@@ -97,177 +96,11 @@ _DYAD_STATUS = {0: "ok", 1: "singular", 2: "invalid input", 3: "out of range"}
 
 
 # ---------------------------------------------------------------------------
-# the FMUs through fmpy's low-level classes
+# the FMUs
 # ---------------------------------------------------------------------------
-class SlaveError(RuntimeError):
-    """An FMU call that failed (status discard, error or fatal): ``label`` (which FMU),
-    ``function``, ``status`` and the FMU's last log ``message``."""
-
-    def __init__(self, label: str, function: str, status: int, message: str = ""):
-        names = {1: "warning", 2: "discard", 3: "error", 4: "fatal"}
-        text = f"{label}: {function} returned {names.get(status, status)}"
-        if message:
-            text += f" ({message})"
-        super().__init__(text)
-        self.label, self.function, self.status, self.message = label, function, status, message
-
-
-_UNPACKED: dict = {}
-
-
-def _unpacked(path: Path):
-    """(model description, directory) of an FMU, unpacked once per file version."""
-    from fmpy import read_model_description
-
-    path = Path(path).resolve()
-    stat = path.stat()
-    key = (str(path), stat.st_mtime_ns, stat.st_size)
-    if key not in _UNPACKED:
-        directory = tempfile.mkdtemp(prefix="dyadfmu_cosim_")
-        with zipfile.ZipFile(path) as archive:
-            archive.extractall(directory)
-        _UNPACKED[key] = (read_model_description(str(path)), directory)
-    return _UNPACKED[key]
-
-
-def _cleanup():  # pragma: no cover - at interpreter exit
-    for _, directory in _UNPACKED.values():
-        shutil.rmtree(directory, ignore_errors=True)
-
-
-atexit.register(_cleanup)
-
-
-class FmuSlave:
-    """One instance of a co-simulation FMU (FMI 2 or 3) with fmpy's FMU2Slave/FMU3Slave,
-    addressed by variable names. Every failing call raises :class:`SlaveError`; the FMU's
-    log messages are captured (``messages``), not printed."""
-
-    def __init__(self, path, instance_name: str = "instance", label: str | None = None):
-        from fmpy.fmi2 import FMU2Slave
-        from fmpy.fmi3 import FMU3Slave
-
-        self.path = Path(path)
-        self.label = label or self.path.stem
-        self.md, directory = _unpacked(self.path)
-        self.version = int(self.md.fmiVersion.split(".")[0])
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.types = {v.name: v.type for v in self.md.modelVariables}
-        self.names = frozenset(self.vr)
-        self.messages: list[str] = []
-        self._vrs: dict = {}
-        cls = FMU2Slave if self.version == 2 else FMU3Slave
-        self.fmu = cls(guid=self.md.guid, unzipDirectory=directory,
-                       modelIdentifier=self.md.coSimulation.modelIdentifier,
-                       instanceName=instance_name)
-        self._instantiated = False
-        self._call("instantiate", self._instantiate)
-        self._instantiated = True
-        if self.version == 2:
-            self._set, self._get = self.fmu.setReal, self.fmu.getReal
-            self._get_int = self.fmu.getInteger
-        else:
-            self._set, self._get = self.fmu.setFloat64, self.fmu.getFloat64
-            self._get_int = self.fmu.getInt32
-
-    # ---- logging -----------------------------------------------------------
-    def _log(self, status, category, message):
-        text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
-        self.messages.append(text)
-        del self.messages[:-20]
-
-    def _instantiate(self):
-        if self.version == 2:
-            from fmpy import calloc, free
-            from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                                   fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
-
-            from ctypes import CFUNCTYPE, c_char_p, c_int, c_void_p, cast
-
-            # The dyadfmu FMUs call the FMI 2 logger as (env, name, status, category,
-            # "%s", text): a callback that takes the text as a sixth argument reads
-            # the message without fmpy's logger proxy, whose single global target
-            # would dangle once this slave is gone.
-            def logger(component, instance_name, status, category, fmt, text):
-                self._log(status, category, text if text is not None else fmt)
-
-            self._logger = CFUNCTYPE(None, c_void_p, c_char_p, c_int, c_char_p, c_char_p,
-                                     c_char_p)(logger)
-            callbacks = fmi2CallbackFunctions()
-            callbacks.logger = cast(self._logger, fmi2CallbackLoggerTYPE)
-            callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-            callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-            self._callbacks = callbacks             # kept alive with the instance
-            self.fmu.instantiate(callbacks=callbacks, loggingOn=False)
-        else:
-            def log_message(environment, status, category, message):
-                self._log(status, category, message)
-
-            self.fmu.instantiate(loggingOn=False, logMessage=log_message)
-
-    def _call(self, function, f, *args):
-        from fmpy.fmi1 import FMICallException
-
-        try:
-            return f(*args)
-        except FMICallException as e:
-            raise SlaveError(self.label, function, e.status,
-                             self.messages[-1] if self.messages else "") from None
-
-    def _refs(self, names):
-        refs = self._vrs.get(names)
-        if refs is None:
-            refs = self._vrs[names] = [self.vr[n] for n in names]
-        return refs
-
-    # ---- the interface the master uses ----------------------------------------
-    def initialize(self, parameters: dict, start_time: float = 0.0) -> None:
-        """Set the parameters, then enter and leave initialisation mode at start_time."""
-        if parameters:
-            names = tuple(parameters)
-            self.set(names, [float(parameters[n]) for n in names])
-        if self.version == 2:
-            self._call("setupExperiment", self.fmu.setupExperiment, None, start_time)
-            self._call("enterInitializationMode", self.fmu.enterInitializationMode)
-        else:
-            self._call("enterInitializationMode", self.fmu.enterInitializationMode, None,
-                       start_time)
-        self._call("exitInitializationMode", self.fmu.exitInitializationMode)
-
-    def set(self, names: tuple, values) -> None:
-        self._call("set", self._set, self._refs(names), [float(v) for v in values])
-
-    def get(self, names: tuple) -> list:
-        return self._call("get", self._get, self._refs(names))
-
-    def get_status(self) -> int:
-        return int(self._call("get", self._get_int, self._refs(("status",)))[0])
-
-    def do_step(self, t: float, h: float) -> None:
-        self._call("doStep", self.fmu.doStep, t, h)
-
-    def directional_derivative(self, unknowns: tuple, knowns: tuple, seed) -> list:
-        return self._call("getDirectionalDerivative", self.fmu.getDirectionalDerivative,
-                          self._refs(unknowns), self._refs(knowns), [float(s) for s in seed])
-
-    def close(self) -> None:
-        if not self._instantiated:
-            return
-        self._instantiated = False
-        try:
-            self.fmu.terminate()
-        except Exception:
-            pass                                    # terminate may be illegal after an error
-        self.fmu.freeInstance()
-
-
 def drive_fmu_path(version: int, build: Path | None = None) -> Path:
     """build/fmus/drive_fmi<version>.fmu (FileNotFoundError while it is not built)."""
-    path = (build or harness.build_dir()) / "fmus" / f"drive_fmi{version}.fmu"
-    if not path.is_file():
-        raise FileNotFoundError(f"{path} does not exist: build the drive FMU first "
-                                "(scripts/run-main does, or cmake --build build)")
-    return path
+    return paths.built_fmu("drive", version, build, what="the drive FMU")
 
 
 def drive_available(version: int = 2, build: Path | None = None) -> bool:
@@ -281,14 +114,14 @@ def drive_available(version: int = 2, build: Path | None = None) -> bool:
 # ---------------------------------------------------------------------------
 # the machine split in two
 # ---------------------------------------------------------------------------
-def crank_inertia_about_pivot(mech: mechanisms.Mechanism) -> float:
+def crank_inertia_about_pivot(mech: builtin.Mechanism) -> float:
     """J_cO [kg m2]: the crank's inertia about its centre of mass plus mass |com|^2 -- its
-    constant share of J(phi) in :mod:`dyadfmu.machine` (m |v_Sc|^2 + J_c at unit speed)."""
+    constant share of J(phi) in :mod:`dyadfmu.reference.machine` (m |v_Sc|^2 + J_c at unit speed)."""
     c = mech.crank
     return float(c["inertia"] + c["mass"] * (c["com"][0] ** 2 + c["com"][1] ** 2))
 
 
-def drive_parameters(mech: mechanisms.Mechanism, motor: machine.Motor, phi0: float,
+def drive_parameters(mech: builtin.Mechanism, motor: machine.Motor, phi0: float,
                      omega0: float) -> dict:
     """The drive FMU's parameters for this mechanism's crank, the motor (with its rotor
     inertia) and the start state: ``inertia`` = J_r + J_cO."""
@@ -301,7 +134,7 @@ def drive_parameters(mech: mechanisms.Mechanism, motor: machine.Motor, phi0: flo
             "start.angle": float(phi0), "start.speed": float(omega0)}
 
 
-def explicit_lag_factor(mech: mechanisms.Mechanism, motor: machine.Motor, step: float = 0.0,
+def explicit_lag_factor(mech: builtin.Mechanism, motor: machine.Motor, step: float = 0.0,
                         samples: int = 720) -> dict:
     """How the explicit scheme's lagged acceleration error propagates from one
     communication point to the next: it is multiplied by -rho(phi), rho = (J(phi) - J_cO) /
@@ -332,7 +165,7 @@ class Setup:
     """A machine to co-simulate: mechanism, motor (its rotor inertia set for ``ratio``),
     start state, simulated time."""
 
-    mech: mechanisms.Mechanism
+    mech: builtin.Mechanism
     motor: machine.Motor
     ratio: float | None
     phi0: float
@@ -343,9 +176,9 @@ class Setup:
 def setup(name: str, ratio: float, t_end: float | None = None,
           phi0: float = START_ANGLE, omega0: float | None = None) -> Setup:
     """The study's machine: ``name``'s default motor with the rotor inertia of
-    :func:`dyadfmu.machine.rotor_inertia_for_ratio` (mean J / J_r = ratio), starting at
+    :func:`dyadfmu.reference.machine.rotor_inertia_for_ratio` (mean J / J_r = ratio), starting at
     phi0 with the nominal crank speed, over :data:`DURATIONS`."""
-    mech = mechanisms.load(name)
+    mech = builtin.load(name)
     if machine.phi_range(mech) is not None:
         raise ValueError(f"{name}: the co-simulation needs a revolving crank")
     motor = machine.default_motor(mech).with_rotor_inertia(
@@ -404,7 +237,7 @@ def _cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
 
 
-def run(mech: mechanisms.Mechanism, scheme: str, step: float, t_end: float,
+def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
         motor: machine.Motor, phi0: float, omega0: float, fmi_version: int = 2,
         drive: Callable | None = None, dyad: Callable | None = None,
         ratio: float | None = None) -> CosimRun:
@@ -414,7 +247,7 @@ def run(mech: mechanisms.Mechanism, scheme: str, step: float, t_end: float,
 
     ``drive`` and ``dyad`` make the slaves, ``f(instance_name) -> slave``; by default the
     FMUs ``build/fmus/drive_fmi<v>.fmu`` and ``harness.fmu_path(mech.dyad, v)``
-    (:class:`FmuSlave`). Divergence stops the run and is reported in the result."""
+    (:class:`Slave`). Divergence stops the run and is reported in the result."""
     if scheme not in SCHEMES:
         raise ValueError(f"unknown scheme {scheme!r}; expected one of {', '.join(SCHEMES)}")
     if not (step > 0 and math.isfinite(step) and t_end > 0 and math.isfinite(t_end)):
@@ -428,12 +261,12 @@ def run(mech: mechanisms.Mechanism, scheme: str, step: float, t_end: float,
         drive_path = drive_fmu_path(fmi_version)
 
         def drive(name):
-            return FmuSlave(drive_path, name, label=f"drive FMU (FMI {fmi_version})")
+            return Slave(drive_path, name, label=f"drive FMU (FMI {fmi_version})")
     if dyad is None:
         dyad_path = harness.fmu_path(mech.dyad, fmi_version)
 
         def dyad(name):
-            return FmuSlave(dyad_path, name, label=f"dyad FMU {mech.dyad} (FMI {fmi_version})")
+            return Slave(dyad_path, name, label=f"dyad FMU {mech.dyad} (FMI {fmi_version})")
 
     limit = DIVERGENCE_SPEED_FACTOR * motor.no_load_speed
     rows = []                        # (t, phi, omega, eps, T, tau, J_load, Rx, Ry, M)
@@ -559,8 +392,8 @@ def run_setup(s: Setup, scheme: str, step: float, fmi_version: int = 2,
 # ---------------------------------------------------------------------------
 @dataclass
 class Reference:
-    """:func:`dyadfmu.machine.monolithic` at the times t (arrays (N,)), with the dyad's
-    reactions there from :func:`dyadfmu.reference.solve` (r_np (N, 2), m_np (N,)).
+    """:func:`dyadfmu.reference.machine.monolithic` at the times t (arrays (N,)), with the dyad's
+    reactions there from :func:`dyadfmu.reference.newton_euler.solve` (r_np (N, 2), m_np (N,)).
     mean_speed: mean of omega over t; peak_reaction: largest |R_np|; wall_time [s] of
     the Radau solve and the reactions."""
 
@@ -578,7 +411,7 @@ class Reference:
     nfev: int = 0
 
 
-def reference(mech: mechanisms.Mechanism, motor: machine.Motor, t_end: float, phi0: float,
+def reference(mech: builtin.Mechanism, motor: machine.Motor, t_end: float, phi0: float,
               omega0: float, times=None, rtol: float = 1e-10, atol: float = 1e-12) -> Reference:
     """The monolithic machine from (phi0, omega0) evaluated at ``times`` (default: the
     solver's steps), Radau with rtol, atol, and its reactions."""
@@ -587,7 +420,7 @@ def reference(mech: mechanisms.Mechanism, motor: machine.Motor, t_end: float, ph
     mono = machine.monolithic(mech, motor, t_end, phi0, omega0, rtol=rtol, atol=atol,
                               t_eval=times, stop_at_range=False)
     kin = machine.state_kinematics(mech, mono.phi, mono.omega, mono.epsilon)
-    sol = _reference.solve(mech.dyad, *mech.reference_inputs(kin))
+    sol = newton_euler.solve(mech.dyad, *mech.reference_inputs(kin))
     r_np = np.asarray(sol["r_np"], dtype=float)
     m_np = np.asarray(sol["m_np"], dtype=float)
     wall = clock.perf_counter() - start

@@ -1,7 +1,7 @@
 """A second FMI importer, independent of fmpy, over the harness's co-simulations.
 
 ``fmi-sim`` (the Rust crate of that name, its own FMI 2 and FMI 3 import layer) runs an
-FMU over the same co-simulation setup as :func:`dyadfmu.harness.simulate` (the grid, the
+FMU over the same co-simulation setup as :func:`dyadfmu.fmi.simulate.simulate` (the grid, the
 input signals, the parameters' start values); its outputs are compared with fmpy's row
 by row. ``fmutool -check`` (PyPI ``fmu-manipulation-toolbox``) checks the model
 description against the FMI XSD schema and the standard's semantic rules.
@@ -26,8 +26,9 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
+from .. import paths
+from ..fmi.simulate import CoSimSetup, setup_for, simulate
 from . import harness, scenes
-from .harness import CoSimSetup, build_dir
 
 DYADS = ("rrr", "rrt", "rtr", "trt", "rtt")
 #: The generic dyad FMUs run over the harness mechanism of their type.
@@ -96,12 +97,12 @@ def drive_setup(version: int, build: Path | None = None) -> CoSimSetup:
     the parameters' start values. The step is a binary fraction (2^-8 s), so that
     t[n+1] - t[n], the step fmpy passes to doStep, is the step exactly, as fmi-sim's FMI 2
     co-simulation passes it: the drive integrates over the step it is given."""
-    path = (build or build_dir()) / "fmus" / f"drive_fmi{version}.fmu"
+    path = (build or paths.build_dir()) / "fmus" / f"drive_fmi{version}.fmu"
     t = np.linspace(0.0, 0.5, 129)
     phase = 2 * math.pi * t / 0.125
     inputs = {"load.torque": -3.0 + 2.0 * np.sin(phase) - 0.5 * np.cos(2 * phase),
               "load.inertia": 1e-3 * (1.0 + 0.4 * np.cos(phase))}
-    return harness.setup_for(path, t, inputs)
+    return setup_for(path, t, inputs)
 
 
 def setup_of(name: str, version: int, build: Path | None = None, steps: int = 120
@@ -113,13 +114,13 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
     if name == "drive":
         return drive_setup(version, build)
     if name.startswith("dyad_"):
-        return harness.scene_setup(MECHANISM_OF[name.removeprefix("dyad_")], version, 1.0, steps,
+        return harness.mechanism_setup(MECHANISM_OF[name.removeprefix("dyad_")], version, 1.0, steps,
                                    build=build)[0]
     if name in TAILORED:
-        generic = harness.scene_setup(MECHANISM_OF[name.removeprefix("tailored_")], version, 1.0, steps,
+        generic = harness.mechanism_setup(MECHANISM_OF[name.removeprefix("tailored_")], version, 1.0, steps,
                                       build=build)[0]
-        path = (build or build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
-        return harness.setup_for(path, generic.time, generic.inputs)
+        path = (build or paths.build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
+        return setup_for(path, generic.time, generic.inputs)
     return scenes.setup(name, version, 1.0, steps, build=build)[0]
 
 
@@ -348,9 +349,9 @@ def table(workdir: Path, executable: str) -> list[str]:
         for version in VERSIONS:
             setup = setup_of(name, version)
             other = run_fmi_sim(setup, workdir, executable)
-            raw = compare(setup, harness.simulate(setup), other)
+            raw = compare(setup, simulate(setup), other)
             same = as_applied_by_fmi_sim(setup)
-            exact = compare(same, harness.simulate(same), other)
+            exact = compare(same, simulate(same), other)
             rows.append(f"| {name} | {version} | {raw.rows} x {raw.outputs} | "
                         f"{raw.max_abs:.1e} | {raw.max_relative:.1e} | "
                         f"{raw.amplification_in_own_roundoff:.2g} | "

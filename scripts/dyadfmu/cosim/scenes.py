@@ -28,13 +28,21 @@ from pathlib import Path
 import numpy as np
 from fmpy import read_model_description
 
-from . import chains, mechanisms, reference
-from .mechanisms import _cross, _rot90, _unit
-from .harness import (OutputError, _match_samples, _Progress, build_dir, communication_grid,
-                      setup_for, simulate)
+from .. import paths
+from ..fmi.simulate import setup_for, simulate
+from ..mechanisms import builtin, chains
+from ..mechanisms import geometry as geo
+from ..reference import newton_euler
+from .compare import (
+    NEAR_SINGULAR,
+    Progress,
+    communication_grid,
+    match_samples,
+    output_error,
+    rows_of,
+)
 
-ROOT = Path(__file__).resolve().parents[2]
-SCENES_DIR = ROOT / "scenes"
+SCENES_DIR = paths.SCENES_DIR
 
 #: The tailored example scenes, in the order of the report.
 NAMES = ("press", "monitor", "engine", "shaper", "sixbar", "rocker_slider")
@@ -52,17 +60,11 @@ FULL_OF = {"press": ("RRT",), "monitor": ("RRR",), "engine": ("RRT",),
            "shaper": ("RTR", "RRT"), "sixbar": ("RRR", "RRR"),
            "rocker_slider": ("RRR", "RRT")}
 
-#: Speeds of the quasi-static press: slow enough that nothing dynamic matters, though the
-#: FMU takes no speeds at all.
-NEAR_SINGULAR = 1e-6
 
 
 def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
-    path = (build or build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
-    if not path.is_file():
-        raise FileNotFoundError(f"{path} does not exist: build the FMUs first "
-                                "(scripts/run-scenes does, or cmake --build build)")
-    return path
+    """build/fmus/<name>_fmi<version>.fmu, the tailored FMU of a scene."""
+    return paths.built_fmu(name, version, build, how="scripts/run-scenes")
 
 
 def scene_data(name: str) -> dict:
@@ -88,7 +90,7 @@ class Source:
         self.crank_name = self.scene.get("crank", {}).get("name", "crank")
         if name in SINGLE:
             mech_name, self.roles = SINGLE[name]
-            self.mechanism = mechanisms.load(mech_name)
+            self.mechanism = builtin.load(mech_name)
             self.chain = None
             self.dyad = self.scene["dyad"][0]
         else:
@@ -139,7 +141,7 @@ class Source:
         n = len(kin["t"])
         zero, zero2 = np.zeros(n), np.zeros((n, 2))
         dynamic = self.inertia
-        return {"dir": _unit(kin[f"{link}.angle"]),
+        return {"dir": geo.unit(kin[f"{link}.angle"]),
                 "length": np.asarray(kin[f"{link}.length"], dtype=float),
                 "omega": kin[f"{link}.omega"] if dynamic else zero,
                 "epsilon": kin[f"{link}.epsilon"] if dynamic else zero,
@@ -159,9 +161,9 @@ class Source:
         links = {t["name"]: t for t in self.scene["link"]}
         m = self._link_input(kin, d["m"], links[d["m"]])
         n = self._link_input(kin, d["n"], links[d["n"]])
-        gk = _unit(kin["guide_k.angle"]) if "guide_k.angle" in kin else None
-        gp = _unit(kin["guide_p.angle"]) if "guide_p.angle" in kin else None
-        r = reference.solve(d["type"], m, n, gk, gp, self.gravity)
+        gk = geo.unit(kin["guide_k.angle"]) if "guide_k.angle" in kin else None
+        gp = geo.unit(kin["guide_p.angle"]) if "guide_p.angle" in kin else None
+        r = newton_euler.solve(d["type"], m, n, gk, gp, self.gravity)
         pre = f"{d['name']}."
         out = {}
         for pair in ("mk", "np", "mn"):
@@ -173,18 +175,18 @@ class Source:
         crank = self.scene["crank"]
         c = self.crank_name
         phi, w, eps = kin[f"{c}.angle"], kin[f"{c}.omega"], kin[f"{c}.epsilon"]
-        i_c = _unit(phi)
-        j_c = _rot90(i_c)
+        i_c = geo.unit(phi)
+        j_c = geo.rot90(i_c)
         pin = float(crank["length"]) * i_c
         com = crank.get("com", (0.0, 0.0))
         r_s = com[0] * i_c + com[1] * j_c
         mass = float(crank.get("mass", 0.0)) if (self.inertia or self.gravity_on) else 0.0
         inertia = float(crank.get("inertia", 0.0)) if self.inertia else 0.0
-        a_s = (eps[:, None] * _rot90(r_s) - (w * w)[:, None] * r_s) if self.inertia \
+        a_s = (eps[:, None] * geo.rot90(r_s) - (w * w)[:, None] * r_s) if self.inertia \
             else np.zeros_like(r_s)
         own = mass * (np.asarray(self.gravity) - a_s)
         r_np = r["r_np"]
-        moments = _cross(pin, -r_np) + _cross(r_s, own) - inertia * (eps if self.inertia else 0.0)
+        moments = geo.cross(pin, -r_np) + geo.cross(r_s, own) - inertia * (eps if self.inertia else 0.0)
         out[f"{c}.torque"] = -moments
         r_o = r_np - own
         out[f"{c}.R_O.x"], out[f"{c}.R_O.y"] = r_o[:, 0], r_o[:, 1]
@@ -240,14 +242,13 @@ def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 
     co, source, crank_motion, kin = setup(name, fmi_version, revolutions, steps, motion, build)
     t, inputs, outputs, units, names = co.time, co.inputs, co.outputs, co.units, list(co.inputs)
 
-    bar = _Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
+    bar = Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
     started = clock.perf_counter()
     fmu = simulate(co, step_finished=bar)
     seconds = clock.perf_counter() - started
     bar.close()
-    sample = _match_samples(fmu, inputs, names, t)
-    rows = {k: (v[sample] if isinstance(v, np.ndarray) and v.shape[:1] == t.shape else v)
-            for k, v in kin.items()}
+    sample = match_samples(fmu, inputs, names, t)
+    rows = rows_of(kin, sample, t)
     full_ref = source.reference(rows)
     full_ref.update(source.conditioning(rows))
     ref = {n: np.asarray(full_ref[n]) for n in outputs if n in full_ref}
@@ -262,11 +263,7 @@ def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 
             continue
         if out not in ref:
             raise KeyError(f"scene {name}: the reference has no output {out}")
-        want, got = ref[out][valid], fmu[out][valid]
-        peak = float(np.max(np.abs(want))) if want.size else 0.0
-        max_abs = float(np.max(np.abs(got - want))) if want.size else math.nan
-        errors.append(OutputError(out, units.get(out, ""), peak, max_abs,
-                                  max_abs / peak if peak > 0 else max_abs))
+        errors.append(output_error(out, units.get(out, ""), ref[out][valid], fmu[out][valid]))
     result = SceneRun(name, fmi_version, source, rows, sample, fmu, ref, valid, errors, seconds,
                       len(t) - 1, units)
     torque = f"{source.crank_name}.torque"
@@ -288,16 +285,6 @@ def energy_balance(source: Source, motion, time, torque, t_samples) -> float:
     loads = source.chain.load_power(kin)
     residual = power + loads - rate
     return float(np.max(np.abs(residual)) / np.max(np.abs(power)))
-
-
-# ---------------------------------------------------------------------------
-# Tables
-# ---------------------------------------------------------------------------
-def error_rows(result: SceneRun) -> list:
-    rows = [["output", "unit", "peak |reference|", "max |FMU - reference|", "relative to peak"]]
-    for e in result.errors:
-        rows.append([e.name, e.unit, f"{e.peak:.6g}", f"{e.max_abs:.3e}", f"{e.relative:.3e}"])
-    return rows
 
 
 def summary(result: SceneRun) -> str:

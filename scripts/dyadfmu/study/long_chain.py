@@ -23,8 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-GENERATOR = ROOT / "modelDescription" / "scene.py"
+from ..paths import GENERATOR, ROOT
 SIZES = (25, 50, 100, 200)
 
 

@@ -1,0 +1,73 @@
+"""Shared helpers of the mechanisms: vectors on arrays of shape (..., 2) and the checked
+reading of numbers and pairs from the data tables."""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+def unit(angle):
+    angle = np.asarray(angle, dtype=float)
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def rot90(v):
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def dot(a, b):
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+def cross(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def col(x):
+    return np.asarray(x, dtype=float)[..., None]
+
+
+def vec(x, y):
+    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    return np.stack([x, y], axis=-1)
+
+
+def merge(base, over):
+    out = copy.deepcopy(base)
+    for key, value in over.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def number(table, key, where, positive=False, nonnegative=False, default=None):
+    if key not in table:
+        if default is not None:
+            return float(default)
+        raise ValueError(f"{where}: missing key {key!r}")
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{where}.{key}: expected a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise ValueError(f"{where}.{key}: must be > 0, got {value!r}")
+    if nonnegative and value < 0:
+        raise ValueError(f"{where}.{key}: must be >= 0, got {value!r}")
+    return float(value)
+
+
+def pair(table, key, where):
+    value = table.get(key)
+    if value is None:
+        raise ValueError(f"{where}: missing key {key!r}")
+    try:
+        x, y = (float(c) for c in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}.{key}: expected two numbers, got {value!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ValueError(f"{where}.{key}: expected finite numbers, got {value!r}")
+    return (x, y)
