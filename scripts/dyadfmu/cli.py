@@ -28,65 +28,110 @@ def _positive_float(text: str) -> float:
     return value
 
 
-def _cosimulation_options(command, out: Path, revolutions_help: str):
+def _cosimulation_options(command: argparse.ArgumentParser, out: Path, revolutions_help: str):
     """The options of a command that co-simulates FMUs over the crank's motion."""
-    command.add_argument("--fmi", choices=("2", "3", "both"), default="both",
-                         help="FMI version of the FMU to run (default both)")
-    command.add_argument("--revolutions", type=_positive_float, default=2.0,
-                         help=revolutions_help)
-    command.add_argument("--steps", type=_positive_int, default=360,
-                         help="communication steps per revolution (default 360)")
-    command.add_argument("--motion", choices=("constant", "varying"), default="constant",
-                         help="crank speed: constant, or varying along the cycle "
-                              "(default constant)")
-    command.add_argument("--out", type=Path, default=out,
-                         help=f"directory for tables and plots (default ./{out})")
-    command.add_argument("--build", type=Path, default=None,
-                         help="CMake build directory holding fmus/ (default: build/ of the "
-                              "checkout)")
+    command.add_argument(
+        "--fmi",
+        choices=("2", "3", "both"),
+        default="both",
+        help="FMI version of the FMU to run (default both)",
+    )
+    command.add_argument("--revolutions", type=_positive_float, default=2.0, help=revolutions_help)
+    command.add_argument(
+        "--steps",
+        type=_positive_int,
+        default=360,
+        help="communication steps per revolution (default 360)",
+    )
+    command.add_argument(
+        "--motion",
+        choices=("constant", "varying"),
+        default="constant",
+        help="crank speed: constant, or varying along the cycle (default constant)",
+    )
+    command.add_argument(
+        "--out", type=Path, default=out, help=f"directory for tables and plots (default ./{out})"
+    )
+    command.add_argument(
+        "--build",
+        type=Path,
+        default=None,
+        help="CMake build directory holding fmus/ (default: build/ of the checkout)",
+    )
     command.add_argument("--no-plots", action="store_true", help="write tables only")
 
 
 def _run_command(sub: argparse._SubParsersAction) -> None:
-    run = sub.add_parser("run", help="co-simulate mechanisms and compare them with the reference",
-                         description="Co-simulate each mechanism's dyad FMU over the crank's "
-                                     "motion, print the error of every output against the "
-                                     "reference, write tables (Markdown, CSV) and plots (PNG).")
-    run.add_argument("mechanisms", nargs="*", metavar="MECHANISM", default=[DEFAULT_MECHANISM],
-                     help=f"mechanism names (default {DEFAULT_MECHANISM}; 'all' for every "
-                          f"mechanism; see 'dyadfmu list')")
-    _cosimulation_options(run, Path("out"),
-                          "crank revolutions (oscillations for trt-slot) to simulate (default 2)")
-    run.add_argument("--angle", type=float, default=60.0,
-                     help="crank angle in degrees at which the mechanism is drawn (default 60)")
+    run = sub.add_parser(
+        "run",
+        help="co-simulate mechanisms and compare them with the reference",
+        description="Co-simulate each mechanism's dyad FMU over the crank's "
+        "motion, print the error of every output against the "
+        "reference, write tables (Markdown, CSV) and plots (PNG).",
+    )
+    run.add_argument(
+        "mechanisms",
+        nargs="*",
+        metavar="MECHANISM",
+        default=[DEFAULT_MECHANISM],
+        help=f"mechanism names (default {DEFAULT_MECHANISM}; 'all' for every "
+        f"mechanism; see 'dyadfmu list')",
+    )
+    _cosimulation_options(
+        run, Path("out"), "crank revolutions (oscillations for trt-slot) to simulate (default 2)"
+    )
+    run.add_argument(
+        "--angle",
+        type=float,
+        default=60.0,
+        help="crank angle in degrees at which the mechanism is drawn (default 60)",
+    )
     run.set_defaults(run=_run)
 
 
 def _study_command(sub: argparse._SubParsersAction) -> None:
     study = sub.add_parser(
-        "study", help="accuracy and speed of every method; writes the report",
+        "study",
+        help="accuracy and speed of every method; writes the report",
         description="Time the C core (double, float), GSL LU and SVD 6x6 solves, NumPy's "
-                    "batched solve and the FMUs (from C and fmpy) on the same inputs; measure "
-                    "their errors against mpmath ground truth on random, near-singular, "
-                    "extreme and cancelling configurations; write report.md, CSVs and plots.")
-    study.add_argument("--quick", action="store_true",
-                       help="small input sets (for CI: under a minute)")
-    study.add_argument("--out", type=Path, default=Path("out/study"),
-                       help="directory for the report (default ./out/study)")
-    study.add_argument("--build", type=Path, default=None,
-                       help="CMake build directory with the benchmark and FMUs (default build/)")
+        "batched solve and the FMUs (from C and fmpy) on the same inputs; measure "
+        "their errors against mpmath ground truth on random, near-singular, "
+        "extreme and cancelling configurations; write report.md, CSVs and plots.",
+    )
+    study.add_argument(
+        "--quick", action="store_true", help="small input sets (for CI: under a minute)"
+    )
+    study.add_argument(
+        "--out",
+        type=Path,
+        default=Path("out/study"),
+        help="directory for the report (default ./out/study)",
+    )
+    study.add_argument(
+        "--build",
+        type=Path,
+        default=None,
+        help="CMake build directory with the benchmark and FMUs (default build/)",
+    )
     study.set_defaults(run=_study)
 
 
 def _scene_command(sub: argparse._SubParsersAction) -> None:
     scene = sub.add_parser(
-        "scene", help="co-simulate tailored scene FMUs (scenes/*.toml) against their reference",
+        "scene",
+        help="co-simulate tailored scene FMUs (scenes/*.toml) against their reference",
         description="Co-simulate each scene's tailored FMU over the crank's motion, print the "
-                    "error of every output against the independent reference, and write "
-                    "tables (Markdown, CSV) and, for the multi-dyad chains, a drawing with "
-                    "every reaction. Scenes: " + ", ".join(scenes_names()) + ".")
-    scene.add_argument("scenes", nargs="*", metavar="SCENE", default=["shaper"],
-                       help="scene names (default shaper; 'all' for every example scene)")
+        "error of every output against the independent reference, and write "
+        "tables (Markdown, CSV) and, for the multi-dyad chains, a drawing with "
+        "every reaction. Scenes: " + ", ".join(scenes_names()) + ".",
+    )
+    scene.add_argument(
+        "scenes",
+        nargs="*",
+        metavar="SCENE",
+        default=["shaper"],
+        help="scene names (default shaper; 'all' for every example scene)",
+    )
     _cosimulation_options(scene, Path("out/scenes"), "crank revolutions to simulate (default 2)")
     scene.set_defaults(run=_scene)
 
@@ -94,19 +139,24 @@ def _scene_command(sub: argparse._SubParsersAction) -> None:
 def _own_commands(sub: argparse._SubParsersAction) -> None:
     """The commands that parse their own options (listed here for --help)."""
     sub.add_parser(
-        "scenes", add_help=False,
+        "scenes",
+        add_help=False,
         help="every example scene against its reference, and the tailored FMUs against the "
-             "generic per-type FMUs: variables, binary size, callgrind instructions per doStep "
-             "(see 'dyadfmu scenes --help')").set_defaults(run=None)
-    sub.add_parser(
-        "cosim", add_help=False,
-        help="the dyad FMU in a closed loop with the drive FMU: explicit and stabilised "
-             "coupling against a monolithic reference (see 'dyadfmu cosim --help')"
+        "generic per-type FMUs: variables, binary size, callgrind instructions per doStep "
+        "(see 'dyadfmu scenes --help')",
     ).set_defaults(run=None)
     sub.add_parser(
-        "scene-bench", add_help=False,
+        "cosim",
+        add_help=False,
+        help="the dyad FMU in a closed loop with the drive FMU: explicit and stabilised "
+        "coupling against a monolithic reference (see 'dyadfmu cosim --help')",
+    ).set_defaults(run=None)
+    sub.add_parser(
+        "scene-bench",
+        add_help=False,
         help="time the scene generator (--check and --out) on chains of 25 to 200 dyads "
-             "(see 'dyadfmu scene-bench --help')").set_defaults(run=None)
+        "(see 'dyadfmu scene-bench --help')",
+    ).set_defaults(run=None)
 
 
 def parser() -> argparse.ArgumentParser:
@@ -114,7 +164,8 @@ def parser() -> argparse.ArgumentParser:
     top = argparse.ArgumentParser(
         prog="dyadfmu",
         description="Co-simulate the dyad FMUs of planar mechanisms with fmpy and check every "
-                    "joint reaction against an independent Newton-Euler solve in NumPy.")
+        "joint reaction against an independent Newton-Euler solve in NumPy.",
+    )
     sub = top.add_subparsers(dest="command", required=True)
     listing = sub.add_parser("list", help="list the mechanisms and their dyads")
     listing.set_defaults(run=_list)
@@ -157,8 +208,10 @@ def _chosen(asked: list[str], names: tuple, what: str) -> list[str] | None:
     chosen = list(names) if asked == ["all"] else asked
     unknown = [n for n in chosen if n not in names]
     if unknown:
-        print(f"dyadfmu: unknown {what} {', '.join(unknown)}; the {what}s are: "
-              f"{', '.join(names)}", file=sys.stderr)
+        print(
+            f"dyadfmu: unknown {what} {', '.join(unknown)}; the {what}s are: {', '.join(names)}",
+            file=sys.stderr,
+        )
         return None
     return chosen
 
@@ -199,8 +252,15 @@ def _run(args: argparse.Namespace) -> int:
     for name in names:
         for version in _versions(args):
             try:
-                result = harness.run_mechanism(name, version, args.revolutions, args.steps,
-                                               args.motion, args.build, progress=True)
+                result = harness.run_mechanism(
+                    name,
+                    version,
+                    args.revolutions,
+                    args.steps,
+                    args.motion,
+                    args.build,
+                    progress=True,
+                )
             except FileNotFoundError as error:
                 print(f"dyadfmu: {error}", file=sys.stderr)
                 return 2
@@ -226,9 +286,15 @@ def _scene_outputs(args: argparse.Namespace, result: scenes.SceneRun) -> list[Pa
     if not args.no_plots and result.source.chain is not None:
         from .report import chain_drawing
 
-        written.append(chain_drawing.figure(
-            result.source.chain, result.kin, scenes.reactions_of(result),
-            scenes.drawing_indices(result), f"{stem}_reactions.png"))
+        written.append(
+            chain_drawing.figure(
+                result.source.chain,
+                result.kin,
+                scenes.reactions_of(result),
+                scenes.drawing_indices(result),
+                f"{stem}_reactions.png",
+            )
+        )
     return written
 
 
@@ -241,8 +307,15 @@ def _scene(args: argparse.Namespace) -> int:
     for name in names:
         for version in _versions(args):
             try:
-                result = scenes.run(name, version, args.revolutions, args.steps, args.motion,
-                                    args.build, progress=True)
+                result = scenes.run(
+                    name,
+                    version,
+                    args.revolutions,
+                    args.steps,
+                    args.motion,
+                    args.build,
+                    progress=True,
+                )
             except FileNotFoundError as error:
                 print(f"dyadfmu: {error}", file=sys.stderr)
                 return 2

@@ -21,17 +21,30 @@ def build_dir() -> Path:
     return Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
 
 
-def built_fmu(identifier: str, version: int, build: Path | None = None,
-              what: str = "the FMUs", how: str = "scripts/run-main") -> Path:
+def built_fmu(
+    identifier: str,
+    version: int,
+    build: Path | None = None,
+    what: str = "the FMUs",
+    how: str = "scripts/run-main",
+) -> Path:
     """build/fmus/<identifier>_fmi<version>.fmu (FileNotFoundError while it is not built)."""
     path = (build or build_dir()) / "fmus" / f"{identifier}_fmi{version}.fmu"
     if not path.is_file():
-        raise FileNotFoundError(f"{path} does not exist: build {what} first "
-                                f"({how} does, or cmake --build build)")
+        raise FileNotFoundError(
+            f"{path} does not exist: build {what} first ({how} does, or cmake --build build)"
+        )
     return path
 
 
 def stage_binary(build: Path, identifier: str, version: int) -> Path:
     """The shared library of a built FMU, in the build's unpacked stage/ folder."""
-    return (build / "fmus" / "stage" / f"{identifier}_fmi{version}" / "binaries" /
-            PLATFORM[version] / f"{identifier}.so")
+    return (
+        build
+        / "fmus"
+        / "stage"
+        / f"{identifier}_fmi{version}"
+        / "binaries"
+        / PLATFORM[version]
+        / f"{identifier}.so"
+    )

@@ -19,9 +19,9 @@ NEAR_SINGULAR = 1e-6
 class OutputError:
     name: str
     unit: str
-    peak: float        # largest |reference| over the valid samples
-    max_abs: float     # largest |FMU - reference|
-    relative: float    # max_abs / peak
+    peak: float  # largest |reference| over the valid samples
+    max_abs: float  # largest |FMU - reference|
+    relative: float  # max_abs / peak
 
 
 def output_error(name: str, unit: str, want: np.ndarray, got: np.ndarray) -> OutputError:
@@ -33,8 +33,10 @@ def output_error(name: str, unit: str, want: np.ndarray, got: np.ndarray) -> Out
 
 def rows_of(kin: dict, sample: np.ndarray, t: np.ndarray) -> dict:
     """The kinematics at the recorded rows: every array over the grid picked at `sample`."""
-    return {k: (v[sample] if isinstance(v, np.ndarray) and v.shape[:1] == t.shape else v)
-            for k, v in kin.items()}
+    return {
+        k: (v[sample] if isinstance(v, np.ndarray) and v.shape[:1] == t.shape else v)
+        for k, v in kin.items()
+    }
 
 
 def communication_grid(duration: float, revolutions: float, steps: int) -> np.ndarray:
@@ -50,7 +52,7 @@ class Progress:
         self.enabled = enabled and sys.stderr.isatty()
         self.shown = -1
 
-    def __call__(self, time, recorder):
+    def __call__(self, time: float, recorder: object):
         if self.enabled:
             percent = int(100 * time / self.duration) if self.duration > 0 else 100
             if percent != self.shown:
@@ -65,7 +67,7 @@ class Progress:
             sys.stderr.write("\n")
 
 
-def match_samples(recorded: dict, inputs: dict, names, t: np.ndarray) -> np.ndarray:
+def match_samples(recorded: dict, inputs: dict, names: list[str], t: np.ndarray) -> np.ndarray:
     """The kinematic sample whose input values each recorded row carries.
 
     fmpy records, after each step, the inputs it applied before the step, so
@@ -81,7 +83,9 @@ def match_samples(recorded: dict, inputs: dict, names, t: np.ndarray) -> np.ndar
         distance = np.max(np.abs(table - row) / scale, axis=1)
         candidates = np.flatnonzero(distance <= 1e-12)
         if candidates.size == 0:
-            raise RuntimeError(f"recorded row {k} matches no input sample "
-                               f"(closest differs by {distance.min():.2e})")
+            raise RuntimeError(
+                f"recorded row {k} matches no input sample "
+                f"(closest differs by {distance.min():.2e})"
+            )
         index[k] = candidates[np.argmin(np.abs(t[candidates] - recorded["time"][k]))]
     return index

@@ -58,9 +58,9 @@ from __future__ import annotations
 
 import math
 import time as clock
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -70,11 +70,27 @@ from ..mechanisms import builtin
 from ..reference import machine, newton_euler
 from . import harness
 
-__all__ = ["SCHEMES", "STUDY_MECHANISMS", "DURATIONS", "START_ANGLE", "DIVERGENCE_SPEED_FACTOR",
-           "drive_fmu_path", "drive_available",
-           "crank_inertia_about_pivot", "drive_parameters", "explicit_lag_factor", "Setup",
-           "setup", "CosimRun", "run", "run_setup", "Reference", "reference", "reference_for",
-           "errors"]
+__all__ = [
+    "SCHEMES",
+    "STUDY_MECHANISMS",
+    "DURATIONS",
+    "START_ANGLE",
+    "DIVERGENCE_SPEED_FACTOR",
+    "drive_fmu_path",
+    "drive_available",
+    "crank_inertia_about_pivot",
+    "drive_parameters",
+    "explicit_lag_factor",
+    "Setup",
+    "setup",
+    "CosimRun",
+    "run",
+    "run_setup",
+    "Reference",
+    "reference",
+    "reference_for",
+    "errors",
+]
 
 #: The coupling schemes of :func:`run`.
 SCHEMES = ("explicit", "stabilised")
@@ -121,21 +137,28 @@ def crank_inertia_about_pivot(mech: builtin.Mechanism) -> float:
     return float(c["inertia"] + c["mass"] * (c["com"][0] ** 2 + c["com"][1] ** 2))
 
 
-def drive_parameters(mech: builtin.Mechanism, motor: machine.Motor, phi0: float,
-                     omega0: float) -> dict:
+def drive_parameters(
+    mech: builtin.Mechanism, motor: machine.Motor, phi0: float, omega0: float
+) -> dict:
     """The drive FMU's parameters for this mechanism's crank, the motor (with its rotor
     inertia) and the start state: ``inertia`` = J_r + J_cO."""
-    return {"motor.stall_torque": motor.stall_torque,
-            "motor.no_load_speed": motor.no_load_speed,
-            "inertia": motor.rotor_inertia + crank_inertia_about_pivot(mech),
-            "crank.mass": mech.crank["mass"],
-            "crank.com.x": mech.crank["com"][0], "crank.com.y": mech.crank["com"][1],
-            "gravity.x": mech.gravity[0], "gravity.y": mech.gravity[1],
-            "start.angle": float(phi0), "start.speed": float(omega0)}
+    return {
+        "motor.stall_torque": motor.stall_torque,
+        "motor.no_load_speed": motor.no_load_speed,
+        "inertia": motor.rotor_inertia + crank_inertia_about_pivot(mech),
+        "crank.mass": mech.crank["mass"],
+        "crank.com.x": mech.crank["com"][0],
+        "crank.com.y": mech.crank["com"][1],
+        "gravity.x": mech.gravity[0],
+        "gravity.y": mech.gravity[1],
+        "start.angle": float(phi0),
+        "start.speed": float(omega0),
+    }
 
 
-def explicit_lag_factor(mech: builtin.Mechanism, motor: machine.Motor, step: float = 0.0,
-                        samples: int = 720) -> dict:
+def explicit_lag_factor(
+    mech: builtin.Mechanism, motor: machine.Motor, step: float = 0.0, samples: int = 720
+) -> dict:
     """How the explicit scheme's lagged acceleration error propagates from one
     communication point to the next: it is multiplied by -rho(phi), rho = (J(phi) - J_cO) /
     (J_r + J_cO) (the links' inertia at the crank against the drive's), and damped within
@@ -154,10 +177,14 @@ def explicit_lag_factor(mech: builtin.Mechanism, motor: machine.Motor, step: flo
     rho = (J - jc) / drive_inertia
     tau_m = drive_inertia * motor.no_load_speed / motor.stall_torque
     damping = math.exp(-float(step) / tau_m)
-    return {"max": float(np.max(rho)), "mean": float(np.mean(rho)),
-            "geometric": float(np.exp(np.mean(np.log(np.maximum(rho, 1e-300))))),
-            "time_constant": float(tau_m), "damping": damping,
-            "effective": float(np.max(rho)) * damping}
+    return {
+        "max": float(np.max(rho)),
+        "mean": float(np.mean(rho)),
+        "geometric": float(np.exp(np.mean(np.log(np.maximum(rho, 1e-300))))),
+        "time_constant": float(tau_m),
+        "damping": damping,
+        "effective": float(np.max(rho)) * damping,
+    }
 
 
 @dataclass(frozen=True)
@@ -173,8 +200,13 @@ class Setup:
     t_end: float
 
 
-def setup(name: str, ratio: float, t_end: float | None = None,
-          phi0: float = START_ANGLE, omega0: float | None = None) -> Setup:
+def setup(
+    name: str,
+    ratio: float,
+    t_end: float | None = None,
+    phi0: float = START_ANGLE,
+    omega0: float | None = None,
+) -> Setup:
     """The study's machine: ``name``'s default motor with the rotor inertia of
     :func:`dyadfmu.reference.machine.rotor_inertia_for_ratio` (mean J / J_r = ratio), starting at
     phi0 with the nominal crank speed, over :data:`DURATIONS`."""
@@ -182,10 +214,17 @@ def setup(name: str, ratio: float, t_end: float | None = None,
     if machine.phi_range(mech) is not None:
         raise ValueError(f"{name}: the co-simulation needs a revolving crank")
     motor = machine.default_motor(mech).with_rotor_inertia(
-        machine.rotor_inertia_for_ratio(mech, ratio))
+        machine.rotor_inertia_for_ratio(mech, ratio)
+    )
     w0 = float(mech.data["motion"]["omega"]) if omega0 is None else float(omega0)
-    return Setup(mech, motor, float(ratio), float(phi0), w0,
-                 float(DURATIONS[name] if t_end is None else t_end))
+    return Setup(
+        mech,
+        motor,
+        float(ratio),
+        float(phi0),
+        w0,
+        float(DURATIONS[name] if t_end is None else t_end),
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -233,14 +272,23 @@ class CosimRun:
         return max(len(self.t) - 1, 0)
 
 
-def _cross(a, b):
+def _cross(a: np.ndarray, b: np.ndarray):
     return a[0] * b[1] - a[1] * b[0]
 
 
-def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
-        motor: machine.Motor, phi0: float, omega0: float, fmi_version: int = 2,
-        drive: Callable | None = None, dyad: Callable | None = None,
-        ratio: float | None = None) -> CosimRun:
+def run(
+    mech: builtin.Mechanism,
+    scheme: str,
+    step: float,
+    t_end: float,
+    motor: machine.Motor,
+    phi0: float,
+    omega0: float,
+    fmi_version: int = 2,
+    drive: Callable | None = None,
+    dyad: Callable | None = None,
+    ratio: float | None = None,
+) -> CosimRun:
     """Co-simulate the drive FMU and the mechanism's dyad FMU from (phi0, omega0) at t = 0
     to t_end with the communication step ``step`` (t_end / step must be an integer within
     1e-9) and the scheme ``explicit`` or ``stabilised`` (module docstring).
@@ -260,16 +308,17 @@ def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
     if drive is None:
         drive_path = drive_fmu_path(fmi_version)
 
-        def drive(name):
+        def drive(name: str):
             return Slave(drive_path, name, label=f"drive FMU (FMI {fmi_version})")
+
     if dyad is None:
         dyad_path = harness.fmu_path(mech.dyad, fmi_version)
 
-        def dyad(name):
+        def dyad(name: str):
             return Slave(dyad_path, name, label=f"dyad FMU {mech.dyad} (FMI {fmi_version})")
 
     limit = DIVERGENCE_SPEED_FACTOR * motor.no_load_speed
-    rows = []                        # (t, phi, omega, eps, T, tau, J_load, Rx, Ry, M)
+    rows = []  # (t, phi, omega, eps, T, tau, J_load, Rx, Ry, M)
     diverged, diverged_at, reason = False, None, ""
     residual = 0.0
     slaves = []
@@ -289,13 +338,17 @@ def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
             phi, omega, eps_prev, _ = d.get(_DRIVE_OUTPUTS)
             if not math.isfinite(omega) or not math.isfinite(phi):
                 diverged, diverged_at = True, t
-                reason = (f"crank state not finite (angle {phi:g} rad, speed {omega:g} rad/s, "
-                          f"drive status {d.get_status()})")
+                reason = (
+                    f"crank state not finite (angle {phi:g} rad, speed {omega:g} rad/s, "
+                    f"drive status {d.get_status()})"
+                )
                 break
             if abs(omega) > limit:
                 diverged, diverged_at = True, t
-                reason = (f"crank speed {omega:.4g} rad/s beyond {DIVERGENCE_SPEED_FACTOR:g} x "
-                          f"the no-load speed ({limit:.4g} rad/s)")
+                reason = (
+                    f"crank speed {omega:.4g} rad/s beyond {DIVERGENCE_SPEED_FACTOR:g} x "
+                    f"the no-load speed ({limit:.4g} rad/s)"
+                )
                 break
             if scheme == "explicit":
                 if not math.isfinite(eps_prev):
@@ -326,8 +379,10 @@ def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
             if not all(map(math.isfinite, r if scheme == "explicit" else r0)):
                 status = y.get_status()
                 diverged, diverged_at = True, t
-                reason = (f"dyad FMU status {status} ({_DYAD_STATUS.get(status, '?')}) at "
-                          f"conditioning {float(kin['conditioning'][0]):.3g}")
+                reason = (
+                    f"dyad FMU status {status} ({_DYAD_STATUS.get(status, '?')}) at "
+                    f"conditioning {float(kin['conditioning'][0]):.3g}"
+                )
                 break
             lever = kin["D_n"][0] - kin["O"][0]
             if scheme == "explicit":
@@ -341,8 +396,10 @@ def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
             eps, torque = d.get(("crank.epsilon", "motor.torque"))
             if not math.isfinite(eps):
                 diverged, diverged_at = True, t
-                reason = (f"crank acceleration not finite (drive status {d.get_status()}, "
-                          f"load.inertia {j_load:.4g} kg.m2)")
+                reason = (
+                    f"crank acceleration not finite (drive status {d.get_status()}, "
+                    f"load.inertia {j_load:.4g} kg.m2)"
+                )
                 break
             if scheme == "stabilised":
                 y.set(inputs, u0 + eps * seed)
@@ -354,11 +411,14 @@ def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
                 if not all(map(math.isfinite, r)):
                     status = y.get_status()
                     diverged, diverged_at = True, t
-                    reason = (f"dyad FMU status {status} ({_DYAD_STATUS.get(status, '?')}) at "
-                              f"the solved acceleration {eps:.4g} rad/s2")
+                    reason = (
+                        f"dyad FMU status {status} ({_DYAD_STATUS.get(status, '?')}) at "
+                        f"the solved acceleration {eps:.4g} rad/s2"
+                    )
                     break
-            rows.append((t, phi, omega, eps, torque, tau, j_load, r[0], r[1],
-                         r[2] if has_m else 0.0))
+            rows.append(
+                (t, phi, omega, eps, torque, tau, j_load, r[0], r[1], r[2] if has_m else 0.0)
+            )
             if k == n:
                 break
             y.do_step(t, step)
@@ -374,17 +434,54 @@ def run(mech: builtin.Mechanism, scheme: str, step: float, t_end: float,
                 pass
     wall = clock.perf_counter() - start
     a = np.array(rows, dtype=float).reshape(-1, 10)
-    return CosimRun(mech.name, scheme, int(fmi_version), float(step), float(t_end),
-                    motor.rotor_inertia, ratio, a[:, 0], a[:, 1], a[:, 2], a[:, 3], a[:, 4],
-                    a[:, 5], a[:, 6], a[:, 7:9].copy(), a[:, 9], wall, diverged, diverged_at,
-                    reason, residual, getattr(slaves[0], "label", "") if slaves else "")
+    return CosimRun(
+        mech.name,
+        scheme,
+        int(fmi_version),
+        float(step),
+        float(t_end),
+        motor.rotor_inertia,
+        ratio,
+        a[:, 0],
+        a[:, 1],
+        a[:, 2],
+        a[:, 3],
+        a[:, 4],
+        a[:, 5],
+        a[:, 6],
+        a[:, 7:9].copy(),
+        a[:, 9],
+        wall,
+        diverged,
+        diverged_at,
+        reason,
+        residual,
+        getattr(slaves[0], "label", "") if slaves else "",
+    )
 
 
-def run_setup(s: Setup, scheme: str, step: float, fmi_version: int = 2,
-              drive: Callable | None = None, dyad: Callable | None = None) -> CosimRun:
+def run_setup(
+    s: Setup,
+    scheme: str,
+    step: float,
+    fmi_version: int = 2,
+    drive: Callable | None = None,
+    dyad: Callable | None = None,
+) -> CosimRun:
     """:func:`run` on a :class:`Setup`."""
-    return run(s.mech, scheme, step, s.t_end, s.motor, s.phi0, s.omega0, fmi_version,
-               drive=drive, dyad=dyad, ratio=s.ratio)
+    return run(
+        s.mech,
+        scheme,
+        step,
+        s.t_end,
+        s.motor,
+        s.phi0,
+        s.omega0,
+        fmi_version,
+        drive=drive,
+        dyad=dyad,
+        ratio=s.ratio,
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -411,25 +508,45 @@ class Reference:
     nfev: int = 0
 
 
-def reference(mech: builtin.Mechanism, motor: machine.Motor, t_end: float, phi0: float,
-              omega0: float, times=None, rtol: float = 1e-10, atol: float = 1e-12) -> Reference:
+def reference(
+    mech: builtin.Mechanism,
+    motor: machine.Motor,
+    t_end: float,
+    phi0: float,
+    omega0: float,
+    times: np.ndarray | None = None,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+) -> Reference:
     """The monolithic machine from (phi0, omega0) evaluated at ``times`` (default: the
     solver's steps), Radau with rtol, atol, and its reactions."""
     start = clock.perf_counter()
     times = None if times is None else np.asarray(times, dtype=float)
-    mono = machine.monolithic(mech, motor, t_end, phi0, omega0, rtol=rtol, atol=atol,
-                              t_eval=times, stop_at_range=False)
+    mono = machine.monolithic(
+        mech, motor, t_end, phi0, omega0, rtol=rtol, atol=atol, t_eval=times, stop_at_range=False
+    )
     kin = machine.state_kinematics(mech, mono.phi, mono.omega, mono.epsilon)
     sol = newton_euler.solve(mech.dyad, *mech.reference_inputs(kin))
     r_np = np.asarray(sol["r_np"], dtype=float)
     m_np = np.asarray(sol["m_np"], dtype=float)
     wall = clock.perf_counter() - start
-    return Reference(mech.name, motor, mono.t, mono.phi, mono.omega, mono.epsilon, r_np, m_np,
-                     float(np.mean(mono.omega)), float(np.max(np.hypot(r_np[:, 0], r_np[:, 1]))),
-                     wall, mono.nfev)
+    return Reference(
+        mech.name,
+        motor,
+        mono.t,
+        mono.phi,
+        mono.omega,
+        mono.epsilon,
+        r_np,
+        m_np,
+        float(np.mean(mono.omega)),
+        float(np.max(np.hypot(r_np[:, 0], r_np[:, 1]))),
+        wall,
+        mono.nfev,
+    )
 
 
-def reference_for(s: Setup, step: float, **kw) -> Reference:
+def reference_for(s: Setup, step: float, **kw: float) -> Reference:
     """The reference of a :class:`Setup` at the communication points of ``step``."""
     n = int(round(s.t_end / step))
     return reference(s.mech, s.motor, s.t_end, s.phi0, s.omega0, np.arange(n + 1) * step, **kw)
@@ -443,18 +560,25 @@ def errors(cosim: CosimRun, ref: Reference) -> dict:
     R_np_ref| / (peak |R_np_ref|); angle [rad]: max |phi - phi_ref|; speed_at, reaction_at
     [s]: where the largest errors are; points: how many were compared. A run that diverged has its errors over the points before it stopped."""
     if len(cosim.t) == 0:
-        return {"speed": math.nan, "reaction": math.nan, "angle": math.nan,
-                "speed_at": math.nan, "reaction_at": math.nan, "points": 0}
+        return {
+            "speed": math.nan,
+            "reaction": math.nan,
+            "angle": math.nan,
+            "speed_at": math.nan,
+            "reaction_at": math.nan,
+            "points": 0,
+        }
     idx = np.searchsorted(ref.t, cosim.t - 1e-9)
     idx = np.minimum(idx, len(ref.t) - 1)
     if np.any(np.abs(ref.t[idx] - cosim.t) > 1e-9):
         raise ValueError("the reference is not evaluated at the run's communication points")
     dw = np.abs(cosim.omega - ref.omega[idx])
     dr = np.hypot(*(cosim.r_np - ref.r_np[idx]).T)
-    return {"speed": float(np.max(dw) / abs(ref.mean_speed)),
-            "reaction": float(np.max(dr) / ref.peak_reaction),
-            "angle": float(np.max(np.abs(cosim.phi - ref.phi[idx]))),
-            "speed_at": float(cosim.t[np.argmax(dw)]),
-            "reaction_at": float(cosim.t[np.argmax(dr)]),
-            "points": int(len(idx))}
-
+    return {
+        "speed": float(np.max(dw) / abs(ref.mean_speed)),
+        "reaction": float(np.max(dr) / ref.peak_reaction),
+        "angle": float(np.max(np.abs(cosim.phi - ref.phi[idx]))),
+        "speed_at": float(cosim.t[np.argmax(dw)]),
+        "reaction_at": float(cosim.t[np.argmax(dr)]),
+        "points": int(len(idx)),
+    }

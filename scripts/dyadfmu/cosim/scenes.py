@@ -32,6 +32,7 @@ from .. import paths
 from ..fmi.simulate import setup_for, simulate
 from ..mechanisms import builtin, chains
 from ..mechanisms import geometry as geo
+from ..mechanisms.motion import CrankMotion
 from ..reference import newton_euler
 from .compare import (
     NEAR_SINGULAR,
@@ -56,10 +57,14 @@ SINGLE = {
 }
 
 #: The generic per-type FMUs a scene would need instead (one per dyad).
-FULL_OF = {"press": ("RRT",), "monitor": ("RRR",), "engine": ("RRT",),
-           "shaper": ("RTR", "RRT"), "sixbar": ("RRR", "RRR"),
-           "rocker_slider": ("RRR", "RRT")}
-
+FULL_OF = {
+    "press": ("RRT",),
+    "monitor": ("RRR",),
+    "engine": ("RRT",),
+    "shaper": ("RTR", "RRT"),
+    "sixbar": ("RRR", "RRR"),
+    "rocker_slider": ("RRR", "RRT"),
+}
 
 
 def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
@@ -85,8 +90,9 @@ class Source:
         self.inertia = bool(effects.get("inertia", False))
         self.gravity_on = bool(effects.get("gravity", False))
         g = self.scene.get("gravity", {})
-        self.gravity = (float(g.get("x", 0.0)), float(g.get("y", 0.0))) if self.gravity_on \
-            else (0.0, 0.0)
+        self.gravity = (
+            (float(g.get("x", 0.0)), float(g.get("y", 0.0))) if self.gravity_on else (0.0, 0.0)
+        )
         self.crank_name = self.scene.get("crank", {}).get("name", "crank")
         if name in SINGLE:
             mech_name, self.roles = SINGLE[name]
@@ -100,7 +106,7 @@ class Source:
     def motion(self, kind: str, revolutions: float):
         return (self.chain or self.mechanism).motion(kind, revolutions)
 
-    def kinematics(self, t, motion) -> dict:
+    def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
         if self.chain is not None:
             return self.chain.kinematics(t, motion)
         kin = self.mechanism.kinematics(t, motion)
@@ -117,46 +123,49 @@ class Source:
                 out[f"{link}.{key}.y"] = kin[f"{role}.{key}"][:, 1]
         return out
 
-    def inputs(self, kin, names) -> dict:
+    def inputs(self, kin: dict, names: list[str]) -> dict:
         """The FMU's input signals, by name."""
         missing = [n for n in names if n not in kin]
         if missing:
             raise KeyError(f"scene {self.name}: no kinematics for input(s) {missing}")
         return {n: np.asarray(kin[n], dtype=float).copy() for n in names}
 
-    def reference(self, kin) -> dict:
+    def reference(self, kin: dict) -> dict:
         """Every output the scene can have, by FMU name."""
         if self.chain is not None:
             return self.chain.reference(kin)
         return self._single_reference(kin)
 
-    def conditioning(self, kin) -> dict:
+    def conditioning(self, kin: dict) -> dict:
         if self.chain is not None:
-            return {f"{d['name']}.conditioning": kin[f"{d['name']}.conditioning"]
-                    for d in self.scene["dyad"]}
+            return {
+                f"{d['name']}.conditioning": kin[f"{d['name']}.conditioning"]
+                for d in self.scene["dyad"]
+            }
         return {f"{self.dyad['name']}.conditioning": self.mechanism.conditioning(kin)}
 
     # ---- single dyad: reference.solve with the scene's effects, crank balance here
-    def _link_input(self, kin, link: str, table: dict) -> dict:
+    def _link_input(self, kin: dict, link: str, table: dict) -> dict:
         n = len(kin["t"])
         zero, zero2 = np.zeros(n), np.zeros((n, 2))
         dynamic = self.inertia
-        return {"dir": geo.unit(kin[f"{link}.angle"]),
-                "length": np.asarray(kin[f"{link}.length"], dtype=float),
-                "omega": kin[f"{link}.omega"] if dynamic else zero,
-                "epsilon": kin[f"{link}.epsilon"] if dynamic else zero,
-                "accel_d": kin[f"{link}.accel_d"] if dynamic else zero2,
-                "com": tuple(table.get("com", (0.0, 0.0))),
-                "mass": float(table.get("mass", 0.0)) if (self.inertia or self.gravity_on)
-                else 0.0,
-                "inertia": float(table.get("inertia", 0.0)) if self.inertia else 0.0,
-                "force": kin[f"{link}.force"] if link in self._loaded("force") else zero2,
-                "moment": kin[f"{link}.moment"] if link in self._loaded("moment") else zero}
+        return {
+            "dir": geo.unit(kin[f"{link}.angle"]),
+            "length": np.asarray(kin[f"{link}.length"], dtype=float),
+            "omega": kin[f"{link}.omega"] if dynamic else zero,
+            "epsilon": kin[f"{link}.epsilon"] if dynamic else zero,
+            "accel_d": kin[f"{link}.accel_d"] if dynamic else zero2,
+            "com": tuple(table.get("com", (0.0, 0.0))),
+            "mass": float(table.get("mass", 0.0)) if (self.inertia or self.gravity_on) else 0.0,
+            "inertia": float(table.get("inertia", 0.0)) if self.inertia else 0.0,
+            "force": kin[f"{link}.force"] if link in self._loaded("force") else zero2,
+            "moment": kin[f"{link}.moment"] if link in self._loaded("moment") else zero,
+        }
 
-    def _loaded(self, key):
+    def _loaded(self, key: str):
         return set(self.scene.get("loads", {}).get(key, []))
 
-    def _single_reference(self, kin) -> dict:
+    def _single_reference(self, kin: dict) -> dict:
         d = self.dyad
         links = {t["name"]: t for t in self.scene["link"]}
         m = self._link_input(kin, d["m"], links[d["m"]])
@@ -182,18 +191,23 @@ class Source:
         r_s = com[0] * i_c + com[1] * j_c
         mass = float(crank.get("mass", 0.0)) if (self.inertia or self.gravity_on) else 0.0
         inertia = float(crank.get("inertia", 0.0)) if self.inertia else 0.0
-        a_s = (eps[:, None] * geo.rot90(r_s) - (w * w)[:, None] * r_s) if self.inertia \
+        a_s = (
+            (eps[:, None] * geo.rot90(r_s) - (w * w)[:, None] * r_s)
+            if self.inertia
             else np.zeros_like(r_s)
+        )
         own = mass * (np.asarray(self.gravity) - a_s)
         r_np = r["r_np"]
-        moments = geo.cross(pin, -r_np) + geo.cross(r_s, own) - inertia * (eps if self.inertia else 0.0)
+        moments = (
+            geo.cross(pin, -r_np) + geo.cross(r_s, own) - inertia * (eps if self.inertia else 0.0)
+        )
         out[f"{c}.torque"] = -moments
         r_o = r_np - own
         out[f"{c}.R_O.x"], out[f"{c}.R_O.y"] = r_o[:, 0], r_o[:, 1]
         return out
 
     # ---- energy of a chain
-    def energy(self, kin) -> np.ndarray:
+    def energy(self, kin: dict) -> np.ndarray:
         return self.chain.kinetic_energy(kin) + self.chain.potential_energy(kin)
 
 
@@ -214,15 +228,21 @@ class SceneRun:
     seconds_fmu: float
     steps: int
     units: dict = field(default_factory=dict)
-    energy_residual: float = math.nan     # worst |M w + P - dE/dt| / peak |M w|
+    energy_residual: float = math.nan  # worst |M w + P - dE/dt| / peak |M w|
 
     @property
     def worst_relative(self) -> float:
         return max(e.relative for e in self.errors)
 
 
-def setup(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
-          motion: str = "constant", build: Path | None = None):
+def setup(
+    name: str,
+    fmi_version: int = 2,
+    revolutions: float = 2.0,
+    steps: int = 360,
+    motion: str = "constant",
+    build: Path | None = None,
+):
     """The co-simulation of a scene's tailored FMU: (setup, source, crank motion,
     kinematics on the grid); its inputs are taken by name from the kinematics."""
     source = Source(name)
@@ -235,8 +255,15 @@ def setup(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int 
     return setup_for(path, t, source.inputs(kin, names)), source, crank_motion, kin
 
 
-def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
-        motion: str = "constant", build: Path | None = None, progress: bool = False) -> SceneRun:
+def run(
+    name: str,
+    fmi_version: int = 2,
+    revolutions: float = 2.0,
+    steps: int = 360,
+    motion: str = "constant",
+    build: Path | None = None,
+    progress: bool = False,
+) -> SceneRun:
     """Co-simulate a scene's tailored FMU over `revolutions` crank turns at `steps`
     communication steps per turn and compare every output with the reference."""
     co, source, crank_motion, kin = setup(name, fmi_version, revolutions, steps, motion, build)
@@ -264,16 +291,20 @@ def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 
         if out not in ref:
             raise KeyError(f"scene {name}: the reference has no output {out}")
         errors.append(output_error(out, units.get(out, ""), ref[out][valid], fmu[out][valid]))
-    result = SceneRun(name, fmi_version, source, rows, sample, fmu, ref, valid, errors, seconds,
-                      len(t) - 1, units)
+    result = SceneRun(
+        name, fmi_version, source, rows, sample, fmu, ref, valid, errors, seconds, len(t) - 1, units
+    )
     torque = f"{source.crank_name}.torque"
     if source.chain is not None and torque in fmu:
-        result.energy_residual = energy_balance(source, crank_motion, fmu["time"], fmu[torque],
-                                                t[sample])
+        result.energy_residual = energy_balance(
+            source, crank_motion, fmu["time"], fmu[torque], t[sample]
+        )
     return result
 
 
-def energy_balance(source: Source, motion, time, torque, t_samples) -> float:
+def energy_balance(
+    source: Source, motion: CrankMotion, time: np.ndarray, torque: np.ndarray, t_samples: np.ndarray
+) -> float:
     """Worst |M omega + P_loads - d(T + V)/dt| over the run, relative to the peak driving
     power; dE/dt by 4th-order central differences of the reference energies."""
     w0 = float(np.max(np.abs(motion.omega(t_samples))))
@@ -288,9 +319,11 @@ def energy_balance(source: Source, motion, time, torque, t_samples) -> float:
 
 
 def summary(result: SceneRun) -> str:
-    text = (f"{result.name}, FMI {result.fmi_version}: {result.steps} steps in "
-            f"{result.seconds_fmu:.3f} s; {len(result.errors)} outputs, worst relative error "
-            f"{result.worst_relative:.2e}")
+    text = (
+        f"{result.name}, FMI {result.fmi_version}: {result.steps} steps in "
+        f"{result.seconds_fmu:.3f} s; {len(result.errors)} outputs, worst relative error "
+        f"{result.worst_relative:.2e}"
+    )
     torque = result.fmu.get(f"{result.source.crank_name}.torque")
     if torque is not None:
         t = torque[result.valid]
@@ -308,7 +341,9 @@ def reactions_of(result: SceneRun) -> dict:
     return {k: v for k, v in result.fmu.items() if k != "time"}
 
 
-def drawing_indices(result: SceneRun, angles_deg=(30.0, 120.0, 210.0, 300.0)) -> list:
+def drawing_indices(
+    result: SceneRun, angles_deg: tuple[float, ...] = (30.0, 120.0, 210.0, 300.0)
+) -> list:
     """The rows nearest to the given crank angles (first occurrence), for drawings."""
     phi = np.mod(np.asarray(result.kin[f"{result.source.crank_name}.angle"]), 2 * math.pi)
     picks = []

@@ -4,6 +4,7 @@ communication grid in, every input and output recorded after each step out. The 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -15,12 +16,13 @@ from fmpy import read_model_description, simulate_fmu
 class CoSimSetup:
     """What one co-simulation feeds an FMU, the same for every importer: the input
     signals on the communication grid, the parameters' start values, what it records."""
+
     path: Path
-    time: np.ndarray                # communication points (s), evenly spaced from 0
-    inputs: dict                    # input name -> values at `time`
-    start_values: dict              # parameter name -> value
-    outputs: list                   # output names, in model-description order
-    units: dict                     # variable name -> unit ("" where none)
+    time: np.ndarray  # communication points (s), evenly spaced from 0
+    inputs: dict  # input name -> values at `time`
+    start_values: dict  # parameter name -> value
+    outputs: list  # output names, in model-description order
+    units: dict  # variable name -> unit ("" where none)
 
     @property
     def step(self) -> float:
@@ -39,8 +41,9 @@ class CoSimSetup:
         return rows
 
 
-def setup_for(path: Path, time: np.ndarray, inputs: dict, start_values: dict | None = None
-              ) -> CoSimSetup:
+def setup_for(
+    path: Path, time: np.ndarray, inputs: dict, start_values: dict | None = None
+) -> CoSimSetup:
     """The setup of an FMU file: its outputs and units from the model description."""
     md = read_model_description(str(path))
     outputs = [v.name for v in md.modelVariables if v.causality == "output"]
@@ -48,11 +51,18 @@ def setup_for(path: Path, time: np.ndarray, inputs: dict, start_values: dict | N
     return CoSimSetup(path, time, inputs, dict(start_values or {}), outputs, units)
 
 
-def simulate(setup: CoSimSetup, step_finished=None) -> dict:
+def simulate(setup: CoSimSetup, step_finished: Callable | None = None) -> dict:
     """Co-simulate with fmpy over the setup's grid; every input and output recorded after
     each step (name -> array, with "time")."""
-    recorded = simulate_fmu(str(setup.path), start_time=0.0, stop_time=setup.stop,
-                            step_size=setup.step, output_interval=setup.step,
-                            input=setup.signals(), output=list(setup.inputs) + setup.outputs,
-                            start_values=dict(setup.start_values), step_finished=step_finished)
+    recorded = simulate_fmu(
+        str(setup.path),
+        start_time=0.0,
+        stop_time=setup.stop,
+        step_size=setup.step,
+        output_interval=setup.step,
+        input=setup.signals(),
+        output=list(setup.inputs) + setup.outputs,
+        start_values=dict(setup.start_values),
+        step_finished=step_finished,
+    )
     return {n: np.asarray(recorded[n]) for n in recorded.dtype.names}

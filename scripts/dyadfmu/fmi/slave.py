@@ -76,8 +76,9 @@ class Slave:
     ``md`` is its model description, ``vr`` maps names to value references, ``fmu`` is
     fmpy's instance for calls beyond load, set, step and get."""
 
-    def __init__(self, path: Path | str, instance_name: str = "instance",
-                 label: str | None = None) -> None:
+    def __init__(
+        self, path: Path | str, instance_name: str = "instance", label: str | None = None
+    ) -> None:
         self.path = Path(path)
         self.label = label or self.path.stem
         self.md, directory = unpacked(self.path)
@@ -88,9 +89,12 @@ class Slave:
         self.messages: list[str] = []
         self._vrs: dict = {}
         cls = FMU2Slave if self.version == 2 else FMU3Slave
-        self.fmu = cls(guid=self.md.guid, unzipDirectory=directory,
-                       modelIdentifier=self.md.coSimulation.modelIdentifier,
-                       instanceName=instance_name)
+        self.fmu = cls(
+            guid=self.md.guid,
+            unzipDirectory=directory,
+            modelIdentifier=self.md.coSimulation.modelIdentifier,
+            instanceName=instance_name,
+        )
         self._instantiated = False
         self._call("instantiate", self._instantiate)
         self._instantiated = True
@@ -113,21 +117,30 @@ class Slave:
             # "%s", text): a callback that takes the text as a sixth argument reads
             # the message without fmpy's logger proxy, whose single global target
             # would dangle once this slave is gone.
-            def logger(component: object, instance_name: object, status: int,
-                       category: object, fmt: bytes, text: bytes | None) -> None:
+            def logger(
+                component: object,
+                instance_name: object,
+                status: int,
+                category: object,
+                fmt: bytes,
+                text: bytes | None,
+            ) -> None:
                 self._log(status, category, text if text is not None else fmt)
 
-            self._logger = CFUNCTYPE(None, c_void_p, c_char_p, c_int, c_char_p, c_char_p,
-                                     c_char_p)(logger)
+            self._logger = CFUNCTYPE(None, c_void_p, c_char_p, c_int, c_char_p, c_char_p, c_char_p)(
+                logger
+            )
             callbacks = fmi2CallbackFunctions()
             callbacks.logger = cast(self._logger, fmi2CallbackLoggerTYPE)
             callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
             callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-            self._callbacks = callbacks             # kept alive with the instance
+            self._callbacks = callbacks  # kept alive with the instance
             self.fmu.instantiate(callbacks=callbacks, loggingOn=False)
         else:
-            def log_message(environment: object, status: int, category: object,
-                            message: object) -> None:
+
+            def log_message(
+                environment: object, status: int, category: object, message: object
+            ) -> None:
                 self._log(status, category, message)
 
             self.fmu.instantiate(loggingOn=False, logMessage=log_message)
@@ -136,8 +149,9 @@ class Slave:
         try:
             return f(*args)
         except FMICallException as e:
-            raise SlaveError(self.label, function, e.status,
-                             self.messages[-1] if self.messages else "") from None
+            raise SlaveError(
+                self.label, function, e.status, self.messages[-1] if self.messages else ""
+            ) from None
 
     def _refs(self, names: tuple) -> list:
         refs = self._vrs.get(names)
@@ -155,8 +169,9 @@ class Slave:
             self._call("setupExperiment", self.fmu.setupExperiment, None, start_time)
             self._call("enterInitializationMode", self.fmu.enterInitializationMode)
         else:
-            self._call("enterInitializationMode", self.fmu.enterInitializationMode, None,
-                       start_time)
+            self._call(
+                "enterInitializationMode", self.fmu.enterInitializationMode, None, start_time
+            )
         self._call("exitInitializationMode", self.fmu.exitInitializationMode)
 
     def set(self, names: tuple | str, values: Sequence[float] | float) -> None:
@@ -184,8 +199,13 @@ class Slave:
 
     def directional_derivative(self, unknowns: tuple, knowns: tuple, seed: Sequence) -> list:
         """d(unknowns)/d(knowns) . seed at the current state."""
-        return self._call("getDirectionalDerivative", self.fmu.getDirectionalDerivative,
-                          self._refs(unknowns), self._refs(knowns), [float(s) for s in seed])
+        return self._call(
+            "getDirectionalDerivative",
+            self.fmu.getDirectionalDerivative,
+            self._refs(unknowns),
+            self._refs(knowns),
+            [float(s) for s in seed],
+        )
 
     def reset(self) -> None:
         """Back to the state after instantiation (start values, not initialised)."""
@@ -199,5 +219,5 @@ class Slave:
         try:
             self.fmu.terminate()
         except Exception:
-            pass                                    # terminate may be illegal after an error
+            pass  # terminate may be illegal after an error
         self.fmu.freeInstance()

@@ -66,13 +66,12 @@ from __future__ import annotations
 import copy
 import math
 import os
+import tomllib
+from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
-
-import tomllib
 
 from ..paths import SCENES_DIR
 from . import geometry as geo
@@ -94,15 +93,15 @@ _TAGS = (("D_m", "mk"), ("E", "mn"), ("D_n", "np"))
 # ---------------------------------------------------------------------------
 # vector helpers on arrays of shape (..., 2)
 # ---------------------------------------------------------------------------
-def _norm(v):
+def _norm(v: np.ndarray):
     return np.hypot(v[..., 0], v[..., 1])
 
 
-def _angle(v):
+def _angle(v: np.ndarray):
     return np.arctan2(v[..., 1], v[..., 0])
 
 
-def _solve2(c1, c2, rhs):
+def _solve2(c1: np.ndarray, c2: np.ndarray, rhs: np.ndarray):
     """x, y with x c1 + y c2 = rhs (Cramer's rule), batched over the leading axis."""
     det = geo.cross(c1, c2)
     return geo.cross(rhs, c2) / det, geo.cross(c1, rhs) / det
@@ -111,7 +110,7 @@ def _solve2(c1, c2, rhs):
 # ---------------------------------------------------------------------------
 # data
 # ---------------------------------------------------------------------------
-def scene_path(name) -> Path:
+def scene_path(name: str) -> Path:
     """The scene file of mechanism ``name``: ``scenes/<name>.toml`` of the project."""
     if name not in NAMES:
         raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
@@ -124,7 +123,7 @@ def default_data() -> dict:
     return tomllib.loads(text)
 
 
-def _sign(table, key, where):
+def _sign(table: Mapping, key: str, where: str):
     value = geo.number(table, key, where)
     if value not in (1.0, -1.0):
         raise ValueError(f"{where}.{key}: expected +1 or -1, got {value!r}")
@@ -166,9 +165,15 @@ class Chain:
         self._crank_com = geo.pair(crank, "com", w)
 
         grav = self.scene.get("gravity", {})
-        self.gravity = (geo.number(grav, "x", f"{where}.gravity"), geo.number(grav, "y", f"{where}.gravity"))
+        self.gravity = (
+            geo.number(grav, "x", f"{where}.gravity"),
+            geo.number(grav, "y", f"{where}.gravity"),
+        )
         eff = self.scene.get("effects", {})
-        self.effects = {"inertia": bool(eff.get("inertia", True)), "gravity": bool(eff.get("gravity", True))}
+        self.effects = {
+            "inertia": bool(eff.get("inertia", True)),
+            "gravity": bool(eff.get("gravity", True)),
+        }
         #: gravity as it enters the dynamics and the potential energy
         self._g = np.array(self.gravity if self.effects["gravity"] else (0.0, 0.0))
 
@@ -206,17 +211,23 @@ class Chain:
         self._sweep()
 
     # ---- resolution of the scene ------------------------------------------
-    def _attachment(self, spec, dyad, pair, done):
+    def _attachment(self, spec: Mapping, dyad: str, pair: str, done: dict):
         """The external link carrying pair ``pair`` ("D_m" or "D_n") of ``dyad``."""
         where = f"scene {self.name}.dyad[{dyad}].{'k' if pair == 'D_m' else 'p'}"
         frame = (self.data.get("frame") or {}).get(dyad, {}).get(pair)
         if spec == "frame":
             if not isinstance(frame, Mapping):
-                raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
-                                 f"(the scene puts {dyad}.{pair} on the frame)")
+                raise ValueError(
+                    f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
+                    f"(the scene puts {dyad}.{pair} on the frame)"
+                )
             pos = geo.pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
-            return {"kind": "pivot", "body": None, "position": pos,
-                    "label": str(frame.get("label", f"{dyad}.{pair}"))}
+            return {
+                "kind": "pivot",
+                "body": None,
+                "position": pos,
+                "label": str(frame.get("label", f"{dyad}.{pair}")),
+            }
         if spec == "crank" or spec == self.crank_name:
             return {"kind": "point", "body": self.crank_name, "at": (self._r, 0.0), "label": "A"}
         if isinstance(spec, Mapping):
@@ -226,23 +237,40 @@ class Chain:
                     raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
                 angle = geo.number(spec, "guide", where)
                 if not isinstance(frame, Mapping):
-                    raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing guide height "
-                                     f"(the scene puts {dyad}.{pair} on a frame guide)")
+                    raise ValueError(
+                        f"{self.name}.frame.{dyad}.{pair}: missing guide height "
+                        f"(the scene puts {dyad}.{pair} on a frame guide)"
+                    )
                 h = geo.number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
-                return {"kind": "guide", "body": None, "angle": angle, "height": h,
-                        "label": str(frame.get("label", f"{dyad}.{pair}"))}
+                return {
+                    "kind": "guide",
+                    "body": None,
+                    "angle": angle,
+                    "height": h,
+                    "label": str(frame.get("label", f"{dyad}.{pair}")),
+                }
             if body == "crank":
                 body = self.crank_name
             if body != self.crank_name and body not in done:
-                raise ValueError(f"{where}: link {body!r} is not the crank nor a link of an "
-                                 f"earlier dyad")
+                raise ValueError(
+                    f"{where}: link {body!r} is not the crank nor a link of an earlier dyad"
+                )
             if "guide" in spec:
                 # a guide fixed in the moving link: through ``at``, along i_body rotated
                 # by ``guide``
-                return {"kind": "link_guide", "body": body, "at": geo.pair(spec, "at", where),
-                        "angle": geo.number(spec, "guide", where), "label": f"{dyad}.guide_k"}
-            return {"kind": "point", "body": body, "at": geo.pair(spec, "at", where),
-                    "label": f"{dyad}.{pair}"}
+                return {
+                    "kind": "link_guide",
+                    "body": body,
+                    "at": geo.pair(spec, "at", where),
+                    "angle": geo.number(spec, "guide", where),
+                    "label": f"{dyad}.guide_k",
+                }
+            return {
+                "kind": "point",
+                "body": body,
+                "at": geo.pair(spec, "at", where),
+                "label": f"{dyad}.{pair}",
+            }
         raise ValueError(f"{where}: expected 'frame', 'crank' or a table, got {spec!r}")
 
     def _resolve_dyads(self):
@@ -256,7 +284,9 @@ class Chain:
                 raise ValueError(f"{where}: bad or repeated dyad name")
             kind = str(d.get("type", "")).upper()
             if kind not in PAIR_KINDS:
-                raise ValueError(f"{where}.type: expected one of {sorted(PAIR_KINDS)}, got {kind!r}")
+                raise ValueError(
+                    f"{where}.type: expected one of {sorted(PAIR_KINDS)}, got {kind!r}"
+                )
             m, n = d.get("m"), d.get("n")
             for g in (m, n):
                 if g not in self.links:
@@ -278,8 +308,10 @@ class Chain:
                 entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
             elif kind == "RRT":
                 if k["kind"] not in guides:
-                    raise ValueError(f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }} "
-                                     f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}")
+                    raise ValueError(
+                        f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }} "
+                        f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}"
+                    )
                 if p["kind"] in guides:
                     raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
                 entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", nonnegative=True)
@@ -288,20 +320,26 @@ class Chain:
                     # the slider translates on the fixed guide: its angle is constant
                     entry["m_angle"] = geo.number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
                 elif "angle" in lm_t:
-                    raise ValueError(f"{where}.{m}.angle: the slider turns with link "
-                                     f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
-                                     f"remove its 'angle'")
+                    raise ValueError(
+                        f"{where}.{m}.angle: the slider turns with link "
+                        f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
+                        f"remove its 'angle'"
+                    )
                 entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
             else:  # RTR
                 if k["kind"] in guides or p["kind"] in guides:
                     raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
                 if "length" in lm_t:
-                    raise ValueError(f"{where}.{m}: the slotted link's length |D_m E| varies; "
-                                     f"remove its 'length'")
+                    raise ValueError(
+                        f"{where}.{m}: the slotted link's length |D_m E| varies; "
+                        f"remove its 'length'"
+                    )
                 entry["ln"] = geo.number(ln_t, "length", f"{where}.{n}", nonnegative=True)
                 if entry["ln"] != 0.0:
-                    raise ValueError(f"{where}.{n}.length: only a block on the pin (length 0) "
-                                     f"is handled, got {entry['ln']!r}")
+                    raise ValueError(
+                        f"{where}.{n}.length: only a block on the pin (length 0) "
+                        f"is handled, got {entry['ln']!r}"
+                    )
             self.plan.append(entry)
             done.update((m, n))
         unused = set(self.links) - done
@@ -326,41 +364,72 @@ class Chain:
             kind = model.get("model")
             if kind == "cutting":
                 if lname not in forces:
-                    raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
-                self._loads[lname] = {"model": kind, "F0": geo.number(model, "F0", where),
-                                      "v_ref": geo.number(model, "v_ref", where, positive=True),
-                                      "s": _sign(model, "s", where) if "s" in model else 1.0}
+                    raise ValueError(
+                        f"{where}: the scene lists no force on {lname!r} ([loads].force)"
+                    )
+                self._loads[lname] = {
+                    "model": kind,
+                    "F0": geo.number(model, "F0", where),
+                    "v_ref": geo.number(model, "v_ref", where, positive=True),
+                    "s": _sign(model, "s", where) if "s" in model else 1.0,
+                }
             elif kind == "resisting-torque":
                 if lname not in moments:
-                    raise ValueError(f"{where}: the scene lists no moment on {lname!r} ([loads].moment)")
-                self._loads[lname] = {"model": kind, "T0": geo.number(model, "T0", where),
-                                      "w_ref": geo.number(model, "w_ref", where, positive=True),
-                                      "c": geo.number(model, "c", where)}
+                    raise ValueError(
+                        f"{where}: the scene lists no moment on {lname!r} ([loads].moment)"
+                    )
+                self._loads[lname] = {
+                    "model": kind,
+                    "T0": geo.number(model, "T0", where),
+                    "w_ref": geo.number(model, "w_ref", where, positive=True),
+                    "c": geo.number(model, "c", where),
+                }
             elif kind == "resisting-force":
                 if lname not in forces:
-                    raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
+                    raise ValueError(
+                        f"{where}: the scene lists no force on {lname!r} ([loads].force)"
+                    )
                 dyad = next((e for e in self.plan if e["type"] == "RRT" and e["m"] == lname), None)
                 if dyad is None:
-                    raise ValueError(f"{where}: model 'resisting-force' needs a slider (link m "
-                                     f"of an RRT dyad); {lname!r} is none")
-                self._loads[lname] = {"model": kind, "F0": geo.number(model, "F0", where),
-                                      "v_ref": geo.number(model, "v_ref", where, positive=True),
-                                      "dyad": dyad["name"]}
+                    raise ValueError(
+                        f"{where}: model 'resisting-force' needs a slider (link m "
+                        f"of an RRT dyad); {lname!r} is none"
+                    )
+                self._loads[lname] = {
+                    "model": kind,
+                    "F0": geo.number(model, "F0", where),
+                    "v_ref": geo.number(model, "v_ref", where, positive=True),
+                    "dyad": dyad["name"],
+                }
             else:
-                raise ValueError(f"{where}.model: expected 'cutting', 'resisting-torque' or "
-                                 f"'resisting-force', got {kind!r}")
+                raise ValueError(
+                    f"{where}.model: expected 'cutting', 'resisting-torque' or "
+                    f"'resisting-force', got {kind!r}"
+                )
         for lname in forces + moments:
             if lname not in self._loads:
-                raise ValueError(f"{self.name}.load: the scene loads link {lname!r} but "
-                                 f"chains.toml has no model for it")
+                raise ValueError(
+                    f"{self.name}.load: the scene loads link {lname!r} but "
+                    f"chains.toml has no model for it"
+                )
 
     def _build_pairs(self):
         """Every pair: output key, kind, the body named first (it receives +R), the other
         body (None: the frame), kin key of its point, and for a translational pair the
         kin key of its guide's angle."""
         c = self.crank_name
-        self.pairs = [{"key": f"{c}.R_O", "kind": "R", "first": c, "second": None,
-                       "point": "O", "guide": None, "dyad": None, "tag": "O"}]
+        self.pairs = [
+            {
+                "key": f"{c}.R_O",
+                "kind": "R",
+                "first": c,
+                "second": None,
+                "point": "O",
+                "guide": None,
+                "dyad": None,
+                "tag": "O",
+            }
+        ]
         for e in self.plan:
             kinds = PAIR_KINDS[e["type"]]
             others = {"D_m": e["k"]["body"], "E": e["n"], "D_n": e["p"]["body"]}
@@ -370,10 +439,18 @@ class Chain:
                 if kind == "T":
                     # D_m: the guide of link k; E: the slot along i_m
                     guide = f"{e['name']}.guide_k.angle" if point == "D_m" else f"{e['m']}.angle"
-                self.pairs.append({"key": f"{e['name']}.R_{tag}", "kind": kind,
-                                   "first": firsts[point], "second": others[point],
-                                   "point": f"{e['name']}.{point}", "guide": guide,
-                                   "dyad": e["name"], "tag": tag})
+                self.pairs.append(
+                    {
+                        "key": f"{e['name']}.R_{tag}",
+                        "kind": kind,
+                        "first": firsts[point],
+                        "second": others[point],
+                        "point": f"{e['name']}.{point}",
+                        "guide": guide,
+                        "dyad": e["name"],
+                        "tag": tag,
+                    }
+                )
 
     def output_names(self) -> list:
         """The names of the outputs of :meth:`reference`, in the order of the unknowns."""
@@ -397,7 +474,7 @@ class Chain:
         return motion_.rotating(kind, self._w0, self._variation, self._phi0, revolutions)
 
     # ---- kinematics -------------------------------------------------------
-    def kinematics(self, t, motion: CrankMotion) -> dict:
+    def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
         """Positions, velocities, accelerations and active loads at the times ``t`` (N,).
 
         Keys (arrays over the N samples; points and vectors (N, 2), scalars (N,)):
@@ -426,21 +503,24 @@ class Chain:
         return kin
 
     @staticmethod
-    def _material(state, at):
+    def _material(state: dict, at: Callable):
         """Position, velocity, acceleration of the point fixed at ``at`` in a body's frame."""
         i = geo.unit(state["angle"])
         rel = at[0] * i + at[1] * geo.rot90(i)
         w, e = geo.col(state["omega"]), geo.col(state["epsilon"])
-        return (state["D"] + rel, state["vD"] + w * geo.rot90(rel),
-                state["aD"] + e * geo.rot90(rel) - w * w * rel)
+        return (
+            state["D"] + rel,
+            state["vD"] + w * geo.rot90(rel),
+            state["aD"] + e * geo.rot90(rel) - w * w * rel,
+        )
 
-    def _point(self, att, states, shape):
+    def _point(self, att: dict, states: dict, shape: tuple):
         if att["kind"] == "pivot":
             z = np.zeros(shape + (2,))
             return z + np.asarray(att["position"]), z.copy(), z.copy()
         return self._material(states[att["body"]], att["at"])
 
-    def _solve(self, t, phi, w, eps) -> dict:
+    def _solve(self, t: np.ndarray, phi: np.ndarray, w: np.ndarray, eps: np.ndarray) -> dict:
         shape = phi.shape
         zero = np.zeros(shape)
         z2 = np.zeros(shape + (2,))
@@ -448,25 +528,52 @@ class Chain:
         i_c = geo.unit(phi)
         crank_state = {"angle": phi, "omega": w, "epsilon": eps, "D": z2, "vD": z2, "aD": z2}
         A, vA, aA = self._material(crank_state, (self._r, 0.0))
-        kin = {"t": t, f"{c}.angle": phi, f"{c}.omega": w, f"{c}.epsilon": eps,
-               "O": z2.copy(), "A": A, "v_A": vA, "a_A": aA}
+        kin = {
+            "t": t,
+            f"{c}.angle": phi,
+            f"{c}.omega": w,
+            f"{c}.epsilon": eps,
+            "O": z2.copy(),
+            "A": A,
+            "v_A": vA,
+            "a_A": aA,
+        }
         states = {c: crank_state}
 
         for e in self.plan:
             dn = e["name"]
-            P, vP, aP = self._point(e["p"], states, shape)      # D_n, on link p
+            P, vP, aP = self._point(e["p"], states, shape)  # D_n, on link p
             if e["type"] == "RRR":
                 K, vK, aK = self._point(e["k"], states, shape)  # D_m, on link k
                 sm, sn, E = _rrr(K, vK, aK, P, vP, aP, e["lm"], e["ln"], e["branch"], dn)
             elif e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
-                sm, sn, E, slide = _rrt_on_link(states[e["k"]["body"]], e["k"]["at"],
-                                                e["k"]["angle"], e["lm"], P, vP, aP, e["ln"],
-                                                e["branch"], dn)
+                sm, sn, E, slide = _rrt_on_link(
+                    states[e["k"]["body"]],
+                    e["k"]["at"],
+                    e["k"]["angle"],
+                    e["lm"],
+                    P,
+                    vP,
+                    aP,
+                    e["ln"],
+                    e["branch"],
+                    dn,
+                )
                 kin[f"{dn}.guide_k.angle"] = sm["angle"].copy()
                 kin[f"{dn}.slide_k"], kin[f"{dn}.slide_k_rate"], kin[f"{dn}.slide_k_accel"] = slide
             elif e["type"] == "RRT":
-                sm, sn, E = _rrt(e["k"]["angle"], e["k"]["height"], e["lm"], e["m_angle"],
-                                 P, vP, aP, e["ln"], e["branch"], dn)
+                sm, sn, E = _rrt(
+                    e["k"]["angle"],
+                    e["k"]["height"],
+                    e["lm"],
+                    e["m_angle"],
+                    P,
+                    vP,
+                    aP,
+                    e["ln"],
+                    e["branch"],
+                    dn,
+                )
                 kin[f"{dn}.guide_k.angle"] = np.full(shape, e["k"]["angle"])
             else:
                 K, vK, aK = self._point(e["k"], states, shape)
@@ -503,9 +610,9 @@ class Chain:
             elif model and model["model"] == "resisting-force":
                 dn = model["dyad"]
                 i_k = geo.unit(kin[f"{dn}.guide_k.angle"])
-                if f"{dn}.slide_k_rate" in kin:                 # guide on a moving link
+                if f"{dn}.slide_k_rate" in kin:  # guide on a moving link
                     v_rel = kin[f"{dn}.slide_k_rate"]
-                else:                                           # frame guide
+                else:  # frame guide
                     v_rel = geo.dot(kin[f"{g}.vel_d"], i_k)
                 force = geo.col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
             kin[f"{g}.force"], kin[f"{g}.moment"] = force, moment
@@ -516,7 +623,7 @@ class Chain:
                 kin[f"{g}.{key}.y"] = kin[f"{g}.{key}"][:, 1].copy()
         return kin
 
-    def _conditioning(self, e, kin):
+    def _conditioning(self, e: np.ndarray, kin: dict):
         i_m, i_n = geo.unit(kin[f"{e['m']}.angle"]), geo.unit(kin[f"{e['n']}.angle"])
         if e["type"] == "RRR":
             return np.abs(geo.dot(i_m, geo.rot90(i_n)))
@@ -525,12 +632,12 @@ class Chain:
         if e["type"] == "RRT":
             return np.abs(geo.dot(i_n, geo.unit(e["k"]["angle"])))
         lm, ln = kin[f"{e['m']}.length"], kin[f"{e['n']}.length"]
-        beta = geo.col(lm) * i_m - geo.col(ln) * i_n                  # D_n - D_m
+        beta = geo.col(lm) * i_m - geo.col(ln) * i_n  # D_n - D_m
         dist = _norm(beta)
         i_beta = beta / geo.col(np.where(dist > 0, dist, 1.0))
         return np.minimum(np.abs(geo.dot(i_beta, i_m)), dist / (lm + ln))
 
-    def _sweep(self, count=720):
+    def _sweep(self, count: int = 720):
         """Positions over one full crank turn (the motion does not matter for them)."""
         phi = self._phi0 + np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
         zero = np.zeros_like(phi)
@@ -559,7 +666,7 @@ class Chain:
                         s = pts @ i
                         pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
                         base = np.array([0.0, att["height"]])
-                        base = base - (base @ i) * i          # foot of O on the guide line
+                        base = base - (base @ i) * i  # foot of O on the guide line
                         x0, x1 = base + (s.min() - pad) * i, base + (s.max() + pad) * i
                         guides[att["label"]] = (tuple(map(float, x0)), tuple(map(float, x1)))
                     elif att["kind"] == "link_guide":
@@ -567,15 +674,18 @@ class Chain:
                         s = sweep[f"{e['name']}.slide_k"]
                         pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
                         link_guides[att["label"]] = {
-                            "link": att["body"], "at": tuple(att["at"]), "angle": att["angle"],
-                            "range": (float(s.min() - pad), float(s.max() + pad + e["lm"]))}
+                            "link": att["body"],
+                            "at": tuple(att["at"]),
+                            "angle": att["angle"],
+                            "range": (float(s.min() - pad), float(s.max() + pad + e["lm"])),
+                        }
             self._frame_cache = {"pivots": pivots, "guides": guides}
             if link_guides:
                 self._frame_cache["link_guides"] = link_guides
         return copy.deepcopy(self._frame_cache)
 
     # ---- dynamics ---------------------------------------------------------
-    def _body_data(self, kin):
+    def _body_data(self, kin: dict):
         """Per body: mass, inertia, S (N, 2), a_S (N, 2) from accel_d, omega, epsilon and
         the centre of mass, epsilon, omega, velocity of S."""
         c = self.crank_name
@@ -583,7 +693,7 @@ class Chain:
         for b in self.bodies:
             if b == c:
                 mass, inertia, com = self._crank_mass, self._crank_inertia, self._crank_com
-                a_d = np.zeros_like(kin["A"])                    # O is fixed
+                a_d = np.zeros_like(kin["A"])  # O is fixed
             else:
                 link = self.links[b]
                 mass, inertia, com = link["mass"], link["inertia"], link["com"]
@@ -594,11 +704,18 @@ class Chain:
             a_s = a_d + geo.col(e) * geo.rot90(rel) - geo.col(w * w) * rel
             force = kin[f"{b}.force"] if b != c else np.zeros_like(a_d)
             moment = kin[f"{b}.moment"] if b != c else np.zeros(len(w))
-            out[b] = {"mass": mass, "inertia": inertia, "S": np.asarray(kin[f"S_{b}"], float),
-                      "a_S": a_s, "epsilon": e, "force": force, "moment": moment}
+            out[b] = {
+                "mass": mass,
+                "inertia": inertia,
+                "S": np.asarray(kin[f"S_{b}"], float),
+                "a_S": a_s,
+                "epsilon": e,
+                "force": force,
+                "moment": moment,
+            }
         return out
 
-    def _known(self, bd):
+    def _known(self, bd: dict):
         """The known terms of body bd: forces (at S) and moments: weight, active load,
         d'Alembert force and moment."""
         forces = [np.broadcast_to(bd["mass"] * self._g, bd["a_S"].shape), bd["force"]]
@@ -608,7 +725,7 @@ class Chain:
             moments.append(-bd["inertia"] * bd["epsilon"])
         return forces, moments
 
-    def reference(self, kin) -> dict:
+    def reference(self, kin: dict) -> dict:
         """Joint reactions and the crank's driving torque from the Newton-Euler equations
         of all moving bodies, solved together (a square linear system per sample).
 
@@ -629,7 +746,7 @@ class Chain:
         ex = np.broadcast_to(np.array([1.0, 0.0]), (count, 2))
         ey = np.broadcast_to(np.array([0.0, 1.0]), (count, 2))
 
-        def put(col, body, point, f, mu, sign):
+        def put(col: int, body: str, point: np.ndarray, f: np.ndarray, mu: int, sign: float):
             """Unknown ``col`` acts on ``body`` as the force ``f`` at ``point`` plus the
             couple ``mu`` (per unit value), with ``sign``."""
             if body is None:
@@ -653,21 +770,24 @@ class Chain:
                 put(col, pr["second"], P, f, mu, -1.0)
                 col += 1
         c = self.crank_name
-        K[:, row[c] + 2, col] = 1.0                           # driving torque
+        K[:, row[c] + 2, col] = 1.0  # driving torque
         col += 1
         assert col == n_eq
 
         for b, bd in bodies.items():
             forces, moments = self._known(bd)
             r = row[b]
-            rhs[:, r:r + 2] -= sum(forces)                    # all act at S: no moment about S
+            rhs[:, r : r + 2] -= sum(forces)  # all act at S: no moment about S
             rhs[:, r + 2] -= sum(moments)
         x = np.linalg.solve(K, rhs[..., None])[..., 0]
 
         out, col = {}, 0
         for pr in self.pairs:
             if pr["kind"] == "R":
-                out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = x[:, col].copy(), x[:, col + 1].copy()
+                out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = (
+                    x[:, col].copy(),
+                    x[:, col + 1].copy(),
+                )
             else:
                 j = geo.rot90(geo.unit(kin[pr["guide"]]))
                 N, M = x[:, col].copy(), x[:, col + 1].copy()
@@ -677,7 +797,7 @@ class Chain:
         out[f"{c}.torque"] = x[:, col].copy()
         return out
 
-    def residuals(self, kin, out) -> np.ndarray:
+    def residuals(self, kin: dict, out: dict) -> np.ndarray:
         """Worst Newton-Euler residual per sample of the output set ``out`` (keys of
         :meth:`reference`), over all bodies: |sum of forces| relative to the largest force
         term of the sample and |sum of moments about S| relative to the largest moment
@@ -690,7 +810,7 @@ class Chain:
         fmax, mmax = np.zeros(count), np.zeros(count)
         tangential = np.zeros(count)
 
-        def force(body, point, f):
+        def force(body: str, point: np.ndarray, f: np.ndarray):
             nonlocal fmax, mmax
             if body is None:
                 return
@@ -700,7 +820,7 @@ class Chain:
             fmax = np.maximum(fmax, _norm(f))
             mmax = np.maximum(mmax, np.abs(m))
 
-        def couple(body, mu):
+        def couple(body: str, mu: int):
             nonlocal mmax
             if body is None:
                 return
@@ -715,8 +835,13 @@ class Chain:
                 couple(b, mu)
         for pr in self.pairs:
             P = np.asarray(kin[pr["point"]], dtype=float)
-            R = np.stack([np.asarray(out[f"{pr['key']}.x"], float),
-                          np.asarray(out[f"{pr['key']}.y"], float)], axis=-1)
+            R = np.stack(
+                [
+                    np.asarray(out[f"{pr['key']}.x"], float),
+                    np.asarray(out[f"{pr['key']}.y"], float),
+                ],
+                axis=-1,
+            )
             force(pr["first"], P, R)
             force(pr["second"], P, -R)
             if pr["kind"] == "T":
@@ -725,8 +850,10 @@ class Chain:
                 M = np.asarray(out[f"{pr['dyad']}.M_{pr['tag']}"], float)
                 couple(pr["first"], M)
                 couple(pr["second"], -M)
-                tangential = np.maximum(tangential, np.maximum(
-                    np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))))
+                tangential = np.maximum(
+                    tangential,
+                    np.maximum(np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))),
+                )
         couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
 
         tiny = np.finfo(float).tiny
@@ -738,12 +865,12 @@ class Chain:
         return worst
 
     # ---- energy -----------------------------------------------------------
-    def _mass(self, b):
+    def _mass(self, b: str):
         if b == self.crank_name:
             return self._crank_mass, self._crank_inertia
         return self.links[b]["mass"], self.links[b]["inertia"]
 
-    def kinetic_energy(self, kin) -> np.ndarray:
+    def kinetic_energy(self, kin: dict) -> np.ndarray:
         """Kinetic energy [J] of all moving bodies, crank included."""
         total = 0.0
         for b in self.bodies:
@@ -753,7 +880,7 @@ class Chain:
             total = total + 0.5 * m * geo.dot(v, v) + 0.5 * J * w * w
         return np.asarray(total, dtype=float)
 
-    def potential_energy(self, kin) -> np.ndarray:
+    def potential_energy(self, kin: dict) -> np.ndarray:
         """Potential energy [J] of the weights of all moving bodies (crank included),
         zero at the origin: -sum m g . S (zero when the scene turns gravity off)."""
         total = 0.0
@@ -762,38 +889,78 @@ class Chain:
             total = total - m * (np.asarray(kin[f"S_{b}"], float) @ self._g)
         return np.asarray(total, dtype=float)
 
-    def load_power(self, kin) -> np.ndarray:
+    def load_power(self, kin: dict) -> np.ndarray:
         """Power [W] of the active loads (weights excluded): sum F . v_S + M omega."""
         total = 0.0
         for g in self.links:
-            total = total + geo.dot(np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float))
-            total = total + np.asarray(kin[f"{g}.moment"], float) * np.asarray(kin[f"{g}.omega"], float)
+            total = total + geo.dot(
+                np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float)
+            )
+            total = total + np.asarray(kin[f"{g}.moment"], float) * np.asarray(
+                kin[f"{g}.omega"], float
+            )
         return np.asarray(total, dtype=float)
 
     def __repr__(self):
-        return f"<Chain {self.name}: " + ", ".join(f"{e['name']} ({e['type']})" for e in self.plan) + ">"
+        return (
+            f"<Chain {self.name}: "
+            + ", ".join(f"{e['name']} ({e['type']})" for e in self.plan)
+            + ">"
+        )
 
 
 # ---------------------------------------------------------------------------
 # the dyads
 # ---------------------------------------------------------------------------
-def _state(angle, omega, epsilon, D, vD, aD, length, rate=0.0, accel=0.0):
-    return {"angle": angle, "omega": omega, "epsilon": epsilon, "D": D, "vD": vD, "aD": aD,
-            "length": length, "length_rate": rate, "length_accel": accel}
+def _state(
+    angle: np.ndarray,
+    omega: np.ndarray,
+    epsilon: np.ndarray,
+    D: np.ndarray,
+    vD: np.ndarray,
+    aD: np.ndarray,
+    length: np.ndarray | float,
+    rate: np.ndarray | float = 0.0,
+    accel: np.ndarray | float = 0.0,
+):
+    return {
+        "angle": angle,
+        "omega": omega,
+        "epsilon": epsilon,
+        "D": D,
+        "vD": vD,
+        "aD": aD,
+        "length": length,
+        "length_rate": rate,
+        "length_accel": accel,
+    }
 
 
-def _rrr(K, vK, aK, P, vP, aP, lm, ln, branch, name):
+def _rrr(
+    K: np.ndarray,
+    vK: np.ndarray,
+    aK: np.ndarray,
+    P: np.ndarray,
+    vP: np.ndarray,
+    aP: np.ndarray,
+    lm: np.ndarray,
+    ln: np.ndarray,
+    branch: float,
+    name: str,
+):
     """RRR: link m pinned at D_m = K (on link k), link n at D_n = P (on link p), joined
     at E. ``branch`` +1: E on the left of the directed line K -> P."""
     d = P - K
     dist = _norm(d)
     u = d / geo.col(dist)
-    a = (lm * lm - ln * ln + dist * dist) / (2.0 * dist)        # along u from K to the chord
+    a = (lm * lm - ln * ln + dist * dist) / (2.0 * dist)  # along u from K to the chord
     h2 = lm * lm - a * a
     if np.any(~(h2 > 0.0)):
-        raise ValueError(f"dyad {name}: the circles about D_m ({lm} m) and D_n ({ln} m) do not "
-                         f"intersect at every crank angle (|D_m D_n| from {dist.min():.4g} to "
-                         f"{dist.max():.4g} m)")
+        raise ValueError(
+            f"dyad {name}: the circles about D_m ({lm} m) and D_n ({ln} m) do not "
+            f"intersect at every crank angle (|D_m D_n| from {dist.min():.4g} to "
+            f"{dist.max():.4g} m)"
+        )
     E = K + geo.col(a) * u + branch * geo.col(np.sqrt(h2)) * geo.rot90(u)
     i_m, i_n = (E - K) / lm, (E - P) / ln
     j_m, j_n = geo.rot90(i_m), geo.rot90(i_n)
@@ -806,7 +973,18 @@ def _rrr(K, vK, aK, P, vP, aP, lm, ln, branch, name):
     return sm, sn, E
 
 
-def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
+def _rrt(
+    guide: np.ndarray,
+    height: float,
+    lm: np.ndarray,
+    m_angle: np.ndarray,
+    P: np.ndarray,
+    vP: np.ndarray,
+    aP: np.ndarray,
+    ln: np.ndarray,
+    branch: float,
+    name: str,
+):
     """RRT: slider m on the fixed guide (direction ``guide``, through (0, height)), its
     pin E = D_m + lm i_m; rod n from D_n = P (on link p) to E. ``branch`` +1: E ahead
     of the foot of P on E's line along the guide direction."""
@@ -814,13 +992,15 @@ def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
     j_k = np.array([-i_k[1], i_k[0]])
     i_m = np.array([math.cos(m_angle), math.sin(m_angle)])
     base = np.array([0.0, height])
-    line = base + lm * i_m                                   # E = line + s i_k
+    line = base + lm * i_m  # E = line + s i_k
     d = P - line
     along, across = d @ i_k, d @ j_k
     root2 = ln * ln - across * across
     if np.any(~(root2 > 0.0)):
-        raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
-                         f"crank angle (distance up to {np.abs(across).max():.4g} m)")
+        raise ValueError(
+            f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
+            f"crank angle (distance up to {np.abs(across).max():.4g} m)"
+        )
     s = along + branch * np.sqrt(root2)
     E = line + geo.col(s) * i_k
     i_n = (E - P) / ln
@@ -836,7 +1016,18 @@ def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
     return sm, sn, E
 
 
-def _rrt_on_link(ks, at, guide, lm, P, vP, aP, ln, branch, name):
+def _rrt_on_link(
+    ks: dict,
+    at: Callable,
+    guide: np.ndarray,
+    lm: np.ndarray,
+    P: np.ndarray,
+    vP: np.ndarray,
+    aP: np.ndarray,
+    ln: np.ndarray,
+    branch: float,
+    name: str,
+):
     """RRT with the guide on the moving link k (state ``ks``): the line through the point
     ``at`` of k's frame, along i_k = i_(link k) rotated by ``guide``. The slider m turns
     with k (i_m = i_k); D_m = Q + s i_k, Q the guide's point ``at``; E = D_m + lm i_k;
@@ -847,22 +1038,30 @@ def _rrt_on_link(ks, at, guide, lm, P, vP, aP, ln, branch, name):
     w, e = np.asarray(ks["omega"], dtype=float), np.asarray(ks["epsilon"], dtype=float)
     i_k = geo.unit(angle)
     j_k = geo.rot90(i_k)
-    d = P - (Q + lm * i_k)                                   # E = Q + (s + lm) i_k
+    d = P - (Q + lm * i_k)  # E = Q + (s + lm) i_k
     along, across = geo.dot(d, i_k), geo.dot(d, j_k)
     root2 = ln * ln - across * across
     if np.any(~(root2 > 0.0)):
-        raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
-                         f"crank angle (distance up to {np.abs(across).max():.4g} m)")
+        raise ValueError(
+            f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
+            f"crank angle (distance up to {np.abs(across).max():.4g} m)"
+        )
     s = along + branch * np.sqrt(root2)
     Dm = Q + geo.col(s) * i_k
     E = Dm + lm * i_k
     i_n = (E - P) / ln
     j_n = geo.rot90(i_n)
-    q = s + lm                                               # E = Q + q i_k
+    q = s + lm  # E = Q + q i_k
     # v_E = v_Q + s' i_k + q w j_k = v_P + ln wn j_n
     ds, wn = _solve2(i_k, -ln * j_n, vP - vQ - geo.col(q * w) * j_k)
     # a_E = a_Q + (s'' - q w^2) i_k + (q e + 2 s' w) j_k = a_P + ln en j_n - ln wn^2 i_n
-    rhs = aP - geo.col(ln * wn * wn) * i_n - aQ + geo.col(q * w * w) * i_k - geo.col(q * e + 2.0 * ds * w) * j_k
+    rhs = (
+        aP
+        - geo.col(ln * wn * wn) * i_n
+        - aQ
+        + geo.col(q * w * w) * i_k
+        - geo.col(q * e + 2.0 * ds * w) * j_k
+    )
     dds, en = _solve2(i_k, -ln * j_n, rhs)
     # the slider's material point at D_m: k's point there, plus relative and Coriolis terms
     vDm = vQ + geo.col(ds) * i_k + geo.col(s * w) * j_k
@@ -872,7 +1071,9 @@ def _rrt_on_link(ks, at, guide, lm, P, vP, aP, ln, branch, name):
     return sm, sn, E, (s, ds, dds)
 
 
-def _rtr(K, vK, aK, P, vP, aP):
+def _rtr(
+    K: np.ndarray, vK: np.ndarray, aK: np.ndarray, P: np.ndarray, vP: np.ndarray, aP: np.ndarray
+):
     """RTR with the block n on the pin D_n = P (l_n = 0, E = P): link m pinned at
     D_m = K, its slot along i_m through P; l_m = |K P| varies. The block turns with m."""
     d, vd, ad = P - K, vP - vK, aP - aK
@@ -893,7 +1094,7 @@ def _rtr(K, vK, aK, P, vP, aP):
 # ---------------------------------------------------------------------------
 # loading
 # ---------------------------------------------------------------------------
-def load(name: str, data=None) -> Chain:
+def load(name: str, data: Mapping | None = None) -> Chain:
     """The chain ``name`` (one of :data:`NAMES`): its scene file plus its table of the
     packaged ``chains.toml``. ``data`` overrides that table key by key (nested tables
     merged): a mapping, either the whole document (with a table ``name``) or the

@@ -9,33 +9,34 @@ from collections.abc import Mapping
 
 import numpy as np
 
-def unit(angle):
+
+def unit(angle: float):
     angle = np.asarray(angle, dtype=float)
     return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
 
 
-def rot90(v):
+def rot90(v: np.ndarray):
     return np.stack([-v[..., 1], v[..., 0]], axis=-1)
 
 
-def dot(a, b):
+def dot(a: np.ndarray, b: np.ndarray):
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
 
 
-def cross(a, b):
+def cross(a: np.ndarray, b: np.ndarray):
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
-def col(x):
+def col(x: str):
     return np.asarray(x, dtype=float)[..., None]
 
 
-def vec(x, y):
+def vec(x: str, y: str):
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     return np.stack([x, y], axis=-1)
 
 
-def merge(base, over):
+def merge(base: Mapping, over: Mapping):
     out = copy.deepcopy(base)
     for key, value in over.items():
         if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
@@ -45,7 +46,14 @@ def merge(base, over):
     return out
 
 
-def number(table, key, where, positive=False, nonnegative=False, default=None):
+def number(
+    table: Mapping,
+    key: str,
+    where: str,
+    positive: bool = False,
+    nonnegative: bool = False,
+    default: tuple[float, float] = None,
+):
     if key not in table:
         if default is not None:
             return float(default)
@@ -60,7 +68,7 @@ def number(table, key, where, positive=False, nonnegative=False, default=None):
     return float(value)
 
 
-def pair(table, key, where):
+def pair(table: Mapping, key: str, where: str):
     value = table.get(key)
     if value is None:
         raise ValueError(f"{where}: missing key {key!r}")

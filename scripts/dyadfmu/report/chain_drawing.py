@@ -20,40 +20,61 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+from typing import TYPE_CHECKING
+
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from . import sketch  # noqa: E402
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ..mechanisms.chains import Chain
+
 __all__ = ["draw", "figure", "reaction_vectors", "chain_size"]
 
 _CRANK_COLOUR = "#dd8452"
 _LINK_COLOURS = ("#4c72b0", "#8c8c3c", "#7f7f7f", "#c49c3c", "#64b5cd", "#8172b3")
-_ARROW_COLOURS = ("tab:red", "tab:green", "tab:purple", "tab:brown", "tab:pink",
-                  "tab:cyan", "black", "magenta", "tab:blue", "tab:olive")
+_ARROW_COLOURS = (
+    "tab:red",
+    "tab:green",
+    "tab:purple",
+    "tab:brown",
+    "tab:pink",
+    "tab:cyan",
+    "black",
+    "magenta",
+    "tab:blue",
+    "tab:olive",
+)
 _WIDTH = 5.0
 
 
-def _u2(angle):
+def _u2(angle: float):
     return np.array([math.cos(angle), math.sin(angle)])
 
 
-def _r90(v):
+def _r90(v: np.ndarray):
     return np.array([-v[1], v[0]])
 
 
-def reaction_vectors(chain, reactions, index):
+def reaction_vectors(chain: Chain, reactions: dict | None, index: int):
     """The pair forces at sample ``index``: list of (output name, body it acts on, kin key
     of its point, force (2,) [N]), crank pivot first, then per dyad R_mk, R_mn, R_np."""
     out = []
     for pr in chain.pairs:
-        f = np.array([float(np.asarray(reactions[f"{pr['key']}.x"])[index]),
-                      float(np.asarray(reactions[f"{pr['key']}.y"])[index])])
+        f = np.array(
+            [
+                float(np.asarray(reactions[f"{pr['key']}.x"])[index]),
+                float(np.asarray(reactions[f"{pr['key']}.y"])[index]),
+            ]
+        )
         out.append((pr["key"], pr["first"], pr["point"], f))
     return out
 
 
-def chain_size(chain, kin) -> float:
+def chain_size(chain: Chain, kin: dict) -> float:
     """Extent (m) of the mechanism over all samples of ``kin``: the larger side of the
     bounding box of its pair points, centres of mass, fixed pivots and guides."""
     keys = ["O", "A"] + [f"S_{b}" for b in chain.bodies]
@@ -69,7 +90,7 @@ def chain_size(chain, kin) -> float:
     return float(max(np.ptp(allp, axis=0).max(), 1e-3))
 
 
-def _point_labels(chain):
+def _point_labels(chain: Chain):
     """kin key of every pair point -> its name in the drawing."""
     names = {"O": "O", "A": chain.labels.get("A", "A")}
     for e in chain.plan:
@@ -79,8 +100,11 @@ def _point_labels(chain):
                 names[key] = chain.labels[key]
             elif att["kind"] == "pivot":
                 names[key] = att["label"]
-            elif att["kind"] == "point" and att["body"] == chain.crank_name and \
-                    tuple(att["at"]) == (float(chain.crank["length"]), 0.0):
+            elif (
+                att["kind"] == "point"
+                and att["body"] == chain.crank_name
+                and tuple(att["at"]) == (float(chain.crank["length"]), 0.0)
+            ):
                 names[key] = names["A"]
             else:
                 names[key] = key
@@ -89,7 +113,7 @@ def _point_labels(chain):
     return names
 
 
-def _link_guides(ax, frame, g, D, angle, colour):
+def _link_guides(ax: Axes, frame: dict, g: str, D: np.ndarray, angle: float, colour: str):
     """The guides carried by link ``g`` (origin D, angle ``angle`` at this sample): a wide
     bar from the link's guide point to the stretch the slider uses, grooved along it."""
     i_g = _u2(angle)
@@ -102,11 +126,20 @@ def _link_guides(ax, frame, g, D, angle, colour):
         s0, s1 = lg["range"]
         if np.hypot(*(Q - D)) > 0.0:
             sketch.bar(ax, D, Q, colour, z=2.2)
-        sketch.bar(ax, Q + min(s0, 0.0) * i_k, Q + max(s1, 0.0) * i_k, colour, width=_WIDTH * 1.6, z=2.5)
+        sketch.bar(
+            ax, Q + min(s0, 0.0) * i_k, Q + max(s1, 0.0) * i_k, colour, width=_WIDTH * 1.6, z=2.5
+        )
         sketch.slot(ax, Q + s0 * i_k, Q + s1 * i_k, z=2.6)
 
 
-def draw(ax, chain, kin, index, reactions=None, scale=None):
+def draw(
+    ax: Axes,
+    chain: Chain,
+    kin: dict,
+    index: int,
+    reactions: dict | None = None,
+    scale: float | None = None,
+):
     """Draw ``chain`` at sample ``index`` of ``kin`` (from ``chain.kinematics``) on ``ax``
     to scale, with equal aspect.
 
@@ -121,7 +154,7 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
         raise IndexError(f"index {index} out of range for {n_samples} samples")
     index = int(index) % n_samples
 
-    def at(key):
+    def at(key: str):
         return np.asarray(kin[key][index], dtype=float)
 
     size = chain_size(chain, kin)
@@ -136,7 +169,7 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
     frame = kin.get("frame") or chain._frame()
     for p in frame["pivots"].values():
         sketch.ground_pivot(ax, p, u)
-    hs = 1.0 * u                                     # half height of a slider on a guide
+    hs = 1.0 * u  # half height of a slider on a guide
     for label, (p0, p1) in frame["guides"].items():
         p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
         n = _r90((p1 - p0) / np.hypot(*(p1 - p0)))
@@ -149,7 +182,9 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
     O, A = at("O"), at("A")
     sketch.bar(ax, O, A, _CRANK_COLOUR, z=2.0)
     i_c = _u2(float(at(f"{chain.crank_name}.angle")))
-    _link_guides(ax, frame, chain.crank_name, O, float(at(f"{chain.crank_name}.angle")), _CRANK_COLOUR)
+    _link_guides(
+        ax, frame, chain.crank_name, O, float(at(f"{chain.crank_name}.angle")), _CRANK_COLOUR
+    )
     link_label_at[chain.crank_name] = 0.5 * (O + A) - 1.8 * u * _r90(i_c)
 
     # the links
@@ -175,10 +210,10 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
             S = at(f"S_{g}")
             col = colours[g]
             _link_guides(ax, frame, g, D, float(at(f"{g}.angle")), col)
-            if e["type"] == "RTR" and g == n:             # block in the slot of m
+            if e["type"] == "RTR" and g == n:  # block in the slot of m
                 sketch.block(ax, E, i_g, 2.4 * u, 1.1 * u, col, z=4.5)
                 link_label_at[g] = E - 2.2 * u * j_g - 1.2 * u * i_g
-            elif e["type"] == "RRT" and g == m:           # slider on the guide
+            elif e["type"] == "RRT" and g == m:  # slider on the guide
                 rel = [p - D for p in own + [S]]
                 xs = [float(r @ i_g) for r in rel]
                 ys = [float(r @ j_g) for r in rel]
@@ -187,21 +222,35 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
                 centre = D + 0.5 * (x0 + x1) * i_g + 0.5 * (y0 + y1) * j_g
                 sketch.block(ax, centre, i_g, x1 - x0, y1 - y0, col, z=3.0)
                 link_label_at[g] = D + 0.5 * (x0 + x1) * i_g + (y1 + 1.6 * u) * j_g
-            elif e["type"] == "RTR" and g == m:           # slotted link
+            elif e["type"] == "RTR" and g == m:  # slotted link
                 lengths = np.asarray(kin[f"{g}.length"], dtype=float)
                 reach = max([float(lengths.max())] + [float((p - D) @ i_g) for p in own]) + 1.2 * u
                 tip = D + reach * i_g
                 sketch.bar(ax, D, tip, col, width=_WIDTH * 1.6, z=2.5)
-                sketch.slot(ax, D + (lengths.min() - 1.0 * u) * i_g, D + (lengths.max() + 1.0 * u) * i_g,
-                      z=2.6)
+                sketch.slot(
+                    ax,
+                    D + (lengths.min() - 1.0 * u) * i_g,
+                    D + (lengths.max() + 1.0 * u) * i_g,
+                    z=2.6,
+                )
                 link_label_at[g] = D + 0.3 * reach * i_g + 2.0 * u * j_g
-            else:                                         # bar (or ternary plate)
+            else:  # bar (or ternary plate)
                 if len(own) >= 3:
-                    ax.add_patch(plt.Polygon([tuple(p) for p in own], closed=True, facecolor=col,
-                                             edgecolor="none", alpha=0.25, zorder=1.8))
+                    ax.add_patch(
+                        plt.Polygon(
+                            [tuple(p) for p in own],
+                            closed=True,
+                            facecolor=col,
+                            edgecolor="none",
+                            alpha=0.25,
+                            zorder=1.8,
+                        )
+                    )
                 for p in own[1:]:
                     sketch.bar(ax, D, p, col, z=2.2)
-                far = max(own[1:], key=lambda p: np.hypot(*(p - D))) if len(own) > 1 else D + u * i_g
+                far = (
+                    max(own[1:], key=lambda p: np.hypot(*(p - D))) if len(own) > 1 else D + u * i_g
+                )
                 side = _r90((far - D) / max(np.hypot(*(far - D)), 1e-300))
                 link_label_at[g] = 0.5 * (D + far) + 1.8 * u * side
     for p in pins:
@@ -227,7 +276,7 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
                 if names[b] not in group:
                     group.append(names[b])
         done.add(a)
-        named = [g for g in group if "." not in g]       # drop raw keys where a name exists
+        named = [g for g in group if "." not in g]  # drop raw keys where a name exists
         group = named or group
         for b in keys:
             if np.hypot(*(pts[a] - pts[b])) <= 1e-9 * size:
@@ -259,14 +308,30 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
             label = f"{name} on {body} at {shown.get(point, names[point])}: {np.hypot(*f):.4g} N"
             # later arrows thinner and on top, so that coincident ones stay visible
             width = 0.2 * u * (1.0 - 0.5 * k / max(len(vectors) - 1, 1))
-            arrows[name] = ax.arrow(p[0], p[1], vec[0], vec[1], width=width,
-                                    head_width=max(0.6 * u, 2.0 * width), head_length=head,
-                                    length_includes_head=True,
-                                    color=_ARROW_COLOURS[k % len(_ARROW_COLOURS)],
-                                    alpha=0.85, zorder=8 + 0.01 * k, label=label)
-        ax.legend(handles=list(arrows.values()), loc="upper center", bbox_to_anchor=(0.5, -0.13),
-                  ncol=2, fontsize=7, title=f"reactions; force scale {scale:.4g} N/m "
-                  f"(1 mm = {scale / 1000:.3g} N)", title_fontsize=7, framealpha=0.9)
+            arrows[name] = ax.arrow(
+                p[0],
+                p[1],
+                vec[0],
+                vec[1],
+                width=width,
+                head_width=max(0.6 * u, 2.0 * width),
+                head_length=head,
+                length_includes_head=True,
+                color=_ARROW_COLOURS[k % len(_ARROW_COLOURS)],
+                alpha=0.85,
+                zorder=8 + 0.01 * k,
+                label=label,
+            )
+        ax.legend(
+            handles=list(arrows.values()),
+            loc="upper center",
+            bbox_to_anchor=(0.5, -0.13),
+            ncol=2,
+            fontsize=7,
+            title=f"reactions; force scale {scale:.4g} N/m (1 mm = {scale / 1000:.3g} N)",
+            title_fontsize=7,
+            framealpha=0.9,
+        )
     elif scale is None:
         scale = 1.0
 
@@ -279,7 +344,7 @@ def draw(ax, chain, kin, index, reactions=None, scale=None):
     return {"scale": scale, "arrows": arrows}
 
 
-def figure(chain, kin, reactions, indices, path):
+def figure(chain: Chain, kin: dict, reactions: dict | None, indices: list[int], path: Path | str):
     """Save a PNG of ``chain`` at 2 to 4 samples ``indices`` of ``kin``, one panel each,
     all with the reactions on one force scale (the largest arrow of all panels is 40 %
     of the mechanism's size). Returns the path."""
@@ -288,8 +353,9 @@ def figure(chain, kin, reactions, indices, path):
         raise ValueError(f"indices: expected 2 to 4 samples, got {len(indices)}")
     scale = None
     if reactions:
-        largest = max(float(np.hypot(*f)) for i in indices
-                      for *_, f in reaction_vectors(chain, reactions, i))
+        largest = max(
+            float(np.hypot(*f)) for i in indices for *_, f in reaction_vectors(chain, reactions, i)
+        )
         scale = largest / (0.4 * chain_size(chain, kin)) if largest > 0 else 1.0
     cols = 2 if len(indices) == 4 else len(indices)
     rows = 2 if len(indices) == 4 else 1
@@ -298,8 +364,9 @@ def figure(chain, kin, reactions, indices, path):
     for ax, i in zip(axes.flat, indices):
         draw(ax, chain, kin, i, reactions, scale)
         phi = math.degrees(float(kin[f"{c}.angle"][i])) % 360.0
-        ax.set_title(f"{chain.name}: {c} angle {phi:.1f} deg, t = {float(kin['t'][i]):.4g} s",
-                     fontsize=10)
+        ax.set_title(
+            f"{chain.name}: {c} angle {phi:.1f} deg, t = {float(kin['t'][i]):.4g} s", fontsize=10
+        )
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=110, bbox_inches="tight")

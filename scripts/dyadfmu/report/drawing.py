@@ -10,23 +10,29 @@ their guide, centres of mass as dots (S_c, S_m, S_n), and labels.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.patches import Circle, Polygon
 
 from . import sketch
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from matplotlib.axes import Axes
+
+    from ..mechanisms.builtin import Mechanism
 
 __all__ = ["draw", "mechanism_size", "APPLICATION"]
 
 #: Where each reaction acts: R_mk on m at D_m, R_np on n at D_n, R_mn on m at E,
 #: R_O on the crank at O (from the frame).
 APPLICATION = {"R_mk": "D_m", "R_np": "D_n", "R_mn": "E", "R_O": "O"}
-_ARROW_COLOURS = {"R_mk": "tab:red", "R_np": "tab:blue", "R_mn": "tab:purple",
-                  "R_O": "tab:green"}
+_ARROW_COLOURS = {"R_mk": "tab:red", "R_np": "tab:blue", "R_mn": "tab:purple", "R_O": "tab:green"}
 _COLOUR = {"p": "tab:orange", "m": "tab:blue", "n": "tab:olive", "k": "0.35"}
 
 
-def mechanism_size(mechanism, kin) -> float:
+def mechanism_size(mechanism: Mechanism, kin: dict) -> float:
     """Extent (m) of the mechanism over all samples of ``kin``: the larger side of the
     bounding box of its pairs, fixed pivots, fixed guides and the crank's circle."""
     pts = [np.asarray(kin[k], dtype=float).reshape(-1, 2) for k in ("O", "A", "D_m", "E", "D_n")]
@@ -46,41 +52,47 @@ def mechanism_size(mechanism, kin) -> float:
 # ---------------------------------------------------------------------------
 # primitives
 # ---------------------------------------------------------------------------
-def _unit(angle):
+def _unit(angle: float):
     return np.array([math.cos(angle), math.sin(angle)])
 
 
-def _rot90(v):
+def _rot90(v: np.ndarray):
     return np.array([-v[1], v[0]])
 
 
 # ---------------------------------------------------------------------------
 # the mechanisms
 # ---------------------------------------------------------------------------
-def _draw_slider_crank(ax, mech, at, u):
+def _draw_slider_crank(ax: Axes, mech: Mechanism, at: Callable, u: float):
     A, B = at("A"), at("D_m")
     x0, x1 = (p[0] for p in mech._frame()["guides"]["k"])
     e = mech.e
-    hb = 1.0 * u                                  # half height of the slider
-    ax.plot([x0, x1], [e, e], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)     # guide line
-    sketch.hatch(ax, (x0, e - hb), (x1, e - hb), (0.0, -1.0), u)                       # rail below
-    sketch.hatch(ax, (x0, e + hb), (x1, e + hb), (0.0, 1.0), u)                        # and above
+    hb = 1.0 * u  # half height of the slider
+    ax.plot([x0, x1], [e, e], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)  # guide line
+    sketch.hatch(ax, (x0, e - hb), (x1, e - hb), (0.0, -1.0), u)  # rail below
+    sketch.hatch(ax, (x0, e + hb), (x1, e + hb), (0.0, 1.0), u)  # and above
     sketch.block(ax, B, (1.0, 0.0), 3.0 * u, 2.0 * hb, _COLOUR["m"])
     sketch.bar(ax, A, B, _COLOUR["n"], z=3)
-    return {"m": B + np.array([0.0, 2.6 * u]), "n": sketch.beside(A, B, u),
-            "k": np.array([x1, e - hb]) + np.array([-0.5 * u, -1.8 * u])}
+    return {
+        "m": B + np.array([0.0, 2.6 * u]),
+        "n": sketch.beside(A, B, u),
+        "k": np.array([x1, e - hb]) + np.array([-0.5 * u, -1.8 * u]),
+    }
 
 
-def _draw_four_bar(ax, mech, at, u):
+def _draw_four_bar(ax: Axes, mech: Mechanism, at: Callable, u: float):
     A, E, O4 = at("A"), at("E"), at("D_m")
     sketch.ground_pivot(ax, O4, u)
     sketch.bar(ax, O4, E, _COLOUR["m"], z=2.5)
     sketch.bar(ax, A, E, _COLOUR["n"], z=3)
-    return {"m": sketch.beside(O4, E, u, up=False), "n": sketch.beside(A, E, u),
-            "k": O4 + np.array([3.4 * u, -1.0 * u])}
+    return {
+        "m": sketch.beside(O4, E, u, up=False),
+        "n": sketch.beside(A, E, u),
+        "k": O4 + np.array([3.4 * u, -1.0 * u]),
+    }
 
 
-def _draw_quick_return(ax, mech, at, u):
+def _draw_quick_return(ax: Axes, mech: Mechanism, at: Callable, u: float):
     A, O2 = at("A"), at("D_m")
     i_m = _unit(at("m.angle"))
     d = math.hypot(*mech.O2)
@@ -88,48 +100,64 @@ def _draw_quick_return(ax, mech, at, u):
     tip = O2 + mech.lever_length * i_m
     sketch.ground_pivot(ax, O2, u)
     sketch.bar(ax, O2, tip, _COLOUR["m"], width=sketch.LINK_WIDTH * 1.6, z=2.5)
-    sketch.slot(ax, O2 + (d - r - 1.2 * u) * i_m, O2 + min(d + r + 1.2 * u, mech.lever_length) * i_m,
-          z=2.6)
+    sketch.slot(
+        ax, O2 + (d - r - 1.2 * u) * i_m, O2 + min(d + r + 1.2 * u, mech.lever_length) * i_m, z=2.6
+    )
     sketch.block(ax, A, i_m, 2.4 * u, 1.1 * u, _COLOUR["n"], z=4)
-    return {"m": O2 + 0.5 * (d - r) * i_m + 1.8 * u * _rot90(i_m),
-            "n": A - 2.0 * u * _rot90(i_m) - 1.0 * u * i_m,
-            "k": O2 + np.array([3.4 * u, -1.0 * u])}
+    return {
+        "m": O2 + 0.5 * (d - r) * i_m + 1.8 * u * _rot90(i_m),
+        "n": A - 2.0 * u * _rot90(i_m) - 1.0 * u * i_m,
+        "k": O2 + np.array([3.4 * u, -1.0 * u]),
+    }
 
 
-def _draw_scotch_yoke(ax, mech, at, u):
+def _draw_scotch_yoke(ax: Axes, mech: Mechanism, at: Callable, u: float):
     A, Dm = at("A"), at("D_m")
     r, h = mech.crank["radius"], mech.h
     (x0, _), (x1, _) = mech._frame()["guides"]["k"]
     x0, x1 = min(x0, -r - 3 * u), max(x1, r + 3 * u)
-    hf = 0.8 * u                                  # half height of the yoke's foot
+    hf = 0.8 * u  # half height of the yoke's foot
     ax.plot([x0, x1], [-h, -h], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)
     sketch.hatch(ax, (x0, -h - hf), (x1, -h - hf), (0.0, -1.0), u)
     top = np.array([Dm[0], r + 2.0 * u])
     sketch.bar(ax, Dm, top, _COLOUR["m"], width=sketch.LINK_WIDTH * 1.6, z=2.5)
     sketch.slot(ax, (Dm[0], -r - 1.0 * u), (Dm[0], r + 1.0 * u), z=2.6)
-    sketch.block(ax, Dm, (1.0, 0.0), 4.0 * u, 2.0 * hf, _COLOUR["m"], z=3)             # foot on k
-    sketch.block(ax, A, (0.0, 1.0), 2.4 * u, 1.1 * u, _COLOUR["n"], z=4)               # block in slot
-    return {"m": top + np.array([1.5 * u, -0.5 * u]), "n": A + np.array([1.8 * u, -1.2 * u]),
-            "k": np.array([x1 - 0.5 * u, -h - hf - 1.6 * u])}
+    sketch.block(ax, Dm, (1.0, 0.0), 4.0 * u, 2.0 * hf, _COLOUR["m"], z=3)  # foot on k
+    sketch.block(ax, A, (0.0, 1.0), 2.4 * u, 1.1 * u, _COLOUR["n"], z=4)  # block in slot
+    return {
+        "m": top + np.array([1.5 * u, -0.5 * u]),
+        "n": A + np.array([1.8 * u, -1.2 * u]),
+        "k": np.array([x1 - 0.5 * u, -h - hf - 1.6 * u]),
+    }
 
 
-def _draw_trt_slot(ax, mech, at, u):
+def _draw_trt_slot(ax: Axes, mech: Mechanism, at: Callable, u: float):
     E = at("E")
     phi = at("crank.angle")
     i_p = _unit(phi)
     r, h = mech.crank["radius"], mech.h
     (x0, _), (x1, _) = mech._frame()["guides"]["k"]
-    hs = 1.0 * u                                  # half height of the slider
+    hs = 1.0 * u  # half height of the slider
     ax.plot([x0, x1], [h, h], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)
     sketch.hatch(ax, (x0, h + hs), (x1, h + hs), (0.0, 1.0), u)
     sketch.hatch(ax, (x0, h - hs), (x1, h - hs), (0.0, -1.0), u)
-    sketch.block(ax, E, (1.0, 0.0), 4.0 * u, 2.0 * hs, _COLOUR["m"], z=3)              # slider on k
-    sketch.block(ax, E, i_p, 2.4 * u, 1.1 * u, _COLOUR["n"], z=4.5)                    # block in slot
-    return {"m": E + np.array([2.8 * u, -2.0 * u]), "n": E + 2.2 * u * _rot90(i_p) - 1.0 * u * i_p,
-            "k": np.array([x1 - 0.5 * u, h + hs + 1.6 * u])}
+    sketch.block(ax, E, (1.0, 0.0), 4.0 * u, 2.0 * hs, _COLOUR["m"], z=3)  # slider on k
+    sketch.block(ax, E, i_p, 2.4 * u, 1.1 * u, _COLOUR["n"], z=4.5)  # block in slot
+    return {
+        "m": E + np.array([2.8 * u, -2.0 * u]),
+        "n": E + 2.2 * u * _rot90(i_p) - 1.0 * u * i_p,
+        "k": np.array([x1 - 0.5 * u, h + hs + 1.6 * u]),
+    }
 
 
-def draw(ax, mechanism, kin, index, reactions=None, scale=None):
+def draw(
+    ax: Axes,
+    mechanism: Mechanism,
+    kin: dict,
+    index: int,
+    reactions: dict | None = None,
+    scale: float | None = None,
+):
     """Draw ``mechanism`` at sample ``index`` of ``kin`` (from ``mechanism.kinematics``)
     on ``ax`` to scale, with equal aspect.
 
@@ -144,24 +172,28 @@ def draw(ax, mechanism, kin, index, reactions=None, scale=None):
         raise IndexError(f"index {index} out of range for {n_samples} samples")
     index = int(index) % n_samples
 
-    def at(key):
+    def at(key: str):
         return np.asarray(kin[key][index], dtype=float)
 
     size = mechanism_size(mechanism, kin)
-    u = 0.035 * size                               # size of the symbols
+    u = 0.035 * size  # size of the symbols
     O, A = at("O"), at("A")
     phi = float(at("crank.angle"))
 
     # frame k at O, the crank p
     sketch.ground_pivot(ax, O, u)
-    side = _rot90(_unit(phi))                      # the crank's label goes on the side away from E
+    side = _rot90(_unit(phi))  # the crank's label goes on the side away from E
     if np.dot(side, at("E") - O) > 0:
         side = -side
     if mechanism.dyad == "TRT":
         tip = O + mechanism.crank["radius"] * _unit(phi)
         sketch.bar(ax, O, tip, _COLOUR["p"], width=sketch.LINK_WIDTH * 1.6, z=2.0)
-        sketch.slot(ax, O + 0.35 * (tip - O), O + (tip - O) * (1 - 1.2 * u / mechanism.crank["radius"]),
-              z=2.1)
+        sketch.slot(
+            ax,
+            O + 0.35 * (tip - O),
+            O + (tip - O) * (1 - 1.2 * u / mechanism.crank["radius"]),
+            z=2.1,
+        )
         p_label = O + 0.25 * (tip - O) + 1.6 * u * side
     else:
         sketch.bar(ax, O, A, _COLOUR["p"], z=2.0)
@@ -179,8 +211,13 @@ def draw(ax, mechanism, kin, index, reactions=None, scale=None):
         where = _draw_trt_slot(ax, mechanism, at, u)
 
     # revolute pairs
-    pins = {"RRT": ("O", "A", "E"), "RRR": ("O", "A", "E", "D_m"),
-            "RTR": ("O", "A", "D_m"), "RTT": ("O", "A"), "TRT": ("O", "E")}[mechanism.dyad]
+    pins = {
+        "RRT": ("O", "A", "E"),
+        "RRR": ("O", "A", "E", "D_m"),
+        "RTR": ("O", "A", "D_m"),
+        "RTT": ("O", "A"),
+        "TRT": ("O", "E"),
+    }[mechanism.dyad]
     for key in pins:
         sketch.pin(ax, at(key), u)
 
@@ -208,8 +245,16 @@ def draw(ax, mechanism, kin, index, reactions=None, scale=None):
     # link labels
     link_at = {"p": p_label, "m": where["m"], "n": where["n"], "k": where["k"]}
     for link, p in link_at.items():
-        sketch.label(ax, p, link, (0.0, 0.0), colour=_COLOUR[link] if link != "k" else "black",
-               size=12, weight="bold", box=False)
+        sketch.label(
+            ax,
+            p,
+            link,
+            (0.0, 0.0),
+            colour=_COLOUR[link] if link != "k" else "black",
+            size=12,
+            weight="bold",
+            box=False,
+        )
 
     # reactions
     if scale is not None:
@@ -220,7 +265,9 @@ def draw(ax, mechanism, kin, index, reactions=None, scale=None):
         forces = {}
         for name, f in reactions.items():
             if name not in APPLICATION:
-                raise ValueError(f"unknown reaction {name!r}; expected some of {sorted(APPLICATION)}")
+                raise ValueError(
+                    f"unknown reaction {name!r}; expected some of {sorted(APPLICATION)}"
+                )
             f = np.asarray(f, dtype=float).reshape(2)
             if np.all(np.isfinite(f)):
                 forces[name] = f
@@ -234,18 +281,38 @@ def draw(ax, mechanism, kin, index, reactions=None, scale=None):
             length = float(np.hypot(*vec))
             label = f"{name} = {np.hypot(*f):.4g} N"
             if length <= 1e-12 * size:
-                handles.append(ax.plot([p[0]], [p[1]], "x", color=_ARROW_COLOURS[name],
-                                       label=label, zorder=8)[0])
+                handles.append(
+                    ax.plot([p[0]], [p[1]], "x", color=_ARROW_COLOURS[name], label=label, zorder=8)[
+                        0
+                    ]
+                )
                 continue
             head = min(1.1 * u, 0.5 * length)
-            handles.append(ax.arrow(p[0], p[1], vec[0], vec[1], width=0.16 * u,
-                                    head_width=0.65 * u, head_length=head,
-                                    length_includes_head=True, color=_ARROW_COLOURS[name],
-                                    alpha=0.85, zorder=8, label=label))
+            handles.append(
+                ax.arrow(
+                    p[0],
+                    p[1],
+                    vec[0],
+                    vec[1],
+                    width=0.16 * u,
+                    head_width=0.65 * u,
+                    head_length=head,
+                    length_includes_head=True,
+                    color=_ARROW_COLOURS[name],
+                    alpha=0.85,
+                    zorder=8,
+                    label=label,
+                )
+            )
         if handles:
-            ax.legend(handles=handles, loc="best", fontsize=8,
-                      title=f"force scale {scale:.3g} N/m\n(1 mm = {scale / 1000:.3g} N)",
-                      title_fontsize=8, framealpha=0.85)
+            ax.legend(
+                handles=handles,
+                loc="best",
+                fontsize=8,
+                title=f"force scale {scale:.3g} N/m\n(1 mm = {scale / 1000:.3g} N)",
+                title_fontsize=8,
+                framealpha=0.85,
+            )
     elif scale is None:
         scale = 1.0
 

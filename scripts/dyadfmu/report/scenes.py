@@ -15,26 +15,34 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
-import shutil
-import subprocess
 import sys
-import tempfile
-from dataclasses import dataclass
 from pathlib import Path
-
-import numpy as np
-from fmpy import read_model_description
 
 from .. import paths
 from ..cosim import scenes
 from ..study.footprint import measure
 from .tables import format_markdown, format_text
 
-def footprint_rows(results) -> list:
-    rows = [["scene", "generic FMUs", "variables (in/par/out)", "generic variables",
-             "binary (bytes)", "generic binaries", ".text (bytes)", "generic .text",
-             "instr./doStep", "generic instr.", "ratio", "ns/doStep", "generic ns", "ratio"]]
+
+def footprint_rows(results: list) -> list:
+    rows = [
+        [
+            "scene",
+            "generic FMUs",
+            "variables (in/par/out)",
+            "generic variables",
+            "binary (bytes)",
+            "generic binaries",
+            ".text (bytes)",
+            "generic .text",
+            "instr./doStep",
+            "generic instr.",
+            "ratio",
+            "ns/doStep",
+            "generic ns",
+            "ratio",
+        ]
+    ]
     for name, mine, full in results:
         unique = {}
         for dyad, f in zip(scenes.FULL_OF[name], full):
@@ -47,65 +55,105 @@ def footprint_rows(results) -> list:
         f_text = sum(f.text_bytes for f in unique.values())
         f_instr = sum(f.instructions for f in full)
         f_sec = sum(f.seconds for f in full)
-        rows.append([
-            name, " + ".join(f"dyad_{d.lower()}" for d in scenes.FULL_OF[name]),
-            f"{mine.variables} ({mine.inputs}/{mine.parameters}/{mine.outputs})",
-            f"{f_vars} ({f_in}/{f_par}/{f_out})",
-            f"{mine.binary_bytes}", f"{f_bytes}", f"{mine.text_bytes}", f"{f_text}",
-            f"{mine.instructions:.0f}", f"{f_instr:.0f}",
-            f"{mine.instructions / f_instr:.2f}" if f_instr else "-",
-            f"{1e9 * mine.seconds:.0f}", f"{1e9 * f_sec:.0f}",
-            f"{mine.seconds / f_sec:.2f}" if f_sec else "-"])
+        rows.append(
+            [
+                name,
+                " + ".join(f"dyad_{d.lower()}" for d in scenes.FULL_OF[name]),
+                f"{mine.variables} ({mine.inputs}/{mine.parameters}/{mine.outputs})",
+                f"{f_vars} ({f_in}/{f_par}/{f_out})",
+                f"{mine.binary_bytes}",
+                f"{f_bytes}",
+                f"{mine.text_bytes}",
+                f"{f_text}",
+                f"{mine.instructions:.0f}",
+                f"{f_instr:.0f}",
+                f"{mine.instructions / f_instr:.2f}" if f_instr else "-",
+                f"{1e9 * mine.seconds:.0f}",
+                f"{1e9 * f_sec:.0f}",
+                f"{mine.seconds / f_sec:.2f}" if f_sec else "-",
+            ]
+        )
     return rows
 
 
-def accuracy_rows(runs) -> list:
-    rows = [["scene", "FMI", "outputs", "steps", "worst error / own peak",
-             "worst error / peak of its unit", "driving torque (N m)", "energy balance",
-             "run time (s)"]]
+def accuracy_rows(runs: list) -> list:
+    rows = [
+        [
+            "scene",
+            "FMI",
+            "outputs",
+            "steps",
+            "worst error / own peak",
+            "worst error / peak of its unit",
+            "driving torque (N m)",
+            "energy balance",
+            "run time (s)",
+        ]
+    ]
     for r in runs:
         torque = r.fmu.get(f"{r.source.crank_name}.torque")
         scale = {}
         for e in r.errors:
             scale[e.unit] = max(scale.get(e.unit, 0.0), e.peak)
         per_unit = max(e.max_abs / scale[e.unit] for e in r.errors if scale[e.unit] > 0)
-        rows.append([r.name, str(r.fmi_version), str(len(r.errors)), str(r.steps),
-                     f"{r.worst_relative:.2e}", f"{per_unit:.2e}",
-                     f"{torque[r.valid].min():.4g} .. {torque[r.valid].max():.4g}"
-                     if torque is not None else "-",
-                     f"{r.energy_residual:.1e}" if not math.isnan(r.energy_residual) else "-",
-                     f"{r.seconds_fmu:.3f}"])
+        rows.append(
+            [
+                r.name,
+                str(r.fmi_version),
+                str(len(r.errors)),
+                str(r.steps),
+                f"{r.worst_relative:.2e}",
+                f"{per_unit:.2e}",
+                f"{torque[r.valid].min():.4g} .. {torque[r.valid].max():.4g}"
+                if torque is not None
+                else "-",
+                f"{r.energy_residual:.1e}" if not math.isnan(r.energy_residual) else "-",
+                f"{r.seconds_fmu:.3f}",
+            ]
+        )
     return rows
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="dyadfmu scenes",
         description="Co-simulate every example scene's tailored FMU against its reference, "
-                    "draw the chains with their reactions, and measure each tailored FMU "
-                    "against the generic per-type FMUs it replaces (variables, binary size, "
-                    "callgrind instructions and time per doStep); writes report.md.")
-    parser.add_argument("--out", type=Path, default=Path("out/scenes"),
-                        help="directory for the report, tables and drawings "
-                             "(default ./out/scenes)")
-    parser.add_argument("--build", type=Path, default=None,
-                        help="CMake build directory with fmus/ and tests/bench (default build/)")
-    parser.add_argument("--quick", action="store_true",
-                        help="fewer steps and rows (for CI)")
+        "draw the chains with their reactions, and measure each tailored FMU "
+        "against the generic per-type FMUs it replaces (variables, binary size, "
+        "callgrind instructions and time per doStep); writes report.md.",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("out/scenes"),
+        help="directory for the report, tables and drawings (default ./out/scenes)",
+    )
+    parser.add_argument(
+        "--build",
+        type=Path,
+        default=None,
+        help="CMake build directory with fmus/ and tests/bench (default build/)",
+    )
+    parser.add_argument("--quick", action="store_true", help="fewer steps and rows (for CI)")
     args = parser.parse_args(argv)
     build = args.build or paths.build_dir()
     out = args.out
     out.mkdir(parents=True, exist_ok=True)
 
-    def log(text):
+    def log(text: str):
         print(text, file=sys.stderr)
 
     try:
         runs = []
         for name in scenes.NAMES:
             for version in (2, 3):
-                result = scenes.run(name, version, revolutions=1.0 if args.quick else 2.0,
-                                    steps=180 if args.quick else 360, build=build)
+                result = scenes.run(
+                    name,
+                    version,
+                    revolutions=1.0 if args.quick else 2.0,
+                    steps=180 if args.quick else 360,
+                    build=build,
+                )
                 runs.append(result)
                 log(scenes.summary(result))
         drawings = []
@@ -113,38 +161,52 @@ def main(argv=None) -> int:
 
         for r in runs:
             if r.source.chain is not None and r.fmi_version == 2:
-                drawings.append(chain_drawing.figure(r.source.chain, r.kin, scenes.reactions_of(r),
-                                                     scenes.drawing_indices(r),
-                                                     out / f"{r.name}_reactions.png"))
-        results = measure(build, 2, rows_count=200 if args.quick else 500,
-                          repeat=5 if args.quick else 21, log=log)
+                drawings.append(
+                    chain_drawing.figure(
+                        r.source.chain,
+                        r.kin,
+                        scenes.reactions_of(r),
+                        scenes.drawing_indices(r),
+                        out / f"{r.name}_reactions.png",
+                    )
+                )
+        results = measure(
+            build, 2, rows_count=200 if args.quick else 500, repeat=5 if args.quick else 21, log=log
+        )
     except FileNotFoundError as error:
         print(f"dyadfmu: {error}", file=sys.stderr)
         return 2
 
     acc = accuracy_rows(runs)
     foot = footprint_rows(results)
-    text = ["# Scenes: tailored FMUs against the generic per-type FMUs", "",
-            "Every example scene's tailored FMU, co-simulated with fmpy over "
-            f"{'one crank turn (180' if args.quick else 'two crank turns (360'} steps per "
-            "turn) and compared output by output with its independent reference. Errors are "
-            "relative to each output's own peak, and to the peak of all outputs in the same "
-            "unit (a reaction that is tiny beside the mechanism's other forces, like the "
-            "shaper's slot moment M_mn of 8e-3 N m among moments of 275 N m, keeps the "
-            "round-off of those); the chains' driving torque is also checked against the "
-            "energy balance of the whole mechanism, relative to the peak driving power:", "",
-            format_markdown(acc), "",
-            "What tailoring buys (FMI 2 binaries; the generic route needs one dyad_<type> FMU "
-            "per dyad, binaries counted once per type; instructions by callgrind per doStep "
-            "including setting the inputs and getting the real outputs; times are medians "
-            "of one run, ratios in the same run):", "",
-            format_markdown(foot), "",
-            "The generic route also leaves the master to carry each dyad's reactions to the "
-            "links it is attached to and to balance the crank; that work is not counted "
-            "above.", ""]
+    text = [
+        "# Scenes: tailored FMUs against the generic per-type FMUs",
+        "",
+        "Every example scene's tailored FMU, co-simulated with fmpy over "
+        f"{'one crank turn (180' if args.quick else 'two crank turns (360'} steps per "
+        "turn) and compared output by output with its independent reference. Errors are "
+        "relative to each output's own peak, and to the peak of all outputs in the same "
+        "unit (a reaction that is tiny beside the mechanism's other forces, like the "
+        "shaper's slot moment M_mn of 8e-3 N m among moments of 275 N m, keeps the "
+        "round-off of those); the chains' driving torque is also checked against the "
+        "energy balance of the whole mechanism, relative to the peak driving power:",
+        "",
+        format_markdown(acc),
+        "",
+        "What tailoring buys (FMI 2 binaries; the generic route needs one dyad_<type> FMU "
+        "per dyad, binaries counted once per type; instructions by callgrind per doStep "
+        "including setting the inputs and getting the real outputs; times are medians "
+        "of one run, ratios in the same run):",
+        "",
+        format_markdown(foot),
+        "",
+        "The generic route also leaves the master to carry each dyad's reactions to the "
+        "links it is attached to and to balance the crank; that work is not counted "
+        "above.",
+        "",
+    ]
     if drawings:
-        text += ["Drawings with every reaction: " +
-                 ", ".join(f"`{p.name}`" for p in drawings), ""]
+        text += ["Drawings with every reaction: " + ", ".join(f"`{p.name}`" for p in drawings), ""]
     report = out / "report.md"
     report.write_text("\n".join(text))
     print(format_text(acc))

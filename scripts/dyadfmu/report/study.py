@@ -12,14 +12,28 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..study.accuracy import EPS, LABELS, SETS, Results  # noqa: E402
+from ..study.accuracy import EPS, LABELS, SETS, Results, Sizes  # noqa: E402
 from ..study.configurations import TYPES  # noqa: E402
 
-MARKERS = {"core": "o", "core_float": "v", "gsl_lu": "s", "gsl_svd": "D", "numpy": "^",
-           "fmu_c2": "P", "fmu_c3": "X", "fmu_fmpy2": "*", "fmu_fmpy3": "h"}
+MARKERS = {
+    "core": "o",
+    "core_float": "v",
+    "gsl_lu": "s",
+    "gsl_svd": "D",
+    "numpy": "^",
+    "fmu_c2": "P",
+    "fmu_c3": "X",
+    "fmu_fmpy2": "*",
+    "fmu_fmpy3": "h",
+}
 COLORS = dict(zip(TYPES, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")))
-METHOD_COLORS = {"core": "tab:blue", "core_float": "tab:cyan", "gsl_lu": "tab:green",
-                 "gsl_svd": "tab:olive", "numpy": "tab:red"}
+METHOD_COLORS = {
+    "core": "tab:blue",
+    "core_float": "tab:cyan",
+    "gsl_lu": "tab:green",
+    "gsl_svd": "tab:olive",
+    "numpy": "tab:red",
+}
 
 
 def _label(method: str) -> str:
@@ -28,21 +42,30 @@ def _label(method: str) -> str:
     return LABELS[method]
 
 
-def plots(out: Path, points, summary) -> dict:
+def plots(out: Path, points: list[tuple], summary: list[dict]) -> dict:
     figures = {}
     # Work-precision: worst error on the random set against time per configuration.
     fig, ax = plt.subplots(figsize=(8.5, 6))
     for s in summary:
-        ax.loglog(s["seconds"], max(s["worst"], 1e-17), MARKERS[s["method"]],
-                  color=COLORS[s["type"]], ms=8, alpha=0.85)
+        ax.loglog(
+            s["seconds"],
+            max(s["worst"], 1e-17),
+            MARKERS[s["method"]],
+            color=COLORS[s["type"]],
+            ms=8,
+            alpha=0.85,
+        )
     for method, marker in MARKERS.items():
         ax.plot([], [], marker, color="gray", label=_label(method))
     for dyad, color in COLORS.items():
         ax.plot([], [], "s", color=color, label=dyad)
     ax.set_xlabel("time per configuration (s)")
     ax.set_ylabel("worst error, relative to the largest reaction")
-    ax.set_title("Work-precision on well-conditioned random configurations\n"
-                 "(FMU points carry the C core's error: they run the same code)", fontsize=10)
+    ax.set_title(
+        "Work-precision on well-conditioned random configurations\n"
+        "(FMU points carry the C core's error: they run the same code)",
+        fontsize=10,
+    )
     ax.grid(which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2, loc="upper right")
     fig.tight_layout()
@@ -58,11 +81,19 @@ def plots(out: Path, points, summary) -> dict:
     amp_line = np.logspace(0, 17, 50)
     for ax, dyad in zip(axes.flat, TYPES):
         for method, color in METHOD_COLORS.items():
-            data = np.array([(a, e) for a, e, _ in by[(dyad, method)]
-                             if np.isfinite(a) and np.isfinite(e)])
+            data = np.array(
+                [(a, e) for a, e, _ in by[(dyad, method)] if np.isfinite(a) and np.isfinite(e)]
+            )
             if data.size:
-                ax.loglog(data[:, 0], np.maximum(data[:, 1], 1e-18), ".", color=color, ms=3,
-                          alpha=0.5, label=LABELS[method])
+                ax.loglog(
+                    data[:, 0],
+                    np.maximum(data[:, 1], 1e-18),
+                    ".",
+                    color=color,
+                    ms=3,
+                    alpha=0.5,
+                    label=LABELS[method],
+                )
         ax.loglog(amp_line, EPS["double"] * amp_line, "k--", lw=1, label="eps(double) x A")
         ax.loglog(amp_line, EPS["float"] * amp_line, "k:", lw=1, label="eps(float) x A")
         ax.set_title(dyad)
@@ -75,8 +106,11 @@ def plots(out: Path, points, summary) -> dict:
     handles, labels = axes[0, 0].get_legend_handles_labels()
     axes.flat[-1].axis("off")
     axes.flat[-1].legend(handles, labels, loc="center", fontsize=9, markerscale=4)
-    fig.suptitle("Error against amplification: random, near-singular, extreme and cancelling "
-                 "sets (ground truth: mpmath, 50 digits)", fontsize=11)
+    fig.suptitle(
+        "Error against amplification: random, near-singular, extreme and cancelling "
+        "sets (ground truth: mpmath, 50 digits)",
+        fontsize=11,
+    )
     fig.tight_layout()
     figures["error_vs_amplification"] = out / "error_vs_amplification.png"
     fig.savefig(figures["error_vs_amplification"], dpi=110)
@@ -88,63 +122,90 @@ def _fmt_time(seconds: float) -> str:
     return f"{seconds * 1e9:.0f} ns" if seconds < 1e-6 else f"{seconds * 1e6:.2f} us"
 
 
-def markdown(out: Path, summary, contract, silent, sizes, quick, elapsed, figures) -> Path:
+def markdown(
+    out: Path,
+    summary: list[dict],
+    contract: dict,
+    silent: dict,
+    sizes: Sizes,
+    quick: bool,
+    elapsed: float,
+    figures: dict,
+) -> Path:
     core_time = {s["type"]: s["seconds"] for s in summary if s["method"] == "core"}
-    lines = ["# dyadfmu: accuracy and speed of every way to compute the reactions", "",
-             f"Generated by `scripts/run-study{' --quick' if quick else ''}` in {elapsed:.0f} s. "
-             f"Random set: {sizes.timing} well-conditioned configurations per type (timed), "
-             f"{sizes.truth} of them against ground truth; near-singular sweeps: "
-             f"{sizes.instances} per type, {sizes.per_decade} points per decade of the type's "
-             f"denominator from 1e-1 to 1e-16; extreme set: {sizes.extreme} per type, and as "
-             "many whose loads cancel as they are summed (each link's active load balancing "
-             "its weight and inertia to 1e-3 ... 1e-12). Ground "
-             "truth: mpmath (50 digits) solving the generic Newton-Euler system from the same "
-             "double inputs. Error = largest |method - truth| over the outputs, relative to "
-             "the largest reaction of the configuration (forces and reactive moments each "
-             "against their own largest, since N and N m do not compare); componentwise = "
-             "each output against its own true value. Times are medians of repeated runs "
-             "in one invocation; instructions per solve from `valgrind --tool=callgrind` "
-             "(solve loop only). Amplification A: the C core's output, data factor / "
-             "conditioning, where the data factor (1 to 1/eps) is how much larger the "
-             "load terms the core sums (active loads, weights, each part of the inertia "
-             "forces, their moments, and the closed forms' own sums) are than the largest "
-             "reaction of their unit: eps x A x that reaction bounds the error of every "
-             "reaction of the unit (src/dyad_amplification.h).", "",
-             "| method | type | median error | worst error | worst componentwise | "
-             "time per configuration | instructions per solve | time / C core |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "# dyadfmu: accuracy and speed of every way to compute the reactions",
+        "",
+        f"Generated by `scripts/run-study{' --quick' if quick else ''}` in {elapsed:.0f} s. "
+        f"Random set: {sizes.timing} well-conditioned configurations per type (timed), "
+        f"{sizes.truth} of them against ground truth; near-singular sweeps: "
+        f"{sizes.instances} per type, {sizes.per_decade} points per decade of the type's "
+        f"denominator from 1e-1 to 1e-16; extreme set: {sizes.extreme} per type, and as "
+        "many whose loads cancel as they are summed (each link's active load balancing "
+        "its weight and inertia to 1e-3 ... 1e-12). Ground "
+        "truth: mpmath (50 digits) solving the generic Newton-Euler system from the same "
+        "double inputs. Error = largest |method - truth| over the outputs, relative to "
+        "the largest reaction of the configuration (forces and reactive moments each "
+        "against their own largest, since N and N m do not compare); componentwise = "
+        "each output against its own true value. Times are medians of repeated runs "
+        "in one invocation; instructions per solve from `valgrind --tool=callgrind` "
+        "(solve loop only). Amplification A: the C core's output, data factor / "
+        "conditioning, where the data factor (1 to 1/eps) is how much larger the "
+        "load terms the core sums (active loads, weights, each part of the inertia "
+        "forces, their moments, and the closed forms' own sums) are than the largest "
+        "reaction of their unit: eps x A x that reaction bounds the error of every "
+        "reaction of the unit (src/dyad_amplification.h).",
+        "",
+        "| method | type | median error | worst error | worst componentwise | "
+        "time per configuration | instructions per solve | time / C core |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for s in summary:
         instructions = s.get("instructions", math.nan)
         lines.append(
             f"| {_label(s['method'])} | {s['type']} | {s['median']:.1e} | {s['worst']:.1e} | "
             f"{s['componentwise']:.1e} | {_fmt_time(s['seconds'])} | "
             f"{'-' if math.isnan(instructions) else f'{instructions:.0f}'} | "
-            f"{s['seconds'] / core_time[s['type']]:.1f} |")
-    lines += ["", "Worst error / (eps x amplification x largest reaction of its unit) on each "
-              "set, over the five types and every solve with status ok that eps x A < 1 "
-              "promises a digit (eps of the method's scalar type; the float core's own "
-              "amplification, the double core's for the other methods):", "",
-              "| method | random | near-singular | extreme | cancelling | "
-              "inf/NaN with status ok |",
-              "|---|---|---|---|---|---|"]
+            f"{s['seconds'] / core_time[s['type']]:.1f} |"
+        )
+    lines += [
+        "",
+        "Worst error / (eps x amplification x largest reaction of its unit) on each "
+        "set, over the five types and every solve with status ok that eps x A < 1 "
+        "promises a digit (eps of the method's scalar type; the float core's own "
+        "amplification, the double core's for the other methods):",
+        "",
+        "| method | random | near-singular | extreme | cancelling | inf/NaN with status ok |",
+        "|---|---|---|---|---|---|",
+    ]
     for method in ("core", "core_float", "gsl_lu", "gsl_svd", "numpy"):
         cells = []
         for set_name in SETS:
-            values = [contract[(method, t, set_name)] for t in TYPES
-                      if not math.isnan(contract[(method, t, set_name)])]
+            values = [
+                contract[(method, t, set_name)]
+                for t in TYPES
+                if not math.isnan(contract[(method, t, set_name)])
+            ]
             cells.append(f"{max(values):.2g}" if values else "-")
         silent_total = sum(silent[(method, t, s)] for t in TYPES for s in SETS)
         lines.append(f"| {LABELS[method]} | " + " | ".join(cells) + f" | {silent_total} |")
-    def ratio(method, t):
-        return next(g["seconds"] for g in summary
-                    if g["method"] == method and g["type"] == t) / core_time[t]
+
+    def ratio(method: str, t: np.ndarray):
+        return (
+            next(g["seconds"] for g in summary if g["method"] == method and g["type"] == t)
+            / core_time[t]
+        )
 
     speedups = [ratio("gsl_lu", t) for t in TYPES]
     silent_all = sum(silent.values())
 
-    def worst_factor(method, sets=SETS):
-        return max(contract[(method, t, s)] for t in TYPES for s in sets
-                   if not math.isnan(contract[(method, t, s)]))
+    def worst_factor(method: str, sets: tuple[str, ...] = SETS):
+        return max(
+            contract[(method, t, s)]
+            for t in TYPES
+            for s in sets
+            if not math.isnan(contract[(method, t, s)])
+        )
 
     core_factor, lu_factor = worst_factor("core"), worst_factor("gsl_lu")
     sweep_factor = worst_factor("core", ("sweep",))
@@ -156,47 +217,56 @@ def markdown(out: Path, summary, contract, silent, sizes, quick, elapsed, figure
     float_threshold = math.sqrt(EPS["float"])
     fmu_c = [s["seconds"] for s in summary if s["method"].startswith("fmu_c")]
     fmpy = [s["seconds"] for s in summary if s["method"].startswith("fmu_fmpy")]
-    lines += ["", "## What the figures show", "",
-              f"- **Use the C core.** It is {min(speedups):.0f} to {max(speedups):.0f} times "
-              "faster than the generic GSL LU solve of the same 6x6 system, and more "
-              f"accurate: its error stays within {core_factor:.2g} x eps x amplification x "
-              f"the largest reaction of its unit on every set, where LU's reaches "
-              f"{lu_factor:.2g} x and NumPy's (the same LU, "
-              "batched) is alike: a generic solve sums the moments of the whole inertia "
-              "forces, which the closed forms avoid. GSL's SVD costs most and is the least "
-              "accurate here; use it only for its condition number.",
-              f"- **The FMU** adds the FMI calls around the same solve: "
-              f"{min(fmu_c) * 1e9:.0f} to {max(fmu_c) * 1e9:.0f} ns per step from C. From "
-              f"Python, fmpy's per-call overhead dominates ({min(fmpy) * 1e6:.0f} to "
-              f"{max(fmpy) * 1e6:.0f} us per step); for many configurations from Python, "
-              "NumPy's batched solve or the core through ctypes is faster.",
-              f"- **float** keeps about 7 digits: median error {float_median:.1e}, worst "
-              f"{float_worst:.1e} of the largest reaction on the random set (where stiff "
-              "inputs sum large load terms); near singular positions it grows like "
-              "6e-8 x amplification. It suits embedded monitors, not reference values.",
-              f"- **Cancelling loads.** Where each link's active load nearly balances its "
-              f"weight and inertia, the reactions are the small residue of large terms and "
-              f"every method loses digits with it: the core's amplification grows by the "
-              f"data factor and still bounds its error (at most {cancelling_core:.2g} x), "
-              f"LU's reaches {cancelling_lu:.2g} x that bound.",
-              f"- **Singular flag against accuracy.** Near singular positions every method "
-              f"loses digits like eps / conditioning (the core: at most {sweep_factor:.2g} x "
-              f"its bound). The default threshold sqrt(eps) = {threshold:.3g} trips where "
-              f"1 / conditioning reaches {1 / threshold:.2g}; there eps x amplification is "
-              f"sqrt(eps) times the data factor, so about 8 digits remain in double where "
-              f"the loads do not cancel (about 3.5 in float at its default "
-              f"{float_threshold:.3g}); accuracy is gone only at amplification ~1e16. So "
-              "sqrt(eps) is the recommended default: it flags the configuration while the "
-              "answer is still good to half the digits. The flag is geometric only; a large "
-              "data factor is reported in the amplification, not refused. A caller who "
-              "needs n digits sets the threshold to 10^n x eps and checks eps x amplification.",
-              ("- No method returned an inf or NaN with status ok on any set (last column)."
-               if silent_all == 0 else
-               f"- {silent_all} configurations returned an inf or NaN with status ok (last "
-               "column): see points.csv."), "",
-              f"![work-precision]({figures['work_precision'].name})", "",
-              f"![error against amplification]({figures['error_vs_amplification'].name})", "",
-              "Every measured point is in `points.csv`; this table in `summary.csv`."]
+    lines += [
+        "",
+        "## What the figures show",
+        "",
+        f"- **Use the C core.** It is {min(speedups):.0f} to {max(speedups):.0f} times "
+        "faster than the generic GSL LU solve of the same 6x6 system, and more "
+        f"accurate: its error stays within {core_factor:.2g} x eps x amplification x "
+        f"the largest reaction of its unit on every set, where LU's reaches "
+        f"{lu_factor:.2g} x and NumPy's (the same LU, "
+        "batched) is alike: a generic solve sums the moments of the whole inertia "
+        "forces, which the closed forms avoid. GSL's SVD costs most and is the least "
+        "accurate here; use it only for its condition number.",
+        f"- **The FMU** adds the FMI calls around the same solve: "
+        f"{min(fmu_c) * 1e9:.0f} to {max(fmu_c) * 1e9:.0f} ns per step from C. From "
+        f"Python, fmpy's per-call overhead dominates ({min(fmpy) * 1e6:.0f} to "
+        f"{max(fmpy) * 1e6:.0f} us per step); for many configurations from Python, "
+        "NumPy's batched solve or the core through ctypes is faster.",
+        f"- **float** keeps about 7 digits: median error {float_median:.1e}, worst "
+        f"{float_worst:.1e} of the largest reaction on the random set (where stiff "
+        "inputs sum large load terms); near singular positions it grows like "
+        "6e-8 x amplification. It suits embedded monitors, not reference values.",
+        f"- **Cancelling loads.** Where each link's active load nearly balances its "
+        f"weight and inertia, the reactions are the small residue of large terms and "
+        f"every method loses digits with it: the core's amplification grows by the "
+        f"data factor and still bounds its error (at most {cancelling_core:.2g} x), "
+        f"LU's reaches {cancelling_lu:.2g} x that bound.",
+        f"- **Singular flag against accuracy.** Near singular positions every method "
+        f"loses digits like eps / conditioning (the core: at most {sweep_factor:.2g} x "
+        f"its bound). The default threshold sqrt(eps) = {threshold:.3g} trips where "
+        f"1 / conditioning reaches {1 / threshold:.2g}; there eps x amplification is "
+        f"sqrt(eps) times the data factor, so about 8 digits remain in double where "
+        f"the loads do not cancel (about 3.5 in float at its default "
+        f"{float_threshold:.3g}); accuracy is gone only at amplification ~1e16. So "
+        "sqrt(eps) is the recommended default: it flags the configuration while the "
+        "answer is still good to half the digits. The flag is geometric only; a large "
+        "data factor is reported in the amplification, not refused. A caller who "
+        "needs n digits sets the threshold to 10^n x eps and checks eps x amplification.",
+        (
+            "- No method returned an inf or NaN with status ok on any set (last column)."
+            if silent_all == 0
+            else f"- {silent_all} configurations returned an inf or NaN with status ok (last "
+            "column): see points.csv."
+        ),
+        "",
+        f"![work-precision]({figures['work_precision'].name})",
+        "",
+        f"![error against amplification]({figures['error_vs_amplification'].name})",
+        "",
+        "Every measured point is in `points.csv`; this table in `summary.csv`.",
+    ]
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
@@ -205,5 +275,13 @@ def markdown(out: Path, summary, contract, silent, sizes, quick, elapsed, figure
 def write(out: Path, results: Results) -> Path:
     """The plots and report.md of the study's results in `out`; returns the report's path."""
     figures = plots(out, results.points, results.summary)
-    return markdown(out, results.summary, results.contract, results.silent, results.sizes,
-                    results.quick, results.elapsed, figures)
+    return markdown(
+        out,
+        results.summary,
+        results.contract,
+        results.silent,
+        results.sizes,
+        results.quick,
+        results.elapsed,
+        figures,
+    )

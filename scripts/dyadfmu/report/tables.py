@@ -10,8 +10,7 @@ from pathlib import Path
 from ..cosim.compare import OutputError
 
 #: The header of an error table.
-ERROR_HEADER = ["output", "unit", "peak |reference|", "max |FMU - reference|",
-                "relative to peak"]
+ERROR_HEADER = ["output", "unit", "peak |reference|", "max |FMU - reference|", "relative to peak"]
 
 
 def error_rows(errors: Sequence[OutputError]) -> list[list[str]]:
@@ -25,8 +24,13 @@ def error_rows(errors: Sequence[OutputError]) -> list[list[str]]:
 def format_text(rows: list[list[str]]) -> str:
     """The rows as aligned plain text, the first one a header underlined with dashes."""
     widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
-    lines = ["  ".join(cell.rjust(w) if c else cell.ljust(w) for c, (cell, w) in
-                       enumerate(zip(row, widths, strict=False))) for row in rows]
+    lines = [
+        "  ".join(
+            cell.rjust(w) if c else cell.ljust(w)
+            for c, (cell, w) in enumerate(zip(row, widths, strict=False))
+        )
+        for row in rows
+    ]
     lines.insert(1, "  ".join("-" * w for w in widths))
     return "\n".join(lines)
 

@@ -10,13 +10,7 @@ Newton-Euler system from exactly the same double inputs.
 from __future__ import annotations
 
 import csv
-import json
 import math
-import os
-import re
-import shutil
-import subprocess
-import sys
 import tempfile
 import time as clock
 from collections.abc import Callable
@@ -30,24 +24,29 @@ from ..reference import newton_euler
 from . import bench
 from . import configurations as cfg
 
-EPS = {"double": 2.0 ** -52, "float": 2.0 ** -23}
+EPS = {"double": 2.0**-52, "float": 2.0**-23}
 METHODS = ("core", "core_float", "gsl_lu", "gsl_svd", "numpy")
-LABELS = {"core": "C core (double)", "core_float": "C core (float)",
-          "gsl_lu": "GSL LU 6x6 (C)", "gsl_svd": "GSL SVD 6x6 (C)",
-          "numpy": "NumPy solve (batched)", "fmu_c": "FMU stepped from C",
-          "fmu_fmpy": "FMU stepped from fmpy"}
+LABELS = {
+    "core": "C core (double)",
+    "core_float": "C core (float)",
+    "gsl_lu": "GSL LU 6x6 (C)",
+    "gsl_svd": "GSL SVD 6x6 (C)",
+    "numpy": "NumPy solve (batched)",
+    "fmu_c": "FMU stepped from C",
+    "fmu_fmpy": "FMU stepped from fmpy",
+}
 
 
 @dataclass
 class Sizes:
-    timing: int            # random configurations timed per type
-    truth: int             # of them compared with mpmath
-    per_decade: int        # near-singular sweep points per decade
-    instances: int         # near-singular sweeps per type
-    extreme: int           # extreme configurations per type, and cancelling ones
+    timing: int  # random configurations timed per type
+    truth: int  # of them compared with mpmath
+    per_decade: int  # near-singular sweep points per decade
+    instances: int  # near-singular sweeps per type
+    extreme: int  # extreme configurations per type, and cancelling ones
     fmu_c_steps: int
     fmpy_steps: int
-    callgrind: int         # solves counted under callgrind
+    callgrind: int  # solves counted under callgrind
     repeat: int
 
 
@@ -87,8 +86,9 @@ def _errors(values: np.ndarray, truth: np.ndarray):
             scale = np.max(np.abs(truth[:, group]), axis=1)
             group_error = np.max(diff[:, group], axis=1) / scale
             normwise = np.fmax(normwise, np.where(scale > 0, group_error, 0.0))
-        normwise = np.where(np.isfinite(values).all(axis=1) | ~np.isfinite(truth).all(axis=1),
-                            normwise, np.inf)
+        normwise = np.where(
+            np.isfinite(values).all(axis=1) | ~np.isfinite(truth).all(axis=1), normwise, np.inf
+        )
         nonzero = np.abs(truth) > 0
         component = np.where(nonzero, diff / np.where(nonzero, np.abs(truth), 1.0), 0.0)
         componentwise = np.max(component, axis=1)
@@ -129,14 +129,17 @@ class _Inputs:
 
 def _inputs(dyad: str, t_index: int, sizes: Sizes, log: Callable) -> _Inputs:
     log(f"{dyad}: generating inputs")
-    sets = {"random": cfg.random_set(dyad, sizes.timing, seed=10 + t_index),
-            "sweep": cfg.sweep_set(dyad, sizes.per_decade, sizes.instances,
-                                   seed=20 + t_index),
-            "extreme": cfg.extreme_set(dyad, sizes.extreme, seed=30 + t_index),
-            "cancelling": cfg.cancelling_set(dyad, sizes.extreme, seed=40 + t_index)}
-    truth_rows = dict(sets, random=sets["random"][:sizes.truth])
-    log(f"{dyad}: ground truth (mpmath, 50 digits) for "
-        f"{sum(len(r) for r in truth_rows.values())} configurations")
+    sets = {
+        "random": cfg.random_set(dyad, sizes.timing, seed=10 + t_index),
+        "sweep": cfg.sweep_set(dyad, sizes.per_decade, sizes.instances, seed=20 + t_index),
+        "extreme": cfg.extreme_set(dyad, sizes.extreme, seed=30 + t_index),
+        "cancelling": cfg.cancelling_set(dyad, sizes.extreme, seed=40 + t_index),
+    }
+    truth_rows = dict(sets, random=sets["random"][: sizes.truth])
+    log(
+        f"{dyad}: ground truth (mpmath, 50 digits) for "
+        f"{sum(len(r) for r in truth_rows.values())} configurations"
+    )
     truth = {name: _truth(dyad, rows) for name, rows in truth_rows.items()}
     return _Inputs(dyad, sets, truth_rows, truth)
 
@@ -155,15 +158,17 @@ def _numpy_set(dyad: str, rows: np.ndarray, set_name: str, sizes: Sizes) -> tupl
     return values, status, float(np.median(runs))
 
 
-def _solve_set(build: Path, method: str, data: _Inputs, set_name: str, sizes: Sizes,
-               work: Path) -> tuple:
+def _solve_set(
+    build: Path, method: str, data: _Inputs, set_name: str, sizes: Sizes, work: Path
+) -> tuple:
     """(values, status, seconds per configuration, amplification) of one method on one
     input set; the float core is measured against its own amplification."""
     rows = data.sets[set_name]
     if method == "numpy":
         return (*_numpy_set(data.dyad, rows, set_name, sizes), data.amplification[set_name])
-    result, seconds = bench.bench_method(build, method, data.dyad, rows, work,
-                                         sizes.repeat if set_name == "random" else 0)
+    result, seconds = bench.bench_method(
+        build, method, data.dyad, rows, work, sizes.repeat if set_name == "random" else 0
+    )
     n = len(data.truth_rows[set_name])
     if method == "core":
         data.amplification[set_name] = result[:n, 15]
@@ -171,8 +176,9 @@ def _solve_set(build: Path, method: str, data: _Inputs, set_name: str, sizes: Si
     return result[:, :12], result[:, 12], seconds, amp
 
 
-def _score(results: Results, method: str, data: _Inputs, set_name: str, solved: tuple,
-           timing: float) -> None:
+def _score(
+    results: Results, method: str, data: _Inputs, set_name: str, solved: tuple, timing: float
+) -> None:
     """The errors of one method on one set against ground truth, into the results."""
     values, status, _, amp = solved
     dyad, truth = data.dyad, data.truth[set_name]
@@ -181,22 +187,28 @@ def _score(results: Results, method: str, data: _Inputs, set_name: str, solved: 
     eps = EPS["float" if method == "core_float" else "double"]
     ok = (status[:n] == 0) & np.isfinite(truth).all(axis=1)
     ratio = cfg.contract_ratio(values[:n][ok], truth[ok], amp[ok], eps)
-    results.contract[(method, dyad, set_name)] = float(np.max(ratio)) if ratio.size \
-        else math.nan
+    results.contract[(method, dyad, set_name)] = float(np.max(ratio)) if ratio.size else math.nan
     results.silent[(method, dyad, set_name)] = _silent_non_finite(values, status)
     for k in range(n):
-        results.points.append((set_name, dyad, method, k, amp[k], normwise[k],
-                               componentwise[k], int(status[k])))
+        results.points.append(
+            (set_name, dyad, method, k, amp[k], normwise[k], componentwise[k], int(status[k]))
+        )
     if set_name == "random":
-        results.summary.append({"method": method, "type": dyad,
-                                "median": float(np.median(normwise[ok])),
-                                "worst": float(np.max(normwise[ok])),
-                                "componentwise": float(np.max(componentwise[ok])),
-                                "seconds": timing})
+        results.summary.append(
+            {
+                "method": method,
+                "type": dyad,
+                "median": float(np.median(normwise[ok])),
+                "worst": float(np.max(normwise[ok])),
+                "componentwise": float(np.max(componentwise[ok])),
+                "seconds": timing,
+            }
+        )
 
 
-def _measure_method(results: Results, build: Path, method: str, data: _Inputs,
-                    sizes: Sizes, work: Path) -> None:
+def _measure_method(
+    results: Results, build: Path, method: str, data: _Inputs, sizes: Sizes, work: Path
+) -> None:
     timing = math.nan
     for set_name in data.sets:
         solved = _solve_set(build, method, data, set_name, sizes, work)
@@ -205,11 +217,13 @@ def _measure_method(results: Results, build: Path, method: str, data: _Inputs,
         _score(results, method, data, set_name, solved, timing)
     if method != "numpy":
         results.summary[-1]["instructions"] = bench.instructions(
-            build, method, data.dyad, data.sets["random"][:sizes.callgrind], work)
+            build, method, data.dyad, data.sets["random"][: sizes.callgrind], work
+        )
 
 
-def _time_fmus(results: Results, build: Path, dyad: str, sizes: Sizes, work: Path,
-               log: Callable) -> None:
+def _time_fmus(
+    results: Results, build: Path, dyad: str, sizes: Sizes, work: Path, log: Callable
+) -> None:
     """The FMUs stepped from C and from fmpy; they carry the C core's errors."""
     core_error = next(s for s in results.summary if s["method"] == "core" and s["type"] == dyad)
     for method in ("fmu_c", "fmu_fmpy"):
@@ -219,15 +233,22 @@ def _time_fmus(results: Results, build: Path, dyad: str, sizes: Sizes, work: Pat
                 seconds = bench.fmu_from_c(build, dyad, version, sizes.fmu_c_steps, work)
             else:
                 seconds = bench.fmu_from_fmpy(dyad, version, sizes.fmpy_steps, work)
-            results.summary.append({"method": f"{method}{version}", "type": dyad,
-                                    "median": core_error["median"],
-                                    "worst": core_error["worst"],
-                                    "componentwise": core_error["componentwise"],
-                                    "seconds": seconds, "instructions": math.nan})
+            results.summary.append(
+                {
+                    "method": f"{method}{version}",
+                    "type": dyad,
+                    "median": core_error["median"],
+                    "worst": core_error["worst"],
+                    "componentwise": core_error["componentwise"],
+                    "seconds": seconds,
+                    "instructions": math.nan,
+                }
+            )
 
 
-def run(out: Path, quick: bool = False, build: Path | None = None,
-        log: Callable = print) -> Results:
+def run(
+    out: Path, quick: bool = False, build: Path | None = None, log: Callable = print
+) -> Results:
     """Runs the whole study and writes points.csv and summary.csv to `out`; the report
     (:func:`dyadfmu.report.study.write`) is written from the results."""
     sizes = QUICK if quick else FULL
@@ -249,23 +270,50 @@ def run(out: Path, quick: bool = False, build: Path | None = None,
     return results
 
 
-def _write_points(path: Path, points) -> None:
+def _write_points(path: Path, points: list[tuple]) -> None:
     with open(path, "w", newline="") as handle:
         writer = csv.writer(handle)
-        writer.writerow(["set", "type", "method", "index", "amplification", "error",
-                         "componentwise_error", "status"])
+        writer.writerow(
+            [
+                "set",
+                "type",
+                "method",
+                "index",
+                "amplification",
+                "error",
+                "componentwise_error",
+                "status",
+            ]
+        )
         for p in points:
-            writer.writerow([p[0], p[1], p[2], p[3], f"{p[4]:.6e}", f"{p[5]:.6e}",
-                             f"{p[6]:.6e}", p[7]])
+            writer.writerow(
+                [p[0], p[1], p[2], p[3], f"{p[4]:.6e}", f"{p[5]:.6e}", f"{p[6]:.6e}", p[7]]
+            )
 
 
-def _write_summary_csv(path: Path, summary) -> None:
+def _write_summary_csv(path: Path, summary: list[dict]) -> None:
     with open(path, "w", newline="") as handle:
         writer = csv.writer(handle)
-        writer.writerow(["method", "type", "median_error", "worst_error",
-                         "worst_componentwise_error", "seconds_per_config",
-                         "instructions_per_solve"])
+        writer.writerow(
+            [
+                "method",
+                "type",
+                "median_error",
+                "worst_error",
+                "worst_componentwise_error",
+                "seconds_per_config",
+                "instructions_per_solve",
+            ]
+        )
         for s in summary:
-            writer.writerow([s["method"], s["type"], f"{s['median']:.3e}", f"{s['worst']:.3e}",
-                             f"{s['componentwise']:.3e}", f"{s['seconds']:.4e}",
-                             f"{s.get('instructions', math.nan):.0f}"])
+            writer.writerow(
+                [
+                    s["method"],
+                    s["type"],
+                    f"{s['median']:.3e}",
+                    f"{s['worst']:.3e}",
+                    f"{s['componentwise']:.3e}",
+                    f"{s['seconds']:.4e}",
+                    f"{s.get('instructions', math.nan):.0f}",
+                ]
+            )

@@ -28,8 +28,10 @@ def bench_binary(build: Path, real: str) -> Path:
     name = "dyad_bench" if real == "double" else "dyad_bench_float"
     path = build / "tests" / "bench" / name
     if not path.is_file():
-        raise FileNotFoundError(f"{path} is missing: configure with GSL installed "
-                                "(libgsl-dev) and build (scripts/run-study does)")
+        raise FileNotFoundError(
+            f"{path} is missing: configure with GSL installed "
+            "(libgsl-dev) and build (scripts/run-study does)"
+        )
     return path
 
 
@@ -46,22 +48,30 @@ def run_bench(binary: Path, args: list[str]) -> dict:
 TIMED_CHUNK = 1000
 
 
-def bench_method(build: Path, method: str, dyad: str, rows: np.ndarray, work: Path,
-                  repeat: int) -> tuple[np.ndarray, float]:
+def bench_method(
+    build: Path, method: str, dyad: str, rows: np.ndarray, work: Path, repeat: int
+) -> tuple[np.ndarray, float]:
     """All rows solved once (for their errors), then a cache-sized chunk timed
     `repeat` times (the median); repeat 0: not timed."""
     real = "float" if method == "core_float" else "double"
     binary = bench_binary(build, real)
     inputs, outputs = work / "inputs.bin", work / "outputs.bin"
     rows.astype("<f8").tofile(inputs)
-    args = ["--type", dyad, "--method", "core" if real == "float" else method,
-            "--inputs", str(inputs)]
+    args = [
+        "--type",
+        dyad,
+        "--method",
+        "core" if real == "float" else method,
+        "--inputs",
+        str(inputs),
+    ]
     run_bench(binary, args + ["--outputs", str(outputs), "--repeat", "1"])
     result = np.fromfile(outputs, dtype="<f8").reshape(len(rows), 16)
     if repeat == 0:
         return result, math.nan
-    info = run_bench(binary, args + ["--count", str(min(TIMED_CHUNK, len(rows))),
-                                      "--repeat", str(repeat)])
+    info = run_bench(
+        binary, args + ["--count", str(min(TIMED_CHUNK, len(rows))), "--repeat", str(repeat)]
+    )
     return result, float(info["seconds_per_config"])
 
 
@@ -73,10 +83,24 @@ def instructions(build: Path, method: str, dyad: str, rows: np.ndarray, work: Pa
     inputs = work / "callgrind.bin"
     rows.astype("<f8").tofile(inputs)
     done = subprocess.run(
-        ["valgrind", "--tool=callgrind", "--toggle-collect=bench_loop_*",
-         f"--callgrind-out-file={work / 'callgrind.out'}", str(bench_binary(build, real)),
-         "--type", dyad, "--method", "core" if real == "float" else method,
-         "--inputs", str(inputs), "--repeat", "1"], capture_output=True, text=True)
+        [
+            "valgrind",
+            "--tool=callgrind",
+            "--toggle-collect=bench_loop_*",
+            f"--callgrind-out-file={work / 'callgrind.out'}",
+            str(bench_binary(build, real)),
+            "--type",
+            dyad,
+            "--method",
+            "core" if real == "float" else method,
+            "--inputs",
+            str(inputs),
+            "--repeat",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+    )
     match = re.search(r"Collected\s*:\s*(\d+)", done.stderr)
     return int(match.group(1)) / len(rows) if match else math.nan
 
@@ -93,7 +117,7 @@ def fmu_rows(dyad: str, count: int, seed: int):
     for k, v in enumerate(inputs):
         if v.unit == "rad":
             swing = 0.3
-        elif v.unit == "m":                 # a sliding length: stays positive
+        elif v.unit == "m":  # a sliding length: stays positive
             swing = 0.3 * float(v.start)
         else:
             swing = 0.2 * (abs(float(v.start)) + 1.0)
@@ -105,11 +129,27 @@ def fmu_from_c(build: Path, dyad: str, version: int, count: int, work: Path) -> 
     md, inputs, outputs, rows = fmu_rows(dyad, count, seed=version)
     binary = paths.stage_binary(build, f"dyad_{dyad.lower()}", version)
     rows.astype("<f8").tofile(work / "fmu_inputs.bin")
-    info = run_bench(bench_binary(build, "double"), [
-        "--method", "fmu", "--fmu", str(binary), "--fmi", str(version), "--token", md.guid,
-        "--fmu-inputs", str(work / "fmu_inputs.bin"),
-        "--in-vrs", ",".join(str(v.valueReference) for v in inputs),
-        "--out-vrs", ",".join(str(v.valueReference) for v in outputs), "--repeat", "3"])
+    info = run_bench(
+        bench_binary(build, "double"),
+        [
+            "--method",
+            "fmu",
+            "--fmu",
+            str(binary),
+            "--fmi",
+            str(version),
+            "--token",
+            md.guid,
+            "--fmu-inputs",
+            str(work / "fmu_inputs.bin"),
+            "--in-vrs",
+            ",".join(str(v.valueReference) for v in inputs),
+            "--out-vrs",
+            ",".join(str(v.valueReference) for v in outputs),
+            "--repeat",
+            "3",
+        ],
+    )
     return float(info["seconds_per_config"])
 
 

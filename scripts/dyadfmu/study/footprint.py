@@ -17,6 +17,7 @@ import subprocess
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from fmpy import read_model_description
@@ -24,6 +25,11 @@ from fmpy import read_model_description
 from .. import paths
 from ..cosim import scenes
 from . import bench
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from fmpy.model_description import ModelDescription
 
 
 @dataclass
@@ -33,8 +39,8 @@ class Footprint:
     outputs: int
     binary_bytes: int
     text_bytes: int
-    instructions: float      # per doStep (set inputs, doStep, get outputs)
-    seconds: float           # per doStep, median of the passes
+    instructions: float  # per doStep (set inputs, doStep, get outputs)
+    seconds: float  # per doStep, median of the passes
 
     @property
     def variables(self) -> int:
@@ -50,39 +56,70 @@ def _text_size(path: Path) -> int:
     return int(match.group(1)) if match else 0
 
 
-def _step(build: Path, identifier: str, version: int, md, rows: np.ndarray, work: Path,
-          repeat: int) -> tuple[float, float]:
+def _step(
+    build: Path,
+    identifier: str,
+    version: int,
+    md: ModelDescription,
+    rows: np.ndarray,
+    work: Path,
+    repeat: int,
+) -> tuple[float, float]:
     """(instructions, seconds) per doStep of an FMU binary over `rows` of its inputs."""
     inputs = [v for v in md.modelVariables if v.causality == "input"]
-    outputs = [v for v in md.modelVariables if v.causality == "output" and
-               v.type in ("Real", "Float64")]
+    outputs = [
+        v for v in md.modelVariables if v.causality == "output" and v.type in ("Real", "Float64")
+    ]
     data = work / f"{identifier}_{version}.bin"
     rows.astype("<f8").tofile(data)
-    args = ["--method", "fmu", "--fmu", str(paths.stage_binary(build, identifier, version)),
-            "--fmi", str(version), "--token", md.guid, "--fmu-inputs", str(data),
-            "--in-vrs", ",".join(str(v.valueReference) for v in inputs),
-            "--out-vrs", ",".join(str(v.valueReference) for v in outputs)]
+    args = [
+        "--method",
+        "fmu",
+        "--fmu",
+        str(paths.stage_binary(build, identifier, version)),
+        "--fmi",
+        str(version),
+        "--token",
+        md.guid,
+        "--fmu-inputs",
+        str(data),
+        "--in-vrs",
+        ",".join(str(v.valueReference) for v in inputs),
+        "--out-vrs",
+        ",".join(str(v.valueReference) for v in outputs),
+    ]
     program = bench.bench_binary(build, "double")
     info = bench.run_bench(program, args + ["--repeat", str(repeat)])
     instructions = math.nan
     if shutil.which("valgrind") is not None:
         done = subprocess.run(
-            ["valgrind", "--tool=callgrind", "--toggle-collect=bench_loop_*",
-             f"--callgrind-out-file={work / 'callgrind.out'}", str(program), *args,
-             "--repeat", "1"], capture_output=True, text=True)
+            [
+                "valgrind",
+                "--tool=callgrind",
+                "--toggle-collect=bench_loop_*",
+                f"--callgrind-out-file={work / 'callgrind.out'}",
+                str(program),
+                *args,
+                "--repeat",
+                "1",
+            ],
+            capture_output=True,
+            text=True,
+        )
         match = re.search(r"Collected\s*:\s*(\d+)", done.stderr)
         if match:
             instructions = int(match.group(1)) / len(rows)
     return instructions, float(info["seconds_per_config"])
 
 
-def _counts(md) -> tuple[int, int, int]:
+def _counts(md: ModelDescription) -> tuple[int, int, int]:
     causes = [v.causality for v in md.modelVariables]
     return causes.count("input"), causes.count("parameter"), causes.count("output")
 
 
-def tailored(name: str, build: Path, version: int, work: Path, rows_count: int,
-             repeat: int) -> Footprint:
+def tailored(
+    name: str, build: Path, version: int, work: Path, rows_count: int, repeat: int
+) -> Footprint:
     path = scenes.fmu_path(name, version, build)
     md = read_model_description(str(path))
     source = scenes.Source(name)
@@ -94,24 +131,24 @@ def tailored(name: str, build: Path, version: int, work: Path, rows_count: int,
     rows = np.stack([inputs[n] for n in names], axis=1) if names else np.zeros((rows_count, 0))
     instructions, seconds = _step(build, name, version, md, rows, work, repeat)
     binary = paths.stage_binary(build, name, version)
-    return Footprint(*_counts(md), binary.stat().st_size, _text_size(binary), instructions,
-                     seconds)
+    return Footprint(*_counts(md), binary.stat().st_size, _text_size(binary), instructions, seconds)
 
 
-def generic(dyad: str, build: Path, version: int, work: Path, rows_count: int,
-            repeat: int) -> Footprint:
+def generic(
+    dyad: str, build: Path, version: int, work: Path, rows_count: int, repeat: int
+) -> Footprint:
     identifier = f"dyad_{dyad.lower()}"
     md, _, _, rows = bench.fmu_rows(dyad, rows_count, seed=version)
     if version != 2:
         md = read_model_description(str(scenes.fmu_path(identifier, version, build)))
     instructions, seconds = _step(build, identifier, version, md, rows, work, repeat)
     binary = paths.stage_binary(build, identifier, version)
-    return Footprint(*_counts(md), binary.stat().st_size, _text_size(binary), instructions,
-                     seconds)
+    return Footprint(*_counts(md), binary.stat().st_size, _text_size(binary), instructions, seconds)
 
 
-def measure(build: Path, version: int = 2, rows_count: int = 500, repeat: int = 21,
-            log=print) -> list:
+def measure(
+    build: Path, version: int = 2, rows_count: int = 500, repeat: int = 21, log: Callable = print
+) -> list:
     """[(scene, tailored Footprint, [generic Footprint per dyad])]."""
     results = []
     with tempfile.TemporaryDirectory(prefix="dyadfmu_scenes_") as tmp:
