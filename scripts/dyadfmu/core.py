@@ -1,6 +1,6 @@
 """Python binding of the C kinetostatic core (``libdyadfmu.so``) through ctypes.
 
-The inputs are the dicts of :mod:`dyadfmu.reference` (same keys, same units), so
+The inputs are the dicts of :mod:`dyadfmu.reference.newton_euler` (same keys, same units), so
 one configuration can be given to both. The library is looked up in
 ``$DYADFMU_LIB``, else in ``build/`` beside ``scripts/``.
 """
@@ -181,6 +181,8 @@ class Core:
         gravity: tuple[float, float] = (0.0, 0.0),
         singular_threshold: float | None = None,
     ) -> dict:
+        """One configuration solved by the C core: the reactions with status, field,
+        conditioning, amplification and denominator."""
         if dyad_type not in TYPES:
             raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
         inp = self._input(m, n, guide_k, guide_p, gravity, singular_threshold)

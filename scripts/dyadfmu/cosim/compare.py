@@ -17,6 +17,8 @@ NEAR_SINGULAR = 1e-6
 
 @dataclass
 class OutputError:
+    """The error of one output over the valid samples, relative to its reference's peak."""
+
     name: str
     unit: str
     peak: float  # largest |reference| over the valid samples
@@ -52,7 +54,8 @@ class Progress:
         self.enabled = enabled and sys.stderr.isatty()
         self.shown = -1
 
-    def __call__(self, time: float, recorder: object):
+    def __call__(self, time: float, recorder: object) -> bool:
+        """fmpy's step callback: redraws the bar; always goes on."""
         if self.enabled:
             percent = int(100 * time / self.duration) if self.duration > 0 else 100
             if percent != self.shown:
@@ -62,7 +65,8 @@ class Progress:
                 sys.stderr.flush()
         return True
 
-    def close(self):
+    def close(self) -> None:
+        """Ends the bar's line."""
         if self.enabled and self.shown >= 0:
             sys.stderr.write("\n")
 

@@ -51,7 +51,7 @@ def fmu_path(dyad: str, version: int, build: Path | None = None) -> Path:
     return paths.built_fmu(f"dyad_{dyad.lower()}", version, build)
 
 
-def links_from_values(values: dict, dyad: str):
+def links_from_values(values: dict, dyad: str) -> tuple:
     """The reference's inputs from FMU variable values (inputs and parameters).
 
     `values` maps FMU variable names to arrays (or scalars); returns

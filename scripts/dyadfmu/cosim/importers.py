@@ -175,7 +175,7 @@ def write_inputs(setup: CoSimSetup, path: Path, perturb: str | None = None) -> N
     with open(path, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["time"] + names)
-        for row in zip(*columns):
+        for row in zip(*columns, strict=False):
             writer.writerow([format(float(x), ".16e") for x in row])
 
 
@@ -270,6 +270,7 @@ def run_fmi_sim(
 
 
 def read_csv(path: Path) -> dict:
+    """The columns of a CSV file of fmi-sim by header name, as float arrays."""
     with open(path, newline="") as handle:
         rows = list(csv.reader(handle))
     header, body = rows[0], rows[1:]
@@ -296,6 +297,7 @@ class Difference:
     amplification_in_own_roundoff: float = 0.0
 
     def line(self) -> str:
+        """The difference as one line of text."""
         return (
             f"{self.fmu}: {self.rows} rows x {self.outputs} outputs, max abs "
             f"{self.max_abs:.2e}, max relative to peak {self.max_relative:.2e}, "
@@ -313,7 +315,7 @@ def ulps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         bits = x.view(np.int64).astype(object)
         return [(-(1 << 63) - v) if v < 0 else v for v in bits]
 
-    distance = np.array([float(abs(p - q)) for p, q in zip(ordered(a), ordered(b))])
+    distance = np.array([float(abs(p - q)) for p, q in zip(ordered(a), ordered(b), strict=False)])
     distance[np.isnan(a) & np.isnan(b)] = 0.0
     distance[np.isnan(a) ^ np.isnan(b)] = math.inf
     return distance
@@ -375,7 +377,7 @@ def fmutool_check(fmu: Path, executable: str) -> subprocess.CompletedProcess:
 
 
 # ---------------------------------------------------------------------------
-# The table of the README: python -m dyadfmu.importers
+# The table of the README: python -m dyadfmu.cosim.importers
 # ---------------------------------------------------------------------------
 def table(workdir: Path, executable: str) -> list[str]:
     """fmi-sim against fmpy for every FMU the build makes, as Markdown rows: over the
@@ -403,11 +405,12 @@ def table(workdir: Path, executable: str) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Print the table of every FMU through fmi-sim against fmpy and fmutool -check."""
     import argparse
     import tempfile
 
     parser = argparse.ArgumentParser(
-        prog="python -m dyadfmu.importers",
+        prog="python -m dyadfmu.cosim.importers",
         description="fmi-sim against fmpy over the harness's co-simulation of every FMU of "
         "the build (DYADFMU_BUILD, default build/): a Markdown table",
     )

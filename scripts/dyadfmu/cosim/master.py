@@ -120,6 +120,7 @@ def drive_fmu_path(version: int, build: Path | None = None) -> Path:
 
 
 def drive_available(version: int = 2, build: Path | None = None) -> bool:
+    """Whether the drive FMU of this FMI version is built."""
     try:
         drive_fmu_path(version, build)
     except FileNotFoundError:
@@ -132,7 +133,8 @@ def drive_available(version: int = 2, build: Path | None = None) -> bool:
 # ---------------------------------------------------------------------------
 def crank_inertia_about_pivot(mech: builtin.Mechanism) -> float:
     """J_cO [kg m2]: the crank's inertia about its centre of mass plus mass |com|^2 -- its
-    constant share of J(phi) in :mod:`dyadfmu.reference.machine` (m |v_Sc|^2 + J_c at unit speed)."""
+    constant share of J(phi) in :mod:`dyadfmu.reference.machine`
+    (m |v_Sc|^2 + J_c at unit speed)."""
     c = mech.crank
     return float(c["inertia"] + c["mass"] * (c["com"][0] ** 2 + c["com"][1] ** 2))
 
@@ -369,7 +371,7 @@ def run(
                 u0 = np.array([u[name][0] for name in inputs])
                 seed = np.array([u[name][1] for name in inputs]) - u0
                 moving = seed != 0.0
-                knowns = tuple(name for name, m in zip(inputs, moving) if m)
+                knowns = tuple(name for name, m in zip(inputs, moving, strict=False) if m)
                 y.set(inputs, u0)
                 r0 = y.get(outputs)
                 if not all(map(math.isfinite, r0)):
@@ -404,7 +406,7 @@ def run(
             if scheme == "stabilised":
                 y.set(inputs, u0 + eps * seed)
                 r = y.get(outputs)
-                linear = [a + eps * b for a, b in zip(r0, dr)]
+                linear = [a + eps * b for a, b in zip(r0, dr, strict=False)]
                 size = math.hypot(r[0], r[1])
                 if size > 0 and all(map(math.isfinite, r)):
                     residual = max(residual, math.hypot(r[0] - linear[0], r[1] - linear[1]) / size)
@@ -558,7 +560,8 @@ def errors(cosim: CosimRun, ref: Reference) -> dict:
 
     speed: max |omega - omega_ref| / (mean reference speed); reaction: max |R_np -
     R_np_ref| / (peak |R_np_ref|); angle [rad]: max |phi - phi_ref|; speed_at, reaction_at
-    [s]: where the largest errors are; points: how many were compared. A run that diverged has its errors over the points before it stopped."""
+    [s]: where the largest errors are; points: how many were compared. A run that diverged has
+    its errors over the points before it stopped."""
     if len(cosim.t) == 0:
         return {
             "speed": math.nan,

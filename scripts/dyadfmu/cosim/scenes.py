@@ -3,12 +3,13 @@ output against independent references.
 
 Two kinds of scene:
 
-* the multi-dyad chains ``shaper``, ``sixbar`` and ``rocker_slider``: kinematics, loads and the reference
+* the multi-dyad chains ``shaper``, ``sixbar`` and ``rocker_slider``: kinematics, loads and
+  the reference
   (one Newton-Euler system of the whole mechanism, crank included) come from
-  :mod:`dyadfmu.chains`;
+  :mod:`dyadfmu.mechanisms.chains`;
 * the single-dyad scenes ``engine``, ``press`` and ``monitor``: kinematics and loads of the
-  slider-crank and four-bar of :mod:`dyadfmu.mechanisms`, the dyad's reactions from
-  :mod:`dyadfmu.reference` (its own 6x6 Newton-Euler solve) with the scene's effects (no
+  slider-crank and four-bar of :mod:`dyadfmu.mechanisms.builtin`, the dyad's reactions from
+  :mod:`dyadfmu.reference.newton_euler` (its own 6x6 Newton-Euler solve) with the scene's effects (no
   inertia in a static scene, no weight without gravity), and the crank's equilibrium
   written out here.
 
@@ -73,6 +74,7 @@ def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
 
 
 def scene_data(name: str) -> dict:
+    """The parsed scene file scenes/<name>.toml."""
     with open(SCENES_DIR / f"{name}.toml", "rb") as f:
         return tomllib.load(f)
 
@@ -103,10 +105,12 @@ class Source:
             self.chain = chains.load(name)
             self.mechanism = None
 
-    def motion(self, kind: str, revolutions: float):
+    def motion(self, kind: str, revolutions: float) -> CrankMotion:
+        """The crank's motion of the scene's mechanism."""
         return (self.chain or self.mechanism).motion(kind, revolutions)
 
     def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
+        """The kinematics under the scene's variable names at the times t."""
         if self.chain is not None:
             return self.chain.kinematics(t, motion)
         kin = self.mechanism.kinematics(t, motion)
@@ -137,6 +141,7 @@ class Source:
         return self._single_reference(kin)
 
     def conditioning(self, kin: dict) -> dict:
+        """The reference conditioning of every dyad, by FMU output name."""
         if self.chain is not None:
             return {
                 f"{d['name']}.conditioning": kin[f"{d['name']}.conditioning"]
@@ -208,6 +213,7 @@ class Source:
 
     # ---- energy of a chain
     def energy(self, kin: dict) -> np.ndarray:
+        """Kinetic plus potential energy of the chain at every sample."""
         return self.chain.kinetic_energy(kin) + self.chain.potential_energy(kin)
 
 
@@ -216,6 +222,8 @@ class Source:
 # ---------------------------------------------------------------------------
 @dataclass
 class SceneRun:
+    """A scene's tailored FMU co-simulated and compared with its reference."""
+
     name: str
     fmi_version: int
     source: Source
@@ -232,6 +240,7 @@ class SceneRun:
 
     @property
     def worst_relative(self) -> float:
+        """The largest relative error of any output."""
         return max(e.relative for e in self.errors)
 
 
@@ -242,7 +251,7 @@ def setup(
     steps: int = 360,
     motion: str = "constant",
     build: Path | None = None,
-):
+) -> tuple:
     """The co-simulation of a scene's tailored FMU: (setup, source, crank motion,
     kinematics on the grid); its inputs are taken by name from the kinematics."""
     source = Source(name)
@@ -319,6 +328,7 @@ def energy_balance(
 
 
 def summary(result: SceneRun) -> str:
+    """One line on the run: steps, time, worst error, driving torque, energy balance."""
     text = (
         f"{result.name}, FMI {result.fmi_version}: {result.steps} steps in "
         f"{result.seconds_fmu:.3f} s; {len(result.errors)} outputs, worst relative error "

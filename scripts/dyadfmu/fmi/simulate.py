@@ -1,6 +1,6 @@
 """A whole co-simulation of one FMU with fmpy's ``simulate_fmu``: the input signals on the
 communication grid in, every input and output recorded after each step out. The same
-:class:`CoSimSetup` feeds the second importer (:mod:`dyadfmu.fmi.importers`)."""
+:class:`CoSimSetup` feeds the second importer (:mod:`dyadfmu.cosim.importers`)."""
 
 from __future__ import annotations
 
@@ -26,10 +26,12 @@ class CoSimSetup:
 
     @property
     def step(self) -> float:
+        """The communication step (s)."""
         return float(self.time[1] - self.time[0])
 
     @property
     def stop(self) -> float:
+        """The last communication point (s)."""
         return float(self.time[-1])
 
     def signals(self) -> np.ndarray:

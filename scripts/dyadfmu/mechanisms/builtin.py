@@ -1,5 +1,5 @@
 """Five class II planar mechanisms, each a crank plus one Assur dyad, with closed-form
-kinematics and active loads, ready for the dyad FMUs and for :mod:`dyadfmu.reference`.
+kinematics and active loads, ready for the dyad FMUs and for :mod:`dyadfmu.reference.newton_euler`.
 
 ============  =====  ========================================================
 name          dyad   mechanism
@@ -331,7 +331,7 @@ class Mechanism:
             u["guide_p.angle"] = np.asarray(kin["guide_p.angle"], dtype=float)
         return u
 
-    def reference_inputs(self, kin: dict):
+    def reference_inputs(self, kin: dict) -> tuple:
         """``(m, n, guide_k, guide_p, gravity)`` for ``reference.solve(dyad, ...)``, batched
         over the samples (a guide is None where the type has none)."""
         links = []
@@ -431,15 +431,15 @@ class SliderCrank(Mechanism):
         vA: np.ndarray,
         aA: np.ndarray,
     ):
-        l, e = self.l, self.e
-        sn = (e - A[:, 1]) / l  # E_y = e = A_y + l sin(theta_n)
+        rod, e = self.l, self.e
+        sn = (e - A[:, 1]) / rod  # E_y = e = A_y + rod sin(theta_n)
         cn = np.sqrt(1.0 - sn * sn)  # piston to the right of the crank pin
         tn = np.arctan2(sn, cn)
-        wn = -vA[:, 1] / (l * cn)
-        en = (l * wn * wn * sn - aA[:, 1]) / (l * cn)
-        B = geo.vec(A[:, 0] + l * cn, np.full_like(cn, e))
-        vB = geo.vec(vA[:, 0] - l * wn * sn, 0.0)
-        aB = geo.vec(aA[:, 0] - l * en * sn - l * wn * wn * cn, 0.0)
+        wn = -vA[:, 1] / (rod * cn)
+        en = (rod * wn * wn * sn - aA[:, 1]) / (rod * cn)
+        B = geo.vec(A[:, 0] + rod * cn, np.full_like(cn, e))
+        vB = geo.vec(vA[:, 0] - rod * wn * sn, 0.0)
+        aB = geo.vec(aA[:, 0] - rod * en * sn - rod * wn * wn * cn, 0.0)
         zero = np.zeros_like(phi)
         out = {
             "D_m": B,
@@ -451,7 +451,7 @@ class SliderCrank(Mechanism):
             "guide_k.angle": zero.copy(),
         }
         out.update(_link("m", zero, zero, zero, zero))
-        out.update(_link("n", tn, wn, en, l))
+        out.update(_link("n", tn, wn, en, rod))
         return out
 
     def _loads(self, kin: dict):
@@ -465,8 +465,8 @@ class SliderCrank(Mechanism):
         }
 
     def _frame(self):
-        r, l, e = self.crank["radius"], self.l, self.e
-        x0, x1 = math.sqrt((l - r) ** 2 - e * e), math.sqrt((l + r) ** 2 - e * e)
+        r, rod, e = self.crank["radius"], self.l, self.e
+        x0, x1 = math.sqrt((rod - r) ** 2 - e * e), math.sqrt((rod + r) ** 2 - e * e)
         pad = 0.25 * r
         return {"pivots": {"O": (0.0, 0.0)}, "guides": {"k": ((x0 - pad, e), (x1 + pad, e))}}
 

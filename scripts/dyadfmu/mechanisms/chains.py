@@ -434,7 +434,7 @@ class Chain:
             kinds = PAIR_KINDS[e["type"]]
             others = {"D_m": e["k"]["body"], "E": e["n"], "D_n": e["p"]["body"]}
             firsts = {"D_m": e["m"], "E": e["m"], "D_n": e["n"]}
-            for (point, tag), kind in zip(_TAGS, kinds):
+            for (point, tag), kind in zip(_TAGS, kinds, strict=False):
                 guide = None
                 if kind == "T":
                     # D_m: the guide of link k; E: the slot along i_m
@@ -503,7 +503,7 @@ class Chain:
         return kin
 
     @staticmethod
-    def _material(state: dict, at: Callable):
+    def _material(state: dict, at: Callable) -> dict:
         """Position, velocity, acceleration of the point fixed at ``at`` in a body's frame."""
         i = geo.unit(state["angle"])
         rel = at[0] * i + at[1] * geo.rot90(i)
@@ -525,7 +525,6 @@ class Chain:
         zero = np.zeros(shape)
         z2 = np.zeros(shape + (2,))
         c = self.crank_name
-        i_c = geo.unit(phi)
         crank_state = {"angle": phi, "omega": w, "epsilon": eps, "D": z2, "vD": z2, "aD": z2}
         A, vA, aA = self._material(crank_state, (self._r, 0.0))
         kin = {
@@ -645,7 +644,9 @@ class Chain:
             with np.errstate(invalid="raise", divide="raise"):
                 return self._solve(zero, phi, zero + self._w0, zero)
         except FloatingPointError:  # pragma: no cover - _rrr/_rrt raise first
-            raise ValueError(f"{self.name}: a dyad does not assemble over a full crank turn")
+            raise ValueError(
+                f"{self.name}: a dyad does not assemble over a full crank turn"
+            ) from None
 
     def _frame(self) -> dict:
         """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))};

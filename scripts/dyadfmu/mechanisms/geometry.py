@@ -10,33 +10,40 @@ from collections.abc import Mapping
 import numpy as np
 
 
-def unit(angle: float):
+def unit(angle: float) -> np.ndarray:
+    """Unit vectors at the given angles (rad)."""
     angle = np.asarray(angle, dtype=float)
     return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
 
 
-def rot90(v: np.ndarray):
+def rot90(v: np.ndarray) -> np.ndarray:
+    """The vectors turned by +90 degrees."""
     return np.stack([-v[..., 1], v[..., 0]], axis=-1)
 
 
-def dot(a: np.ndarray, b: np.ndarray):
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The dot products of a and b."""
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
 
 
-def cross(a: np.ndarray, b: np.ndarray):
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The z components of the cross products a x b."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
-def col(x: str):
+def col(x: str) -> np.ndarray:
+    """The values as a column (a trailing axis of length 1)."""
     return np.asarray(x, dtype=float)[..., None]
 
 
-def vec(x: str, y: str):
+def vec(x: str, y: str) -> np.ndarray:
+    """Vectors from their x and y components, broadcast together."""
     x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     return np.stack([x, y], axis=-1)
 
 
-def merge(base: Mapping, over: Mapping):
+def merge(base: Mapping, over: Mapping) -> dict:
+    """A deep copy of base with the tables of over merged in, key by key."""
     out = copy.deepcopy(base)
     for key, value in over.items():
         if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
@@ -53,7 +60,8 @@ def number(
     positive: bool = False,
     nonnegative: bool = False,
     default: tuple[float, float] = None,
-):
+) -> float:
+    """The finite number table[key] (or the default), checked; errors name where."""
     if key not in table:
         if default is not None:
             return float(default)
@@ -68,7 +76,8 @@ def number(
     return float(value)
 
 
-def pair(table: Mapping, key: str, where: str):
+def pair(table: Mapping, key: str, where: str) -> tuple[float, float]:
+    """The pair of finite numbers table[key]; errors name where."""
     value = table.get(key)
     if value is None:
         raise ValueError(f"{where}: missing key {key!r}")

@@ -25,7 +25,9 @@ class CrankMotion:
     description: str = ""
 
 
-def rotating(kind: str, w0: float, variation: float, phi0: float, revolutions: float):
+def rotating(
+    kind: str, w0: float, variation: float, phi0: float, revolutions: float
+) -> CrankMotion:
     """Full rotation. constant: phi = phi0 + w0 t. varying: omega = w0 (1 + a sin(w0 t)),
     phi = phi0 + w0 t + a (1 - cos(w0 t)), epsilon = a w0^2 cos(w0 t)."""
     a = variation if kind == "varying" else 0.0
@@ -63,7 +65,7 @@ def rotating(kind: str, w0: float, variation: float, phi0: float, revolutions: f
 
 def oscillating(
     kind: str, w: np.ndarray, centre: np.ndarray, amplitude: float, harmonic2: float, cycles: float
-):
+) -> CrankMotion:
     """Oscillation phi = centre + A1 sin(w t) + A2 sin(2 w t) (A2 = 0 for kind constant)."""
     a2 = harmonic2 if kind == "varying" else 0.0
 

@@ -1,19 +1,20 @@
-"""A machine: one of the mechanisms of :mod:`dyadfmu.mechanisms` driven at its crank by
+"""A machine: one of the mechanisms of :mod:`dyadfmu.mechanisms.builtin` driven at its crank by
 a DC motor through a rigid shaft -- the groundwork for a motor-driven co-simulation.
 
 The mechanism has one degree of freedom, the crank angle phi. Every velocity is linear
 in the crank speed omega, v = omega dv/dphi, so its kinetic energy is
 
-    KE = J(phi) omega^2 / 2,   J(phi) = sum over crank, m, n of (m |dS/dphi|^2 + J_g (dtheta_g/dphi)^2)
+    KE = J(phi) omega^2 / 2,
+    J(phi) = sum over crank, m, n of (m |dS/dphi|^2 + J_g (dtheta_g/dphi)^2)
 
 (the reduced inertia, J_g about the link's centre of mass; the crank's own mass and
-inertia included as in :func:`dyadfmu.crank.kinetic_energy`). The rotor of the motor
+inertia included as in :func:`dyadfmu.mechanisms.crank.kinetic_energy`). The rotor of the motor
 (inertia J_r) turns with the crank, and Lagrange's equation of the machine is
 
     (J_r + J(phi)) epsilon + J'(phi) omega^2 / 2 = T_motor(omega) + Q(phi, omega)
 
 with Q the generalised force of the active loads and gravity (their power over omega).
-The kinetostatic driving torque of :func:`dyadfmu.crank.balance` -- what a kinetostatic
+The kinetostatic driving torque of :func:`dyadfmu.mechanisms.crank.balance` -- what a kinetostatic
 dyad FMU hands to a motor -- is the left side without the rotor:
 M_drive = J epsilon + J' omega^2 / 2 - Q.
 
@@ -108,7 +109,7 @@ class Motor:
         if self.rotor_inertia < 0:
             raise ValueError(f"Motor.rotor_inertia must be >= 0, got {self.rotor_inertia!r}")
 
-    def torque(self, omega: np.ndarray):
+    def torque(self, omega: np.ndarray) -> np.ndarray:
         """Motor torque [N m] at the shaft speed omega [rad/s]."""
         return self.stall_torque * (1.0 - np.asarray(omega, dtype=float) / self.no_load_speed)
 
@@ -234,7 +235,7 @@ def _machine_terms(mech: Mechanism, phi: np.ndarray, omega: np.ndarray):
     return J, dJ, Q
 
 
-def reduced_inertia(mech: Mechanism, phi: np.ndarray):
+def reduced_inertia(mech: Mechanism, phi: np.ndarray) -> tuple:
     """(J, dJ/dphi) [kg m2, kg m2/rad] at the crank angles phi (any shape): twice the
     kinetic energy of crank, m and n at unit crank speed; the derivative is exact
     (closed-form accelerations at unit speed, see the module docstring)."""
@@ -245,7 +246,7 @@ def reduced_inertia(mech: Mechanism, phi: np.ndarray):
     return J.reshape(shape), dJ.reshape(shape)
 
 
-def generalized_load(mech: Mechanism, phi: np.ndarray, omega: np.ndarray):
+def generalized_load(mech: Mechanism, phi: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Generalised force Q [N m] of the active loads and gravity on crank and links at
     the crank states (phi, omega) (broadcast): their power at speed omega divided by
     omega, computed as the loads at (phi, omega) times the unit-speed velocities, which
@@ -262,10 +263,10 @@ def generalized_load(mech: Mechanism, phi: np.ndarray, omega: np.ndarray):
 
 def crank_torque_from_kinetostatics(
     mech: Mechanism, phi: np.ndarray, omega: np.ndarray, epsilon: np.ndarray
-):
+) -> np.ndarray:
     """Driving torque [N m] the crank needs at the given crank states (broadcast): the
-    dyad's reactions from :func:`dyadfmu.reference.solve` on the state's kinematics and
-    loads, then the crank's moment balance (:func:`dyadfmu.crank.balance`). This is what
+    dyad's reactions from :func:`dyadfmu.reference.newton_euler.solve` on the state's kinematics and
+    loads, then the crank's moment balance (:func:`dyadfmu.mechanisms.crank.balance`). This is what
     a kinetostatic dyad FMU gives a motor (the rotor's own inertia not included)."""
     shape, (phi, omega, epsilon) = _broadcast(phi, omega, epsilon)
     kin = _state_kinematics_flat(mech, phi, omega, epsilon)
@@ -277,7 +278,7 @@ def crank_torque_from_kinetostatics(
 # ---------------------------------------------------------------------------
 # inertia ratio
 # ---------------------------------------------------------------------------
-def phi_range(mech: Mechanism):
+def phi_range(mech: Mechanism) -> tuple[float, float] | None:
     """The crank angles the machine may take: None for a revolving crank; for the
     oscillating trt-slot crank, the range (lo, hi) swept by its data's motions (both
     kinds), inside which the mechanism is well conditioned (sin phi >= 0.2 is checked
@@ -400,7 +401,8 @@ def monolithic(
 ) -> MachineRun:
     """The machine as one ODE in (phi, omega), with the works as two quadrature states:
 
-        phi' = omega,   (J_r + J(phi)) omega' = T_motor(omega) + Q(phi, omega) - J'(phi) omega^2 / 2,
+        phi' = omega,
+        (J_r + J(phi)) omega' = T_motor(omega) + Q(phi, omega) - J'(phi) omega^2 / 2,
         W_motor' = T_motor omega,   W_load' = Q omega,
 
     from (phi0, omega0) at t = 0 to t_end [s], by ``scipy.integrate.solve_ivp`` with
@@ -448,7 +450,7 @@ def monolithic(
     if rng is not None and sol.status == 1 and t_eval is not None:
         # append the event state so the run's end is in the output
         te, ye = sol.t_events, sol.y_events
-        for tk, yk in zip(te, ye):
+        for tk, yk in zip(te, ye, strict=False):
             if len(tk):
                 t = np.append(t, tk[0])
                 phi, omega = np.append(phi, yk[0][0]), np.append(omega, yk[0][1])

@@ -77,7 +77,7 @@ _VEC_KEYS = ("dir", "accel_d", "com", "force")
 UNKNOWNS = {
     t: tuple(
         name
-        for pair, kind in zip(("mk", "np", "mn"), (p[0], p[2], p[1]))
+        for pair, kind in zip(("mk", "np", "mn"), (p[0], p[2], p[1]), strict=False)
         for name in ((f"r_{pair}.x", f"r_{pair}.y") if kind == "R" else (f"n_{pair}", f"m_{pair}"))
     )
     for t, p in PAIRS.items()
@@ -256,7 +256,7 @@ def assemble(
     guide_k: np.ndarray | None = None,
     guide_p: np.ndarray | None = None,
     gravity: tuple[float, float] = (0.0, 0.0),
-):
+) -> tuple:
     """Build the batched Newton-Euler system ``A u = b`` of a dyad.
 
     Parameters
@@ -306,7 +306,7 @@ def solve(
     guide_k: np.ndarray | None = None,
     guide_p: np.ndarray | None = None,
     gravity: tuple[float, float] = (0.0, 0.0),
-):
+) -> dict:
     """Solve the dyad reactions for a batch of N configurations (float64).
 
     Returns a dict with
@@ -354,7 +354,7 @@ def solve_mp(
     guide_p: np.ndarray | None = None,
     gravity: tuple[float, float] = (0.0, 0.0),
     dps: int = 50,
-):
+) -> dict:
     """High-precision solve of ONE configuration with mpmath (``dps`` digits).
 
     Inputs are plain floats / length-2 sequences, converted exactly from double

@@ -1,7 +1,7 @@
-"""Drawing of a chain mechanism of :mod:`dyadfmu.chains` to scale, at one sample, with
+"""Drawing of a chain mechanism of :mod:`dyadfmu.mechanisms.chains` to scale, at one sample, with
 its joint reactions as arrows on one force scale.
 
-Symbols (those of :mod:`dyadfmu.drawing`): fixed pivots as triangles on hatched ground,
+Symbols (those of :mod:`dyadfmu.report.drawing`): fixed pivots as triangles on hatched ground,
 fixed guides as hatched rails, the crank and the links as bars (a ternary link also as a
 shaded triangle, a slotted link with its groove, a link carrying a guide with a widened
 grooved part along the stretch the slider uses), blocks and sliders as rectangles,
@@ -59,7 +59,7 @@ def _r90(v: np.ndarray):
     return np.array([-v[1], v[0]])
 
 
-def reaction_vectors(chain: Chain, reactions: dict | None, index: int):
+def reaction_vectors(chain: Chain, reactions: dict | None, index: int) -> dict:
     """The pair forces at sample ``index``: list of (output name, body it acts on, kin key
     of its point, force (2,) [N]), crank pivot first, then per dyad R_mk, R_mn, R_np."""
     out = []
@@ -139,7 +139,7 @@ def draw(
     index: int,
     reactions: dict | None = None,
     scale: float | None = None,
-):
+) -> float:
     """Draw ``chain`` at sample ``index`` of ``kin`` (from ``chain.kinematics``) on ``ax``
     to scale, with equal aspect.
 
@@ -179,21 +179,21 @@ def draw(
         sketch.label(ax, p1 + 2.5 * u * n, label, (0.0, 0.0), colour="0.3", size=8, box=False)
 
     # the crank
-    O, A = at("O"), at("A")
-    sketch.bar(ax, O, A, _CRANK_COLOUR, z=2.0)
+    pivot, A = at("O"), at("A")
+    sketch.bar(ax, pivot, A, _CRANK_COLOUR, z=2.0)
     i_c = _u2(float(at(f"{chain.crank_name}.angle")))
     _link_guides(
-        ax, frame, chain.crank_name, O, float(at(f"{chain.crank_name}.angle")), _CRANK_COLOUR
+        ax, frame, chain.crank_name, pivot, float(at(f"{chain.crank_name}.angle")), _CRANK_COLOUR
     )
-    link_label_at[chain.crank_name] = 0.5 * (O + A) - 1.8 * u * _r90(i_c)
+    link_label_at[chain.crank_name] = 0.5 * (pivot + A) - 1.8 * u * _r90(i_c)
 
     # the links
-    pins = [O]
+    pins = [pivot]
     for e in chain.plan:
         dn, m, n = e["name"], e["m"], e["n"]
         Dm, E, Dn = at(f"{dn}.D_m"), at(f"{dn}.E"), at(f"{dn}.D_n")
         kinds = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR"}[e["type"]]
-        for point, kind in zip((Dm, E, Dn), kinds):
+        for point, kind in zip((Dm, E, Dn), kinds, strict=False):
             if kind == "R":
                 pins.append(point)
         for g, D in ((m, Dm), (n, Dn)):
@@ -344,7 +344,9 @@ def draw(
     return {"scale": scale, "arrows": arrows}
 
 
-def figure(chain: Chain, kin: dict, reactions: dict | None, indices: list[int], path: Path | str):
+def figure(
+    chain: Chain, kin: dict, reactions: dict | None, indices: list[int], path: Path | str
+) -> Path:
     """Save a PNG of ``chain`` at 2 to 4 samples ``indices`` of ``kin``, one panel each,
     all with the reactions on one force scale (the largest arrow of all panels is 40 %
     of the mechanism's size). Returns the path."""
@@ -361,7 +363,7 @@ def figure(chain: Chain, kin: dict, reactions: dict | None, indices: list[int], 
     rows = 2 if len(indices) == 4 else 1
     fig, axes = plt.subplots(rows, cols, figsize=(6.4 * cols, 7.4 * rows), squeeze=False)
     c = chain.crank_name
-    for ax, i in zip(axes.flat, indices):
+    for ax, i in zip(axes.flat, indices, strict=False):
         draw(ax, chain, kin, i, reactions, scale)
         phi = math.degrees(float(kin[f"{c}.angle"][i])) % 360.0
         ax.set_title(

@@ -1,11 +1,11 @@
 """The co-simulation study: the drive FMU coupled to a dyad FMU by the master of
-:mod:`dyadfmu.cosim`, both schemes, over inertia ratios and communication steps, against
+:mod:`dyadfmu.cosim.master`, both schemes, over inertia ratios and communication steps, against
 the monolithic machine; writes ``<out>/cosim/report.md``, ``points.csv`` and
 ``error_vs_time.png``.
 
 Command line (the ``dyadfmu cosim`` subcommand calls :func:`main`)::
 
-    python -m dyadfmu.cosim_report [--quick] [--out DIR] [--fmi-version {2,3}]
+    python -m dyadfmu.report.cosim [--quick] [--out DIR] [--fmi-version {2,3}]
 """
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ def study_points(
     verbose: bool = False,
 ) -> tuple[list[dict], dict]:
     """Every run of the study as a row of :data:`FIELDS`, and {(mechanism, ratio):
-    :class:`dyadfmu.cosim.Reference`} (evaluated on the finest step's grid)."""
+    :class:`dyadfmu.cosim.master.Reference`} (evaluated on the finest step's grid)."""
     ratios = tuple(ratios or (QUICK_RATIOS if quick else RATIOS))
     steps = tuple(sorted(steps or (QUICK_STEPS if quick else STEPS), reverse=True))
     rtol, atol = REFERENCE_TOLERANCES[bool(quick)]
@@ -148,6 +148,7 @@ def study_points(
 # outputs
 # ---------------------------------------------------------------------------
 def write_csv(path: Path, rows: list) -> Path:
+    """The study's points as CSV."""
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=FIELDS)
         w.writeheader()
@@ -157,6 +158,7 @@ def write_csv(path: Path, rows: list) -> Path:
 
 
 def plot(path: Path, rows: list) -> Path:
+    """The speed error against wall time per step, one marker per run."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -235,6 +237,7 @@ def _status(r: dict) -> str:
 def markdown(
     path: Path, rows: list, refs: dict, quick: bool, elapsed: float, figure: Path, fmi_version: int
 ) -> Path:
+    """The co-simulation report in Markdown."""
     names = list(dict.fromkeys(r["mechanism"] for r in rows))
     ratios = sorted({r["ratio"] for r in rows})
     steps = sorted({r["step"] for r in rows}, reverse=True)
@@ -466,6 +469,7 @@ def run_study(
 
 
 def parser() -> argparse.ArgumentParser:
+    """The options of 'dyadfmu cosim'."""
     p = argparse.ArgumentParser(
         prog="dyadfmu cosim",
         description="Co-simulate the drive FMU with the dyad FMU of the slider-crank and the "
@@ -491,6 +495,7 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run 'dyadfmu cosim' with `argv`: the study, its report and a summary."""
     args = parser().parse_args(argv)
     try:
         result = run_study(

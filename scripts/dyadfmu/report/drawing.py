@@ -1,4 +1,4 @@
-"""Drawing of a mechanism of :mod:`dyadfmu.mechanisms` to scale on a matplotlib Axes,
+"""Drawing of a mechanism of :mod:`dyadfmu.mechanisms.builtin` to scale on a matplotlib Axes,
 optionally with joint reactions as arrows on one force scale.
 
 Symbols: the frame k as hatched ground under fixed pivots and along fixed guides,
@@ -135,7 +135,7 @@ def _draw_trt_slot(ax: Axes, mech: Mechanism, at: Callable, u: float):
     E = at("E")
     phi = at("crank.angle")
     i_p = _unit(phi)
-    r, h = mech.crank["radius"], mech.h
+    h = mech.h
     (x0, _), (x1, _) = mech._frame()["guides"]["k"]
     hs = 1.0 * u  # half height of the slider
     ax.plot([x0, x1], [h, h], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)
@@ -157,12 +157,12 @@ def draw(
     index: int,
     reactions: dict | None = None,
     scale: float | None = None,
-):
+) -> float:
     """Draw ``mechanism`` at sample ``index`` of ``kin`` (from ``mechanism.kinematics``)
     on ``ax`` to scale, with equal aspect.
 
     reactions: optional dict name -> (Fx, Fy) in N, names among ``R_mk`` (at D_m),
-    ``R_np`` (at D_n), ``R_mn`` (at E) and ``R_O`` (the frame on the crank at O); each
+    ``R_np`` (at D_n), ``R_mn`` (at E) and ``R_O`` (the frame on the crank at pivot); each
     is drawn as an arrow from its point of application, all with one force scale in
     N per m of drawing: ``scale`` if given, else chosen so that the largest arrow is
     40 % of the mechanism's size. Returns the scale used (N/m).
@@ -177,27 +177,27 @@ def draw(
 
     size = mechanism_size(mechanism, kin)
     u = 0.035 * size  # size of the symbols
-    O, A = at("O"), at("A")
+    pivot, A = at("O"), at("A")
     phi = float(at("crank.angle"))
 
-    # frame k at O, the crank p
-    sketch.ground_pivot(ax, O, u)
+    # frame k at pivot, the crank p
+    sketch.ground_pivot(ax, pivot, u)
     side = _rot90(_unit(phi))  # the crank's label goes on the side away from E
-    if np.dot(side, at("E") - O) > 0:
+    if np.dot(side, at("E") - pivot) > 0:
         side = -side
     if mechanism.dyad == "TRT":
-        tip = O + mechanism.crank["radius"] * _unit(phi)
-        sketch.bar(ax, O, tip, _COLOUR["p"], width=sketch.LINK_WIDTH * 1.6, z=2.0)
+        tip = pivot + mechanism.crank["radius"] * _unit(phi)
+        sketch.bar(ax, pivot, tip, _COLOUR["p"], width=sketch.LINK_WIDTH * 1.6, z=2.0)
         sketch.slot(
             ax,
-            O + 0.35 * (tip - O),
-            O + (tip - O) * (1 - 1.2 * u / mechanism.crank["radius"]),
+            pivot + 0.35 * (tip - pivot),
+            pivot + (tip - pivot) * (1 - 1.2 * u / mechanism.crank["radius"]),
             z=2.1,
         )
-        p_label = O + 0.25 * (tip - O) + 1.6 * u * side
+        p_label = pivot + 0.25 * (tip - pivot) + 1.6 * u * side
     else:
-        sketch.bar(ax, O, A, _COLOUR["p"], z=2.0)
-        p_label = 0.5 * (O + A) + 1.6 * u * side
+        sketch.bar(ax, pivot, A, _COLOUR["p"], z=2.0)
+        p_label = 0.5 * (pivot + A) + 1.6 * u * side
 
     if mechanism.dyad == "RRT":
         where = _draw_slider_crank(ax, mechanism, at, u)

@@ -22,13 +22,14 @@ FRAME_COLOUR = "0.35"
 
 def bar(
     ax: Axes, p0: np.ndarray, p1: np.ndarray, colour: str, width: float = LINK_WIDTH, z: float = 2.0
-):
+) -> None:
+    """A link as a bar from p0 to p1."""
     ax.plot(
         [p0[0], p1[0]], [p0[1], p1[1]], color=colour, lw=width, solid_capstyle="round", zorder=z
     )
 
 
-def slot(ax: Axes, p0: np.ndarray, p1: np.ndarray, z: float):
+def slot(ax: Axes, p0: np.ndarray, p1: np.ndarray, z: float) -> None:
     """A slot along a bar: a white groove drawn over it."""
     ax.plot(
         [p0[0], p1[0]],
@@ -40,7 +41,8 @@ def slot(ax: Axes, p0: np.ndarray, p1: np.ndarray, z: float):
     )
 
 
-def pin(ax: Axes, p: np.ndarray, u: float, z: float = 6.0):
+def pin(ax: Axes, p: np.ndarray, u: float, z: float = 6.0) -> None:
+    """A revolute pair: a white pin at p."""
     ax.add_patch(Circle(tuple(p), 0.42 * u, facecolor="white", edgecolor="black", lw=1.2, zorder=z))
 
 
@@ -52,7 +54,7 @@ def block(
     width: float,
     colour: str,
     z: float = 4.0,
-):
+) -> None:
     """A rectangle centred at ``centre`` with its long side along ``direction``."""
     i = np.asarray(direction, dtype=float)
     i = i / np.hypot(*i)
@@ -67,7 +69,9 @@ def block(
     )
 
 
-def hatch(ax: Axes, p0: np.ndarray, p1: np.ndarray, side: np.ndarray, u: float, z: float = 1.0):
+def hatch(
+    ax: Axes, p0: np.ndarray, p1: np.ndarray, side: np.ndarray, u: float, z: float = 1.0
+) -> None:
     """A fixed surface from p0 to p1 with hatch strokes on the side ``side`` (a vector)."""
     p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
     ax.plot([p0[0], p1[0]], [p0[1], p1[1]], color=FRAME_COLOUR, lw=1.5, zorder=z)
@@ -86,7 +90,7 @@ def hatch(ax: Axes, p0: np.ndarray, p1: np.ndarray, side: np.ndarray, u: float, 
         ax.plot([q[0], q1[0]], [q[1], q1[1]], color=FRAME_COLOUR, lw=0.8, zorder=z)
 
 
-def ground_pivot(ax: Axes, p: np.ndarray, u: float):
+def ground_pivot(ax: Axes, p: np.ndarray, u: float) -> None:
     """A fixed pivot: a triangle standing on a hatched base."""
     p = np.asarray(p, dtype=float)
     base = p - np.array([0.0, 1.5 * u])
@@ -106,7 +110,7 @@ def label(
     size: float = 9,
     weight: str = "normal",
     box: bool = True,
-):
+) -> None:
     """Text near p, ``offset`` in points; aligned so that it grows away from p."""
     dx, dy = offset
     ha = (
@@ -139,7 +143,7 @@ def label(
     )
 
 
-def beside(p0: np.ndarray, p1: np.ndarray, u: float, up: bool = True):
+def beside(p0: np.ndarray, p1: np.ndarray, u: float, up: bool = True) -> np.ndarray:
     """A point 1.8 u beside the middle of the bar p0-p1 (on its upper side if ``up``)."""
     p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
     t = p1 - p0
@@ -149,7 +153,10 @@ def beside(p0: np.ndarray, p1: np.ndarray, u: float, up: bool = True):
     return 0.5 * (p0 + p1) + 1.8 * u * n
 
 
-def away(p: np.ndarray, centre: np.ndarray, default: tuple[float, float] = (1.0, 1.0)):
+def away(
+    p: np.ndarray, centre: np.ndarray, default: tuple[float, float] = (1.0, 1.0)
+) -> np.ndarray:
+    """The unit vector from centre towards p (default where they coincide)."""
     d = np.asarray(p, dtype=float) - centre
     n = float(np.hypot(*d))
     if n < 1e-12:

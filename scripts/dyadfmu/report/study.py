@@ -26,7 +26,9 @@ MARKERS = {
     "fmu_fmpy2": "*",
     "fmu_fmpy3": "h",
 }
-COLORS = dict(zip(TYPES, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")))
+COLORS = dict(
+    zip(TYPES, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"), strict=True)
+)
 METHOD_COLORS = {
     "core": "tab:blue",
     "core_float": "tab:cyan",
@@ -43,6 +45,7 @@ def _label(method: str) -> str:
 
 
 def plots(out: Path, points: list[tuple], summary: list[dict]) -> dict:
+    """The work-precision and error-against-amplification plots; their paths by name."""
     figures = {}
     # Work-precision: worst error on the random set against time per configuration.
     fig, ax = plt.subplots(figsize=(8.5, 6))
@@ -79,7 +82,7 @@ def plots(out: Path, points: list[tuple], summary: list[dict]) -> dict:
         by[(p[1], p[2])].append((p[4], p[5], p[0]))
     fig, axes = plt.subplots(2, 3, figsize=(13, 8.5), sharey=True)
     amp_line = np.logspace(0, 17, 50)
-    for ax, dyad in zip(axes.flat, TYPES):
+    for ax, dyad in zip(axes.flat, TYPES, strict=False):
         for method, color in METHOD_COLORS.items():
             data = np.array(
                 [(a, e) for a, e, _ in by[(dyad, method)] if np.isfinite(a) and np.isfinite(e)]
@@ -132,6 +135,7 @@ def markdown(
     elapsed: float,
     figures: dict,
 ) -> Path:
+    """The study's report.md from its summary, contract ratios and figures."""
     core_time = {s["type"]: s["seconds"] for s in summary if s["method"] == "core"}
     lines = [
         "# dyadfmu: accuracy and speed of every way to compute the reactions",

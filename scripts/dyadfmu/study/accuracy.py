@@ -39,6 +39,8 @@ LABELS = {
 
 @dataclass
 class Sizes:
+    """How many configurations, steps and repetitions the study takes."""
+
     timing: int  # random configurations timed per type
     truth: int  # of them compared with mpmath
     per_decade: int  # near-singular sweep points per decade

@@ -25,6 +25,7 @@ def fmu_path(dyad: str, version: int) -> Path:
 
 
 def bench_binary(build: Path, real: str) -> Path:
+    """The benchmark program of the build, in double or float."""
     name = "dyad_bench" if real == "double" else "dyad_bench_float"
     path = build / "tests" / "bench" / name
     if not path.is_file():
@@ -36,6 +37,7 @@ def bench_binary(build: Path, real: str) -> Path:
 
 
 def run_bench(binary: Path, args: list[str]) -> dict:
+    """Run the benchmark program; its last line of output as JSON."""
     done = subprocess.run([str(binary), *args], capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(f"{binary.name} {' '.join(args)} failed: {done.stderr.strip()}")
@@ -105,7 +107,7 @@ def instructions(build: Path, method: str, dyad: str, rows: np.ndarray, work: Pa
     return int(match.group(1)) / len(rows) if match else math.nan
 
 
-def fmu_rows(dyad: str, count: int, seed: int):
+def fmu_rows(dyad: str, count: int, seed: int) -> tuple:
     """Inputs for stepping an FMU: its start values with smooth variations."""
     path = fmu_path(dyad, 2)
     md = read_model_description(str(path))
@@ -126,6 +128,7 @@ def fmu_rows(dyad: str, count: int, seed: int):
 
 
 def fmu_from_c(build: Path, dyad: str, version: int, count: int, work: Path) -> float:
+    """Seconds per doStep of the dyad FMU's binary stepped from C by the benchmark."""
     md, inputs, outputs, rows = fmu_rows(dyad, count, seed=version)
     binary = paths.stage_binary(build, f"dyad_{dyad.lower()}", version)
     rows.astype("<f8").tofile(work / "fmu_inputs.bin")

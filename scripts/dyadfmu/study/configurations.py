@@ -95,7 +95,7 @@ def _random_links(
     load_range: tuple[float, float] = (-2, 4),
 ):
     rows = np.zeros((count, len(COLUMNS)))
-    for g, zero_ok in zip(("m", "n"), ZERO_OK[dyad]):
+    for g, zero_ok in zip(("m", "n"), ZERO_OK[dyad], strict=False):
         length = 10.0 ** rng.uniform(*length_range, count)
         if zero_ok:
             length[rng.random(count) < 0.1] = 0.0
@@ -304,7 +304,7 @@ def cancelling_set(dyad: str, count: int, seed: int) -> np.ndarray:
     return rows
 
 
-def reference_args(dyad: str, row: np.ndarray):
+def reference_args(dyad: str, row: np.ndarray) -> tuple:
     """One configuration as the arguments of reference.solve / solve_mp."""
 
     def link(g: str):
@@ -327,7 +327,7 @@ def reference_args(dyad: str, row: np.ndarray):
     return link("m"), link("n"), guide_k, guide_p, (row[COL["gravity.x"]], row[COL["gravity.y"]])
 
 
-def batched_reference_args(dyad: str, rows: np.ndarray):
+def batched_reference_args(dyad: str, rows: np.ndarray) -> tuple:
     """All configurations at once, for the batched reference.solve."""
 
     def link(g: str):

@@ -34,6 +34,8 @@ if TYPE_CHECKING:
 
 @dataclass
 class Footprint:
+    """An FMU's variables, binary and code size, instructions and time per doStep."""
+
     inputs: int
     parameters: int
     outputs: int
@@ -44,6 +46,7 @@ class Footprint:
 
     @property
     def variables(self) -> int:
+        """Inputs, parameters and outputs together."""
         return self.inputs + self.parameters + self.outputs
 
 
@@ -120,6 +123,7 @@ def _counts(md: ModelDescription) -> tuple[int, int, int]:
 def tailored(
     name: str, build: Path, version: int, work: Path, rows_count: int, repeat: int
 ) -> Footprint:
+    """The footprint of a scene's tailored FMU, stepped through its own kinematics."""
     path = scenes.fmu_path(name, version, build)
     md = read_model_description(str(path))
     source = scenes.Source(name)
@@ -137,6 +141,7 @@ def tailored(
 def generic(
     dyad: str, build: Path, version: int, work: Path, rows_count: int, repeat: int
 ) -> Footprint:
+    """The footprint of the generic FMU of a dyad type."""
     identifier = f"dyad_{dyad.lower()}"
     md, _, _, rows = bench.fmu_rows(dyad, rows_count, seed=version)
     if version != 2:

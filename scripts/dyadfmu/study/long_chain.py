@@ -86,6 +86,7 @@ def chain_scene(dyads: int, identifier: str | None = None) -> str:
 
 
 def write_chain(dyads: int, folder: Path) -> Path:
+    """The chain of `dyads` RRR dyads written to <folder>/chain<dyads>.toml."""
     path = Path(folder) / f"chain{dyads}.toml"
     path.write_text(chain_scene(dyads), encoding="utf-8")
     return path
@@ -129,6 +130,7 @@ def measure(
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run 'dyadfmu scene-bench' with `argv`: print the generator's times."""
     parser = argparse.ArgumentParser(
         prog="dyadfmu scene-bench",
         description="Time the scene generator (modelDescription/scene.py --check and --out) "
