@@ -278,6 +278,174 @@ def _cross(a: np.ndarray, b: np.ndarray):
     return a[0] * b[1] - a[1] * b[0]
 
 
+class _Diverged(Exception):
+    """A run that stops: the time and the reason."""
+
+    def __init__(self, t: float, reason: str) -> None:
+        super().__init__(reason)
+        self.t, self.reason = t, reason
+
+
+class _Coupling:
+    """One communication point of a run: the crank state from the drive, the dyad's
+    reaction on the crank, the drive's acceleration under it (module docstring)."""
+
+    def __init__(
+        self, mech: builtin.Mechanism, scheme: str, motor: machine.Motor, d: Slave, y: Slave
+    ) -> None:
+        self.mech, self.scheme, self.d, self.y = mech, scheme, d, y
+        self.outputs = ("R_np.x", "R_np.y") + (("M_np",) if "M_np" in y.names else ())
+        self.has_m = len(self.outputs) == 3
+        self.limit = DIVERGENCE_SPEED_FACTOR * motor.no_load_speed
+        self.inputs = None
+        self.residual = 0.0
+
+    def _crank_state(self, t: float) -> tuple:
+        phi, omega, eps_prev, _ = self.d.get(_DRIVE_OUTPUTS)
+        if not math.isfinite(omega) or not math.isfinite(phi):
+            raise _Diverged(
+                t,
+                f"crank state not finite (angle {phi:g} rad, speed {omega:g} "
+                f"rad/s, drive status {self.d.get_status()})",
+            )
+        if abs(omega) > self.limit:
+            raise _Diverged(
+                t,
+                f"crank speed {omega:.4g} rad/s beyond "
+                f"{DIVERGENCE_SPEED_FACTOR:g} x the no-load speed "
+                f"({self.limit:.4g} rad/s)",
+            )
+        return phi, omega, eps_prev
+
+    def _dyad_failed(self, t: float, where: str) -> _Diverged:
+        status = self.y.get_status()
+        return _Diverged(
+            t, f"dyad FMU status {status} ({_DYAD_STATUS.get(status, '?')}) at {where}"
+        )
+
+    def _moment(self, kin: dict, r: list) -> float:
+        """The dyad's torque on the crank about O from the reaction r (or its slope)."""
+        lever = kin["D_n"][0] - kin["O"][0]
+        return _cross(lever, (-r[0], -r[1])) - (r[2] if self.has_m else 0.0)
+
+    def _set_dyad(self, u: dict, row: int) -> np.ndarray:
+        if self.inputs is None:
+            self.inputs = tuple(u)
+        values = np.array([u[name][row] for name in self.inputs])
+        self.y.set(self.inputs, values)
+        return values
+
+    def _explicit_load(self, t: float, phi: float, omega: float, eps_prev: float) -> tuple:
+        if not math.isfinite(eps_prev):
+            raise _Diverged(t, f"crank acceleration not finite ({eps_prev:g} rad/s2)")
+        kin = machine.state_kinematics(self.mech, phi, omega, eps_prev)
+        self._set_dyad(self.mech.fmu_inputs(kin), 0)
+        r = self.y.get(self.outputs)
+        if not all(map(math.isfinite, r)):
+            raise self._dyad_failed(t, f"conditioning {float(kin['conditioning'][0]):.3g}")
+        return self._moment(kin, r), 0.0, r
+
+    def _stabilised_load(self, t: float, phi: float, omega: float) -> tuple:
+        kin = machine.state_kinematics(self.mech, (phi, phi), (omega, omega), (0.0, 1.0))
+        u = self.mech.fmu_inputs(kin)
+        u0 = self._set_dyad(u, 0)
+        seed = np.array([u[name][1] for name in self.inputs]) - u0
+        moving = seed != 0.0
+        knowns = tuple(name for name, m in zip(self.inputs, moving, strict=True) if m)
+        r0 = self.y.get(self.outputs)
+        if not all(map(math.isfinite, r0)):
+            raise self._dyad_failed(t, f"conditioning {float(kin['conditioning'][0]):.3g}")
+        dr = self.y.directional_derivative(self.outputs, knowns, seed[moving])
+        return self._moment(kin, r0), -self._moment(kin, dr), (u0, seed, r0, dr)
+
+    def _drive_acceleration(self, t: float, tau: float, j_load: float) -> tuple:
+        self.d.set(_DRIVE_INPUTS, (tau, j_load))
+        eps, torque = self.d.get(("crank.epsilon", "motor.torque"))
+        if not math.isfinite(eps):
+            raise _Diverged(
+                t,
+                f"crank acceleration not finite (drive status "
+                f"{self.d.get_status()}, load.inertia {j_load:.4g} kg.m2)",
+            )
+        return eps, torque
+
+    def _stabilised_reaction(self, t: float, eps: float, slope: tuple) -> list:
+        """The dyad set to the inputs at the solved eps; its reaction there, and how far it
+        is from the linear prediction."""
+        u0, seed, r0, dr = slope
+        self.y.set(self.inputs, u0 + eps * seed)
+        r = self.y.get(self.outputs)
+        linear = [a + eps * b for a, b in zip(r0, dr, strict=True)]
+        size = math.hypot(r[0], r[1])
+        if size > 0 and all(map(math.isfinite, r)):
+            self.residual = max(
+                self.residual, math.hypot(r[0] - linear[0], r[1] - linear[1]) / size
+            )
+        if not all(map(math.isfinite, r)):
+            raise self._dyad_failed(t, f"the solved acceleration {eps:.4g} rad/s2")
+        return r
+
+    def row(self, t: float) -> tuple:
+        """(t, phi, omega, eps, T, tau, J_load, Rx, Ry, M) at the communication point t;
+        :class:`_Diverged` where the run stops."""
+        phi, omega, eps_prev = self._crank_state(t)
+        if self.scheme == "explicit":
+            tau, j_load, r = self._explicit_load(t, phi, omega, eps_prev)
+            eps, torque = self._drive_acceleration(t, tau, j_load)
+        else:
+            tau, j_load, slope = self._stabilised_load(t, phi, omega)
+            eps, torque = self._drive_acceleration(t, tau, j_load)
+            r = self._stabilised_reaction(t, eps, slope)
+        return (t, phi, omega, eps, torque, tau, j_load, r[0], r[1], r[2] if self.has_m else 0.0)
+
+
+def _steps(scheme: str, step: float, t_end: float, fmi_version: int) -> int:
+    """The number of communication steps of a run, its arguments checked."""
+    if scheme not in SCHEMES:
+        raise ValueError(f"unknown scheme {scheme!r}; expected one of {', '.join(SCHEMES)}")
+    if not (step > 0 and math.isfinite(step) and t_end > 0 and math.isfinite(t_end)):
+        raise ValueError(f"step and t_end must be positive numbers, got {step!r}, {t_end!r}")
+    n = int(round(t_end / step))
+    if n < 1 or abs(n * step - t_end) > 1e-9 * t_end:
+        raise ValueError(f"t_end = {t_end!r} s is not a whole number of steps of {step!r} s")
+    if fmi_version not in (2, 3):
+        raise ValueError(f"fmi_version must be 2 or 3, got {fmi_version!r}")
+    return n
+
+
+def _fmu_factories(
+    mech: builtin.Mechanism, fmi_version: int, drive: Callable | None, dyad: Callable | None
+) -> tuple[Callable, Callable]:
+    """The makers of the drive and dyad slaves: the given ones, else the built FMUs."""
+    if drive is None:
+        drive_path = drive_fmu_path(fmi_version)
+
+        def drive(name: str) -> Slave:
+            return Slave(drive_path, name, label=f"drive FMU (FMI {fmi_version})")
+
+    if dyad is None:
+        dyad_path = harness.fmu_path(mech.dyad, fmi_version)
+
+        def dyad(name: str) -> Slave:
+            return Slave(dyad_path, name, label=f"dyad FMU {mech.dyad} (FMI {fmi_version})")
+
+    return drive, dyad
+
+
+def _close(slaves: list) -> None:
+    for s in reversed(slaves):
+        try:
+            s.close()
+        except Exception:  # pragma: no cover - freeing never hides the run's result
+            pass
+
+
+def _columns(rows: list) -> tuple:
+    """t, phi, omega, eps, motor torque, tau, load inertia, R_np (N, 2), M_np of the rows."""
+    a = np.array(rows, dtype=float).reshape(-1, 10)
+    return (*(a[:, k] for k in range(7)), a[:, 7:9].copy(), a[:, 9])
+
+
 def run(
     mech: builtin.Mechanism,
     scheme: str,
@@ -298,144 +466,33 @@ def run(
     ``drive`` and ``dyad`` make the slaves, ``f(instance_name) -> slave``; by default the
     FMUs ``build/fmus/drive_fmi<v>.fmu`` and ``harness.fmu_path(mech.dyad, v)``
     (:class:`Slave`). Divergence stops the run and is reported in the result."""
-    if scheme not in SCHEMES:
-        raise ValueError(f"unknown scheme {scheme!r}; expected one of {', '.join(SCHEMES)}")
-    if not (step > 0 and math.isfinite(step) and t_end > 0 and math.isfinite(t_end)):
-        raise ValueError(f"step and t_end must be positive numbers, got {step!r}, {t_end!r}")
-    n = int(round(t_end / step))
-    if n < 1 or abs(n * step - t_end) > 1e-9 * t_end:
-        raise ValueError(f"t_end = {t_end!r} s is not a whole number of steps of {step!r} s")
-    if fmi_version not in (2, 3):
-        raise ValueError(f"fmi_version must be 2 or 3, got {fmi_version!r}")
-    if drive is None:
-        drive_path = drive_fmu_path(fmi_version)
-
-        def drive(name: str):
-            return Slave(drive_path, name, label=f"drive FMU (FMI {fmi_version})")
-
-    if dyad is None:
-        dyad_path = harness.fmu_path(mech.dyad, fmi_version)
-
-        def dyad(name: str):
-            return Slave(dyad_path, name, label=f"dyad FMU {mech.dyad} (FMI {fmi_version})")
-
-    limit = DIVERGENCE_SPEED_FACTOR * motor.no_load_speed
-    rows = []  # (t, phi, omega, eps, T, tau, J_load, Rx, Ry, M)
+    n = _steps(scheme, step, t_end, fmi_version)
+    drive, dyad = _fmu_factories(mech, fmi_version, drive, dyad)
+    rows, slaves, coupling = [], [], None  # rows: (t, phi, omega, eps, T, tau, J_load, Rx, Ry, M)
     diverged, diverged_at, reason = False, None, ""
-    residual = 0.0
-    slaves = []
     start = clock.perf_counter()
     try:
-        d = drive("drive")
-        slaves.append(d)
-        y = dyad("dyad")
-        slaves.append(y)
-        outputs = ("R_np.x", "R_np.y") + (("M_np",) if "M_np" in y.names else ())
-        has_m = len(outputs) == 3
+        slaves.append(drive("drive"))
+        slaves.append(dyad("dyad"))
+        d, y = slaves
+        coupling = _Coupling(mech, scheme, motor, d, y)
         d.initialize(drive_parameters(mech, motor, phi0, omega0), 0.0)
         y.initialize(mech.fmu_parameters(), 0.0)
-        inputs = None
         for k in range(n + 1):
             t = k * step
-            phi, omega, eps_prev, _ = d.get(_DRIVE_OUTPUTS)
-            if not math.isfinite(omega) or not math.isfinite(phi):
-                diverged, diverged_at = True, t
-                reason = (
-                    f"crank state not finite (angle {phi:g} rad, speed {omega:g} rad/s, "
-                    f"drive status {d.get_status()})"
-                )
-                break
-            if abs(omega) > limit:
-                diverged, diverged_at = True, t
-                reason = (
-                    f"crank speed {omega:.4g} rad/s beyond {DIVERGENCE_SPEED_FACTOR:g} x "
-                    f"the no-load speed ({limit:.4g} rad/s)"
-                )
-                break
-            if scheme == "explicit":
-                if not math.isfinite(eps_prev):
-                    diverged, diverged_at = True, t
-                    reason = f"crank acceleration not finite ({eps_prev:g} rad/s2)"
-                    break
-                kin = machine.state_kinematics(mech, phi, omega, eps_prev)
-                u = mech.fmu_inputs(kin)
-                if inputs is None:
-                    inputs = tuple(u)
-                y.set(inputs, [u[name][0] for name in inputs])
-                r = y.get(outputs)
-            else:
-                kin = machine.state_kinematics(mech, (phi, phi), (omega, omega), (0.0, 1.0))
-                u = mech.fmu_inputs(kin)
-                if inputs is None:
-                    inputs = tuple(u)
-                u0 = np.array([u[name][0] for name in inputs])
-                seed = np.array([u[name][1] for name in inputs]) - u0
-                moving = seed != 0.0
-                knowns = tuple(name for name, m in zip(inputs, moving, strict=False) if m)
-                y.set(inputs, u0)
-                r0 = y.get(outputs)
-                if not all(map(math.isfinite, r0)):
-                    r = r0
-                else:
-                    dr = y.directional_derivative(outputs, knowns, seed[moving])
-            if not all(map(math.isfinite, r if scheme == "explicit" else r0)):
-                status = y.get_status()
-                diverged, diverged_at = True, t
-                reason = (
-                    f"dyad FMU status {status} ({_DYAD_STATUS.get(status, '?')}) at "
-                    f"conditioning {float(kin['conditioning'][0]):.3g}"
-                )
-                break
-            lever = kin["D_n"][0] - kin["O"][0]
-            if scheme == "explicit":
-                tau = _cross(lever, (-r[0], -r[1])) - (r[2] if has_m else 0.0)
-                j_load = 0.0
-            else:
-                tau = _cross(lever, (-r0[0], -r0[1])) - (r0[2] if has_m else 0.0)
-                tau1 = _cross(lever, (-dr[0], -dr[1])) - (dr[2] if has_m else 0.0)
-                j_load = -tau1
-            d.set(_DRIVE_INPUTS, (tau, j_load))
-            eps, torque = d.get(("crank.epsilon", "motor.torque"))
-            if not math.isfinite(eps):
-                diverged, diverged_at = True, t
-                reason = (
-                    f"crank acceleration not finite (drive status {d.get_status()}, "
-                    f"load.inertia {j_load:.4g} kg.m2)"
-                )
-                break
-            if scheme == "stabilised":
-                y.set(inputs, u0 + eps * seed)
-                r = y.get(outputs)
-                linear = [a + eps * b for a, b in zip(r0, dr, strict=False)]
-                size = math.hypot(r[0], r[1])
-                if size > 0 and all(map(math.isfinite, r)):
-                    residual = max(residual, math.hypot(r[0] - linear[0], r[1] - linear[1]) / size)
-                if not all(map(math.isfinite, r)):
-                    status = y.get_status()
-                    diverged, diverged_at = True, t
-                    reason = (
-                        f"dyad FMU status {status} ({_DYAD_STATUS.get(status, '?')}) at "
-                        f"the solved acceleration {eps:.4g} rad/s2"
-                    )
-                    break
-            rows.append(
-                (t, phi, omega, eps, torque, tau, j_load, r[0], r[1], r[2] if has_m else 0.0)
-            )
+            rows.append(coupling.row(t))
             if k == n:
                 break
             y.do_step(t, step)
             d.do_step(t, step)
+    except _Diverged as e:
+        diverged, diverged_at, reason = True, e.t, e.reason
     except SlaveError as e:
         diverged, diverged_at = True, (rows[-1][0] if rows else 0.0)
         reason = str(e)
     finally:
-        for s in reversed(slaves):
-            try:
-                s.close()
-            except Exception:  # pragma: no cover - freeing never hides the run's result
-                pass
+        _close(slaves)
     wall = clock.perf_counter() - start
-    a = np.array(rows, dtype=float).reshape(-1, 10)
     return CosimRun(
         mech.name,
         scheme,
@@ -444,20 +501,12 @@ def run(
         float(t_end),
         motor.rotor_inertia,
         ratio,
-        a[:, 0],
-        a[:, 1],
-        a[:, 2],
-        a[:, 3],
-        a[:, 4],
-        a[:, 5],
-        a[:, 6],
-        a[:, 7:9].copy(),
-        a[:, 9],
+        *_columns(rows),
         wall,
         diverged,
         diverged_at,
         reason,
-        residual,
+        coupling.residual if coupling else 0.0,
         getattr(slaves[0], "label", "") if slaves else "",
     )
 

@@ -150,6 +150,128 @@ def _draw_trt_slot(ax: Axes, mech: Mechanism, at: Callable, u: float):
     }
 
 
+_DRAW_DYAD = {
+    "RRT": _draw_slider_crank,
+    "RRR": _draw_four_bar,
+    "RTR": _draw_quick_return,
+    "RTT": _draw_scotch_yoke,
+    "TRT": _draw_trt_slot,
+}
+#: The revolute pairs drawn as pins, per dyad type.
+_PINS = {
+    "RRT": ("O", "A", "E"),
+    "RRR": ("O", "A", "E", "D_m"),
+    "RTR": ("O", "A", "D_m"),
+    "RTT": ("O", "A"),
+    "TRT": ("O", "E"),
+}
+
+
+def _draw_crank(ax: Axes, mechanism: Mechanism, at: Callable, u: float) -> np.ndarray:
+    """The frame's pivot and the crank p (slotted for the TRT slot); returns where the
+    crank's label goes."""
+    pivot, A = at("O"), at("A")
+    phi = float(at("crank.angle"))
+    sketch.ground_pivot(ax, pivot, u)
+    side = _rot90(_unit(phi))  # the crank's label goes on the side away from E
+    if np.dot(side, at("E") - pivot) > 0:
+        side = -side
+    if mechanism.dyad == "TRT":
+        tip = pivot + mechanism.crank["radius"] * _unit(phi)
+        sketch.bar(ax, pivot, tip, _COLOUR["p"], width=sketch.LINK_WIDTH * 1.6, z=2.0)
+        sketch.slot(
+            ax,
+            pivot + 0.35 * (tip - pivot),
+            pivot + (tip - pivot) * (1 - 1.2 * u / mechanism.crank["radius"]),
+            z=2.1,
+        )
+        return pivot + 0.25 * (tip - pivot) + 1.6 * u * side
+    sketch.bar(ax, pivot, A, _COLOUR["p"], z=2.0)
+    return 0.5 * (pivot + A) + 1.6 * u * side
+
+
+def _label_points(ax: Axes, at: Callable, size: float) -> None:
+    """The point labels, coincident points merged ("A = D_n = E")."""
+    names = [("O", "O"), ("A", "A"), ("D_m", "$D_m$"), ("E", "$E$"), ("D_n", "$D_n$")]
+    pts = [at(k) for k, _ in names]
+    centre = np.mean([at(k) for k in ("O", "A", "D_m", "E")], axis=0)
+    done = [False] * len(names)
+    for a in range(len(names)):
+        if done[a]:
+            continue
+        group = [names[a][1]]
+        for b in range(a + 1, len(names)):
+            if not done[b] and np.hypot(*(pts[a] - pts[b])) <= 1e-9 * size:
+                group.append(names[b][1])
+                done[b] = True
+        off = 10.0 * sketch.away(pts[a], centre, default=(-1.0, 1.0))
+        sketch.label(ax, pts[a], " = ".join(group), off, size=10)
+
+
+def _finite_forces(reactions: dict) -> dict:
+    """The reactions as 2-vectors, checked by name; those not finite left out."""
+    forces = {}
+    for name, f in reactions.items():
+        if name not in APPLICATION:
+            raise ValueError(f"unknown reaction {name!r}; expected some of {sorted(APPLICATION)}")
+        f = np.asarray(f, dtype=float).reshape(2)
+        if np.all(np.isfinite(f)):
+            forces[name] = f
+    return forces
+
+
+def _draw_reactions(
+    ax: Axes, at: Callable, u: float, size: float, forces: dict, scale: float
+) -> None:
+    """Each force as an arrow from its point of application (a cross where it is too
+    short to draw), with a legend."""
+    handles = []
+    for name, f in forces.items():
+        p = at(APPLICATION[name])
+        vec = f / scale
+        length = float(np.hypot(*vec))
+        label = f"{name} = {np.hypot(*f):.4g} N"
+        if length <= 1e-12 * size:
+            handles += ax.plot(
+                [p[0]], [p[1]], "x", color=_ARROW_COLOURS[name], label=label, zorder=8
+            )[:1]
+            continue
+        head = min(1.1 * u, 0.5 * length)
+        handles.append(
+            ax.arrow(
+                p[0],
+                p[1],
+                vec[0],
+                vec[1],
+                width=0.16 * u,
+                head_width=0.65 * u,
+                head_length=head,
+                length_includes_head=True,
+                color=_ARROW_COLOURS[name],
+                alpha=0.85,
+                zorder=8,
+                label=label,
+            )
+        )
+    if handles:
+        ax.legend(
+            handles=handles,
+            loc="best",
+            fontsize=8,
+            title=f"force scale {scale:.3g} N/m\n(1 mm = {scale / 1000:.3g} N)",
+            title_fontsize=8,
+            framealpha=0.85,
+        )
+
+
+def _checked_scale(scale: float | None) -> float | None:
+    if scale is not None:
+        scale = float(scale)
+        if not (scale > 0 and math.isfinite(scale)):
+            raise ValueError(f"scale must be a positive number (N/m), got {scale!r}")
+    return scale
+
+
 def draw(
     ax: Axes,
     mechanism: Mechanism,
@@ -172,77 +294,19 @@ def draw(
         raise IndexError(f"index {index} out of range for {n_samples} samples")
     index = int(index) % n_samples
 
-    def at(key: str):
+    def at(key: str) -> np.ndarray:
         return np.asarray(kin[key][index], dtype=float)
 
     size = mechanism_size(mechanism, kin)
     u = 0.035 * size  # size of the symbols
-    pivot, A = at("O"), at("A")
-    phi = float(at("crank.angle"))
-
-    # frame k at pivot, the crank p
-    sketch.ground_pivot(ax, pivot, u)
-    side = _rot90(_unit(phi))  # the crank's label goes on the side away from E
-    if np.dot(side, at("E") - pivot) > 0:
-        side = -side
-    if mechanism.dyad == "TRT":
-        tip = pivot + mechanism.crank["radius"] * _unit(phi)
-        sketch.bar(ax, pivot, tip, _COLOUR["p"], width=sketch.LINK_WIDTH * 1.6, z=2.0)
-        sketch.slot(
-            ax,
-            pivot + 0.35 * (tip - pivot),
-            pivot + (tip - pivot) * (1 - 1.2 * u / mechanism.crank["radius"]),
-            z=2.1,
-        )
-        p_label = pivot + 0.25 * (tip - pivot) + 1.6 * u * side
-    else:
-        sketch.bar(ax, pivot, A, _COLOUR["p"], z=2.0)
-        p_label = 0.5 * (pivot + A) + 1.6 * u * side
-
-    if mechanism.dyad == "RRT":
-        where = _draw_slider_crank(ax, mechanism, at, u)
-    elif mechanism.dyad == "RRR":
-        where = _draw_four_bar(ax, mechanism, at, u)
-    elif mechanism.dyad == "RTR":
-        where = _draw_quick_return(ax, mechanism, at, u)
-    elif mechanism.dyad == "RTT":
-        where = _draw_scotch_yoke(ax, mechanism, at, u)
-    else:
-        where = _draw_trt_slot(ax, mechanism, at, u)
-
-    # revolute pairs
-    pins = {
-        "RRT": ("O", "A", "E"),
-        "RRR": ("O", "A", "E", "D_m"),
-        "RTR": ("O", "A", "D_m"),
-        "RTT": ("O", "A"),
-        "TRT": ("O", "E"),
-    }[mechanism.dyad]
-    for key in pins:
+    p_label = _draw_crank(ax, mechanism, at, u)
+    where = _DRAW_DYAD[mechanism.dyad](ax, mechanism, at, u)
+    for key in _PINS[mechanism.dyad]:
         sketch.pin(ax, at(key), u)
-
-    # centres of mass
     for key, colour in (("S_c", _COLOUR["p"]), ("S_m", _COLOUR["m"]), ("S_n", _COLOUR["n"])):
         s = at(key)
         ax.plot([s[0]], [s[1]], "o", ms=4.5, mfc=colour, mec="black", mew=0.8, zorder=7)
-
-    # point labels, coincident points merged ("A = D_n = E")
-    names = [("O", "O"), ("A", "A"), ("D_m", "$D_m$"), ("E", "$E$"), ("D_n", "$D_n$")]
-    pts = [at(k) for k, _ in names]
-    centre = np.mean([at(k) for k in ("O", "A", "D_m", "E")], axis=0)
-    done = [False] * len(names)
-    for a in range(len(names)):
-        if done[a]:
-            continue
-        group = [names[a][1]]
-        for b in range(a + 1, len(names)):
-            if not done[b] and np.hypot(*(pts[a] - pts[b])) <= 1e-9 * size:
-                group.append(names[b][1])
-                done[b] = True
-        off = 10.0 * sketch.away(pts[a], centre, default=(-1.0, 1.0))
-        sketch.label(ax, pts[a], " = ".join(group), off, size=10)
-
-    # link labels
+    _label_points(ax, at, size)
     link_at = {"p": p_label, "m": where["m"], "n": where["n"], "k": where["k"]}
     for link, p in link_at.items():
         sketch.label(
@@ -255,67 +319,15 @@ def draw(
             weight="bold",
             box=False,
         )
-
-    # reactions
-    if scale is not None:
-        scale = float(scale)
-        if not (scale > 0 and math.isfinite(scale)):
-            raise ValueError(f"scale must be a positive number (N/m), got {scale!r}")
+    scale = _checked_scale(scale)
     if reactions:
-        forces = {}
-        for name, f in reactions.items():
-            if name not in APPLICATION:
-                raise ValueError(
-                    f"unknown reaction {name!r}; expected some of {sorted(APPLICATION)}"
-                )
-            f = np.asarray(f, dtype=float).reshape(2)
-            if np.all(np.isfinite(f)):
-                forces[name] = f
+        forces = _finite_forces(reactions)
         largest = max((float(np.hypot(*f)) for f in forces.values()), default=0.0)
         if scale is None:
             scale = largest / (0.4 * size) if largest > 0 else 1.0
-        handles = []
-        for name, f in forces.items():
-            p = at(APPLICATION[name])
-            vec = f / scale
-            length = float(np.hypot(*vec))
-            label = f"{name} = {np.hypot(*f):.4g} N"
-            if length <= 1e-12 * size:
-                handles.append(
-                    ax.plot([p[0]], [p[1]], "x", color=_ARROW_COLOURS[name], label=label, zorder=8)[
-                        0
-                    ]
-                )
-                continue
-            head = min(1.1 * u, 0.5 * length)
-            handles.append(
-                ax.arrow(
-                    p[0],
-                    p[1],
-                    vec[0],
-                    vec[1],
-                    width=0.16 * u,
-                    head_width=0.65 * u,
-                    head_length=head,
-                    length_includes_head=True,
-                    color=_ARROW_COLOURS[name],
-                    alpha=0.85,
-                    zorder=8,
-                    label=label,
-                )
-            )
-        if handles:
-            ax.legend(
-                handles=handles,
-                loc="best",
-                fontsize=8,
-                title=f"force scale {scale:.3g} N/m\n(1 mm = {scale / 1000:.3g} N)",
-                title_fontsize=8,
-                framealpha=0.85,
-            )
+        _draw_reactions(ax, at, u, size, forces, scale)
     elif scale is None:
         scale = 1.0
-
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.margins(0.08)
