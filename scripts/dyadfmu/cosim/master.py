@@ -432,6 +432,17 @@ def _fmu_factories(
     return drive, dyad
 
 
+def _step_through(coupling: _Coupling, n: int, step: float, rows: list) -> None:
+    """The n communication steps: a row at each point, then both FMUs step."""
+    for k in range(n + 1):
+        t = k * step
+        rows.append(coupling.row(t))
+        if k == n:
+            break
+        coupling.y.do_step(t, step)
+        coupling.d.do_step(t, step)
+
+
 def _close(slaves: list) -> None:
     for s in reversed(slaves):
         try:
@@ -478,13 +489,7 @@ def run(
         coupling = _Coupling(mech, scheme, motor, d, y)
         d.initialize(drive_parameters(mech, motor, phi0, omega0), 0.0)
         y.initialize(mech.fmu_parameters(), 0.0)
-        for k in range(n + 1):
-            t = k * step
-            rows.append(coupling.row(t))
-            if k == n:
-                break
-            y.do_step(t, step)
-            d.do_step(t, step)
+        _step_through(coupling, n, step, rows)
     except _Diverged as e:
         diverged, diverged_at, reason = True, e.t, e.reason
     except SlaveError as e:

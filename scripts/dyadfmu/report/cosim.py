@@ -68,13 +68,81 @@ def _log(verbose: bool, text: str):
         print(text, file=sys.stderr, flush=True)
 
 
+def _point(
+    name: str,
+    ratio: float,
+    s: cosim.Setup,
+    scheme: str,
+    h: float,
+    fmi_version: int,
+    r: cosim.CosimRun,
+    ref: cosim.Reference,
+) -> dict:
+    """One run of the study as a row of :data:`FIELDS`."""
+    lag = cosim.explicit_lag_factor(s.mech, s.motor, h)
+    e = cosim.errors(r, ref)
+    return {
+        "mechanism": name,
+        "dyad": s.mech.dyad,
+        "ratio": ratio,
+        "rotor_inertia": s.motor.rotor_inertia,
+        "scheme": scheme,
+        "fmi_version": fmi_version,
+        "step": h,
+        "t_end": s.t_end,
+        "steps": r.steps,
+        "wall_time": r.wall_time,
+        "speed_error": e["speed"],
+        "reaction_error": e["reaction"],
+        "angle_error": e["angle"],
+        "speed_error_at": e["speed_at"],
+        "reaction_error_at": e["reaction_at"],
+        "diverged": r.diverged,
+        "diverged_at": r.diverged_at,
+        "reason": r.reason,
+        "lag_factor_max": lag["max"],
+        "lag_factor_geometric": lag["geometric"],
+        "motor_time_constant": lag["time_constant"],
+        "lag_factor_effective": lag["effective"],
+        "affine_residual": r.affine_residual,
+        "reference_wall_time": ref.wall_time,
+        "drive": r.drive_label,
+    }
+
+
+def _machine_points(
+    name: str,
+    ratio: float,
+    s: cosim.Setup,
+    ref: cosim.Reference,
+    steps: tuple[float, ...],
+    fmi_version: int,
+    drive: Callable | None,
+    verbose: bool,
+) -> list[dict]:
+    """Every scheme at every step on one machine."""
+    rows = []
+    for scheme in cosim.SCHEMES:
+        for h in steps:
+            r = cosim.run_setup(s, scheme, h, fmi_version, drive=drive)
+            rows.append(_point(name, ratio, s, scheme, h, fmi_version, r, ref))
+            _log(
+                verbose,
+                f"  {scheme:10s} h {h:.0e}: {r.wall_time:7.2f} s, speed "
+                f"{rows[-1]['speed_error']:.2e}, reactions "
+                f"{rows[-1]['reaction_error']:.2e}"
+                + (f", DIVERGED at {r.diverged_at:.4g} s" if r.diverged else ""),
+            )
+    return rows
+
+
 def study_points(
     quick: bool = False,
     fmi_version: int = 2,
     drive: Callable | None = None,
     mechanisms: tuple[str, ...] = cosim.STUDY_MECHANISMS,
-    ratios: tuple[float, ...] = None,
-    steps: tuple[float, ...] = None,
+    ratios: tuple[float, ...] | None = None,
+    steps: tuple[float, ...] | None = None,
     verbose: bool = False,
 ) -> tuple[list[dict], dict]:
     """Every run of the study as a row of :data:`FIELDS`, and {(mechanism, ratio):
@@ -101,46 +169,7 @@ def study_points(
             ref = cosim.reference_for(s, min(steps), rtol=rtol, atol=atol)
             refs[(name, ratio)] = ref
             _log(verbose, f"{name} ratio {ratio:g}: reference in {ref.wall_time:.1f} s")
-            for scheme in cosim.SCHEMES:
-                for h in steps:
-                    lag = cosim.explicit_lag_factor(s.mech, s.motor, h)
-                    r = cosim.run_setup(s, scheme, h, fmi_version, drive=drive)
-                    e = cosim.errors(r, ref)
-                    rows.append(
-                        {
-                            "mechanism": name,
-                            "dyad": s.mech.dyad,
-                            "ratio": ratio,
-                            "rotor_inertia": s.motor.rotor_inertia,
-                            "scheme": scheme,
-                            "fmi_version": fmi_version,
-                            "step": h,
-                            "t_end": s.t_end,
-                            "steps": r.steps,
-                            "wall_time": r.wall_time,
-                            "speed_error": e["speed"],
-                            "reaction_error": e["reaction"],
-                            "angle_error": e["angle"],
-                            "speed_error_at": e["speed_at"],
-                            "reaction_error_at": e["reaction_at"],
-                            "diverged": r.diverged,
-                            "diverged_at": r.diverged_at,
-                            "reason": r.reason,
-                            "lag_factor_max": lag["max"],
-                            "lag_factor_geometric": lag["geometric"],
-                            "motor_time_constant": lag["time_constant"],
-                            "lag_factor_effective": lag["effective"],
-                            "affine_residual": r.affine_residual,
-                            "reference_wall_time": ref.wall_time,
-                            "drive": r.drive_label,
-                        }
-                    )
-                    _log(
-                        verbose,
-                        f"  {scheme:10s} h {h:.0e}: {r.wall_time:7.2f} s, speed "
-                        f"{e['speed']:.2e}, reactions {e['reaction']:.2e}"
-                        + (f", DIVERGED at {r.diverged_at:.4g} s" if r.diverged else ""),
-                    )
+            rows += _machine_points(name, ratio, s, ref, steps, fmi_version, drive, verbose)
     return rows, refs
 
 
@@ -157,58 +186,67 @@ def write_csv(path: Path, rows: list) -> Path:
     return path
 
 
+def _panel(ax: object, rows: list, name: str, key: str, label: str) -> None:
+    """One error against run time, a marker per run (diverged runs above the line)."""
+    from matplotlib.ticker import NullFormatter
+
+    for r in rows:
+        if r["mechanism"] != name:
+            continue
+        color = RATIO_COLORS.get(r["ratio"], "k")
+        x = max(r["wall_time"], 1e-4)
+        if r["diverged"]:
+            ax.loglog(x, DIVERGED_Y, MARKERS[r["scheme"]], mfc="none", mec=color, ms=9)
+            ax.loglog(x, DIVERGED_Y, "x", color=color, ms=7)
+        else:
+            y = max(r[key], 1e-12)
+            ax.loglog(x, y, MARKERS[r["scheme"]], color=color, ms=7, alpha=0.85)
+    ax.axhline(DIVERGED_Y / 2, color="gray", lw=0.6, ls="--")
+    ax.text(
+        0.01,
+        DIVERGED_Y * 0.6,
+        "above: diverged (run stopped)",
+        fontsize=7,
+        color="gray",
+        transform=ax.get_yaxis_transform(),
+    )
+    ax.set_ylim(top=DIVERGED_Y * 3)
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel("wall-clock time of the run (s)")
+    ax.set_ylabel(label)
+    ax.set_title(f"{name}: {label.split(' /')[0]}", fontsize=10)
+    ax.grid(which="both", alpha=0.3)
+
+
+def _legend_handles(ax: object, rows: list) -> list:
+    handles = []
+    for scheme, marker in MARKERS.items():
+        handles.append(ax.plot([], [], marker, color="gray", label=scheme)[0])
+    for ratio, color in RATIO_COLORS.items():
+        if any(r["ratio"] == ratio for r in rows):
+            handles.append(ax.plot([], [], "s", color=color, label=f"ratio {ratio:g}")[0])
+    handles.append(ax.plot([], [], "x", color="gray", label="diverged")[0])
+    return handles
+
+
 def plot(path: Path, rows: list) -> Path:
     """The speed error against wall time per step, one marker per run."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import NullFormatter
 
     names = list(dict.fromkeys(r["mechanism"] for r in rows))
     fig, axes = plt.subplots(len(names), 2, figsize=(12, 4.6 * len(names)), squeeze=False)
     steps = sorted({r["step"] for r in rows}, reverse=True)
+    panels = (
+        ("speed_error", "crank speed error / mean speed"),
+        ("reaction_error", "|R_np| error / peak |R_np|"),
+    )
     for i, name in enumerate(names):
-        for j, (key, label) in enumerate(
-            (
-                ("speed_error", "crank speed error / mean speed"),
-                ("reaction_error", "|R_np| error / peak |R_np|"),
-            )
-        ):
-            ax = axes[i][j]
-            for r in rows:
-                if r["mechanism"] != name:
-                    continue
-                color = RATIO_COLORS.get(r["ratio"], "k")
-                x = max(r["wall_time"], 1e-4)
-                if r["diverged"]:
-                    ax.loglog(x, DIVERGED_Y, MARKERS[r["scheme"]], mfc="none", mec=color, ms=9)
-                    ax.loglog(x, DIVERGED_Y, "x", color=color, ms=7)
-                else:
-                    y = max(r[key], 1e-12)
-                    ax.loglog(x, y, MARKERS[r["scheme"]], color=color, ms=7, alpha=0.85)
-            ax.axhline(DIVERGED_Y / 2, color="gray", lw=0.6, ls="--")
-            ax.text(
-                0.01,
-                DIVERGED_Y * 0.6,
-                "above: diverged (run stopped)",
-                fontsize=7,
-                color="gray",
-                transform=ax.get_yaxis_transform(),
-            )
-            ax.set_ylim(top=DIVERGED_Y * 3)
-            ax.xaxis.set_minor_formatter(NullFormatter())
-            ax.set_xlabel("wall-clock time of the run (s)")
-            ax.set_ylabel(label)
-            ax.set_title(f"{name}: {label.split(' /')[0]}", fontsize=10)
-            ax.grid(which="both", alpha=0.3)
-    handles = []
-    for scheme, marker in MARKERS.items():
-        handles.append(axes[0][0].plot([], [], marker, color="gray", label=scheme)[0])
-    for ratio, color in RATIO_COLORS.items():
-        if any(r["ratio"] == ratio for r in rows):
-            handles.append(axes[0][0].plot([], [], "s", color=color, label=f"ratio {ratio:g}")[0])
-    handles.append(axes[0][0].plot([], [], "x", color="gray", label="diverged")[0])
+        for j, (key, label) in enumerate(panels):
+            _panel(axes[i][j], rows, name, key, label)
+    handles = _legend_handles(axes[0][0], rows)
     fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=len(handles))
     fig.suptitle(
         "Co-simulation drive FMU + dyad FMU against the monolithic machine "
@@ -234,21 +272,21 @@ def _status(r: dict) -> str:
     return f"**diverged** at {r['diverged_at']:.4g} s: {reason}"
 
 
-def markdown(
-    path: Path, rows: list, refs: dict, quick: bool, elapsed: float, figure: Path, fmi_version: int
-) -> Path:
-    """The co-simulation report in Markdown."""
-    names = list(dict.fromkeys(r["mechanism"] for r in rows))
-    ratios = sorted({r["ratio"] for r in rows})
-    steps = sorted({r["step"] for r in rows}, reverse=True)
+def _header(rows: list, quick: bool, elapsed: float, figure: Path, fmi_version: int) -> list[str]:
     drive = rows[0]["drive"] if rows else ""
-    lines = [
+    return [
         "# Co-simulation of the drive FMU with a dyad FMU",
         "",
         f"{'Quick' if quick else 'Full'} study, FMI {fmi_version}, drive: {drive}; "
         f"{len(rows)} runs in {elapsed:.0f} s. Every figure is in `points.csv`; the plot "
         f"is `{figure.name}`.",
         "",
+    ]
+
+
+def _setup_section(names: list[str], quick: bool) -> list[str]:
+    """How the two FMUs are coupled, the schemes, the start, and the machines' table head."""
+    return [
         "## Setup",
         "",
         "The drive FMU carries the motor (linear torque-speed line), the rotor and the "
@@ -290,6 +328,11 @@ def markdown(
         "tau_m (s) | reference wall time (s) | mean speed (rad/s) | peak R_np (N) |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
+
+
+def _machine_rows(rows: list, refs: dict, names: list[str], ratios: list[float]) -> list[str]:
+    """One row per mechanism and inertia ratio: inertias, lag factors, the reference."""
+    lines = []
     for name in names:
         for ratio in ratios:
             r = next(x for x in rows if x["mechanism"] == name and x["ratio"] == ratio)
@@ -301,7 +344,12 @@ def markdown(
                 f"{r['motor_time_constant']:.2e} | {ref.wall_time:.1f} | "
                 f"{ref.mean_speed:.2f} | {ref.peak_reaction:.4g} |"
             )
-    lines += [
+    return lines
+
+
+def _results_section(rows: list) -> list[str]:
+    """The table of every run."""
+    lines = [
         "",
         "## Results",
         "",
@@ -320,9 +368,12 @@ def markdown(
             f"{r['steps']} | {r['wall_time']:.3f} | {_e(r['speed_error'])} | "
             f"{_e(r['reaction_error'])} | {lag} | {_status(r)} |"
         )
-    lines += ["", f"![error against run time]({figure.name})", "", "## Findings", ""]
-    lines += _findings(rows, steps)
-    lines += [
+    return lines
+
+
+def _advice() -> list[str]:
+    """What the study means for a user of the dyad FMU in another simulator."""
+    return [
         "",
         "## For a user of the dyad FMU in another simulator",
         "",
@@ -342,11 +393,26 @@ def markdown(
         "(in this study 1e-4 s for about 1 % of speed on the slider-crank at 3000 rpm, "
         "1e-3 s on the four-bar at 300 rpm).",
     ]
+
+
+def markdown(
+    path: Path, rows: list, refs: dict, quick: bool, elapsed: float, figure: Path, fmi_version: int
+) -> Path:
+    """The co-simulation report in Markdown."""
+    names = list(dict.fromkeys(r["mechanism"] for r in rows))
+    ratios = sorted({r["ratio"] for r in rows})
+    steps = sorted({r["step"] for r in rows}, reverse=True)
+    lines = _header(rows, quick, elapsed, figure, fmi_version) + _setup_section(names, quick)
+    lines += _machine_rows(rows, refs, names, ratios) + _results_section(rows)
+    lines += ["", f"![error against run time]({figure.name})", "", "## Findings", ""]
+    lines += _findings(rows, steps)
+    lines += _advice()
     path.write_text("\n".join(lines) + "\n")
     return path
 
 
-def _findings(rows: list, steps: tuple[float, ...]) -> list[str]:
+def _divergence_findings(rows: list) -> list[str]:
+    """Which runs diverged, against the prediction; where the explicit errors are."""
     out = []
     ex = [r for r in rows if r["scheme"] == "explicit"]
     st = [r for r in rows if r["scheme"] == "stabilised"]
@@ -385,6 +451,13 @@ def _findings(rows: list, steps: tuple[float, ...]) -> list[str]:
         )
         + "."
     )
+    return out
+
+
+def _order_findings(rows: list, steps: tuple[float, ...]) -> list[str]:
+    """The stabilised scheme's speed error over the steps, and its observed order."""
+    out = []
+    st = [r for r in rows if r["scheme"] == "stabilised"]
     if len(steps) > 1:
         for name in dict.fromkeys(r["mechanism"] for r in rows):
             for ratio in sorted({r["ratio"] for r in rows}):
@@ -411,6 +484,13 @@ def _findings(rows: list, steps: tuple[float, ...]) -> list[str]:
                         + ", ".join(f"{r['step']:.0e}" for r in sel)
                         + f" s (observed order {order:.2f} between the two finest)."
                     )
+    return out
+
+
+def _cost_findings(rows: list) -> list[str]:
+    """Time per communication step, the reference's time, the slope's exactness."""
+    out = []
+    st = [r for r in rows if r["scheme"] == "stabilised"]
     for scheme in ("explicit", "stabilised"):
         sel = [r for r in rows if r["scheme"] == scheme and r["steps"] >= 100]
         if sel:
@@ -442,6 +522,10 @@ def _findings(rows: list, steps: tuple[float, ...]) -> list[str]:
         f"(relative)."
     )
     return out
+
+
+def _findings(rows: list, steps: tuple[float, ...]) -> list[str]:
+    return _divergence_findings(rows) + _order_findings(rows, steps) + _cost_findings(rows)
 
 
 def run_study(

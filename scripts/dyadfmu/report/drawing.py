@@ -264,6 +264,15 @@ def _draw_reactions(
         )
 
 
+def _finish_axes(ax: Axes) -> None:
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.autoscale_view()
+    ax.margins(0.08)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.grid(True, lw=0.3, alpha=0.5)
+
+
 def _checked_scale(scale: float | None) -> float | None:
     if scale is not None:
         scale = float(scale)
@@ -328,10 +337,5 @@ def draw(
         _draw_reactions(ax, at, u, size, forces, scale)
     elif scale is None:
         scale = 1.0
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.autoscale_view()
-    ax.margins(0.08)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.grid(True, lw=0.3, alpha=0.5)
+    _finish_axes(ax)
     return scale

@@ -116,8 +116,7 @@ def accuracy_rows(runs: list) -> list:
     return rows
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run 'dyadfmu scenes' with `argv`: every scene, drawings, footprints, report.md."""
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="dyadfmu scenes",
         description="Co-simulate every example scene's tailored FMU against its reference, "
@@ -138,55 +137,54 @@ def main(argv: list[str] | None = None) -> int:
         help="CMake build directory with fmus/ and tests/bench (default build/)",
     )
     parser.add_argument("--quick", action="store_true", help="fewer steps and rows (for CI)")
-    args = parser.parse_args(argv)
-    build = args.build or paths.build_dir()
-    out = args.out
-    out.mkdir(parents=True, exist_ok=True)
+    return parser
 
-    def log(text: str):
-        print(text, file=sys.stderr)
 
-    try:
-        runs = []
-        for name in scenes.NAMES:
-            for version in (2, 3):
-                result = scenes.run(
-                    name,
-                    version,
-                    revolutions=1.0 if args.quick else 2.0,
-                    steps=180 if args.quick else 360,
-                    build=build,
-                )
-                runs.append(result)
-                log(scenes.summary(result))
-        drawings = []
-        from . import chain_drawing
+def _log(text: str) -> None:
+    print(text, file=sys.stderr)
 
-        for r in runs:
-            if r.source.chain is not None and r.fmi_version == 2:
-                drawings.append(
-                    chain_drawing.figure(
-                        r.source.chain,
-                        r.kin,
-                        scenes.reactions_of(r),
-                        scenes.drawing_indices(r),
-                        out / f"{r.name}_reactions.png",
-                    )
-                )
-        results = measure(
-            build, 2, rows_count=200 if args.quick else 500, repeat=5 if args.quick else 21, log=log
+
+def _runs(build: Path, quick: bool) -> list:
+    """Every example scene's tailored FMU, FMI 2 and 3, against its reference."""
+    runs = []
+    for name in scenes.NAMES:
+        for version in (2, 3):
+            result = scenes.run(
+                name,
+                version,
+                revolutions=1.0 if quick else 2.0,
+                steps=180 if quick else 360,
+                build=build,
+            )
+            runs.append(result)
+            _log(scenes.summary(result))
+    return runs
+
+
+def _drawings(runs: list, out: Path) -> list[Path]:
+    """The chains drawn with every reaction (FMI 2 runs)."""
+    from . import chain_drawing
+
+    return [
+        chain_drawing.figure(
+            r.source.chain,
+            r.kin,
+            scenes.reactions_of(r),
+            scenes.drawing_indices(r),
+            out / f"{r.name}_reactions.png",
         )
-    except FileNotFoundError as error:
-        print(f"dyadfmu: {error}", file=sys.stderr)
-        return 2
+        for r in runs
+        if r.source.chain is not None and r.fmi_version == 2
+    ]
 
-    acc = accuracy_rows(runs)
-    foot = footprint_rows(results)
-    text = [
+
+def _report_text(acc: list, foot: list, quick: bool) -> list[str]:
+    """The report: the accuracy table, the footprint table, what they leave out."""
+    return [
         "# Scenes: tailored FMUs against the generic per-type FMUs",
         "",
         "Every example scene's tailored FMU, co-simulated with fmpy over "
-        f"{'one crank turn (180' if args.quick else 'two crank turns (360'} steps per "
+        f"{'one crank turn (180' if quick else 'two crank turns (360'} steps per "
         "turn) and compared output by output with its independent reference. Errors are "
         "relative to each output's own peak, and to the peak of all outputs in the same "
         "unit (a reaction that is tiny beside the mechanism's other forces, like the "
@@ -208,6 +206,30 @@ def main(argv: list[str] | None = None) -> int:
         "above.",
         "",
     ]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run 'dyadfmu scenes' with `argv`: every scene, drawings, footprints, report.md."""
+    args = _parser().parse_args(argv)
+    build = args.build or paths.build_dir()
+    out = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        runs = _runs(build, args.quick)
+        drawings = _drawings(runs, out)
+        results = measure(
+            build,
+            2,
+            rows_count=200 if args.quick else 500,
+            repeat=5 if args.quick else 21,
+            log=_log,
+        )
+    except FileNotFoundError as error:
+        print(f"dyadfmu: {error}", file=sys.stderr)
+        return 2
+    acc = accuracy_rows(runs)
+    foot = footprint_rows(results)
+    text = _report_text(acc, foot, args.quick)
     if drawings:
         text += ["Drawings with every reaction: " + ", ".join(f"`{p.name}`" for p in drawings), ""]
     report = out / "report.md"
