@@ -83,6 +83,9 @@ __all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
 #: The chain mechanisms.
 NAMES = ("shaper", "sixbar", "rocker_slider")
 
+#: The attachments that are guides (a translational pair at the dyad's outer pair).
+_GUIDES = ("guide", "link_guide")
+
 #: Dyad types handled, with the pair kinds at (D_m, E, D_n).
 PAIR_KINDS = {"RRR": ("R", "R", "R"), "RRT": ("T", "R", "R"), "RTR": ("R", "T", "R")}
 
@@ -133,6 +136,44 @@ def _sign(table: Mapping, key: str, where: str):
 # ---------------------------------------------------------------------------
 # the chains
 # ---------------------------------------------------------------------------
+class _Balance:
+    """The sums of forces and of moments about S on every body, and the largest terms."""
+
+    def __init__(self, names: list, bodies: dict, count: int) -> None:
+        self.names, self.bodies = names, bodies
+        self.fsum = {b: np.zeros((count, 2)) for b in names}
+        self.msum = {b: np.zeros(count) for b in names}
+        self.fmax, self.mmax = np.zeros(count), np.zeros(count)
+        self.tangential = np.zeros(count)
+
+    def force(self, body: str | None, point: np.ndarray, f: np.ndarray) -> None:
+        """The force f at point on body (nothing for the frame)."""
+        if body is None:
+            return
+        m = geo.cross(point - self.bodies[body]["S"], f)
+        self.fsum[body] += f
+        self.msum[body] += m
+        self.fmax = np.maximum(self.fmax, _norm(f))
+        self.mmax = np.maximum(self.mmax, np.abs(m))
+
+    def couple(self, body: str | None, mu: np.ndarray) -> None:
+        """The couple mu on body (nothing for the frame)."""
+        if body is None:
+            return
+        self.msum[body] += mu
+        self.mmax = np.maximum(self.mmax, np.abs(mu))
+
+    def worst(self) -> np.ndarray:
+        """The worst residual per sample, relative to the largest terms."""
+        tiny = np.finfo(float).tiny
+        fscale, mscale = np.maximum(self.fmax, tiny), np.maximum(self.mmax, tiny)
+        worst = self.tangential / fscale
+        for b in self.names:
+            worst = np.maximum(worst, _norm(self.fsum[b]) / fscale)
+            worst = np.maximum(worst, np.abs(self.msum[b]) / mscale)
+        return worst
+
+
 class Chain:
     """A crank plus the dyads of a scene file, with the harness data of ``chains.toml``.
 
@@ -153,17 +194,7 @@ class Chain:
         self.description = str(self.data.get("description", name))
         where = f"scene {name}"
 
-        crank = self.scene.get("crank")
-        if not isinstance(crank, Mapping):
-            raise ValueError(f"{where}: missing table [crank]")
-        self.crank = dict(crank)
-        self.crank_name = str(crank.get("name", "crank"))
-        w = f"{where}.crank"
-        self._r = geo.number(crank, "length", w, positive=True)
-        self._crank_mass = geo.number(crank, "mass", w, nonnegative=True)
-        self._crank_inertia = geo.number(crank, "inertia", w, nonnegative=True)
-        self._crank_com = geo.pair(crank, "com", w)
-
+        self._read_crank(where)
         grav = self.scene.get("gravity", {})
         self.gravity = (
             geo.number(grav, "x", f"{where}.gravity"),
@@ -177,6 +208,35 @@ class Chain:
         #: gravity as it enters the dynamics and the potential energy
         self._g = np.array(self.gravity if self.effects["gravity"] else (0.0, 0.0))
 
+        self._read_links(where)
+        self.dyads = [dict(d) for d in self.scene.get("dyad", [])]
+        if not self.dyads:
+            raise ValueError(f"{where}: no [[dyad]]")
+
+        self._read_motion()
+        self._resolve_dyads()
+        self._resolve_loads()
+        self.labels = {"O": "O", "A": "A"}
+        for key, value in (self.data.get("labels") or {}).items():
+            self.labels[str(key)] = str(value)
+        self._build_pairs()
+        self._frame_cache = None
+        # every dyad must assemble over a full crank turn
+        self._sweep()
+
+    def _read_crank(self, where: str) -> None:
+        crank = self.scene.get("crank")
+        if not isinstance(crank, Mapping):
+            raise ValueError(f"{where}: missing table [crank]")
+        self.crank = dict(crank)
+        self.crank_name = str(crank.get("name", "crank"))
+        w = f"{where}.crank"
+        self._r = geo.number(crank, "length", w, positive=True)
+        self._crank_mass = geo.number(crank, "mass", w, nonnegative=True)
+        self._crank_inertia = geo.number(crank, "inertia", w, nonnegative=True)
+        self._crank_com = geo.pair(crank, "com", w)
+
+    def _read_links(self, where: str) -> None:
         self.links = {}
         for lt in self.scene.get("link", []):
             lname = str(lt.get("name", ""))
@@ -188,67 +248,63 @@ class Chain:
             link["inertia"] = geo.number(lt, "inertia", wl, nonnegative=True)
             link["com"] = geo.pair(lt, "com", wl)
             self.links[lname] = link
-        self.dyads = [dict(d) for d in self.scene.get("dyad", [])]
-        if not self.dyads:
-            raise ValueError(f"{where}: no [[dyad]]")
 
+    def _read_motion(self) -> None:
         md = self.data.get("motion", {})
-        wm = f"{name}.motion"
+        wm = f"{self.name}.motion"
         self._w0 = geo.number(md, "omega", wm, positive=True)
         self._variation = geo.number(md, "variation", wm, default=0.3)
         if not 0.0 <= self._variation < 1.0:
             raise ValueError(f"{wm}.variation: must be in [0, 1), got {self._variation!r}")
         self._phi0 = geo.number(md, "phi0", wm, default=0.0)
 
-        self._resolve_dyads()
-        self._resolve_loads()
-        self.labels = {"O": "O", "A": "A"}
-        for key, value in (self.data.get("labels") or {}).items():
-            self.labels[str(key)] = str(value)
-        self._build_pairs()
-        self._frame_cache = None
-        # every dyad must assemble over a full crank turn
-        self._sweep()
-
     # ---- resolution of the scene ------------------------------------------
+    def _frame_pivot(self, frame: Mapping | None, dyad: str, pair: str) -> dict:
+        if not isinstance(frame, Mapping):
+            raise ValueError(
+                f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
+                f"(the scene puts {dyad}.{pair} on the frame)"
+            )
+        pos = geo.pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
+        return {
+            "kind": "pivot",
+            "body": None,
+            "position": pos,
+            "label": str(frame.get("label", f"{dyad}.{pair}")),
+        }
+
+    def _frame_guide(
+        self, spec: Mapping, frame: Mapping | None, dyad: str, pair: str, where: str
+    ) -> dict:
+        if "guide" not in spec:
+            raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
+        angle = geo.number(spec, "guide", where)
+        if not isinstance(frame, Mapping):
+            raise ValueError(
+                f"{self.name}.frame.{dyad}.{pair}: missing guide height "
+                f"(the scene puts {dyad}.{pair} on a frame guide)"
+            )
+        h = geo.number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
+        return {
+            "kind": "guide",
+            "body": None,
+            "angle": angle,
+            "height": h,
+            "label": str(frame.get("label", f"{dyad}.{pair}")),
+        }
+
     def _attachment(self, spec: Mapping, dyad: str, pair: str, done: dict):
         """The external link carrying pair ``pair`` ("D_m" or "D_n") of ``dyad``."""
         where = f"scene {self.name}.dyad[{dyad}].{'k' if pair == 'D_m' else 'p'}"
         frame = (self.data.get("frame") or {}).get(dyad, {}).get(pair)
         if spec == "frame":
-            if not isinstance(frame, Mapping):
-                raise ValueError(
-                    f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
-                    f"(the scene puts {dyad}.{pair} on the frame)"
-                )
-            pos = geo.pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
-            return {
-                "kind": "pivot",
-                "body": None,
-                "position": pos,
-                "label": str(frame.get("label", f"{dyad}.{pair}")),
-            }
+            return self._frame_pivot(frame, dyad, pair)
         if spec == "crank" or spec == self.crank_name:
             return {"kind": "point", "body": self.crank_name, "at": (self._r, 0.0), "label": "A"}
         if isinstance(spec, Mapping):
             body = spec.get("link")
             if body == "frame":
-                if "guide" not in spec:
-                    raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
-                angle = geo.number(spec, "guide", where)
-                if not isinstance(frame, Mapping):
-                    raise ValueError(
-                        f"{self.name}.frame.{dyad}.{pair}: missing guide height "
-                        f"(the scene puts {dyad}.{pair} on a frame guide)"
-                    )
-                h = geo.number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
-                return {
-                    "kind": "guide",
-                    "body": None,
-                    "angle": angle,
-                    "height": h,
-                    "label": str(frame.get("label", f"{dyad}.{pair}")),
-                }
+                return self._frame_guide(spec, frame, dyad, pair, where)
             if body == "crank":
                 body = self.crank_name
             if body != self.crank_name and body not in done:
@@ -273,73 +329,86 @@ class Chain:
             }
         raise ValueError(f"{where}: expected 'frame', 'crank' or a table, got {spec!r}")
 
-    def _resolve_dyads(self):
+    def _checked_dyad(self, d: Mapping, done: set) -> tuple:
+        """(name, type, m, n, where) of a [[dyad]] table, checked against the earlier ones."""
+        dname = str(d.get("name", ""))
+        where = f"scene {self.name}.dyad[{dname}]"
+        if not dname or any(p["name"] == dname for p in self.plan) or dname == self.crank_name:
+            raise ValueError(f"{where}: bad or repeated dyad name")
+        kind = str(d.get("type", "")).upper()
+        if kind not in PAIR_KINDS:
+            raise ValueError(f"{where}.type: expected one of {sorted(PAIR_KINDS)}, got {kind!r}")
+        m, n = d.get("m"), d.get("n")
+        for g in (m, n):
+            if g not in self.links:
+                raise ValueError(f"{where}: unknown link {g!r}")
+            if g in done:
+                raise ValueError(f"{where}: link {g!r} belongs to an earlier dyad")
+        if m == n:
+            raise ValueError(f"{where}: links m and n must differ")
+        return dname, kind, m, n, where
+
+    def _rrr_entry(self, entry: dict, where: str, branches: Mapping) -> None:
+        k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
+        if k["kind"] in _GUIDES or p["kind"] in _GUIDES:
+            raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
+        entry["lm"] = geo.number(self.links[m], "length", f"{where}.{m}", positive=True)
+        entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", positive=True)
+        entry["branch"] = _sign(branches, entry["name"], f"{self.name}.branches")
+
+    def _rrt_entry(self, entry: dict, where: str, branches: Mapping) -> None:
+        k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
+        lm_t = self.links[m]
+        if k["kind"] not in _GUIDES:
+            raise ValueError(
+                f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }} "
+                f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}"
+            )
+        if p["kind"] in _GUIDES:
+            raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
+        entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", nonnegative=True)
+        entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", positive=True)
+        if k["kind"] == "guide":
+            # the slider translates on the fixed guide: its angle is constant
+            entry["m_angle"] = geo.number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
+        elif "angle" in lm_t:
+            raise ValueError(
+                f"{where}.{m}.angle: the slider turns with link "
+                f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
+                f"remove its 'angle'"
+            )
+        entry["branch"] = _sign(branches, entry["name"], f"{self.name}.branches")
+
+    def _rtr_entry(self, entry: dict, where: str) -> None:
+        k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
+        if k["kind"] in _GUIDES or p["kind"] in _GUIDES:
+            raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
+        if "length" in self.links[m]:
+            raise ValueError(
+                f"{where}.{m}: the slotted link's length |D_m E| varies; remove its 'length'"
+            )
+        entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", nonnegative=True)
+        if entry["ln"] != 0.0:
+            raise ValueError(
+                f"{where}.{n}.length: only a block on the pin (length 0) "
+                f"is handled, got {entry['ln']!r}"
+            )
+
+    def _resolve_dyads(self) -> None:
         done = set()
         branches = self.data.get("branches") or {}
         self.plan = []
         for d in self.dyads:
-            dname = str(d.get("name", ""))
-            where = f"scene {self.name}.dyad[{dname}]"
-            if not dname or any(p["name"] == dname for p in self.plan) or dname == self.crank_name:
-                raise ValueError(f"{where}: bad or repeated dyad name")
-            kind = str(d.get("type", "")).upper()
-            if kind not in PAIR_KINDS:
-                raise ValueError(
-                    f"{where}.type: expected one of {sorted(PAIR_KINDS)}, got {kind!r}"
-                )
-            m, n = d.get("m"), d.get("n")
-            for g in (m, n):
-                if g not in self.links:
-                    raise ValueError(f"{where}: unknown link {g!r}")
-                if g in done:
-                    raise ValueError(f"{where}: link {g!r} belongs to an earlier dyad")
-            if m == n:
-                raise ValueError(f"{where}: links m and n must differ")
+            dname, kind, m, n, where = self._checked_dyad(d, done)
             k = self._attachment(d.get("k"), dname, "D_m", done)
             p = self._attachment(d.get("p"), dname, "D_n", done)
             entry = {"name": dname, "type": kind, "m": m, "n": n, "k": k, "p": p}
-            lm_t, ln_t = self.links[m], self.links[n]
-            guides = ("guide", "link_guide")
             if kind == "RRR":
-                if k["kind"] in guides or p["kind"] in guides:
-                    raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
-                entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", positive=True)
-                entry["ln"] = geo.number(ln_t, "length", f"{where}.{n}", positive=True)
-                entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
+                self._rrr_entry(entry, where, branches)
             elif kind == "RRT":
-                if k["kind"] not in guides:
-                    raise ValueError(
-                        f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }} "
-                        f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}"
-                    )
-                if p["kind"] in guides:
-                    raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
-                entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", nonnegative=True)
-                entry["ln"] = geo.number(ln_t, "length", f"{where}.{n}", positive=True)
-                if k["kind"] == "guide":
-                    # the slider translates on the fixed guide: its angle is constant
-                    entry["m_angle"] = geo.number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
-                elif "angle" in lm_t:
-                    raise ValueError(
-                        f"{where}.{m}.angle: the slider turns with link "
-                        f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
-                        f"remove its 'angle'"
-                    )
-                entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
+                self._rrt_entry(entry, where, branches)
             else:  # RTR
-                if k["kind"] in guides or p["kind"] in guides:
-                    raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
-                if "length" in lm_t:
-                    raise ValueError(
-                        f"{where}.{m}: the slotted link's length |D_m E| varies; "
-                        f"remove its 'length'"
-                    )
-                entry["ln"] = geo.number(ln_t, "length", f"{where}.{n}", nonnegative=True)
-                if entry["ln"] != 0.0:
-                    raise ValueError(
-                        f"{where}.{n}.length: only a block on the pin (length 0) "
-                        f"is handled, got {entry['ln']!r}"
-                    )
+                self._rtr_entry(entry, where)
             self.plan.append(entry)
             done.update((m, n))
         unused = set(self.links) - done
@@ -520,6 +589,74 @@ class Chain:
             return z + np.asarray(att["position"]), z.copy(), z.copy()
         return self._material(states[att["body"]], att["at"])
 
+    def _dyad_states(self, e: dict, states: dict, shape: tuple, kin: dict) -> tuple:
+        """(state of m, state of n, E) of one dyad from the states of the links it is on;
+        a guide's angle and slide go into kin."""
+        dn = e["name"]
+        P, vP, aP = self._point(e["p"], states, shape)  # D_n, on link p
+        if e["type"] == "RRR":
+            K, vK, aK = self._point(e["k"], states, shape)  # D_m, on link k
+            return _rrr(K, vK, aK, P, vP, aP, e["lm"], e["ln"], e["branch"], dn)
+        if e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
+            k = e["k"]
+            sm, sn, E, slide = _rrt_on_link(
+                states[k["body"]], k["at"], k["angle"], e["lm"], P, vP, aP, e["ln"], e["branch"], dn
+            )
+            kin[f"{dn}.guide_k.angle"] = sm["angle"].copy()
+            kin[f"{dn}.slide_k"], kin[f"{dn}.slide_k_rate"], kin[f"{dn}.slide_k_accel"] = slide
+            return sm, sn, E
+        if e["type"] == "RRT":
+            sm, sn, E = _rrt(
+                e["k"]["angle"],
+                e["k"]["height"],
+                e["lm"],
+                e["m_angle"],
+                P,
+                vP,
+                aP,
+                e["ln"],
+                e["branch"],
+                dn,
+            )
+            kin[f"{dn}.guide_k.angle"] = np.full(shape, e["k"]["angle"])
+            return sm, sn, E
+        K, vK, aK = self._point(e["k"], states, shape)
+        return _rtr(K, vK, aK, P, vP, aP)
+
+    @staticmethod
+    def _store_dyad(e: dict, sm: dict, sn: dict, E: np.ndarray, shape: tuple, kin: dict) -> None:
+        """A dyad's points and its links' motion under their kinematics names."""
+        dn = e["name"]
+        kin[f"{dn}.D_m"], kin[f"{dn}.E"], kin[f"{dn}.D_n"] = sm["D"], E, sn["D"]
+        for g, st in ((e["m"], sm), (e["n"], sn)):
+            kin[f"{g}.angle"] = np.broadcast_to(st["angle"], shape).astype(float)
+            kin[f"{g}.omega"] = np.broadcast_to(st["omega"], shape).astype(float)
+            kin[f"{g}.epsilon"] = np.broadcast_to(st["epsilon"], shape).astype(float)
+            kin[f"{g}.accel_d"] = st["aD"]
+            kin[f"{g}.vel_d"] = st["vD"]
+            for key in ("length", "length_rate", "length_accel"):
+                kin[f"{g}.{key}"] = np.broadcast_to(st[key], shape).astype(float)
+
+    def _active_load(self, g: str, kin: dict, zero: np.ndarray, z2: np.ndarray) -> tuple:
+        """(force at S, moment) of link g's load model over the samples."""
+        force, moment = z2.copy(), zero.copy()
+        model = self._loads.get(g)
+        if model and model["model"] == "cutting":
+            v, s = kin[f"v_S_{g}"][:, 0], model["s"]
+            force[:, 0] = -s * model["F0"] * 0.5 * (1.0 + np.tanh(s * v / model["v_ref"]))
+        elif model and model["model"] == "resisting-torque":
+            om = kin[f"{g}.omega"]
+            moment = -model["T0"] * np.tanh(om / model["w_ref"]) - model["c"] * om
+        elif model and model["model"] == "resisting-force":
+            dn = model["dyad"]
+            i_k = geo.unit(kin[f"{dn}.guide_k.angle"])
+            if f"{dn}.slide_k_rate" in kin:  # guide on a moving link
+                v_rel = kin[f"{dn}.slide_k_rate"]
+            else:  # frame guide
+                v_rel = geo.dot(kin[f"{g}.vel_d"], i_k)
+            force = geo.col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
+        return force, moment
+
     def _solve(self, t: np.ndarray, phi: np.ndarray, w: np.ndarray, eps: np.ndarray) -> dict:
         shape = phi.shape
         zero = np.zeros(shape)
@@ -538,83 +675,17 @@ class Chain:
             "a_A": aA,
         }
         states = {c: crank_state}
-
         for e in self.plan:
-            dn = e["name"]
-            P, vP, aP = self._point(e["p"], states, shape)  # D_n, on link p
-            if e["type"] == "RRR":
-                K, vK, aK = self._point(e["k"], states, shape)  # D_m, on link k
-                sm, sn, E = _rrr(K, vK, aK, P, vP, aP, e["lm"], e["ln"], e["branch"], dn)
-            elif e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
-                sm, sn, E, slide = _rrt_on_link(
-                    states[e["k"]["body"]],
-                    e["k"]["at"],
-                    e["k"]["angle"],
-                    e["lm"],
-                    P,
-                    vP,
-                    aP,
-                    e["ln"],
-                    e["branch"],
-                    dn,
-                )
-                kin[f"{dn}.guide_k.angle"] = sm["angle"].copy()
-                kin[f"{dn}.slide_k"], kin[f"{dn}.slide_k_rate"], kin[f"{dn}.slide_k_accel"] = slide
-            elif e["type"] == "RRT":
-                sm, sn, E = _rrt(
-                    e["k"]["angle"],
-                    e["k"]["height"],
-                    e["lm"],
-                    e["m_angle"],
-                    P,
-                    vP,
-                    aP,
-                    e["ln"],
-                    e["branch"],
-                    dn,
-                )
-                kin[f"{dn}.guide_k.angle"] = np.full(shape, e["k"]["angle"])
-            else:
-                K, vK, aK = self._point(e["k"], states, shape)
-                sm, sn, E = _rtr(K, vK, aK, P, vP, aP)
+            sm, sn, E = self._dyad_states(e, states, shape, kin)
             states[e["m"]], states[e["n"]] = sm, sn
-            kin[f"{dn}.D_m"], kin[f"{dn}.E"], kin[f"{dn}.D_n"] = sm["D"], E, sn["D"]
-            for g, st in ((e["m"], sm), (e["n"], sn)):
-                kin[f"{g}.angle"] = np.broadcast_to(st["angle"], shape).astype(float)
-                kin[f"{g}.omega"] = np.broadcast_to(st["omega"], shape).astype(float)
-                kin[f"{g}.epsilon"] = np.broadcast_to(st["epsilon"], shape).astype(float)
-                kin[f"{g}.accel_d"] = st["aD"]
-                kin[f"{g}.vel_d"] = st["vD"]
-                for key in ("length", "length_rate", "length_accel"):
-                    kin[f"{g}.{key}"] = np.broadcast_to(st[key], shape).astype(float)
-            kin[f"{dn}.conditioning"] = self._conditioning(e, kin)
-
+            self._store_dyad(e, sm, sn, E, shape, kin)
+            kin[f"{e['name']}.conditioning"] = self._conditioning(e, kin)
         # centres of mass (S = D + rel, rel fixed in the body)
         for b in self.bodies:
-            st = states[b]
             com = self._crank_com if b == c else self.links[b]["com"]
-            S, vS, aS = self._material(st, com)
-            kin[f"S_{b}"], kin[f"v_S_{b}"], kin[f"a_S_{b}"] = S, vS, aS
-
-        # active loads
+            kin[f"S_{b}"], kin[f"v_S_{b}"], kin[f"a_S_{b}"] = self._material(states[b], com)
         for g in self.links:
-            force, moment = z2.copy(), zero.copy()
-            model = self._loads.get(g)
-            if model and model["model"] == "cutting":
-                v, s = kin[f"v_S_{g}"][:, 0], model["s"]
-                force[:, 0] = -s * model["F0"] * 0.5 * (1.0 + np.tanh(s * v / model["v_ref"]))
-            elif model and model["model"] == "resisting-torque":
-                om = kin[f"{g}.omega"]
-                moment = -model["T0"] * np.tanh(om / model["w_ref"]) - model["c"] * om
-            elif model and model["model"] == "resisting-force":
-                dn = model["dyad"]
-                i_k = geo.unit(kin[f"{dn}.guide_k.angle"])
-                if f"{dn}.slide_k_rate" in kin:  # guide on a moving link
-                    v_rel = kin[f"{dn}.slide_k_rate"]
-                else:  # frame guide
-                    v_rel = geo.dot(kin[f"{g}.vel_d"], i_k)
-                force = geo.col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
-            kin[f"{g}.force"], kin[f"{g}.moment"] = force, moment
+            kin[f"{g}.force"], kin[f"{g}.moment"] = self._active_load(g, kin, zero, z2)
         # scalar views with the FMU input names
         for g in self.links:
             for key in ("accel_d", "force"):
@@ -622,7 +693,7 @@ class Chain:
                 kin[f"{g}.{key}.y"] = kin[f"{g}.{key}"][:, 1].copy()
         return kin
 
-    def _conditioning(self, e: np.ndarray, kin: dict):
+    def _conditioning(self, e: dict, kin: dict) -> np.ndarray:
         i_m, i_n = geo.unit(kin[f"{e['m']}.angle"]), geo.unit(kin[f"{e['n']}.angle"])
         if e["type"] == "RRR":
             return np.abs(geo.dot(i_m, geo.rot90(i_n)))
@@ -738,7 +809,12 @@ class Chain:
         moment -J epsilon. Returns output name -> (N,) array (see :meth:`output_names`;
         for a translational pair also its force's x and y components).
         """
-        bodies = self._body_data(kin)
+        K, rhs = self._system(kin, self._body_data(kin))
+        x = np.linalg.solve(K, rhs[..., None])[..., 0]
+        return self._outputs(kin, x)
+
+    def _system(self, kin: dict, bodies: dict) -> tuple:
+        """The matrix and right-hand side of the Newton-Euler system of every body."""
         row = {b: 3 * i for i, b in enumerate(self.bodies)}
         n_eq = 3 * len(self.bodies)
         count = len(np.atleast_1d(kin["t"]))
@@ -747,7 +823,9 @@ class Chain:
         ex = np.broadcast_to(np.array([1.0, 0.0]), (count, 2))
         ey = np.broadcast_to(np.array([0.0, 1.0]), (count, 2))
 
-        def put(col: int, body: str, point: np.ndarray, f: np.ndarray, mu: int, sign: float):
+        def put(
+            col: int, body: str, point: np.ndarray, f: np.ndarray, mu: np.ndarray, sign: float
+        ) -> None:
             """Unknown ``col`` acts on ``body`` as the force ``f`` at ``point`` plus the
             couple ``mu`` (per unit value), with ``sign``."""
             if body is None:
@@ -770,18 +848,18 @@ class Chain:
                 put(col, pr["first"], P, f, mu, 1.0)
                 put(col, pr["second"], P, f, mu, -1.0)
                 col += 1
-        c = self.crank_name
-        K[:, row[c] + 2, col] = 1.0  # driving torque
+        K[:, row[self.crank_name] + 2, col] = 1.0  # driving torque
         col += 1
         assert col == n_eq
-
         for b, bd in bodies.items():
             forces, moments = self._known(bd)
             r = row[b]
             rhs[:, r : r + 2] -= sum(forces)  # all act at S: no moment about S
             rhs[:, r + 2] -= sum(moments)
-        x = np.linalg.solve(K, rhs[..., None])[..., 0]
+        return K, rhs
 
+    def _outputs(self, kin: dict, x: np.ndarray) -> dict:
+        """The solution of the system under the output names."""
         out, col = {}, 0
         for pr in self.pairs:
             if pr["kind"] == "R":
@@ -795,7 +873,7 @@ class Chain:
                 out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = N * j[:, 0], N * j[:, 1]
                 out[f"{pr['dyad']}.N_{pr['tag']}"], out[f"{pr['dyad']}.M_{pr['tag']}"] = N, M
             col += 2
-        out[f"{c}.torque"] = x[:, col].copy()
+        out[f"{self.crank_name}.torque"] = x[:, col].copy()
         return out
 
     def residuals(self, kin: dict, out: dict) -> np.ndarray:
@@ -805,35 +883,13 @@ class Chain:
         term. A translational pair's force must also lie along j of its guide and equal
         N j (both relative to the largest force term)."""
         bodies = self._body_data(kin)
-        count = len(np.atleast_1d(kin["t"]))
-        fsum = {b: np.zeros((count, 2)) for b in self.bodies}
-        msum = {b: np.zeros(count) for b in self.bodies}
-        fmax, mmax = np.zeros(count), np.zeros(count)
-        tangential = np.zeros(count)
-
-        def force(body: str, point: np.ndarray, f: np.ndarray):
-            nonlocal fmax, mmax
-            if body is None:
-                return
-            m = geo.cross(point - bodies[body]["S"], f)
-            fsum[body] += f
-            msum[body] += m
-            fmax = np.maximum(fmax, _norm(f))
-            mmax = np.maximum(mmax, np.abs(m))
-
-        def couple(body: str, mu: int):
-            nonlocal mmax
-            if body is None:
-                return
-            msum[body] += mu
-            mmax = np.maximum(mmax, np.abs(mu))
-
+        balance = _Balance(self.bodies, bodies, len(np.atleast_1d(kin["t"])))
         for b, bd in bodies.items():
             forces, moments = self._known(bd)
             for f in forces:
-                force(b, bd["S"], f)
+                balance.force(b, bd["S"], f)
             for mu in moments:
-                couple(b, mu)
+                balance.couple(b, mu)
         for pr in self.pairs:
             P = np.asarray(kin[pr["point"]], dtype=float)
             R = np.stack(
@@ -843,27 +899,20 @@ class Chain:
                 ],
                 axis=-1,
             )
-            force(pr["first"], P, R)
-            force(pr["second"], P, -R)
+            balance.force(pr["first"], P, R)
+            balance.force(pr["second"], P, -R)
             if pr["kind"] == "T":
                 i = geo.unit(kin[pr["guide"]])
                 N = np.asarray(out[f"{pr['dyad']}.N_{pr['tag']}"], float)
                 M = np.asarray(out[f"{pr['dyad']}.M_{pr['tag']}"], float)
-                couple(pr["first"], M)
-                couple(pr["second"], -M)
-                tangential = np.maximum(
-                    tangential,
+                balance.couple(pr["first"], M)
+                balance.couple(pr["second"], -M)
+                balance.tangential = np.maximum(
+                    balance.tangential,
                     np.maximum(np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))),
                 )
-        couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
-
-        tiny = np.finfo(float).tiny
-        fscale, mscale = np.maximum(fmax, tiny), np.maximum(mmax, tiny)
-        worst = tangential / fscale
-        for b in self.bodies:
-            worst = np.maximum(worst, _norm(fsum[b]) / fscale)
-            worst = np.maximum(worst, np.abs(msum[b]) / mscale)
-        return worst
+        balance.couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
+        return balance.worst()
 
     # ---- energy -----------------------------------------------------------
     def _mass(self, b: str):
