@@ -9,8 +9,8 @@ Two kinds of scene:
   :mod:`dyadfmu.mechanisms.chains`;
 * the single-dyad scenes ``engine``, ``press`` and ``monitor``: kinematics and loads of the
   slider-crank and four-bar of :mod:`dyadfmu.mechanisms.builtin`, the dyad's reactions from
-  :mod:`dyadfmu.reference.newton_euler` (its own 6x6 Newton-Euler solve) with the scene's effects (no
-  inertia in a static scene, no weight without gravity), and the crank's equilibrium
+  :mod:`dyadfmu.reference.newton_euler` (its own 6x6 Newton-Euler solve) with the scene's
+  effects (no inertia in a static scene, no weight without gravity), and the crank's equilibrium
   written out here.
 
 The FMU's inputs are taken by name from the kinematics; its outputs are compared by name

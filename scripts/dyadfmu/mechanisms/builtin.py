@@ -239,6 +239,17 @@ class Mechanism:
         }
         kin.update(self._dyad_kinematics(phi, w, eps, A, vA, aA))
 
+        self._point_e(kin)
+        self._centres_of_mass(kin, w, eps)
+        kin.update(self._loads(kin))
+        kin["conditioning"] = self.conditioning(kin)
+        kin["frame"] = self._frame()
+        kin["mechanism"] = self.name
+        return kin
+
+    @staticmethod
+    def _point_e(kin: dict) -> None:
+        """The geometric point E from link m, with its velocity and acceleration."""
         # the geometric point E from link m: E = D_m + l_m i_m
         i_m = geo.unit(kin["m.angle"])
         j_m = geo.rot90(i_m)
@@ -252,6 +263,11 @@ class Mechanism:
             + geo.col(lm * em + 2.0 * dlm * wm) * j_m
         )
 
+    def _centres_of_mass(self, kin: dict, w: np.ndarray, eps: np.ndarray) -> None:
+        """The centres of mass of m, n and the crank, with their velocities and
+        accelerations."""
+        i_c = geo.unit(kin["crank.angle"])
+        j_c = geo.rot90(i_c)
         # centres of mass: rigid-body relations from D_g (fixed in link g)
         for g in ("m", "n"):
             i_g = geo.unit(kin[f"{g}.angle"])
@@ -266,12 +282,6 @@ class Mechanism:
         kin["S_c"] = rel
         kin["v_S_c"] = geo.col(w) * geo.rot90(rel)
         kin["a_S_c"] = geo.col(eps) * geo.rot90(rel) - geo.col(w * w) * rel
-
-        kin.update(self._loads(kin))
-        kin["conditioning"] = self.conditioning(kin)
-        kin["frame"] = self._frame()
-        kin["mechanism"] = self.name
-        return kin
 
     def _frame(self) -> dict:
         """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))}."""

@@ -387,6 +387,37 @@ def _rhs_factory(mech: Mechanism, motor: Motor):
     return rhs, jac, accel
 
 
+def _range_events(rng: tuple[float, float]) -> list:
+    """Terminal events of solve_ivp where phi leaves [rng[0], rng[1]]."""
+
+    def below(t: float, y: np.ndarray) -> np.ndarray:
+        return y[0] - rng[0]
+
+    def above(t: float, y: np.ndarray) -> np.ndarray:
+        return rng[1] - y[0]
+
+    below.terminal = above.terminal = True
+    below.direction = above.direction = -1.0
+    return [below, above]
+
+
+def _with_event_state(
+    sol: object,
+    t: np.ndarray,
+    phi: np.ndarray,
+    omega: np.ndarray,
+    w_motor: np.ndarray,
+    w_load: np.ndarray,
+) -> tuple:
+    """The output with the event state appended, so that the run's end is in it."""
+    for tk, yk in zip(sol.t_events, sol.y_events, strict=True):
+        if len(tk):
+            t = np.append(t, tk[0])
+            phi, omega = np.append(phi, yk[0][0]), np.append(omega, yk[0][1])
+            w_motor, w_load = np.append(w_motor, yk[0][2]), np.append(w_load, yk[0][3])
+    return t, phi, omega, w_motor, w_load
+
+
 def monolithic(
     mech: Mechanism,
     motor: Motor,
@@ -419,18 +450,7 @@ def monolithic(
     if rng is not None and not (rng[0] <= phi0 <= rng[1]):
         raise ValueError(f"phi0 = {phi0!r} is outside the admissible range {rng} of {mech.name}")
     rhs, jac, accel = _rhs_factory(mech, motor)
-    events = None
-    if rng is not None:
-
-        def below(t: float, y: np.ndarray):
-            return y[0] - rng[0]
-
-        def above(t: float, y: np.ndarray):
-            return rng[1] - y[0]
-
-        below.terminal = above.terminal = True
-        below.direction = above.direction = -1.0
-        events = [below, above]
+    events = _range_events(rng) if rng is not None else None
     sol = solve_ivp(
         rhs,
         (0.0, float(t_end)),
@@ -448,29 +468,8 @@ def monolithic(
         raise RuntimeError(f"monolithic {mech.name}: {sol.message}")
     t, (phi, omega, w_motor, w_load) = sol.t, sol.y
     if rng is not None and sol.status == 1 and t_eval is not None:
-        # append the event state so the run's end is in the output
-        te, ye = sol.t_events, sol.y_events
-        for tk, yk in zip(te, ye, strict=False):
-            if len(tk):
-                t = np.append(t, tk[0])
-                phi, omega = np.append(phi, yk[0][0]), np.append(omega, yk[0][1])
-                w_motor, w_load = np.append(w_motor, yk[0][2]), np.append(w_load, yk[0][3])
+        t, phi, omega, w_motor, w_load = _with_event_state(sol, t, phi, omega, w_motor, w_load)
     eps, T, Q, J = accel(phi, omega)
     kinetic = 0.5 * (motor.rotor_inertia + J) * omega * omega
-    return MachineRun(
-        mech.name,
-        motor,
-        t,
-        phi,
-        omega,
-        eps,
-        T,
-        Q,
-        J,
-        kinetic,
-        w_motor,
-        w_load,
-        bool(sol.status == 1),
-        int(sol.nfev),
-        sol,
-    )
+    states = (t, phi, omega, eps, T, Q, J, kinetic, w_motor, w_load)
+    return MachineRun(mech.name, motor, *states, bool(sol.status == 1), int(sol.nfev), sol)

@@ -44,10 +44,8 @@ def _label(method: str) -> str:
     return LABELS[method]
 
 
-def plots(out: Path, points: list[tuple], summary: list[dict]) -> dict:
-    """The work-precision and error-against-amplification plots; their paths by name."""
-    figures = {}
-    # Work-precision: worst error on the random set against time per configuration.
+def _work_precision(out: Path, summary: list[dict]) -> Path:
+    """Worst error on the random set against time per configuration."""
     fig, ax = plt.subplots(figsize=(8.5, 6))
     for s in summary:
         ax.loglog(
@@ -72,11 +70,14 @@ def plots(out: Path, points: list[tuple], summary: list[dict]) -> dict:
     ax.grid(which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2, loc="upper right")
     fig.tight_layout()
-    figures["work_precision"] = out / "work_precision.png"
-    fig.savefig(figures["work_precision"], dpi=110)
+    path = out / "work_precision.png"
+    fig.savefig(path, dpi=110)
     plt.close(fig)
+    return path
 
-    # Error against amplification, per type.
+
+def _error_vs_amplification(out: Path, points: list[tuple]) -> Path:
+    """The error of every point against its amplification, per type."""
     by = defaultdict(list)
     for p in points:
         by[(p[1], p[2])].append((p[4], p[5], p[0]))
@@ -115,10 +116,18 @@ def plots(out: Path, points: list[tuple], summary: list[dict]) -> dict:
         fontsize=11,
     )
     fig.tight_layout()
-    figures["error_vs_amplification"] = out / "error_vs_amplification.png"
-    fig.savefig(figures["error_vs_amplification"], dpi=110)
+    path = out / "error_vs_amplification.png"
+    fig.savefig(path, dpi=110)
     plt.close(fig)
-    return figures
+    return path
+
+
+def plots(out: Path, points: list[tuple], summary: list[dict]) -> dict:
+    """The work-precision and error-against-amplification plots; their paths by name."""
+    return {
+        "work_precision": _work_precision(out, summary),
+        "error_vs_amplification": _error_vs_amplification(out, points),
+    }
 
 
 def _fmt_time(seconds: float) -> str:
