@@ -243,7 +243,7 @@ class Mechanism:
         self._centres_of_mass(kin, w, eps)
         kin.update(self._loads(kin))
         kin["conditioning"] = self.conditioning(kin)
-        kin["frame"] = self._frame()
+        kin["frame"] = self.frame()
         kin["mechanism"] = self.name
         return kin
 
@@ -283,7 +283,7 @@ class Mechanism:
         kin["v_S_c"] = geo.col(w) * geo.rot90(rel)
         kin["a_S_c"] = geo.col(eps) * geo.rot90(rel) - geo.col(w * w) * rel
 
-    def _frame(self) -> dict:
+    def frame(self) -> dict:
         """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))}."""
         return {"pivots": {"O": (0.0, 0.0)}, "guides": {}}
 
@@ -474,7 +474,7 @@ class SliderCrank(Mechanism):
             "n.moment": zero.copy(),
         }
 
-    def _frame(self):
+    def frame(self) -> dict:
         r, rod, e = self.crank["radius"], self.l, self.e
         x0, x1 = math.sqrt((rod - r) ** 2 - e * e), math.sqrt((rod + r) ** 2 - e * e)
         pad = 0.25 * r
@@ -557,7 +557,7 @@ class FourBar(Mechanism):
             "n.moment": zero.copy(),
         }
 
-    def _frame(self):
+    def frame(self) -> dict:
         return {"pivots": {"O": (0.0, 0.0), "O4": tuple(self.O4)}, "guides": {}}
 
 
@@ -631,7 +631,7 @@ class QuickReturn(Mechanism):
             "n.moment": zero.copy(),
         }
 
-    def _frame(self):
+    def frame(self) -> dict:
         return {"pivots": {"O": (0.0, 0.0), "O2": tuple(self.O2)}, "guides": {}}
 
 
@@ -698,7 +698,7 @@ class ScotchYoke(Mechanism):
     def _loads(self, kin: dict):
         return _resistance_along_x(kin, self.F0, self.v_ref, self.c_visc)
 
-    def _frame(self):
+    def frame(self) -> dict:
         r, h = self.crank["radius"], self.h
         return {"pivots": {"O": (0.0, 0.0)}, "guides": {"k": ((-1.6 * r, -h), (1.6 * r, -h))}}
 
@@ -794,7 +794,7 @@ class TRTSlot(Mechanism):
     def _loads(self, kin: dict):
         return _resistance_along_x(kin, self.F0, self.v_ref, self.c_visc)
 
-    def _frame(self):
+    def frame(self) -> dict:
         r, h = self.crank["radius"], self.h
         reach = math.sqrt(max(r * r - h * h, 0.0))
         return {

@@ -567,7 +567,7 @@ class Chain:
         w = np.broadcast_to(motion.omega(t), t.shape).astype(float)
         eps = np.broadcast_to(motion.epsilon(t), t.shape).astype(float)
         kin = self._solve(t, phi, w, eps)
-        kin["frame"] = self._frame()
+        kin["frame"] = self.frame()
         kin["mechanism"] = self.name
         return kin
 
@@ -719,7 +719,7 @@ class Chain:
                 f"{self.name}: a dyad does not assemble over a full crank turn"
             ) from None
 
-    def _frame(self) -> dict:
+    def frame(self) -> dict:
         """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))};
         with guides on moving links also ``link_guides`` {label: {"link": k, "at": (x, y),
         "angle": guide, "range": (s0, s1)}}: the part s0 <= slide_k <= s1 of the guide

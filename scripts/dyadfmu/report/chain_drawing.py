@@ -394,7 +394,7 @@ def draw(
         colours[g] = _LINK_COLOURS[i % len(_LINK_COLOURS)]
     c = _Canvas(ax, at, 0.03 * size, size, colours)
     names = _point_labels(chain)
-    frame = kin.get("frame") or chain._frame()
+    frame = kin.get("frame") or chain.frame()
     _draw_frame(c, frame)
     pivot = _draw_crank(c, chain, frame)
     _draw_links(c, chain, kin, frame, pivot)

@@ -65,7 +65,7 @@ def _rot90(v: np.ndarray):
 # ---------------------------------------------------------------------------
 def _draw_slider_crank(ax: Axes, mech: Mechanism, at: Callable, u: float):
     A, B = at("A"), at("D_m")
-    x0, x1 = (p[0] for p in mech._frame()["guides"]["k"])
+    x0, x1 = (p[0] for p in mech.frame()["guides"]["k"])
     e = mech.e
     hb = 1.0 * u  # half height of the slider
     ax.plot([x0, x1], [e, e], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)  # guide line
@@ -114,7 +114,7 @@ def _draw_quick_return(ax: Axes, mech: Mechanism, at: Callable, u: float):
 def _draw_scotch_yoke(ax: Axes, mech: Mechanism, at: Callable, u: float):
     A, Dm = at("A"), at("D_m")
     r, h = mech.crank["radius"], mech.h
-    (x0, _), (x1, _) = mech._frame()["guides"]["k"]
+    (x0, _), (x1, _) = mech.frame()["guides"]["k"]
     x0, x1 = min(x0, -r - 3 * u), max(x1, r + 3 * u)
     hf = 0.8 * u  # half height of the yoke's foot
     ax.plot([x0, x1], [-h, -h], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)
@@ -136,7 +136,7 @@ def _draw_trt_slot(ax: Axes, mech: Mechanism, at: Callable, u: float):
     phi = at("crank.angle")
     i_p = _unit(phi)
     h = mech.h
-    (x0, _), (x1, _) = mech._frame()["guides"]["k"]
+    (x0, _), (x1, _) = mech.frame()["guides"]["k"]
     hs = 1.0 * u  # half height of the slider
     ax.plot([x0, x1], [h, h], color=_COLOUR["k"], lw=0.8, ls="-.", zorder=1)
     sketch.hatch(ax, (x0, h + hs), (x1, h + hs), (0.0, 1.0), u)
