@@ -46,10 +46,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..mechanisms import crank as _crank
+from ..mechanisms import crank as crank_balance
 from ..mechanisms.builtin import Mechanism
 from ..mechanisms.motion import CrankMotion
-from . import newton_euler as _reference
+from . import newton_euler
 
 __all__ = [
     "Motor",
@@ -219,7 +219,7 @@ def _load_term(mech: Mechanism, kin1: dict, kin_w: dict):
     merged = dict(kin1)
     for key in _LOAD_KEYS:
         merged[key] = kin_w[key]
-    return _crank.load_power(mech, merged)
+    return crank_balance.load_power(mech, merged)
 
 
 def _machine_terms(mech: Mechanism, phi: np.ndarray, omega: np.ndarray):
@@ -270,8 +270,8 @@ def crank_torque_from_kinetostatics(
     a kinetostatic dyad FMU gives a motor (the rotor's own inertia not included)."""
     shape, (phi, omega, epsilon) = _broadcast(phi, omega, epsilon)
     kin = _state_kinematics_flat(mech, phi, omega, epsilon)
-    ref = _reference.solve(mech.dyad, *mech.reference_inputs(kin))
-    torque = _crank.balance(mech, kin, ref["r_np"], ref["m_np"])["torque"]
+    ref = newton_euler.solve(mech.dyad, *mech.reference_inputs(kin))
+    torque = crank_balance.balance(mech, kin, ref["r_np"], ref["m_np"])["torque"]
     return torque.reshape(shape)
 
 
