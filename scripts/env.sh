@@ -78,7 +78,7 @@ dyadfmu_build_tsan() {
 
 # ---- the second FMI importer (scripts/tests/test_importers.py) ----------------------
 # fmi-sim, a Rust FMI 2 / FMI 3 importer independent of fmpy, at the version
-# scripts/dyadfmu/importers.py pins (FMI_SIM_VERSION). `cargo install` builds it once into
+# scripts/dyadfmu/cosim/importers.py pins (FMI_SIM_VERSION). `cargo install` builds it once into
 # the cargo install root (~/.cargo/bin unless CARGO_INSTALL_ROOT or CARGO_HOME say
 # otherwise; about 12 CPU minutes); a later run finds the pinned version there and skips.
 # The build needs cargo (PATH or ~/.cargo/bin, else Debian's cargo-web, since bookworm's
@@ -87,7 +87,7 @@ dyadfmu_build_tsan() {
 # (scripts/pyproject.toml, test extras). Where fmi-sim cannot be installed, the tests
 # skip it, except under CI (CI=true), where this returns non-zero.
 dyadfmu_fmi_sim_pin() {
-    sed -n 's/^FMI_SIM_VERSION = "\([0-9.]*\)"$/\1/p' "$DYADFMU_ROOT/scripts/dyadfmu/importers.py"
+    sed -n 's/^FMI_SIM_VERSION = "\([0-9.]*\)"$/\1/p' "$DYADFMU_ROOT/scripts/dyadfmu/cosim/importers.py"
 }
 
 dyadfmu_fmi_sim_installed() {   # the version of the fmi-sim at $1, or nothing

@@ -1,1 +1,2 @@
-"""Python helpers for the planar Assur dyad project (independent numerical reference in :mod:`dyadfmu.reference`)."""
+"""Python harness of the planar Assur dyad project: mechanisms, references, FMUs through
+fmpy, co-simulations, studies and reports."""

@@ -7,9 +7,11 @@ import argparse
 import sys
 from pathlib import Path
 
-from . import harness, mechanisms
+from .cosim import harness, scenes
+from .mechanisms import builtin
+from .report import tables
 
-DEFAULT_SCENE = "slider-crank"
+DEFAULT_MECHANISM = "slider-crank"
 
 
 def _positive_int(text: str) -> int:
@@ -26,214 +28,316 @@ def _positive_float(text: str) -> float:
     return value
 
 
-def _cosimulation_options(command, out: Path, revolutions_help: str):
+def _cosimulation_options(command: argparse.ArgumentParser, out: Path, revolutions_help: str):
     """The options of a command that co-simulates FMUs over the crank's motion."""
-    command.add_argument("--fmi", choices=("2", "3", "both"), default="both",
-                         help="FMI version of the FMU to run (default both)")
-    command.add_argument("--revolutions", type=_positive_float, default=2.0,
-                         help=revolutions_help)
-    command.add_argument("--steps", type=_positive_int, default=360,
-                         help="communication steps per revolution (default 360)")
-    command.add_argument("--motion", choices=("constant", "varying"), default="constant",
-                         help="crank speed: constant, or varying along the cycle "
-                              "(default constant)")
-    command.add_argument("--out", type=Path, default=out,
-                         help=f"directory for tables and plots (default ./{out})")
-    command.add_argument("--build", type=Path, default=None,
-                         help="CMake build directory holding fmus/ (default: build/ of the "
-                              "checkout)")
+    command.add_argument(
+        "--fmi",
+        choices=("2", "3", "both"),
+        default="both",
+        help="FMI version of the FMU to run (default both)",
+    )
+    command.add_argument("--revolutions", type=_positive_float, default=2.0, help=revolutions_help)
+    command.add_argument(
+        "--steps",
+        type=_positive_int,
+        default=360,
+        help="communication steps per revolution (default 360)",
+    )
+    command.add_argument(
+        "--motion",
+        choices=("constant", "varying"),
+        default="constant",
+        help="crank speed: constant, or varying along the cycle (default constant)",
+    )
+    command.add_argument(
+        "--out", type=Path, default=out, help=f"directory for tables and plots (default ./{out})"
+    )
+    command.add_argument(
+        "--build",
+        type=Path,
+        default=None,
+        help="CMake build directory holding fmus/ (default: build/ of the checkout)",
+    )
     command.add_argument("--no-plots", action="store_true", help="write tables only")
 
 
-def parser() -> argparse.ArgumentParser:
-    top = argparse.ArgumentParser(
-        prog="dyadfmu",
-        description="Co-simulate the dyad FMUs of planar mechanisms with fmpy and check every "
-                    "joint reaction against an independent Newton-Euler solve in NumPy.")
-    sub = top.add_subparsers(dest="command", required=True)
-
-    listing = sub.add_parser("list", help="list the scenes (mechanisms) and their dyads")
-    listing.set_defaults(run=_list)
-
-    run = sub.add_parser("run", help="co-simulate scenes and compare them with the reference",
-                         description="Co-simulate each scene's dyad FMU over the crank's motion, "
-                                     "print the error of every output against the reference, "
-                                     "write tables (Markdown, CSV) and plots (PNG).")
-    run.add_argument("scenes", nargs="*", metavar="SCENE", default=[DEFAULT_SCENE],
-                     help=f"scene names (default {DEFAULT_SCENE}; 'all' for every scene; "
-                          f"see 'dyadfmu list')")
-    _cosimulation_options(run, Path("out"),
-                          "crank revolutions (oscillations for trt-slot) to simulate (default 2)")
-    run.add_argument("--angle", type=float, default=60.0,
-                     help="crank angle in degrees at which the mechanism is drawn (default 60)")
+def _run_command(sub: argparse._SubParsersAction) -> None:
+    run = sub.add_parser(
+        "run",
+        help="co-simulate mechanisms and compare them with the reference",
+        description="Co-simulate each mechanism's dyad FMU over the crank's "
+        "motion, print the error of every output against the "
+        "reference, write tables (Markdown, CSV) and plots (PNG).",
+    )
+    run.add_argument(
+        "mechanisms",
+        nargs="*",
+        metavar="MECHANISM",
+        default=[DEFAULT_MECHANISM],
+        help=f"mechanism names (default {DEFAULT_MECHANISM}; 'all' for every "
+        f"mechanism; see 'dyadfmu list')",
+    )
+    _cosimulation_options(
+        run, Path("out"), "crank revolutions (oscillations for trt-slot) to simulate (default 2)"
+    )
+    run.add_argument(
+        "--angle",
+        type=float,
+        default=60.0,
+        help="crank angle in degrees at which the mechanism is drawn (default 60)",
+    )
     run.set_defaults(run=_run)
 
+
+def _study_command(sub: argparse._SubParsersAction) -> None:
     study = sub.add_parser(
-        "study", help="accuracy and speed of every method; writes the report",
+        "study",
+        help="accuracy and speed of every method; writes the report",
         description="Time the C core (double, float), GSL LU and SVD 6x6 solves, NumPy's "
-                    "batched solve and the FMUs (from C and fmpy) on the same inputs; measure "
-                    "their errors against mpmath ground truth on random, near-singular, "
-                    "extreme and cancelling configurations; write report.md, CSVs and plots.")
-    study.add_argument("--quick", action="store_true",
-                       help="small input sets (for CI: under a minute)")
-    study.add_argument("--out", type=Path, default=Path("out/study"),
-                       help="directory for the report (default ./out/study)")
-    study.add_argument("--build", type=Path, default=None,
-                       help="CMake build directory with the benchmark and FMUs (default build/)")
+        "batched solve and the FMUs (from C and fmpy) on the same inputs; measure "
+        "their errors against mpmath ground truth on random, near-singular, "
+        "extreme and cancelling configurations; write report.md, CSVs and plots.",
+    )
+    study.add_argument(
+        "--quick", action="store_true", help="small input sets (for CI: under a minute)"
+    )
+    study.add_argument(
+        "--out",
+        type=Path,
+        default=Path("out/study"),
+        help="directory for the report (default ./out/study)",
+    )
+    study.add_argument(
+        "--build",
+        type=Path,
+        default=None,
+        help="CMake build directory with the benchmark and FMUs (default build/)",
+    )
     study.set_defaults(run=_study)
 
+
+def _scene_command(sub: argparse._SubParsersAction) -> None:
     scene = sub.add_parser(
-        "scene", help="co-simulate tailored scene FMUs (scenes/*.toml) against their reference",
+        "scene",
+        help="co-simulate tailored scene FMUs (scenes/*.toml) against their reference",
         description="Co-simulate each scene's tailored FMU over the crank's motion, print the "
-                    "error of every output against the independent reference, and write "
-                    "tables (Markdown, CSV) and, for the multi-dyad chains, a drawing with "
-                    "every reaction. Scenes: " + ", ".join(scenes_names()) + ".")
-    scene.add_argument("scenes", nargs="*", metavar="SCENE", default=["shaper"],
-                       help="scene names (default shaper; 'all' for every example scene)")
+        "error of every output against the independent reference, and write "
+        "tables (Markdown, CSV) and, for the multi-dyad chains, a drawing with "
+        "every reaction. Scenes: " + ", ".join(scenes_names()) + ".",
+    )
+    scene.add_argument(
+        "scenes",
+        nargs="*",
+        metavar="SCENE",
+        default=["shaper"],
+        help="scene names (default shaper; 'all' for every example scene)",
+    )
     _cosimulation_options(scene, Path("out/scenes"), "crank revolutions to simulate (default 2)")
     scene.set_defaults(run=_scene)
 
+
+def _own_commands(sub: argparse._SubParsersAction) -> None:
+    """The commands that parse their own options (listed here for --help)."""
     sub.add_parser(
-        "scenes", add_help=False,
+        "scenes",
+        add_help=False,
         help="every example scene against its reference, and the tailored FMUs against the "
-             "generic per-type FMUs: variables, binary size, callgrind instructions per doStep "
-             "(see 'dyadfmu scenes --help')").set_defaults(run=None)
-
-    cosim = sub.add_parser(
-        "cosim", add_help=False,
-        help="the dyad FMU in a closed loop with the drive FMU: explicit and stabilised "
-             "coupling against a monolithic reference (see 'dyadfmu cosim --help')")
-    cosim.set_defaults(run=None)
-
+        "generic per-type FMUs: variables, binary size, callgrind instructions per doStep "
+        "(see 'dyadfmu scenes --help')",
+    ).set_defaults(run=None)
     sub.add_parser(
-        "scene-bench", add_help=False,
+        "cosim",
+        add_help=False,
+        help="the dyad FMU in a closed loop with the drive FMU: explicit and stabilised "
+        "coupling against a monolithic reference (see 'dyadfmu cosim --help')",
+    ).set_defaults(run=None)
+    sub.add_parser(
+        "scene-bench",
+        add_help=False,
         help="time the scene generator (--check and --out) on chains of 25 to 200 dyads "
-             "(see 'dyadfmu scene-bench --help')").set_defaults(run=None)
+        "(see 'dyadfmu scene-bench --help')",
+    ).set_defaults(run=None)
+
+
+def parser() -> argparse.ArgumentParser:
+    """The parser of the dyadfmu command and its subcommands."""
+    top = argparse.ArgumentParser(
+        prog="dyadfmu",
+        description="Co-simulate the dyad FMUs of planar mechanisms with fmpy and check every "
+        "joint reaction against an independent Newton-Euler solve in NumPy.",
+    )
+    sub = top.add_subparsers(dest="command", required=True)
+    listing = sub.add_parser("list", help="list the mechanisms and their dyads")
+    listing.set_defaults(run=_list)
+    _run_command(sub)
+    _study_command(sub)
+    _scene_command(sub)
+    _own_commands(sub)
     return top
 
 
-def _study(args) -> int:
-    from . import study
+def _log(text: str) -> None:
+    print(text, file=sys.stderr)
+
+
+def _study(args: argparse.Namespace) -> int:
+    from .report import study as study_report
+    from .study import accuracy
 
     try:
-        report = study.run(args.out, quick=args.quick, build=args.build,
-                           log=lambda text: print(text, file=sys.stderr))
+        results = accuracy.run(args.out, quick=args.quick, build=args.build, log=_log)
     except FileNotFoundError as error:
         print(f"dyadfmu: {error}", file=sys.stderr)
         return 2
+    report = study_report.write(args.out, results)
+    _log(f"report written to {report} ({results.elapsed:.0f} s)")
     print(report.read_text())
     print(f"report: {report}")
     return 0
 
 
-def _list(args) -> int:
-    for name in mechanisms.NAMES:
-        mech = mechanisms.load(name)
+def _list(args: argparse.Namespace) -> int:
+    for name in builtin.NAMES:
+        mech = builtin.load(name)
         print(f"{name:14s} {mech.dyad}  {mech.description}")
     return 0
 
 
-def _run(args) -> int:
-    scenes = list(mechanisms.NAMES) if args.scenes == ["all"] else args.scenes
-    unknown = [s for s in scenes if s not in mechanisms.NAMES]
+def _chosen(asked: list[str], names: tuple, what: str) -> list[str] | None:
+    """The names asked for ('all': every one), or None after reporting unknown ones."""
+    chosen = list(names) if asked == ["all"] else asked
+    unknown = [n for n in chosen if n not in names]
     if unknown:
-        print(f"dyadfmu: unknown scene {', '.join(unknown)}; the scenes are: "
-              f"{', '.join(mechanisms.NAMES)}", file=sys.stderr)
-        return 2
-    versions = (2, 3) if args.fmi == "both" else (int(args.fmi),)
-    written = []
-    worst = 0.0
-    for scene in scenes:
-        for version in versions:
-            try:
-                result = harness.run_scene(scene, version, args.revolutions, args.steps,
-                                           args.motion, args.build, progress=True)
-            except FileNotFoundError as error:
-                print(f"dyadfmu: {error}", file=sys.stderr)
-                return 2
-            print(harness.summary(result))
-            print(harness.format_text(harness.error_table(result)))
-            print()
-            worst = max(worst, result.worst_relative)
-            written += harness.write_tables(result, args.out)
-            if not args.no_plots:
-                from . import plots  # matplotlib only when plotting
+        print(
+            f"dyadfmu: unknown {what} {', '.join(unknown)}; the {what}s are: {', '.join(names)}",
+            file=sys.stderr,
+        )
+        return None
+    return chosen
 
-                stem = f"{scene}_fmi{version}"
-                written.append(plots.plot_reactions(result, args.out / f"{stem}_reactions.png"))
-                written.append(plots.plot_mechanism(result, args.angle,
-                                                    args.out / f"{stem}_mechanism.png"))
+
+def _versions(args: argparse.Namespace) -> tuple[int, ...]:
+    return (2, 3) if args.fmi == "both" else (int(args.fmi),)
+
+
+def _print_written(worst: float, written: list[Path]) -> None:
     print(f"worst relative error of any output: {worst:.2e}")
     print("written:")
     for path in written:
         print(f"  {path}")
+
+
+def _mechanism_outputs(args: argparse.Namespace, result: harness.MechanismResult) -> list[Path]:
+    """Print one mechanism run's table; write its tables and plots."""
+    rows = tables.error_rows(result.errors)
+    print(harness.summary(result))
+    print(tables.format_text(rows))
+    print()
+    args.out.mkdir(parents=True, exist_ok=True)
+    stem = args.out / f"{result.mechanism.name}_fmi{result.fmi_version}"
+    written = tables.write_error_tables(stem, harness.summary(result), rows)
+    if not args.no_plots:
+        from .report import plots  # matplotlib only when plotting
+
+        written.append(plots.plot_reactions(result, Path(f"{stem}_reactions.png")))
+        written.append(plots.plot_mechanism(result, args.angle, Path(f"{stem}_mechanism.png")))
+    return written
+
+
+def _run(args: argparse.Namespace) -> int:
+    names = _chosen(args.mechanisms, builtin.NAMES, "mechanism")
+    if names is None:
+        return 2
+    written, worst = [], 0.0
+    for name in names:
+        for version in _versions(args):
+            try:
+                result = harness.run_mechanism(
+                    name,
+                    version,
+                    args.revolutions,
+                    args.steps,
+                    args.motion,
+                    args.build,
+                    progress=True,
+                )
+            except FileNotFoundError as error:
+                print(f"dyadfmu: {error}", file=sys.stderr)
+                return 2
+            worst = max(worst, result.worst_relative)
+            written += _mechanism_outputs(args, result)
+    _print_written(worst, written)
     return 0
 
 
-def scenes_names():
-    from . import scenes
-
+def scenes_names() -> tuple[str, ...]:
+    """The example scenes, for the help text."""
     return scenes.NAMES
 
 
-def _scene(args) -> int:
-    import csv
+def _scene_outputs(args: argparse.Namespace, result: scenes.SceneRun) -> list[Path]:
+    """Print one scene run's table; write its tables and, for a chain, its drawing."""
+    rows = tables.error_rows(result.errors)
+    print(scenes.summary(result))
+    print(tables.format_text(rows))
+    print()
+    stem = args.out / f"{result.name}_fmi{result.fmi_version}"
+    written = tables.write_error_tables(stem, scenes.summary(result), rows)
+    if not args.no_plots and result.source.chain is not None:
+        from .report import chain_drawing
 
-    from . import scenes
+        written.append(
+            chain_drawing.figure(
+                result.source.chain,
+                result.kin,
+                scenes.reactions_of(result),
+                scenes.drawing_indices(result),
+                f"{stem}_reactions.png",
+            )
+        )
+    return written
 
-    names = list(scenes.NAMES) if args.scenes == ["all"] else args.scenes
-    unknown = [n for n in names if n not in scenes.NAMES]
-    if unknown:
-        print(f"dyadfmu: unknown scene {', '.join(unknown)}; the example scenes are: "
-              f"{', '.join(scenes.NAMES)}", file=sys.stderr)
+
+def _scene(args: argparse.Namespace) -> int:
+    names = _chosen(args.scenes, scenes.NAMES, "scene")
+    if names is None:
         return 2
-    versions = (2, 3) if args.fmi == "both" else (int(args.fmi),)
     args.out.mkdir(parents=True, exist_ok=True)
     written, worst = [], 0.0
     for name in names:
-        for version in versions:
+        for version in _versions(args):
             try:
-                result = scenes.run(name, version, args.revolutions, args.steps, args.motion,
-                                    args.build, progress=True)
+                result = scenes.run(
+                    name,
+                    version,
+                    args.revolutions,
+                    args.steps,
+                    args.motion,
+                    args.build,
+                    progress=True,
+                )
             except FileNotFoundError as error:
                 print(f"dyadfmu: {error}", file=sys.stderr)
                 return 2
-            rows = scenes.error_rows(result)
-            print(scenes.summary(result))
-            print(harness.format_text(rows))
-            print()
             worst = max(worst, result.worst_relative)
-            stem = args.out / f"{name}_fmi{version}"
-            Path(f"{stem}_errors.md").write_text(
-                f"# {scenes.summary(result)}\n\n{harness.format_markdown(rows)}\n")
-            with open(f"{stem}_errors.csv", "w", newline="") as handle:
-                csv.writer(handle).writerows(rows)
-            written += [Path(f"{stem}_errors.md"), Path(f"{stem}_errors.csv")]
-            if not args.no_plots and result.source.chain is not None:
-                from . import chain_drawing
-
-                written.append(chain_drawing.figure(
-                    result.source.chain, result.kin, scenes.reactions_of(result),
-                    scenes.drawing_indices(result), f"{stem}_reactions.png"))
-    print(f"worst relative error of any output: {worst:.2e}")
-    print("written:")
-    for path in written:
-        print(f"  {path}")
+            written += _scene_outputs(args, result)
+    _print_written(worst, written)
     return 0
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
+    """Run the dyadfmu command with `argv` (default: the process's arguments)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["scenes"]:
-        from . import scene_report  # its own options: --quick, --out, ...
+        from .report import scenes as scene_report  # its own options: --quick, --out, ...
 
         return scene_report.main(argv[1:])
     if argv[:1] == ["cosim"]:
-        from . import cosim_report  # its own options: --quick, --out, ...
+        from .report import cosim as cosim_report  # its own options: --quick, --out, ...
 
         return cosim_report.main(argv[1:])
     if argv[:1] == ["scene-bench"]:
-        from . import long_chain  # its own options: --sizes, --generator, --write
+        from .study import long_chain  # its own options: --sizes, --generator, --write
 
         return long_chain.main(argv[1:])
     args = parser().parse_args(argv)

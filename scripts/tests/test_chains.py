@@ -1,5 +1,5 @@
-"""Tests of the chain mechanisms (scripts/dyadfmu/chains.py) and their drawing
-(scripts/dyadfmu/chain_drawing.py).
+"""Tests of the chain mechanisms (scripts/dyadfmu/mechanisms/chains.py) and their drawing
+(scripts/dyadfmu/report/chain_drawing.py).
 
 For every mechanism (shaper, sixbar, rocker_slider) and both crank motions (constant,
 varying):
@@ -38,7 +38,8 @@ from matplotlib.patches import FancyArrow  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-from dyadfmu import chain_drawing, chains  # noqa: E402
+from dyadfmu.mechanisms import chains  # noqa: E402
+from dyadfmu.report import chain_drawing  # noqa: E402
 
 NAMES = ("shaper", "sixbar", "rocker_slider")
 KINDS = ("constant", "varying")
@@ -93,7 +94,7 @@ def scene(name):
 
 @lru_cache(maxsize=None)
 def harness(name):
-    with open(ROOT / "scripts" / "dyadfmu" / "chains.toml", "rb") as f:
+    with open(ROOT / "scripts" / "dyadfmu" / "mechanisms" / "chains.toml", "rb") as f:
         return tomllib.load(f)[name]
 
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from dyadfmu import reference as ref
+from dyadfmu.reference import newton_euler as ref
 from dyadfmu.core import Core, library_path
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")

@@ -1,5 +1,5 @@
-"""Tests of the co-simulation master (scripts/dyadfmu/cosim.py) and its study
-(scripts/dyadfmu/cosim_report.py).
+"""Tests of the co-simulation master (scripts/dyadfmu/cosim/master.py) and its study
+(scripts/dyadfmu/report/cosim.py).
 
 Without the drive FMU (they need only the dyad FMUs):
 - the split of the machine: the drive's inertia J_r + J_cO plus the dyad's effective
@@ -36,7 +36,12 @@ import numpy as np
 import pytest
 
 HERE = Path(__file__).resolve().parent
-from dyadfmu import cosim, cosim_report, machine, mechanisms, reference  # noqa: E402
+from dyadfmu.cosim import master as cosim  # noqa: E402
+from dyadfmu.fmi.slave import Slave, SlaveError  # noqa: E402
+from dyadfmu.mechanisms import builtin as mechanisms  # noqa: E402
+from dyadfmu.reference import machine  # noqa: E402
+from dyadfmu.reference import newton_euler as reference  # noqa: E402
+from dyadfmu.report import cosim as cosim_report  # noqa: E402
 
 ROOT = HERE.parents[1]
 BUILD = Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
@@ -129,7 +134,7 @@ class PythonStandInDrive:
         v = self.v
         inertia = v["inertia"] + v["load.inertia"]
         if not inertia > 0:
-            raise cosim.SlaveError(self.label, "doStep", 3, "inertia + load.inertia <= 0")
+            raise SlaveError(self.label, "doStep", 3, "inertia + load.inertia <= 0")
         tau = inertia * v["motor.no_load_speed"] / v["motor.stall_torque"]
         turn = 0.005 / abs(self.speed) if self.speed else h
         limit = min(0.05 * tau, turn)
@@ -149,7 +154,7 @@ class PythonStandInDrive:
             a += dt / 6 * (w + 2 * w2 + 2 * w3 + w4)
             w += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
         if not (math.isfinite(a) and math.isfinite(w)):
-            raise cosim.SlaveError(self.label, "doStep", 2, "the state is no longer finite")
+            raise SlaveError(self.label, "doStep", 2, "the state is no longer finite")
         self.angle, self.speed, self.time = a, w, t + h
 
     def directional_derivative(self, unknowns, knowns, seed):  # pragma: no cover
@@ -255,7 +260,7 @@ def test_a_failing_fmu_call_ends_the_run_with_a_reason():
     class Failing(PythonStandInDrive):
         def do_step(self, t, h):
             if t >= 0.0105:
-                raise cosim.SlaveError(self.label, "doStep", 2, "the test's discard")
+                raise SlaveError(self.label, "doStep", 2, "the test's discard")
             super().do_step(t, h)
 
     s = _setup("four-bar", 1.0)
@@ -284,7 +289,7 @@ def test_drive_fmu_acceleration_is_for_the_current_inputs(version):
     _needs_drive_version(version)
     s = _setup("four-bar", 1.0)
     params = cosim.drive_parameters(s.mech, s.motor, 0.7, 30.0)
-    fmu = cosim.FmuSlave(cosim.drive_fmu_path(version), "drive")
+    fmu = Slave(cosim.drive_fmu_path(version), "drive")
     stand_in = PythonStandInDrive()
     try:
         for slave in (fmu, stand_in):
@@ -301,7 +306,7 @@ def test_drive_fmu_acceleration_is_for_the_current_inputs(version):
                                    stand_in.get(cosim._DRIVE_OUTPUTS), rtol=1e-7)
         assert fmu.get_status() == 0
         fmu.set(("load.inertia",), (-1.0,))                  # inertia + load.inertia < 0
-        with pytest.raises(cosim.SlaveError, match="load.inertia"):   # error, named, logged
+        with pytest.raises(SlaveError, match="load.inertia"):   # error, named, logged
             fmu.get(("crank.epsilon",))
     finally:
         fmu.close()

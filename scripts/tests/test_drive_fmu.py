@@ -3,18 +3,16 @@ its integration against SciPy's Radau at tight tolerances, independence of the
 communication step, and bad inputs."""
 
 import math
-import zipfile
 
 import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave
-from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
 from scipy.integrate import solve_ivp
 
-from dyadfmu.harness import build_dir
+from dyadfmu.fmi.slave import Slave
+from dyadfmu.paths import build_dir
 
 VERSIONS = (2, 3)
 
@@ -75,41 +73,14 @@ def test_drive_integrates_like_radau(version, step):
     assert error_phi < 1e-7 and error_omega < 1e-7
 
 
-class Drive:
-    def __init__(self, version, tmp_path):
-        md = read_model_description(str(drive_path(version)))
-        self.version = version
-        self.vr = {v.name: v.valueReference for v in md.modelVariables}
-        unzipdir = tmp_path / f"drive{version}"
-        with zipfile.ZipFile(drive_path(version)) as archive:
-            archive.extractall(unzipdir)
-        cls = FMU2Slave if version == 2 else FMU3Slave
-        self.fmu = cls(guid=md.guid, unzipDirectory=str(unzipdir),
-                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="drive")
-        self.fmu.instantiate()
-
-    def set(self, name, value):
-        (self.fmu.setReal if self.version == 2 else self.fmu.setFloat64)([self.vr[name]], [value])
-
-    def get(self, name):
-        if name == "status":
-            return (self.fmu.getInteger if self.version == 2 else self.fmu.getInt32)(
-                [self.vr[name]])[0]
-        return (self.fmu.getReal if self.version == 2 else self.fmu.getFloat64)([self.vr[name]])[0]
-
-    def initialize(self):
-        if self.version == 2:
-            self.fmu.setupExperiment(startTime=0)
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
-
-    def step(self, t, h):
-        return self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+def drive(version):
+    """An instantiated drive FMU of either version (dyadfmu's fmpy wrapper)."""
+    return Slave(drive_path(version), instance_name="drive")
 
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_drive_states_bad_inertia_and_reset(version, tmp_path):
-    d = Drive(version, tmp_path)
+    d = drive(version)
     for name, value in PARAMS.items():
         d.set(name, value)
     with pytest.raises(FMICallException):
@@ -117,20 +88,20 @@ def test_drive_states_bad_inertia_and_reset(version, tmp_path):
     d.initialize()
     assert d.get("crank.angle") == PARAMS["start.angle"]
     assert d.get("crank.omega") == PARAMS["start.speed"]
-    d.step(0, 0.01)
+    d.do_step(0, 0.01)
     moved = d.get("crank.angle")
     assert moved > PARAMS["start.angle"]
     d.set("load.inertia", -1.0)                   # loaded inertia no longer positive
     with pytest.raises(FMICallException):
-        d.step(0.01, 0.01)
+        d.do_step(0.01, 0.01)
     assert d.get("status") == 2
     d.set("load.inertia", 0.0)                    # usable again
-    d.step(0.01, 0.01)
+    d.do_step(0.01, 0.01)
     assert d.get("status") == 0 and d.get("crank.angle") > moved
     d.fmu.reset()
     d.initialize()
     assert d.get("crank.angle") == 0.0            # the table's start value after reset
-    d.fmu.freeInstance()
+    d.close()
 
 
 def _state(d):
@@ -145,19 +116,19 @@ def test_drive_refuses_a_step_beyond_the_substep_cap(version, tmp_path, inertia,
     """A step that needs more than a million substeps (here up to 7e300, beyond every
     integer type) is refused with Error before any substep: the state stays where it
     was, and a step short enough then goes on from it."""
-    d = Drive(version, tmp_path)
+    d = drive(version)
     d.set("inertia", inertia)
     d.initialize()
     before = _state(d)
     with pytest.raises(FMICallException) as error:
-        d.step(0, step)
+        d.do_step(0, step)
     assert error.value.status == 3
     assert _state(d) == before
     if next_step is not None:
-        d.step(0, next_step)
+        d.do_step(0, next_step)
         assert d.get("status") == 0
         assert d.get("crank.angle") != before[0]
-    d.fmu.freeInstance()
+    d.close()
 
 
 @pytest.mark.parametrize("version", VERSIONS)
@@ -168,7 +139,7 @@ def test_drive_reports_an_overflow_as_out_of_range(version, tmp_path, name, valu
     """Accepted values whose acceleration or motor torque overflow double give status 3
     and NaN for them, never status 0 beside an infinite output; the step is discarded
     and the state kept."""
-    d = Drive(version, tmp_path)
+    d = drive(version)
     parameter = name.startswith("motor.")
     if parameter:
         d.set(name, value)
@@ -179,9 +150,9 @@ def test_drive_reports_an_overflow_as_out_of_range(version, tmp_path, name, valu
     assert d.get("status") == 3
     assert math.isnan(d.get("crank.epsilon")) and not math.isinf(d.get("motor.torque"))
     with pytest.raises(FMICallException):
-        d.step(0, 0.01)
+        d.do_step(0, 0.01)
     assert _state(d) == before and all(math.isfinite(x) for x in before)
-    d.fmu.freeInstance()
+    d.close()
 
 
 @pytest.mark.parametrize("version", VERSIONS)
@@ -190,12 +161,12 @@ def test_drive_reports_an_overflow_as_out_of_range(version, tmp_path, name, valu
 def test_drive_refuses_a_step_whose_end_is_not_a_later_finite_time(version, tmp_path, t, h):
     """t + h overflowing, or rounding back to t, is refused with Error, and the
     instance steps on normally afterwards."""
-    d = Drive(version, tmp_path)
+    d = drive(version)
     d.initialize()
     before = _state(d)
     with pytest.raises(FMICallException):
-        d.step(t, h)
+        d.do_step(t, h)
     assert _state(d) == before
-    d.step(0, 0.01)
+    d.do_step(0, 0.01)
     assert d.get("status") == 0 and d.get("crank.angle") != before[0]
-    d.fmu.freeInstance()
+    d.close()

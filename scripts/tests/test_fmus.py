@@ -11,12 +11,11 @@ import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave
-from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
 
 from dyadfmu.core import Core
-from dyadfmu.harness import OUTPUTS, links_from_values
+from dyadfmu.cosim.harness import OUTPUTS, links_from_values
+from dyadfmu.fmi.slave import Slave
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
@@ -121,53 +120,16 @@ def test_cosimulation_reproduces_core(core, dyad, version):
 
 # ---- misuse through the low-level classes ------------------------------------------
 
-class Slave:
-    """An instantiated FMU of either version, with a name -> value reference map."""
-
-    def __init__(self, dyad, version, tmp_path, name="instance"):
-        path = fmu_path(dyad, version)
-        self.version = version
-        self.md = read_model_description(str(path))
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        unzipdir = tmp_path / f"{dyad}{version}{name}"
-        with zipfile.ZipFile(path) as archive:
-            archive.extractall(unzipdir)
-        cls = FMU2Slave if version == 2 else FMU3Slave
-        self.fmu = cls(guid=self.md.guid, unzipDirectory=str(unzipdir),
-                       modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
-        self.fmu.instantiate(loggingOn=False)
-
-    def set(self, name, value):
-        vr = [self.vr[name]]
-        if self.version == 2:
-            self.fmu.setReal(vr, [value])
-        else:
-            self.fmu.setFloat64(vr, [value])
-
-    def get(self, name):
-        vr = [self.vr[name]]
-        if name == "status":
-            return (self.fmu.getInteger if self.version == 2 else self.fmu.getInt32)(vr)[0]
-        return (self.fmu.getReal if self.version == 2 else self.fmu.getFloat64)(vr)[0]
-
-    def initialize(self):
-        if self.version == 2:
-            self.fmu.setupExperiment(startTime=0)
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
-
-    def step(self, t, h=0.01):
-        return self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-
-    def close(self):
-        self.fmu.freeInstance()
+def slave(dyad, version, name="instance"):
+    """An instantiated generic dyad FMU of either version (dyadfmu's fmpy wrapper)."""
+    return Slave(fmu_path(dyad, version), instance_name=name)
 
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_wrong_call_order_is_an_error(tmp_path, version):
-    s = Slave("rrt", version, tmp_path)
+    s = slave("rrt", version)
     with pytest.raises(FMICallException):
-        s.step(0)                       # before initialization
+        s.do_step(0, 0.01)                       # before initialization
     with pytest.raises(FMICallException):
         s.get("R_np.x")                 # outputs need initialization
     s.initialize()
@@ -175,10 +137,10 @@ def test_wrong_call_order_is_an_error(tmp_path, version):
         s.fmu.enterInitializationMode()
     with pytest.raises(FMICallException):
         s.set("link_m.mass", 3.0)       # fixed parameter after initialization
-    s.step(0)
+    s.do_step(0, 0.01)
     s.fmu.terminate()
     with pytest.raises(FMICallException):
-        s.step(0.01)
+        s.do_step(0.01, 0.01)
     s.close()
 
 
@@ -187,26 +149,26 @@ def test_wrong_call_order_is_an_error(tmp_path, version):
                                   (1e9, 1e-9)))
 def test_step_must_end_at_a_later_finite_time(tmp_path, version, t, h):
     """t + h that overflows (or rounds back to t) is an Error, and the instance steps on."""
-    s = Slave("rrt", version, tmp_path)
+    s = slave("rrt", version)
     s.initialize()
     with pytest.raises(FMICallException) as error:
-        s.step(t, h)
+        s.do_step(t, h)
     assert error.value.status == 3
-    s.step(0)
+    s.do_step(0, 0.01)
     assert s.get("status") == 0 and math.isfinite(s.get("R_np.x"))
     s.close()
 
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_bad_inputs_and_parameters_are_rejected(tmp_path, version):
-    s = Slave("rrr", version, tmp_path)
+    s = slave("rrr", version)
     for name, value in (("link_m.force.x", math.nan), ("link_n.omega", math.inf),
                         ("link_m.mass", -1.0), ("link_n.length", 0.0),
                         ("singular_threshold", 1.5)):
         with pytest.raises(FMICallException):
             s.set(name, value)
     s.initialize()
-    s.step(0)                           # still usable, with the start values
+    s.do_step(0, 0.01)                           # still usable, with the start values
     assert s.get("status") == 0
     assert math.isfinite(s.get("R_mk.x"))
     assert s.get("link_m.force.x") == 0.0
@@ -215,35 +177,35 @@ def test_bad_inputs_and_parameters_are_rejected(tmp_path, version):
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_singular_configuration(tmp_path, version):
-    s = Slave("rrr", version, tmp_path)
+    s = slave("rrr", version)
     s.initialize()
-    s.step(0)
+    s.do_step(0, 0.01)
     s.set("link_n.angle", s.get("link_m.angle") + math.pi)   # links aligned
     with pytest.raises(FMICallException) as error:
-        s.step(0.01)
+        s.do_step(0.01, 0.01)
     assert error.value.status == 2                           # discard
     assert s.get("status") == 1
     assert math.isnan(s.get("R_mn.x")) and math.isnan(s.get("R_np.y"))
     assert s.get("conditioning") < 1e-12
     s.set("link_n.angle", 2.0)                               # leave the singular position
-    s.step(0.01)
+    s.do_step(0.01, 0.01)
     assert s.get("status") == 0 and math.isfinite(s.get("R_mn.x"))
     s.close()
 
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_two_instances_do_not_interfere(tmp_path, version):
-    a = Slave("rtt", version, tmp_path, "a")
-    b = Slave("rtt", version, tmp_path, "b")
+    a = slave("rtt", version, "a")
+    b = slave("rtt", version, "b")
     a.initialize()
     b.initialize()
     a.set("link_m.force.x", -500.0)
     b.set("link_m.force.x", 800.0)
-    a.step(0)
-    b.step(0)
+    a.do_step(0, 0.01)
+    b.do_step(0, 0.01)
     ra, rb = a.get("R_np.x"), b.get("R_np.x")
     assert ra != rb
-    a.step(0.01)
+    a.do_step(0.01, 0.01)
     assert a.get("R_np.x") == ra and b.get("R_np.x") == rb
     a.close()
     b.close()
@@ -251,18 +213,18 @@ def test_two_instances_do_not_interfere(tmp_path, version):
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_reset_restores_start_values(tmp_path, version):
-    s = Slave("rtr", version, tmp_path)
+    s = slave("rtr", version)
     s.initialize()
-    s.step(0)
+    s.do_step(0, 0.01)
     first = s.get("R_mk.y")
     s.set("link_m.moment", 123.0)
-    s.step(0.01)
+    s.do_step(0.01, 0.01)
     assert s.get("R_mk.y") != first
     s.fmu.reset()
     s.set("link_m.mass", 2.5)                                # parameters settable again
     s.set("link_m.mass", 2.0)
     s.initialize()
-    s.step(0)
+    s.do_step(0, 0.01)
     assert s.get("link_m.moment") == 0.0
     assert s.get("R_mk.y") == first
     s.close()
@@ -302,7 +264,7 @@ def test_source_fmu_rebuilds(tmp_path, version):
 def test_directional_derivatives_match_finite_differences(tmp_path, dyad, version):
     """d(every Real output)/d(each input) from the FMU's directional derivative
     against central differences of the FMU's own outputs, at a moving state."""
-    s = Slave(dyad, version, tmp_path)
+    s = slave(dyad, version)
     s.initialize()
     inputs = [v for v in s.md.modelVariables if v.causality == "input"]
     outputs = [v.name for v in s.md.modelVariables
@@ -315,7 +277,7 @@ def test_directional_derivatives_match_finite_differences(tmp_path, dyad, versio
             value = float(v.start) + 50 * rng.normal()
         state[v.name] = value
         s.set(v.name, value)
-    s.step(0)
+    s.do_step(0, 0.01)
     out_vrs = [s.vr[n] for n in outputs]
 
     def outputs_now():

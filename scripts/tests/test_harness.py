@@ -7,15 +7,18 @@ import sys
 import numpy as np
 import pytest
 
-from dyadfmu import crank, harness, mechanisms, reference
+from dyadfmu.cosim import harness
+from dyadfmu.mechanisms import builtin as mechanisms
+from dyadfmu.mechanisms import crank
+from dyadfmu.reference import newton_euler as reference
 
-SCENES = mechanisms.NAMES
+MECHANISMS = mechanisms.NAMES
 
 
 @pytest.mark.parametrize("version", (2, 3))
-@pytest.mark.parametrize("scene", SCENES)
-def test_fmu_matches_reference(scene, version):
-    result = harness.run_scene(scene, version, revolutions=2.0, steps=90)
+@pytest.mark.parametrize("mechanism", MECHANISMS)
+def test_fmu_matches_reference(mechanism, version):
+    result = harness.run_mechanism(mechanism, version, revolutions=2.0, steps=90)
     assert result.steps == 180
     assert result.valid.mean() > 0.95, "too many near-singular samples"
     # fmpy applies the inputs of t_k before the step to t_k+1: every sample but
@@ -25,7 +28,7 @@ def test_fmu_matches_reference(scene, version):
     for error in result.errors:
         # An output may vanish by construction (R_mk.x on a horizontal guide), then exactly.
         assert error.relative <= 1e-9 if error.peak > 0 else error.max_abs == 0, \
-            f"{scene} FMI {version}: {error}"
+            f"{mechanism} FMI {version}: {error}"
     print(harness.summary(result))
 
 
@@ -35,11 +38,11 @@ def _fd_derivative(f, t, h):
 
 
 @pytest.mark.parametrize("motion", ("constant", "varying"))
-@pytest.mark.parametrize("scene", SCENES)
-def test_driving_torque_satisfies_energy_balance(scene, motion):
+@pytest.mark.parametrize("mechanism", MECHANISMS)
+def test_driving_torque_satisfies_energy_balance(mechanism, motion):
     """Driving power + power of loads and gravity = rate of change of kinetic
     energy, with the kinetic energy differentiated numerically in time."""
-    mech = mechanisms.load(scene)
+    mech = mechanisms.load(mechanism)
     crank_motion = mech.motion(motion, 1.0)
     t = np.linspace(0.0, crank_motion.duration, 241)[1:-1]
     kin = mech.kinematics(t, crank_motion)
@@ -55,7 +58,7 @@ def test_driving_torque_satisfies_energy_balance(scene, motion):
     energy_rate = _fd_derivative(energy, t, h)
     residual = driving + crank.load_power(mech, kin) - energy_rate
     scale = np.max(np.abs(driving))
-    print(f"{scene} ({motion}): energy residual {np.max(np.abs(residual)) / scale:.2e} "
+    print(f"{mechanism} ({motion}): energy residual {np.max(np.abs(residual)) / scale:.2e} "
           f"of the peak driving power {scale:.4g} W")
     assert scale > 0
     assert np.max(np.abs(residual)) <= 1e-6 * scale
@@ -82,15 +85,15 @@ def _cli(*args, cwd=None):
                           text=True, cwd=cwd, timeout=600)
 
 
-@pytest.mark.parametrize("scene", SCENES)
-def test_cli_runs_each_scene(scene, tmp_path):
-    done = _cli("run", scene, "--fmi", "both", "--revolutions", "1", "--steps", "36",
+@pytest.mark.parametrize("mechanism", MECHANISMS)
+def test_cli_runs_each_mechanism(mechanism, tmp_path):
+    done = _cli("run", mechanism, "--fmi", "both", "--revolutions", "1", "--steps", "36",
                 "--out", str(tmp_path))
     assert done.returncode == 0, done.stderr
     assert "worst relative error of any output" in done.stdout
     for version in (2, 3):
         for suffix in ("errors.md", "errors.csv", "reactions.png", "mechanism.png"):
-            path = tmp_path / f"{scene}_fmi{version}_{suffix}"
+            path = tmp_path / f"{mechanism}_fmi{version}_{suffix}"
             assert path.is_file() and path.stat().st_size > 0, path
 
 
@@ -98,7 +101,7 @@ def test_cli_help_list_and_errors(tmp_path):
     assert _cli("--help").returncode == 0
     assert "--revolutions" in _cli("run", "--help").stdout
     listing = _cli("list")
-    assert listing.returncode == 0 and all(s in listing.stdout for s in SCENES)
-    wrong = _cli("run", "no-such-scene", "--out", str(tmp_path))
-    assert wrong.returncode == 2 and "unknown scene" in wrong.stderr
+    assert listing.returncode == 0 and all(s in listing.stdout for s in MECHANISMS)
+    wrong = _cli("run", "no-such-mechanism", "--out", str(tmp_path))
+    assert wrong.returncode == 2 and "unknown mechanism" in wrong.stderr
     assert _cli("run", "--steps", "0").returncode == 2

@@ -41,7 +41,8 @@ MD_DIR = ROOT / "modelDescription"
 import cnames  # noqa: E402
 import scene  # noqa: E402
 import textsafe  # noqa: E402
-from dyadfmu import long_chain, scenes  # noqa: E402
+from dyadfmu.cosim import scenes  # noqa: E402
+from dyadfmu.study import long_chain  # noqa: E402
 
 SCENE_TOOL = MD_DIR / "scene.py"
 SCENES_DIR = ROOT / "scenes"
@@ -410,30 +411,22 @@ def test_a_planted_constructor_stays_a_comment_even_past_the_check(tmp_path):
 # a tunable pair point
 # ---------------------------------------------------------------------------
 class _Slave:
+    """A pair-point FMU whose parameters are set before initialisation (dyadfmu's fmpy
+    wrapper)."""
+
     def __init__(self, fmu: Path, tmp_path, tag):
-        from fmpy import read_model_description
-        from fmpy.fmi2 import FMU2Slave
-        self.md = read_model_description(str(fmu))
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        unzipped = tmp_path / f"unzipped_{tag}"
-        with zipfile.ZipFile(fmu) as archive:
-            archive.extractall(unzipped)
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=str(unzipped),
-                             modelIdentifier=self.md.coSimulation.modelIdentifier,
-                             instanceName=tag)
-        self.fmu.instantiate(loggingOn=False)
-        self.fmu.setupExperiment(startTime=0)
-        self.fmu.enterInitializationMode()
+        from dyadfmu.fmi.slave import Slave
+
+        self.slave = Slave(fmu, instance_name=tag)
+        self.md, self.vr = self.slave.md, self.slave.vr
 
     def start(self, parameters: dict):
-        if parameters:
-            self.fmu.setReal([self.vr[n] for n in parameters], list(parameters.values()))
-        self.fmu.exitInitializationMode()
+        self.slave.initialize(parameters)
 
     def outputs(self, inputs: dict, names):
-        self.fmu.setReal([self.vr[n] for n in inputs], list(inputs.values()))
-        self.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
-        return np.array(self.fmu.getReal([self.vr[n] for n in names]))
+        self.slave.set(tuple(inputs), list(inputs.values()))
+        self.slave.do_step(0.0, 1e-3)
+        return np.array(self.slave.get(tuple(names)))
 
 
 @needs_gcc

@@ -27,7 +27,9 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from lxml import etree
 
-from dyadfmu import harness, importers
+from dyadfmu.cosim import importers
+from dyadfmu import paths
+from dyadfmu.fmi.simulate import simulate
 
 CI = os.environ.get("CI", "").lower() == "true"
 ALL = [(name, version) for name in importers.fmu_names() for version in importers.VERSIONS]
@@ -48,7 +50,7 @@ AMPLIFICATION_BOUND = 16.0
 
 
 def fmu_file(name, version) -> Path:
-    path = harness.build_dir() / "fmus" / f"{name}_fmi{version}.fmu"
+    path = paths.build_dir() / "fmus" / f"{name}_fmi{version}.fmu"
     if not path.is_file():
         pytest.fail(f"{path} is missing: build the FMUs first (scripts/run-tests does)")
     return path
@@ -79,7 +81,7 @@ def fmutool() -> str:
 
 
 def test_the_comparison_covers_every_fmu_the_build_makes():
-    built = {p.stem for p in (harness.build_dir() / "fmus").glob("*.fmu")}
+    built = {p.stem for p in (paths.build_dir() / "fmus").glob("*.fmu")}
     assert built == {f"{name}_fmi{version}" for name, version in ALL}
 
 
@@ -92,8 +94,8 @@ def test_fmi_sim_gives_fmpys_outputs(name, version, fmi_sim, tmp_path):
     setup = importers.setup_of(name, version)
     other = importers.run_fmi_sim(setup, tmp_path, fmi_sim)
     same_inputs = importers.as_applied_by_fmi_sim(setup)
-    exact = importers.compare(same_inputs, harness.simulate(same_inputs), other)
-    raw = importers.compare(setup, harness.simulate(setup), other)
+    exact = importers.compare(same_inputs, simulate(same_inputs), other)
+    raw = importers.compare(setup, simulate(setup), other)
     print(f"fmi-sim vs fmpy, harness inputs: {raw.line()}, amplification "
           f"{raw.amplification_in_own_roundoff:.2g} x eps a^2; same inputs: "
           f"{exact.max_ulps:.0f} ulps")
@@ -111,8 +113,8 @@ def test_the_comparison_fails_on_a_perturbed_input(name, version, column, fmi_si
     assert np.ptp(setup.inputs[column]) > 0          # a column that moves
     other = importers.run_fmi_sim(setup, tmp_path, fmi_sim, perturb=column)
     same_inputs = importers.as_applied_by_fmi_sim(setup)
-    assert importers.compare(same_inputs, harness.simulate(same_inputs), other).max_ulps > 0
-    assert importers.compare(setup, harness.simulate(setup), other).max_relative > RAW_BOUND
+    assert importers.compare(same_inputs, simulate(same_inputs), other).max_ulps > 0
+    assert importers.compare(setup, simulate(setup), other).max_relative > RAW_BOUND
 
 
 @pytest.mark.parametrize("version", importers.VERSIONS)
@@ -127,13 +129,13 @@ def test_a_singular_position_ends_both_runs_alike(version, fmi_sim, tmp_path):
     setup = replace(setup, inputs=inputs)
     if version == 3:
         with pytest.raises(FMICallException):
-            harness.simulate(setup)
+            simulate(setup)
         with pytest.raises(importers.ImporterError, match="do_step"):
             importers.run_fmi_sim(setup, tmp_path, fmi_sim)
         return
     other = importers.run_fmi_sim(setup, tmp_path, fmi_sim)
     same_inputs = importers.as_applied_by_fmi_sim(setup)
-    ours = harness.simulate(same_inputs)
+    ours = simulate(same_inputs)
     assert len(ours["time"]) == 62 and ours["status"][-1] == 1 and np.isnan(ours["R_mn.x"][-1])
     assert importers.compare(same_inputs, ours, other).max_ulps == 0
 

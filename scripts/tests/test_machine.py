@@ -1,4 +1,4 @@
-"""Tests of the motor-driven machine (scripts/dyadfmu/machine.py).
+"""Tests of the motor-driven machine (scripts/dyadfmu/reference/machine.py).
 
 - J(phi) is twice the kinetic energy of crank.kinetic_energy at unit crank speed, its
   exact derivative matches a 4th-order central difference, and Q equals
@@ -21,7 +21,9 @@ import math
 import numpy as np
 import pytest
 
-from dyadfmu import crank, machine, mechanisms
+from dyadfmu.mechanisms import builtin as mechanisms
+from dyadfmu.mechanisms import crank
+from dyadfmu.reference import machine
 
 NAMES = mechanisms.NAMES
 RATIOS = (0.1, 1.0, 10.0, 100.0)

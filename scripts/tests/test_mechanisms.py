@@ -1,5 +1,5 @@
-"""Tests of the five class II mechanisms (scripts/dyadfmu/mechanisms.py) and their
-drawing (scripts/dyadfmu/drawing.py).
+"""Tests of the five class II mechanisms (scripts/dyadfmu/mechanisms/builtin.py) and their
+drawing (scripts/dyadfmu/report/drawing.py).
 
 For every mechanism and both crank motions:
 - positions close (E = D_m + l_m i_m = D_n + l_n i_n, A on the crank circle, points on
@@ -31,7 +31,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-from dyadfmu import drawing, mechanisms, reference  # noqa: E402
+from dyadfmu.mechanisms import builtin as mechanisms  # noqa: E402
+from dyadfmu.reference import newton_euler as reference  # noqa: E402
+from dyadfmu.report import drawing  # noqa: E402
 
 NAMES = mechanisms.NAMES
 KINDS = ("constant", "varying")

@@ -37,7 +37,7 @@ GENERATOR = MD_DIR / "generate.py"
 
 import generate  # noqa: E402
 import scene  # noqa: E402
-from dyadfmu import reference as ref  # noqa: E402
+from dyadfmu.reference import newton_euler as ref  # noqa: E402
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}  # D_m, E, D_n

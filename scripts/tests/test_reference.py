@@ -1,11 +1,11 @@
-"""Tests of the independent Newton-Euler dyad reference (scripts/dyadfmu/reference.py)."""
+"""Tests of the independent Newton-Euler dyad reference (scripts/dyadfmu/reference/newton_euler.py)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from dyadfmu import reference as ref
+from dyadfmu.reference import newton_euler as ref
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 # pair kinds (D_m, E, D_n) written out independently of ref.PAIRS

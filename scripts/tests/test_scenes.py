@@ -9,25 +9,24 @@ import math
 import re
 import subprocess
 import sys
-import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import read_model_description
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave
-from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
 
-from dyadfmu import scenes
+from dyadfmu import paths
+from dyadfmu.cosim import scenes
+from dyadfmu.fmi import slave as fmi_slave
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
 SCENES_DIR = ROOT / "scenes"
 MALFORMED = sorted((SCENES_DIR / "malformed").glob("*.toml"))
 VERSIONS = (2, 3)
-GENERATED = scenes.build_dir() / "generated"
+GENERATED = paths.build_dir() / "generated"
 
 
 def run_tool(*args):
@@ -197,38 +196,25 @@ def test_energy_balance_detects_a_wrong_torque():
 
 
 class Slave:
+    """A scene FMU initialised at t = 0 and stepped by 1 ms (dyadfmu's fmpy wrapper)."""
+
     def __init__(self, name, version, tmp_path):
-        path = scenes.fmu_path(name, version)
-        self.version = version
-        self.md = read_model_description(str(path))
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        unzipdir = tmp_path / f"{name}{version}"
-        with zipfile.ZipFile(path) as archive:
-            archive.extractall(unzipdir)
-        cls = FMU2Slave if version == 2 else FMU3Slave
-        self.fmu = cls(guid=self.md.guid, unzipDirectory=str(unzipdir),
-                       modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
-        self.fmu.instantiate(loggingOn=False)
-        if version == 2:
-            self.fmu.setupExperiment(startTime=0)
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
+        self.slave = fmi_slave.Slave(scenes.fmu_path(name, version), instance_name=name)
+        self.md = self.slave.md
+        self.slave.initialize()
         self.t = 0.0
 
     def set(self, values: dict):
-        vrs = [self.vr[n] for n in values]
-        (self.fmu.setReal if self.version == 2 else self.fmu.setFloat64)(vrs, list(values.values()))
+        self.slave.set(tuple(values), list(values.values()))
 
     def get(self, names):
-        return np.array((self.fmu.getReal if self.version == 2 else self.fmu.getFloat64)(
-            [self.vr[n] for n in names]))
+        return np.array(self.slave.get(tuple(names)))
 
     def status(self):
-        vr = [self.vr["status"]]
-        return (self.fmu.getInteger if self.version == 2 else self.fmu.getInt32)(vr)[0]
+        return self.slave.get_status()
 
     def step(self):
-        self.fmu.doStep(currentCommunicationPoint=self.t, communicationStepSize=1e-3)
+        self.slave.do_step(self.t, 1e-3)
         self.t += 1e-3
 
 

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from dyadfmu import configurations as cfg
-from dyadfmu import reference
+from dyadfmu.reference import newton_euler as reference
+from dyadfmu.study import configurations as cfg
 from dyadfmu.core import Core, library_path
 
 pytestmark = pytest.mark.skipif(not library_path().is_file(),

@@ -66,24 +66,25 @@ from __future__ import annotations
 import copy
 import math
 import os
+import tomllib
+from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
-    import tomli as tomllib
-
-from .mechanisms import (CrankMotion, _col, _cross, _dot, _merge, _number, _pair, _rot90,
-                         _rotating, _unit)
+from ..paths import SCENES_DIR
+from . import geometry as geo
+from . import motion as motion_
+from .motion import CrankMotion
 
 __all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
 
 #: The chain mechanisms.
 NAMES = ("shaper", "sixbar", "rocker_slider")
+
+#: The attachments that are guides (a translational pair at the dyad's outer pair).
+_GUIDES = ("guide", "link_guide")
 
 #: Dyad types handled, with the pair kinds at (D_m, E, D_n).
 PAIR_KINDS = {"RRR": ("R", "R", "R"), "RRT": ("T", "R", "R"), "RTR": ("R", "T", "R")}
@@ -95,28 +96,28 @@ _TAGS = (("D_m", "mk"), ("E", "mn"), ("D_n", "np"))
 # ---------------------------------------------------------------------------
 # vector helpers on arrays of shape (..., 2)
 # ---------------------------------------------------------------------------
-def _norm(v):
+def _norm(v: np.ndarray):
     return np.hypot(v[..., 0], v[..., 1])
 
 
-def _angle(v):
+def _angle(v: np.ndarray):
     return np.arctan2(v[..., 1], v[..., 0])
 
 
-def _solve2(c1, c2, rhs):
+def _solve2(c1: np.ndarray, c2: np.ndarray, rhs: np.ndarray):
     """x, y with x c1 + y c2 = rhs (Cramer's rule), batched over the leading axis."""
-    det = _cross(c1, c2)
-    return _cross(rhs, c2) / det, _cross(c1, rhs) / det
+    det = geo.cross(c1, c2)
+    return geo.cross(rhs, c2) / det, geo.cross(c1, rhs) / det
 
 
 # ---------------------------------------------------------------------------
 # data
 # ---------------------------------------------------------------------------
-def scene_path(name) -> Path:
+def scene_path(name: str) -> Path:
     """The scene file of mechanism ``name``: ``scenes/<name>.toml`` of the project."""
     if name not in NAMES:
         raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
-    return Path(__file__).resolve().parents[2] / "scenes" / f"{name}.toml"
+    return SCENES_DIR / f"{name}.toml"
 
 
 def default_data() -> dict:
@@ -125,8 +126,8 @@ def default_data() -> dict:
     return tomllib.loads(text)
 
 
-def _sign(table, key, where):
-    value = _number(table, key, where)
+def _sign(table: Mapping, key: str, where: str):
+    value = geo.number(table, key, where)
     if value not in (1.0, -1.0):
         raise ValueError(f"{where}.{key}: expected +1 or -1, got {value!r}")
     return value
@@ -135,6 +136,44 @@ def _sign(table, key, where):
 # ---------------------------------------------------------------------------
 # the chains
 # ---------------------------------------------------------------------------
+class _Balance:
+    """The sums of forces and of moments about S on every body, and the largest terms."""
+
+    def __init__(self, names: list, bodies: dict, count: int) -> None:
+        self.names, self.bodies = names, bodies
+        self.fsum = {b: np.zeros((count, 2)) for b in names}
+        self.msum = {b: np.zeros(count) for b in names}
+        self.fmax, self.mmax = np.zeros(count), np.zeros(count)
+        self.tangential = np.zeros(count)
+
+    def force(self, body: str | None, point: np.ndarray, f: np.ndarray) -> None:
+        """The force f at point on body (nothing for the frame)."""
+        if body is None:
+            return
+        m = geo.cross(point - self.bodies[body]["S"], f)
+        self.fsum[body] += f
+        self.msum[body] += m
+        self.fmax = np.maximum(self.fmax, _norm(f))
+        self.mmax = np.maximum(self.mmax, np.abs(m))
+
+    def couple(self, body: str | None, mu: np.ndarray) -> None:
+        """The couple mu on body (nothing for the frame)."""
+        if body is None:
+            return
+        self.msum[body] += mu
+        self.mmax = np.maximum(self.mmax, np.abs(mu))
+
+    def worst(self) -> np.ndarray:
+        """The worst residual per sample, relative to the largest terms."""
+        tiny = np.finfo(float).tiny
+        fscale, mscale = np.maximum(self.fmax, tiny), np.maximum(self.mmax, tiny)
+        worst = self.tangential / fscale
+        for b in self.names:
+            worst = np.maximum(worst, _norm(self.fsum[b]) / fscale)
+            worst = np.maximum(worst, np.abs(self.msum[b]) / mscale)
+        return worst
+
+
 class Chain:
     """A crank plus the dyads of a scene file, with the harness data of ``chains.toml``.
 
@@ -155,47 +194,26 @@ class Chain:
         self.description = str(self.data.get("description", name))
         where = f"scene {name}"
 
-        crank = self.scene.get("crank")
-        if not isinstance(crank, Mapping):
-            raise ValueError(f"{where}: missing table [crank]")
-        self.crank = dict(crank)
-        self.crank_name = str(crank.get("name", "crank"))
-        w = f"{where}.crank"
-        self._r = _number(crank, "length", w, positive=True)
-        self._crank_mass = _number(crank, "mass", w, nonnegative=True)
-        self._crank_inertia = _number(crank, "inertia", w, nonnegative=True)
-        self._crank_com = _pair(crank, "com", w)
-
+        self._read_crank(where)
         grav = self.scene.get("gravity", {})
-        self.gravity = (_number(grav, "x", f"{where}.gravity"), _number(grav, "y", f"{where}.gravity"))
+        self.gravity = (
+            geo.number(grav, "x", f"{where}.gravity"),
+            geo.number(grav, "y", f"{where}.gravity"),
+        )
         eff = self.scene.get("effects", {})
-        self.effects = {"inertia": bool(eff.get("inertia", True)), "gravity": bool(eff.get("gravity", True))}
+        self.effects = {
+            "inertia": bool(eff.get("inertia", True)),
+            "gravity": bool(eff.get("gravity", True)),
+        }
         #: gravity as it enters the dynamics and the potential energy
         self._g = np.array(self.gravity if self.effects["gravity"] else (0.0, 0.0))
 
-        self.links = {}
-        for lt in self.scene.get("link", []):
-            lname = str(lt.get("name", ""))
-            if not lname or lname in self.links or lname in (self.crank_name, "frame"):
-                raise ValueError(f"{where}: bad or repeated link name {lname!r}")
-            wl = f"{where}.link[{lname}]"
-            link = dict(lt)
-            link["mass"] = _number(lt, "mass", wl, nonnegative=True)
-            link["inertia"] = _number(lt, "inertia", wl, nonnegative=True)
-            link["com"] = _pair(lt, "com", wl)
-            self.links[lname] = link
+        self._read_links(where)
         self.dyads = [dict(d) for d in self.scene.get("dyad", [])]
         if not self.dyads:
             raise ValueError(f"{where}: no [[dyad]]")
 
-        md = self.data.get("motion", {})
-        wm = f"{name}.motion"
-        self._w0 = _number(md, "omega", wm, positive=True)
-        self._variation = _number(md, "variation", wm, default=0.3)
-        if not 0.0 <= self._variation < 1.0:
-            raise ValueError(f"{wm}.variation: must be in [0, 1), got {self._variation!r}")
-        self._phi0 = _number(md, "phi0", wm, default=0.0)
-
+        self._read_motion()
         self._resolve_dyads()
         self._resolve_loads()
         self.labels = {"O": "O", "A": "A"}
@@ -206,103 +224,191 @@ class Chain:
         # every dyad must assemble over a full crank turn
         self._sweep()
 
+    def _read_crank(self, where: str) -> None:
+        crank = self.scene.get("crank")
+        if not isinstance(crank, Mapping):
+            raise ValueError(f"{where}: missing table [crank]")
+        self.crank = dict(crank)
+        self.crank_name = str(crank.get("name", "crank"))
+        w = f"{where}.crank"
+        self._r = geo.number(crank, "length", w, positive=True)
+        self._crank_mass = geo.number(crank, "mass", w, nonnegative=True)
+        self._crank_inertia = geo.number(crank, "inertia", w, nonnegative=True)
+        self._crank_com = geo.pair(crank, "com", w)
+
+    def _read_links(self, where: str) -> None:
+        self.links = {}
+        for lt in self.scene.get("link", []):
+            lname = str(lt.get("name", ""))
+            if not lname or lname in self.links or lname in (self.crank_name, "frame"):
+                raise ValueError(f"{where}: bad or repeated link name {lname!r}")
+            wl = f"{where}.link[{lname}]"
+            link = dict(lt)
+            link["mass"] = geo.number(lt, "mass", wl, nonnegative=True)
+            link["inertia"] = geo.number(lt, "inertia", wl, nonnegative=True)
+            link["com"] = geo.pair(lt, "com", wl)
+            self.links[lname] = link
+
+    def _read_motion(self) -> None:
+        md = self.data.get("motion", {})
+        wm = f"{self.name}.motion"
+        self._w0 = geo.number(md, "omega", wm, positive=True)
+        self._variation = geo.number(md, "variation", wm, default=0.3)
+        if not 0.0 <= self._variation < 1.0:
+            raise ValueError(f"{wm}.variation: must be in [0, 1), got {self._variation!r}")
+        self._phi0 = geo.number(md, "phi0", wm, default=0.0)
+
     # ---- resolution of the scene ------------------------------------------
-    def _attachment(self, spec, dyad, pair, done):
+    def _frame_pivot(self, frame: Mapping | None, dyad: str, pair: str) -> dict:
+        if not isinstance(frame, Mapping):
+            raise ValueError(
+                f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
+                f"(the scene puts {dyad}.{pair} on the frame)"
+            )
+        pos = geo.pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
+        return {
+            "kind": "pivot",
+            "body": None,
+            "position": pos,
+            "label": str(frame.get("label", f"{dyad}.{pair}")),
+        }
+
+    def _frame_guide(
+        self, spec: Mapping, frame: Mapping | None, dyad: str, pair: str, where: str
+    ) -> dict:
+        if "guide" not in spec:
+            raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
+        angle = geo.number(spec, "guide", where)
+        if not isinstance(frame, Mapping):
+            raise ValueError(
+                f"{self.name}.frame.{dyad}.{pair}: missing guide height "
+                f"(the scene puts {dyad}.{pair} on a frame guide)"
+            )
+        h = geo.number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
+        return {
+            "kind": "guide",
+            "body": None,
+            "angle": angle,
+            "height": h,
+            "label": str(frame.get("label", f"{dyad}.{pair}")),
+        }
+
+    def _attachment(self, spec: Mapping, dyad: str, pair: str, done: dict):
         """The external link carrying pair ``pair`` ("D_m" or "D_n") of ``dyad``."""
         where = f"scene {self.name}.dyad[{dyad}].{'k' if pair == 'D_m' else 'p'}"
         frame = (self.data.get("frame") or {}).get(dyad, {}).get(pair)
         if spec == "frame":
-            if not isinstance(frame, Mapping):
-                raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
-                                 f"(the scene puts {dyad}.{pair} on the frame)")
-            pos = _pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
-            return {"kind": "pivot", "body": None, "position": pos,
-                    "label": str(frame.get("label", f"{dyad}.{pair}"))}
+            return self._frame_pivot(frame, dyad, pair)
         if spec == "crank" or spec == self.crank_name:
             return {"kind": "point", "body": self.crank_name, "at": (self._r, 0.0), "label": "A"}
         if isinstance(spec, Mapping):
             body = spec.get("link")
             if body == "frame":
-                if "guide" not in spec:
-                    raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
-                angle = _number(spec, "guide", where)
-                if not isinstance(frame, Mapping):
-                    raise ValueError(f"{self.name}.frame.{dyad}.{pair}: missing guide height "
-                                     f"(the scene puts {dyad}.{pair} on a frame guide)")
-                h = _number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
-                return {"kind": "guide", "body": None, "angle": angle, "height": h,
-                        "label": str(frame.get("label", f"{dyad}.{pair}"))}
+                return self._frame_guide(spec, frame, dyad, pair, where)
             if body == "crank":
                 body = self.crank_name
             if body != self.crank_name and body not in done:
-                raise ValueError(f"{where}: link {body!r} is not the crank nor a link of an "
-                                 f"earlier dyad")
+                raise ValueError(
+                    f"{where}: link {body!r} is not the crank nor a link of an earlier dyad"
+                )
             if "guide" in spec:
                 # a guide fixed in the moving link: through ``at``, along i_body rotated
                 # by ``guide``
-                return {"kind": "link_guide", "body": body, "at": _pair(spec, "at", where),
-                        "angle": _number(spec, "guide", where), "label": f"{dyad}.guide_k"}
-            return {"kind": "point", "body": body, "at": _pair(spec, "at", where),
-                    "label": f"{dyad}.{pair}"}
+                return {
+                    "kind": "link_guide",
+                    "body": body,
+                    "at": geo.pair(spec, "at", where),
+                    "angle": geo.number(spec, "guide", where),
+                    "label": f"{dyad}.guide_k",
+                }
+            return {
+                "kind": "point",
+                "body": body,
+                "at": geo.pair(spec, "at", where),
+                "label": f"{dyad}.{pair}",
+            }
         raise ValueError(f"{where}: expected 'frame', 'crank' or a table, got {spec!r}")
 
-    def _resolve_dyads(self):
+    def _checked_dyad(self, d: Mapping, done: set) -> tuple:
+        """(name, type, m, n, where) of a [[dyad]] table, checked against the earlier ones."""
+        dname = str(d.get("name", ""))
+        where = f"scene {self.name}.dyad[{dname}]"
+        if not dname or any(p["name"] == dname for p in self.plan) or dname == self.crank_name:
+            raise ValueError(f"{where}: bad or repeated dyad name")
+        kind = str(d.get("type", "")).upper()
+        if kind not in PAIR_KINDS:
+            raise ValueError(f"{where}.type: expected one of {sorted(PAIR_KINDS)}, got {kind!r}")
+        m, n = d.get("m"), d.get("n")
+        for g in (m, n):
+            if g not in self.links:
+                raise ValueError(f"{where}: unknown link {g!r}")
+            if g in done:
+                raise ValueError(f"{where}: link {g!r} belongs to an earlier dyad")
+        if m == n:
+            raise ValueError(f"{where}: links m and n must differ")
+        return dname, kind, m, n, where
+
+    def _rrr_entry(self, entry: dict, where: str, branches: Mapping) -> None:
+        k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
+        if k["kind"] in _GUIDES or p["kind"] in _GUIDES:
+            raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
+        entry["lm"] = geo.number(self.links[m], "length", f"{where}.{m}", positive=True)
+        entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", positive=True)
+        entry["branch"] = _sign(branches, entry["name"], f"{self.name}.branches")
+
+    def _rrt_entry(self, entry: dict, where: str, branches: Mapping) -> None:
+        k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
+        lm_t = self.links[m]
+        if k["kind"] not in _GUIDES:
+            raise ValueError(
+                f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }} "
+                f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}"
+            )
+        if p["kind"] in _GUIDES:
+            raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
+        entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", nonnegative=True)
+        entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", positive=True)
+        if k["kind"] == "guide":
+            # the slider translates on the fixed guide: its angle is constant
+            entry["m_angle"] = geo.number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
+        elif "angle" in lm_t:
+            raise ValueError(
+                f"{where}.{m}.angle: the slider turns with link "
+                f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
+                f"remove its 'angle'"
+            )
+        entry["branch"] = _sign(branches, entry["name"], f"{self.name}.branches")
+
+    def _rtr_entry(self, entry: dict, where: str) -> None:
+        k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
+        if k["kind"] in _GUIDES or p["kind"] in _GUIDES:
+            raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
+        if "length" in self.links[m]:
+            raise ValueError(
+                f"{where}.{m}: the slotted link's length |D_m E| varies; remove its 'length'"
+            )
+        entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", nonnegative=True)
+        if entry["ln"] != 0.0:
+            raise ValueError(
+                f"{where}.{n}.length: only a block on the pin (length 0) "
+                f"is handled, got {entry['ln']!r}"
+            )
+
+    def _resolve_dyads(self) -> None:
         done = set()
         branches = self.data.get("branches") or {}
         self.plan = []
         for d in self.dyads:
-            dname = str(d.get("name", ""))
-            where = f"scene {self.name}.dyad[{dname}]"
-            if not dname or any(p["name"] == dname for p in self.plan) or dname == self.crank_name:
-                raise ValueError(f"{where}: bad or repeated dyad name")
-            kind = str(d.get("type", "")).upper()
-            if kind not in PAIR_KINDS:
-                raise ValueError(f"{where}.type: expected one of {sorted(PAIR_KINDS)}, got {kind!r}")
-            m, n = d.get("m"), d.get("n")
-            for g in (m, n):
-                if g not in self.links:
-                    raise ValueError(f"{where}: unknown link {g!r}")
-                if g in done:
-                    raise ValueError(f"{where}: link {g!r} belongs to an earlier dyad")
-            if m == n:
-                raise ValueError(f"{where}: links m and n must differ")
+            dname, kind, m, n, where = self._checked_dyad(d, done)
             k = self._attachment(d.get("k"), dname, "D_m", done)
             p = self._attachment(d.get("p"), dname, "D_n", done)
             entry = {"name": dname, "type": kind, "m": m, "n": n, "k": k, "p": p}
-            lm_t, ln_t = self.links[m], self.links[n]
-            guides = ("guide", "link_guide")
             if kind == "RRR":
-                if k["kind"] in guides or p["kind"] in guides:
-                    raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
-                entry["lm"] = _number(lm_t, "length", f"{where}.{m}", positive=True)
-                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
-                entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
+                self._rrr_entry(entry, where, branches)
             elif kind == "RRT":
-                if k["kind"] not in guides:
-                    raise ValueError(f"{where}: an RRT dyad needs k = {{ link = 'frame', guide = angle }} "
-                                     f"or a guide on a link, {{ link = '...', guide = angle, at = [x, y] }}")
-                if p["kind"] in guides:
-                    raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
-                entry["lm"] = _number(lm_t, "length", f"{where}.{m}", nonnegative=True)
-                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", positive=True)
-                if k["kind"] == "guide":
-                    # the slider translates on the fixed guide: its angle is constant
-                    entry["m_angle"] = _number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
-                elif "angle" in lm_t:
-                    raise ValueError(f"{where}.{m}.angle: the slider turns with link "
-                                     f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
-                                     f"remove its 'angle'")
-                entry["branch"] = _sign(branches, dname, f"{self.name}.branches")
+                self._rrt_entry(entry, where, branches)
             else:  # RTR
-                if k["kind"] in guides or p["kind"] in guides:
-                    raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
-                if "length" in lm_t:
-                    raise ValueError(f"{where}.{m}: the slotted link's length |D_m E| varies; "
-                                     f"remove its 'length'")
-                entry["ln"] = _number(ln_t, "length", f"{where}.{n}", nonnegative=True)
-                if entry["ln"] != 0.0:
-                    raise ValueError(f"{where}.{n}.length: only a block on the pin (length 0) "
-                                     f"is handled, got {entry['ln']!r}")
+                self._rtr_entry(entry, where)
             self.plan.append(entry)
             done.update((m, n))
         unused = set(self.links) - done
@@ -327,54 +433,93 @@ class Chain:
             kind = model.get("model")
             if kind == "cutting":
                 if lname not in forces:
-                    raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
-                self._loads[lname] = {"model": kind, "F0": _number(model, "F0", where),
-                                      "v_ref": _number(model, "v_ref", where, positive=True),
-                                      "s": _sign(model, "s", where) if "s" in model else 1.0}
+                    raise ValueError(
+                        f"{where}: the scene lists no force on {lname!r} ([loads].force)"
+                    )
+                self._loads[lname] = {
+                    "model": kind,
+                    "F0": geo.number(model, "F0", where),
+                    "v_ref": geo.number(model, "v_ref", where, positive=True),
+                    "s": _sign(model, "s", where) if "s" in model else 1.0,
+                }
             elif kind == "resisting-torque":
                 if lname not in moments:
-                    raise ValueError(f"{where}: the scene lists no moment on {lname!r} ([loads].moment)")
-                self._loads[lname] = {"model": kind, "T0": _number(model, "T0", where),
-                                      "w_ref": _number(model, "w_ref", where, positive=True),
-                                      "c": _number(model, "c", where)}
+                    raise ValueError(
+                        f"{where}: the scene lists no moment on {lname!r} ([loads].moment)"
+                    )
+                self._loads[lname] = {
+                    "model": kind,
+                    "T0": geo.number(model, "T0", where),
+                    "w_ref": geo.number(model, "w_ref", where, positive=True),
+                    "c": geo.number(model, "c", where),
+                }
             elif kind == "resisting-force":
                 if lname not in forces:
-                    raise ValueError(f"{where}: the scene lists no force on {lname!r} ([loads].force)")
+                    raise ValueError(
+                        f"{where}: the scene lists no force on {lname!r} ([loads].force)"
+                    )
                 dyad = next((e for e in self.plan if e["type"] == "RRT" and e["m"] == lname), None)
                 if dyad is None:
-                    raise ValueError(f"{where}: model 'resisting-force' needs a slider (link m "
-                                     f"of an RRT dyad); {lname!r} is none")
-                self._loads[lname] = {"model": kind, "F0": _number(model, "F0", where),
-                                      "v_ref": _number(model, "v_ref", where, positive=True),
-                                      "dyad": dyad["name"]}
+                    raise ValueError(
+                        f"{where}: model 'resisting-force' needs a slider (link m "
+                        f"of an RRT dyad); {lname!r} is none"
+                    )
+                self._loads[lname] = {
+                    "model": kind,
+                    "F0": geo.number(model, "F0", where),
+                    "v_ref": geo.number(model, "v_ref", where, positive=True),
+                    "dyad": dyad["name"],
+                }
             else:
-                raise ValueError(f"{where}.model: expected 'cutting', 'resisting-torque' or "
-                                 f"'resisting-force', got {kind!r}")
+                raise ValueError(
+                    f"{where}.model: expected 'cutting', 'resisting-torque' or "
+                    f"'resisting-force', got {kind!r}"
+                )
         for lname in forces + moments:
             if lname not in self._loads:
-                raise ValueError(f"{self.name}.load: the scene loads link {lname!r} but "
-                                 f"chains.toml has no model for it")
+                raise ValueError(
+                    f"{self.name}.load: the scene loads link {lname!r} but "
+                    f"chains.toml has no model for it"
+                )
 
     def _build_pairs(self):
         """Every pair: output key, kind, the body named first (it receives +R), the other
         body (None: the frame), kin key of its point, and for a translational pair the
         kin key of its guide's angle."""
         c = self.crank_name
-        self.pairs = [{"key": f"{c}.R_O", "kind": "R", "first": c, "second": None,
-                       "point": "O", "guide": None, "dyad": None, "tag": "O"}]
+        self.pairs = [
+            {
+                "key": f"{c}.R_O",
+                "kind": "R",
+                "first": c,
+                "second": None,
+                "point": "O",
+                "guide": None,
+                "dyad": None,
+                "tag": "O",
+            }
+        ]
         for e in self.plan:
             kinds = PAIR_KINDS[e["type"]]
             others = {"D_m": e["k"]["body"], "E": e["n"], "D_n": e["p"]["body"]}
             firsts = {"D_m": e["m"], "E": e["m"], "D_n": e["n"]}
-            for (point, tag), kind in zip(_TAGS, kinds):
+            for (point, tag), kind in zip(_TAGS, kinds, strict=False):
                 guide = None
                 if kind == "T":
                     # D_m: the guide of link k; E: the slot along i_m
                     guide = f"{e['name']}.guide_k.angle" if point == "D_m" else f"{e['m']}.angle"
-                self.pairs.append({"key": f"{e['name']}.R_{tag}", "kind": kind,
-                                   "first": firsts[point], "second": others[point],
-                                   "point": f"{e['name']}.{point}", "guide": guide,
-                                   "dyad": e["name"], "tag": tag})
+                self.pairs.append(
+                    {
+                        "key": f"{e['name']}.R_{tag}",
+                        "kind": kind,
+                        "first": firsts[point],
+                        "second": others[point],
+                        "point": f"{e['name']}.{point}",
+                        "guide": guide,
+                        "dyad": e["name"],
+                        "tag": tag,
+                    }
+                )
 
     def output_names(self) -> list:
         """The names of the outputs of :meth:`reference`, in the order of the unknowns."""
@@ -395,10 +540,10 @@ class Chain:
         revolutions = float(revolutions)
         if not (revolutions > 0 and math.isfinite(revolutions)):
             raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
-        return _rotating(kind, self._w0, self._variation, self._phi0, revolutions)
+        return motion_.rotating(kind, self._w0, self._variation, self._phi0, revolutions)
 
     # ---- kinematics -------------------------------------------------------
-    def kinematics(self, t, motion: CrankMotion) -> dict:
+    def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
         """Positions, velocities, accelerations and active loads at the times ``t`` (N,).
 
         Keys (arrays over the N samples; points and vectors (N, 2), scalars (N,)):
@@ -422,94 +567,125 @@ class Chain:
         w = np.broadcast_to(motion.omega(t), t.shape).astype(float)
         eps = np.broadcast_to(motion.epsilon(t), t.shape).astype(float)
         kin = self._solve(t, phi, w, eps)
-        kin["frame"] = self._frame()
+        kin["frame"] = self.frame()
         kin["mechanism"] = self.name
         return kin
 
     @staticmethod
-    def _material(state, at):
+    def _material(state: dict, at: Callable) -> dict:
         """Position, velocity, acceleration of the point fixed at ``at`` in a body's frame."""
-        i = _unit(state["angle"])
-        rel = at[0] * i + at[1] * _rot90(i)
-        w, e = _col(state["omega"]), _col(state["epsilon"])
-        return (state["D"] + rel, state["vD"] + w * _rot90(rel),
-                state["aD"] + e * _rot90(rel) - w * w * rel)
+        i = geo.unit(state["angle"])
+        rel = at[0] * i + at[1] * geo.rot90(i)
+        w, e = geo.col(state["omega"]), geo.col(state["epsilon"])
+        return (
+            state["D"] + rel,
+            state["vD"] + w * geo.rot90(rel),
+            state["aD"] + e * geo.rot90(rel) - w * w * rel,
+        )
 
-    def _point(self, att, states, shape):
+    def _point(self, att: dict, states: dict, shape: tuple):
         if att["kind"] == "pivot":
             z = np.zeros(shape + (2,))
             return z + np.asarray(att["position"]), z.copy(), z.copy()
         return self._material(states[att["body"]], att["at"])
 
-    def _solve(self, t, phi, w, eps) -> dict:
+    def _dyad_states(self, e: dict, states: dict, shape: tuple, kin: dict) -> tuple:
+        """(state of m, state of n, E) of one dyad from the states of the links it is on;
+        a guide's angle and slide go into kin."""
+        dn = e["name"]
+        P, vP, aP = self._point(e["p"], states, shape)  # D_n, on link p
+        if e["type"] == "RRR":
+            K, vK, aK = self._point(e["k"], states, shape)  # D_m, on link k
+            return _rrr(K, vK, aK, P, vP, aP, e["lm"], e["ln"], e["branch"], dn)
+        if e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
+            k = e["k"]
+            sm, sn, E, slide = _rrt_on_link(
+                states[k["body"]], k["at"], k["angle"], e["lm"], P, vP, aP, e["ln"], e["branch"], dn
+            )
+            kin[f"{dn}.guide_k.angle"] = sm["angle"].copy()
+            kin[f"{dn}.slide_k"], kin[f"{dn}.slide_k_rate"], kin[f"{dn}.slide_k_accel"] = slide
+            return sm, sn, E
+        if e["type"] == "RRT":
+            sm, sn, E = _rrt(
+                e["k"]["angle"],
+                e["k"]["height"],
+                e["lm"],
+                e["m_angle"],
+                P,
+                vP,
+                aP,
+                e["ln"],
+                e["branch"],
+                dn,
+            )
+            kin[f"{dn}.guide_k.angle"] = np.full(shape, e["k"]["angle"])
+            return sm, sn, E
+        K, vK, aK = self._point(e["k"], states, shape)
+        return _rtr(K, vK, aK, P, vP, aP)
+
+    @staticmethod
+    def _store_dyad(e: dict, sm: dict, sn: dict, E: np.ndarray, shape: tuple, kin: dict) -> None:
+        """A dyad's points and its links' motion under their kinematics names."""
+        dn = e["name"]
+        kin[f"{dn}.D_m"], kin[f"{dn}.E"], kin[f"{dn}.D_n"] = sm["D"], E, sn["D"]
+        for g, st in ((e["m"], sm), (e["n"], sn)):
+            kin[f"{g}.angle"] = np.broadcast_to(st["angle"], shape).astype(float)
+            kin[f"{g}.omega"] = np.broadcast_to(st["omega"], shape).astype(float)
+            kin[f"{g}.epsilon"] = np.broadcast_to(st["epsilon"], shape).astype(float)
+            kin[f"{g}.accel_d"] = st["aD"]
+            kin[f"{g}.vel_d"] = st["vD"]
+            for key in ("length", "length_rate", "length_accel"):
+                kin[f"{g}.{key}"] = np.broadcast_to(st[key], shape).astype(float)
+
+    def _active_load(self, g: str, kin: dict, zero: np.ndarray, z2: np.ndarray) -> tuple:
+        """(force at S, moment) of link g's load model over the samples."""
+        force, moment = z2.copy(), zero.copy()
+        model = self._loads.get(g)
+        if model and model["model"] == "cutting":
+            v, s = kin[f"v_S_{g}"][:, 0], model["s"]
+            force[:, 0] = -s * model["F0"] * 0.5 * (1.0 + np.tanh(s * v / model["v_ref"]))
+        elif model and model["model"] == "resisting-torque":
+            om = kin[f"{g}.omega"]
+            moment = -model["T0"] * np.tanh(om / model["w_ref"]) - model["c"] * om
+        elif model and model["model"] == "resisting-force":
+            dn = model["dyad"]
+            i_k = geo.unit(kin[f"{dn}.guide_k.angle"])
+            if f"{dn}.slide_k_rate" in kin:  # guide on a moving link
+                v_rel = kin[f"{dn}.slide_k_rate"]
+            else:  # frame guide
+                v_rel = geo.dot(kin[f"{g}.vel_d"], i_k)
+            force = geo.col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
+        return force, moment
+
+    def _solve(self, t: np.ndarray, phi: np.ndarray, w: np.ndarray, eps: np.ndarray) -> dict:
         shape = phi.shape
         zero = np.zeros(shape)
         z2 = np.zeros(shape + (2,))
         c = self.crank_name
-        i_c = _unit(phi)
         crank_state = {"angle": phi, "omega": w, "epsilon": eps, "D": z2, "vD": z2, "aD": z2}
         A, vA, aA = self._material(crank_state, (self._r, 0.0))
-        kin = {"t": t, f"{c}.angle": phi, f"{c}.omega": w, f"{c}.epsilon": eps,
-               "O": z2.copy(), "A": A, "v_A": vA, "a_A": aA}
+        kin = {
+            "t": t,
+            f"{c}.angle": phi,
+            f"{c}.omega": w,
+            f"{c}.epsilon": eps,
+            "O": z2.copy(),
+            "A": A,
+            "v_A": vA,
+            "a_A": aA,
+        }
         states = {c: crank_state}
-
         for e in self.plan:
-            dn = e["name"]
-            P, vP, aP = self._point(e["p"], states, shape)      # D_n, on link p
-            if e["type"] == "RRR":
-                K, vK, aK = self._point(e["k"], states, shape)  # D_m, on link k
-                sm, sn, E = _rrr(K, vK, aK, P, vP, aP, e["lm"], e["ln"], e["branch"], dn)
-            elif e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
-                sm, sn, E, slide = _rrt_on_link(states[e["k"]["body"]], e["k"]["at"],
-                                                e["k"]["angle"], e["lm"], P, vP, aP, e["ln"],
-                                                e["branch"], dn)
-                kin[f"{dn}.guide_k.angle"] = sm["angle"].copy()
-                kin[f"{dn}.slide_k"], kin[f"{dn}.slide_k_rate"], kin[f"{dn}.slide_k_accel"] = slide
-            elif e["type"] == "RRT":
-                sm, sn, E = _rrt(e["k"]["angle"], e["k"]["height"], e["lm"], e["m_angle"],
-                                 P, vP, aP, e["ln"], e["branch"], dn)
-                kin[f"{dn}.guide_k.angle"] = np.full(shape, e["k"]["angle"])
-            else:
-                K, vK, aK = self._point(e["k"], states, shape)
-                sm, sn, E = _rtr(K, vK, aK, P, vP, aP)
+            sm, sn, E = self._dyad_states(e, states, shape, kin)
             states[e["m"]], states[e["n"]] = sm, sn
-            kin[f"{dn}.D_m"], kin[f"{dn}.E"], kin[f"{dn}.D_n"] = sm["D"], E, sn["D"]
-            for g, st in ((e["m"], sm), (e["n"], sn)):
-                kin[f"{g}.angle"] = np.broadcast_to(st["angle"], shape).astype(float)
-                kin[f"{g}.omega"] = np.broadcast_to(st["omega"], shape).astype(float)
-                kin[f"{g}.epsilon"] = np.broadcast_to(st["epsilon"], shape).astype(float)
-                kin[f"{g}.accel_d"] = st["aD"]
-                kin[f"{g}.vel_d"] = st["vD"]
-                for key in ("length", "length_rate", "length_accel"):
-                    kin[f"{g}.{key}"] = np.broadcast_to(st[key], shape).astype(float)
-            kin[f"{dn}.conditioning"] = self._conditioning(e, kin)
-
+            self._store_dyad(e, sm, sn, E, shape, kin)
+            kin[f"{e['name']}.conditioning"] = self._conditioning(e, kin)
         # centres of mass (S = D + rel, rel fixed in the body)
         for b in self.bodies:
-            st = states[b]
             com = self._crank_com if b == c else self.links[b]["com"]
-            S, vS, aS = self._material(st, com)
-            kin[f"S_{b}"], kin[f"v_S_{b}"], kin[f"a_S_{b}"] = S, vS, aS
-
-        # active loads
+            kin[f"S_{b}"], kin[f"v_S_{b}"], kin[f"a_S_{b}"] = self._material(states[b], com)
         for g in self.links:
-            force, moment = z2.copy(), zero.copy()
-            model = self._loads.get(g)
-            if model and model["model"] == "cutting":
-                v, s = kin[f"v_S_{g}"][:, 0], model["s"]
-                force[:, 0] = -s * model["F0"] * 0.5 * (1.0 + np.tanh(s * v / model["v_ref"]))
-            elif model and model["model"] == "resisting-torque":
-                om = kin[f"{g}.omega"]
-                moment = -model["T0"] * np.tanh(om / model["w_ref"]) - model["c"] * om
-            elif model and model["model"] == "resisting-force":
-                dn = model["dyad"]
-                i_k = _unit(kin[f"{dn}.guide_k.angle"])
-                if f"{dn}.slide_k_rate" in kin:                 # guide on a moving link
-                    v_rel = kin[f"{dn}.slide_k_rate"]
-                else:                                           # frame guide
-                    v_rel = _dot(kin[f"{g}.vel_d"], i_k)
-                force = _col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
-            kin[f"{g}.force"], kin[f"{g}.moment"] = force, moment
+            kin[f"{g}.force"], kin[f"{g}.moment"] = self._active_load(g, kin, zero, z2)
         # scalar views with the FMU input names
         for g in self.links:
             for key in ("accel_d", "force"):
@@ -517,21 +693,21 @@ class Chain:
                 kin[f"{g}.{key}.y"] = kin[f"{g}.{key}"][:, 1].copy()
         return kin
 
-    def _conditioning(self, e, kin):
-        i_m, i_n = _unit(kin[f"{e['m']}.angle"]), _unit(kin[f"{e['n']}.angle"])
+    def _conditioning(self, e: dict, kin: dict) -> np.ndarray:
+        i_m, i_n = geo.unit(kin[f"{e['m']}.angle"]), geo.unit(kin[f"{e['n']}.angle"])
         if e["type"] == "RRR":
-            return np.abs(_dot(i_m, _rot90(i_n)))
+            return np.abs(geo.dot(i_m, geo.rot90(i_n)))
         if e["type"] == "RRT" and e["k"]["kind"] == "link_guide":
-            return np.abs(_dot(i_n, _unit(kin[f"{e['name']}.guide_k.angle"])))
+            return np.abs(geo.dot(i_n, geo.unit(kin[f"{e['name']}.guide_k.angle"])))
         if e["type"] == "RRT":
-            return np.abs(_dot(i_n, _unit(e["k"]["angle"])))
+            return np.abs(geo.dot(i_n, geo.unit(e["k"]["angle"])))
         lm, ln = kin[f"{e['m']}.length"], kin[f"{e['n']}.length"]
-        beta = _col(lm) * i_m - _col(ln) * i_n                  # D_n - D_m
+        beta = geo.col(lm) * i_m - geo.col(ln) * i_n  # D_n - D_m
         dist = _norm(beta)
-        i_beta = beta / _col(np.where(dist > 0, dist, 1.0))
-        return np.minimum(np.abs(_dot(i_beta, i_m)), dist / (lm + ln))
+        i_beta = beta / geo.col(np.where(dist > 0, dist, 1.0))
+        return np.minimum(np.abs(geo.dot(i_beta, i_m)), dist / (lm + ln))
 
-    def _sweep(self, count=720):
+    def _sweep(self, count: int = 720):
         """Positions over one full crank turn (the motion does not matter for them)."""
         phi = self._phi0 + np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
         zero = np.zeros_like(phi)
@@ -539,9 +715,11 @@ class Chain:
             with np.errstate(invalid="raise", divide="raise"):
                 return self._solve(zero, phi, zero + self._w0, zero)
         except FloatingPointError:  # pragma: no cover - _rrr/_rrt raise first
-            raise ValueError(f"{self.name}: a dyad does not assemble over a full crank turn")
+            raise ValueError(
+                f"{self.name}: a dyad does not assemble over a full crank turn"
+            ) from None
 
-    def _frame(self) -> dict:
+    def frame(self) -> dict:
         """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))};
         with guides on moving links also ``link_guides`` {label: {"link": k, "at": (x, y),
         "angle": guide, "range": (s0, s1)}}: the part s0 <= slide_k <= s1 of the guide
@@ -560,7 +738,7 @@ class Chain:
                         s = pts @ i
                         pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
                         base = np.array([0.0, att["height"]])
-                        base = base - (base @ i) * i          # foot of O on the guide line
+                        base = base - (base @ i) * i  # foot of O on the guide line
                         x0, x1 = base + (s.min() - pad) * i, base + (s.max() + pad) * i
                         guides[att["label"]] = (tuple(map(float, x0)), tuple(map(float, x1)))
                     elif att["kind"] == "link_guide":
@@ -568,15 +746,18 @@ class Chain:
                         s = sweep[f"{e['name']}.slide_k"]
                         pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
                         link_guides[att["label"]] = {
-                            "link": att["body"], "at": tuple(att["at"]), "angle": att["angle"],
-                            "range": (float(s.min() - pad), float(s.max() + pad + e["lm"]))}
+                            "link": att["body"],
+                            "at": tuple(att["at"]),
+                            "angle": att["angle"],
+                            "range": (float(s.min() - pad), float(s.max() + pad + e["lm"])),
+                        }
             self._frame_cache = {"pivots": pivots, "guides": guides}
             if link_guides:
                 self._frame_cache["link_guides"] = link_guides
         return copy.deepcopy(self._frame_cache)
 
     # ---- dynamics ---------------------------------------------------------
-    def _body_data(self, kin):
+    def _body_data(self, kin: dict):
         """Per body: mass, inertia, S (N, 2), a_S (N, 2) from accel_d, omega, epsilon and
         the centre of mass, epsilon, omega, velocity of S."""
         c = self.crank_name
@@ -584,22 +765,29 @@ class Chain:
         for b in self.bodies:
             if b == c:
                 mass, inertia, com = self._crank_mass, self._crank_inertia, self._crank_com
-                a_d = np.zeros_like(kin["A"])                    # O is fixed
+                a_d = np.zeros_like(kin["A"])  # O is fixed
             else:
                 link = self.links[b]
                 mass, inertia, com = link["mass"], link["inertia"], link["com"]
                 a_d = np.asarray(kin[f"{b}.accel_d"], dtype=float)
-            i = _unit(kin[f"{b}.angle"])
-            rel = com[0] * i + com[1] * _rot90(i)
+            i = geo.unit(kin[f"{b}.angle"])
+            rel = com[0] * i + com[1] * geo.rot90(i)
             w, e = np.asarray(kin[f"{b}.omega"], float), np.asarray(kin[f"{b}.epsilon"], float)
-            a_s = a_d + _col(e) * _rot90(rel) - _col(w * w) * rel
+            a_s = a_d + geo.col(e) * geo.rot90(rel) - geo.col(w * w) * rel
             force = kin[f"{b}.force"] if b != c else np.zeros_like(a_d)
             moment = kin[f"{b}.moment"] if b != c else np.zeros(len(w))
-            out[b] = {"mass": mass, "inertia": inertia, "S": np.asarray(kin[f"S_{b}"], float),
-                      "a_S": a_s, "epsilon": e, "force": force, "moment": moment}
+            out[b] = {
+                "mass": mass,
+                "inertia": inertia,
+                "S": np.asarray(kin[f"S_{b}"], float),
+                "a_S": a_s,
+                "epsilon": e,
+                "force": force,
+                "moment": moment,
+            }
         return out
 
-    def _known(self, bd):
+    def _known(self, bd: dict):
         """The known terms of body bd: forces (at S) and moments: weight, active load,
         d'Alembert force and moment."""
         forces = [np.broadcast_to(bd["mass"] * self._g, bd["a_S"].shape), bd["force"]]
@@ -609,7 +797,7 @@ class Chain:
             moments.append(-bd["inertia"] * bd["epsilon"])
         return forces, moments
 
-    def reference(self, kin) -> dict:
+    def reference(self, kin: dict) -> dict:
         """Joint reactions and the crank's driving torque from the Newton-Euler equations
         of all moving bodies, solved together (a square linear system per sample).
 
@@ -621,7 +809,12 @@ class Chain:
         moment -J epsilon. Returns output name -> (N,) array (see :meth:`output_names`;
         for a translational pair also its force's x and y components).
         """
-        bodies = self._body_data(kin)
+        K, rhs = self._system(kin, self._body_data(kin))
+        x = np.linalg.solve(K, rhs[..., None])[..., 0]
+        return self._outputs(kin, x)
+
+    def _system(self, kin: dict, bodies: dict) -> tuple:
+        """The matrix and right-hand side of the Newton-Euler system of every body."""
         row = {b: 3 * i for i, b in enumerate(self.bodies)}
         n_eq = 3 * len(self.bodies)
         count = len(np.atleast_1d(kin["t"]))
@@ -630,7 +823,9 @@ class Chain:
         ex = np.broadcast_to(np.array([1.0, 0.0]), (count, 2))
         ey = np.broadcast_to(np.array([0.0, 1.0]), (count, 2))
 
-        def put(col, body, point, f, mu, sign):
+        def put(
+            col: int, body: str, point: np.ndarray, f: np.ndarray, mu: np.ndarray, sign: float
+        ) -> None:
             """Unknown ``col`` acts on ``body`` as the force ``f`` at ``point`` plus the
             couple ``mu`` (per unit value), with ``sign``."""
             if body is None:
@@ -638,7 +833,7 @@ class Chain:
             r = row[body]
             K[:, r, col] += sign * f[:, 0]
             K[:, r + 1, col] += sign * f[:, 1]
-            K[:, r + 2, col] += sign * (_cross(point - bodies[body]["S"], f) + mu)
+            K[:, r + 2, col] += sign * (geo.cross(point - bodies[body]["S"], f) + mu)
 
         col = 0
         zero = np.zeros(count)
@@ -647,114 +842,95 @@ class Chain:
             if pr["kind"] == "R":
                 columns = ((ex, zero), (ey, zero))
             else:
-                j = _rot90(_unit(kin[pr["guide"]]))
+                j = geo.rot90(geo.unit(kin[pr["guide"]]))
                 columns = ((j, zero), (0.0 * j, zero + 1.0))
             for f, mu in columns:
                 put(col, pr["first"], P, f, mu, 1.0)
                 put(col, pr["second"], P, f, mu, -1.0)
                 col += 1
-        c = self.crank_name
-        K[:, row[c] + 2, col] = 1.0                           # driving torque
+        K[:, row[self.crank_name] + 2, col] = 1.0  # driving torque
         col += 1
         assert col == n_eq
-
         for b, bd in bodies.items():
             forces, moments = self._known(bd)
             r = row[b]
-            rhs[:, r:r + 2] -= sum(forces)                    # all act at S: no moment about S
+            rhs[:, r : r + 2] -= sum(forces)  # all act at S: no moment about S
             rhs[:, r + 2] -= sum(moments)
-        x = np.linalg.solve(K, rhs[..., None])[..., 0]
+        return K, rhs
 
+    def _outputs(self, kin: dict, x: np.ndarray) -> dict:
+        """The solution of the system under the output names."""
         out, col = {}, 0
         for pr in self.pairs:
             if pr["kind"] == "R":
-                out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = x[:, col].copy(), x[:, col + 1].copy()
+                out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = (
+                    x[:, col].copy(),
+                    x[:, col + 1].copy(),
+                )
             else:
-                j = _rot90(_unit(kin[pr["guide"]]))
+                j = geo.rot90(geo.unit(kin[pr["guide"]]))
                 N, M = x[:, col].copy(), x[:, col + 1].copy()
                 out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = N * j[:, 0], N * j[:, 1]
                 out[f"{pr['dyad']}.N_{pr['tag']}"], out[f"{pr['dyad']}.M_{pr['tag']}"] = N, M
             col += 2
-        out[f"{c}.torque"] = x[:, col].copy()
+        out[f"{self.crank_name}.torque"] = x[:, col].copy()
         return out
 
-    def residuals(self, kin, out) -> np.ndarray:
+    def residuals(self, kin: dict, out: dict) -> np.ndarray:
         """Worst Newton-Euler residual per sample of the output set ``out`` (keys of
         :meth:`reference`), over all bodies: |sum of forces| relative to the largest force
         term of the sample and |sum of moments about S| relative to the largest moment
         term. A translational pair's force must also lie along j of its guide and equal
         N j (both relative to the largest force term)."""
         bodies = self._body_data(kin)
-        count = len(np.atleast_1d(kin["t"]))
-        fsum = {b: np.zeros((count, 2)) for b in self.bodies}
-        msum = {b: np.zeros(count) for b in self.bodies}
-        fmax, mmax = np.zeros(count), np.zeros(count)
-        tangential = np.zeros(count)
-
-        def force(body, point, f):
-            nonlocal fmax, mmax
-            if body is None:
-                return
-            m = _cross(point - bodies[body]["S"], f)
-            fsum[body] += f
-            msum[body] += m
-            fmax = np.maximum(fmax, _norm(f))
-            mmax = np.maximum(mmax, np.abs(m))
-
-        def couple(body, mu):
-            nonlocal mmax
-            if body is None:
-                return
-            msum[body] += mu
-            mmax = np.maximum(mmax, np.abs(mu))
-
+        balance = _Balance(self.bodies, bodies, len(np.atleast_1d(kin["t"])))
         for b, bd in bodies.items():
             forces, moments = self._known(bd)
             for f in forces:
-                force(b, bd["S"], f)
+                balance.force(b, bd["S"], f)
             for mu in moments:
-                couple(b, mu)
+                balance.couple(b, mu)
         for pr in self.pairs:
             P = np.asarray(kin[pr["point"]], dtype=float)
-            R = np.stack([np.asarray(out[f"{pr['key']}.x"], float),
-                          np.asarray(out[f"{pr['key']}.y"], float)], axis=-1)
-            force(pr["first"], P, R)
-            force(pr["second"], P, -R)
+            R = np.stack(
+                [
+                    np.asarray(out[f"{pr['key']}.x"], float),
+                    np.asarray(out[f"{pr['key']}.y"], float),
+                ],
+                axis=-1,
+            )
+            balance.force(pr["first"], P, R)
+            balance.force(pr["second"], P, -R)
             if pr["kind"] == "T":
-                i = _unit(kin[pr["guide"]])
+                i = geo.unit(kin[pr["guide"]])
                 N = np.asarray(out[f"{pr['dyad']}.N_{pr['tag']}"], float)
                 M = np.asarray(out[f"{pr['dyad']}.M_{pr['tag']}"], float)
-                couple(pr["first"], M)
-                couple(pr["second"], -M)
-                tangential = np.maximum(tangential, np.maximum(
-                    np.abs(_dot(R, i)), np.abs(N - _dot(R, _rot90(i)))))
-        couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
-
-        tiny = np.finfo(float).tiny
-        fscale, mscale = np.maximum(fmax, tiny), np.maximum(mmax, tiny)
-        worst = tangential / fscale
-        for b in self.bodies:
-            worst = np.maximum(worst, _norm(fsum[b]) / fscale)
-            worst = np.maximum(worst, np.abs(msum[b]) / mscale)
-        return worst
+                balance.couple(pr["first"], M)
+                balance.couple(pr["second"], -M)
+                balance.tangential = np.maximum(
+                    balance.tangential,
+                    np.maximum(np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))),
+                )
+        balance.couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
+        return balance.worst()
 
     # ---- energy -----------------------------------------------------------
-    def _mass(self, b):
+    def _mass(self, b: str):
         if b == self.crank_name:
             return self._crank_mass, self._crank_inertia
         return self.links[b]["mass"], self.links[b]["inertia"]
 
-    def kinetic_energy(self, kin) -> np.ndarray:
+    def kinetic_energy(self, kin: dict) -> np.ndarray:
         """Kinetic energy [J] of all moving bodies, crank included."""
         total = 0.0
         for b in self.bodies:
             m, J = self._mass(b)
             v = np.asarray(kin[f"v_S_{b}"], float)
             w = np.asarray(kin[f"{b}.omega"], float)
-            total = total + 0.5 * m * _dot(v, v) + 0.5 * J * w * w
+            total = total + 0.5 * m * geo.dot(v, v) + 0.5 * J * w * w
         return np.asarray(total, dtype=float)
 
-    def potential_energy(self, kin) -> np.ndarray:
+    def potential_energy(self, kin: dict) -> np.ndarray:
         """Potential energy [J] of the weights of all moving bodies (crank included),
         zero at the origin: -sum m g . S (zero when the scene turns gravity off)."""
         total = 0.0
@@ -763,51 +939,102 @@ class Chain:
             total = total - m * (np.asarray(kin[f"S_{b}"], float) @ self._g)
         return np.asarray(total, dtype=float)
 
-    def load_power(self, kin) -> np.ndarray:
+    def load_power(self, kin: dict) -> np.ndarray:
         """Power [W] of the active loads (weights excluded): sum F . v_S + M omega."""
         total = 0.0
         for g in self.links:
-            total = total + _dot(np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float))
-            total = total + np.asarray(kin[f"{g}.moment"], float) * np.asarray(kin[f"{g}.omega"], float)
+            total = total + geo.dot(
+                np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float)
+            )
+            total = total + np.asarray(kin[f"{g}.moment"], float) * np.asarray(
+                kin[f"{g}.omega"], float
+            )
         return np.asarray(total, dtype=float)
 
     def __repr__(self):
-        return f"<Chain {self.name}: " + ", ".join(f"{e['name']} ({e['type']})" for e in self.plan) + ">"
+        return (
+            f"<Chain {self.name}: "
+            + ", ".join(f"{e['name']} ({e['type']})" for e in self.plan)
+            + ">"
+        )
 
 
 # ---------------------------------------------------------------------------
 # the dyads
 # ---------------------------------------------------------------------------
-def _state(angle, omega, epsilon, D, vD, aD, length, rate=0.0, accel=0.0):
-    return {"angle": angle, "omega": omega, "epsilon": epsilon, "D": D, "vD": vD, "aD": aD,
-            "length": length, "length_rate": rate, "length_accel": accel}
+def _state(
+    angle: np.ndarray,
+    omega: np.ndarray,
+    epsilon: np.ndarray,
+    D: np.ndarray,
+    vD: np.ndarray,
+    aD: np.ndarray,
+    length: np.ndarray | float,
+    rate: np.ndarray | float = 0.0,
+    accel: np.ndarray | float = 0.0,
+):
+    return {
+        "angle": angle,
+        "omega": omega,
+        "epsilon": epsilon,
+        "D": D,
+        "vD": vD,
+        "aD": aD,
+        "length": length,
+        "length_rate": rate,
+        "length_accel": accel,
+    }
 
 
-def _rrr(K, vK, aK, P, vP, aP, lm, ln, branch, name):
+def _rrr(
+    K: np.ndarray,
+    vK: np.ndarray,
+    aK: np.ndarray,
+    P: np.ndarray,
+    vP: np.ndarray,
+    aP: np.ndarray,
+    lm: np.ndarray,
+    ln: np.ndarray,
+    branch: float,
+    name: str,
+):
     """RRR: link m pinned at D_m = K (on link k), link n at D_n = P (on link p), joined
     at E. ``branch`` +1: E on the left of the directed line K -> P."""
     d = P - K
     dist = _norm(d)
-    u = d / _col(dist)
-    a = (lm * lm - ln * ln + dist * dist) / (2.0 * dist)        # along u from K to the chord
+    u = d / geo.col(dist)
+    a = (lm * lm - ln * ln + dist * dist) / (2.0 * dist)  # along u from K to the chord
     h2 = lm * lm - a * a
     if np.any(~(h2 > 0.0)):
-        raise ValueError(f"dyad {name}: the circles about D_m ({lm} m) and D_n ({ln} m) do not "
-                         f"intersect at every crank angle (|D_m D_n| from {dist.min():.4g} to "
-                         f"{dist.max():.4g} m)")
-    E = K + _col(a) * u + branch * _col(np.sqrt(h2)) * _rot90(u)
+        raise ValueError(
+            f"dyad {name}: the circles about D_m ({lm} m) and D_n ({ln} m) do not "
+            f"intersect at every crank angle (|D_m D_n| from {dist.min():.4g} to "
+            f"{dist.max():.4g} m)"
+        )
+    E = K + geo.col(a) * u + branch * geo.col(np.sqrt(h2)) * geo.rot90(u)
     i_m, i_n = (E - K) / lm, (E - P) / ln
-    j_m, j_n = _rot90(i_m), _rot90(i_n)
+    j_m, j_n = geo.rot90(i_m), geo.rot90(i_n)
     # vK + lm wm j_m = vP + ln wn j_n, differentiated once more for the accelerations
     c1, c2 = lm * j_m, -ln * j_n
     wm, wn = _solve2(c1, c2, vP - vK)
-    em, en = _solve2(c1, c2, aP - aK + _col(lm * wm * wm) * i_m - _col(ln * wn * wn) * i_n)
+    em, en = _solve2(c1, c2, aP - aK + geo.col(lm * wm * wm) * i_m - geo.col(ln * wn * wn) * i_n)
     sm = _state(_angle(i_m), wm, em, K, vK, aK, lm)
     sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
     return sm, sn, E
 
 
-def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
+def _rrt(
+    guide: np.ndarray,
+    height: float,
+    lm: np.ndarray,
+    m_angle: np.ndarray,
+    P: np.ndarray,
+    vP: np.ndarray,
+    aP: np.ndarray,
+    ln: np.ndarray,
+    branch: float,
+    name: str,
+):
     """RRT: slider m on the fixed guide (direction ``guide``, through (0, height)), its
     pin E = D_m + lm i_m; rod n from D_n = P (on link p) to E. ``branch`` +1: E ahead
     of the foot of P on E's line along the guide direction."""
@@ -815,29 +1042,42 @@ def _rrt(guide, height, lm, m_angle, P, vP, aP, ln, branch, name):
     j_k = np.array([-i_k[1], i_k[0]])
     i_m = np.array([math.cos(m_angle), math.sin(m_angle)])
     base = np.array([0.0, height])
-    line = base + lm * i_m                                   # E = line + s i_k
+    line = base + lm * i_m  # E = line + s i_k
     d = P - line
     along, across = d @ i_k, d @ j_k
     root2 = ln * ln - across * across
     if np.any(~(root2 > 0.0)):
-        raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
-                         f"crank angle (distance up to {np.abs(across).max():.4g} m)")
+        raise ValueError(
+            f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
+            f"crank angle (distance up to {np.abs(across).max():.4g} m)"
+        )
     s = along + branch * np.sqrt(root2)
-    E = line + _col(s) * i_k
+    E = line + geo.col(s) * i_k
     i_n = (E - P) / ln
-    j_n = _rot90(i_n)
+    j_n = geo.rot90(i_n)
     # ds i_k = vP + ln wn j_n, and its derivative
     ik = np.broadcast_to(i_k, P.shape)
     ds, wn = _solve2(ik, -ln * j_n, vP)
-    dds, en = _solve2(ik, -ln * j_n, aP - _col(ln * wn * wn) * i_n)
+    dds, en = _solve2(ik, -ln * j_n, aP - geo.col(ln * wn * wn) * i_n)
     zero = np.zeros(len(s))
-    Dm = base + _col(s) * i_k
-    sm = _state(zero + m_angle, zero, zero, Dm, _col(ds) * i_k, _col(dds) * i_k, lm)
+    Dm = base + geo.col(s) * i_k
+    sm = _state(zero + m_angle, zero, zero, Dm, geo.col(ds) * i_k, geo.col(dds) * i_k, lm)
     sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
     return sm, sn, E
 
 
-def _rrt_on_link(ks, at, guide, lm, P, vP, aP, ln, branch, name):
+def _rrt_on_link(
+    ks: dict,
+    at: Callable,
+    guide: np.ndarray,
+    lm: np.ndarray,
+    P: np.ndarray,
+    vP: np.ndarray,
+    aP: np.ndarray,
+    ln: np.ndarray,
+    branch: float,
+    name: str,
+):
     """RRT with the guide on the moving link k (state ``ks``): the line through the point
     ``at`` of k's frame, along i_k = i_(link k) rotated by ``guide``. The slider m turns
     with k (i_m = i_k); D_m = Q + s i_k, Q the guide's point ``at``; E = D_m + lm i_k;
@@ -846,45 +1086,55 @@ def _rrt_on_link(ks, at, guide, lm, P, vP, aP, ln, branch, name):
     Q, vQ, aQ = Chain._material(ks, at)
     angle = np.asarray(ks["angle"], dtype=float) + guide
     w, e = np.asarray(ks["omega"], dtype=float), np.asarray(ks["epsilon"], dtype=float)
-    i_k = _unit(angle)
-    j_k = _rot90(i_k)
-    d = P - (Q + lm * i_k)                                   # E = Q + (s + lm) i_k
-    along, across = _dot(d, i_k), _dot(d, j_k)
+    i_k = geo.unit(angle)
+    j_k = geo.rot90(i_k)
+    d = P - (Q + lm * i_k)  # E = Q + (s + lm) i_k
+    along, across = geo.dot(d, i_k), geo.dot(d, j_k)
     root2 = ln * ln - across * across
     if np.any(~(root2 > 0.0)):
-        raise ValueError(f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
-                         f"crank angle (distance up to {np.abs(across).max():.4g} m)")
+        raise ValueError(
+            f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
+            f"crank angle (distance up to {np.abs(across).max():.4g} m)"
+        )
     s = along + branch * np.sqrt(root2)
-    Dm = Q + _col(s) * i_k
+    Dm = Q + geo.col(s) * i_k
     E = Dm + lm * i_k
     i_n = (E - P) / ln
-    j_n = _rot90(i_n)
-    q = s + lm                                               # E = Q + q i_k
+    j_n = geo.rot90(i_n)
+    q = s + lm  # E = Q + q i_k
     # v_E = v_Q + s' i_k + q w j_k = v_P + ln wn j_n
-    ds, wn = _solve2(i_k, -ln * j_n, vP - vQ - _col(q * w) * j_k)
+    ds, wn = _solve2(i_k, -ln * j_n, vP - vQ - geo.col(q * w) * j_k)
     # a_E = a_Q + (s'' - q w^2) i_k + (q e + 2 s' w) j_k = a_P + ln en j_n - ln wn^2 i_n
-    rhs = aP - _col(ln * wn * wn) * i_n - aQ + _col(q * w * w) * i_k - _col(q * e + 2.0 * ds * w) * j_k
+    rhs = (
+        aP
+        - geo.col(ln * wn * wn) * i_n
+        - aQ
+        + geo.col(q * w * w) * i_k
+        - geo.col(q * e + 2.0 * ds * w) * j_k
+    )
     dds, en = _solve2(i_k, -ln * j_n, rhs)
     # the slider's material point at D_m: k's point there, plus relative and Coriolis terms
-    vDm = vQ + _col(ds) * i_k + _col(s * w) * j_k
-    aDm = aQ + _col(dds - s * w * w) * i_k + _col(s * e + 2.0 * ds * w) * j_k
+    vDm = vQ + geo.col(ds) * i_k + geo.col(s * w) * j_k
+    aDm = aQ + geo.col(dds - s * w * w) * i_k + geo.col(s * e + 2.0 * ds * w) * j_k
     sm = _state(angle, w.copy(), e.copy(), Dm, vDm, aDm, lm)
     sn = _state(_angle(i_n), wn, en, P, vP, aP, ln)
     return sm, sn, E, (s, ds, dds)
 
 
-def _rtr(K, vK, aK, P, vP, aP):
+def _rtr(
+    K: np.ndarray, vK: np.ndarray, aK: np.ndarray, P: np.ndarray, vP: np.ndarray, aP: np.ndarray
+):
     """RTR with the block n on the pin D_n = P (l_n = 0, E = P): link m pinned at
     D_m = K, its slot along i_m through P; l_m = |K P| varies. The block turns with m."""
     d, vd, ad = P - K, vP - vK, aP - aK
     L = _norm(d)
-    i_m = d / _col(L)
-    j_m = _rot90(i_m)
+    i_m = d / geo.col(L)
+    j_m = geo.rot90(i_m)
     # d = L i_m: vd = L' i_m + L w j_m; ad = (L'' - L w^2) i_m + (L eps + 2 L' w) j_m
-    Ld = _dot(vd, i_m)
-    w = _dot(vd, j_m) / L
-    Ldd = _dot(ad, i_m) + L * w * w
-    e = (_dot(ad, j_m) - 2.0 * Ld * w) / L
+    Ld = geo.dot(vd, i_m)
+    w = geo.dot(vd, j_m) / L
+    Ldd = geo.dot(ad, i_m) + L * w * w
+    e = (geo.dot(ad, j_m) - 2.0 * Ld * w) / L
     angle = _angle(i_m)
     sm = _state(angle, w, e, K, vK, aK, L, Ld, Ldd)
     sn = _state(angle.copy(), w.copy(), e.copy(), P, vP, aP, 0.0)
@@ -894,7 +1144,7 @@ def _rtr(K, vK, aK, P, vP, aP):
 # ---------------------------------------------------------------------------
 # loading
 # ---------------------------------------------------------------------------
-def load(name: str, data=None) -> Chain:
+def load(name: str, data: Mapping | None = None) -> Chain:
     """The chain ``name`` (one of :data:`NAMES`): its scene file plus its table of the
     packaged ``chains.toml``. ``data`` overrides that table key by key (nested tables
     merged): a mapping, either the whole document (with a table ``name``) or the
@@ -911,7 +1161,7 @@ def load(name: str, data=None) -> Chain:
         over = data[name] if name in data else data
         if not isinstance(over, Mapping):
             raise ValueError(f"data[{name!r}]: expected a table")
-        table = _merge(table, over)
+        table = geo.merge(table, over)
     with open(scene_path(name), "rb") as f:
         scene = tomllib.load(f)
     return Chain(name, scene, table)

@@ -1,7 +1,7 @@
 """A second FMI importer, independent of fmpy, over the harness's co-simulations.
 
 ``fmi-sim`` (the Rust crate of that name, its own FMI 2 and FMI 3 import layer) runs an
-FMU over the same co-simulation setup as :func:`dyadfmu.harness.simulate` (the grid, the
+FMU over the same co-simulation setup as :func:`dyadfmu.fmi.simulate.simulate` (the grid, the
 input signals, the parameters' start values); its outputs are compared with fmpy's row
 by row. ``fmutool -check`` (PyPI ``fmu-manipulation-toolbox``) checks the model
 description against the FMI XSD schema and the standard's semantic rules.
@@ -26,13 +26,19 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
+from .. import paths
+from ..fmi.simulate import CoSimSetup, setup_for, simulate
 from . import harness, scenes
-from .harness import CoSimSetup, build_dir
 
 DYADS = ("rrr", "rrt", "rtr", "trt", "rtt")
 #: The generic dyad FMUs run over the harness mechanism of their type.
-MECHANISM_OF = {"rrr": "four-bar", "rrt": "slider-crank", "rtr": "quick-return",
-                "trt": "trt-slot", "rtt": "scotch-yoke"}
+MECHANISM_OF = {
+    "rrr": "four-bar",
+    "rrt": "slider-crank",
+    "rtr": "quick-return",
+    "trt": "trt-slot",
+    "rtt": "scotch-yoke",
+}
 #: The tailored test FMUs (tests/scenes/tailored_<type>.toml) have the generic dyad's inputs.
 TAILORED = tuple(f"tailored_{d}" for d in DYADS)
 VERSIONS = (2, 3)
@@ -50,8 +56,11 @@ class ImporterError(RuntimeError):
 def fmi_sim_executable() -> str | None:
     """fmi-sim: $DYADFMU_FMI_SIM, else on PATH, else where cargo install puts it."""
     explicit = os.environ.get("DYADFMU_FMI_SIM")
-    candidates = [explicit] if explicit else [shutil.which("fmi-sim"),
-                                              str(Path.home() / ".cargo" / "bin" / "fmi-sim")]
+    candidates = (
+        [explicit]
+        if explicit
+        else [shutil.which("fmi-sim"), str(Path.home() / ".cargo" / "bin" / "fmi-sim")]
+    )
     for c in candidates:
         if c and os.path.isfile(c) and os.access(c, os.X_OK):
             return c
@@ -68,8 +77,9 @@ def fmutool_executable() -> str | None:
 
 def fmi_sim_version(executable: str) -> str:
     """The version fmi-sim reports (it prints `fmi-sim X.Y.Z` and exits 1 on --version)."""
-    done = subprocess.run([executable, "--version"], capture_output=True, text=True,
-                          env=_quiet_env())
+    done = subprocess.run(
+        [executable, "--version"], capture_output=True, text=True, env=_quiet_env()
+    )
     found = re.search(r"fmi-sim (\d+\.\d+\.\d+)", done.stdout + done.stderr)
     if not found:
         raise ImporterError(f"{executable} --version printed no version:\n{done.stderr}")
@@ -96,16 +106,17 @@ def drive_setup(version: int, build: Path | None = None) -> CoSimSetup:
     the parameters' start values. The step is a binary fraction (2^-8 s), so that
     t[n+1] - t[n], the step fmpy passes to doStep, is the step exactly, as fmi-sim's FMI 2
     co-simulation passes it: the drive integrates over the step it is given."""
-    path = (build or build_dir()) / "fmus" / f"drive_fmi{version}.fmu"
+    path = (build or paths.build_dir()) / "fmus" / f"drive_fmi{version}.fmu"
     t = np.linspace(0.0, 0.5, 129)
     phase = 2 * math.pi * t / 0.125
-    inputs = {"load.torque": -3.0 + 2.0 * np.sin(phase) - 0.5 * np.cos(2 * phase),
-              "load.inertia": 1e-3 * (1.0 + 0.4 * np.cos(phase))}
-    return harness.setup_for(path, t, inputs)
+    inputs = {
+        "load.torque": -3.0 + 2.0 * np.sin(phase) - 0.5 * np.cos(2 * phase),
+        "load.inertia": 1e-3 * (1.0 + 0.4 * np.cos(phase)),
+    }
+    return setup_for(path, t, inputs)
 
 
-def setup_of(name: str, version: int, build: Path | None = None, steps: int = 120
-             ) -> CoSimSetup:
+def setup_of(name: str, version: int, build: Path | None = None, steps: int = 120) -> CoSimSetup:
     """The harness's co-simulation of the FMU `name` (one crank revolution at `steps`
     communication steps): a generic dyad over the mechanism of its type, a tailored scene
     over its scene's kinematics, a tailored test FMU over the generic dyad's mechanism
@@ -113,13 +124,15 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
     if name == "drive":
         return drive_setup(version, build)
     if name.startswith("dyad_"):
-        return harness.scene_setup(MECHANISM_OF[name.removeprefix("dyad_")], version, 1.0, steps,
-                                   build=build)[0]
+        return harness.mechanism_setup(
+            MECHANISM_OF[name.removeprefix("dyad_")], version, 1.0, steps, build=build
+        )[0]
     if name in TAILORED:
-        generic = harness.scene_setup(MECHANISM_OF[name.removeprefix("tailored_")], version, 1.0, steps,
-                                      build=build)[0]
-        path = (build or build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
-        return harness.setup_for(path, generic.time, generic.inputs)
+        generic = harness.mechanism_setup(
+            MECHANISM_OF[name.removeprefix("tailored_")], version, 1.0, steps, build=build
+        )[0]
+        path = (build or paths.build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
+        return setup_for(path, generic.time, generic.inputs)
     return scenes.setup(name, version, 1.0, steps, build=build)[0]
 
 
@@ -162,7 +175,7 @@ def write_inputs(setup: CoSimSetup, path: Path, perturb: str | None = None) -> N
     with open(path, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["time"] + names)
-        for row in zip(*columns):
+        for row in zip(*columns, strict=False):
             writer.writerow([format(float(x), ".16e") for x in row])
 
 
@@ -184,8 +197,10 @@ def as_applied_by_fmi_sim(setup: CoSimSetup) -> CoSimSetup:
     """
     k = np.arange(len(setup.time))
     if not np.array_equal(setup.time[:-1], k[:-1] * setup.step):
-        raise ValueError(f"{setup.path.name}: the grid is not n * step, so fmi-sim's "
-                         "communication points fall between its samples")
+        raise ValueError(
+            f"{setup.path.name}: the grid is not n * step, so fmi-sim's "
+            "communication points fall between its samples"
+        )
     if _fmi_version(setup.path) == 3:
         return setup
     applied = {}
@@ -203,16 +218,29 @@ def _fmi_version(fmu: Path) -> int:
     return int(root.get("fmiVersion").split(".")[0])
 
 
-def fmi_sim(executable: str, model: Path, output: Path, stop: float, step: float,
-            inputs: Path | None = None, start_values: dict | None = None
-            ) -> subprocess.CompletedProcess:
+def fmi_sim(
+    executable: str,
+    model: Path,
+    output: Path,
+    stop: float,
+    step: float,
+    inputs: Path | None = None,
+    start_values: dict | None = None,
+) -> subprocess.CompletedProcess:
     """One fmi-sim co-simulation from 0 to `stop` with communication step `step` (it takes
     the step from --output-interval; --step it ignores), outputs written to `output`."""
     command = [executable, "--model", str(model), "-o", str(output)]
     if inputs is not None:
         command += ["-i", str(inputs)]
-    command += ["co-simulation", "-s", "0", "-f", repr(float(stop)),
-                "--output-interval", repr(float(step))]
+    command += [
+        "co-simulation",
+        "-s",
+        "0",
+        "-f",
+        repr(float(stop)),
+        "--output-interval",
+        repr(float(step)),
+    ]
     for name, value in (start_values or {}).items():
         command += ["--init-values", f"{name}={float(value)!r}"]
     done = subprocess.run(command, capture_output=True, text=True, env=_quiet_env())
@@ -220,8 +248,9 @@ def fmi_sim(executable: str, model: Path, output: Path, stop: float, step: float
     return done
 
 
-def run_fmi_sim(setup: CoSimSetup, workdir: Path, executable: str,
-                perturb: str | None = None) -> dict:
+def run_fmi_sim(
+    setup: CoSimSetup, workdir: Path, executable: str, perturb: str | None = None
+) -> dict:
     """Run fmi-sim's co-simulation over the setup; returns output name -> array, with
     "time" (fmi-sim 0.7.0 records outputs only: it accepts --print-all and ignores it)."""
     workdir.mkdir(parents=True, exist_ok=True)
@@ -229,15 +258,19 @@ def run_fmi_sim(setup: CoSimSetup, workdir: Path, executable: str,
     model = readable_copy(setup.path, workdir / f"{stem}.fmu")
     inputs, outputs = workdir / f"{stem}_in.csv", workdir / f"{stem}_out.csv"
     write_inputs(setup, inputs, perturb)
-    done = fmi_sim(executable, model, outputs, fmi_sim_stop(setup), setup.step, inputs,
-                   setup.start_values)
+    done = fmi_sim(
+        executable, model, outputs, fmi_sim_stop(setup), setup.step, inputs, setup.start_values
+    )
     if done.returncode != 0 or not outputs.is_file():
-        raise ImporterError(f"fmi-sim failed ({done.returncode}) on {setup.path.name}: "
-                            f"{' '.join(done.args)}\n{done.stderr.strip()}")
+        raise ImporterError(
+            f"fmi-sim failed ({done.returncode}) on {setup.path.name}: "
+            f"{' '.join(done.args)}\n{done.stderr.strip()}"
+        )
     return read_csv(outputs)
 
 
 def read_csv(path: Path) -> dict:
+    """The columns of a CSV file of fmi-sim by header name, as float arrays."""
     with open(path, newline="") as handle:
         rows = list(csv.reader(handle))
     header, body = rows[0], rows[1:]
@@ -250,35 +283,39 @@ def read_csv(path: Path) -> dict:
 @dataclass
 class Difference:
     """fmi-sim against fmpy over one FMU's co-simulation, over every output and row."""
+
     fmu: str
     rows: int
     outputs: int
-    max_abs: float          # largest |fmi-sim - fmpy|
-    max_relative: float     # largest |fmi-sim - fmpy| / peak |fmpy| of that output
-    max_ulps: float         # largest distance in units in the last place
-    worst: str              # the output with the largest relative difference
+    max_abs: float  # largest |fmi-sim - fmpy|
+    max_relative: float  # largest |fmi-sim - fmpy| / peak |fmpy| of that output
+    max_ulps: float  # largest distance in units in the last place
+    worst: str  # the output with the largest relative difference
     #: largest |fmi-sim - fmpy| / (eps a^2) over the amplification outputs a: an
     #: amplification divides by the outputs it measures, so it is itself known only to
     #: about eps x a relative, and a one-ulp change of an input moves it by that much.
     amplification_in_own_roundoff: float = 0.0
 
     def line(self) -> str:
-        return (f"{self.fmu}: {self.rows} rows x {self.outputs} outputs, max abs "
-                f"{self.max_abs:.2e}, max relative to peak {self.max_relative:.2e}, "
-                f"{self.max_ulps:.0f} ulps ({self.worst})")
+        """The difference as one line of text."""
+        return (
+            f"{self.fmu}: {self.rows} rows x {self.outputs} outputs, max abs "
+            f"{self.max_abs:.2e}, max relative to peak {self.max_relative:.2e}, "
+            f"{self.max_ulps:.0f} ulps ({self.worst})"
+        )
 
 
-def ulps(a, b) -> np.ndarray:
+def ulps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Distance between doubles in units in the last place: 0 where equal (+0 and -0
     too, NaN and NaN too), inf for NaN against a number."""
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
 
-    def ordered(x):        # the doubles' bit patterns as integers in the doubles' order
+    def ordered(x: np.ndarray):  # the doubles' bit patterns as integers in the doubles' order
         bits = x.view(np.int64).astype(object)
         return [(-(1 << 63) - v) if v < 0 else v for v in bits]
 
-    distance = np.array([float(abs(p - q)) for p, q in zip(ordered(a), ordered(b))])
+    distance = np.array([float(abs(p - q)) for p, q in zip(ordered(a), ordered(b), strict=False)])
     distance[np.isnan(a) & np.isnan(b)] = 0.0
     distance[np.isnan(a) ^ np.isnan(b)] = math.inf
     return distance
@@ -288,8 +325,10 @@ def compare(setup: CoSimSetup, fmpy_run: dict, fmi_sim_run: dict) -> Difference:
     """Row by row over the same communication points, every output of the setup."""
     name = setup.path.stem
     if len(fmpy_run["time"]) != len(fmi_sim_run["time"]):
-        raise AssertionError(f"{name}: fmpy recorded {len(fmpy_run['time'])} rows, fmi-sim "
-                             f"{len(fmi_sim_run['time'])}")
+        raise AssertionError(
+            f"{name}: fmpy recorded {len(fmpy_run['time'])} rows, fmi-sim "
+            f"{len(fmi_sim_run['time'])}"
+        )
     if not np.array_equal(fmpy_run["time"], fmi_sim_run["time"]):
         raise AssertionError(f"{name}: the communication points differ")
     missing = [n for n in setup.outputs if n not in fmi_sim_run]
@@ -315,8 +354,9 @@ def compare(setup: CoSimSetup, fmpy_run: dict, fmi_sim_run: dict) -> Difference:
         if rel > max_rel:
             max_rel, worst = rel, out
         max_abs = max(max_abs, biggest)
-    return Difference(name, len(fmpy_run["time"]), len(setup.outputs), max_abs, max_rel,
-                      max_ulp, worst, max_amp)
+    return Difference(
+        name, len(fmpy_run["time"]), len(setup.outputs), max_abs, max_rel, max_ulp, worst, max_amp
+    )
 
 
 EPS = float(np.finfo(np.float64).eps)
@@ -331,41 +371,49 @@ def is_amplification(output: str) -> bool:
 def fmutool_check(fmu: Path, executable: str) -> subprocess.CompletedProcess:
     """fmutool -check on one FMU: exit 0 when the model description validates against the
     FMI XSD schema of its version and breaks none of the standard's semantic rules."""
-    return subprocess.run([executable, "-input", str(fmu), "-check"], capture_output=True,
-                          text=True)
+    return subprocess.run(
+        [executable, "-input", str(fmu), "-check"], capture_output=True, text=True
+    )
 
 
 # ---------------------------------------------------------------------------
-# The table of the README: python -m dyadfmu.importers
+# The table of the README: python -m dyadfmu.cosim.importers
 # ---------------------------------------------------------------------------
 def table(workdir: Path, executable: str) -> list[str]:
     """fmi-sim against fmpy for every FMU the build makes, as Markdown rows: over the
     harness's signals, and with the same input values applied."""
-    rows = ["| FMU | FMI | rows x outputs | max abs | max relative to peak "
-            "| amplification / (eps a^2) | same inputs |",
-            "|---|---|---|---|---|---|---|"]
+    rows = [
+        "| FMU | FMI | rows x outputs | max abs | max relative to peak "
+        "| amplification / (eps a^2) | same inputs |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for name in fmu_names():
         for version in VERSIONS:
             setup = setup_of(name, version)
             other = run_fmi_sim(setup, workdir, executable)
-            raw = compare(setup, harness.simulate(setup), other)
+            raw = compare(setup, simulate(setup), other)
             same = as_applied_by_fmi_sim(setup)
-            exact = compare(same, harness.simulate(same), other)
-            rows.append(f"| {name} | {version} | {raw.rows} x {raw.outputs} | "
-                        f"{raw.max_abs:.1e} | {raw.max_relative:.1e} | "
-                        f"{raw.amplification_in_own_roundoff:.2g} | "
-                        + ("bit-identical" if exact.max_ulps == 0
-                           else f"{exact.max_ulps:.0f} ulps") + " |")
+            exact = compare(same, simulate(same), other)
+            rows.append(
+                f"| {name} | {version} | {raw.rows} x {raw.outputs} | "
+                f"{raw.max_abs:.1e} | {raw.max_relative:.1e} | "
+                f"{raw.amplification_in_own_roundoff:.2g} | "
+                + ("bit-identical" if exact.max_ulps == 0 else f"{exact.max_ulps:.0f} ulps")
+                + " |"
+            )
     return rows
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
+    """Print the table of every FMU through fmi-sim against fmpy and fmutool -check."""
     import argparse
     import tempfile
+
     parser = argparse.ArgumentParser(
-        prog="python -m dyadfmu.importers",
+        prog="python -m dyadfmu.cosim.importers",
         description="fmi-sim against fmpy over the harness's co-simulation of every FMU of "
-                    "the build (DYADFMU_BUILD, default build/): a Markdown table")
+        "the build (DYADFMU_BUILD, default build/): a Markdown table",
+    )
     parser.parse_args(argv)
     executable = fmi_sim_executable()
     if executable is None:

@@ -15,14 +15,19 @@ frame on the crank at O follow directly.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
+from .geometry import cross
 
-def _cross(a, b):
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+if TYPE_CHECKING:
+    from .builtin import Mechanism
 
 
-def balance(mechanism, kin: dict, r_np: np.ndarray, m_np: np.ndarray | None = None) -> dict:
+def balance(
+    mechanism: Mechanism, kin: dict, r_np: np.ndarray, m_np: np.ndarray | None = None
+) -> dict:
     """Driving torque and pivot reaction of the crank over the samples of `kin`.
 
     r_np: (N, 2) force on the dyad's link n from the crank at D_n (N);
@@ -35,31 +40,42 @@ def balance(mechanism, kin: dict, r_np: np.ndarray, m_np: np.ndarray | None = No
     crank = mechanism.crank
     weight_and_inertia = crank["mass"] * (np.asarray(mechanism.gravity) - kin["a_S_c"])
     r_o = r_np - weight_and_inertia
-    torque = -(_cross(kin["D_n"] - kin["O"], -r_np) - m_np
-               + _cross(kin["S_c"] - kin["O"], weight_and_inertia)
-               - crank["inertia"] * kin["crank.epsilon"])
+    torque = -(
+        cross(kin["D_n"] - kin["O"], -r_np)
+        - m_np
+        + cross(kin["S_c"] - kin["O"], weight_and_inertia)
+        - crank["inertia"] * kin["crank.epsilon"]
+    )
     return {"torque": torque, "R_O": r_o}
 
 
-def kinetic_energy(mechanism, kin: dict) -> np.ndarray:
+def kinetic_energy(mechanism: Mechanism, kin: dict) -> np.ndarray:
     """Kinetic energy (J) of crank and both dyad links."""
     params = mechanism.fmu_parameters()
     crank = mechanism.crank
-    energy = 0.5 * crank["mass"] * np.sum(kin["v_S_c"] ** 2, axis=-1) \
+    energy = (
+        0.5 * crank["mass"] * np.sum(kin["v_S_c"] ** 2, axis=-1)
         + 0.5 * crank["inertia"] * kin["crank.omega"] ** 2
+    )
     for g in ("m", "n"):
-        energy = energy + 0.5 * params[f"link_{g}.mass"] * np.sum(kin[f"v_S_{g}"] ** 2, axis=-1) \
+        energy = (
+            energy
+            + 0.5 * params[f"link_{g}.mass"] * np.sum(kin[f"v_S_{g}"] ** 2, axis=-1)
             + 0.5 * params[f"link_{g}.inertia"] * kin[f"{g}.omega"] ** 2
+        )
     return energy
 
 
-def load_power(mechanism, kin: dict) -> np.ndarray:
+def load_power(mechanism: Mechanism, kin: dict) -> np.ndarray:
     """Power (W) of the active loads and of gravity on crank and links."""
     params = mechanism.fmu_parameters()
     g = np.asarray(mechanism.gravity)
     power = mechanism.crank["mass"] * kin["v_S_c"] @ g
     for link in ("m", "n"):
-        power = power + np.sum(kin[f"{link}.force"] * kin[f"v_S_{link}"], axis=-1) \
-            + kin[f"{link}.moment"] * kin[f"{link}.omega"] \
+        power = (
+            power
+            + np.sum(kin[f"{link}.force"] * kin[f"v_S_{link}"], axis=-1)
+            + kin[f"{link}.moment"] * kin[f"{link}.omega"]
             + params[f"link_{link}.mass"] * kin[f"v_S_{link}"] @ g
+        )
     return power

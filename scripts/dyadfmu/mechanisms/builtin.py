@@ -1,5 +1,5 @@
 """Five class II planar mechanisms, each a crank plus one Assur dyad, with closed-form
-kinematics and active loads, ready for the dyad FMUs and for :mod:`dyadfmu.reference`.
+kinematics and active loads, ready for the dyad FMUs and for :mod:`dyadfmu.reference.newton_euler`.
 
 ============  =====  ========================================================
 name          dyad   mechanism
@@ -59,16 +59,15 @@ from __future__ import annotations
 import copy
 import math
 import os
-from dataclasses import dataclass
+import tomllib
+from collections.abc import Mapping
 from importlib import resources
-from typing import Callable, Mapping
 
 import numpy as np
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
-    import tomli as tomllib
+from . import geometry as geo
+from . import motion as motion_
+from .motion import CrankMotion
 
 __all__ = ["NAMES", "CrankMotion", "Mechanism", "load", "default_data"]
 
@@ -76,8 +75,13 @@ __all__ = ["NAMES", "CrankMotion", "Mechanism", "load", "default_data"]
 NAMES = ("slider-crank", "four-bar", "quick-return", "scotch-yoke", "trt-slot")
 
 #: Dyad type of each mechanism.
-DYADS = {"slider-crank": "RRT", "four-bar": "RRR", "quick-return": "RTR",
-         "scotch-yoke": "RTT", "trt-slot": "TRT"}
+DYADS = {
+    "slider-crank": "RRT",
+    "four-bar": "RRR",
+    "quick-return": "RTR",
+    "scotch-yoke": "RTT",
+    "trt-slot": "TRT",
+}
 
 #: Types whose link m has a sliding length (an FMU input rather than a parameter).
 _SLIDING_M = ("RTR", "RTT")
@@ -87,151 +91,12 @@ _GUIDE_P = ("TRT",)
 
 
 # ---------------------------------------------------------------------------
-# vector helpers on arrays of shape (..., 2)
-# ---------------------------------------------------------------------------
-def _unit(angle):
-    angle = np.asarray(angle, dtype=float)
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
-
-
-def _rot90(v):
-    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
-
-
-def _dot(a, b):
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
-
-
-def _cross(a, b):
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
-def _col(x):
-    return np.asarray(x, dtype=float)[..., None]
-
-
-def _vec(x, y):
-    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-    return np.stack([x, y], axis=-1)
-
-
-# ---------------------------------------------------------------------------
-# crank motion
-# ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class CrankMotion:
-    """A crank motion: phi(t) [rad], omega(t) [rad/s], epsilon(t) [rad/s2] as vectorised
-    callables, consistent with each other in closed form, and ``duration`` [s] covering
-    the requested number of revolutions (or oscillation cycles)."""
-
-    kind: str
-    phi: Callable[[np.ndarray], np.ndarray]
-    omega: Callable[[np.ndarray], np.ndarray]
-    epsilon: Callable[[np.ndarray], np.ndarray]
-    duration: float
-    cycles: float
-    description: str = ""
-
-
-def _rotating(kind, w0, variation, phi0, revolutions):
-    """Full rotation. constant: phi = phi0 + w0 t. varying: omega = w0 (1 + a sin(w0 t)),
-    phi = phi0 + w0 t + a (1 - cos(w0 t)), epsilon = a w0^2 cos(w0 t)."""
-    a = variation if kind == "varying" else 0.0
-
-    def phi(t):
-        t = np.asarray(t, dtype=float)
-        return phi0 + w0 * t + a * (1.0 - np.cos(w0 * t))
-
-    def omega(t):
-        t = np.asarray(t, dtype=float)
-        return w0 * (1.0 + a * np.sin(w0 * t))
-
-    def epsilon(t):
-        t = np.asarray(t, dtype=float)
-        return a * w0 * w0 * np.cos(w0 * t)
-
-    # duration: phi(T) - phi0 = 2 pi N; exact for integer N, Newton otherwise
-    # (the left side increases strictly since |a| < 1)
-    target = 2.0 * math.pi * revolutions
-    x = target                                       # x = w0 T
-    for _ in range(60):
-        f = x + a * (1.0 - math.cos(x)) - target
-        x_new = x - f / (1.0 + a * math.sin(x))
-        if abs(x_new - x) <= 1e-15 * max(1.0, abs(x)):
-            x = x_new
-            break
-        x = x_new
-    text = (f"constant speed {w0:.6g} rad/s" if a == 0.0 else
-            f"omega = {w0:.6g} (1 + {a:g} sin({w0:.6g} t)) rad/s")
-    return CrankMotion(kind, phi, omega, epsilon, x / w0, float(revolutions), text)
-
-
-def _oscillating(kind, w, centre, amplitude, harmonic2, cycles):
-    """Oscillation phi = centre + A1 sin(w t) + A2 sin(2 w t) (A2 = 0 for kind constant)."""
-    a2 = harmonic2 if kind == "varying" else 0.0
-
-    def phi(t):
-        t = np.asarray(t, dtype=float)
-        return centre + amplitude * np.sin(w * t) + a2 * np.sin(2.0 * w * t)
-
-    def omega(t):
-        t = np.asarray(t, dtype=float)
-        return amplitude * w * np.cos(w * t) + 2.0 * a2 * w * np.cos(2.0 * w * t)
-
-    def epsilon(t):
-        t = np.asarray(t, dtype=float)
-        return -amplitude * w * w * np.sin(w * t) - 4.0 * a2 * w * w * np.sin(2.0 * w * t)
-
-    text = f"phi = {centre:.4g} + {amplitude:g} sin({w:.6g} t)" + \
-        (f" + {a2:g} sin({2 * w:.6g} t)" if a2 else "") + " rad"
-    return CrankMotion(kind, phi, omega, epsilon, cycles * 2.0 * math.pi / w, float(cycles), text)
-
-
-# ---------------------------------------------------------------------------
 # data
 # ---------------------------------------------------------------------------
 def default_data() -> dict:
     """The packaged ``mechanisms.toml`` as a dict (a fresh copy)."""
     text = resources.files(__package__ or "dyadfmu").joinpath("mechanisms.toml").read_text("utf-8")
     return tomllib.loads(text)
-
-
-def _merge(base, over):
-    out = copy.deepcopy(base)
-    for key, value in over.items():
-        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
-            out[key] = _merge(out[key], value)
-        else:
-            out[key] = copy.deepcopy(value)
-    return out
-
-
-def _number(table, key, where, positive=False, nonnegative=False, default=None):
-    if key not in table:
-        if default is not None:
-            return float(default)
-        raise ValueError(f"{where}: missing key {key!r}")
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"{where}.{key}: expected a finite number, got {value!r}")
-    if positive and value <= 0:
-        raise ValueError(f"{where}.{key}: must be > 0, got {value!r}")
-    if nonnegative and value < 0:
-        raise ValueError(f"{where}.{key}: must be >= 0, got {value!r}")
-    return float(value)
-
-
-def _pair(table, key, where):
-    value = table.get(key)
-    if value is None:
-        raise ValueError(f"{where}: missing key {key!r}")
-    try:
-        x, y = (float(c) for c in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{where}.{key}: expected two numbers, got {value!r}") from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise ValueError(f"{where}.{key}: expected finite numbers, got {value!r}")
-    return (x, y)
 
 
 # ---------------------------------------------------------------------------
@@ -259,24 +124,28 @@ class Mechanism:
         if dyad != self.dyad:
             raise ValueError(f"{where}.dyad: the mechanism is an {self.dyad} dyad, got {dyad!r}")
         self.description = str(table.get("description", name))
-        self.gravity = _pair(table, "gravity", where) if "gravity" in table else (0.0, -9.81)
+        self.gravity = geo.pair(table, "gravity", where) if "gravity" in table else (0.0, -9.81)
         crank = table.get("crank", {})
-        self.crank = {"radius": _number(crank, "radius", f"{where}.crank", positive=True),
-                      "mass": _number(crank, "mass", f"{where}.crank", nonnegative=True),
-                      "inertia": _number(crank, "inertia", f"{where}.crank", nonnegative=True),
-                      "com": _pair(crank, "com", f"{where}.crank")}
+        self.crank = {
+            "radius": geo.number(crank, "radius", f"{where}.crank", positive=True),
+            "mass": geo.number(crank, "mass", f"{where}.crank", nonnegative=True),
+            "inertia": geo.number(crank, "inertia", f"{where}.crank", nonnegative=True),
+            "com": geo.pair(crank, "com", f"{where}.crank"),
+        }
         self.links = {}
         for g in ("m", "n"):
             lt = table.get(f"link_{g}", {})
             w = f"{where}.link_{g}"
-            link = {"mass": _number(lt, "mass", w, nonnegative=True),
-                    "inertia": _number(lt, "inertia", w, nonnegative=True),
-                    "com": _pair(lt, "com", w)}
+            link = {
+                "mass": geo.number(lt, "mass", w, nonnegative=True),
+                "inertia": geo.number(lt, "inertia", w, nonnegative=True),
+                "com": geo.pair(lt, "com", w),
+            }
             fixed = self._fixed_lengths().get(g)
             if fixed is not None:
                 link["length"] = fixed
             elif self._constant_length[g]:
-                link["length"] = _number(lt, "length", w, positive=True)
+                link["length"] = geo.number(lt, "length", w, positive=True)
             self.links[g] = link
         self.geometry = dict(table.get("geometry", {}))
         self.load_data = dict(table.get("load", {}))
@@ -289,13 +158,21 @@ class Mechanism:
         """Lengths fixed at 0 by the mechanism's construction."""
         return {}
 
-    def _setup(self, where):  # pragma: no cover - overridden
+    def _setup(self, where: str):  # pragma: no cover - overridden
         raise NotImplementedError
 
-    def _dyad_kinematics(self, phi, w, eps, A, vA, aA) -> dict:  # pragma: no cover
+    def _dyad_kinematics(
+        self,
+        phi: np.ndarray,
+        w: np.ndarray,
+        eps: np.ndarray,
+        A: np.ndarray,
+        vA: np.ndarray,
+        aA: np.ndarray,
+    ) -> dict:  # pragma: no cover
         raise NotImplementedError
 
-    def _loads(self, kin) -> dict:  # pragma: no cover
+    def _loads(self, kin: dict) -> dict:  # pragma: no cover
         raise NotImplementedError
 
     # ---- motion -----------------------------------------------------------
@@ -308,18 +185,22 @@ class Mechanism:
         if not (revolutions > 0 and math.isfinite(revolutions)):
             raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
         md, w = self._motion_data, f"{self.name}.motion"
-        return _rotating(kind, _number(md, "omega", w, positive=True),
-                         _number(md, "variation", w) if "variation" in md else 0.3,
-                         _number(md, "phi0", w) if "phi0" in md else 0.0, revolutions)
+        return motion_.rotating(
+            kind,
+            geo.number(md, "omega", w, positive=True),
+            geo.number(md, "variation", w) if "variation" in md else 0.3,
+            geo.number(md, "phi0", w) if "phi0" in md else 0.0,
+            revolutions,
+        )
 
-    def _check_motion(self, where):
+    def _check_motion(self, where: str):
         variation = self._motion_data.get("variation", 0.3)
         if not (isinstance(variation, (int, float)) and 0 <= variation < 1):
             raise ValueError(f"{where}.motion.variation: must be in [0, 1), got {variation!r}")
         self.motion("constant", 1.0)
 
     # ---- kinematics -------------------------------------------------------
-    def kinematics(self, t, motion: CrankMotion) -> dict:
+    def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
         """Positions, velocities, accelerations and active loads at the times ``t`` (N,).
 
         Keys (arrays over the N samples; points and vectors (N, 2), scalars (N,)):
@@ -340,68 +221,91 @@ class Mechanism:
         w = np.broadcast_to(motion.omega(t), t.shape).astype(float)
         eps = np.broadcast_to(motion.epsilon(t), t.shape).astype(float)
         r = self.crank["radius"]
-        i_c = _unit(phi)
-        j_c = _rot90(i_c)
+        i_c = geo.unit(phi)
+        j_c = geo.rot90(i_c)
         A = r * i_c
-        vA = r * _col(w) * j_c
-        aA = r * _col(eps) * j_c - r * _col(w * w) * i_c
+        vA = r * geo.col(w) * j_c
+        aA = r * geo.col(eps) * j_c - r * geo.col(w * w) * i_c
 
-        kin = {"t": t, "crank.angle": phi, "crank.omega": w, "crank.epsilon": eps,
-               "O": np.zeros_like(A), "A": A, "v_A": vA, "a_A": aA}
+        kin = {
+            "t": t,
+            "crank.angle": phi,
+            "crank.omega": w,
+            "crank.epsilon": eps,
+            "O": np.zeros_like(A),
+            "A": A,
+            "v_A": vA,
+            "a_A": aA,
+        }
         kin.update(self._dyad_kinematics(phi, w, eps, A, vA, aA))
 
-        # the geometric point E from link m: E = D_m + l_m i_m
-        i_m = _unit(kin["m.angle"])
-        j_m = _rot90(i_m)
-        lm, dlm, ddlm = kin["m.length"], kin["m.length_rate"], kin["m.length_accel"]
-        wm, em = kin["m.omega"], kin["m.epsilon"]
-        kin["E"] = kin["D_m"] + _col(lm) * i_m
-        kin["v_E"] = kin["v_D_m"] + _col(dlm) * i_m + _col(lm * wm) * j_m
-        kin["a_E"] = (kin["m.accel_d"] + _col(ddlm - lm * wm * wm) * i_m
-                      + _col(lm * em + 2.0 * dlm * wm) * j_m)
-
-        # centres of mass: rigid-body relations from D_g (fixed in link g)
-        for g in ("m", "n"):
-            i_g = _unit(kin[f"{g}.angle"])
-            x_s, y_s = self.links[g]["com"]
-            rel = x_s * i_g + y_s * _rot90(i_g)
-            wg, eg = _col(kin[f"{g}.omega"]), _col(kin[f"{g}.epsilon"])
-            kin[f"S_{g}"] = kin[f"D_{g}"] + rel
-            kin[f"v_S_{g}"] = kin[f"v_D_{g}"] + wg * _rot90(rel)
-            kin[f"a_S_{g}"] = kin[f"{g}.accel_d"] + eg * _rot90(rel) - wg * wg * rel
-        x_c, y_c = self.crank["com"]
-        rel = x_c * i_c + y_c * j_c
-        kin["S_c"] = rel
-        kin["v_S_c"] = _col(w) * _rot90(rel)
-        kin["a_S_c"] = _col(eps) * _rot90(rel) - _col(w * w) * rel
-
+        self._point_e(kin)
+        self._centres_of_mass(kin, w, eps)
         kin.update(self._loads(kin))
         kin["conditioning"] = self.conditioning(kin)
-        kin["frame"] = self._frame()
+        kin["frame"] = self.frame()
         kin["mechanism"] = self.name
         return kin
 
-    def _frame(self) -> dict:
+    @staticmethod
+    def _point_e(kin: dict) -> None:
+        """The geometric point E from link m, with its velocity and acceleration."""
+        # the geometric point E from link m: E = D_m + l_m i_m
+        i_m = geo.unit(kin["m.angle"])
+        j_m = geo.rot90(i_m)
+        lm, dlm, ddlm = kin["m.length"], kin["m.length_rate"], kin["m.length_accel"]
+        wm, em = kin["m.omega"], kin["m.epsilon"]
+        kin["E"] = kin["D_m"] + geo.col(lm) * i_m
+        kin["v_E"] = kin["v_D_m"] + geo.col(dlm) * i_m + geo.col(lm * wm) * j_m
+        kin["a_E"] = (
+            kin["m.accel_d"]
+            + geo.col(ddlm - lm * wm * wm) * i_m
+            + geo.col(lm * em + 2.0 * dlm * wm) * j_m
+        )
+
+    def _centres_of_mass(self, kin: dict, w: np.ndarray, eps: np.ndarray) -> None:
+        """The centres of mass of m, n and the crank, with their velocities and
+        accelerations."""
+        i_c = geo.unit(kin["crank.angle"])
+        j_c = geo.rot90(i_c)
+        # centres of mass: rigid-body relations from D_g (fixed in link g)
+        for g in ("m", "n"):
+            i_g = geo.unit(kin[f"{g}.angle"])
+            x_s, y_s = self.links[g]["com"]
+            rel = x_s * i_g + y_s * geo.rot90(i_g)
+            wg, eg = geo.col(kin[f"{g}.omega"]), geo.col(kin[f"{g}.epsilon"])
+            kin[f"S_{g}"] = kin[f"D_{g}"] + rel
+            kin[f"v_S_{g}"] = kin[f"v_D_{g}"] + wg * geo.rot90(rel)
+            kin[f"a_S_{g}"] = kin[f"{g}.accel_d"] + eg * geo.rot90(rel) - wg * wg * rel
+        x_c, y_c = self.crank["com"]
+        rel = x_c * i_c + y_c * j_c
+        kin["S_c"] = rel
+        kin["v_S_c"] = geo.col(w) * geo.rot90(rel)
+        kin["a_S_c"] = geo.col(eps) * geo.rot90(rel) - geo.col(w * w) * rel
+
+    def frame(self) -> dict:
         """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))}."""
         return {"pivots": {"O": (0.0, 0.0)}, "guides": {}}
 
-    def conditioning(self, kin) -> np.ndarray:
+    def conditioning(self, kin: dict) -> np.ndarray:
         """The dyad's conditioning per sample, as the C core computes it (README)."""
-        i_m, i_n = _unit(kin["m.angle"]), _unit(kin["n.angle"])
+        i_m, i_n = geo.unit(kin["m.angle"]), geo.unit(kin["n.angle"])
         if self.dyad == "RRR":
-            return np.abs(_dot(i_m, _rot90(i_n)))
+            return np.abs(geo.dot(i_m, geo.rot90(i_n)))
         if self.dyad == "RRT":
-            return np.abs(_dot(i_n, _unit(kin["guide_k.angle"])))
+            return np.abs(geo.dot(i_n, geo.unit(kin["guide_k.angle"])))
         if self.dyad == "RTR":
             lm, ln = kin["m.length"], kin["n.length"]
             d = kin["D_n"] - kin["D_m"]
             dist = np.hypot(d[:, 0], d[:, 1])
-            i_beta = d / _col(np.where(dist > 0, dist, 1.0))
-            c = np.abs(_dot(i_beta, i_m))
+            i_beta = d / geo.col(np.where(dist > 0, dist, 1.0))
+            c = np.abs(geo.dot(i_beta, i_m))
             return np.minimum(c, np.minimum(1.0, dist / (lm + ln)))
         if self.dyad == "TRT":
-            return np.abs(_dot(_rot90(_unit(kin["guide_k.angle"])), _unit(kin["guide_p.angle"])))
-        return np.abs(_dot(_rot90(_unit(kin["guide_k.angle"])), i_m))      # RTT
+            return np.abs(
+                geo.dot(geo.rot90(geo.unit(kin["guide_k.angle"])), geo.unit(kin["guide_p.angle"]))
+            )
+        return np.abs(geo.dot(geo.rot90(geo.unit(kin["guide_k.angle"])), i_m))  # RTT
 
     # ---- FMU and reference ------------------------------------------------
     def fmu_parameters(self) -> dict:
@@ -417,7 +321,7 @@ class Mechanism:
         p["gravity.x"], p["gravity.y"] = (float(c) for c in self.gravity)
         return p
 
-    def fmu_inputs(self, kin) -> dict:
+    def fmu_inputs(self, kin: dict) -> dict:
         """The FMU's inputs as arrays (N,): name -> values, in the table's order."""
         u = {}
         for g in ("m", "n"):
@@ -437,40 +341,61 @@ class Mechanism:
             u["guide_p.angle"] = np.asarray(kin["guide_p.angle"], dtype=float)
         return u
 
-    def reference_inputs(self, kin):
+    def reference_inputs(self, kin: dict) -> tuple:
         """``(m, n, guide_k, guide_p, gravity)`` for ``reference.solve(dyad, ...)``, batched
         over the samples (a guide is None where the type has none)."""
         links = []
         for g in ("m", "n"):
             link = self.links[g]
-            links.append({"dir": _unit(kin[f"{g}.angle"]),
-                          "length": np.asarray(kin[f"{g}.length"], dtype=float),
-                          "omega": np.asarray(kin[f"{g}.omega"], dtype=float),
-                          "epsilon": np.asarray(kin[f"{g}.epsilon"], dtype=float),
-                          "accel_d": np.asarray(kin[f"{g}.accel_d"], dtype=float),
-                          "com": tuple(link["com"]), "mass": link["mass"],
-                          "inertia": link["inertia"],
-                          "force": np.asarray(kin[f"{g}.force"], dtype=float),
-                          "moment": np.asarray(kin[f"{g}.moment"], dtype=float)})
-        gk = _unit(kin["guide_k.angle"]) if self.dyad in _GUIDE_K else None
-        gp = _unit(kin["guide_p.angle"]) if self.dyad in _GUIDE_P else None
+            links.append(
+                {
+                    "dir": geo.unit(kin[f"{g}.angle"]),
+                    "length": np.asarray(kin[f"{g}.length"], dtype=float),
+                    "omega": np.asarray(kin[f"{g}.omega"], dtype=float),
+                    "epsilon": np.asarray(kin[f"{g}.epsilon"], dtype=float),
+                    "accel_d": np.asarray(kin[f"{g}.accel_d"], dtype=float),
+                    "com": tuple(link["com"]),
+                    "mass": link["mass"],
+                    "inertia": link["inertia"],
+                    "force": np.asarray(kin[f"{g}.force"], dtype=float),
+                    "moment": np.asarray(kin[f"{g}.moment"], dtype=float),
+                }
+            )
+        gk = geo.unit(kin["guide_k.angle"]) if self.dyad in _GUIDE_K else None
+        gp = geo.unit(kin["guide_p.angle"]) if self.dyad in _GUIDE_P else None
         return links[0], links[1], gk, gp, tuple(self.gravity)
 
     def __repr__(self):
         return f"<Mechanism {self.name} ({self.dyad})>"
 
 
-def _link(prefix, angle, omega, epsilon, length, rate=None, accel=None):
+def _link(
+    prefix: str,
+    angle: np.ndarray,
+    omega: np.ndarray,
+    epsilon: np.ndarray,
+    length: np.ndarray | float,
+    rate: np.ndarray | None = None,
+    accel: np.ndarray | None = None,
+):
     """Per-link entries; rate/accel of the length default to 0 (constant length)."""
     n = np.shape(angle)
-    return {f"{prefix}.angle": np.broadcast_to(np.asarray(angle, dtype=float), n).copy(),
-            f"{prefix}.omega": np.broadcast_to(np.asarray(omega, dtype=float), n).copy(),
-            f"{prefix}.epsilon": np.broadcast_to(np.asarray(epsilon, dtype=float), n).copy(),
-            f"{prefix}.length": np.broadcast_to(np.asarray(length, dtype=float), n).copy(),
-            f"{prefix}.length_rate": (np.zeros(n) if rate is None
-                                      else np.broadcast_to(np.asarray(rate, dtype=float), n).copy()),
-            f"{prefix}.length_accel": (np.zeros(n) if accel is None
-                                       else np.broadcast_to(np.asarray(accel, dtype=float), n).copy())}
+    return {
+        f"{prefix}.angle": np.broadcast_to(np.asarray(angle, dtype=float), n).copy(),
+        f"{prefix}.omega": np.broadcast_to(np.asarray(omega, dtype=float), n).copy(),
+        f"{prefix}.epsilon": np.broadcast_to(np.asarray(epsilon, dtype=float), n).copy(),
+        f"{prefix}.length": np.broadcast_to(np.asarray(length, dtype=float), n).copy(),
+        f"{prefix}.length_rate": (
+            np.zeros(n)
+            if rate is None
+            else np.broadcast_to(np.asarray(rate, dtype=float), n).copy()
+        ),
+        f"{prefix}.length_accel": (
+            np.zeros(n)
+            if accel is None
+            else np.broadcast_to(np.asarray(accel, dtype=float), n).copy()
+        ),
+    }
 
 
 class SliderCrank(Mechanism):
@@ -483,58 +408,77 @@ class SliderCrank(Mechanism):
     def _fixed_lengths(self):
         return {"m": 0.0}
 
-    def _setup(self, where):
-        self.e = _number(self.geometry, "offset", f"{where}.geometry")
+    def _setup(self, where: str):
+        self.e = geo.number(self.geometry, "offset", f"{where}.geometry")
         self.l = self.links["n"]["length"]
         r = self.crank["radius"]
         if not self.l > r + abs(self.e):
-            raise ValueError(f"{where}: the rod ({self.l} m) must be longer than crank radius "
-                             f"+ |offset| ({r + abs(self.e)} m) for the crank to turn round")
+            raise ValueError(
+                f"{where}: the rod ({self.l} m) must be longer than crank radius "
+                f"+ |offset| ({r + abs(self.e)} m) for the crank to turn round"
+            )
         ld, w = self.load_data, f"{where}.load"
-        self.area = math.pi * _number(ld, "bore", w, positive=True) ** 2 / 4.0
-        self.p_peak = _number(ld, "p_peak", w)
-        self.p_base = _number(ld, "p_base", w)
-        self.psi_peak = _number(ld, "psi_peak", w)
-        self.kappa = _number(ld, "kappa", w, nonnegative=True)
+        self.area = math.pi * geo.number(ld, "bore", w, positive=True) ** 2 / 4.0
+        self.p_peak = geo.number(ld, "p_peak", w)
+        self.p_base = geo.number(ld, "p_base", w)
+        self.psi_peak = geo.number(ld, "psi_peak", w)
+        self.kappa = geo.number(ld, "kappa", w, nonnegative=True)
         #: crank angle of top dead centre (crank and rod in line, piston farthest out)
         self.phi_tdc = math.asin(self.e / (self.l + r))
 
-    def gas_force(self, phi):
+    def gas_force(self, phi: np.ndarray):
         """Magnitude [N] of the gas force on the piston (it acts along -x)."""
         psi = np.asarray(phi, dtype=float) - self.phi_tdc - self.psi_peak
         pulse = np.exp(self.kappa * (np.cos(psi) - 1.0))
         return self.area * (self.p_base + (self.p_peak - self.p_base) * pulse)
 
-    def _dyad_kinematics(self, phi, w, eps, A, vA, aA):
-        l, e = self.l, self.e
-        sn = (e - A[:, 1]) / l                      # E_y = e = A_y + l sin(theta_n)
-        cn = np.sqrt(1.0 - sn * sn)                 # piston to the right of the crank pin
+    def _dyad_kinematics(
+        self,
+        phi: np.ndarray,
+        w: np.ndarray,
+        eps: np.ndarray,
+        A: np.ndarray,
+        vA: np.ndarray,
+        aA: np.ndarray,
+    ):
+        rod, e = self.l, self.e
+        sn = (e - A[:, 1]) / rod  # E_y = e = A_y + rod sin(theta_n)
+        cn = np.sqrt(1.0 - sn * sn)  # piston to the right of the crank pin
         tn = np.arctan2(sn, cn)
-        wn = -vA[:, 1] / (l * cn)
-        en = (l * wn * wn * sn - aA[:, 1]) / (l * cn)
-        B = _vec(A[:, 0] + l * cn, np.full_like(cn, e))
-        vB = _vec(vA[:, 0] - l * wn * sn, 0.0)
-        aB = _vec(aA[:, 0] - l * en * sn - l * wn * wn * cn, 0.0)
+        wn = -vA[:, 1] / (rod * cn)
+        en = (rod * wn * wn * sn - aA[:, 1]) / (rod * cn)
+        B = geo.vec(A[:, 0] + rod * cn, np.full_like(cn, e))
+        vB = geo.vec(vA[:, 0] - rod * wn * sn, 0.0)
+        aB = geo.vec(aA[:, 0] - rod * en * sn - rod * wn * wn * cn, 0.0)
         zero = np.zeros_like(phi)
-        out = {"D_m": B, "v_D_m": vB, "m.accel_d": aB,
-               "D_n": A.copy(), "v_D_n": vA.copy(), "n.accel_d": aA.copy(),
-               "guide_k.angle": zero.copy()}
+        out = {
+            "D_m": B,
+            "v_D_m": vB,
+            "m.accel_d": aB,
+            "D_n": A.copy(),
+            "v_D_n": vA.copy(),
+            "n.accel_d": aA.copy(),
+            "guide_k.angle": zero.copy(),
+        }
         out.update(_link("m", zero, zero, zero, zero))
-        out.update(_link("n", tn, wn, en, l))
+        out.update(_link("n", tn, wn, en, rod))
         return out
 
-    def _loads(self, kin):
+    def _loads(self, kin: dict):
         f = self.gas_force(kin["crank.angle"])
         zero = np.zeros_like(f)
-        return {"m.force": _vec(-f, zero), "m.moment": zero.copy(),
-                "n.force": _vec(zero, zero), "n.moment": zero.copy()}
+        return {
+            "m.force": geo.vec(-f, zero),
+            "m.moment": zero.copy(),
+            "n.force": geo.vec(zero, zero),
+            "n.moment": zero.copy(),
+        }
 
-    def _frame(self):
-        r, l, e = self.crank["radius"], self.l, self.e
-        x0, x1 = math.sqrt((l - r) ** 2 - e * e), math.sqrt((l + r) ** 2 - e * e)
+    def frame(self) -> dict:
+        r, rod, e = self.crank["radius"], self.l, self.e
+        x0, x1 = math.sqrt((rod - r) ** 2 - e * e), math.sqrt((rod + r) ** 2 - e * e)
         pad = 0.25 * r
-        return {"pivots": {"O": (0.0, 0.0)},
-                "guides": {"k": ((x0 - pad, e), (x1 + pad, e))}}
+        return {"pivots": {"O": (0.0, 0.0)}, "guides": {"k": ((x0 - pad, e), (x1 + pad, e))}}
 
 
 class FourBar(Mechanism):
@@ -543,58 +487,77 @@ class FourBar(Mechanism):
 
     dyad = "RRR"
 
-    def _setup(self, where):
+    def _setup(self, where: str):
         g = self.geometry
-        self.O4 = _pair(g, "O4", f"{where}.geometry")
-        self.branch = 1.0 if _number(g, "branch", f"{where}.geometry") >= 0 else -1.0
+        self.O4 = geo.pair(g, "O4", f"{where}.geometry")
+        self.branch = 1.0 if geo.number(g, "branch", f"{where}.geometry") >= 0 else -1.0
         a = self.crank["radius"]
         b, c = self.links["n"]["length"], self.links["m"]["length"]
         d = math.hypot(*self.O4)
         s, l_ = min(a, b, c, d), max(a, b, c, d)
         if not (a == s and s + l_ < a + b + c + d - s - l_):
-            raise ValueError(f"{where}: not a Grashof crank-rocker (crank {a}, coupler {b}, "
-                             f"rocker {c}, ground {d} m): the crank must be the shortest link "
-                             f"and shortest + longest < the other two")
+            raise ValueError(
+                f"{where}: not a Grashof crank-rocker (crank {a}, coupler {b}, "
+                f"rocker {c}, ground {d} m): the crank must be the shortest link "
+                f"and shortest + longest < the other two"
+            )
         ld, w = self.load_data, f"{where}.load"
-        self.T0 = _number(ld, "T0", w)
-        self.w_ref = _number(ld, "w_ref", w, positive=True)
-        self.c_visc = _number(ld, "c", w)
+        self.T0 = geo.number(ld, "T0", w)
+        self.w_ref = geo.number(ld, "w_ref", w, positive=True)
+        self.c_visc = geo.number(ld, "c", w)
 
-    def _dyad_kinematics(self, phi, w, eps, A, vA, aA):
+    def _dyad_kinematics(
+        self,
+        phi: np.ndarray,
+        w: np.ndarray,
+        eps: np.ndarray,
+        A: np.ndarray,
+        vA: np.ndarray,
+        aA: np.ndarray,
+    ):
         b, c = self.links["n"]["length"], self.links["m"]["length"]
         O4 = np.broadcast_to(np.asarray(self.O4, dtype=float), A.shape)
         dv = A - O4
         dist = np.hypot(dv[:, 0], dv[:, 1])
-        u = dv / _col(dist)
+        u = dv / geo.col(dist)
         along = (c * c - b * b + dist * dist) / (2.0 * dist)
         height = np.sqrt(c * c - along * along)
         # branch +1: E on the left of the directed line A -> O4, i.e. on the right of O4 -> A
-        E = O4 + _col(along) * u - self.branch * _col(height) * _rot90(u)
+        E = O4 + geo.col(along) * u - self.branch * geo.col(height) * geo.rot90(u)
         i_m = (E - O4) / c
         i_n = (E - A) / b
         tm = np.arctan2(i_m[:, 1], i_m[:, 0])
         tn = np.arctan2(i_n[:, 1], i_n[:, 0])
-        s_mn = _cross(i_n, i_m)                     # sin(theta_m - theta_n)
-        wn = -_dot(vA, i_m) / (b * s_mn)
-        wm = -_dot(vA, i_n) / (c * s_mn)
-        K = aA - _col(wn * wn * b) * i_n + _col(wm * wm * c) * i_m
-        en = -_dot(K, i_m) / (b * s_mn)
-        em = -_dot(K, i_n) / (c * s_mn)
+        s_mn = geo.cross(i_n, i_m)  # sin(theta_m - theta_n)
+        wn = -geo.dot(vA, i_m) / (b * s_mn)
+        wm = -geo.dot(vA, i_n) / (c * s_mn)
+        K = aA - geo.col(wn * wn * b) * i_n + geo.col(wm * wm * c) * i_m
+        en = -geo.dot(K, i_m) / (b * s_mn)
+        em = -geo.dot(K, i_n) / (c * s_mn)
         zero = np.zeros_like(A)
-        out = {"D_m": O4.copy(), "v_D_m": zero.copy(), "m.accel_d": zero.copy(),
-               "D_n": A.copy(), "v_D_n": vA.copy(), "n.accel_d": aA.copy()}
+        out = {
+            "D_m": O4.copy(),
+            "v_D_m": zero.copy(),
+            "m.accel_d": zero.copy(),
+            "D_n": A.copy(),
+            "v_D_n": vA.copy(),
+            "n.accel_d": aA.copy(),
+        }
         out.update(_link("m", tm, wm, em, c))
         out.update(_link("n", tn, wn, en, b))
         return out
 
-    def _loads(self, kin):
+    def _loads(self, kin: dict):
         wm = kin["m.omega"]
         zero = np.zeros_like(wm)
-        return {"m.force": _vec(zero, zero),
-                "m.moment": -self.T0 * np.tanh(wm / self.w_ref) - self.c_visc * wm,
-                "n.force": _vec(zero, zero), "n.moment": zero.copy()}
+        return {
+            "m.force": geo.vec(zero, zero),
+            "m.moment": -self.T0 * np.tanh(wm / self.w_ref) - self.c_visc * wm,
+            "n.force": geo.vec(zero, zero),
+            "n.moment": zero.copy(),
+        }
 
-    def _frame(self):
+    def frame(self) -> dict:
         return {"pivots": {"O": (0.0, 0.0), "O4": tuple(self.O4)}, "guides": {}}
 
 
@@ -609,57 +572,81 @@ class QuickReturn(Mechanism):
     def _fixed_lengths(self):
         return {"n": 0.0}
 
-    def _setup(self, where):
+    def _setup(self, where: str):
         g, w = self.geometry, f"{where}.geometry"
-        self.O2 = _pair(g, "O2", w)
+        self.O2 = geo.pair(g, "O2", w)
         r = self.crank["radius"]
         d = math.hypot(*self.O2)
         if not d > 1.05 * r:
-            raise ValueError(f"{where}: |O O2| = {d} m must exceed the crank radius {r} m "
-                             f"(by 5 %) for the lever to oscillate")
-        self.lever_length = _number(g, "lever_length", w, positive=True)
+            raise ValueError(
+                f"{where}: |O O2| = {d} m must exceed the crank radius {r} m "
+                f"(by 5 %) for the lever to oscillate"
+            )
+        self.lever_length = geo.number(g, "lever_length", w, positive=True)
         if self.lever_length < d + r:
             raise ValueError(f"{w}.lever_length: must be at least |O O2| + r = {d + r} m")
         ld, wl = self.load_data, f"{where}.load"
-        self.M0 = _number(ld, "M0", wl)
-        self.w_ref = _number(ld, "w_ref", wl, positive=True)
+        self.M0 = geo.number(ld, "M0", wl)
+        self.w_ref = geo.number(ld, "w_ref", wl, positive=True)
 
-    def _dyad_kinematics(self, phi, w, eps, A, vA, aA):
+    def _dyad_kinematics(
+        self,
+        phi: np.ndarray,
+        w: np.ndarray,
+        eps: np.ndarray,
+        A: np.ndarray,
+        vA: np.ndarray,
+        aA: np.ndarray,
+    ):
         O2 = np.broadcast_to(np.asarray(self.O2, dtype=float), A.shape)
         dv = A - O2
         lm = np.hypot(dv[:, 0], dv[:, 1])
-        i_m = dv / _col(lm)
-        j_m = _rot90(i_m)
+        i_m = dv / geo.col(lm)
+        j_m = geo.rot90(i_m)
         tm = np.arctan2(i_m[:, 1], i_m[:, 0])
-        dlm = _dot(vA, i_m)                          # A = O2 + l_m i_m
-        wm = _dot(vA, j_m) / lm
-        ddlm = _dot(aA, i_m) + lm * wm * wm
-        em = (_dot(aA, j_m) - 2.0 * dlm * wm) / lm
+        dlm = geo.dot(vA, i_m)  # A = O2 + l_m i_m
+        wm = geo.dot(vA, j_m) / lm
+        ddlm = geo.dot(aA, i_m) + lm * wm * wm
+        em = (geo.dot(aA, j_m) - 2.0 * dlm * wm) / lm
         zero = np.zeros_like(A)
-        out = {"D_m": O2.copy(), "v_D_m": zero.copy(), "m.accel_d": zero.copy(),
-               "D_n": A.copy(), "v_D_n": vA.copy(), "n.accel_d": aA.copy()}
+        out = {
+            "D_m": O2.copy(),
+            "v_D_m": zero.copy(),
+            "m.accel_d": zero.copy(),
+            "D_n": A.copy(),
+            "v_D_n": vA.copy(),
+            "n.accel_d": aA.copy(),
+        }
         out.update(_link("m", tm, wm, em, lm, dlm, ddlm))
-        out.update(_link("n", tm, wm, em, 0.0 * lm))   # the block turns with the lever
+        out.update(_link("n", tm, wm, em, 0.0 * lm))  # the block turns with the lever
         return out
 
-    def _loads(self, kin):
+    def _loads(self, kin: dict):
         u = np.tanh(kin["m.omega"] / self.w_ref)
         zero = np.zeros_like(u)
-        return {"m.force": _vec(zero, zero), "m.moment": -self.M0 * u * (1.0 + u) / 2.0,
-                "n.force": _vec(zero, zero), "n.moment": zero.copy()}
+        return {
+            "m.force": geo.vec(zero, zero),
+            "m.moment": -self.M0 * u * (1.0 + u) / 2.0,
+            "n.force": geo.vec(zero, zero),
+            "n.moment": zero.copy(),
+        }
 
-    def _frame(self):
+    def frame(self) -> dict:
         return {"pivots": {"O": (0.0, 0.0), "O2": tuple(self.O2)}, "guides": {}}
 
 
-def _resistance_along_x(kin, f0, v_ref, c_visc):
+def _resistance_along_x(kin: dict, f0: float, v_ref: float, c_visc: float):
     """Loads of a link m that translates along x against a smooth resisting force
     F = -f0 tanh(v / v_ref) - c_visc v (N), v the velocity of D_m (m/s)."""
     v = kin["v_D_m"][:, 0]
     zero = np.zeros_like(v)
     fx = -f0 * np.tanh(v / v_ref) - c_visc * v
-    return {"m.force": _vec(fx, zero), "m.moment": zero.copy(),
-            "n.force": _vec(zero, zero), "n.moment": zero.copy()}
+    return {
+        "m.force": geo.vec(fx, zero),
+        "m.moment": zero.copy(),
+        "n.force": geo.vec(zero, zero),
+        "n.moment": zero.copy(),
+    }
 
 
 class ScotchYoke(Mechanism):
@@ -673,35 +660,47 @@ class ScotchYoke(Mechanism):
     def _fixed_lengths(self):
         return {"n": 0.0}
 
-    def _setup(self, where):
-        self.h = _number(self.geometry, "h", f"{where}.geometry", positive=True)
+    def _setup(self, where: str):
+        self.h = geo.number(self.geometry, "h", f"{where}.geometry", positive=True)
         r = self.crank["radius"]
         if not self.h > 1.05 * r:
             raise ValueError(f"{where}.geometry.h: must exceed the crank radius {r} m by 5 %")
         ld, w = self.load_data, f"{where}.load"
-        self.F0 = _number(ld, "F0", w)
-        self.v_ref = _number(ld, "v_ref", w, positive=True)
-        self.c_visc = _number(ld, "c", w)
+        self.F0 = geo.number(ld, "F0", w)
+        self.v_ref = geo.number(ld, "v_ref", w, positive=True)
+        self.c_visc = geo.number(ld, "c", w)
 
-    def _dyad_kinematics(self, phi, w, eps, A, vA, aA):
+    def _dyad_kinematics(
+        self,
+        phi: np.ndarray,
+        w: np.ndarray,
+        eps: np.ndarray,
+        A: np.ndarray,
+        vA: np.ndarray,
+        aA: np.ndarray,
+    ):
         h = self.h
         up = np.full_like(phi, math.pi / 2.0)
         zero = np.zeros_like(phi)
-        out = {"D_m": _vec(A[:, 0], -h + zero), "v_D_m": _vec(vA[:, 0], zero),
-               "m.accel_d": _vec(aA[:, 0], zero),
-               "D_n": A.copy(), "v_D_n": vA.copy(), "n.accel_d": aA.copy(),
-               "guide_k.angle": zero.copy()}
+        out = {
+            "D_m": geo.vec(A[:, 0], -h + zero),
+            "v_D_m": geo.vec(vA[:, 0], zero),
+            "m.accel_d": geo.vec(aA[:, 0], zero),
+            "D_n": A.copy(),
+            "v_D_n": vA.copy(),
+            "n.accel_d": aA.copy(),
+            "guide_k.angle": zero.copy(),
+        }
         out.update(_link("m", up, zero, zero, A[:, 1] + h, vA[:, 1], aA[:, 1]))
         out.update(_link("n", up, zero, zero, zero))
         return out
 
-    def _loads(self, kin):
+    def _loads(self, kin: dict):
         return _resistance_along_x(kin, self.F0, self.v_ref, self.c_visc)
 
-    def _frame(self):
+    def frame(self) -> dict:
         r, h = self.crank["radius"], self.h
-        return {"pivots": {"O": (0.0, 0.0)},
-                "guides": {"k": ((-1.6 * r, -h), (1.6 * r, -h))}}
+        return {"pivots": {"O": (0.0, 0.0)}, "guides": {"k": ((-1.6 * r, -h), (1.6 * r, -h))}}
 
 
 class TRTSlot(Mechanism):
@@ -715,12 +714,12 @@ class TRTSlot(Mechanism):
     def _fixed_lengths(self):
         return {"m": 0.0, "n": 0.0}
 
-    def _setup(self, where):
-        self.h = _number(self.geometry, "h", f"{where}.geometry", positive=True)
+    def _setup(self, where: str):
+        self.h = geo.number(self.geometry, "h", f"{where}.geometry", positive=True)
         ld, w = self.load_data, f"{where}.load"
-        self.F0 = _number(ld, "F0", w)
-        self.v_ref = _number(ld, "v_ref", w, positive=True)
-        self.c_visc = _number(ld, "c", w)
+        self.F0 = geo.number(ld, "F0", w)
+        self.v_ref = geo.number(ld, "v_ref", w, positive=True)
+        self.c_visc = geo.number(ld, "c", w)
 
     def motion(self, kind: str = "constant", revolutions: float = 2.0) -> CrankMotion:
         """The crank's oscillation over ``revolutions`` cycles: phi = centre + amplitude
@@ -733,57 +732,87 @@ class TRTSlot(Mechanism):
         if not (revolutions > 0 and math.isfinite(revolutions)):
             raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
         md, w = self._motion_data, f"{self.name}.motion"
-        return _oscillating(kind, _number(md, "omega", w, positive=True),
-                            _number(md, "centre", w), _number(md, "amplitude", w),
-                            _number(md, "harmonic2", w) if "harmonic2" in md else 0.0,
-                            revolutions)
+        return motion_.oscillating(
+            kind,
+            geo.number(md, "omega", w, positive=True),
+            geo.number(md, "centre", w),
+            geo.number(md, "amplitude", w),
+            geo.number(md, "harmonic2", w) if "harmonic2" in md else 0.0,
+            revolutions,
+        )
 
-    def _check_motion(self, where):
+    def _check_motion(self, where: str):
         r, h = self.crank["radius"], self.h
         for kind in ("constant", "varying"):
             m = self.motion(kind, 1.0)
             phi = m.phi(np.linspace(0.0, m.duration, 2001))
             s = float(np.min(np.sin(phi)))
             if s < 0.2:
-                raise ValueError(f"{where}.motion: the {kind} oscillation reaches sin(phi) = "
-                                 f"{s:.3g}; it must stay inside (0, pi) with sin(phi) >= 0.2 "
-                                 f"(the slot is parallel to the guide at 0 and pi)")
+                raise ValueError(
+                    f"{where}.motion: the {kind} oscillation reaches sin(phi) = "
+                    f"{s:.3g}; it must stay inside (0, pi) with sin(phi) >= 0.2 "
+                    f"(the slot is parallel to the guide at 0 and pi)"
+                )
             if h / s > r:
-                raise ValueError(f"{where}.crank.radius: the slot ({r} m) must reach the "
-                                 f"guide at the extreme angle ({h / s:.4g} m)")
+                raise ValueError(
+                    f"{where}.crank.radius: the slot ({r} m) must reach the "
+                    f"guide at the extreme angle ({h / s:.4g} m)"
+                )
 
-    def _dyad_kinematics(self, phi, w, eps, A, vA, aA):
+    def _dyad_kinematics(
+        self,
+        phi: np.ndarray,
+        w: np.ndarray,
+        eps: np.ndarray,
+        A: np.ndarray,
+        vA: np.ndarray,
+        aA: np.ndarray,
+    ):
         h = self.h
         c, s = np.cos(phi), np.sin(phi)
         x = h * c / s
         dx = -h * w / (s * s)
-        ddx = -h * eps / (s * s) + 2.0 * h * w * w * c / (s ** 3)
+        ddx = -h * eps / (s * s) + 2.0 * h * w * w * c / (s**3)
         zero = np.zeros_like(phi)
-        E = _vec(x, h + zero)
-        vE = _vec(dx, zero)
-        aE = _vec(ddx, zero)
-        out = {"D_m": E, "v_D_m": vE, "m.accel_d": aE,
-               "D_n": E.copy(), "v_D_n": vE.copy(), "n.accel_d": aE.copy(),
-               "guide_k.angle": zero.copy(), "guide_p.angle": np.asarray(phi, dtype=float).copy()}
+        E = geo.vec(x, h + zero)
+        vE = geo.vec(dx, zero)
+        aE = geo.vec(ddx, zero)
+        out = {
+            "D_m": E,
+            "v_D_m": vE,
+            "m.accel_d": aE,
+            "D_n": E.copy(),
+            "v_D_n": vE.copy(),
+            "n.accel_d": aE.copy(),
+            "guide_k.angle": zero.copy(),
+            "guide_p.angle": np.asarray(phi, dtype=float).copy(),
+        }
         out.update(_link("m", zero, zero, zero, zero))
         out.update(_link("n", phi, w, eps, zero))
         return out
 
-    def _loads(self, kin):
+    def _loads(self, kin: dict):
         return _resistance_along_x(kin, self.F0, self.v_ref, self.c_visc)
 
-    def _frame(self):
+    def frame(self) -> dict:
         r, h = self.crank["radius"], self.h
         reach = math.sqrt(max(r * r - h * h, 0.0))
-        return {"pivots": {"O": (0.0, 0.0)},
-                "guides": {"k": ((-reach - 0.1 * r, h), (reach + 0.1 * r, h))}}
+        return {
+            "pivots": {"O": (0.0, 0.0)},
+            "guides": {"k": ((-reach - 0.1 * r, h), (reach + 0.1 * r, h))},
+        }
 
 
-_CLASSES = {"slider-crank": SliderCrank, "four-bar": FourBar, "quick-return": QuickReturn,
-            "scotch-yoke": ScotchYoke, "trt-slot": TRTSlot}
+_CLASSES = {
+    "slider-crank": SliderCrank,
+    "four-bar": FourBar,
+    "quick-return": QuickReturn,
+    "scotch-yoke": ScotchYoke,
+    "trt-slot": TRTSlot,
+}
 
 
-def load(name: str, data=None) -> Mechanism:
+def load(name: str, data: Mapping | None = None) -> Mechanism:
     """The mechanism ``name`` (one of :data:`NAMES`) with its default data.
 
     ``data`` overrides the packaged defaults key by key (nested tables merged): a
@@ -802,5 +831,5 @@ def load(name: str, data=None) -> Mechanism:
         over = data[name] if name in data else data
         if not isinstance(over, Mapping):
             raise ValueError(f"data[{name!r}]: expected a table")
-        table = _merge(table, over)
+        table = geo.merge(table, over)
     return _CLASSES[name](name, table)

@@ -21,10 +21,11 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-GENERATOR = ROOT / "modelDescription" / "scene.py"
+from ..paths import GENERATOR
+
 SIZES = (25, 50, 100, 200)
 
 
@@ -34,27 +35,58 @@ def chain_scene(dyads: int, identifier: str | None = None) -> str:
     if dyads < 1:
         raise ValueError(f"a chain has at least one dyad, not {dyads}")
     ident = identifier or f"chain{dyads}"
-    lines = ["[scene]", f'identifier = "{ident}"',
-             f'description = "A crank and a chain of {dyads} RRR dyads"',
-             'outputs = ["all"]', 'tunable = ["gravity", "rocker1.mass"]', "",
-             "[effects]", "inertia = true", "gravity = true", "",
-             "[gravity]", "x = 0.0", "y = -9.81", "",
-             "[crank]", "length = 0.05", "com = [0.01, 0.0]", "mass = 0.8",
-             "inertia = 6.0e-4", ""]
+    lines = [
+        "[scene]",
+        f'identifier = "{ident}"',
+        f'description = "A crank and a chain of {dyads} RRR dyads"',
+        'outputs = ["all"]',
+        'tunable = ["gravity", "rocker1.mass"]',
+        "",
+        "[effects]",
+        "inertia = true",
+        "gravity = true",
+        "",
+        "[gravity]",
+        "x = 0.0",
+        "y = -9.81",
+        "",
+        "[crank]",
+        "length = 0.05",
+        "com = [0.01, 0.0]",
+        "mass = 0.8",
+        "inertia = 6.0e-4",
+        "",
+    ]
     for k in range(1, dyads + 1):
         carrier = '"crank"' if k == 1 else f'{{ link = "rocker{k - 1}", at = [0.12, 0.02] }}'
-        lines += ["[[dyad]]", f'name = "d{k}"', 'type = "RRR"', f'm = "coupler{k}"',
-                  f'n = "rocker{k}"', f"k = {carrier}", 'p = "frame"', ""]
+        lines += [
+            "[[dyad]]",
+            f'name = "d{k}"',
+            'type = "RRR"',
+            f'm = "coupler{k}"',
+            f'n = "rocker{k}"',
+            f"k = {carrier}",
+            'p = "frame"',
+            "",
+        ]
     for k in range(1, dyads + 1):
         for link, length in (("coupler", 0.2), ("rocker", 0.15)):
-            lines += ["[[link]]", f'name = "{link}{k}"', f"length = {length}",
-                      "com = [0.07, 0.01]", "mass = 1.0", "inertia = 3.0e-3", ""]
+            lines += [
+                "[[link]]",
+                f'name = "{link}{k}"',
+                f"length = {length}",
+                "com = [0.07, 0.01]",
+                "mass = 1.0",
+                "inertia = 3.0e-3",
+                "",
+            ]
     rockers = ", ".join(f'"rocker{k}"' for k in range(1, dyads + 1))
     lines += ["[loads]", f"force = [{rockers}]", f"moment = [{rockers}]", ""]
     return "\n".join(lines)
 
 
 def write_chain(dyads: int, folder: Path) -> Path:
+    """The chain of `dyads` RRR dyads written to <folder>/chain<dyads>.toml."""
     path = Path(folder) / f"chain{dyads}.toml"
     path.write_text(chain_scene(dyads), encoding="utf-8")
     return path
@@ -75,8 +107,12 @@ def _timed(command: list) -> tuple[float, float]:
     return elapsed, cpu
 
 
-def measure(sizes=SIZES, generator: Path = GENERATOR, python: str = sys.executable,
-            log=None) -> list[tuple]:
+def measure(
+    sizes: tuple[int, ...] = SIZES,
+    generator: Path = GENERATOR,
+    python: str = sys.executable,
+    log: Callable | None = None,
+) -> list[tuple]:
     """(dyads, (elapsed, CPU) of --check, (elapsed, CPU) of --out) for each size, in s."""
     rows = []
     with tempfile.TemporaryDirectory(prefix="dyadfmu-chain-") as tmp:
@@ -86,29 +122,44 @@ def measure(sizes=SIZES, generator: Path = GENERATOR, python: str = sys.executab
             out = _timed([python, str(generator), str(scene), "--out", str(Path(tmp) / f"g{n}")])
             rows.append((n, check, out))
             if log:
-                log(f"{n} dyads: --check {check[0]:.2f} s ({check[1]:.2f} s CPU), "
-                    f"--out {out[0]:.2f} s ({out[1]:.2f} s CPU)")
+                log(
+                    f"{n} dyads: --check {check[0]:.2f} s ({check[1]:.2f} s CPU), "
+                    f"--out {out[0]:.2f} s ({out[1]:.2f} s CPU)"
+                )
     return rows
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
+    """Run 'dyadfmu scene-bench' with `argv`: print the generator's times."""
     parser = argparse.ArgumentParser(
         prog="dyadfmu scene-bench",
         description="Time the scene generator (modelDescription/scene.py --check and --out) "
-                    "on chains of 25, 50, 100 and 200 RRR dyads; print a Markdown table.")
-    parser.add_argument("--sizes", type=int, nargs="+", default=list(SIZES),
-                        help="numbers of dyads (default 25 50 100 200)")
-    parser.add_argument("--generator", type=Path, default=GENERATOR,
-                        help="the scene.py to time (default: this checkout's)")
-    parser.add_argument("--write", type=int, metavar="N",
-                        help="only write the chain of N dyads to stdout")
+        "on chains of 25, 50, 100 and 200 RRR dyads; print a Markdown table.",
+    )
+    parser.add_argument(
+        "--sizes",
+        type=int,
+        nargs="+",
+        default=list(SIZES),
+        help="numbers of dyads (default 25 50 100 200)",
+    )
+    parser.add_argument(
+        "--generator",
+        type=Path,
+        default=GENERATOR,
+        help="the scene.py to time (default: this checkout's)",
+    )
+    parser.add_argument(
+        "--write", type=int, metavar="N", help="only write the chain of N dyads to stdout"
+    )
     args = parser.parse_args(argv)
     if args.write is not None:
         sys.stdout.write(chain_scene(args.write))
         return 0
     rows = measure(args.sizes, args.generator, log=lambda t: print(t, file=sys.stderr))
-    print("| dyads | --check: elapsed (s) | --check: CPU (s) | --out: elapsed (s) | "
-          "--out: CPU (s) |")
+    print(
+        "| dyads | --check: elapsed (s) | --check: CPU (s) | --out: elapsed (s) | --out: CPU (s) |"
+    )
     print("|---|---|---|---|---|")
     for n, check, out in rows:
         print(f"| {n} | {check[0]:.2f} | {check[1]:.2f} | {out[0]:.2f} | {out[1]:.2f} |")

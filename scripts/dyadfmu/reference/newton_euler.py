@@ -59,15 +59,27 @@ __all__ = ["PAIRS", "LINK_KEYS", "UNKNOWNS", "assemble", "solve", "solve_mp"]
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}
 
 #: Required keys of the link dicts ``m`` and ``n``.
-LINK_KEYS = ("dir", "length", "omega", "epsilon", "accel_d", "com",
-             "mass", "inertia", "force", "moment")
+LINK_KEYS = (
+    "dir",
+    "length",
+    "omega",
+    "epsilon",
+    "accel_d",
+    "com",
+    "mass",
+    "inertia",
+    "force",
+    "moment",
+)
 _VEC_KEYS = ("dir", "accel_d", "com", "force")
 
 #: Names of the six unknowns per dyad type (ordering of ``u``, see module doc).
 UNKNOWNS = {
-    t: tuple(name for pair, kind in zip(("mk", "np", "mn"), (p[0], p[2], p[1]))
-             for name in ((f"r_{pair}.x", f"r_{pair}.y") if kind == "R"
-                          else (f"n_{pair}", f"m_{pair}")))
+    t: tuple(
+        name
+        for pair, kind in zip(("mk", "np", "mn"), (p[0], p[2], p[1]), strict=False)
+        for name in ((f"r_{pair}.x", f"r_{pair}.y") if kind == "R" else (f"n_{pair}", f"m_{pair}"))
+    )
     for t, p in PAIRS.items()
 }
 
@@ -75,7 +87,7 @@ UNKNOWNS = {
 # ---------------------------------------------------------------------------
 # validation
 # ---------------------------------------------------------------------------
-def _kinds(dyad_type, guide_k, guide_p):
+def _kinds(dyad_type: str, guide_k: np.ndarray | None, guide_p: np.ndarray | None):
     """Return pair kinds (D_m, E, D_n) after validating type and guides."""
     key = dyad_type.upper() if isinstance(dyad_type, str) else dyad_type
     if key not in PAIRS:
@@ -88,7 +100,7 @@ def _kinds(dyad_type, guide_k, guide_p):
     return key, (k_dm, k_e, k_dn)
 
 
-def _check_link(name, link):
+def _check_link(name: str, link: dict):
     missing = [k for k in LINK_KEYS if k not in link]
     if missing:
         raise ValueError(f"link {name!r} is missing keys {missing}")
@@ -98,15 +110,15 @@ def _check_link(name, link):
 # backend-neutral physics (works on numpy arrays of shape (N,) or mpf scalars)
 # vectors are (x, y) tuples of components
 # ---------------------------------------------------------------------------
-def _rot90(v):
+def _rot90(v: np.ndarray):
     return (-v[1], v[0])
 
 
-def _cross(a, b):
+def _cross(a: np.ndarray, b: np.ndarray):
     return a[0] * b[1] - a[1] * b[0]
 
 
-def _known_loads(L, grav):
+def _known_loads(L: dict, grav: np.ndarray):
     """Resultant known force and its moment about D of one link.
 
     Sum of active load, weight and d'Alembert inertia force (all at S) and of
@@ -115,7 +127,7 @@ def _known_loads(L, grav):
     i = L["dir"]
     j = _rot90(i)
     xs, ys = L["com"]
-    r = (xs * i[0] + ys * j[0], xs * i[1] + ys * j[1])          # S - D
+    r = (xs * i[0] + ys * j[0], xs * i[1] + ys * j[1])  # S - D
     w2, eps = L["omega"] * L["omega"], L["epsilon"]
     er = _rot90(r)
     a_s = tuple(L["accel_d"][c] + eps * er[c] - w2 * r[c] for c in (0, 1))
@@ -125,18 +137,20 @@ def _known_loads(L, grav):
     return F, M
 
 
-def _system(kinds, m, n, gk, gp, grav):
+def _system(
+    kinds: tuple, m: dict, n: dict, gk: np.ndarray | None, gp: np.ndarray | None, grav: np.ndarray
+):
     """Assemble A (6x6 nested list) and b (list of 6) of the dyad equations."""
     A = [[0] * 6 for _ in range(6)]
     k_dm, k_e, k_dn = kinds
 
-    def put_force(col, row0, sign, f, arm):
+    def put_force(col: int, row0: int, sign: float, f: np.ndarray, arm: np.ndarray):
         # force f (per unit unknown) at a point with arm (point - D_link)
         A[row0][col] = A[row0][col] + sign * f[0]
         A[row0 + 1][col] = A[row0 + 1][col] + sign * f[1]
         A[row0 + 2][col] = A[row0 + 2][col] + sign * _cross(arm, f)
 
-    def put_pair(kind, col, links, guide):
+    def put_pair(kind: str, col: int, links: tuple, guide: np.ndarray):
         # links: sequence of (row0, sign, arm) the pair acts on
         for row0, sign, arm in links:
             if kind == "R":
@@ -147,8 +161,8 @@ def _system(kinds, m, n, gk, gp, grav):
                 A[row0 + 2][col + 1] = A[row0 + 2][col + 1] + sign
 
     zero = (0, 0)
-    arm_em = tuple(m["length"] * c for c in m["dir"])            # E - D_m
-    arm_en = tuple(n["length"] * c for c in n["dir"])            # E - D_n
+    arm_em = tuple(m["length"] * c for c in m["dir"])  # E - D_m
+    arm_en = tuple(n["length"] * c for c in n["dir"])  # E - D_n
     put_pair(k_dm, 0, [(0, 1, zero)], gk)
     put_pair(k_dn, 2, [(3, 1, zero)], gp)
     put_pair(k_e, 4, [(0, 1, arm_em), (3, -1, arm_en)], m["dir"])
@@ -159,12 +173,22 @@ def _system(kinds, m, n, gk, gp, grav):
     return A, b
 
 
-def _unpack(kinds, u, gk, gp, dir_m, nan, zero):
+def _unpack(
+    kinds: tuple,
+    u: np.ndarray,
+    gk: np.ndarray | None,
+    gp: np.ndarray | None,
+    dir_m: np.ndarray,
+    nan: np.ndarray,
+    zero: np.ndarray,
+):
     """Map the unknown vector u (indexable, 6 entries) to the output dict."""
     out = {}
-    for pair, kind, col, guide in (("mk", kinds[0], 0, gk),
-                                   ("np", kinds[2], 2, gp),
-                                   ("mn", kinds[1], 4, dir_m)):
+    for pair, kind, col, guide in (
+        ("mk", kinds[0], 0, gk),
+        ("np", kinds[2], 2, gp),
+        ("mn", kinds[1], 4, dir_m),
+    ):
         if kind == "R":
             out[f"r_{pair}"] = (u[col], u[col + 1])
             out[f"m_{pair}"] = zero
@@ -173,14 +197,20 @@ def _unpack(kinds, u, gk, gp, dir_m, nan, zero):
             j = _rot90(guide)
             out[f"r_{pair}"] = (u[col] * j[0], u[col] * j[1])
             out[f"m_{pair}"] = u[col + 1]
-            out[f"n_{pair}"] = u[col]   # = r . j for a unit guide
+            out[f"n_{pair}"] = u[col]  # = r . j for a unit guide
     return out
 
 
 # ---------------------------------------------------------------------------
 # numpy backend
 # ---------------------------------------------------------------------------
-def _np_inputs(m, n, guide_k, guide_p, gravity):
+def _np_inputs(
+    m: dict,
+    n: dict,
+    guide_k: np.ndarray | None,
+    guide_p: np.ndarray | None,
+    gravity: tuple[float, float],
+):
     """Convert inputs to component tuples of arrays, broadcast to a batch N."""
     _check_link("m", m)
     _check_link("n", n)
@@ -195,7 +225,9 @@ def _np_inputs(m, n, guide_k, guide_p, gravity):
     for name, (arr, is_vec) in raw.items():
         if is_vec:
             if arr.ndim not in (1, 2) or arr.shape[-1] != 2:
-                raise ValueError(f"{name}: expected a vector of shape (2,) or (N, 2), got {arr.shape}")
+                raise ValueError(
+                    f"{name}: expected a vector of shape (2,) or (N, 2), got {arr.shape}"
+                )
             lead.append(arr.shape[:-1])
         else:
             if arr.ndim > 1:
@@ -203,7 +235,7 @@ def _np_inputs(m, n, guide_k, guide_p, gravity):
             lead.append(arr.shape)
     N = np.broadcast_shapes(*lead, (1,))[0]
 
-    def conv(arr, is_vec):
+    def conv(arr: object, is_vec: bool):
         if is_vec:
             a = np.broadcast_to(arr, (N, 2))
             return (a[:, 0], a[:, 1])
@@ -217,7 +249,14 @@ def _np_inputs(m, n, guide_k, guide_p, gravity):
     return N, links[0], links[1], gk, gp, conv(*raw["gravity"])
 
 
-def assemble(dyad_type, m, n, guide_k=None, guide_p=None, gravity=(0.0, 0.0)):
+def assemble(
+    dyad_type: str,
+    m: dict,
+    n: dict,
+    guide_k: np.ndarray | None = None,
+    guide_p: np.ndarray | None = None,
+    gravity: tuple[float, float] = (0.0, 0.0),
+) -> tuple:
     """Build the batched Newton-Euler system ``A u = b`` of a dyad.
 
     Parameters
@@ -242,7 +281,15 @@ def assemble(dyad_type, m, n, guide_k=None, guide_p=None, gravity=(0.0, 0.0)):
     return _assemble_np(kinds, *_np_inputs(m, n, guide_k, guide_p, gravity))
 
 
-def _assemble_np(kinds, N, mm, nn, gk, gp, grav):
+def _assemble_np(
+    kinds: tuple,
+    N: int,
+    mm: dict,
+    nn: dict,
+    gk: np.ndarray | None,
+    gp: np.ndarray | None,
+    grav: np.ndarray,
+):
     A_l, b_l = _system(kinds, mm, nn, gk, gp, grav)
     A = np.empty((N, 6, 6))
     for r in range(6):
@@ -252,7 +299,14 @@ def _assemble_np(kinds, N, mm, nn, gk, gp, grav):
     return A, b
 
 
-def solve(dyad_type, m, n, guide_k=None, guide_p=None, gravity=(0.0, 0.0)):
+def solve(
+    dyad_type: str,
+    m: dict,
+    n: dict,
+    guide_k: np.ndarray | None = None,
+    guide_p: np.ndarray | None = None,
+    gravity: tuple[float, float] = (0.0, 0.0),
+) -> dict:
     """Solve the dyad reactions for a batch of N configurations (float64).
 
     Returns a dict with
@@ -267,7 +321,7 @@ def solve(dyad_type, m, n, guide_k=None, guide_p=None, gravity=(0.0, 0.0)):
     A, b = _assemble_np(kinds, N, mm, nn, gk, gp, grav)
     try:
         u = np.linalg.solve(A, b[..., None])[..., 0]
-    except np.linalg.LinAlgError:       # some sample exactly singular: do one by one
+    except np.linalg.LinAlgError:  # some sample exactly singular: do one by one
         u = np.full(b.shape, np.nan)
         for s in range(A.shape[0]):
             try:
@@ -287,12 +341,20 @@ def solve(dyad_type, m, n, guide_k=None, guide_p=None, gravity=(0.0, 0.0)):
 # ---------------------------------------------------------------------------
 # mpmath backend
 # ---------------------------------------------------------------------------
-def _mpf_exact(x):
+def _mpf_exact(x: float):
     """Exact conversion of a double (or int) to mpf (mpf(float) is exact)."""
     return mpmath.mpf(float(x))
 
 
-def solve_mp(dyad_type, m, n, guide_k=None, guide_p=None, gravity=(0.0, 0.0), dps=50):
+def solve_mp(
+    dyad_type: str,
+    m: dict,
+    n: dict,
+    guide_k: np.ndarray | None = None,
+    guide_p: np.ndarray | None = None,
+    gravity: tuple[float, float] = (0.0, 0.0),
+    dps: int = 50,
+) -> dict:
     """High-precision solve of ONE configuration with mpmath (``dps`` digits).
 
     Inputs are plain floats / length-2 sequences, converted exactly from double
@@ -309,15 +371,17 @@ def solve_mp(dyad_type, m, n, guide_k=None, guide_p=None, gravity=(0.0, 0.0), dp
     _check_link("m", m)
     _check_link("n", n)
 
-    def vec(v, name):
+    def vec(v: np.ndarray, name: str):
         v = tuple(v)
         if len(v) != 2:
             raise ValueError(f"{name}: expected a length-2 vector")
         return (_mpf_exact(v[0]), _mpf_exact(v[1]))
 
     with mpmath.workdps(dps):
-        links = [{k: (vec(L[k], k) if k in _VEC_KEYS else _mpf_exact(L[k])) for k in LINK_KEYS}
-                 for L in (m, n)]
+        links = [
+            {k: (vec(L[k], k) if k in _VEC_KEYS else _mpf_exact(L[k])) for k in LINK_KEYS}
+            for L in (m, n)
+        ]
         gk = vec(guide_k, "guide_k") if guide_k is not None else None
         gp = vec(guide_p, "guide_p") if guide_p is not None else None
         A_l, b_l = _system(kinds, links[0], links[1], gk, gp, vec(gravity, "gravity"))

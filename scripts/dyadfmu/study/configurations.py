@@ -20,19 +20,60 @@ import numpy as np
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}
 # Lengths that may be zero (m, n), as the paper states.
-ZERO_OK = {"RRR": (False, False), "RRT": (True, False), "RTR": (False, True),
-           "TRT": (True, True), "RTT": (False, True)}
+ZERO_OK = {
+    "RRR": (False, False),
+    "RRT": (True, False),
+    "RTR": (False, True),
+    "TRT": (True, True),
+    "RTT": (False, True),
+}
 
-LINK_COLUMNS = ("dir.x", "dir.y", "length", "omega", "epsilon", "accel_d.x", "accel_d.y",
-                "com.x", "com.y", "mass", "inertia", "force.x", "force.y", "moment")
-COLUMNS = tuple(f"m.{c}" for c in LINK_COLUMNS) + tuple(f"n.{c}" for c in LINK_COLUMNS) + (
-    "guide_k.x", "guide_k.y", "guide_p.x", "guide_p.y", "gravity.x", "gravity.y",
-    "singular_threshold")
+LINK_COLUMNS = (
+    "dir.x",
+    "dir.y",
+    "length",
+    "omega",
+    "epsilon",
+    "accel_d.x",
+    "accel_d.y",
+    "com.x",
+    "com.y",
+    "mass",
+    "inertia",
+    "force.x",
+    "force.y",
+    "moment",
+)
+COLUMNS = (
+    tuple(f"m.{c}" for c in LINK_COLUMNS)
+    + tuple(f"n.{c}" for c in LINK_COLUMNS)
+    + (
+        "guide_k.x",
+        "guide_k.y",
+        "guide_p.x",
+        "guide_p.y",
+        "gravity.x",
+        "gravity.y",
+        "singular_threshold",
+    )
+)
 COL = {name: k for k, name in enumerate(COLUMNS)}
 
 #: Output columns of the benchmark (and of `outputs_of`).
-OUTPUT_COLUMNS = ("r_mk.x", "r_mk.y", "r_np.x", "r_np.y", "r_mn.x", "r_mn.y",
-                  "n_mk", "n_np", "n_mn", "m_mk", "m_np", "m_mn")
+OUTPUT_COLUMNS = (
+    "r_mk.x",
+    "r_mk.y",
+    "r_np.x",
+    "r_np.y",
+    "r_mn.x",
+    "r_mn.y",
+    "n_mk",
+    "n_np",
+    "n_mn",
+    "m_mk",
+    "m_np",
+    "m_mn",
+)
 
 #: Threshold given to the solvers in the study: low enough that the core
 #: solves right down to the singular position, so its error can be measured
@@ -40,14 +81,21 @@ OUTPUT_COLUMNS = ("r_mk.x", "r_mk.y", "r_np.x", "r_np.y", "r_mn.x", "r_mn.y",
 STUDY_THRESHOLD = 1e-30
 
 
-def _unit(angle):
+def _unit(angle: np.ndarray):
     return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
 
 
-def _random_links(rng, dyad, count, length_range=(-3, 3), mass_range=(-3, 3),
-                  omega_max=100.0, load_range=(-2, 4)):
+def _random_links(
+    rng: np.random.Generator,
+    dyad: str,
+    count: int,
+    length_range: tuple[float, float] = (-3, 3),
+    mass_range: tuple[float, float] = (-3, 3),
+    omega_max: float = 100.0,
+    load_range: tuple[float, float] = (-2, 4),
+):
     rows = np.zeros((count, len(COLUMNS)))
-    for g, zero_ok in zip(("m", "n"), ZERO_OK[dyad]):
+    for g, zero_ok in zip(("m", "n"), ZERO_OK[dyad], strict=False):
         length = 10.0 ** rng.uniform(*length_range, count)
         if zero_ok:
             length[rng.random(count) < 0.1] = 0.0
@@ -57,15 +105,17 @@ def _random_links(rng, dyad, count, length_range=(-3, 3), mass_range=(-3, 3),
         rows[:, COL[f"{g}.length"]] = length
         rows[:, COL[f"{g}.omega"]] = rng.uniform(-omega_max, omega_max, count)
         rows[:, COL[f"{g}.epsilon"]] = rng.uniform(-10 * omega_max, 10 * omega_max, count)
-        rows[:, [COL[f"{g}.accel_d.x"], COL[f"{g}.accel_d.y"]]] = \
-            rng.uniform(-1, 1, (count, 2)) * (omega_max ** 2) * size[:, None]
+        rows[:, [COL[f"{g}.accel_d.x"], COL[f"{g}.accel_d.y"]]] = (
+            rng.uniform(-1, 1, (count, 2)) * (omega_max**2) * size[:, None]
+        )
         rows[:, COL[f"{g}.com.x"]] = size * rng.uniform(-0.5, 1.5, count)
         rows[:, COL[f"{g}.com.y"]] = size * rng.uniform(-0.5, 0.5, count)
         rows[:, COL[f"{g}.mass"]] = mass
         rows[:, COL[f"{g}.inertia"]] = mass * (size * rng.uniform(0.05, 0.6, count)) ** 2
         load = 10.0 ** rng.uniform(*load_range, count)
-        rows[:, [COL[f"{g}.force.x"], COL[f"{g}.force.y"]]] = \
-            load[:, None] * _unit(rng.uniform(0, 2 * math.pi, count))
+        rows[:, [COL[f"{g}.force.x"], COL[f"{g}.force.y"]]] = load[:, None] * _unit(
+            rng.uniform(0, 2 * math.pi, count)
+        )
         rows[:, COL[f"{g}.moment"]] = load * size * rng.uniform(-1, 1, count)
     rows[:, [COL["guide_k.x"], COL["guide_k.y"]]] = _unit(rng.uniform(0, 2 * math.pi, count))
     rows[:, [COL["guide_p.x"], COL["guide_p.y"]]] = _unit(rng.uniform(0, 2 * math.pi, count))
@@ -81,10 +131,10 @@ def conditioning(dyad: str, rows: np.ndarray) -> np.ndarray:
     i_k = rows[:, [COL["guide_k.x"], COL["guide_k.y"]]]
     i_p = rows[:, [COL["guide_p.x"], COL["guide_p.y"]]]
 
-    def perp(v):
+    def perp(v: np.ndarray):
         return np.stack([-v[:, 1], v[:, 0]], axis=-1)
 
-    def dot(a, b):
+    def dot(a: np.ndarray, b: np.ndarray):
         return np.sum(a * b, axis=-1)
 
     if dyad == "RRR":
@@ -107,8 +157,9 @@ def conditioning(dyad: str, rows: np.ndarray) -> np.ndarray:
 UNITS = (slice(0, 9), slice(9, 12))
 
 
-def contract_ratio(values: np.ndarray, truth: np.ndarray, amplification: np.ndarray,
-                   eps: float) -> np.ndarray:
+def contract_ratio(
+    values: np.ndarray, truth: np.ndarray, amplification: np.ndarray, eps: float
+) -> np.ndarray:
     """The contract of the core's ``amplification`` output (src/dyad_amplification.h),
     per configuration: the worst |value - truth| of an output over eps x amplification
     x the largest reported |output| of its unit. With status ok it is at most a small
@@ -137,41 +188,41 @@ def random_set(dyad: str, count: int, seed: int) -> np.ndarray:
     return np.concatenate(chunks)[:count]
 
 
-def _rotated(base_angle, delta):
+def _rotated(base_angle: np.ndarray, delta: np.ndarray):
     """(cos, sin) of base_angle + delta, rounded once from 50-digit values."""
     with mpmath.workdps(50):
         a = mpmath.mpf(float(base_angle)) + mpmath.mpf(delta)
         return float(mpmath.cos(a)), float(mpmath.sin(a))
 
 
-def sweep_set(dyad: str, per_decade: int, instances: int, seed: int,
-              decades=(1, 16)) -> np.ndarray:
+def sweep_set(
+    dyad: str, per_decade: int, instances: int, seed: int, decades: tuple[int, int] = (1, 16)
+) -> np.ndarray:
     """Configurations approaching the type's singular position: the geometric
     distance delta from it runs over 10^-1 ... 10^-16."""
     rng = np.random.default_rng(seed)
-    exponents = np.linspace(-decades[0], -decades[1],
-                            per_decade * (decades[1] - decades[0]) + 1)
+    exponents = np.linspace(-decades[0], -decades[1], per_decade * (decades[1] - decades[0]) + 1)
     rows = []
     for _ in range(instances):
         base = _random_links(rng, dyad, 1, length_range=(-1, 0.5), load_range=(0, 3))[0]
         theta = rng.uniform(0, 2 * math.pi)
         for e in exponents:
-            delta = 10.0 ** e
+            delta = 10.0**e
             row = base.copy()
-            if dyad == "RRR":        # links aligned: i_n along i_m
+            if dyad == "RRR":  # links aligned: i_n along i_m
                 m_dir, n_dir = _rotated(theta, 0), _rotated(theta, delta)
                 row[[COL["m.dir.x"], COL["m.dir.y"]]] = m_dir
                 row[[COL["n.dir.x"], COL["n.dir.y"]]] = n_dir
-            elif dyad == "RRT":      # rod normal to the guide
+            elif dyad == "RRT":  # rod normal to the guide
                 row[[COL["guide_k.x"], COL["guide_k.y"]]] = _rotated(theta, 0)
                 row[[COL["n.dir.x"], COL["n.dir.y"]]] = _rotated(theta, math.pi / 2 - delta)
-            elif dyad == "TRT":      # parallel guides
+            elif dyad == "TRT":  # parallel guides
                 row[[COL["guide_k.x"], COL["guide_k.y"]]] = _rotated(theta, 0)
                 row[[COL["guide_p.x"], COL["guide_p.y"]]] = _rotated(theta, delta)
-            elif dyad == "RTT":      # slot parallel to the guide
+            elif dyad == "RTT":  # slot parallel to the guide
                 row[[COL["guide_k.x"], COL["guide_k.y"]]] = _rotated(theta, 0)
                 row[[COL["m.dir.x"], COL["m.dir.y"]]] = _rotated(theta, delta)
-            else:                    # RTR: slot normal to D_m D_n
+            else:  # RTR: slot normal to D_m D_n
                 l_m = row[COL["m.length"]]
                 row[[COL["m.dir.x"], COL["m.dir.y"]]] = _rotated(theta, 0)
                 # l_n i_n = l_m i_m - l_m (delta i_m + j_m): D_m D_n nearly along j_m
@@ -180,7 +231,7 @@ def sweep_set(dyad: str, per_decade: int, instances: int, seed: int,
                     lm = mpmath.mpf(float(l_m))
                     vx = lm * c - lm * (mpmath.mpf(delta) * c - s)
                     vy = lm * s - lm * (mpmath.mpf(delta) * s + c)
-                    ln = mpmath.sqrt(vx ** 2 + vy ** 2)
+                    ln = mpmath.sqrt(vx**2 + vy**2)
                     row[COL["n.length"]] = float(ln)
                     row[[COL["n.dir.x"], COL["n.dir.y"]]] = (float(vx / ln), float(vy / ln))
             rows.append(row)
@@ -196,22 +247,29 @@ def extreme_set(dyad: str, count: int, seed: int) -> np.ndarray:
     rng = np.random.default_rng(seed)
     chunks, have = [], 0
     while have < count:
-        rows = _random_links(rng, dyad, 2 * count, length_range=(-6, 4), mass_range=(-6, 6),
-                             omega_max=1e4, load_range=(-9, 9))
+        rows = _random_links(
+            rng,
+            dyad,
+            2 * count,
+            length_range=(-6, 4),
+            mass_range=(-6, 6),
+            omega_max=1e4,
+            load_range=(-9, 9),
+        )
         rows = rows[conditioning(dyad, rows) >= 0.1]
         chunks.append(rows)
         have += len(rows)
     rows = np.concatenate(chunks)[:count]
     quarter = count // 4
-    heavy = slice(0, quarter)                      # one link 1e6 times heavier
+    heavy = slice(0, quarter)  # one link 1e6 times heavier
     rows[heavy, COL["m.mass"]] = rows[heavy, COL["n.mass"]] * 1e6
     rows[heavy, COL["m.inertia"]] = rows[heavy, COL["n.inertia"]] * 1e6
-    stiff = slice(quarter, 2 * quarter)           # inertia ~1e8 x weight
+    stiff = slice(quarter, 2 * quarter)  # inertia ~1e8 x weight
     for g in ("m", "n"):
         size = np.maximum(rows[stiff, COL[f"{g}.length"]], 1e-3)
         rows[stiff, COL[f"{g}.omega"]] = np.sqrt(1e8 * 9.81 / size)
         rows[stiff, COL["gravity.y"]] = -9.81
-    tiny = slice(2 * quarter, 3 * quarter)        # tiny loads on huge inertia
+    tiny = slice(2 * quarter, 3 * quarter)  # tiny loads on huge inertia
     for g in ("m", "n"):
         rows[tiny, COL[f"{g}.force.x"]] *= 1e-12
         rows[tiny, COL[f"{g}.force.y"]] *= 1e-12
@@ -238,7 +296,7 @@ def cancelling_set(dyad: str, count: int, seed: int) -> np.ndarray:
         gravity = row[[COL["gravity.x"], COL["gravity.y"]]]
         accel_d = row[[COL[f"{g}.accel_d.x"], COL[f"{g}.accel_d.y"]]]
         # weight and inertia force: m (g - a_D - epsilon k0 x r + omega^2 r)
-        passive = mass * (gravity - accel_d - epsilon * np.array([-r[1], r[0]]) + omega ** 2 * r)
+        passive = mass * (gravity - accel_d - epsilon * np.array([-r[1], r[0]]) + omega**2 * r)
         row[[COL[f"{g}.force.x"], COL[f"{g}.force.y"]]] = -passive * (1 - residue)
         row[COL[f"{g}.moment"]] = row[COL[f"{g}.inertia"]] * epsilon * (1 - residue)
         for k in ("mass", "inertia", "force.x", "force.y", "moment"):
@@ -246,17 +304,22 @@ def cancelling_set(dyad: str, count: int, seed: int) -> np.ndarray:
     return rows
 
 
-def reference_args(dyad: str, row: np.ndarray):
+def reference_args(dyad: str, row: np.ndarray) -> tuple:
     """One configuration as the arguments of reference.solve / solve_mp."""
-    def link(g):
-        return dict(dir=(row[COL[f"{g}.dir.x"]], row[COL[f"{g}.dir.y"]]),
-                    length=row[COL[f"{g}.length"]], omega=row[COL[f"{g}.omega"]],
-                    epsilon=row[COL[f"{g}.epsilon"]],
-                    accel_d=(row[COL[f"{g}.accel_d.x"]], row[COL[f"{g}.accel_d.y"]]),
-                    com=(row[COL[f"{g}.com.x"]], row[COL[f"{g}.com.y"]]),
-                    mass=row[COL[f"{g}.mass"]], inertia=row[COL[f"{g}.inertia"]],
-                    force=(row[COL[f"{g}.force.x"]], row[COL[f"{g}.force.y"]]),
-                    moment=row[COL[f"{g}.moment"]])
+
+    def link(g: str):
+        return dict(
+            dir=(row[COL[f"{g}.dir.x"]], row[COL[f"{g}.dir.y"]]),
+            length=row[COL[f"{g}.length"]],
+            omega=row[COL[f"{g}.omega"]],
+            epsilon=row[COL[f"{g}.epsilon"]],
+            accel_d=(row[COL[f"{g}.accel_d.x"]], row[COL[f"{g}.accel_d.y"]]),
+            com=(row[COL[f"{g}.com.x"]], row[COL[f"{g}.com.y"]]),
+            mass=row[COL[f"{g}.mass"]],
+            inertia=row[COL[f"{g}.inertia"]],
+            force=(row[COL[f"{g}.force.x"]], row[COL[f"{g}.force.y"]]),
+            moment=row[COL[f"{g}.moment"]],
+        )
 
     pairs = PAIRS[dyad]
     guide_k = (row[COL["guide_k.x"]], row[COL["guide_k.y"]]) if pairs[0] == "T" else None
@@ -264,16 +327,25 @@ def reference_args(dyad: str, row: np.ndarray):
     return link("m"), link("n"), guide_k, guide_p, (row[COL["gravity.x"]], row[COL["gravity.y"]])
 
 
-def batched_reference_args(dyad: str, rows: np.ndarray):
+def batched_reference_args(dyad: str, rows: np.ndarray) -> tuple:
     """All configurations at once, for the batched reference.solve."""
-    def link(g):
-        def vec(a, b):
+
+    def link(g: str):
+        def vec(a: np.ndarray, b: np.ndarray):
             return rows[:, [COL[f"{g}.{a}"], COL[f"{g}.{b}"]]]
-        return dict(dir=vec("dir.x", "dir.y"), length=rows[:, COL[f"{g}.length"]],
-                    omega=rows[:, COL[f"{g}.omega"]], epsilon=rows[:, COL[f"{g}.epsilon"]],
-                    accel_d=vec("accel_d.x", "accel_d.y"), com=vec("com.x", "com.y"),
-                    mass=rows[:, COL[f"{g}.mass"]], inertia=rows[:, COL[f"{g}.inertia"]],
-                    force=vec("force.x", "force.y"), moment=rows[:, COL[f"{g}.moment"]])
+
+        return dict(
+            dir=vec("dir.x", "dir.y"),
+            length=rows[:, COL[f"{g}.length"]],
+            omega=rows[:, COL[f"{g}.omega"]],
+            epsilon=rows[:, COL[f"{g}.epsilon"]],
+            accel_d=vec("accel_d.x", "accel_d.y"),
+            com=vec("com.x", "com.y"),
+            mass=rows[:, COL[f"{g}.mass"]],
+            inertia=rows[:, COL[f"{g}.inertia"]],
+            force=vec("force.x", "force.y"),
+            moment=rows[:, COL[f"{g}.moment"]],
+        )
 
     pairs = PAIRS[dyad]
     guide_k = rows[:, [COL["guide_k.x"], COL["guide_k.y"]]] if pairs[0] == "T" else None

@@ -3,13 +3,14 @@ output against independent references.
 
 Two kinds of scene:
 
-* the multi-dyad chains ``shaper``, ``sixbar`` and ``rocker_slider``: kinematics, loads and the reference
+* the multi-dyad chains ``shaper``, ``sixbar`` and ``rocker_slider``: kinematics, loads and
+  the reference
   (one Newton-Euler system of the whole mechanism, crank included) come from
-  :mod:`dyadfmu.chains`;
+  :mod:`dyadfmu.mechanisms.chains`;
 * the single-dyad scenes ``engine``, ``press`` and ``monitor``: kinematics and loads of the
-  slider-crank and four-bar of :mod:`dyadfmu.mechanisms`, the dyad's reactions from
-  :mod:`dyadfmu.reference` (its own 6x6 Newton-Euler solve) with the scene's effects (no
-  inertia in a static scene, no weight without gravity), and the crank's equilibrium
+  slider-crank and four-bar of :mod:`dyadfmu.mechanisms.builtin`, the dyad's reactions from
+  :mod:`dyadfmu.reference.newton_euler` (its own 6x6 Newton-Euler solve) with the scene's
+  effects (no inertia in a static scene, no weight without gravity), and the crank's equilibrium
   written out here.
 
 The FMU's inputs are taken by name from the kinematics; its outputs are compared by name
@@ -28,13 +29,22 @@ from pathlib import Path
 import numpy as np
 from fmpy import read_model_description
 
-from . import chains, mechanisms, reference
-from .mechanisms import _cross, _rot90, _unit
-from .harness import (OutputError, _match_samples, _Progress, build_dir, communication_grid,
-                      setup_for, simulate)
+from .. import paths
+from ..fmi.simulate import setup_for, simulate
+from ..mechanisms import builtin, chains
+from ..mechanisms import geometry as geo
+from ..mechanisms.motion import CrankMotion
+from ..reference import newton_euler
+from .compare import (
+    NEAR_SINGULAR,
+    Progress,
+    communication_grid,
+    match_samples,
+    output_error,
+    rows_of,
+)
 
-ROOT = Path(__file__).resolve().parents[2]
-SCENES_DIR = ROOT / "scenes"
+SCENES_DIR = paths.SCENES_DIR
 
 #: The tailored example scenes, in the order of the report.
 NAMES = ("press", "monitor", "engine", "shaper", "sixbar", "rocker_slider")
@@ -48,24 +58,23 @@ SINGLE = {
 }
 
 #: The generic per-type FMUs a scene would need instead (one per dyad).
-FULL_OF = {"press": ("RRT",), "monitor": ("RRR",), "engine": ("RRT",),
-           "shaper": ("RTR", "RRT"), "sixbar": ("RRR", "RRR"),
-           "rocker_slider": ("RRR", "RRT")}
-
-#: Speeds of the quasi-static press: slow enough that nothing dynamic matters, though the
-#: FMU takes no speeds at all.
-NEAR_SINGULAR = 1e-6
+FULL_OF = {
+    "press": ("RRT",),
+    "monitor": ("RRR",),
+    "engine": ("RRT",),
+    "shaper": ("RTR", "RRT"),
+    "sixbar": ("RRR", "RRR"),
+    "rocker_slider": ("RRR", "RRT"),
+}
 
 
 def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
-    path = (build or build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
-    if not path.is_file():
-        raise FileNotFoundError(f"{path} does not exist: build the FMUs first "
-                                "(scripts/run-scenes does, or cmake --build build)")
-    return path
+    """build/fmus/<name>_fmi<version>.fmu, the tailored FMU of a scene."""
+    return paths.built_fmu(name, version, build, how="scripts/run-scenes")
 
 
 def scene_data(name: str) -> dict:
+    """The parsed scene file scenes/<name>.toml."""
     with open(SCENES_DIR / f"{name}.toml", "rb") as f:
         return tomllib.load(f)
 
@@ -83,22 +92,25 @@ class Source:
         self.inertia = bool(effects.get("inertia", False))
         self.gravity_on = bool(effects.get("gravity", False))
         g = self.scene.get("gravity", {})
-        self.gravity = (float(g.get("x", 0.0)), float(g.get("y", 0.0))) if self.gravity_on \
-            else (0.0, 0.0)
+        self.gravity = (
+            (float(g.get("x", 0.0)), float(g.get("y", 0.0))) if self.gravity_on else (0.0, 0.0)
+        )
         self.crank_name = self.scene.get("crank", {}).get("name", "crank")
         if name in SINGLE:
             mech_name, self.roles = SINGLE[name]
-            self.mechanism = mechanisms.load(mech_name)
+            self.mechanism = builtin.load(mech_name)
             self.chain = None
             self.dyad = self.scene["dyad"][0]
         else:
             self.chain = chains.load(name)
             self.mechanism = None
 
-    def motion(self, kind: str, revolutions: float):
+    def motion(self, kind: str, revolutions: float) -> CrankMotion:
+        """The crank's motion of the scene's mechanism."""
         return (self.chain or self.mechanism).motion(kind, revolutions)
 
-    def kinematics(self, t, motion) -> dict:
+    def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
+        """The kinematics under the scene's variable names at the times t."""
         if self.chain is not None:
             return self.chain.kinematics(t, motion)
         kin = self.mechanism.kinematics(t, motion)
@@ -115,53 +127,57 @@ class Source:
                 out[f"{link}.{key}.y"] = kin[f"{role}.{key}"][:, 1]
         return out
 
-    def inputs(self, kin, names) -> dict:
+    def inputs(self, kin: dict, names: list[str]) -> dict:
         """The FMU's input signals, by name."""
         missing = [n for n in names if n not in kin]
         if missing:
             raise KeyError(f"scene {self.name}: no kinematics for input(s) {missing}")
         return {n: np.asarray(kin[n], dtype=float).copy() for n in names}
 
-    def reference(self, kin) -> dict:
+    def reference(self, kin: dict) -> dict:
         """Every output the scene can have, by FMU name."""
         if self.chain is not None:
             return self.chain.reference(kin)
         return self._single_reference(kin)
 
-    def conditioning(self, kin) -> dict:
+    def conditioning(self, kin: dict) -> dict:
+        """The reference conditioning of every dyad, by FMU output name."""
         if self.chain is not None:
-            return {f"{d['name']}.conditioning": kin[f"{d['name']}.conditioning"]
-                    for d in self.scene["dyad"]}
+            return {
+                f"{d['name']}.conditioning": kin[f"{d['name']}.conditioning"]
+                for d in self.scene["dyad"]
+            }
         return {f"{self.dyad['name']}.conditioning": self.mechanism.conditioning(kin)}
 
     # ---- single dyad: reference.solve with the scene's effects, crank balance here
-    def _link_input(self, kin, link: str, table: dict) -> dict:
+    def _link_input(self, kin: dict, link: str, table: dict) -> dict:
         n = len(kin["t"])
         zero, zero2 = np.zeros(n), np.zeros((n, 2))
         dynamic = self.inertia
-        return {"dir": _unit(kin[f"{link}.angle"]),
-                "length": np.asarray(kin[f"{link}.length"], dtype=float),
-                "omega": kin[f"{link}.omega"] if dynamic else zero,
-                "epsilon": kin[f"{link}.epsilon"] if dynamic else zero,
-                "accel_d": kin[f"{link}.accel_d"] if dynamic else zero2,
-                "com": tuple(table.get("com", (0.0, 0.0))),
-                "mass": float(table.get("mass", 0.0)) if (self.inertia or self.gravity_on)
-                else 0.0,
-                "inertia": float(table.get("inertia", 0.0)) if self.inertia else 0.0,
-                "force": kin[f"{link}.force"] if link in self._loaded("force") else zero2,
-                "moment": kin[f"{link}.moment"] if link in self._loaded("moment") else zero}
+        return {
+            "dir": geo.unit(kin[f"{link}.angle"]),
+            "length": np.asarray(kin[f"{link}.length"], dtype=float),
+            "omega": kin[f"{link}.omega"] if dynamic else zero,
+            "epsilon": kin[f"{link}.epsilon"] if dynamic else zero,
+            "accel_d": kin[f"{link}.accel_d"] if dynamic else zero2,
+            "com": tuple(table.get("com", (0.0, 0.0))),
+            "mass": float(table.get("mass", 0.0)) if (self.inertia or self.gravity_on) else 0.0,
+            "inertia": float(table.get("inertia", 0.0)) if self.inertia else 0.0,
+            "force": kin[f"{link}.force"] if link in self._loaded("force") else zero2,
+            "moment": kin[f"{link}.moment"] if link in self._loaded("moment") else zero,
+        }
 
-    def _loaded(self, key):
+    def _loaded(self, key: str):
         return set(self.scene.get("loads", {}).get(key, []))
 
-    def _single_reference(self, kin) -> dict:
+    def _single_reference(self, kin: dict) -> dict:
         d = self.dyad
         links = {t["name"]: t for t in self.scene["link"]}
         m = self._link_input(kin, d["m"], links[d["m"]])
         n = self._link_input(kin, d["n"], links[d["n"]])
-        gk = _unit(kin["guide_k.angle"]) if "guide_k.angle" in kin else None
-        gp = _unit(kin["guide_p.angle"]) if "guide_p.angle" in kin else None
-        r = reference.solve(d["type"], m, n, gk, gp, self.gravity)
+        gk = geo.unit(kin["guide_k.angle"]) if "guide_k.angle" in kin else None
+        gp = geo.unit(kin["guide_p.angle"]) if "guide_p.angle" in kin else None
+        r = newton_euler.solve(d["type"], m, n, gk, gp, self.gravity)
         pre = f"{d['name']}."
         out = {}
         for pair in ("mk", "np", "mn"):
@@ -173,25 +189,31 @@ class Source:
         crank = self.scene["crank"]
         c = self.crank_name
         phi, w, eps = kin[f"{c}.angle"], kin[f"{c}.omega"], kin[f"{c}.epsilon"]
-        i_c = _unit(phi)
-        j_c = _rot90(i_c)
+        i_c = geo.unit(phi)
+        j_c = geo.rot90(i_c)
         pin = float(crank["length"]) * i_c
         com = crank.get("com", (0.0, 0.0))
         r_s = com[0] * i_c + com[1] * j_c
         mass = float(crank.get("mass", 0.0)) if (self.inertia or self.gravity_on) else 0.0
         inertia = float(crank.get("inertia", 0.0)) if self.inertia else 0.0
-        a_s = (eps[:, None] * _rot90(r_s) - (w * w)[:, None] * r_s) if self.inertia \
+        a_s = (
+            (eps[:, None] * geo.rot90(r_s) - (w * w)[:, None] * r_s)
+            if self.inertia
             else np.zeros_like(r_s)
+        )
         own = mass * (np.asarray(self.gravity) - a_s)
         r_np = r["r_np"]
-        moments = _cross(pin, -r_np) + _cross(r_s, own) - inertia * (eps if self.inertia else 0.0)
+        moments = (
+            geo.cross(pin, -r_np) + geo.cross(r_s, own) - inertia * (eps if self.inertia else 0.0)
+        )
         out[f"{c}.torque"] = -moments
         r_o = r_np - own
         out[f"{c}.R_O.x"], out[f"{c}.R_O.y"] = r_o[:, 0], r_o[:, 1]
         return out
 
     # ---- energy of a chain
-    def energy(self, kin) -> np.ndarray:
+    def energy(self, kin: dict) -> np.ndarray:
+        """Kinetic plus potential energy of the chain at every sample."""
         return self.chain.kinetic_energy(kin) + self.chain.potential_energy(kin)
 
 
@@ -200,6 +222,8 @@ class Source:
 # ---------------------------------------------------------------------------
 @dataclass
 class SceneRun:
+    """A scene's tailored FMU co-simulated and compared with its reference."""
+
     name: str
     fmi_version: int
     source: Source
@@ -212,15 +236,22 @@ class SceneRun:
     seconds_fmu: float
     steps: int
     units: dict = field(default_factory=dict)
-    energy_residual: float = math.nan     # worst |M w + P - dE/dt| / peak |M w|
+    energy_residual: float = math.nan  # worst |M w + P - dE/dt| / peak |M w|
 
     @property
     def worst_relative(self) -> float:
+        """The largest relative error of any output."""
         return max(e.relative for e in self.errors)
 
 
-def setup(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
-          motion: str = "constant", build: Path | None = None):
+def setup(
+    name: str,
+    fmi_version: int = 2,
+    revolutions: float = 2.0,
+    steps: int = 360,
+    motion: str = "constant",
+    build: Path | None = None,
+) -> tuple:
     """The co-simulation of a scene's tailored FMU: (setup, source, crank motion,
     kinematics on the grid); its inputs are taken by name from the kinematics."""
     source = Source(name)
@@ -233,21 +264,27 @@ def setup(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int 
     return setup_for(path, t, source.inputs(kin, names)), source, crank_motion, kin
 
 
-def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 360,
-        motion: str = "constant", build: Path | None = None, progress: bool = False) -> SceneRun:
+def run(
+    name: str,
+    fmi_version: int = 2,
+    revolutions: float = 2.0,
+    steps: int = 360,
+    motion: str = "constant",
+    build: Path | None = None,
+    progress: bool = False,
+) -> SceneRun:
     """Co-simulate a scene's tailored FMU over `revolutions` crank turns at `steps`
     communication steps per turn and compare every output with the reference."""
     co, source, crank_motion, kin = setup(name, fmi_version, revolutions, steps, motion, build)
     t, inputs, outputs, units, names = co.time, co.inputs, co.outputs, co.units, list(co.inputs)
 
-    bar = _Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
+    bar = Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
     started = clock.perf_counter()
     fmu = simulate(co, step_finished=bar)
     seconds = clock.perf_counter() - started
     bar.close()
-    sample = _match_samples(fmu, inputs, names, t)
-    rows = {k: (v[sample] if isinstance(v, np.ndarray) and v.shape[:1] == t.shape else v)
-            for k, v in kin.items()}
+    sample = match_samples(fmu, inputs, names, t)
+    rows = rows_of(kin, sample, t)
     full_ref = source.reference(rows)
     full_ref.update(source.conditioning(rows))
     ref = {n: np.asarray(full_ref[n]) for n in outputs if n in full_ref}
@@ -262,21 +299,21 @@ def run(name: str, fmi_version: int = 2, revolutions: float = 2.0, steps: int = 
             continue
         if out not in ref:
             raise KeyError(f"scene {name}: the reference has no output {out}")
-        want, got = ref[out][valid], fmu[out][valid]
-        peak = float(np.max(np.abs(want))) if want.size else 0.0
-        max_abs = float(np.max(np.abs(got - want))) if want.size else math.nan
-        errors.append(OutputError(out, units.get(out, ""), peak, max_abs,
-                                  max_abs / peak if peak > 0 else max_abs))
-    result = SceneRun(name, fmi_version, source, rows, sample, fmu, ref, valid, errors, seconds,
-                      len(t) - 1, units)
+        errors.append(output_error(out, units.get(out, ""), ref[out][valid], fmu[out][valid]))
+    result = SceneRun(
+        name, fmi_version, source, rows, sample, fmu, ref, valid, errors, seconds, len(t) - 1, units
+    )
     torque = f"{source.crank_name}.torque"
     if source.chain is not None and torque in fmu:
-        result.energy_residual = energy_balance(source, crank_motion, fmu["time"], fmu[torque],
-                                                t[sample])
+        result.energy_residual = energy_balance(
+            source, crank_motion, fmu["time"], fmu[torque], t[sample]
+        )
     return result
 
 
-def energy_balance(source: Source, motion, time, torque, t_samples) -> float:
+def energy_balance(
+    source: Source, motion: CrankMotion, time: np.ndarray, torque: np.ndarray, t_samples: np.ndarray
+) -> float:
     """Worst |M omega + P_loads - d(T + V)/dt| over the run, relative to the peak driving
     power; dE/dt by 4th-order central differences of the reference energies."""
     w0 = float(np.max(np.abs(motion.omega(t_samples))))
@@ -290,20 +327,13 @@ def energy_balance(source: Source, motion, time, torque, t_samples) -> float:
     return float(np.max(np.abs(residual)) / np.max(np.abs(power)))
 
 
-# ---------------------------------------------------------------------------
-# Tables
-# ---------------------------------------------------------------------------
-def error_rows(result: SceneRun) -> list:
-    rows = [["output", "unit", "peak |reference|", "max |FMU - reference|", "relative to peak"]]
-    for e in result.errors:
-        rows.append([e.name, e.unit, f"{e.peak:.6g}", f"{e.max_abs:.3e}", f"{e.relative:.3e}"])
-    return rows
-
-
 def summary(result: SceneRun) -> str:
-    text = (f"{result.name}, FMI {result.fmi_version}: {result.steps} steps in "
-            f"{result.seconds_fmu:.3f} s; {len(result.errors)} outputs, worst relative error "
-            f"{result.worst_relative:.2e}")
+    """One line on the run: steps, time, worst error, driving torque, energy balance."""
+    text = (
+        f"{result.name}, FMI {result.fmi_version}: {result.steps} steps in "
+        f"{result.seconds_fmu:.3f} s; {len(result.errors)} outputs, worst relative error "
+        f"{result.worst_relative:.2e}"
+    )
     torque = result.fmu.get(f"{result.source.crank_name}.torque")
     if torque is not None:
         t = torque[result.valid]
@@ -321,7 +351,9 @@ def reactions_of(result: SceneRun) -> dict:
     return {k: v for k, v in result.fmu.items() if k != "time"}
 
 
-def drawing_indices(result: SceneRun, angles_deg=(30.0, 120.0, 210.0, 300.0)) -> list:
+def drawing_indices(
+    result: SceneRun, angles_deg: tuple[float, ...] = (30.0, 120.0, 210.0, 300.0)
+) -> list:
     """The rows nearest to the given crank angles (first occurrence), for drawings."""
     phi = np.mod(np.asarray(result.kin[f"{result.source.crank_name}.angle"]), 2 * math.pi)
     picks = []

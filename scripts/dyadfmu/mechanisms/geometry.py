@@ -1,0 +1,90 @@
+"""Shared helpers of the mechanisms: vectors on arrays of shape (..., 2) and the checked
+reading of numbers and pairs from the data tables."""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+
+def unit(angle: float) -> np.ndarray:
+    """Unit vectors at the given angles (rad)."""
+    angle = np.asarray(angle, dtype=float)
+    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def rot90(v: np.ndarray) -> np.ndarray:
+    """The vectors turned by +90 degrees."""
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The dot products of a and b."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The z components of the cross products a x b."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def col(x: str) -> np.ndarray:
+    """The values as a column (a trailing axis of length 1)."""
+    return np.asarray(x, dtype=float)[..., None]
+
+
+def vec(x: str, y: str) -> np.ndarray:
+    """Vectors from their x and y components, broadcast together."""
+    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    return np.stack([x, y], axis=-1)
+
+
+def merge(base: Mapping, over: Mapping) -> dict:
+    """A deep copy of base with the tables of over merged in, key by key."""
+    out = copy.deepcopy(base)
+    for key, value in over.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def number(
+    table: Mapping,
+    key: str,
+    where: str,
+    positive: bool = False,
+    nonnegative: bool = False,
+    default: tuple[float, float] = None,
+) -> float:
+    """The finite number table[key] (or the default), checked; errors name where."""
+    if key not in table:
+        if default is not None:
+            return float(default)
+        raise ValueError(f"{where}: missing key {key!r}")
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{where}.{key}: expected a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise ValueError(f"{where}.{key}: must be > 0, got {value!r}")
+    if nonnegative and value < 0:
+        raise ValueError(f"{where}.{key}: must be >= 0, got {value!r}")
+    return float(value)
+
+
+def pair(table: Mapping, key: str, where: str) -> tuple[float, float]:
+    """The pair of finite numbers table[key]; errors name where."""
+    value = table.get(key)
+    if value is None:
+        raise ValueError(f"{where}: missing key {key!r}")
+    try:
+        x, y = (float(c) for c in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}.{key}: expected two numbers, got {value!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ValueError(f"{where}.{key}: expected finite numbers, got {value!r}")
+    return (x, y)

@@ -1,0 +1,89 @@
+"""Crank motions: closed-form angle, speed and acceleration of a turning or oscillating
+crank."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class CrankMotion:
+    """A crank motion: phi(t) [rad], omega(t) [rad/s], epsilon(t) [rad/s2] as vectorised
+    callables, consistent with each other in closed form, and ``duration`` [s] covering
+    the requested number of revolutions (or oscillation cycles)."""
+
+    kind: str
+    phi: Callable[[np.ndarray], np.ndarray]
+    omega: Callable[[np.ndarray], np.ndarray]
+    epsilon: Callable[[np.ndarray], np.ndarray]
+    duration: float
+    cycles: float
+    description: str = ""
+
+
+def rotating(
+    kind: str, w0: float, variation: float, phi0: float, revolutions: float
+) -> CrankMotion:
+    """Full rotation. constant: phi = phi0 + w0 t. varying: omega = w0 (1 + a sin(w0 t)),
+    phi = phi0 + w0 t + a (1 - cos(w0 t)), epsilon = a w0^2 cos(w0 t)."""
+    a = variation if kind == "varying" else 0.0
+
+    def phi(t: np.ndarray):
+        t = np.asarray(t, dtype=float)
+        return phi0 + w0 * t + a * (1.0 - np.cos(w0 * t))
+
+    def omega(t: np.ndarray):
+        t = np.asarray(t, dtype=float)
+        return w0 * (1.0 + a * np.sin(w0 * t))
+
+    def epsilon(t: np.ndarray):
+        t = np.asarray(t, dtype=float)
+        return a * w0 * w0 * np.cos(w0 * t)
+
+    # duration: phi(T) - phi0 = 2 pi N; exact for integer N, Newton otherwise
+    # (the left side increases strictly since |a| < 1)
+    target = 2.0 * math.pi * revolutions
+    x = target  # x = w0 T
+    for _ in range(60):
+        f = x + a * (1.0 - math.cos(x)) - target
+        x_new = x - f / (1.0 + a * math.sin(x))
+        if abs(x_new - x) <= 1e-15 * max(1.0, abs(x)):
+            x = x_new
+            break
+        x = x_new
+    text = (
+        f"constant speed {w0:.6g} rad/s"
+        if a == 0.0
+        else f"omega = {w0:.6g} (1 + {a:g} sin({w0:.6g} t)) rad/s"
+    )
+    return CrankMotion(kind, phi, omega, epsilon, x / w0, float(revolutions), text)
+
+
+def oscillating(
+    kind: str, w: np.ndarray, centre: np.ndarray, amplitude: float, harmonic2: float, cycles: float
+) -> CrankMotion:
+    """Oscillation phi = centre + A1 sin(w t) + A2 sin(2 w t) (A2 = 0 for kind constant)."""
+    a2 = harmonic2 if kind == "varying" else 0.0
+
+    def phi(t: np.ndarray):
+        t = np.asarray(t, dtype=float)
+        return centre + amplitude * np.sin(w * t) + a2 * np.sin(2.0 * w * t)
+
+    def omega(t: np.ndarray):
+        t = np.asarray(t, dtype=float)
+        return amplitude * w * np.cos(w * t) + 2.0 * a2 * w * np.cos(2.0 * w * t)
+
+    def epsilon(t: np.ndarray):
+        t = np.asarray(t, dtype=float)
+        return -amplitude * w * w * np.sin(w * t) - 4.0 * a2 * w * w * np.sin(2.0 * w * t)
+
+    text = (
+        f"phi = {centre:.4g} + {amplitude:g} sin({w:.6g} t)"
+        + (f" + {a2:g} sin({2 * w:.6g} t)" if a2 else "")
+        + " rad"
+    )
+    return CrankMotion(kind, phi, omega, epsilon, cycles * 2.0 * math.pi / w, float(cycles), text)

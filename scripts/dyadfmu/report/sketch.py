@@ -1,0 +1,164 @@
+"""The parts the mechanism drawings are made of, on a matplotlib Axes: bars, slots, pins,
+blocks, hatched ground, fixed pivots and labels; ``u`` is the drawing's unit length."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from matplotlib.patches import Circle, Polygon
+
+from ..mechanisms import geometry as geo
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+#: Line width of a link drawn as a bar (points).
+LINK_WIDTH = 5.0
+#: Colour of the frame: ground, fixed guides, fixed pivots.
+FRAME_COLOUR = "0.35"
+
+
+def bar(
+    ax: Axes, p0: np.ndarray, p1: np.ndarray, colour: str, width: float = LINK_WIDTH, z: float = 2.0
+) -> None:
+    """A link as a bar from p0 to p1."""
+    ax.plot(
+        [p0[0], p1[0]], [p0[1], p1[1]], color=colour, lw=width, solid_capstyle="round", zorder=z
+    )
+
+
+def slot(ax: Axes, p0: np.ndarray, p1: np.ndarray, z: float) -> None:
+    """A slot along a bar: a white groove drawn over it."""
+    ax.plot(
+        [p0[0], p1[0]],
+        [p0[1], p1[1]],
+        color="white",
+        lw=LINK_WIDTH * 0.35,
+        solid_capstyle="round",
+        zorder=z,
+    )
+
+
+def pin(ax: Axes, p: np.ndarray, u: float, z: float = 6.0) -> None:
+    """A revolute pair: a white pin at p."""
+    ax.add_patch(Circle(tuple(p), 0.42 * u, facecolor="white", edgecolor="black", lw=1.2, zorder=z))
+
+
+def block(
+    ax: Axes,
+    centre: np.ndarray,
+    direction: np.ndarray,
+    length: float,
+    width: float,
+    colour: str,
+    z: float = 4.0,
+) -> None:
+    """A rectangle centred at ``centre`` with its long side along ``direction``."""
+    i = np.asarray(direction, dtype=float)
+    i = i / np.hypot(*i)
+    j = geo.rot90(i)
+    c = np.asarray(centre, dtype=float)
+    a, b = 0.5 * length * i, 0.5 * width * j
+    corners = [c - a - b, c + a - b, c + a + b, c - a + b]
+    ax.add_patch(
+        Polygon(
+            corners, closed=True, facecolor=colour, edgecolor="black", lw=1.0, alpha=0.9, zorder=z
+        )
+    )
+
+
+def hatch(
+    ax: Axes, p0: np.ndarray, p1: np.ndarray, side: np.ndarray, u: float, z: float = 1.0
+) -> None:
+    """A fixed surface from p0 to p1 with hatch strokes on the side ``side`` (a vector)."""
+    p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
+    ax.plot([p0[0], p1[0]], [p0[1], p1[1]], color=FRAME_COLOUR, lw=1.5, zorder=z)
+    along = p1 - p0
+    length = float(np.hypot(*along))
+    if length == 0:
+        return
+    t = along / length
+    s = np.asarray(side, dtype=float)
+    s = s / np.hypot(*s)
+    step = 0.7 * u
+    count = max(int(length / step), 1)
+    for k in range(count + 1):
+        q = p0 + t * (k * length / count)
+        q1 = q + 0.8 * u * s - 0.6 * u * t
+        ax.plot([q[0], q1[0]], [q[1], q1[1]], color=FRAME_COLOUR, lw=0.8, zorder=z)
+
+
+def ground_pivot(ax: Axes, p: np.ndarray, u: float) -> None:
+    """A fixed pivot: a triangle standing on a hatched base."""
+    p = np.asarray(p, dtype=float)
+    base = p - np.array([0.0, 1.5 * u])
+    tri = [p, base + np.array([-0.9 * u, 0.0]), base + np.array([0.9 * u, 0.0])]
+    ax.add_patch(
+        Polygon(tri, closed=True, facecolor="0.85", edgecolor=FRAME_COLOUR, lw=1.0, zorder=1.5)
+    )
+    hatch(ax, base - np.array([1.4 * u, 0.0]), base + np.array([1.4 * u, 0.0]), (0.0, -1.0), u)
+
+
+def label(
+    ax: Axes,
+    p: np.ndarray,
+    text: str,
+    offset: tuple[float, float],
+    colour: str = "black",
+    size: float = 9,
+    weight: str = "normal",
+    box: bool = True,
+) -> None:
+    """Text near p, ``offset`` in points; aligned so that it grows away from p."""
+    dx, dy = offset
+    ha = (
+        "left"
+        if dx > 0.35 * math.hypot(dx, dy)
+        else "right"
+        if dx < -0.35 * math.hypot(dx, dy)
+        else "center"
+    )
+    va = (
+        "bottom"
+        if dy > 0.35 * math.hypot(dx, dy)
+        else "top"
+        if dy < -0.35 * math.hypot(dx, dy)
+        else "center"
+    )
+    bbox = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75) if box else None
+    ax.annotate(
+        text,
+        xy=(p[0], p[1]),
+        xytext=(dx, dy),
+        textcoords="offset points",
+        ha=ha,
+        va=va,
+        fontsize=size,
+        color=colour,
+        weight=weight,
+        zorder=9,
+        bbox=bbox,
+    )
+
+
+def beside(p0: np.ndarray, p1: np.ndarray, u: float, up: bool = True) -> np.ndarray:
+    """A point 1.8 u beside the middle of the bar p0-p1 (on its upper side if ``up``)."""
+    p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
+    t = p1 - p0
+    n = geo.rot90(t) / max(float(np.hypot(*t)), 1e-300)
+    if (n[1] < 0) == up:
+        n = -n
+    return 0.5 * (p0 + p1) + 1.8 * u * n
+
+
+def away(
+    p: np.ndarray, centre: np.ndarray, default: tuple[float, float] = (1.0, 1.0)
+) -> np.ndarray:
+    """The unit vector from centre towards p (default where they coincide)."""
+    d = np.asarray(p, dtype=float) - centre
+    n = float(np.hypot(*d))
+    if n < 1e-12:
+        d, n = np.asarray(default, dtype=float), float(np.hypot(*default))
+    return d / n
