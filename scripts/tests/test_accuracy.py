@@ -12,12 +12,11 @@ import math
 
 import numpy as np
 import pytest
-
+from dyadfmu.core import Core, library_path
 from dyadfmu.reference import newton_euler as reference
 from dyadfmu.study import configurations as cfg
-from dyadfmu.core import Core, library_path
 
-EPS = 2.0 ** -52
+EPS = 2.0**-52
 #: The constant of the contract. Every output is reached from the inputs by a chain of
 #: fewer than 32 rounded operations (the resultant's terms, its moment about D, the
 #: closed forms, a reactive moment's lever), each off by at most u = eps / 2 of a
@@ -28,8 +27,9 @@ C = 16.0
 #: each type, the worst error reaches at least this share of the bound.
 TIGHT = 1 / 20
 
-pytestmark = pytest.mark.skipif(not library_path().is_file(),
-                                reason=f"C core not built at {library_path()}")
+pytestmark = pytest.mark.skipif(
+    not library_path().is_file(), reason=f"C core not built at {library_path()}"
+)
 
 
 @pytest.fixture(scope="module")
@@ -42,11 +42,23 @@ def issue_12_trt() -> np.ndarray:
     The reactive moment M_mk = 9.6e64 N m is the difference of two moments of 4e85 N m
     about E; the core used to report 0 with status ok and amplification 1.006."""
     row = np.zeros(len(cfg.COLUMNS))
-    values = {"m.dir.x": 1.0, "m.length": 2e19, "m.mass": 1.0, "m.accel_d.x": 2e66,
-              "m.accel_d.y": 2e66, "m.com.x": 0.024, "m.com.y": -0.024,
-              "n.dir.y": 1.0, "n.length": 0.0, "n.mass": 1.0, "n.accel_d.x": 2e66,
-              "guide_k.x": math.cos(0.11), "guide_k.y": math.sin(0.11), "guide_p.y": 1.0,
-              "singular_threshold": 1.4901161193847656e-08}
+    values = {
+        "m.dir.x": 1.0,
+        "m.length": 2e19,
+        "m.mass": 1.0,
+        "m.accel_d.x": 2e66,
+        "m.accel_d.y": 2e66,
+        "m.com.x": 0.024,
+        "m.com.y": -0.024,
+        "n.dir.y": 1.0,
+        "n.length": 0.0,
+        "n.mass": 1.0,
+        "n.accel_d.x": 2e66,
+        "guide_k.x": math.cos(0.11),
+        "guide_k.y": math.sin(0.11),
+        "guide_p.y": 1.0,
+        "singular_threshold": 1.4901161193847656e-08,
+    }
     for name, value in values.items():
         row[cfg.COL[name]] = value
     return row[None, :]
@@ -58,8 +70,9 @@ def _rows(dyad, kind):
         return cfg.random_set(dyad, 80, seed)
     if kind == "sweep":
         return cfg.sweep_set(dyad, per_decade=1, instances=1, seed=seed)
-    rows = cfg.extreme_set(dyad, 80, seed) if kind == "extreme" \
-        else cfg.cancelling_set(dyad, 20, seed)
+    rows = (
+        cfg.extreme_set(dyad, 80, seed) if kind == "extreme" else cfg.cancelling_set(dyad, 20, seed)
+    )
     # the extreme TRT of issue 12 is both: extreme scales whose moments cancel
     return np.concatenate([issue_12_trt(), rows]) if dyad == "TRT" else rows
 
@@ -68,18 +81,27 @@ def _solve(core, dyad, rows):
     """Outputs (rows of OUTPUT_COLUMNS), status and amplification of the core."""
     values, status, amplification = np.empty((len(rows), len(cfg.OUTPUT_COLUMNS))), [], []
     for k, row in enumerate(rows):
-        got = core.solve(dyad, *cfg.reference_args(dyad, row),
-                         singular_threshold=row[cfg.COL["singular_threshold"]])
-        values[k] = [got[name.split(".")[0]][0 if name.endswith(".x") else 1]
-                     if "." in name else got[name] for name in cfg.OUTPUT_COLUMNS]
+        got = core.solve(
+            dyad,
+            *cfg.reference_args(dyad, row),
+            singular_threshold=row[cfg.COL["singular_threshold"]],
+        )
+        values[k] = [
+            got[name.split(".")[0]][0 if name.endswith(".x") else 1] if "." in name else got[name]
+            for name in cfg.OUTPUT_COLUMNS
+        ]
         status.append(got["status"])
         amplification.append(got["amplification"])
     return values, np.array(status), np.array(amplification)
 
 
 def _truth(dyad, rows):
-    return np.array([cfg.outputs_of(reference.solve_mp(dyad, *cfg.reference_args(dyad, r),
-                                                       dps=50), dyad) for r in rows])
+    return np.array(
+        [
+            cfg.outputs_of(reference.solve_mp(dyad, *cfg.reference_args(dyad, r), dps=50), dyad)
+            for r in rows
+        ]
+    )
 
 
 @pytest.mark.parametrize("dyad", cfg.TYPES)
@@ -90,12 +112,15 @@ def test_error_within_eps_times_amplification(core, dyad, kind):
     solved = status == "ok"
     # the threshold of the sets is far below eps (the sweep's last points aside)
     assert solved.sum() >= len(rows) - (2 if kind == "sweep" else 0)
-    ratio = cfg.contract_ratio(values[solved], _truth(dyad, rows[solved]),
-                               amplification[solved], EPS)
+    ratio = cfg.contract_ratio(
+        values[solved], _truth(dyad, rows[solved]), amplification[solved], EPS
+    )
     assert np.all(np.isfinite(amplification[solved]))
-    print(f"{dyad} {kind}: worst error / (eps x amplification x largest of its unit) = "
-          f"{ratio.max():.3g} over {solved.sum()} configurations, "
-          f"{np.sum(EPS * amplification[solved] >= 1)} without a promised digit")
+    print(
+        f"{dyad} {kind}: worst error / (eps x amplification x largest of its unit) = "
+        f"{ratio.max():.3g} over {solved.sum()} configurations, "
+        f"{np.sum(EPS * amplification[solved] >= 1)} without a promised digit"
+    )
     worst = int(np.argmax(ratio))
     assert ratio[worst] <= C, (rows[solved][worst], amplification[solved][worst])
 
@@ -120,8 +145,9 @@ def test_amplification_is_not_loose(core, dyad):
         rows = _rows(dyad, kind)
         values, status, amplification = _solve(core, dyad, rows)
         solved = status == "ok"
-        ratio = cfg.contract_ratio(values[solved], _truth(dyad, rows[solved]),
-                                   amplification[solved], EPS)
+        ratio = cfg.contract_ratio(
+            values[solved], _truth(dyad, rows[solved]), amplification[solved], EPS
+        )
         worst = max(worst, float(ratio.max()))
     assert worst >= TIGHT, worst
 
@@ -131,12 +157,12 @@ def test_no_silent_inf_or_nan(core, dyad):
     """Overflowing and underflowing inputs: every output and the amplification are
     finite when the status is ok, and every non-ok status comes with NaN outputs."""
     rows = cfg.extreme_set(dyad, 50, seed=77)
-    rows[:10, cfg.COL["m.mass"]] = 1e300                # inertia force overflows
+    rows[:10, cfg.COL["m.mass"]] = 1e300  # inertia force overflows
     rows[:10, cfg.COL["m.accel_d.x"]] = 1e300
-    rows[10:20, cfg.COL["n.omega"]] = 1e200             # omega^2 overflows
-    rows[20:30, cfg.COL["m.force.x"]] = 1e-310          # subnormal loads
-    rows[30:40, cfg.COL["singular_threshold"]] = 0.999   # flagged singular, mostly
-    rows[40:50, cfg.COL["n.mass"]] = 0.0                # the sizes of the terms overflow
+    rows[10:20, cfg.COL["n.omega"]] = 1e200  # omega^2 overflows
+    rows[20:30, cfg.COL["m.force.x"]] = 1e-310  # subnormal loads
+    rows[30:40, cfg.COL["singular_threshold"]] = 0.999  # flagged singular, mostly
+    rows[40:50, cfg.COL["n.mass"]] = 0.0  # the sizes of the terms overflow
     rows[40:50, cfg.COL["n.accel_d.x"]] = 1.5e308
     rows[40:50, cfg.COL["n.accel_d.y"]] = -1.5e308
     values, status, amplification = _solve(core, dyad, rows)

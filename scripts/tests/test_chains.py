@@ -24,13 +24,12 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 import pytest
-
-import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -81,18 +80,18 @@ def d2(f, h):
     return (-f[0] + 16.0 * f[1] - 30.0 * f[2] + 16.0 * f[3] - f[4]) / (12.0 * h * h)
 
 
-@lru_cache(maxsize=None)
+@cache
 def chain(name):
     return chains.load(name)
 
 
-@lru_cache(maxsize=None)
+@cache
 def scene(name):
     with open(ROOT / "scenes" / f"{name}.toml", "rb") as f:
         return tomllib.load(f)
 
 
-@lru_cache(maxsize=None)
+@cache
 def harness(name):
     with open(ROOT / "scripts" / "dyadfmu" / "mechanisms" / "chains.toml", "rb") as f:
         return tomllib.load(f)[name]
@@ -103,7 +102,7 @@ def times(motion, count=97):
     return (np.arange(count) + 0.37) * motion.duration / count
 
 
-@lru_cache(maxsize=None)
+@cache
 def stencil(name, kind, step):
     """kinematics at t + j h, j = -2..2, and h = step / w0."""
     ch = chain(name)
@@ -154,7 +153,12 @@ def test_attributes(name):
         assert ch.links["slider"]["length"] == 0.0
         assert all(ch.links[g]["length"] > 0 for g in ch.links if g != "slider")
         k = ch.plan[1]["k"]
-        assert (k["kind"], k["body"], k["at"], k["angle"]) == ("link_guide", "rocker", (0.0, 0.0), 0.0)
+        assert (k["kind"], k["body"], k["at"], k["angle"]) == (
+            "link_guide",
+            "rocker",
+            (0.0, 0.0),
+            0.0,
+        )
         assert [pr["second"] for pr in ch.pairs if pr["key"] == "second.R_mk"] == ["rocker"]
     else:
         assert all(ch.links[g]["length"] > 0 for g in ch.links)
@@ -164,8 +168,9 @@ def test_overrides_and_bad_data():
     moved = chains.load("sixbar", {"frame": {"second": {"D_n": {"position": [0.12, -0.28]}}}})
     assert moved.data["frame"]["second"]["D_n"]["position"] == [0.12, -0.28]
     assert moved.data["motion"] == chain("sixbar").data["motion"]
-    assert chains.load("shaper", {"shaper": {"motion": {"omega": 3.0}}}).motion().duration == \
-        pytest.approx(2 * 2 * math.pi / 3.0)
+    assert chains.load(
+        "shaper", {"shaper": {"motion": {"omega": 3.0}}}
+    ).motion().duration == pytest.approx(2 * 2 * math.pi / 3.0)
     with pytest.raises(ValueError, match="intersect"):
         chains.load("sixbar", {"frame": {"second": {"D_n": {"position": [0.12, -0.6]}}}})
     with pytest.raises(ValueError, match="reach"):
@@ -195,7 +200,7 @@ def test_bad_guides_on_links():
             edit_table(t)
         return chains.Chain("rocker_slider", s, t)
 
-    build()                                           # as it is: fine
+    build()  # as it is: fine
     with pytest.raises(ValueError, match="turns with link 'rocker'"):
         build(lambda s: s["link"][2].update(angle=0.0))
     with pytest.raises(ValueError, match="revolute pair at D_n"):
@@ -212,22 +217,43 @@ def test_bad_guides_on_links():
 
     def scene_rod(s):
         s["loads"]["force"] = ["rod"]
+
     with pytest.raises(ValueError, match="needs a slider"):
         build(scene_rod, rod_loaded)
 
 
 def test_output_names():
     assert set(chain("shaper").output_names()) == {
-        "crank.R_O.x", "crank.R_O.y", "crank.torque",
-        "slot.R_mk.x", "slot.R_mk.y", "slot.R_mn.x", "slot.R_mn.y", "slot.N_mn", "slot.M_mn",
-        "slot.R_np.x", "slot.R_np.y",
-        "ram.R_mk.x", "ram.R_mk.y", "ram.N_mk", "ram.M_mk", "ram.R_mn.x", "ram.R_mn.y",
-        "ram.R_np.x", "ram.R_np.y"}
+        "crank.R_O.x",
+        "crank.R_O.y",
+        "crank.torque",
+        "slot.R_mk.x",
+        "slot.R_mk.y",
+        "slot.R_mn.x",
+        "slot.R_mn.y",
+        "slot.N_mn",
+        "slot.M_mn",
+        "slot.R_np.x",
+        "slot.R_np.y",
+        "ram.R_mk.x",
+        "ram.R_mk.y",
+        "ram.N_mk",
+        "ram.M_mk",
+        "ram.R_mn.x",
+        "ram.R_mn.y",
+        "ram.R_np.x",
+        "ram.R_np.y",
+    }
     assert set(chain("sixbar").output_names()) == {"crank.R_O.x", "crank.R_O.y", "crank.torque"} | {
-        f"{d}.R_{t}.{c}" for d in ("first", "second") for t in ("mk", "mn", "np") for c in "xy"}
-    assert set(chain("rocker_slider").output_names()) == \
-        {"crank.R_O.x", "crank.R_O.y", "crank.torque", "second.N_mk", "second.M_mk"} | {
-        f"{d}.R_{t}.{c}" for d in ("first", "second") for t in ("mk", "mn", "np") for c in "xy"}
+        f"{d}.R_{t}.{c}" for d in ("first", "second") for t in ("mk", "mn", "np") for c in "xy"
+    }
+    assert set(chain("rocker_slider").output_names()) == {
+        "crank.R_O.x",
+        "crank.R_O.y",
+        "crank.torque",
+        "second.N_mk",
+        "second.M_mk",
+    } | {f"{d}.R_{t}.{c}" for d in ("first", "second") for t in ("mk", "mn", "np") for c in "xy"}
 
 
 # ---------------------------------------------------------------------------
@@ -257,6 +283,53 @@ def external_point(name, dyad, pair, spec, kin, origins):
     return origins[g] + x * i_g + y * rot90(i_g)
 
 
+def _check_outer_pairs(name, d, kin, origins, tol):
+    """D_m and D_n of dyad d from the external links: a pin, or a point on a guide."""
+    dn = d["name"]
+    for pair, spec in (("D_m", d["k"]), ("D_n", d["p"])):
+        P = external_point(name, dn, pair, spec, kin, origins)
+        if P is None and spec["link"] != "frame":
+            # on the guide of a moving link k: through Q (``at`` in k's frame), along
+            # i_k = i_(link k) rotated by the guide angle; D_m = Q + slide_k i_k
+            k = spec["link"]
+            i_g = unit(kin[f"{k}.angle"])
+            x, y = spec["at"]
+            Q = origins[k] + x * i_g + y * rot90(i_g)
+            i_k = unit(kin[f"{k}.angle"] + spec["guide"])
+            assert np.all(kin[f"{dn}.guide_k.angle"] == kin[f"{k}.angle"] + spec["guide"])
+            off = dot(kin[f"{dn}.{pair}"] - Q, rot90(i_k))
+            assert np.max(np.abs(off)) < tol, f"{dn}.{pair} on its guide"
+            want = Q + col(kin[f"{dn}.slide_k"]) * i_k
+            assert np.max(norm(want - kin[f"{dn}.{pair}"])) < tol, f"{dn}.slide_k"
+        elif P is None:  # on a frame guide through (0, height)
+            i_k = unit(spec["guide"])
+            foot = np.array([0.0, harness(name)["frame"][dn][pair]["height"]])
+            off = dot(kin[f"{dn}.{pair}"] - foot, rot90(i_k))
+            assert np.max(np.abs(off)) < tol, f"{dn}.{pair} on its guide"
+        else:
+            assert np.max(norm(P - kin[f"{dn}.{pair}"])) < tol, f"{dn}.{pair} from {spec}"
+
+
+def _check_pair_constraints(sc, d, kin, tol):
+    """What the inner pairs of dyad d impose on its links' angles and rates."""
+    dn, m, n = d["name"], d["m"], d["n"]
+    i_m, lm = unit(kin[f"{m}.angle"]), kin[f"{m}.length"]
+    if d["type"] == "RTR":  # block turns with the lever; E = A on the slot
+        assert np.max(np.abs(np.sin(kin[f"{n}.angle"] - kin[f"{m}.angle"]))) < 1e-14
+        assert np.max(np.abs(dot(kin[f"{dn}.D_n"] - kin[f"{dn}.D_m"], rot90(i_m)))) < tol
+        assert np.min(lm) > 0
+    if d["type"] == "RRT" and d["k"]["link"] == "frame":  # the slider translates
+        for key in ("omega", "epsilon"):
+            assert np.all(kin[f"{m}.{key}"] == 0.0)
+        link = next(lt for lt in sc["link"] if lt["name"] == m)
+        assert np.all(kin[f"{m}.angle"] == link.get("angle", d["k"]["guide"]))
+    elif d["type"] == "RRT":  # the slider turns with the link carrying its guide
+        k = d["k"]["link"]
+        assert np.all(kin[f"{m}.angle"] == kin[f"{k}.angle"] + d["k"]["guide"])
+        for key in ("omega", "epsilon"):
+            assert np.all(kin[f"{m}.{key}"] == kin[f"{k}.{key}"])
+
+
 @pytest.mark.parametrize("name, kind", CASES)
 def test_loop_closure(name, kind):
     ch = chain(name)
@@ -280,44 +353,8 @@ def test_loop_closure(name, kind):
         E_n = kin[f"{dn}.D_n"] + col(ln) * i_n
         assert np.max(norm(E_m - kin[f"{dn}.E"])) < tol, f"{dn}.E from {m}"
         assert np.max(norm(E_n - kin[f"{dn}.E"])) < tol, f"{dn}.E from {n}"
-        # D_m and D_n from the external links
-        for pair, spec in (("D_m", d["k"]), ("D_n", d["p"])):
-            P = external_point(name, dn, pair, spec, kin, origins)
-            if P is None and spec["link"] != "frame":
-                # on the guide of a moving link k: through Q (``at`` in k's frame), along
-                # i_k = i_(link k) rotated by the guide angle; D_m = Q + slide_k i_k
-                k = spec["link"]
-                i_g = unit(kin[f"{k}.angle"])
-                x, y = spec["at"]
-                Q = origins[k] + x * i_g + y * rot90(i_g)
-                i_k = unit(kin[f"{k}.angle"] + spec["guide"])
-                assert np.all(kin[f"{dn}.guide_k.angle"] == kin[f"{k}.angle"] + spec["guide"])
-                off = dot(kin[f"{dn}.{pair}"] - Q, rot90(i_k))
-                assert np.max(np.abs(off)) < tol, f"{dn}.{pair} on its guide"
-                want = Q + col(kin[f"{dn}.slide_k"]) * i_k
-                assert np.max(norm(want - kin[f"{dn}.{pair}"])) < tol, f"{dn}.slide_k"
-            elif P is None:      # on a frame guide through (0, height)
-                i_k = unit(spec["guide"])
-                foot = np.array([0.0, harness(name)["frame"][dn][pair]["height"]])
-                off = dot(kin[f"{dn}.{pair}"] - foot, rot90(i_k))
-                assert np.max(np.abs(off)) < tol, f"{dn}.{pair} on its guide"
-            else:
-                assert np.max(norm(P - kin[f"{dn}.{pair}"])) < tol, f"{dn}.{pair} from {spec}"
-        # pair constraints
-        if d["type"] == "RTR":       # block turns with the lever; E = A on the slot
-            assert np.max(np.abs(np.sin(kin[f"{n}.angle"] - kin[f"{m}.angle"]))) < 1e-14
-            assert np.max(np.abs(dot(kin[f"{dn}.D_n"] - kin[f"{dn}.D_m"], rot90(i_m)))) < tol
-            assert np.min(lm) > 0
-        if d["type"] == "RRT" and d["k"]["link"] == "frame":       # the slider translates
-            for key in ("omega", "epsilon"):
-                assert np.all(kin[f"{m}.{key}"] == 0.0)
-            link = next(lt for lt in sc["link"] if lt["name"] == m)
-            assert np.all(kin[f"{m}.angle"] == link.get("angle", d["k"]["guide"]))
-        elif d["type"] == "RRT":     # the slider turns with the link carrying its guide
-            k = d["k"]["link"]
-            assert np.all(kin[f"{m}.angle"] == kin[f"{k}.angle"] + d["k"]["guide"])
-            for key in ("omega", "epsilon"):
-                assert np.all(kin[f"{m}.{key}"] == kin[f"{k}.{key}"])
+        _check_outer_pairs(name, d, kin, origins, tol)
+        _check_pair_constraints(sc, d, kin, tol)
         # centres of mass
         for g, D, i_g in ((m, kin[f"{dn}.D_m"], i_m), (n, kin[f"{dn}.D_n"], i_n)):
             x, y = next(lt for lt in sc["link"] if lt["name"] == g)["com"]
@@ -329,20 +366,20 @@ def test_loop_closure(name, kind):
 
 def test_branches():
     kin = chain("shaper").kinematics(np.linspace(0, 2, 200), chain("shaper").motion())
-    assert np.all(kin["ram.E"][:, 0] > kin["ram.D_n"][:, 0])           # C right of B
+    assert np.all(kin["ram.E"][:, 0] > kin["ram.D_n"][:, 0])  # C right of B
     rod = np.degrees(np.abs(np.arctan2(*(kin["ram.E"] - kin["ram.D_n"]).T[::-1])))
     assert rod.max() < 16.0
     lever = np.degrees(kin["lever.angle"])
     assert lever.min() == pytest.approx(90 - math.degrees(math.asin(1 / 3)), abs=0.05)
     kin = chain("sixbar").kinematics(np.linspace(0, 2, 200), chain("sixbar").motion())
-    assert np.all(kin["first.E"][:, 1] > 0)                            # B above O C
-    assert np.all(kin["second.E"][:, 0] > 0.12)                        # F right of G
+    assert np.all(kin["first.E"][:, 1] > 0)  # B above O C
+    assert np.all(kin["second.E"][:, 0] > 0.12)  # F right of G
     kin = chain("rocker_slider").kinematics(np.linspace(0, 2, 200), chain("rocker_slider").motion())
-    assert np.all(kin["first.E"][:, 1] > 0)                            # B above O C
-    assert np.all(kin["second.slide_k"] < 0)                           # slider below C
+    assert np.all(kin["first.E"][:, 1] > 0)  # B above O C
+    assert np.all(kin["second.slide_k"] < 0)  # slider below C
     G = np.asarray(harness("rocker_slider")["frame"]["second"]["D_n"]["position"])
     i_k = unit(kin["second.guide_k.angle"])
-    assert np.all(dot(kin["second.E"] - G, i_k) > 0)                   # ahead of G's foot
+    assert np.all(dot(kin["second.E"] - G, i_k) > 0)  # ahead of G's foot
     assert np.ptp(kin["second.slide_k"]) > 0.02
 
 
@@ -373,9 +410,13 @@ def test_derivatives(name, kind):
             dn = d["name"]
             s = np.array([k[f"{dn}.slide_k"] for k in kins])
             assert_close(d1(s, h), mid[f"{dn}.slide_k_rate"], rel, f"{dn}.slide_k_rate", floor=1e-3)
-            assert_close(d2(s, h), mid[f"{dn}.slide_k_accel"], rel, f"{dn}.slide_k_accel", floor=1e-2)
+            assert_close(
+                d2(s, h), mid[f"{dn}.slide_k_accel"], rel, f"{dn}.slide_k_accel", floor=1e-2
+            )
             sd = np.array([k[f"{dn}.slide_k_rate"] for k in kins])
-            assert_close(d1(sd, h), mid[f"{dn}.slide_k_accel"], rel, f"{dn}.slide_k_accel", floor=1e-2)
+            assert_close(
+                d1(sd, h), mid[f"{dn}.slide_k_accel"], rel, f"{dn}.slide_k_accel", floor=1e-2
+            )
             g = np.unwrap(np.array([k[f"{dn}.guide_k.angle"] for k in kins]), axis=0)
             assert_close(d1(g, h), mid[f"{d['k']['link']}.omega"], rel, f"{dn}.guide_k.angle'")
     assert np.ptp(mid["lever.length"] if name == "shaper" else mid["rocker.angle"]) > 0.1
@@ -407,7 +448,9 @@ def test_accel_d(name, kind):
         transport = col(e) * rot90(r) - col(w * w) * r
         relative = col(mid["second.slide_k_accel"]) * i_k
         coriolis = col(2.0 * w * mid["second.slide_k_rate"]) * rot90(i_k)
-        assert_close(transport + relative + coriolis, mid["slider.accel_d"], 1e-12, "slider.accel_d")
+        assert_close(
+            transport + relative + coriolis, mid["slider.accel_d"], 1e-12, "slider.accel_d"
+        )
         # no term is negligible
         for term in (transport, relative, coriolis):
             assert np.max(norm(term)) > 0.1 * np.max(norm(mid["slider.accel_d"]))
@@ -432,7 +475,7 @@ def test_conditioning(name):
             elif d["type"] == "RRT":
                 want = np.abs(dot(i_n, unit(d["k"]["guide"])))
             else:
-                want = np.ones_like(c)          # block on the pin: i_beta = i_m, l_n = 0
+                want = np.ones_like(c)  # block on the pin: i_beta = i_m, l_n = 0
             assert_close(c, want, 1e-14, f"{d['name']}.conditioning")
 
 
@@ -459,10 +502,12 @@ def test_loads(name, kind):
         assert np.min(np.abs(kin["slider.force.x"])) < 1.0
     elif name == "rocker_slider":
         ld = load["slider"]
-        i_k = unit(kin["rocker.angle"])                  # guide = 0: along the rocker
+        i_k = unit(kin["rocker.angle"])  # guide = 0: along the rocker
         # the velocity of D_m relative to the rocker: v_D - w k x (D_m - C)
         C = np.asarray(harness(name)["frame"]["first"]["D_n"]["position"])
-        v_rel = dot(kin["slider.vel_d"] - col(kin["rocker.omega"]) * rot90(kin["second.D_m"] - C), i_k)
+        v_rel = dot(
+            kin["slider.vel_d"] - col(kin["rocker.omega"]) * rot90(kin["second.D_m"] - C), i_k
+        )
         assert_close(v_rel, kin["second.slide_k_rate"], 1e-12, "v_rel")
         want = col(-ld["F0"] * np.tanh(v_rel / ld["v_ref"])) * i_k
         assert_close(kin["slider.force"], want, 1e-12, "resisting force")
@@ -533,7 +578,7 @@ def test_reactions_physics():
         o = c.reference(k)
         total = np.stack([o["crank.R_O.x"], o["crank.R_O.y"]], axis=-1)
         for pr in c.pairs[1:]:
-            if pr["second"] is None:               # a pair with the frame
+            if pr["second"] is None:  # a pair with the frame
                 total = total + np.stack([o[pr["key"] + ".x"], o[pr["key"] + ".y"]], axis=-1)
         g = np.array(c.gravity)
         for b in c.bodies:
@@ -568,7 +613,9 @@ def test_rocker_slider_balances(kind):
     def inertial(b):
         link = ch.links[b]
         f = link["mass"] * g - link["mass"] * kin[f"a_S_{b}"] + kin[f"{b}.force"]
-        return f, cross(kin[f"S_{b}"], f) - link["inertia"] * kin[f"{b}.epsilon"] + kin[f"{b}.moment"]
+        return f, cross(kin[f"S_{b}"], f) - link["inertia"] * kin[f"{b}.epsilon"] + kin[
+            f"{b}.moment"
+        ]
 
     def check(b, terms, couples):
         F, M = inertial(b)
@@ -585,8 +632,11 @@ def test_rocker_slider_balances(kind):
     G, C, B = kin["second.D_n"], kin["first.D_n"], kin["first.E"]
     check("slider", [(D, R_mk), (E, vec(out, "second.R_mn"))], [out["second.M_mk"]])
     check("rod", [(E, -vec(out, "second.R_mn")), (G, vec(out, "second.R_np"))], [])
-    check("rocker", [(C, vec(out, "first.R_np")), (B, -vec(out, "first.R_mn")), (D, -R_mk)],
-          [-out["second.M_mk"]])
+    check(
+        "rocker",
+        [(C, vec(out, "first.R_np")), (B, -vec(out, "first.R_mn")), (D, -R_mk)],
+        [-out["second.M_mk"]],
+    )
 
 
 @pytest.mark.parametrize("name, kind", CASES)
@@ -610,12 +660,14 @@ def test_energy_functions():
     ch = chain("sixbar")
     kin = ch.kinematics(np.array([0.0]), ch.motion())
     sc = scene("sixbar")
-    want_T = 0.5 * sc["crank"]["inertia"] * 10.0 ** 2 + 0.5 * sc["crank"]["mass"] * (0.01 * 10.0) ** 2
+    want_T = 0.5 * sc["crank"]["inertia"] * 10.0**2 + 0.5 * sc["crank"]["mass"] * (0.01 * 10.0) ** 2
     want_V = 0.0
     for lt in sc["link"]:
         g = lt["name"]
-        want_T += 0.5 * lt["mass"] * dot(kin[f"v_S_{g}"], kin[f"v_S_{g}"])[0] + \
-            0.5 * lt["inertia"] * kin[f"{g}.omega"][0] ** 2
+        want_T += (
+            0.5 * lt["mass"] * dot(kin[f"v_S_{g}"], kin[f"v_S_{g}"])[0]
+            + 0.5 * lt["inertia"] * kin[f"{g}.omega"][0] ** 2
+        )
         want_V += lt["mass"] * 9.81 * kin[f"S_{g}"][0, 1]
     want_V += sc["crank"]["mass"] * 9.81 * kin["S_crank"][0, 1]
     assert ch.kinetic_energy(kin)[0] == pytest.approx(want_T, rel=1e-14)

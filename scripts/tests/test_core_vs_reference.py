@@ -4,15 +4,15 @@ import math
 
 import numpy as np
 import pytest
-
-from dyadfmu.reference import newton_euler as ref
 from dyadfmu.core import Core, library_path
+from dyadfmu.reference import newton_euler as ref
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 OUTPUTS = ("r_mk", "r_np", "r_mn", "m_mk", "m_np", "m_mn")
 
-pytestmark = pytest.mark.skipif(not library_path().is_file(),
-                                reason=f"C core not built at {library_path()}")
+pytestmark = pytest.mark.skipif(
+    not library_path().is_file(), reason=f"C core not built at {library_path()}"
+)
 
 
 @pytest.fixture(scope="module")
@@ -25,19 +25,28 @@ def random_link(rng, may_be_zero):
     size = length if length > 0 else 10 ** rng.uniform(-3, 0)
     mass = 10 ** rng.uniform(-3, 3)
     angle = rng.uniform(0, 2 * math.pi)
-    return dict(dir=(math.cos(angle), math.sin(angle)), length=length,
-                omega=rng.choice([-1, 1]) * 10 ** rng.uniform(-2, 2),
-                epsilon=rng.choice([-1, 1]) * 10 ** rng.uniform(-2, 3),
-                accel_d=tuple(rng.uniform(-1e3, 1e3, 2)),
-                com=(size * rng.uniform(-0.5, 1.5), size * rng.uniform(-0.5, 0.5)),
-                mass=mass, inertia=mass * (size * rng.uniform(0.05, 0.6)) ** 2,
-                force=tuple(rng.uniform(-1e4, 1e4, 2)),
-                moment=rng.uniform(-1e4, 1e4) * size)
+    return dict(
+        dir=(math.cos(angle), math.sin(angle)),
+        length=length,
+        omega=rng.choice([-1, 1]) * 10 ** rng.uniform(-2, 2),
+        epsilon=rng.choice([-1, 1]) * 10 ** rng.uniform(-2, 3),
+        accel_d=tuple(rng.uniform(-1e3, 1e3, 2)),
+        com=(size * rng.uniform(-0.5, 1.5), size * rng.uniform(-0.5, 0.5)),
+        mass=mass,
+        inertia=mass * (size * rng.uniform(0.05, 0.6)) ** 2,
+        force=tuple(rng.uniform(-1e4, 1e4, 2)),
+        moment=rng.uniform(-1e4, 1e4) * size,
+    )
 
 
 # Lengths that may be zero in each type, as the paper states (D_m, D_n links).
-ZERO_OK = {"RRR": (False, False), "RRT": (True, False), "RTR": (False, True),
-           "TRT": (True, True), "RTT": (False, True)}
+ZERO_OK = {
+    "RRR": (False, False),
+    "RRT": (True, False),
+    "RTR": (False, True),
+    "TRT": (True, True),
+    "RTT": (False, True),
+}
 
 
 def configurations(dyad_type, count, seed):
@@ -82,8 +91,9 @@ def test_core_matches_numpy_reference(core, dyad_type):
         worst = max(worst, np.max(np.abs(a - b)) / np.max(np.abs(b)))
         for name in ("n_mk", "n_np", "n_mn"):  # normal forces where the pair slides
             if not math.isnan(want[name]):
-                assert got[name] == pytest.approx(want[name], rel=1e-9,
-                                                  abs=1e-11 * np.max(np.abs(b)))
+                assert got[name] == pytest.approx(
+                    want[name], rel=1e-9, abs=1e-11 * np.max(np.abs(b))
+                )
     print(f"{dyad_type}: worst difference to numpy.linalg.solve {worst:.2e} of the largest output")
     assert worst < 1e-11
 
@@ -101,8 +111,18 @@ def test_core_matches_mpmath_truth(core, dyad_type):
 
 
 def test_core_reports_invalid_field(core):
-    m = dict(dir=(1.0, 0.0), length=1.0, omega=0.0, epsilon=0.0, accel_d=(0.0, 0.0),
-             com=(0.5, 0.0), mass=-2.0, inertia=0.1, force=(0.0, 0.0), moment=0.0)
+    m = dict(
+        dir=(1.0, 0.0),
+        length=1.0,
+        omega=0.0,
+        epsilon=0.0,
+        accel_d=(0.0, 0.0),
+        com=(0.5, 0.0),
+        mass=-2.0,
+        inertia=0.1,
+        force=(0.0, 0.0),
+        moment=0.0,
+    )
     n = dict(m, mass=1.0, dir=(0.0, 1.0))
     got = core.solve("RRR", m, n)
     assert got["status"] == "invalid input"

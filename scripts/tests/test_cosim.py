@@ -51,8 +51,14 @@ NAMES = cosim.STUDY_MECHANISMS
 
 def _drive_missing(version):
     path = BUILD / "fmus" / f"drive_fmi{version}.fmu"
-    return None if path.is_file() else (f"{path} is absent: the drive FMU is not built yet "
-                                        "(cmake --build build, or scripts/run-tests)")
+    return (
+        None
+        if path.is_file()
+        else (
+            f"{path} is absent: the drive FMU is not built yet "
+            "(cmake --build build, or scripts/run-tests)"
+        )
+    )
 
 
 needs_drive = pytest.mark.skipif(_drive_missing(2) is not None, reason=str(_drive_missing(2)))
@@ -64,12 +70,12 @@ def _needs_drive_version(version):
         pytest.skip(reason)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _setup(name, ratio):
     return cosim.setup(name, ratio)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _reference(name, ratio, step):
     """The monolithic machine at the communication points of `step` (rtol 1e-8: 5e-9 of
     the mean speed from rtol 1e-10, far below every bound here)."""
@@ -88,10 +94,27 @@ class PythonStandInDrive:
     it need not copy)."""
 
     label = "Python stand-in drive (tests only)"
-    names = frozenset(("load.torque", "load.inertia", "motor.stall_torque",
-                       "motor.no_load_speed", "inertia", "crank.mass", "crank.com.x",
-                       "crank.com.y", "gravity.x", "gravity.y", "start.angle", "start.speed",
-                       "crank.angle", "crank.omega", "crank.epsilon", "motor.torque", "status"))
+    names = frozenset(
+        (
+            "load.torque",
+            "load.inertia",
+            "motor.stall_torque",
+            "motor.no_load_speed",
+            "inertia",
+            "crank.mass",
+            "crank.com.x",
+            "crank.com.y",
+            "gravity.x",
+            "gravity.y",
+            "start.angle",
+            "start.speed",
+            "crank.angle",
+            "crank.omega",
+            "crank.epsilon",
+            "motor.torque",
+            "status",
+        )
+    )
 
     def __init__(self, instance_name="drive"):
         self.v = {"load.torque": 0.0, "load.inertia": 0.0}
@@ -104,7 +127,7 @@ class PythonStandInDrive:
         self.time = start_time
 
     def set(self, names, values):
-        for name, value in zip(names, values):
+        for name, value in zip(names, values, strict=True):
             self.v[name] = float(value)
 
     def _torque(self, speed):
@@ -122,9 +145,12 @@ class PythonStandInDrive:
         return (self._torque(speed) + v["load.torque"] + gravity) / inertia
 
     def get(self, names):
-        out = {"crank.angle": self.angle, "crank.omega": self.speed,
-               "crank.epsilon": self._acceleration(self.angle, self.speed),
-               "motor.torque": self._torque(self.speed)}
+        out = {
+            "crank.angle": self.angle,
+            "crank.omega": self.speed,
+            "crank.epsilon": self._acceleration(self.angle, self.speed),
+            "motor.torque": self._torque(self.speed),
+        }
         return [out[n] if n in out else self.v[n] for n in names]
 
     def get_status(self):
@@ -189,7 +215,9 @@ def test_drive_plus_dyad_is_the_monolithic_machine(name):
     np.testing.assert_allclose(-tau1, J - jc, rtol=1e-9, atol=0)
     assert np.all(J - jc > 0)
     # the stabilised acceleration solves the machine's equation of motion
-    motor = machine.default_motor(mech).with_rotor_inertia(machine.rotor_inertia_for_ratio(mech, 10))
+    motor = machine.default_motor(mech).with_rotor_inertia(
+        machine.rotor_inertia_for_ratio(mech, 10)
+    )
     p = cosim.drive_parameters(mech, motor, 0.0, w0)
     assert p["inertia"] == pytest.approx(motor.rotor_inertia + jc, rel=1e-15)
     c, s = np.cos(phi), np.sin(phi)
@@ -198,7 +226,7 @@ def test_drive_plus_dyad_is_the_monolithic_machine(name):
     gravity = p["crank.mass"] * (rx * p["gravity.y"] - ry * p["gravity.x"])
     T = float(motor.torque(w0))
     eps = (T + tau0 + gravity) / (p["inertia"] - tau1)
-    shaft = machine.crank_torque_from_kinetostatics(mech, phi, w0, eps)   # crank + links
+    shaft = machine.crank_torque_from_kinetostatics(mech, phi, w0, eps)  # crank + links
     residual = motor.rotor_inertia * eps + shaft - T
     assert np.max(np.abs(residual)) <= 1e-9 * np.max(np.abs(shaft))
 
@@ -214,7 +242,8 @@ def test_lag_factor():
     lag = cosim.explicit_lag_factor(s.mech, s.motor, 1e-3)
     assert lag["max"] > 5 and lag["geometric"] > 1
     assert lag["time_constant"] == pytest.approx(
-        (s.motor.rotor_inertia + cosim.crank_inertia_about_pivot(s.mech)) * 36.0 / 12.0)
+        (s.motor.rotor_inertia + cosim.crank_inertia_about_pivot(s.mech)) * 36.0 / 12.0
+    )
     assert lag["effective"] == pytest.approx(lag["max"] * math.exp(-1e-3 / lag["time_constant"]))
     assert cosim.explicit_lag_factor(s.mech, s.motor, 1e-2)["effective"] < 1e-3
 
@@ -231,9 +260,26 @@ def test_run_rejects_bad_arguments():
 
 def test_errors_of_the_reference_itself_are_zero():
     ref = _reference("four-bar", 1.0, 1e-2)
-    run = cosim.CosimRun("four-bar", "stabilised", 2, 1e-2, 0.25, 1.0, 1.0, ref.t, ref.phi,
-                         ref.omega, ref.epsilon, ref.t * 0, ref.t * 0, ref.t * 0, ref.r_np,
-                         ref.m_np, 0.0, False)
+    run = cosim.CosimRun(
+        "four-bar",
+        "stabilised",
+        2,
+        1e-2,
+        0.25,
+        1.0,
+        1.0,
+        ref.t,
+        ref.phi,
+        ref.omega,
+        ref.epsilon,
+        ref.t * 0,
+        ref.t * 0,
+        ref.t * 0,
+        ref.r_np,
+        ref.m_np,
+        0.0,
+        False,
+    )
     e = cosim.errors(run, ref)
     assert e["speed"] == e["reaction"] == e["angle"] == 0.0 and e["points"] == 26
     run.t = run.t + 1e-3
@@ -248,8 +294,8 @@ def test_master_logic_with_the_stand_in_drive():
     st = cosim.run_setup(s, "stabilised", 1e-3, drive=PythonStandInDrive)
     assert not st.diverged and st.steps == 250 and st.t[-1] == pytest.approx(0.25)
     e = cosim.errors(st, ref)
-    assert e["speed"] < 1.5e-2 and e["reaction"] < 5e-2           # 7.4e-3, 2.2e-2
-    assert st.affine_residual < 1e-12                              # 1.2e-15
+    assert e["speed"] < 1.5e-2 and e["reaction"] < 5e-2  # 7.4e-3, 2.2e-2
+    assert st.affine_residual < 1e-12  # 1.2e-15
     assert np.all(st.load_inertia > 0)
     ex = cosim.run_setup(s, "explicit", 1e-3, drive=PythonStandInDrive)
     assert ex.diverged and 0 < ex.diverged_at < 0.25 and "no-load speed" in ex.reason
@@ -297,16 +343,17 @@ def test_drive_fmu_acceleration_is_for_the_current_inputs(version):
             slave.set(("load.torque", "load.inertia"), (-1.5, 4e-4))
         got, want = fmu.get(("crank.epsilon",))[0], stand_in.get(("crank.epsilon",))[0]
         assert got == pytest.approx(want, rel=1e-14)
-        fmu.set(("load.inertia",), (1e-3,))                  # changes eps at once
+        fmu.set(("load.inertia",), (1e-3,))  # changes eps at once
         assert fmu.get(("crank.epsilon",))[0] != got
         fmu.set(("load.inertia",), (4e-4,))
         for slave in (fmu, stand_in):
             slave.do_step(0.0, 1e-3)
-        np.testing.assert_allclose(fmu.get(cosim._DRIVE_OUTPUTS),
-                                   stand_in.get(cosim._DRIVE_OUTPUTS), rtol=1e-7)
+        np.testing.assert_allclose(
+            fmu.get(cosim._DRIVE_OUTPUTS), stand_in.get(cosim._DRIVE_OUTPUTS), rtol=1e-7
+        )
         assert fmu.get_status() == 0
-        fmu.set(("load.inertia",), (-1.0,))                  # inertia + load.inertia < 0
-        with pytest.raises(SlaveError, match="load.inertia"):   # error, named, logged
+        fmu.set(("load.inertia",), (-1.0,))  # inertia + load.inertia < 0
+        with pytest.raises(SlaveError, match="load.inertia"):  # error, named, logged
             fmu.get(("crank.epsilon",))
     finally:
         fmu.close()
@@ -322,21 +369,25 @@ def test_stabilised_at_ratio_100_and_a_coarse_step(name, version):
     over it -- and at 1e-4 s speed 7.9e-3, reactions 5.5e-2 (first order in h)."""
     _needs_drive_version(version)
     s = _setup(name, 100.0)
-    bounds = {"four-bar": {1e-3: (1.5e-2, 5e-2)},
-              "slider-crank": {1e-3: (0.15, 1.0), 1e-4: (1.5e-2, 0.1)}}[name]
+    bounds = {
+        "four-bar": {1e-3: (1.5e-2, 5e-2)},
+        "slider-crank": {1e-3: (0.15, 1.0), 1e-4: (1.5e-2, 0.1)},
+    }[name]
     ref = _reference(name, 100.0, min(bounds))
     speed = {}
     for step, (speed_bound, reaction_bound) in bounds.items():
         run = cosim.run_setup(s, "stabilised", step, version)
         e = cosim.errors(run, ref)
-        print(f"{name} FMI {version} stabilised ratio 100 h {step:g}: speed {e['speed']:.2e}, "
-              f"reactions {e['reaction']:.2e}, {run.wall_time:.2f} s")
+        print(
+            f"{name} FMI {version} stabilised ratio 100 h {step:g}: speed {e['speed']:.2e}, "
+            f"reactions {e['reaction']:.2e}, {run.wall_time:.2f} s"
+        )
         assert not run.diverged, run.reason
         assert run.steps == round(s.t_end / step)
         assert e["speed"] <= speed_bound and e["reaction"] <= reaction_bound
         assert run.affine_residual < 1e-12
         speed[step] = e["speed"]
-    if len(speed) == 2:                                  # first order: 10 x smaller
+    if len(speed) == 2:  # first order: 10 x smaller
         assert 0.05 < speed[1e-4] / speed[1e-3] < 0.2
 
 
@@ -347,9 +398,11 @@ def test_explicit_at_ratio_100_and_a_coarse_step(name, version):
     _needs_drive_version(version)
     s = _setup(name, 100.0)
     lag = cosim.explicit_lag_factor(s.mech, s.motor, 1e-3)
-    run = cosim.run_setup(s, "explicit", 1e-3, version)       # must not raise
-    print(f"{name} FMI {version} explicit ratio 100 h 1e-3: rho max x damping "
-          f"{lag['effective']:.3g}, diverged {run.diverged} at {run.diverged_at}: {run.reason}")
+    run = cosim.run_setup(s, "explicit", 1e-3, version)  # must not raise
+    print(
+        f"{name} FMI {version} explicit ratio 100 h 1e-3: rho max x damping "
+        f"{lag['effective']:.3g}, diverged {run.diverged} at {run.diverged_at}: {run.reason}"
+    )
     assert run.diverged == (lag["effective"] > 1)
     if name == "four-bar":
         # rho up to 7.7, exp(-h / tau_m) = 0.17: diverged at 0.039 s of 0.25 s
@@ -367,10 +420,12 @@ def test_explicit_at_ratio_100_and_a_coarse_step(name, version):
 #: 9.9e-4 / 1.0e-3 (explicit / stabilised), reactions 2.6e-2 both; four-bar speed 1.8e-4 /
 #: 2.0e-4, reactions 7.4e-3 / 1.2e-3 (the explicit figure is its start: the first exchange
 #: uses the drive's acceleration without load).
-FINE_BOUNDS = {("slider-crank", "explicit"): (2e-3, 5e-2),
-               ("slider-crank", "stabilised"): (2e-3, 5e-2),
-               ("four-bar", "explicit"): (4e-4, 1.5e-2),
-               ("four-bar", "stabilised"): (4e-4, 2.5e-3)}
+FINE_BOUNDS = {
+    ("slider-crank", "explicit"): (2e-3, 5e-2),
+    ("slider-crank", "stabilised"): (2e-3, 5e-2),
+    ("four-bar", "explicit"): (4e-4, 1.5e-2),
+    ("four-bar", "stabilised"): (4e-4, 2.5e-3),
+}
 
 
 @needs_drive
@@ -382,8 +437,10 @@ def test_both_schemes_agree_at_ratio_0_1_and_a_fine_step(name, scheme, version):
     s = _setup(name, 0.1)
     run = cosim.run_setup(s, scheme, 1e-4, version)
     e = cosim.errors(run, _reference(name, 0.1, 1e-4))
-    print(f"{name} FMI {version} {scheme} ratio 0.1 h 1e-4: speed {e['speed']:.2e}, "
-          f"reactions {e['reaction']:.2e}, {run.wall_time:.2f} s")
+    print(
+        f"{name} FMI {version} {scheme} ratio 0.1 h 1e-4: speed {e['speed']:.2e}, "
+        f"reactions {e['reaction']:.2e}, {run.wall_time:.2f} s"
+    )
     speed_bound, reaction_bound = FINE_BOUNDS[(name, scheme)]
     assert not run.diverged, run.reason
     assert e["speed"] <= speed_bound and e["reaction"] <= reaction_bound
@@ -417,10 +474,13 @@ def test_quick_report_writes_its_files(tmp_path):
         assert (folder / name).is_file() and (folder / name).stat().st_size > 0
     with open(folder / "points.csv") as f:
         rows = list(csv.DictReader(f))
-    assert len(rows) == len(result["rows"]) == 2 * 2 * 2 * 2    # mechanisms, ratios, schemes, steps
+    assert len(rows) == len(result["rows"]) == 2 * 2 * 2 * 2  # mechanisms, ratios, schemes, steps
     text = (folder / "report.md").read_text()
     assert "stabilised" in text and "explicit" in text and "diverged" in text
     assert "For a user of the dyad FMU" in text
     assert not any(r["diverged"] == "True" for r in rows if r["scheme"] == "stabilised")
-    assert any(r["diverged"] == "True" for r in rows
-               if r["scheme"] == "explicit" and r["mechanism"] == "four-bar")
+    assert any(
+        r["diverged"] == "True"
+        for r in rows
+        if r["scheme"] == "explicit" and r["mechanism"] == "four-bar"
+    )

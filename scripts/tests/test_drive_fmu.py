@@ -6,13 +6,12 @@ import math
 
 import numpy as np
 import pytest
+from dyadfmu.fmi.slave import Slave
+from dyadfmu.paths import build_dir
 from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
 from scipy.integrate import solve_ivp
-
-from dyadfmu.fmi.slave import Slave
-from dyadfmu.paths import build_dir
 
 VERSIONS = (2, 3)
 
@@ -24,9 +23,18 @@ def drive_path(version):
     return path
 
 
-PARAMS = {"motor.stall_torque": 12.0, "motor.no_load_speed": 36.0, "inertia": 2e-3,
-          "crank.mass": 0.25, "crank.com.x": 0.02, "crank.com.y": 0.003,
-          "gravity.x": 0.0, "gravity.y": -9.81, "start.angle": 0.3, "start.speed": 20.0}
+PARAMS = {
+    "motor.stall_torque": 12.0,
+    "motor.no_load_speed": 36.0,
+    "inertia": 2e-3,
+    "crank.mass": 0.25,
+    "crank.com.x": 0.02,
+    "crank.com.y": 0.003,
+    "gravity.x": 0.0,
+    "gravity.y": -9.81,
+    "start.angle": 0.3,
+    "start.speed": 20.0,
+}
 
 
 def reference(t_end, load_torque, load_inertia, t_eval):
@@ -36,13 +44,23 @@ def reference(t_end, load_torque, load_inertia, t_eval):
     def rhs(t, y):
         phi, omega = y
         c, s = math.cos(phi), math.sin(phi)
-        rx, ry = c * p["crank.com.x"] - s * p["crank.com.y"], s * p["crank.com.x"] + c * p["crank.com.y"]
+        rx, ry = (
+            c * p["crank.com.x"] - s * p["crank.com.y"],
+            s * p["crank.com.x"] + c * p["crank.com.y"],
+        )
         gravity = p["crank.mass"] * (rx * p["gravity.y"] - ry * p["gravity.x"])
         motor = p["motor.stall_torque"] * (1 - omega / p["motor.no_load_speed"])
         return [omega, (motor + load_torque + gravity) / (p["inertia"] + load_inertia)]
 
-    sol = solve_ivp(rhs, (0, t_end), [p["start.angle"], p["start.speed"]], method="Radau",
-                    rtol=1e-12, atol=1e-12, t_eval=t_eval)
+    sol = solve_ivp(
+        rhs,
+        (0, t_end),
+        [p["start.angle"], p["start.speed"]],
+        method="Radau",
+        rtol=1e-12,
+        atol=1e-12,
+        t_eval=t_eval,
+    )
     return sol.y
 
 
@@ -59,16 +77,26 @@ def test_drive_validates(version):
 @pytest.mark.parametrize("step", (1e-2, 1e-3))
 def test_drive_integrates_like_radau(version, step):
     t = np.linspace(0, 0.5, 51)
-    load = np.array(list(zip(t, -3 + 0 * t, 1e-3 + 0 * t)),
-                    dtype=[("time", float), ("load.torque", float), ("load.inertia", float)])
-    result = simulate_fmu(str(drive_path(version)), stop_time=0.5, step_size=step,
-                          output_interval=0.01, start_values=PARAMS, input=load,
-                          output=["crank.angle", "crank.omega", "crank.epsilon", "status"])
+    load = np.array(
+        list(zip(t, -3 + 0 * t, 1e-3 + 0 * t, strict=True)),
+        dtype=[("time", float), ("load.torque", float), ("load.inertia", float)],
+    )
+    result = simulate_fmu(
+        str(drive_path(version)),
+        stop_time=0.5,
+        step_size=step,
+        output_interval=0.01,
+        start_values=PARAMS,
+        input=load,
+        output=["crank.angle", "crank.omega", "crank.epsilon", "status"],
+    )
     phi, omega = reference(0.5, -3.0, 1e-3, result["time"])
     error_phi = np.max(np.abs(result["crank.angle"] - phi))
     error_omega = np.max(np.abs(result["crank.omega"] - omega)) / np.max(np.abs(omega))
-    print(f"drive FMI {version}, step {step}: angle error {error_phi:.1e} rad, speed "
-          f"{error_omega:.1e} relative")
+    print(
+        f"drive FMI {version}, step {step}: angle error {error_phi:.1e} rad, speed "
+        f"{error_omega:.1e} relative"
+    )
     assert np.all(result["status"] == 0)
     assert error_phi < 1e-7 and error_omega < 1e-7
 
@@ -84,23 +112,23 @@ def test_drive_states_bad_inertia_and_reset(version, tmp_path):
     for name, value in PARAMS.items():
         d.set(name, value)
     with pytest.raises(FMICallException):
-        d.set("inertia", 0.0)                     # must be positive
+        d.set("inertia", 0.0)  # must be positive
     d.initialize()
     assert d.get("crank.angle") == PARAMS["start.angle"]
     assert d.get("crank.omega") == PARAMS["start.speed"]
     d.do_step(0, 0.01)
     moved = d.get("crank.angle")
     assert moved > PARAMS["start.angle"]
-    d.set("load.inertia", -1.0)                   # loaded inertia no longer positive
+    d.set("load.inertia", -1.0)  # loaded inertia no longer positive
     with pytest.raises(FMICallException):
         d.do_step(0.01, 0.01)
     assert d.get("status") == 2
-    d.set("load.inertia", 0.0)                    # usable again
+    d.set("load.inertia", 0.0)  # usable again
     d.do_step(0.01, 0.01)
     assert d.get("status") == 0 and d.get("crank.angle") > moved
     d.fmu.reset()
     d.initialize()
-    assert d.get("crank.angle") == 0.0            # the table's start value after reset
+    assert d.get("crank.angle") == 0.0  # the table's start value after reset
     d.close()
 
 
@@ -109,10 +137,11 @@ def _state(d):
 
 
 @pytest.mark.parametrize("version", VERSIONS)
-@pytest.mark.parametrize("inertia, step, next_step", ((2e-3, 1e16, 1e-3), (1e-12, 1.0, 1e-8),
-                                                      (1e-300, 1.0, None), (2e-3, 1e3, 1e-3)))
-def test_drive_refuses_a_step_beyond_the_substep_cap(version, tmp_path, inertia, step,
-                                                     next_step):
+@pytest.mark.parametrize(
+    "inertia, step, next_step",
+    ((2e-3, 1e16, 1e-3), (1e-12, 1.0, 1e-8), (1e-300, 1.0, None), (2e-3, 1e3, 1e-3)),
+)
+def test_drive_refuses_a_step_beyond_the_substep_cap(version, tmp_path, inertia, step, next_step):
     """A step that needs more than a million substeps (here up to 7e300, beyond every
     integer type) is refused with Error before any substep: the state stays where it
     was, and a step short enough then goes on from it."""
@@ -132,9 +161,14 @@ def test_drive_refuses_a_step_beyond_the_substep_cap(version, tmp_path, inertia,
 
 
 @pytest.mark.parametrize("version", VERSIONS)
-@pytest.mark.parametrize("name, value", (("load.torque", -1.7976931348623157e308),
-                                         ("load.torque", 1.7976931348623157e308),
-                                         ("motor.stall_torque", 1.7976931348623157e308)))
+@pytest.mark.parametrize(
+    "name, value",
+    (
+        ("load.torque", -1.7976931348623157e308),
+        ("load.torque", 1.7976931348623157e308),
+        ("motor.stall_torque", 1.7976931348623157e308),
+    ),
+)
 def test_drive_reports_an_overflow_as_out_of_range(version, tmp_path, name, value):
     """Accepted values whose acceleration or motor torque overflow double give status 3
     and NaN for them, never status 0 beside an infinite output; the step is discarded
@@ -156,8 +190,7 @@ def test_drive_reports_an_overflow_as_out_of_range(version, tmp_path, name, valu
 
 
 @pytest.mark.parametrize("version", VERSIONS)
-@pytest.mark.parametrize("t, h", ((1.7976931348623157e308, 1e300), (1e300, 1e-300),
-                                  (1e9, 1e-9)))
+@pytest.mark.parametrize("t, h", ((1.7976931348623157e308, 1e300), (1e300, 1e-300), (1e9, 1e-9)))
 def test_drive_refuses_a_step_whose_end_is_not_a_later_finite_time(version, tmp_path, t, h):
     """t + h overflowing, or rounding back to t, is refused with Error, and the
     instance steps on normally afterwards."""

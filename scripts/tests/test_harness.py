@@ -6,7 +6,6 @@ import sys
 
 import numpy as np
 import pytest
-
 from dyadfmu.cosim import harness
 from dyadfmu.mechanisms import builtin as mechanisms
 from dyadfmu.mechanisms import crank
@@ -27,8 +26,9 @@ def test_fmu_matches_reference(mechanism, version):
     assert sum(error.peak > 0 for error in result.errors) >= 5, "too few non-zero outputs"
     for error in result.errors:
         # An output may vanish by construction (R_mk.x on a horizontal guide), then exactly.
-        assert error.relative <= 1e-9 if error.peak > 0 else error.max_abs == 0, \
+        assert error.relative <= 1e-9 if error.peak > 0 else error.max_abs == 0, (
             f"{mechanism} FMI {version}: {error}"
+        )
     print(harness.summary(result))
 
 
@@ -58,8 +58,10 @@ def test_driving_torque_satisfies_energy_balance(mechanism, motion):
     energy_rate = _fd_derivative(energy, t, h)
     residual = driving + crank.load_power(mech, kin) - energy_rate
     scale = np.max(np.abs(driving))
-    print(f"{mechanism} ({motion}): energy residual {np.max(np.abs(residual)) / scale:.2e} "
-          f"of the peak driving power {scale:.4g} W")
+    print(
+        f"{mechanism} ({motion}): energy residual {np.max(np.abs(residual)) / scale:.2e} "
+        f"of the peak driving power {scale:.4g} W"
+    )
     assert scale > 0
     assert np.max(np.abs(residual)) <= 1e-6 * scale
 
@@ -74,21 +76,37 @@ def test_energy_balance_detects_a_wrong_torque():
     torque = crank.balance(mech, kin, ref["r_np"])["torque"]
     torque = torque + 0.01 * np.max(np.abs(torque))
     h = crank_motion.duration * 1e-4
-    rate = _fd_derivative(lambda s: crank.kinetic_energy(mech, mech.kinematics(s, crank_motion)),
-                          t, h)
+    rate = _fd_derivative(
+        lambda s: crank.kinetic_energy(mech, mech.kinematics(s, crank_motion)), t, h
+    )
     residual = torque * kin["crank.omega"] + crank.load_power(mech, kin) - rate
     assert np.max(np.abs(residual)) > 1e-6 * np.max(np.abs(torque * kin["crank.omega"]))
 
 
 def _cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "dyadfmu.cli", *args], capture_output=True,
-                          text=True, cwd=cwd, timeout=600)
+    return subprocess.run(
+        [sys.executable, "-m", "dyadfmu.cli", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=600,
+    )
 
 
 @pytest.mark.parametrize("mechanism", MECHANISMS)
 def test_cli_runs_each_mechanism(mechanism, tmp_path):
-    done = _cli("run", mechanism, "--fmi", "both", "--revolutions", "1", "--steps", "36",
-                "--out", str(tmp_path))
+    done = _cli(
+        "run",
+        mechanism,
+        "--fmi",
+        "both",
+        "--revolutions",
+        "1",
+        "--steps",
+        "36",
+        "--out",
+        str(tmp_path),
+    )
     assert done.returncode == 0, done.stderr
     assert "worst relative error of any output" in done.stdout
     for version in (2, 3):

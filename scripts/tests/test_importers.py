@@ -24,12 +24,11 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
+from dyadfmu import paths
+from dyadfmu.cosim import importers
+from dyadfmu.fmi.simulate import simulate
 from fmpy.fmi1 import FMICallException
 from lxml import etree
-
-from dyadfmu.cosim import importers
-from dyadfmu import paths
-from dyadfmu.fmi.simulate import simulate
 
 CI = os.environ.get("CI", "").lower() == "true"
 ALL = [(name, version) for name in importers.fmu_names() for version in importers.VERSIONS]
@@ -71,7 +70,8 @@ def fmi_sim() -> str:
     version = importers.fmi_sim_version(exe)
     assert version == importers.FMI_SIM_VERSION, (
         f"{exe} is fmi-sim {version}; the comparison is made with "
-        f"{importers.FMI_SIM_VERSION} (scripts/run-tests installs it, DYADFMU_FMI_SIM names it)")
+        f"{importers.FMI_SIM_VERSION} (scripts/run-tests installs it, DYADFMU_FMI_SIM names it)"
+    )
     return exe
 
 
@@ -96,21 +96,24 @@ def test_fmi_sim_gives_fmpys_outputs(name, version, fmi_sim, tmp_path):
     same_inputs = importers.as_applied_by_fmi_sim(setup)
     exact = importers.compare(same_inputs, simulate(same_inputs), other)
     raw = importers.compare(setup, simulate(setup), other)
-    print(f"fmi-sim vs fmpy, harness inputs: {raw.line()}, amplification "
-          f"{raw.amplification_in_own_roundoff:.2g} x eps a^2; same inputs: "
-          f"{exact.max_ulps:.0f} ulps")
+    print(
+        f"fmi-sim vs fmpy, harness inputs: {raw.line()}, amplification "
+        f"{raw.amplification_in_own_roundoff:.2g} x eps a^2; same inputs: "
+        f"{exact.max_ulps:.0f} ulps"
+    )
     assert exact.max_ulps == 0, f"same inputs, different outputs: {exact.line()}"
     assert raw.max_relative <= RAW_BOUND, raw.line()
     assert raw.amplification_in_own_roundoff <= AMPLIFICATION_BOUND, raw.line()
 
 
-@pytest.mark.parametrize("name,version,column", [
-    ("dyad_rrt", 3, "link_m.force.x"), ("shaper", 2, "lever.omega"),
-    ("drive", 2, "load.torque")])
+@pytest.mark.parametrize(
+    "name,version,column",
+    [("dyad_rrt", 3, "link_m.force.x"), ("shaper", 2, "lever.omega"), ("drive", 2, "load.torque")],
+)
 def test_the_comparison_fails_on_a_perturbed_input(name, version, column, fmi_sim, tmp_path):
     """One input column scaled by 1 + 1e-9 for fmi-sim only: both checks above fail."""
     setup = importers.setup_of(name, version)
-    assert np.ptp(setup.inputs[column]) > 0          # a column that moves
+    assert np.ptp(setup.inputs[column]) > 0  # a column that moves
     other = importers.run_fmi_sim(setup, tmp_path, fmi_sim, perturb=column)
     same_inputs = importers.as_applied_by_fmi_sim(setup)
     assert importers.compare(same_inputs, simulate(same_inputs), other).max_ulps > 0

@@ -20,7 +20,6 @@ import math
 
 import numpy as np
 import pytest
-
 from dyadfmu.mechanisms import builtin as mechanisms
 from dyadfmu.mechanisms import crank
 from dyadfmu.reference import machine
@@ -56,7 +55,7 @@ def test_reduced_inertia_is_twice_the_kinetic_energy_at_unit_speed(name):
     for omega in (1.0, 7.5, -3.0):
         kin = machine.state_kinematics(mech, phi, omega, 0.3)
         ke = crank.kinetic_energy(mech, kin)
-        np.testing.assert_allclose(J, 2.0 * ke / omega ** 2, rtol=1e-12, atol=0)
+        np.testing.assert_allclose(J, 2.0 * ke / omega**2, rtol=1e-12, atol=0)
     assert np.all(J > 0)
     # shapes follow the input
     J2, dJ2 = machine.reduced_inertia(mech, phi.reshape(19, 19))
@@ -78,7 +77,7 @@ def test_exact_inertia_derivative_matches_finite_differences(name):
     peak = np.max(np.abs(dJ))
     err = np.max(np.abs(fd - dJ)) / peak
     print(f"{name}: |J'| peak {peak:.4g} kg m2/rad, exact vs 4th-order FD {err:.1e}")
-    assert peak > 1e-3 * np.max(J)              # J really varies
+    assert peak > 1e-3 * np.max(J)  # J really varies
     assert err < 1e-8
 
 
@@ -109,10 +108,16 @@ def test_kinetostatic_torque_matches_lagrange(name):
     w0 = _nominal_speed(mech)
     J, dJ = machine.reduced_inertia(mech, phi)
     worst = 0.0
-    for omega, eps in ((w0, 0.0), (w0, 0.3 * w0 * w0), (0.4 * w0, -0.5 * w0 * w0),
-                       (-0.8 * w0, 0.2 * w0 * w0), (0.0, 0.0), (0.0, w0 * w0)):
+    for omega, eps in (
+        (w0, 0.0),
+        (w0, 0.3 * w0 * w0),
+        (0.4 * w0, -0.5 * w0 * w0),
+        (-0.8 * w0, 0.2 * w0 * w0),
+        (0.0, 0.0),
+        (0.0, w0 * w0),
+    ):
         torque = machine.crank_torque_from_kinetostatics(mech, phi, omega, eps)
-        lagrange = J * eps + 0.5 * dJ * omega ** 2 - machine.generalized_load(mech, phi, omega)
+        lagrange = J * eps + 0.5 * dJ * omega**2 - machine.generalized_load(mech, phi, omega)
         peak = np.max(np.abs(torque))
         rel = np.max(np.abs(torque - lagrange)) / peak
         worst = max(worst, rel)
@@ -124,11 +129,15 @@ def test_kinetostatic_torque_matches_lagrange(name):
             assert np.max(np.abs(torque - wrong)) / peak > 1e-4
     # effective inertia: d(torque)/d(epsilon) = J(phi), the torque being linear in epsilon
     e1, e2 = -0.5 * w0 * w0, 0.7 * w0 * w0
-    slope = (machine.crank_torque_from_kinetostatics(mech, phi, w0, e2)
-             - machine.crank_torque_from_kinetostatics(mech, phi, w0, e1)) / (e2 - e1)
+    slope = (
+        machine.crank_torque_from_kinetostatics(mech, phi, w0, e2)
+        - machine.crank_torque_from_kinetostatics(mech, phi, w0, e1)
+    ) / (e2 - e1)
     rel_j = np.max(np.abs(slope - J)) / np.max(J)
-    print(f"{name}: kinetostatic vs Lagrange torque {worst:.1e} of the peak; "
-          f"effective inertia vs J {rel_j:.1e}")
+    print(
+        f"{name}: kinetostatic vs Lagrange torque {worst:.1e} of the peak; "
+        f"effective inertia vs J {rel_j:.1e}"
+    )
     assert rel_j <= 1e-9
 
 
@@ -136,8 +145,9 @@ def test_kinetostatic_torque_matches_lagrange(name):
 # the monolithic machine
 # ---------------------------------------------------------------------------
 def _energy_error(run):
-    scale = max(np.max(np.abs(run.motor_work)), np.max(np.abs(run.load_work)),
-                np.max(run.kinetic_energy))
+    scale = max(
+        np.max(np.abs(run.motor_work)), np.max(np.abs(run.load_work)), np.max(run.kinetic_energy)
+    )
     return np.max(np.abs(run.energy_residual())) / scale
 
 
@@ -174,13 +184,16 @@ def test_monolithic_runs_up_and_conserves_energy(name):
         revs = (run.phi[-1] - phi0) / (2 * math.pi)
         assert revs > 3.0
         grid = np.linspace(0.0, 2 * math.pi, 73)[:-1]
-        last, before = (_speed_over_revolution(run, phi0, k, grid)
-                        for k in (int(revs) - 1, int(revs) - 2))
+        last, before = (
+            _speed_over_revolution(run, phi0, k, grid) for k in (int(revs) - 1, int(revs) - 2)
+        )
         change = np.max(np.abs(last - before)) / np.mean(last)
         mean = np.mean(last)
-        msg += (f", {revs:.2f} rev, mean speed of the last revolution {mean:.4g} rad/s "
-                f"(nominal {w0:.4g}), range {last.min():.4g}..{last.max():.4g}, change over "
-                f"the last revolution {change:.1e}")
+        msg += (
+            f", {revs:.2f} rev, mean speed of the last revolution {mean:.4g} rad/s "
+            f"(nominal {w0:.4g}), range {last.min():.4g}..{last.max():.4g}, change over "
+            f"the last revolution {change:.1e}"
+        )
         assert change < 5e-3, "not near a periodic steady state"
         assert abs(mean - w0) < 0.1 * w0
     else:
@@ -226,8 +239,12 @@ def test_t_eval_gives_dense_output_at_default_tolerances():
     steps = machine.monolithic(mech, motor, 0.03, 0.0, w0)
     np.testing.assert_array_equal(dense.t, t_eval)
     np.testing.assert_allclose(dense.phi[-1], steps.phi[-1], rtol=1e-10)
-    np.testing.assert_allclose(dense.omega, np.interp(t_eval, steps.t, steps.omega),
-                               rtol=0, atol=1e-3 * np.max(steps.omega))
+    np.testing.assert_allclose(
+        dense.omega,
+        np.interp(t_eval, steps.t, steps.omega),
+        rtol=0,
+        atol=1e-3 * np.max(steps.omega),
+    )
     assert _energy_error(steps) <= 1e-9
     assert np.all(steps.omega[1:] > 0)
 
@@ -256,15 +273,20 @@ def test_inertia_ratios_run(name):
     for ratio in RATIOS:
         jr = machine.rotor_inertia_for_ratio(mech, ratio)
         assert mean_j / jr == pytest.approx(ratio, rel=1e-12)
-        run = machine.monolithic(mech, base.with_rotor_inertia(jr), t_end, phi0, 0.0,
-                                 rtol=1e-6, atol=1e-8)
+        run = machine.monolithic(
+            mech, base.with_rotor_inertia(jr), t_end, phi0, 0.0, rtol=1e-6, atol=1e-8
+        )
         energy = _energy_error(run)
         assert run.solution.success
         assert np.all(run.omega[1:] > 0), f"{name} ratio {ratio}: stalled"
         assert energy <= 1e-6
         assert run.stopped == (not revolving)
-        fluct = (np.max(run.omega[run.t > 0.5 * run.t[-1]]) - np.min(run.omega[run.t > 0.5 * run.t[-1]]))
-        lines.append(f"ratio {ratio:g} (J_r {jr:.3g}): {len(run.t)} steps, "
-                     f"phi {run.phi[-1] - phi0:.3g} rad, speed swing {fluct:.3g} rad/s, "
-                     f"energy {energy:.1e}")
+        fluct = np.max(run.omega[run.t > 0.5 * run.t[-1]]) - np.min(
+            run.omega[run.t > 0.5 * run.t[-1]]
+        )
+        lines.append(
+            f"ratio {ratio:g} (J_r {jr:.3g}): {len(run.t)} steps, "
+            f"phi {run.phi[-1] - phi0:.3g} rad, speed swing {fluct:.3g} rad/s, "
+            f"energy {energy:.1e}"
+        )
     print(f"{name}: mean J {mean_j:.4g} kg m2; " + "; ".join(lines))

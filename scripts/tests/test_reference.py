@@ -1,16 +1,21 @@
-"""Tests of the independent Newton-Euler dyad reference (scripts/dyadfmu/reference/newton_euler.py)."""
+"""Tests of the independent Newton-Euler dyad reference
+(scripts/dyadfmu/reference/newton_euler.py)."""
 
 import math
 
 import numpy as np
 import pytest
-
 from dyadfmu.reference import newton_euler as ref
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 # pair kinds (D_m, E, D_n) written out independently of ref.PAIRS
-KINDS = {"RRR": ("R", "R", "R"), "RRT": ("T", "R", "R"), "RTR": ("R", "T", "R"),
-         "TRT": ("T", "R", "T"), "RTT": ("T", "T", "R")}
+KINDS = {
+    "RRR": ("R", "R", "R"),
+    "RRT": ("T", "R", "R"),
+    "RTR": ("R", "T", "R"),
+    "TRT": ("T", "R", "T"),
+    "RTT": ("T", "T", "R"),
+}
 
 
 def rot90(v):
@@ -28,8 +33,18 @@ def unit(angle):
 
 def link(**kw):
     """Massless, unloaded, non-moving link with overridable fields."""
-    d = dict(dir=(1.0, 0.0), length=1.0, omega=0.0, epsilon=0.0, accel_d=(0.0, 0.0),
-             com=(0.0, 0.0), mass=0.0, inertia=0.0, force=(0.0, 0.0), moment=0.0)
+    d = dict(
+        dir=(1.0, 0.0),
+        length=1.0,
+        omega=0.0,
+        epsilon=0.0,
+        accel_d=(0.0, 0.0),
+        com=(0.0, 0.0),
+        mass=0.0,
+        inertia=0.0,
+        force=(0.0, 0.0),
+        moment=0.0,
+    )
     d.update(kw)
     return d
 
@@ -47,13 +62,13 @@ def test_symmetric_static_rrr_three_hinged_arch(solver):
     # compression).  The pin force on m from n is then a pure horizontal thrust
     # r_mn = -r_mk - (0,-P/2) = (-P/(2 tan(alpha)), 0): n pushes m to the left.
     a, h, P = 0.7, 0.4, 250.0
-    l = math.hypot(a, h)
-    i_m = np.array([a, h]) / l
-    i_n = np.array([-a, h]) / l
-    m = link(dir=i_m, length=l, com=(l, 0.0), force=(0.0, -P / 2))
-    n = link(dir=i_n, length=l, com=(l, 0.0), force=(0.0, -P / 2))
+    length = math.hypot(a, h)
+    i_m = np.array([a, h]) / length
+    i_n = np.array([-a, h]) / length
+    m = link(dir=i_m, length=length, com=(length, 0.0), force=(0.0, -P / 2))
+    n = link(dir=i_n, length=length, com=(length, 0.0), force=(0.0, -P / 2))
     res = _run(solver, "RRR", m, n)
-    sin_a, tan_a = h / l, h / a
+    sin_a, tan_a = h / length, h / a
     np.testing.assert_allclose(res["r_mk"], P / (2 * sin_a) * i_m, rtol=1e-13)
     np.testing.assert_allclose(res["r_np"], P / (2 * sin_a) * i_n, rtol=1e-13)
     np.testing.assert_allclose(res["r_mn"], [-P / (2 * tan_a), 0.0], rtol=1e-13, atol=1e-12)
@@ -111,8 +126,16 @@ def test_trt_cross_slides_with_mass_gravity_and_acceleration(solver):
     L, th, M, g = 0.8, math.radians(50.0), 3.0, 9.81
     ax, ay, Fx, Fy, M0 = 2.0, -0.5, 7.0, 4.0, 1.5
     i_m = np.array([math.cos(th), math.sin(th)])
-    m = link(dir=i_m, length=L, com=(L, 0.0), mass=M, inertia=0.2,
-             accel_d=(ax, ay), force=(Fx, Fy), moment=M0)
+    m = link(
+        dir=i_m,
+        length=L,
+        com=(L, 0.0),
+        mass=M,
+        inertia=0.2,
+        accel_d=(ax, ay),
+        force=(Fx, Fy),
+        moment=M0,
+    )
     n = link(dir=(0.0, 1.0), length=0.0)
     res = _run(solver, "TRT", m, n, guide_k=(1.0, 0.0), guide_p=(0.0, 1.0), gravity=(0.0, -g))
     Qx, Qy = Fx - M * ax, Fy - M * g - M * ay
@@ -139,18 +162,29 @@ def _run(solver, t, m, n, **kw):
 # ---------------------------------------------------------------------------
 def random_case(rng, N, t):
     """Random dyad data; positions are consistent: D_n = D_m + l_m i_m - l_n i_n."""
+
     def vec(scale=1.0):
         return rng.uniform(-scale, scale, (N, 2))
 
     def lnk():
-        return dict(dir=unit(rng.uniform(-np.pi, np.pi, N)),
-                    length=rng.uniform(0.05, 2.0, N), omega=rng.uniform(-20, 20, N),
-                    epsilon=rng.uniform(-200, 200, N), accel_d=vec(50.0), com=vec(1.0),
-                    mass=rng.uniform(0.1, 5.0, N), inertia=rng.uniform(1e-3, 0.5, N),
-                    force=vec(100.0), moment=rng.uniform(-50, 50, N))
-    kw = dict(guide_k=unit(rng.uniform(-np.pi, np.pi, N)) if KINDS[t][0] == "T" else None,
-              guide_p=unit(rng.uniform(-np.pi, np.pi, N)) if KINDS[t][2] == "T" else None,
-              gravity=vec(10.0))
+        return dict(
+            dir=unit(rng.uniform(-np.pi, np.pi, N)),
+            length=rng.uniform(0.05, 2.0, N),
+            omega=rng.uniform(-20, 20, N),
+            epsilon=rng.uniform(-200, 200, N),
+            accel_d=vec(50.0),
+            com=vec(1.0),
+            mass=rng.uniform(0.1, 5.0, N),
+            inertia=rng.uniform(1e-3, 0.5, N),
+            force=vec(100.0),
+            moment=rng.uniform(-50, 50, N),
+        )
+
+    kw = dict(
+        guide_k=unit(rng.uniform(-np.pi, np.pi, N)) if KINDS[t][0] == "T" else None,
+        guide_p=unit(rng.uniform(-np.pi, np.pi, N)) if KINDS[t][2] == "T" else None,
+        gravity=vec(10.0),
+    )
     return lnk(), lnk(), kw
 
 
@@ -166,17 +200,21 @@ def balance_residuals(m, n, res, gravity, rng):
     E = D_m + m["length"][:, None] * m["dir"]
     D_n = E - n["length"][:, None] * n["dir"]
     # link n sees -r_mn and -m_mn at E
-    reac = {"m": [(D_m, res["r_mk"], res["m_mk"]), (E, res["r_mn"], res["m_mn"])],
-            "n": [(D_n, res["r_np"], res["m_np"]), (E, -res["r_mn"], -res["m_mn"])]}
+    reac = {
+        "m": [(D_m, res["r_mk"], res["m_mk"]), (E, res["r_mn"], res["m_mn"])],
+        "n": [(D_n, res["r_np"], res["m_np"]), (E, -res["r_mn"], -res["m_mn"])],
+    }
     resid, scale = [], []
     for name, L, D in (("m", m, D_m), ("n", n, D_n)):
         i = L["dir"]
         S = D + L["com"][:, :1] * i + L["com"][:, 1:] * rot90(i)
         r = S - D
-        a_S = (L["accel_d"] + L["epsilon"][:, None] * rot90(r)
-               - (L["omega"] ** 2)[:, None] * r)
-        forces = [(S, L["force"]), (S, L["mass"][:, None] * gravity),
-                  (S, -L["mass"][:, None] * a_S)] + [(P, f) for P, f, _ in reac[name]]
+        a_S = L["accel_d"] + L["epsilon"][:, None] * rot90(r) - (L["omega"] ** 2)[:, None] * r
+        forces = [
+            (S, L["force"]),
+            (S, L["mass"][:, None] * gravity),
+            (S, -L["mass"][:, None] * a_S),
+        ] + [(P, f) for P, f, _ in reac[name]]
         couples = [L["moment"], -L["inertia"] * L["epsilon"]] + [c for _, _, c in reac[name]]
         fsum = sum(f for _, f in forces)
         fabs = sum(np.abs(f) for _, f in forces)
@@ -193,13 +231,13 @@ def test_random_solution_satisfies_balance_and_pair_constraints(t):
     m, n, kw = random_case(rng, N, t)
     res = ref.solve(t, m, n, **kw)
     assert res["r_mk"].shape == (N, 2) and res["m_np"].shape == (N,) and res["cond"].shape == (N,)
-    ok = res["cond"] < 1e8          # drop near-singular configurations
+    ok = res["cond"] < 1e8  # drop near-singular configurations
     assert ok.mean() > 0.9
     resid, scale = balance_residuals(m, n, res, kw["gravity"], rng)
     rel = np.abs(resid[ok]) / scale[ok]
     assert rel.max() < 1e-12, rel.max()
     # pair-kind constraints
-    kinds = dict(zip(("mk", "mn", "np"), KINDS[t]))
+    kinds = dict(zip(("mk", "mn", "np"), KINDS[t], strict=True))
     guides = {"mk": kw["guide_k"], "np": kw["guide_p"], "mn": m["dir"]}
     for pair, kind in kinds.items():
         r = res[f"r_{pair}"]
@@ -209,8 +247,12 @@ def test_random_solution_satisfies_balance_and_pair_constraints(t):
             g = guides[pair]
             # force normal to the guide, n = r . rot90(guide)
             np.testing.assert_allclose(np.sum(r * g, -1)[ok], 0.0, atol=1e-12 * np.abs(r).max())
-            np.testing.assert_allclose(np.sum(r * rot90(g), -1)[ok], res[f"n_{pair}"][ok],
-                                       rtol=1e-13, atol=1e-13 * np.abs(r).max())
+            np.testing.assert_allclose(
+                np.sum(r * rot90(g), -1)[ok],
+                res[f"n_{pair}"][ok],
+                rtol=1e-13,
+                atol=1e-13 * np.abs(r).max(),
+            )
 
 
 @pytest.mark.parametrize("t", TYPES)
@@ -223,12 +265,19 @@ def test_random_solve_matches_solve_mp(t):
     for s in range(N):
         if res["cond"][s] > 1e6:
             continue
-        pick = lambda d: {k: (v[s] if np.ndim(v) else v) for k, v in d.items()}  # noqa: E731
+
+        def pick(d, s=s):
+            return {k: (v[s] if np.ndim(v) else v) for k, v in d.items()}
+
         kws = {k: (None if v is None else v[s]) for k, v in kw.items()}
         mp = ref.solve_mp(t, pick(m), pick(n), **kws)
         # normwise over all reactions of the sample (forces and moments in one scale)
-        vals_np = np.concatenate([np.ravel(res[k][s]) for k in ("r_mk", "r_np", "r_mn", "m_mk", "m_np", "m_mn")])
-        vals_mp = np.concatenate([np.ravel(mp[k]) for k in ("r_mk", "r_np", "r_mn", "m_mk", "m_np", "m_mn")])
+        vals_np = np.concatenate(
+            [np.ravel(res[k][s]) for k in ("r_mk", "r_np", "r_mn", "m_mk", "m_np", "m_mn")]
+        )
+        vals_mp = np.concatenate(
+            [np.ravel(mp[k]) for k in ("r_mk", "r_np", "r_mn", "m_mk", "m_np", "m_mn")]
+        )
         sc = np.abs(vals_mp).max()
         assert np.abs(vals_np - vals_mp).max() <= 1e-12 * sc
         np.testing.assert_array_equal(np.isnan(res["n_mk"][s]), math.isnan(mp["n_mk"]))
@@ -253,7 +302,9 @@ def test_solve_mp_uses_high_precision():
 
 
 def test_broadcasting_and_assemble_shapes():
-    m = link(dir=(0.6, 0.8), length=1.2, com=(0.4, 0.1), mass=np.array([1.0, 2.0, 3.0]), inertia=0.1)
+    m = link(
+        dir=(0.6, 0.8), length=1.2, com=(0.4, 0.1), mass=np.array([1.0, 2.0, 3.0]), inertia=0.1
+    )
     n = link(dir=(-0.8, 0.6), length=0.9, com=(0.3, -0.05), mass=1.5, inertia=0.05, omega=2.0)
     A, b = ref.assemble("RRR", m, n, gravity=(0.0, -9.81))
     assert A.shape == (3, 6, 6) and b.shape == (3, 6)
@@ -280,10 +331,15 @@ def test_unknown_type_raises(bad):
         ref.solve_mp(bad, m, n)
 
 
-@pytest.mark.parametrize("t,missing,given", [
-    ("RRT", "guide_k", {}), ("TRT", "guide_k", {"guide_p": (0.0, 1.0)}),
-    ("TRT", "guide_p", {"guide_k": (1.0, 0.0)}), ("RTT", "guide_k", {"guide_p": (0.0, 1.0)}),
-])
+@pytest.mark.parametrize(
+    "t,missing,given",
+    [
+        ("RRT", "guide_k", {}),
+        ("TRT", "guide_k", {"guide_p": (0.0, 1.0)}),
+        ("TRT", "guide_p", {"guide_k": (1.0, 0.0)}),
+        ("RTT", "guide_k", {"guide_p": (0.0, 1.0)}),
+    ],
+)
 def test_missing_guide_raises_naming_it(t, missing, given):
     m, n = link(), link(dir=(0.0, 1.0))
     for f in (ref.solve, ref.assemble, ref.solve_mp):

@@ -13,13 +13,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import read_model_description
-from fmpy.fmi1 import FMICallException
-from fmpy.validation import validate_fmu
-
 from dyadfmu import paths
 from dyadfmu.cosim import scenes
 from dyadfmu.fmi import slave as fmi_slave
+from fmpy import read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.validation import validate_fmu
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
@@ -30,14 +29,17 @@ GENERATED = paths.build_dir() / "generated"
 
 
 def run_tool(*args):
-    return subprocess.run([sys.executable, str(SCENE_TOOL), *map(str, args)],
-                          capture_output=True, text=True)
+    return subprocess.run(
+        [sys.executable, str(SCENE_TOOL), *map(str, args)], capture_output=True, text=True
+    )
 
 
 def variables(name, version=2):
     md = read_model_description(str(scenes.fmu_path(name, version)))
-    return {c: [v.name for v in md.modelVariables if v.causality == c]
-            for c in ("input", "parameter", "output")}
+    return {
+        c: [v.name for v in md.modelVariables if v.causality == c]
+        for c in ("input", "parameter", "output")
+    }
 
 
 # ---------------------------------------------------------------------------
@@ -50,8 +52,12 @@ def test_every_example_scene_is_accepted(path, tmp_path):
     out = tmp_path / path.stem
     done = run_tool(path, "--out", out)
     assert done.returncode == 0, done.stderr
-    for rel in ("fmi2/modelDescription.xml", "fmi3/modelDescription.xml",
-                "fmi3/buildDescription.xml", "documentation/index.html"):
+    for rel in (
+        "fmi2/modelDescription.xml",
+        "fmi3/modelDescription.xml",
+        "fmi3/buildDescription.xml",
+        "documentation/index.html",
+    ):
         assert (out / rel).is_file(), rel
     # the same scene gives the same files, byte for byte
     again = tmp_path / (path.stem + "_again")
@@ -63,8 +69,7 @@ def test_every_example_scene_is_accepted(path, tmp_path):
 
 def test_malformed_examples_exist():
     kinds = {p.stem for p in MALFORMED}
-    assert {"unknown_type", "link_twice", "output_no_pair_provides",
-            "missing_parameter"} <= kinds
+    assert {"unknown_type", "link_twice", "output_no_pair_provides", "missing_parameter"} <= kinds
     assert len(kinds) >= 10
 
 
@@ -79,7 +84,7 @@ def test_malformed_scene_is_rejected_naming_line_and_problem(path, tmp_path):
     errors = [ln for ln in done.stderr.splitlines() if ln.startswith("error:")]
     assert any(f"{path.name}:{line}:" in ln and fragment in ln for ln in errors), done.stderr
     assert "nothing written" in done.stderr
-    assert not out.exists()                       # nothing built
+    assert not out.exists()  # nothing built
 
 
 def test_cmake_stops_on_a_malformed_scene(tmp_path):
@@ -87,10 +92,20 @@ def test_cmake_stops_on_a_malformed_scene(tmp_path):
     generator's message."""
     build = tmp_path / "build"
     done = subprocess.run(
-        ["cmake", "-S", str(ROOT), "-B", str(build), "-DDYADFMU_BUILD_TESTS=OFF",
-         "-DDYADFMU_BUILD_BENCH=OFF", f"-DPython3_EXECUTABLE={sys.executable}",
-         f"-DDYADFMU_SCENES={SCENES_DIR / 'malformed' / 'link_twice.toml'}"],
-        capture_output=True, text=True)
+        [
+            "cmake",
+            "-S",
+            str(ROOT),
+            "-B",
+            str(build),
+            "-DDYADFMU_BUILD_TESTS=OFF",
+            "-DDYADFMU_BUILD_BENCH=OFF",
+            f"-DPython3_EXECUTABLE={sys.executable}",
+            f"-DDYADFMU_SCENES={SCENES_DIR / 'malformed' / 'link_twice.toml'}",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode != 0
     assert "link_twice.toml:42:" in done.stderr and "connected twice" in done.stderr
 
@@ -102,10 +117,9 @@ def test_static_press_takes_no_motion_and_computes_no_inertia_or_weight():
     v = variables("press")
     assert v["input"] == ["crank.angle", "ram.force.x", "ram.force.y", "rod.angle"]
     assert v["parameter"] == []
-    assert v["output"] == ["press.N_mk", "press.R_np.x", "press.R_np.y", "crank.torque",
-                           "status"]
+    assert v["output"] == ["press.N_mk", "press.R_np.x", "press.R_np.y", "crank.torque", "status"]
     code = (GENERATED / "press" / "press_scene.c").read_text()
-    body = code[code.index("static void evaluate"):]
+    body = code[code.index("static void evaluate") :]
     for absent in ("omega", "epsilon", "gravity", "accel", "crank_r_o"):
         assert absent not in body, absent
     # baked constants, not parameters: the rod length and the crank radius
@@ -118,16 +132,19 @@ def test_horizontal_monitor_has_no_weight_and_one_reaction():
     assert v["parameter"] == ["rocker.mass"]
     assert not any("gravity" in n for n in v["input"] + v["parameter"])
     code = (GENERATED / "monitor" / "monitor_scene.c").read_text()
-    body = code[code.index("static void evaluate"):]
+    body = code[code.index("static void evaluate") :]
     assert "gravity" not in body
-    assert "crank_torque" not in body and "crank_r_o" not in body   # no crank balance
+    assert "crank_torque" not in body and "crank_r_o" not in body  # no crank balance
     assert "in->rocker_mass" in body
 
 
 def test_outputs_of_one_dyad_solve_only_what_loads_it(tmp_path):
     """Asking the six-bar for the second dyad's reactions only solves that dyad."""
-    text = (SCENES_DIR / "sixbar.toml").read_text().replace(
-        'outputs = ["all"]', 'outputs = ["second.R_np"]')
+    text = (
+        (SCENES_DIR / "sixbar.toml")
+        .read_text()
+        .replace('outputs = ["all"]', 'outputs = ["second.R_np"]')
+    )
     scene = tmp_path / "sixbar_second.toml"
     scene.write_text(text.replace('identifier = "sixbar"', 'identifier = "sixbar_second"'))
     out = tmp_path / "gen"
@@ -136,7 +153,7 @@ def test_outputs_of_one_dyad_solve_only_what_loads_it(tmp_path):
     assert "dyad_react_rrr(&load, &second)" in code
     assert "&first)" not in code
     md = (out / "fmi2" / "modelDescription.xml").read_text()
-    assert 'name="coupler.angle"' not in md     # the first dyad's links are not inputs
+    assert 'name="coupler.angle"' not in md  # the first dyad's links are not inputs
     assert 'name="connector.angle"' in md
 
 
@@ -171,8 +188,10 @@ def test_tailored_fmu_matches_the_reference(name, version):
     for e in result.errors:
         assert e.max_abs <= 1e-12 * max(scale[e.unit], 1e-300), (e.name, e.max_abs, e.peak)
     assert {e.name for e in result.errors} == {
-        n for n in variables(name, version)["output"]
-        if n != "status" and not n.endswith("amplification")}
+        n
+        for n in variables(name, version)["output"]
+        if n != "status" and not n.endswith("amplification")
+    }
 
 
 @pytest.mark.parametrize("motion", ("constant", "varying"))
@@ -181,7 +200,7 @@ def test_chain_driving_torque_against_the_energy_balance(name, motion):
     result = scenes.run(name, 2, revolutions=1.0, steps=180, motion=motion)
     assert result.energy_residual < 1e-9, result.energy_residual
     torque = result.fmu["crank.torque"]
-    assert np.ptp(torque) > 0.1 * np.max(np.abs(torque))          # a varying load
+    assert np.ptp(torque) > 0.1 * np.max(np.abs(torque))  # a varying load
 
 
 def test_energy_balance_detects_a_wrong_torque():
@@ -237,7 +256,7 @@ def test_declared_dependencies_cover_every_true_one(name, tmp_path):
     for n in inputs:
         s.set({**base, n: base[n] + 1e-3 * (abs(base[n]) + 1.0)})
         s.step()
-        changed = [o for o, a, b in zip(names, before, s.get(names)) if a != b]
+        changed = [o for o, a, b in zip(names, before, s.get(names), strict=True) if a != b]
         for o in changed:
             assert n in declared[o], f"{o} changes with {n} but does not declare it"
     s.set(base)
@@ -256,10 +275,10 @@ def test_a_singular_dyad_discards_and_names_itself(version, tmp_path):
     s.set(base)
     s.step()
     assert s.status() == 0
-    s.set({"rocker.angle": base["coupler.angle"] + math.pi})   # coupler and rocker aligned
+    s.set({"rocker.angle": base["coupler.angle"] + math.pi})  # coupler and rocker aligned
     with pytest.raises(FMICallException) as error:
         s.step()
-    assert error.value.status == 2                              # discard
+    assert error.value.status == 2  # discard
     assert s.status() == 1
     assert all(math.isnan(x) for x in s.get(["first.R_mk.x", "crank.torque", "second.R_np.y"]))
     s.set(base)
@@ -270,8 +289,11 @@ def test_a_singular_dyad_discards_and_names_itself(version, tmp_path):
 @pytest.mark.parametrize("version", VERSIONS)
 def test_tailored_fmu_rejects_a_bad_value_by_name(version, tmp_path):
     s = Slave("shaper", version, tmp_path)
-    for name, value in (("slider.force.x", math.nan), ("lever.length", -0.1),
-                        ("lever.omega", math.inf)):
+    for name, value in (
+        ("slider.force.x", math.nan),
+        ("lever.length", -0.1),
+        ("lever.omega", math.inf),
+    ):
         with pytest.raises(FMICallException):
             s.set({name: value})
     s.step()
@@ -301,8 +323,11 @@ def test_generated_code_agrees_with_the_generic_fmu(dyad, version, tmp_path):
     generic = Slave(f"dyad_{dyad}", version, tmp_path / "generic")
     tailored = Slave(f"tailored_{dyad}", version, tmp_path / "tailored")
     inputs = [v for v in tailored.md.modelVariables if v.causality == "input"]
-    outputs = [v.name for v in tailored.md.modelVariables
-               if v.causality == "output" and v.type in ("Real", "Float64")]
+    outputs = [
+        v.name
+        for v in tailored.md.modelVariables
+        if v.causality == "output" and v.type in ("Real", "Float64")
+    ]
     generic_outputs = [v.name for v in generic.md.modelVariables if v.causality == "output"]
     assert set(outputs) | {"status"} == set(generic_outputs)
     rng = np.random.default_rng(7)
@@ -313,7 +338,7 @@ def test_generated_code_agrees_with_the_generic_fmu(dyad, version, tmp_path):
             start = float(v.start)
             if v.unit == "rad":
                 values[v.name] = start + rng.uniform(-0.3, 0.3)
-            elif v.unit == "m":                                  # a sliding length
+            elif v.unit == "m":  # a sliding length
                 values[v.name] = start * rng.uniform(0.7, 1.3)
             else:
                 values[v.name] = start + rng.uniform(-1, 1) * (abs(start) + 10.0)
@@ -322,8 +347,8 @@ def test_generated_code_agrees_with_the_generic_fmu(dyad, version, tmp_path):
         generic.step()
         tailored.step()
         want, got = generic.get(outputs), tailored.get(outputs)
-        scale = np.max(np.abs(want[:-2]))          # the reactions, not the conditioning
+        scale = np.max(np.abs(want[:-2]))  # the reactions, not the conditioning
         worst = max(worst, float(np.max(np.abs(got - want)[:-2]) / scale))
-        assert np.allclose(got[-2:], want[-2:], rtol=1e-14)   # conditioning, amplification
+        assert np.allclose(got[-2:], want[-2:], rtol=1e-14)  # conditioning, amplification
     print(f"tailored_{dyad} FMI {version}: worst difference {worst:.2e} of the largest reaction")
     assert worst < 1e-13, worst

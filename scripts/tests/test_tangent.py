@@ -5,13 +5,13 @@ import math
 
 import numpy as np
 import pytest
-
+from dyadfmu.core import Core, library_path
 from dyadfmu.reference import newton_euler as reference
 from dyadfmu.study import configurations as cfg
-from dyadfmu.core import Core, library_path
 
-pytestmark = pytest.mark.skipif(not library_path().is_file(),
-                                reason=f"C core not built at {library_path()}")
+pytestmark = pytest.mark.skipif(
+    not library_path().is_file(), reason=f"C core not built at {library_path()}"
+)
 
 OUTPUTS = ("r_mk", "r_np", "r_mn", "n_mk", "n_np", "n_mn", "m_mk", "m_np", "m_mn")
 SCALARS = ("length", "omega", "epsilon", "mass", "inertia", "moment")
@@ -41,8 +41,13 @@ def _perturbed(dyad, row, seed, h):
             out[key] = (k[key][0] + h * s[key][0], k[key][1] + h * s[key][1])
         return out
 
-    return (link(m, sm), link(n, sn), None if gk is None else turn(gk, sgk),
-            None if gp is None else turn(gp, sgp), (grav[0] + h * sgrav[0], grav[1] + h * sgrav[1]))
+    return (
+        link(m, sm),
+        link(n, sn),
+        None if gk is None else turn(gk, sgk),
+        None if gp is None else turn(gp, sgp),
+        (grav[0] + h * sgrav[0], grav[1] + h * sgrav[1]),
+    )
 
 
 def _reference_scalar(dyad, m, n, gk, gp, grav):
@@ -95,8 +100,13 @@ def _core_seed(dyad, row, seed):
         out.update({key: s[key] for key in SCALARS + VECTORS})
         return out
 
-    return (link(m, sm), link(n, sn), None if gk is None else rate(gk, sgk),
-            None if gp is None else rate(gp, sgp), sgrav)
+    return (
+        link(m, sm),
+        link(n, sn),
+        None if gk is None else rate(gk, sgk),
+        None if gp is None else rate(gp, sgp),
+        sgrav,
+    )
 
 
 @pytest.mark.parametrize("dyad", cfg.TYPES)
@@ -109,21 +119,24 @@ def test_tangent_matches_complex_step_and_finite_differences(core, dyad):
         seed = _random_seed(rng, dyad)
         if row[cfg.COL["m.length"]] == 0 or row[cfg.COL["n.length"]] == 0:
             continue
-        value, derivative = core.solve_tangent(dyad, cfg.reference_args(dyad, row),
-                                               _core_seed(dyad, row, seed))
+        value, derivative = core.solve_tangent(
+            dyad, cfg.reference_args(dyad, row), _core_seed(dyad, row, seed)
+        )
         assert value["status"] == "ok" and derivative["status"] == "ok", derivative
         got = _core_flat(derivative)
         h = 1e-30
         complex_step = _reference_scalar(dyad, *_perturbed(dyad, row, seed, 1j * h)).imag / h
         step = 1e-6
-        central = (_reference_scalar(dyad, *_perturbed(dyad, row, seed, step)).real
-                   - _reference_scalar(dyad, *_perturbed(dyad, row, seed, -step)).real) / (2 * step)
+        central = (
+            _reference_scalar(dyad, *_perturbed(dyad, row, seed, step)).real
+            - _reference_scalar(dyad, *_perturbed(dyad, row, seed, -step)).real
+        ) / (2 * step)
         scale = np.max(np.abs(complex_step))
         worst_cs = max(worst_cs, np.max(np.abs(got - complex_step)) / scale)
         worst_fd = max(worst_fd, np.max(np.abs(got - central)) / scale)
     print(f"{dyad}: tangent vs complex step {worst_cs:.1e}, vs central differences {worst_fd:.1e}")
     assert worst_cs < 1e-10
-    assert worst_fd < 1e-5   # truncation error of the central difference
+    assert worst_fd < 1e-5  # truncation error of the central difference
 
 
 @pytest.mark.parametrize("dyad", cfg.TYPES)
@@ -132,18 +145,19 @@ def test_conditioning_rate(core, dyad):
     rows = cfg.random_set(dyad, 10, seed=900)
     for row in rows:
         seed = _random_seed(rng, dyad)
-        for link in seed[:2]:   # the conditioning depends on angles and lengths only
+        for link in seed[:2]:  # the conditioning depends on angles and lengths only
             for key in ("omega", "epsilon", "mass", "inertia", "moment"):
                 link[key] = 0.0
             for key in VECTORS:
                 link[key] = (0.0, 0.0)
         if row[cfg.COL["m.length"]] == 0 or row[cfg.COL["n.length"]] == 0:
             continue
-        _, derivative = core.solve_tangent(dyad, cfg.reference_args(dyad, row),
-                                           _core_seed(dyad, row, seed))
+        _, derivative = core.solve_tangent(
+            dyad, cfg.reference_args(dyad, row), _core_seed(dyad, row, seed)
+        )
         step = 1e-7
 
-        def conditioning(h):
+        def conditioning(h, row=row, seed=seed):
             p = _perturbed(dyad, row, seed, h)
             return core.solve(dyad, *p)["conditioning"]
 
@@ -155,8 +169,9 @@ def _amplification_rates(core, dyad, row, seed):
     """The core's rate of the amplification along the seed and the central difference
     of its values, or None where the one-sided differences disagree (a max, a clamp or
     a choice of form switches within the step: no derivative there)."""
-    value, derivative = core.solve_tangent(dyad, cfg.reference_args(dyad, row),
-                                           _core_seed(dyad, row, seed))
+    value, derivative = core.solve_tangent(
+        dyad, cfg.reference_args(dyad, row), _core_seed(dyad, row, seed)
+    )
     step = 1e-7 * value["amplification"] / max(1.0, abs(derivative["amplification"]))
 
     def amplification(h):
@@ -179,17 +194,24 @@ def test_amplification_rate(core, dyad):
     and along seeds that move only the loads and motion."""
     rng = np.random.default_rng(11)
     rows = cfg.random_set(dyad, 25, seed=950 + cfg.TYPES.index(dyad))
-    for g, floor in (("m", 0.05), ("n", 0.07)):   # a length of 0 may not move down; and
+    for g, floor in (("m", 0.05), ("n", 0.07)):  # a length of 0 may not move down; and
         # l_m = l_n would put RTR on the kink of its conditioning (both forms equal)
         rows[:, cfg.COL[f"{g}.length"]] = np.maximum(rows[:, cfg.COL[f"{g}.length"]], floor)
     checked = moved_by_loads = 0
     for row in rows:
         seed = _random_seed(rng, dyad)
-        for g, link in zip("mn", seed[:2]):   # quantities >= 0 move relative to their size
+        for g, link in zip(
+            "mn", seed[:2], strict=True
+        ):  # quantities >= 0 move relative to their size
             for key in ("length", "mass", "inertia"):
                 link[key] *= row[cfg.COL[f"{g}.{key}"]]
-        loads_only = (dict(seed[0], angle=0.0, length=0.0), dict(seed[1], angle=0.0, length=0.0),
-                      0.0, 0.0, (0.0, 0.0))
+        loads_only = (
+            dict(seed[0], angle=0.0, length=0.0),
+            dict(seed[1], angle=0.0, length=0.0),
+            0.0,
+            0.0,
+            (0.0, 0.0),
+        )
         for s, counts in ((seed, False), (loads_only, True)):
             rates = _amplification_rates(core, dyad, row, s)
             if rates is None:
