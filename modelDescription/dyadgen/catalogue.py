@@ -58,7 +58,13 @@ def _dyad_inputs(dyad_type: str) -> list[Entry]:
         ]
         if g == "m" and e == "T":  # link m slides: its length varies
             entries.append(
-                Entry(f"{p}.length", f"{link}.length", "input", "m", domain=_length_domain(dyad_type, g))
+                Entry(
+                    f"{p}.length",
+                    f"{link}.length",
+                    "input",
+                    "m",
+                    domain=_length_domain(dyad_type, g),
+                )
             )
     if d_m == "T":
         entries.append(Entry("input.guide_k@angle", "guide_k.angle", "input", "rad"))
@@ -75,7 +81,13 @@ def _dyad_parameters(dyad_type: str) -> list[Entry]:
         link = f"link_{g}"
         if not (g == "m" and e == "T"):
             entries.append(
-                Entry(f"{p}.length", f"{link}.length", "parameter", "m", domain=_length_domain(dyad_type, g))
+                Entry(
+                    f"{p}.length",
+                    f"{link}.length",
+                    "parameter",
+                    "m",
+                    domain=_length_domain(dyad_type, g),
+                )
             )
         entries += [
             Entry(f"{p}.com.x", f"{link}.com.x", "parameter", "m"),
@@ -87,7 +99,13 @@ def _dyad_parameters(dyad_type: str) -> list[Entry]:
     return entries + [
         Entry("input.gravity.x", "gravity.x", "parameter", "m/s2"),
         Entry("input.gravity.y", "gravity.y", "parameter", "m/s2"),
-        Entry("input.singular_threshold", "singular_threshold", "parameter", None, domain=threshold_domain),
+        Entry(
+            "input.singular_threshold",
+            "singular_threshold",
+            "parameter",
+            None,
+            domain=threshold_domain,
+        ),
     ]
 
 

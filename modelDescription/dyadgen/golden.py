@@ -13,7 +13,13 @@ from dyadgen.pipeline import build_table, load_scene, load_table
 #: The variable tables written by hand; the dyad FMUs' tables come from their scenes.
 TABLES = ("drive.toml",)
 #: The scenes of the generic per-type dyad FMUs, whose model descriptions are golden.
-GOLDEN_SCENES = ("dyad_rrr.toml", "dyad_rrt.toml", "dyad_rtr.toml", "dyad_trt.toml", "dyad_rtt.toml")
+GOLDEN_SCENES = (
+    "dyad_rrr.toml",
+    "dyad_rrt.toml",
+    "dyad_rtr.toml",
+    "dyad_trt.toml",
+    "dyad_rtt.toml",
+)
 
 
 def golden_files() -> dict[Path, str]:

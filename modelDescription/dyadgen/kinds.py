@@ -43,33 +43,49 @@ from dyadgen.table import Table, TableError, table_from_data
 SHIM_FILES = {2: ["fmi2_functions.c"], 3: ["fmi3_functions.c", "fmi3_unsupported.c"]}
 
 LOG_CATEGORIES = (
-    ("logStatusError", "Errors: illegal call sequences, bad arguments, inputs the solver "
-     "rejects (the offending variable is named)"),
+    (
+        "logStatusError",
+        "Errors: illegal call sequences, bad arguments, inputs the solver "
+        "rejects (the offending variable is named)",
+    ),
     ("logStatusWarning", "Warnings, e.g. a singular configuration at exitInitializationMode"),
-    ("logStatusDiscard", "Discarded steps: singular configuration or overflowing reactions "
-     "(reaction outputs NaN)"),
+    (
+        "logStatusDiscard",
+        "Discarded steps: singular configuration or overflowing reactions (reaction outputs NaN)",
+    ),
     ("logCalls", "Calls into the FMU"),
-)  # fmt: skip
+)
 #: The same categories (fmu_instance.c knows them by name) as the drive uses them.
 DRIVE_LOG_CATEGORIES = (
-    ("logStatusError", "Errors: illegal call sequences, bad arguments, inputs the model "
-     "rejects (the offending variable is named, e.g. load.inertia when inertia + "
-     "load.inertia is not positive)"),
+    (
+        "logStatusError",
+        "Errors: illegal call sequences, bad arguments, inputs the model "
+        "rejects (the offending variable is named, e.g. load.inertia when inertia + "
+        "load.inertia is not positive)",
+    ),
     ("logStatusWarning", "Warnings"),
-    ("logStatusDiscard", "Discarded steps: a step that would need more than 1e7 integrator "
-     "substeps, or a crank state that is no longer finite (the state stays at the step's "
-     "start)"),
+    (
+        "logStatusDiscard",
+        "Discarded steps: a step that would need more than 1e7 integrator "
+        "substeps, or a crank state that is no longer finite (the state stays at the step's "
+        "start)",
+    ),
     ("logCalls", "Calls into the FMU"),
-)  # fmt: skip
+)
 #: The same categories as a scene uses them.
 SCENE_LOG_CATEGORIES = (
-    ("logStatusError", "Errors: illegal call sequences, bad arguments, values outside a "
-     "variable's range (the variable is named)"),
+    (
+        "logStatusError",
+        "Errors: illegal call sequences, bad arguments, values outside a "
+        "variable's range (the variable is named)",
+    ),
     ("logStatusWarning", "Warnings, e.g. a singular dyad at exitInitializationMode"),
-    ("logStatusDiscard", "Discarded steps: a singular dyad (named) or overflowing reactions "
-     "(outputs NaN)"),
+    (
+        "logStatusDiscard",
+        "Discarded steps: a singular dyad (named) or overflowing reactions (outputs NaN)",
+    ),
     ("logCalls", "Calls into the FMU"),
-)  # fmt: skip
+)
 
 
 class Kind(Structs):
@@ -172,8 +188,15 @@ class DyadKind(Kind):
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The dyad's solver, its derivatives and the dyad behaviour."""
-        return ["dyad_common.c", f"dyad_{table.type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
-                "fmu_instance.c", *SHIM_FILES[version], f"{table.identifier}_model.c"]  # fmt: skip
+        return [
+            "dyad_common.c",
+            f"dyad_{table.type.lower()}.c",
+            "dyad_tangent.c",
+            "fmu_dyad.c",
+            "fmu_instance.c",
+            *SHIM_FILES[version],
+            f"{table.identifier}_model.c",
+        ]
 
     def subject(self, table: Table) -> str:
         """The dyad FMU of its type."""
@@ -182,7 +205,10 @@ class DyadKind(Kind):
     def model_data(self, table: Table) -> tuple[list[str], str]:
         """fmu_dyad_data: the type and its solver."""
         t = table.type
-        return [f"static const fmu_dyad_data dyad = {{DYAD_{t}, dyad_solve_{t.lower()}}};", ""], "&dyad"
+        return [
+            f"static const fmu_dyad_data dyad = {{DYAD_{t}, dyad_solve_{t.lower()}}};",
+            "",
+        ], "&dyad"
 
     def documentation(self, table: Table) -> str:
         """The page of the dyad type."""
@@ -218,7 +244,12 @@ class DriveKind(Kind):
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The drive's behaviour."""
-        return ["fmu_drive.c", "fmu_instance.c", *SHIM_FILES[version], f"{table.identifier}_model.c"]
+        return [
+            "fmu_drive.c",
+            "fmu_instance.c",
+            *SHIM_FILES[version],
+            f"{table.identifier}_model.c",
+        ]
 
     def subject(self, table: Table) -> str:
         """The crank drive."""
@@ -259,16 +290,30 @@ class SceneKind(Kind):
 
     def __init__(self, scene: Scene, input_members: dict, output_members: dict) -> None:
         ident = scene.identifier
-        super().__init__("scene", f"{ident}_input", f"{ident}_output", input_members,
-                         output_members, f"{ident}_scene.h", f"{ident}_behaviour")  # fmt: skip
+        super().__init__(
+            "scene",
+            f"{ident}_input",
+            f"{ident}_output",
+            input_members,
+            output_members,
+            f"{ident}_scene.h",
+            f"{ident}_behaviour",
+        )
         self.scene = scene
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The closed forms of the scene's dyad types and its generated code."""
         types = sorted({d.type.lower() for d in table.scene.dyads})
-        return (["dyad_common.c"] + [f"dyad_{t}.c" for t in types] +
-                [f"{table.identifier}_scene.c", "fmu_instance.c", *SHIM_FILES[version],
-                 f"{table.identifier}_model.c"])  # fmt: skip
+        return (
+            ["dyad_common.c"]
+            + [f"dyad_{t}.c" for t in types]
+            + [
+                f"{table.identifier}_scene.c",
+                "fmu_instance.c",
+                *SHIM_FILES[version],
+                f"{table.identifier}_model.c",
+            ]
+        )
 
     def subject(self, table: Table) -> str:
         """The scene."""
@@ -290,10 +335,24 @@ class SceneKind(Kind):
         return documentation.scene_page(table)
 
 
-DYAD = DyadKind("dyad", "dyad_input", "dyad_result", INPUT_MEMBERS, RESULT_MEMBERS,
-                "fmu_dyad.h", "fmu_dyad_behaviour")  # fmt: skip
-DRIVE = DriveKind("drive", "fmu_drive_input", "fmu_drive_output", DRIVE_INPUT_MEMBERS,
-                  DRIVE_OUTPUT_MEMBERS, "fmu_drive.h", "fmu_drive_behaviour")  # fmt: skip
+DYAD = DyadKind(
+    "dyad",
+    "dyad_input",
+    "dyad_result",
+    INPUT_MEMBERS,
+    RESULT_MEMBERS,
+    "fmu_dyad.h",
+    "fmu_dyad_behaviour",
+)
+DRIVE = DriveKind(
+    "drive",
+    "fmu_drive_input",
+    "fmu_drive_output",
+    DRIVE_INPUT_MEMBERS,
+    DRIVE_OUTPUT_MEMBERS,
+    "fmu_drive.h",
+    "fmu_drive_behaviour",
+)
 #: The kinds a table file may name in [model] kind.
 KINDS = {"dyad": DYAD, "drive": DRIVE}
 
@@ -331,19 +390,44 @@ def scene_table(scene: Scene) -> SceneTable:
     output_members: dict[str, str] = {}
     for i in scene.inputs:
         lives = f"input.{i.member}{'@angle' if i.angle else ''}"
-        raw = _row(rows, i.name, "input", i.unit, type="Real", start=i.start,
-                   description=i.description, lives=lives)  # fmt: skip
+        raw = _row(
+            rows,
+            i.name,
+            "input",
+            i.unit,
+            type="Real",
+            start=i.start,
+            description=i.description,
+            lives=lives,
+        )
         _bounds(raw, i.domain)
         input_members[i.member] = "dir" if i.angle else "real"
     for prm in scene.parameters():
         if prm.tunable:
-            raw = _row(rows, prm.name, "parameter", prm.unit, type="Real", start=prm.value,
-                       description=prm.description, lives=f"input.{prm.member}")  # fmt: skip
+            raw = _row(
+                rows,
+                prm.name,
+                "parameter",
+                prm.unit,
+                type="Real",
+                start=prm.value,
+                description=prm.description,
+                lives=f"input.{prm.member}",
+            )
             _bounds(raw, prm.domain)
             input_members[prm.member] = "real"
     for o in scene.outputs:
-        _row(rows, o.name, "output", o.unit, type="Integer" if o.integer else "Real",
-             description=o.description, lives=f"result.{o.member}", depends=list(o.depends))  # fmt: skip
+        value_type = "Integer" if o.integer else "Real"
+        _row(
+            rows,
+            o.name,
+            "output",
+            o.unit,
+            type=value_type,
+            description=o.description,
+            lives=f"result.{o.member}",
+            depends=list(o.depends),
+        )
         output_members[o.member] = "status" if o.integer else "real"
     return SceneTable(scene, rows, SceneKind(scene, input_members, output_members))
 
@@ -357,12 +441,18 @@ def is_generic(scene: Scene) -> bool:
     d = scene.dyads[0]
     links = [scene.links[d.m], scene.links[d.n]]
     offered = 2 * 3 + 2 * sum(k == "T" for k in PAIRS[d.type]) + 2 + 1
-    return (d.name == "" and d.m == "link_m" and d.n == "link_n" and
-            d.k.kind == "external" and d.p.kind == "external" and
-            scene.inertia and scene.gravity and
-            all(link.force and link.moment for link in links) and
-            len(scene.outputs) == offered and
-            all(prm.tunable for prm in scene.parameters()))  # fmt: skip
+    return (
+        d.name == ""
+        and d.m == "link_m"
+        and d.n == "link_n"
+        and d.k.kind == "external"
+        and d.p.kind == "external"
+        and scene.inertia
+        and scene.gravity
+        and all(link.force and link.moment for link in links)
+        and len(scene.outputs) == offered
+        and all(prm.tunable for prm in scene.parameters())
+    )
 
 
 def generic_data(scene: Scene) -> dict:
@@ -372,8 +462,12 @@ def generic_data(scene: Scene) -> dict:
     starts = {i.name: i.start for i in scene.inputs}
     rows = []
     for entry in dyad_catalogue(d.type).values():
-        raw = {"name": entry.name, "vr": len(rows) + 1, "causality": entry.causality,
-               "type": entry.value_type}  # fmt: skip
+        raw = {
+            "name": entry.name,
+            "vr": len(rows) + 1,
+            "causality": entry.causality,
+            "type": entry.value_type,
+        }
         if entry.unit:
             raw["unit"] = entry.unit
         if entry.causality == "input":

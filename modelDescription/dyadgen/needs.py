@@ -10,7 +10,18 @@ from __future__ import annotations
 import re
 
 from dyadgen.dyadtypes import PAIR_NAMES, PAIRS, pair_label
-from dyadgen.model import Dyad, Input, Link, Output, Scene, ancestors, carriers, loaders, member, own_accel
+from dyadgen.model import (
+    Dyad,
+    Input,
+    Link,
+    Output,
+    Scene,
+    ancestors,
+    carriers,
+    loaders,
+    member,
+    own_accel,
+)
 
 #: What a dyad's amplification output means (README, "Status, conditioning, amplification").
 AMPLIFICATION_TEXT = (
@@ -37,9 +48,19 @@ def _motion_inputs(scene: Scene, link: Link) -> list[Input]:
             )
         )
         if scene.inertia:
-            out.append(Input(f"{g}.omega", "rad/s", f"Angular velocity of {g}", member(g) + "_omega", owner=g))
             out.append(
-                Input(f"{g}.epsilon", "rad/s2", f"Angular acceleration of {g}", member(g) + "_epsilon", owner=g)
+                Input(
+                    f"{g}.omega", "rad/s", f"Angular velocity of {g}", member(g) + "_omega", owner=g
+                )
+            )
+            out.append(
+                Input(
+                    f"{g}.epsilon",
+                    "rad/s2",
+                    f"Angular acceleration of {g}",
+                    member(g) + "_epsilon",
+                    owner=g,
+                )
             )
     if scene.inertia and own_accel(link):
         for c in "xy":
@@ -71,7 +92,13 @@ def _link_inputs(scene: Scene, link: Link) -> list[Input]:
             )
     if link.moment:
         out.append(
-            Input(f"{g}.moment", "N.m", f"Active moment on {g}, counter-clockwise", member(g) + "_moment", owner=g)
+            Input(
+                f"{g}.moment",
+                "N.m",
+                f"Active moment on {g}, counter-clockwise",
+                member(g) + "_moment",
+                owner=g,
+            )
         )
     if link.sliding:
         out.append(
@@ -90,10 +117,29 @@ def _link_inputs(scene: Scene, link: Link) -> list[Input]:
 
 def _crank_inputs(scene: Scene) -> list[Input]:
     c = scene.crank.name
-    inputs = [Input(f"{c}.angle", "rad", "Crank angle phi (i_c from O towards A)", member(c) + "_dir", True, owner=c)]
+    inputs = [
+        Input(
+            f"{c}.angle",
+            "rad",
+            "Crank angle phi (i_c from O towards A)",
+            member(c) + "_dir",
+            True,
+            owner=c,
+        )
+    ]
     if scene.inertia:
-        inputs.append(Input(f"{c}.omega", "rad/s", "Crank angular velocity", member(c) + "_omega", owner=c))
-        inputs.append(Input(f"{c}.epsilon", "rad/s2", "Crank angular acceleration", member(c) + "_epsilon", owner=c))
+        inputs.append(
+            Input(f"{c}.omega", "rad/s", "Crank angular velocity", member(c) + "_omega", owner=c)
+        )
+        inputs.append(
+            Input(
+                f"{c}.epsilon",
+                "rad/s2",
+                "Crank angular acceleration",
+                member(c) + "_epsilon",
+                owner=c,
+            )
+        )
     return inputs
 
 
@@ -107,7 +153,8 @@ def _guide_inputs(d: Dyad) -> list[Input]:
                 Input(
                     f"{d.prefix()}slide_{side}",
                     "m",
-                    f"Position of {pair} along the guide on {att.link}, from the guide's point 'at'",
+                    f"Position of {pair} along the guide on {att.link}, "
+                    "from the guide's point 'at'",
                     f"{member(d.prefix())}slide_{side}",
                     owner=slider,
                 )
@@ -156,7 +203,9 @@ class _Index:
     def __init__(self, scene: Scene) -> None:
         self.carrier_of = carriers(scene)
         self.geometry = {
-            i.name for i in scene.inputs if i.unit in ("rad", "m") and not i.name.endswith(".moment")
+            i.name
+            for i in scene.inputs
+            if i.unit in ("rad", "m") and not i.name.endswith(".moment")
         }
         self.owner_of = {i.name: i.owner for i in scene.inputs}
         # the inputs of no link: the guides of external links, DYAD.guide_k.angle
@@ -197,17 +246,35 @@ def _dyad_outputs(offer: _Offer, d: Dyad, deps: list, own_geometry: list) -> Non
     named = d.name or "the dyad"
     for pair, idx in PAIR_NAMES:
         group = [
-            Output(f"{pre}R_{pair}.{c}", "N", reaction_text(d, pair) + f", global {c}",
-                   f"{member(pre)}r_{pair}_{c}", depends=deps, source=source)
+            Output(
+                f"{pre}R_{pair}.{c}",
+                "N",
+                reaction_text(d, pair) + f", global {c}",
+                f"{member(pre)}r_{pair}_{c}",
+                depends=deps,
+                source=source,
+            )
             for c in "xy"
         ]
         offer.add(f"{pre}R_{pair}", group)
         if PAIRS[d.type][idx] == "T":
             label = f"the sliding pair {pair_label(pair)} of {named}"
-            n_out = Output(f"{pre}N_{pair}", "N", f"Normal force of {label}", f"{member(pre)}n_{pair}",
-                           depends=deps, source=source)
-            m_out = Output(f"{pre}M_{pair}", "N.m", f"Reactive moment of {label}", f"{member(pre)}m_{pair}",
-                           depends=deps, source=source)
+            n_out = Output(
+                f"{pre}N_{pair}",
+                "N",
+                f"Normal force of {label}",
+                f"{member(pre)}n_{pair}",
+                depends=deps,
+                source=source,
+            )
+            m_out = Output(
+                f"{pre}M_{pair}",
+                "N.m",
+                f"Reactive moment of {label}",
+                f"{member(pre)}m_{pair}",
+                depends=deps,
+                source=source,
+            )
             offer.add(n_out.name, [n_out])
             offer.add(m_out.name, [m_out])
     cond = Output(
@@ -218,8 +285,14 @@ def _dyad_outputs(offer: _Offer, d: Dyad, deps: list, own_geometry: list) -> Non
         depends=own_geometry,
         source=source,
     )
-    amp = Output(f"{pre}amplification", None, AMPLIFICATION_TEXT, f"{member(pre)}amplification",
-                 depends=deps, source=source)
+    amp = Output(
+        f"{pre}amplification",
+        None,
+        AMPLIFICATION_TEXT,
+        f"{member(pre)}amplification",
+        depends=deps,
+        source=source,
+    )
     offer.add(cond.name, [cond])
     offer.add(amp.name, [amp])
 
@@ -236,8 +309,14 @@ def _crank_outputs(offer: _Offer, scene: Scene) -> None:
         source="crank",
     )
     r_o = [
-        Output(f"{c}.R_O.{x}", "N", f"Force on the crank from the frame at O, global {x}",
-               f"{member(c)}_r_o_{x}", depends=every, source="crank")
+        Output(
+            f"{c}.R_O.{x}",
+            "N",
+            f"Force on the crank from the frame at O, global {x}",
+            f"{member(c)}_r_o_{x}",
+            depends=every,
+            source="crank",
+        )
         for x in "xy"
     ]
     offer.add(torque.name, [torque])

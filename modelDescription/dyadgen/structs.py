@@ -176,9 +176,7 @@ class Structs:
         members = self.input_members if struct == "input" else self.output_members
         type_name = self.input_type if struct == "input" else self.output_type
         if path not in members:
-            raise ValueError(
-                f"{type_name} has no member '{path}' (members: {', '.join(members)})"
-            )
+            raise ValueError(f"{type_name} has no member '{path}' (members: {', '.join(members)})")
         if angle and members[path] != "dir":
             raise ValueError(
                 f"'@angle' applies only to a direction; {type_name}.{path} is a plain double"

@@ -35,9 +35,20 @@ from dyadgen.structs import Structs
 CAUSALITIES = ("input", "parameter", "output")
 VALUE_TYPES = ("Real", "Integer")
 VARIABLE_KEYS = {
-    "name", "vr", "causality", "type", "unit", "start", "min", "max",
-    "min_exclusive", "max_exclusive", "description", "lives", "depends",
-}  # fmt: skip
+    "name",
+    "vr",
+    "causality",
+    "type",
+    "unit",
+    "start",
+    "min",
+    "max",
+    "min_exclusive",
+    "max_exclusive",
+    "description",
+    "lives",
+    "depends",
+}
 MODEL_KEYS = {"kind", "type", "identifier", "description"}
 REQUIRED_KEYS = ("name", "vr", "causality", "type", "description", "lives")
 _RANK = {"input": 0, "parameter": 1, "output": 2}
@@ -178,7 +189,9 @@ class _Check:
         self.owner = self.kind.owner(model)
         self.absence_reason = functools.partial(self.kind.absence_reason, model)
         identifier = model.get("identifier")
-        if not isinstance(identifier, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", identifier):
+        if not isinstance(identifier, str) or not re.fullmatch(
+            r"[A-Za-z_][A-Za-z0-9_]*", identifier
+        ):
             self.fail(f"[model]: identifier {identifier!r} must be a C identifier")
         problem = textsafe.description_problem(model.get("description"))
         if problem:
@@ -279,7 +292,14 @@ class _Check:
             self.seen_lives[key] = raw["name"]
         return entry
 
-    def matches(self, entry: Entry, raw: dict, causality: str | None, value_type: str | None, unit: str | None) -> None:
+    def matches(
+        self,
+        entry: Entry,
+        raw: dict,
+        causality: str | None,
+        value_type: str | None,
+        unit: str | None,
+    ) -> None:
         name = raw["name"]
         if causality is not None and causality != entry.causality:
             self.bad(
@@ -358,7 +378,9 @@ class _Check:
         if causality == "output":
             if "depends" not in raw:
                 self.bad("depends is missing (list the inputs this output depends on; [] if none)")
-            elif not isinstance(raw["depends"], list) or not all(isinstance(x, str) for x in raw["depends"]):
+            elif not isinstance(raw["depends"], list) or not all(
+                isinstance(x, str) for x in raw["depends"]
+            ):
                 self.bad("depends must be a list of input names")
         elif "depends" in raw and causality is not None:
             self.bad(

@@ -77,7 +77,9 @@ class Plan:
         self.solved = [d for d in scene.dyads if d.index in needed]
         crank = [self.crank.name] if self.crank else []
         self.everything = crank + [g for d in scene.dyads for g in (d.m, d.n)]
-        self.moving = (crank if self.crank_needed else []) + [g for d in self.solved for g in (d.m, d.n)]
+        self.moving = (crank if self.crank_needed else []) + [
+            g for d in self.solved for g in (d.m, d.n)
+        ]
         self.accel: dict[str, str | None] = {}  # link -> C name of a_D or None for zero
         self.accel_size: dict[str, str] = {}  # link -> C expression of the size of a_D's terms
 

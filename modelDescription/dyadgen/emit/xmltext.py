@@ -16,7 +16,11 @@ def num(x: float) -> str:
 
 
 def element(
-    indent: int, tag: str, attributes: list[tuple[str, object]], close: bool = True, wrap: bool = False
+    indent: int,
+    tag: str,
+    attributes: list[tuple[str, object]],
+    close: bool = True,
+    wrap: bool = False,
 ) -> str:
     """One start tag; with wrap, one attribute a line (indented 2 deeper)."""
     pad = "  " * indent

@@ -35,7 +35,9 @@ def _learn_c_names() -> CNames:
     kind_of.update({d.name: "dyad" for d in probe.dyads})
     kind_of.update({g: "link" for g in probe.links})
     reserved = set(cnames.C_KEYWORDS) | cnames.COMMON_MACROS
-    reserved |= cnames.headers_names("\n".join(files.values()), list(HEADER_DIRS), {header: files["scene.h"]})
+    reserved |= cnames.headers_names(
+        "\n".join(files.values()), list(HEADER_DIRS), {header: files["scene.h"]}
+    )
     patterns: dict[str, set] = {kind: set() for kind in ("identifier", "crank", "dyad", "link")}
     for file, code in files.items():
         for t in cnames.identifiers(code):
@@ -51,7 +53,12 @@ def _learn_c_names() -> CNames:
             # member of the input or output block; in the code, after '.' or '->'
             member = t.member or (kind != "identifier" and file != "scene.c")
             patterns[kind].add(
-                ("member" if member else "code", t.text[: found.start()], t.text[found.end() :], found.group().isupper())
+                (
+                    "member" if member else "code",
+                    t.text[: found.start()],
+                    t.text[found.end() :],
+                    found.group().isupper(),
+                )
             )
     reserved = {n for n in reserved if not _PROBE_NAME.search(n)}
     return CNames(frozenset(reserved), {k: frozenset(v) for k, v in patterns.items()})

@@ -19,8 +19,8 @@ class Locator:
         self.keys: dict[tuple[str, int, str], int] = {}
         self._counts: dict[str, int] = {}
         self._section, self._index = "", 0
-        depth = 0              # inside a multi-line array or inline table
-        closing = None         # the closing quotes of an open multi-line string
+        depth = 0  # inside a multi-line array or inline table
+        closing = None  # the closing quotes of an open multi-line string
         # TOML ends lines at LF only (str.splitlines would split at U+2028 and others too)
         for number, line in enumerate(text.split("\n"), start=1):
             line = line.removesuffix("\r")

@@ -119,7 +119,9 @@ class _Attaching:
         if target == "frame" and not self.sliding:
             return Attachment("frame")
         crank = self.crank
-        kind = "frame" if target == "frame" else "crank" if crank and target == crank.name else "link"
+        kind = (
+            "frame" if target == "frame" else "crank" if crank and target == crank.name else "link"
+        )
         guide = None
         if self.sliding:
             guide = self.guide(spec, target, kind)
@@ -144,7 +146,9 @@ class _Attaching:
         if kind == "frame":
             text = f"Direction of the frame guide at {pair} (angle of i_{side} from x)"
         else:
-            text = f"Direction of the guide at {pair} on {target}: angle of i_{side} from {target}'s i"
+            text = (
+                f"Direction of the guide at {pair} on {target}: angle of i_{side} from {target}'s i"
+            )
         return Param(f"{self.prefix}guide_{side}.angle", real(angle), "rad", text)
 
     def point(self, spec: dict, target: str, kind: str, guide: Param | None) -> Attachment | None:
@@ -166,7 +170,10 @@ class _Attaching:
             return None
         frame = f"{target}'s frame"
         if self.sliding:
-            pname, what = f"{self.prefix}guide_{self.side}.at", f"A point of the guide at {self.pair} on {target}"
+            pname, what = (
+                f"{self.prefix}guide_{self.side}.at",
+                f"A point of the guide at {self.pair} on {target}",
+            )
         else:
             pname, what = f"{self.prefix}{self.pair}", f"Pair {self.pair} on {target}"
         x = Param(f"{pname}.x", real(at[0]), "m", f"{what}: x in the {frame}")
@@ -263,7 +270,9 @@ class Mechanism:
             )
             return False
         if self.crank and lname == self.crank.name:
-            p.add(f"{label}: link '{lname}' is the crank, which no dyad may contain", "dyad", i, side)
+            p.add(
+                f"{label}: link '{lname}' is the crank, which no dyad may contain", "dyad", i, side
+            )
             return False
         if lname not in self.tables:
             p.add(
@@ -292,7 +301,9 @@ def _length_and_angle(p: Problems, link: Link, row: dict, i: int) -> None:
                 "length",
             )
     else:
-        length = number(p, row, "length", where, "link", i, nonnegative=may_be_zero, positive=not may_be_zero)
+        length = number(
+            p, row, "length", where, "link", i, nonnegative=may_be_zero, positive=not may_be_zero
+        )
         if length is not None:
             text = "may be 0" if may_be_zero else "positive"
             link.params["length"] = Param(
@@ -312,7 +323,9 @@ def _length_and_angle(p: Problems, link: Link, row: dict, i: int) -> None:
         p.add(f"{where}: its angle is an input (the link turns); drop 'angle'", "link", i, "angle")
 
 
-def link_params(p: Problems, link: Link, row: dict, i: int, inertia: bool, needs_mass: bool) -> None:
+def link_params(
+    p: Problems, link: Link, row: dict, i: int, inertia: bool, needs_mass: bool
+) -> None:
     """A link's numbers: length (unless it slides), angle (if it translates), centre of
     mass, and mass and inertia where the effects need them."""
     _length_and_angle(p, link, row, i)
@@ -320,8 +333,12 @@ def link_params(p: Problems, link: Link, row: dict, i: int, inertia: bool, needs
     where = f"link '{g}'"
     com = pair_of_numbers(p, row, "com", where, "link", i, required=True)
     if com is not None:
-        link.params["com.x"] = Param(f"{g}.com.x", com[0], "m", f"Centre of mass of {g}, x in its frame")
-        link.params["com.y"] = Param(f"{g}.com.y", com[1], "m", f"Centre of mass of {g}, y in its frame")
+        link.params["com.x"] = Param(
+            f"{g}.com.x", com[0], "m", f"Centre of mass of {g}, x in its frame"
+        )
+        link.params["com.y"] = Param(
+            f"{g}.com.y", com[1], "m", f"Centre of mass of {g}, y in its frame"
+        )
     mass = number(p, row, "mass", where, "link", i, nonnegative=True, required=needs_mass)
     if mass is not None and needs_mass:
         link.params["mass"] = Param(f"{g}.mass", mass, "kg", f"Mass of {g}", {"min": 0.0})

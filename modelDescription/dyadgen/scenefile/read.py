@@ -27,12 +27,23 @@ def _named_objects(identifier: str, found: mechanism.Mechanism, crank_name: str 
     objects = []
     if not identifier_problem(identifier):
         objects.append(
-            ("identifier", identifier, f"[scene]: identifier '{identifier}'", ("scene", 0, "identifier"))
+            (
+                "identifier",
+                identifier,
+                f"[scene]: identifier '{identifier}'",
+                ("scene", 0, "identifier"),
+            )
         )
     if crank_name is not None:
         objects.append(("crank", crank_name, f"crank '{crank_name}'", ("crank", 0, "name")))
-    objects += [("dyad", d.name, f"dyad '{d.name}'", ("dyad", d.index, "name")) for d in found.dyads if d.name]
-    objects += [("link", g, f"link '{g}'", ("link", i, "name")) for g, (row, i) in found.tables.items()]
+    objects += [
+        ("dyad", d.name, f"dyad '{d.name}'", ("dyad", d.index, "name"))
+        for d in found.dyads
+        if d.name
+    ]
+    objects += [
+        ("link", g, f"link '{g}'", ("link", i, "name")) for g, (row, i) in found.tables.items()
+    ]
     return objects
 
 
@@ -86,9 +97,17 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
         c_name_clashes(p, objects, c_names())
     sections.loads(p, data, found.links)
     scene = Scene(
-        path, identifier, description, inertia, gravity, crank, found.dyads, found.links,
-        gravity_params, threshold,
-    )  # fmt: skip
+        path,
+        identifier,
+        description,
+        inertia,
+        gravity,
+        crank,
+        found.dyads,
+        found.links,
+        gravity_params,
+        threshold,
+    )
     sections.tunable(p, scene_t, scene)
     if not p.items:
         _derive(p, scene, scene_t, data)

@@ -11,7 +11,15 @@ from pathlib import Path
 from dyadgen import textsafe
 from dyadgen.model import Crank, Param, Scene, member
 from dyadgen.scenefile.names import identifier_problem, name_problem
-from dyadgen.scenefile.problems import Problems, SceneError, number, pair_of_numbers, real, shown, unknown_keys
+from dyadgen.scenefile.problems import (
+    Problems,
+    SceneError,
+    number,
+    pair_of_numbers,
+    real,
+    shown,
+    unknown_keys,
+)
 
 SCENE_KEYS = {"identifier", "description", "outputs", "tunable", "singular_threshold"}
 EFFECT_KEYS = {"inertia", "gravity"}
@@ -89,8 +97,7 @@ def gravity(p: Problems, data: dict, on: bool) -> tuple[Param, Param] | None:
     if not on:
         if gravity_t is not None:
             p.add(
-                "[gravity] is given, but [effects] gravity is not true: set it or remove the "
-                "table",
+                "[gravity] is given, but [effects] gravity is not true: set it or remove the table",
                 "gravity",
                 0,
             )
@@ -135,7 +142,9 @@ def threshold(p: Problems, scene_t: dict) -> Param:
     )
 
 
-def _crank_params(p: Problems, crank: Crank, crank_t: dict, inertia: bool, needs_mass: bool) -> None:
+def _crank_params(
+    p: Problems, crank: Crank, crank_t: dict, inertia: bool, needs_mass: bool
+) -> None:
     cname = crank.name
     where = f"crank '{cname}'"
     length = number(p, crank_t, "length", where, "crank", 0, positive=True)
@@ -150,9 +159,14 @@ def _crank_params(p: Problems, crank: Crank, crank_t: dict, inertia: bool, needs
     com = pair_of_numbers(p, crank_t, "com", where, "crank", 0, required=needs_mass)
     if com is not None and needs_mass:
         crank.params["com.x"] = Param(
-            f"{cname}.com.x", com[0], "m", "Crank's centre of mass, x in the crank frame {O; i_c, j_c}"
+            f"{cname}.com.x",
+            com[0],
+            "m",
+            "Crank's centre of mass, x in the crank frame {O; i_c, j_c}",
         )
-        crank.params["com.y"] = Param(f"{cname}.com.y", com[1], "m", "Crank's centre of mass, y in the crank frame")
+        crank.params["com.y"] = Param(
+            f"{cname}.com.y", com[1], "m", "Crank's centre of mass, y in the crank frame"
+        )
     mass = number(p, crank_t, "mass", where, "crank", 0, nonnegative=True, required=needs_mass)
     if mass is not None and needs_mass:
         crank.params["mass"] = Param(f"{cname}.mass", mass, "kg", "Crank's mass", {"min": 0.0})
@@ -243,8 +257,7 @@ def outputs(p: Problems, scene_t: dict) -> list[str] | None:
     wanted = scene_t.get("outputs")
     if wanted is None:
         p.add(
-            '[scene]: missing \'outputs\' (a list such as ["all"] or ["ram.R_np", '
-            '"crank.torque"])',
+            '[scene]: missing \'outputs\' (a list such as ["all"] or ["ram.R_np", "crank.torque"])',
             "scene",
             0,
         )
