@@ -98,8 +98,8 @@ class Kind(Structs):
     directional_derivatives = "false"
     log_categories: tuple = ()
     #: How a scene of this kind is realised (scene.py --cmake-info) and named (--check).
-    realisation = "generic"
-    label = "generic dyad"
+    realisation = ""
+    label = ""
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The C files an importer compiles to rebuild the FMI `version` binary."""
@@ -161,6 +161,8 @@ class DyadKind(Kind):
 
     directional_derivatives = "true"
     log_categories = LOG_CATEGORIES
+    realisation = "generic"
+    label = "generic dyad"
 
     def lives_syntax(self) -> str:
         """What a `lives` of a dyad looks like."""

@@ -26,11 +26,12 @@ import re
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Protocol
 
 from dyadgen import textsafe
 from dyadgen.catalogue import Entry
 from dyadgen.dyadtypes import UNITS
-from dyadgen.structs import Structs
+from dyadgen.structs import Lives, Structs
 
 CAUSALITIES = ("input", "parameter", "output")
 VALUE_TYPES = ("Real", "Integer")
@@ -53,6 +54,25 @@ MODEL_KEYS = {"kind", "type", "identifier", "description"}
 REQUIRED_KEYS = ("name", "vr", "causality", "type", "description", "lives")
 _RANK = {"input": 0, "parameter": 1, "output": 2}
 _REAL_KEYS = ("start", "min", "max")
+
+
+class TableKind(Protocol):
+    """What checking a table file needs of its kind of model (kinds.Kind)."""
+
+    def parse_lives(self, text: object) -> Lives:
+        """A `lives` of the kind's structs; ValueError with the reason."""
+
+    def catalogue_for(self, model: dict) -> dict[str, Entry]:
+        """Every variable a table of this [model] must have; ValueError if there is none."""
+
+    def model_problems(self, model: dict) -> list[str]:
+        """What is wrong with [model] for this kind."""
+
+    def owner(self, model: dict) -> str:
+        """The model, as messages name it."""
+
+    def absence_reason(self, model: dict, lives: str) -> str:
+        """Why a well-formed `lives` is not a variable of this model."""
 
 
 class TableError(Exception):
@@ -149,7 +169,7 @@ class _Check:
         self.fname = fname
         self.problems: list[str] = []
         self.label = ""
-        self.kind: Structs | None = None
+        self.kind: TableKind | None = None
         self.known: dict[str, Entry] = {}
         self.owner = ""
         self.absence_reason = None
@@ -168,7 +188,7 @@ class _Check:
         return TableError(self.problems + [f"{self.fname}: {message}"])
 
     # ---- [model]
-    def model(self, data: dict, kinds: Mapping) -> dict:
+    def model(self, data: dict, kinds: Mapping[str, TableKind]) -> dict:
         for key in sorted(set(data) - {"model", "variable"}):
             self.fail(f"unknown top-level key '{key}' (expected [model] and [[variable]])")
         model = data.get("model")
@@ -426,7 +446,7 @@ class _Check:
             )
 
 
-def table_from_data(data: dict, path: Path, kinds: Mapping) -> Table:
+def table_from_data(data: dict, path: Path, kinds: Mapping[str, TableKind]) -> Table:
     """Validate a table already read (a file's, or one a scene generates); `path` names
     it in messages and in the generated files; `kinds`: the kinds of model a table may
     be of, by name. Raises TableError listing every problem."""
