@@ -12,7 +12,7 @@ reaction come last. The closed forms are the core's dyad_react_<type>
 The emitter first makes a plan (which dyads the wanted outputs need, which links move)
 and then writes the function body in passes: frames, accelerations of the pairs D,
 resultants, the chain, the crank, the outputs. A last pass drops the constants nothing
-reads; the body goes into templates/scene.c.
+reads; the body goes into templates/scene.c.in.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from dyadgen import textsafe
 from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, loaders, member
 from dyadgen.table import Table
 
-TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c"
+TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c.in"
 
 
 def _vec(x: str, y: str) -> str:
