@@ -254,6 +254,14 @@ class Mechanism:
             self.links[lname] = Link(lname, dyad, side, line, sliding, translating)
         self.dyads.append(dyad)
 
+    def link_numbers(self, inertia: bool, needs_mass: bool) -> None:
+        """Every described link's numbers; a link of no dyad is a problem."""
+        for lname, (row, i) in self.tables.items():
+            if lname in self.links:
+                link_params(self.p, self.links[lname], row, i, inertia, needs_mass)
+            elif lname not in self.owner:
+                self.p.add(f"link '{lname}' belongs to no dyad", "link", i)
+
     def link(self, dyad: Dyad, row: dict, side: str, label: str) -> bool:
         """Link m or n of a dyad: whether it names a described link no other dyad has."""
         p, i = self.p, dyad.index

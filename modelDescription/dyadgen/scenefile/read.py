@@ -87,26 +87,22 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     crank = sections.crank(p, data, inertia, needs_mass)
     found = mechanism.Mechanism(p, crank, mechanism.link_tables(p, data, crank))
     found.parse(data)
-    for lname, (row, i) in found.tables.items():
-        if lname in found.links:
-            mechanism.link_params(p, found.links[lname], row, i, inertia, needs_mass)
-        elif lname not in found.owner:
-            p.add(f"link '{lname}' belongs to no dyad", "link", i)
+    found.link_numbers(inertia, needs_mass)
     if c_names is not None:
         objects = _named_objects(identifier, found, crank.name if crank else None)
         c_name_clashes(p, objects, c_names())
     sections.loads(p, data, found.links)
     scene = Scene(
-        path,
-        identifier,
-        description,
-        inertia,
-        gravity,
-        crank,
-        found.dyads,
-        found.links,
-        gravity_params,
-        threshold,
+        path=path,
+        identifier=identifier,
+        description=description,
+        inertia=inertia,
+        gravity=gravity,
+        crank=crank,
+        dyads=found.dyads,
+        links=found.links,
+        gravity_params=gravity_params,
+        threshold=threshold,
     )
     sections.tunable(p, scene_t, scene)
     if not p.items:
