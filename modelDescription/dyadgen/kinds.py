@@ -154,6 +154,10 @@ class Kind(Structs):
         """Why a well-formed `lives` is not a variable of this model."""
         raise NotImplementedError
 
+    def table_of_scene(self, scene: Scene) -> Table:
+        """The variable table of a scene this kind realises."""
+        raise NotImplementedError
+
 
 class DyadKind(Kind):
     """The generic dyad FMU of one type, on the core's validating solver and its exact
@@ -231,7 +235,7 @@ class DyadKind(Kind):
         """Why the type has no such variable."""
         return dyad_absence_reason(model["type"], lives)
 
-    def scene_table(self, scene: Scene) -> Table:
+    def table_of_scene(self, scene: Scene) -> Table:
         """The table of a generic scene (is_generic), checked as a table file is."""
         try:
             return table_from_data(generic_data(scene), scene.path, KINDS)
@@ -290,14 +294,17 @@ class SceneKind(Kind):
     label = "tailored"
     log_categories = SCENE_LOG_CATEGORIES
 
-    def __init__(self, scene: Scene, input_members: dict, output_members: dict) -> None:
+    def __init__(self, scene: Scene) -> None:
         ident = scene.identifier
+        inputs = {i.member: "dir" if i.angle else "real" for i in scene.inputs}
+        inputs.update((prm.member, "real") for prm in scene.parameters() if prm.tunable)
+        outputs = {o.member: "status" if o.integer else "real" for o in scene.outputs}
         super().__init__(
             "scene",
             f"{ident}_input",
             f"{ident}_output",
-            input_members,
-            output_members,
+            inputs,
+            outputs,
             f"{ident}_scene.h",
             f"{ident}_behaviour",
         )
@@ -335,6 +342,10 @@ class SceneKind(Kind):
     def documentation(self, table: Table) -> str:
         """The page of the scene."""
         return documentation.scene_page(table)
+
+    def table_of_scene(self, scene: Scene) -> Table:
+        """The scene's table, valid by construction."""
+        return SceneTable(scene, _scene_rows(scene), self)
 
 
 DYAD = DyadKind(
@@ -385,11 +396,9 @@ def _row(rows: list, name: str, causality: str, unit: str | None, **values: obje
     return raw
 
 
-def scene_table(scene: Scene) -> SceneTable:
-    """The variable table of a tailored scene: its inputs, tunable parameters, outputs."""
+def _scene_rows(scene: Scene) -> list[dict]:
+    """The rows of a tailored scene's table: its inputs, tunable parameters, outputs."""
     rows: list[dict] = []
-    input_members: dict[str, str] = {}
-    output_members: dict[str, str] = {}
     for i in scene.inputs:
         lives = f"input.{i.member}{'@angle' if i.angle else ''}"
         raw = _row(
@@ -403,7 +412,6 @@ def scene_table(scene: Scene) -> SceneTable:
             lives=lives,
         )
         _bounds(raw, i.domain)
-        input_members[i.member] = "dir" if i.angle else "real"
     for prm in scene.parameters():
         if prm.tunable:
             raw = _row(
@@ -417,21 +425,18 @@ def scene_table(scene: Scene) -> SceneTable:
                 lives=f"input.{prm.member}",
             )
             _bounds(raw, prm.domain)
-            input_members[prm.member] = "real"
     for o in scene.outputs:
-        value_type = "Integer" if o.integer else "Real"
         _row(
             rows,
             o.name,
             "output",
             o.unit,
-            type=value_type,
+            type="Integer" if o.integer else "Real",
             description=o.description,
             lives=f"result.{o.member}",
             depends=list(o.depends),
         )
-        output_members[o.member] = "status" if o.integer else "real"
-    return SceneTable(scene, rows, SceneKind(scene, input_members, output_members))
+    return rows
 
 
 def is_generic(scene: Scene) -> bool:
@@ -486,6 +491,11 @@ def generic_data(scene: Scene) -> dict:
     return {"model": model, "variable": rows}
 
 
+def kind_of_scene(scene: Scene) -> Kind:
+    """The kind that realises a scene: the generic dyad, or the scene's own."""
+    return DYAD if is_generic(scene) else SceneKind(scene)
+
+
 def build_table(scene: Scene) -> Table:
     """The scene's variable table: generic (of kind dyad) or tailored."""
-    return DYAD.scene_table(scene) if is_generic(scene) else scene_table(scene)
+    return kind_of_scene(scene).table_of_scene(scene)

@@ -19,7 +19,7 @@ C_NAMES_PROBE = INTERFACE_DIR / "c_names_probe.toml"
 HEADER_DIRS = (ROOT / "src" / "include", ROOT / "src", ROOT / "fmu")
 
 
-def shown(path: Path) -> str:
+def relative_to_checkout(path: Path) -> str:
     """A path relative to the checkout where it lies inside it."""
     try:
         return str(path.relative_to(ROOT))

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from dyadgen.golden import golden_files
-from dyadgen.locations import shown
+from dyadgen.locations import relative_to_checkout
 from dyadgen.pipeline import load_table, outputs_of, write_files
 from dyadgen.table import TableError
 
@@ -38,7 +38,7 @@ def update_golden() -> int:
     """Rewrite every golden file."""
     for path, text in golden_files().items():
         write_files(path.parent, {path.name: text})
-        print(f"wrote {shown(path)}")
+        print(f"wrote {relative_to_checkout(path)}")
     return 0
 
 
@@ -49,7 +49,7 @@ def check_golden() -> int:
         old = path.read_text(encoding="utf-8") if path.is_file() else ""
         if old != text:
             differs.append(path)
-            rel = shown(path)
+            rel = relative_to_checkout(path)
             sys.stdout.writelines(
                 difflib.unified_diff(
                     old.splitlines(keepends=True),

@@ -10,7 +10,7 @@ import re
 from dyadgen import cnames
 from dyadgen.emit.c_table import model_c
 from dyadgen.emit.scene_c import scene_c, scene_header
-from dyadgen.kinds import scene_table
+from dyadgen.kinds import SceneKind
 from dyadgen.locations import C_NAMES_PROBE, HEADER_DIRS
 from dyadgen.scenefile.names import CNames
 from dyadgen.scenefile.read import read_scene
@@ -28,7 +28,7 @@ def c_names() -> CNames:
 
 def _learn_c_names() -> CNames:
     probe = read_scene(C_NAMES_PROBE, c_names=None)
-    table = scene_table(probe)
+    table = SceneKind(probe).table_of_scene(probe)
     header = f"{probe.identifier}_scene.h"
     files = {"scene.c": scene_c(probe), "scene.h": scene_header(table), "model.c": model_c(table)}
     kind_of = {probe.identifier: "identifier", probe.crank.name: "crank"}

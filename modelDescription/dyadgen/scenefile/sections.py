@@ -50,7 +50,7 @@ def read_text(path: Path) -> tuple[str, dict]:
         raise SceneError([f"{where}: invalid TOML: {textsafe.plain(exc)}"]) from None
 
 
-def scene_table(p: Problems, data: dict) -> tuple[dict, str, str]:
+def scene_section(p: Problems, data: dict) -> tuple[dict, str, str]:
     """The top-level tables, and [scene]: the table, the identifier and the description
     (stand-ins where they are invalid); raises SceneError where [scene] is missing."""
     for key in data:
