@@ -172,7 +172,7 @@ class _Check:
         self.kind: TableKind | None = None
         self.known: dict[str, Entry] = {}
         self.owner = ""
-        self.absence_reason = None
+        self.model: dict = {}
         self.seen_names: dict[str, int] = {}
         self.seen_vrs: dict[int, str] = {}
         self.seen_lives: dict[str, str] = {}
@@ -188,7 +188,7 @@ class _Check:
         return TableError(self.problems + [f"{self.fname}: {message}"])
 
     # ---- [model]
-    def model(self, data: dict, kinds: Mapping[str, TableKind]) -> dict:
+    def check_model(self, data: dict, kinds: Mapping[str, TableKind]) -> dict:
         for key in sorted(set(data) - {"model", "variable"}):
             self.fail(f"unknown top-level key '{key}' (expected [model] and [[variable]])")
         model = data.get("model")
@@ -207,7 +207,7 @@ class _Check:
         for message in self.kind.model_problems(model):
             self.fail(f"[model]: {message}")
         self.owner = self.kind.owner(model)
-        self.absence_reason = functools.partial(self.kind.absence_reason, model)
+        self.model = model
         identifier = model.get("identifier")
         if not isinstance(identifier, str) or not re.fullmatch(
             r"[A-Za-z_][A-Za-z0-9_]*", identifier
@@ -304,7 +304,7 @@ class _Check:
         key = raw["lives"]
         entry = self.known.get(key)
         if entry is None:
-            self.bad(f"lives {key!r}: {self.absence_reason(key)}")
+            self.bad(f"lives {key!r}: {self.kind.absence_reason(self.model, key)}")
         elif key in self.seen_lives:
             self.bad(f"lives {key!r} is also the home of '{self.seen_lives[key]}'")
             entry = None
@@ -452,7 +452,7 @@ def table_from_data(data: dict, path: Path, kinds: Mapping[str, TableKind]) -> T
     be of, by name. Raises TableError listing every problem."""
     path = Path(path)
     check = _Check(path.name)
-    model = check.model(data, kinds)
+    model = check.check_model(data, kinds)
     rows = data.get("variable")
     if not isinstance(rows, list) or not rows:
         raise check.fatal("no [[variable]] entries")

@@ -25,6 +25,12 @@ def template(name: str) -> Template:
     return Template((TEMPLATES / name).read_text(encoding="utf-8"))
 
 
+@functools.cache
+def stylesheet() -> str:
+    """The style every page embeds (templates/style.css)."""
+    return (TEMPLATES / "style.css").read_text(encoding="utf-8")
+
+
 def _fmt_bounds(v: Variable) -> str:
     if v.min is None and v.max is None:
         return ""
@@ -61,7 +67,7 @@ def page(name: str, table: Table, **values: object) -> str:
         identifier=h(table.identifier), token=h(table.token), table_file=h(table.path.name)
     )
     return template(name).substitute(
-        css=template("style.css").template,
+        css=stylesheet(),
         identity=identity,
         identifier=h(table.identifier),
         description=h(table.description),
