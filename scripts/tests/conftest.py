@@ -1,5 +1,5 @@
 """What every test file shares: the harness package (scripts/dyadfmu) and the generator
-modules (modelDescription/) importable, this checkout's ahead of any installed copy."""
+package (modelDescription/dyadgen) importable, this checkout's ahead of any installed copy."""
 
 import sys
 from pathlib import Path

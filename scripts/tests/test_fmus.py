@@ -53,11 +53,11 @@ def test_fmu_validates(dyad, version):
         assert "sources/buildDescription.xml" in names
         with zipfile.ZipFile(path) as archive:
             assert archive.read("modelDescription.xml") == \
-                (ROOT / "modelDescription" / "golden" / f"dyad_{dyad}_fmi3.xml").read_bytes()
+                (ROOT / "modelDescription" / "interface" / "golden" / f"dyad_{dyad}_fmi3.xml").read_bytes()
     else:
         with zipfile.ZipFile(path) as archive:
             assert archive.read("modelDescription.xml") == \
-                (ROOT / "modelDescription" / "golden" / f"dyad_{dyad}_fmi2.xml").read_bytes()
+                (ROOT / "modelDescription" / "interface" / "golden" / f"dyad_{dyad}_fmi2.xml").read_bytes()
 
 
 # ---- co-simulation against the core ----------------------------------------------

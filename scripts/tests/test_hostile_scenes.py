@@ -38,11 +38,14 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 MD_DIR = ROOT / "modelDescription"
 
-import cnames  # noqa: E402
-import scene  # noqa: E402
-import textsafe  # noqa: E402
 from dyadfmu.cosim import scenes  # noqa: E402
 from dyadfmu.study import long_chain  # noqa: E402
+from dyadgen import cnames, pipeline, textsafe  # noqa: E402
+from dyadgen.emit import scene_c as scene_emit  # noqa: E402
+from dyadgen.kinds import SceneTable  # noqa: E402
+from dyadgen.scenefile import names as scene_names  # noqa: E402
+from dyadgen.scenefile.c_names import c_names  # noqa: E402
+from dyadgen.scenefile.problems import SceneError  # noqa: E402
 
 SCENE_TOOL = MD_DIR / "scene.py"
 SCENES_DIR = ROOT / "scenes"
@@ -108,8 +111,8 @@ def test_hostile_scene_is_refused_with_its_exact_message(path, tmp_path):
 def test_a_file_that_is_not_utf8_is_refused_with_its_line(tmp_path):
     path = tmp_path / "latin1.toml"
     path.write_bytes(b'[scene]\nidentifier = "x"\ndescription = "Pr\xe9sse"\n')
-    with pytest.raises(scene.SceneError) as error:
-        scene.load_scene(path)
+    with pytest.raises(SceneError) as error:
+        pipeline.load_scene(path)
     assert error.value.args[0] == ["latin1.toml:3: not UTF-8 text (byte 43)"]
 
 
@@ -120,8 +123,8 @@ def _refusal(tmp_path, text: str) -> list[str]:
     path = tmp_path / "named.toml"
     path.write_text(text, encoding="utf-8")
     try:
-        scene.load_scene(path)
-    except scene.SceneError as error:
+        pipeline.load_scene(path)
+    except SceneError as error:
         return error.args[0]
     return []
 
@@ -130,10 +133,10 @@ def test_every_name_the_generated_code_uses_is_refused_as_a_dyad_name(tmp_path):
     """A dyad's name is a local variable of the generated code; every identifier that C,
     the headers the code includes, the core and the generated code use is refused, with
     the dyad's line."""
-    names = scene.c_names()
+    names = c_names()
     base = SIXBAR.read_text()
     line = base.splitlines().index('name = "second"') + 1
-    candidates = sorted(n for n in names.reserved if scene.NAME.fullmatch(n))
+    candidates = sorted(n for n in names.reserved if scene_names.NAME.fullmatch(n))
     # the examples of the issue, and the macros a C program must leave alone
     assert {"in", "out", "load", "check", "model", "evaluation", "cos", "snprintf", "memset",
             "errno", "int", "double"} <= set(candidates)
@@ -155,7 +158,7 @@ def test_an_identifier_named_after_c_or_the_core_is_refused(name, tmp_path):
 
 
 @pytest.mark.parametrize("keyword", sorted(k for k in cnames.C_KEYWORDS
-                                           if scene.NAME.fullmatch(k)))
+                                           if scene_names.NAME.fullmatch(k)))
 def test_a_c_keyword_is_refused_as_a_link_name(keyword, tmp_path):
     text = SIXBAR.read_text().replace('"connector"', f'"{keyword}"')
     line = text.splitlines().index(f'name = "{keyword}"') + 1
@@ -177,7 +180,7 @@ SCENE_FILES = sorted(SCENES_DIR.glob("*.toml")) + sorted((ROOT / "tests" / "scen
 
 def _generates_code(path: Path) -> bool:
     """A tailored scene (its own C); a generic dyad's scene has none."""
-    return isinstance(scene.build_table(scene.load_scene(path)), scene.SceneTable)
+    return isinstance(pipeline.build_table(pipeline.load_scene(path)), SceneTable)
 
 
 TAILORED_SCENE_FILES = [p for p in SCENE_FILES if _generates_code(p)]
@@ -189,21 +192,21 @@ def test_the_refused_names_cover_the_generated_code(path):
     headers', the core's, the generated code's own), or one it derives from a name of
     the scene, or a member: the probe the refused names are learnt from has every
     feature of the examples."""
-    names = scene.c_names()
-    sc = scene.load_scene(path)
-    table = scene.build_table(sc)
+    names = c_names()
+    sc = pipeline.load_scene(path)
+    table = pipeline.build_table(sc)
     derived = {c for kind, name in _scene_objects(sc) for _, c in names.derived(kind, name)}
-    code = [t.text for t in cnames.identifiers(scene.scene_c(table)) if not t.member]
-    declared = sorted(cnames.declared_names(scene.scene_header(table)))
+    code = [t.text for t in cnames.identifiers(scene_emit.scene_c(table.scene)) if not t.member]
+    declared = sorted(cnames.declared_names(scene_emit.scene_header(table)))
     for name in code + declared:
         assert name in names.reserved or name in derived, (path.name, name)
 
 
 def test_generated_names_stay_within_c99_significance():
     """MAX_NAME keeps every derived C name within the 63 characters C99 guarantees."""
-    names = scene.c_names()
+    names = c_names()
     longest = max(len(c) for kind in names.patterns
-                  for _, c in names.derived(kind, "x" * scene.MAX_NAME))
+                  for _, c in names.derived(kind, "x" * scene_names.MAX_NAME))
     assert longest <= 63
 
 
@@ -344,7 +347,7 @@ def _build_fmu(table, tmp_path, name) -> Path:
     """The FMI 2 FMU of a tailored table, compiled as CMake compiles it (hidden
     visibility, the FMI functions exported and nothing else, unused sections dropped)."""
     gen = tmp_path / name
-    for rel, text in scene.outputs_of(table).items():
+    for rel, text in pipeline.outputs_of(table).items():
         (gen / rel).parent.mkdir(parents=True, exist_ok=True)
         (gen / rel).write_text(text, encoding="utf-8")
     ident = table.identifier
@@ -390,11 +393,11 @@ def test_a_planted_constructor_stays_a_comment_even_past_the_check(tmp_path):
     description, and fmpy validates and runs it."""
     from fmpy import simulate_fmu
     from fmpy.validation import validate_fmu
-    plain = scene.build_table(scene.load_scene(SIXBAR))
-    planted_scene = scene.load_scene(SIXBAR)
+    plain = pipeline.build_table(pipeline.load_scene(SIXBAR))
+    planted_scene = pipeline.load_scene(SIXBAR)
     planted_scene.description = PLANT
-    planted = scene.build_table(planted_scene)
-    assert textsafe.html(PLANT) in scene.outputs_of(planted)["documentation/index.html"]
+    planted = pipeline.build_table(planted_scene)
+    assert textsafe.html(PLANT) in pipeline.outputs_of(planted)["documentation/index.html"]
     plain_fmu = _build_fmu(plain, tmp_path, "plain")
     planted_fmu = _build_fmu(planted, tmp_path, "planted")
     want = _symbols_and_constructors(plain_fmu, tmp_path)
@@ -437,10 +440,10 @@ def test_a_tunable_pair_point_is_a_parameter_that_works(tunable, tmp_path):
     other outputs at another value."""
     path = sixbar_with(tmp_path, "tunable.toml", tunable=tunable)
     assert run_tool(path, "--check").returncode == 0
-    tuned = scene.build_table(scene.load_scene(path))
+    tuned = pipeline.build_table(pipeline.load_scene(path))
     params = [v.name for v in tuned.variables if v.causality == "parameter"]
     assert {"second.D_m.x", "second.D_m.y"} <= set(params)
-    baked = scene.build_table(scene.load_scene(SIXBAR))
+    baked = pipeline.build_table(pipeline.load_scene(SIXBAR))
     source = scenes.Source("sixbar")
     motion = source.motion("varying", 1.0)
     kin = source.kinematics(np.array([0.37 * motion.duration]), motion)
@@ -546,9 +549,9 @@ def test_mutated_scenes_give_messages_never_tracebacks(tmp_path):
         except (ValueError, TypeError, tomllib.TOMLDecodeError):
             continue
         try:
-            scene.outputs_of(scene.build_table(scene.load_scene(target)))
+            pipeline.outputs_of(pipeline.build_table(pipeline.load_scene(target)))
             outcomes["accepted"] += 1
-        except scene.SceneError as error:
+        except SceneError as error:
             outcomes["refused"] += 1
             for message in error.args[0]:
                 assert re.match(rf"{re.escape(path.name)}:\d+: \S", message), (trial, message)
@@ -569,7 +572,7 @@ def _calls_to_check(path: Path) -> int:
 
     sys.setprofile(profile)
     try:
-        scene.build_table(scene.load_scene(path))
+        pipeline.build_table(pipeline.load_scene(path))
     finally:
         sys.setprofile(None)
     return count
@@ -578,7 +581,7 @@ def _calls_to_check(path: Path) -> int:
 def test_checking_a_chain_grows_linearly_with_its_dyads(tmp_path):
     """Function calls, not time: twice the dyads may cost a little more than twice the
     calls (the dependency lists are longer), not four or eight times."""
-    scene.c_names()                                   # learnt once per process
+    c_names()                                   # learnt once per process
     small = _calls_to_check(long_chain.write_chain(50, tmp_path))
     large = _calls_to_check(long_chain.write_chain(100, tmp_path))
     print(f"calls to check 50 dyads: {small}, 100 dyads: {large} ({large / small:.2f} x)")

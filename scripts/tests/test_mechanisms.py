@@ -460,9 +460,9 @@ def test_quick_return_strokes():
 # ---------------------------------------------------------------------------
 def toml_names(dyad, causality):
     """The generic dyad FMU's variables, as the scene generator makes them."""
-    import scene
+    from dyadgen import pipeline
 
-    table = scene.build_table(scene.load_scene(ROOT / "scenes" / f"dyad_{dyad.lower()}.toml"))
+    table = pipeline.build_table(pipeline.load_scene(ROOT / "scenes" / f"dyad_{dyad.lower()}.toml"))
     return [v.name for v in table.variables if v.causality == causality]
 
 

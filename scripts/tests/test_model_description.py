@@ -10,7 +10,7 @@
 Also: the generated C tables compile, the start values give a well-conditioned
 solve, and the instantiation token follows the table.
 
-(e) The crank drive (drive.toml, a model with states; fmu/fmu_drive.h): golden
+(e) The crank drive (drive.toml, a model with states; fmu/models/fmu_drive.h): golden
     files, fmpy validation, its variables, units, causalities and dependencies
     (including empty ones), its C table, its documentation, and malformed drive
     tables. The dyad-only tests above stay parametrized over the five dyad types.
@@ -35,9 +35,12 @@ ROOT = HERE.parents[1]
 MD_DIR = ROOT / "modelDescription"
 GENERATOR = MD_DIR / "generate.py"
 
-import generate  # noqa: E402
-import scene  # noqa: E402
 from dyadfmu.reference import newton_euler as ref  # noqa: E402
+from dyadgen import golden as golden_module  # noqa: E402
+from dyadgen import kinds, pipeline  # noqa: E402
+from dyadgen.cli import generate as generate_cli  # noqa: E402
+from dyadgen.structs import DRIVE_INPUT_MEMBERS, DRIVE_OUTPUT_MEMBERS  # noqa: E402
+from dyadgen.table import instantiation_token  # noqa: E402
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}  # D_m, E, D_n
@@ -288,7 +291,7 @@ def test_generator_writes_every_file(generated):
 @pytest.mark.parametrize("dyad_type", TYPES)
 def test_generated_xml_equals_golden(generated, dyad_type):
     for version in ("fmi2", "fmi3"):
-        golden = MD_DIR / "golden" / f"{identifier(dyad_type)}_{version}.xml"
+        golden = MD_DIR / "interface" / "golden" / f"{identifier(dyad_type)}_{version}.xml"
         produced = generated[dyad_type] / version / "modelDescription.xml"
         assert golden.is_file(), f"{golden} missing: run generate.py --update-golden"
         assert produced.read_bytes() == golden.read_bytes(), (
@@ -302,11 +305,11 @@ def test_check_golden_passes():
 
 
 def test_check_golden_reports_a_difference(tmp_path, monkeypatch):
-    monkeypatch.setattr(generate, "GOLDEN_DIR", tmp_path)
-    assert generate.main(["--update-golden"]) == 0
+    monkeypatch.setattr(golden_module, "GOLDEN_DIR", tmp_path)
+    assert generate_cli.main(["--update-golden"]) == 0
     target = tmp_path / "dyad_rrt_fmi3.xml"
     target.write_text(target.read_text().replace('stopTime="1"', 'stopTime="2"'))
-    assert generate.main(["--check-golden"]) == 1
+    assert generate_cli.main(["--check-golden"]) == 1
 
 
 def test_output_is_deterministic(generated, tmp_path):
@@ -578,15 +581,15 @@ def test_start_values_solve_ok_in_the_c_core(dyad_type):
 # ---------------------------------------------------------------------------
 def test_token_follows_the_table():
     raw = load_raw("RRT")
-    token = generate.instantiation_token(raw["model"], raw["variable"])
-    assert token == generate.load_table(TABLE_OF["RRT"]).token
+    token = instantiation_token(raw["model"], raw["variable"])
+    assert token == pipeline.load_table(TABLE_OF["RRT"]).token
     changed = [dict(v) for v in raw["variable"]]
     changed[0]["description"] += "."
-    assert generate.instantiation_token(raw["model"], changed) != token
+    assert instantiation_token(raw["model"], changed) != token
     as_int = [dict(v, start=int(v["start"])) if v.get("start") == int(v.get("start", 0.5))
               else v for v in raw["variable"]]
-    assert generate.instantiation_token(raw["model"], as_int) == token  # 0 and 0.0 agree
-    tokens = {generate.load_table(TABLE_OF[t]).token for t in TYPES}
+    assert instantiation_token(raw["model"], as_int) == token  # 0 and 0.0 agree
+    tokens = {pipeline.load_table(TABLE_OF[t]).token for t in TYPES}
     assert len(tokens) == len(TYPES)
 
 
@@ -717,7 +720,7 @@ def test_unmodified_copy_is_accepted(tmp_path):
 # ---------------------------------------------------------------------------
 # (e) the crank drive
 # ---------------------------------------------------------------------------
-DRIVE_TABLE = MD_DIR / "drive.toml"
+DRIVE_TABLE = MD_DIR / "interface" / "drive.toml"
 DRIVE_HEADER = ROOT / "fmu" / "models" / "fmu_drive.h"
 
 #: name -> (causality, unit, lives), in table order, written out from the specification.
@@ -767,18 +770,18 @@ def test_tables_are_the_drive_and_the_scenes_of_the_five_dyads():
     """The drive's table is the one written by hand; the dyads' tables come from their
     scenes, and both are golden-checked. Only the dyad tables go through the dyad-only
     tests (dependency derivation, reference solve)."""
-    on_disk = {p.name for p in MD_DIR.glob("*.toml")}
+    on_disk = {p.name for p in (MD_DIR / "interface").glob("*.toml")}
     # (c_names_probe.toml is a scene the scene generator learns its C names from)
     assert on_disk == {"drive.toml", "dyad_interface.toml", "c_names_probe.toml"}
-    assert generate.TABLES == ("drive.toml",)
-    assert {p.name for p in TABLE_OF.values()} == set(generate.GOLDEN_SCENES)
-    assert all((SCENES_DIR / name).is_file() for name in generate.GOLDEN_SCENES)
-    assert generate.load_table(DRIVE_TABLE).kind is generate.DRIVE
-    assert all(generate.load_table(p).kind is generate.DYAD for p in TABLE_OF.values())
+    assert golden_module.TABLES == ("drive.toml",)
+    assert {p.name for p in TABLE_OF.values()} == set(golden_module.GOLDEN_SCENES)
+    assert all((SCENES_DIR / name).is_file() for name in golden_module.GOLDEN_SCENES)
+    assert pipeline.load_table(DRIVE_TABLE).kind is kinds.DRIVE
+    assert all(pipeline.load_table(p).kind is kinds.DYAD for p in TABLE_OF.values())
     for t in TYPES:
-        built = scene.build_table(scene.load_scene(SCENES_DIR / f"dyad_{t.lower()}.toml"))
-        assert built.kind is generate.DYAD and built.type == t
-        assert built.token == generate.load_table(TABLE_OF[t]).token
+        built = pipeline.build_table(pipeline.load_scene(SCENES_DIR / f"dyad_{t.lower()}.toml"))
+        assert built.kind is kinds.DYAD and built.type == t
+        assert built.token == pipeline.load_table(TABLE_OF[t]).token
 
 
 def test_drive_generator_writes_every_file(generated_drive):
@@ -789,7 +792,7 @@ def test_drive_generator_writes_every_file(generated_drive):
 
 def test_drive_xml_equals_golden(generated_drive):
     for version in ("fmi2", "fmi3"):
-        golden = MD_DIR / "golden" / f"drive_{version}.xml"
+        golden = MD_DIR / "interface" / "golden" / f"drive_{version}.xml"
         produced = generated_drive / version / "modelDescription.xml"
         assert golden.is_file(), f"{golden} missing: run generate.py --update-golden"
         assert produced.read_bytes() == golden.read_bytes(), (
@@ -833,7 +836,7 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
     token = md2.guid
     assert re.fullmatch(r"\{[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}\}", token)
     assert md3.instantiationToken == token
-    assert token not in {generate.load_table(TABLE_OF[t]).token for t in TYPES}
+    assert token not in {pipeline.load_table(TABLE_OF[t]).token for t in TYPES}
 
     for md, shim in ((md2, ["fmi2_functions.c"]),
                      (md3, ["fmi3_functions.c", "fmi3_unsupported.c"])):
@@ -921,8 +924,8 @@ def _struct_members(header_text, struct):
 def test_drive_members_match_the_header():
     """The generator's view of fmu_drive_input / fmu_drive_output is the header's."""
     text = DRIVE_HEADER.read_text()
-    assert _struct_members(text, "fmu_drive_input") == list(generate.DRIVE_INPUT_MEMBERS)
-    assert _struct_members(text, "fmu_drive_output") == list(generate.DRIVE_OUTPUT_MEMBERS)
+    assert _struct_members(text, "fmu_drive_input") == list(DRIVE_INPUT_MEMBERS)
+    assert _struct_members(text, "fmu_drive_output") == list(DRIVE_OUTPUT_MEMBERS)
     assert re.search(r"^\s*int status;", text, re.M)
 
 
@@ -938,7 +941,7 @@ def test_drive_c_table_compiles(generated_drive, tmp_path):
 
 def test_drive_c_table_matches_the_table(generated_drive):
     raw = load_drive_raw()
-    token = generate.load_table(DRIVE_TABLE).token
+    token = pipeline.load_table(DRIVE_TABLE).token
     c_text = (generated_drive / "drive_model.c").read_text()
     assert '#include "fmu_drive.h"' in c_text and "fmu_dyad" not in c_text
     assert "dyad_solve" not in c_text and "DYAD_FIELD" not in c_text
@@ -982,12 +985,12 @@ def test_drive_documentation_is_complete(generated_drive):
                    "Runge-Kutta", "RK4", "substeps", "time constant", "0.005 rad",
                    "Explicit", "Stabilised", "directional derivatives", "J_eff",
                    "invalid input", "Discard", "Error", "NaN", "counter-clockwise",
-                   "providesDirectionalDerivative", generate.load_table(DRIVE_TABLE).token):
+                   "providesDirectionalDerivative", pipeline.load_table(DRIVE_TABLE).token):
         assert phrase in page, phrase
     assert "dyad_solve" not in page
 
 
-# The drive's equations (fmu/fmu_drive.c), to check the declared dependencies by
+# The drive's equations (fmu/models/fmu_drive.c), to check the declared dependencies by
 # perturbation as the dyad tables are checked against the reference solver.
 def drive_outputs(values, angle, speed):
     total = values["inertia"] + values["load.inertia"]
@@ -1047,10 +1050,10 @@ def test_drive_start_values_are_valid():
 
 def test_drive_and_dyad_tokens_differ_and_follow_the_table():
     raw = load_drive_raw()
-    token = generate.load_table(DRIVE_TABLE).token
-    assert token == generate.instantiation_token(raw["model"], raw["variable"])
+    token = pipeline.load_table(DRIVE_TABLE).token
+    assert token == instantiation_token(raw["model"], raw["variable"])
     changed = dict(raw["model"], description=raw["model"]["description"] + ".")
-    assert generate.instantiation_token(changed, raw["variable"]) != token
+    assert instantiation_token(changed, raw["variable"]) != token
 
 
 def _drive_var(raw, name):
@@ -1169,13 +1172,13 @@ def test_dyad_table_may_name_its_kind(tmp_path):
 
 def test_drive_lives_must_not_name_dyad_structs():
     with pytest.raises(ValueError, match="no member"):
-        generate.parse_lives("input.m.omega", generate.DRIVE)
+        kinds.DRIVE.parse_lives("input.m.omega")
     with pytest.raises(ValueError, match="no member"):
-        generate.parse_lives("input.load_torque")  # a dyad's lives
-    lives = generate.parse_lives("result.status", generate.DRIVE)
+        kinds.DYAD.parse_lives("input.load_torque")  # a dyad's lives
+    lives = kinds.DRIVE.parse_lives("result.status")
     assert (lives.target, lives.offset, lives.field) == (
         "FMU_TARGET_RESULT_STATUS", "offsetof(fmu_drive_output, status)", "DYAD_FIELD_NONE")
-    assert generate.parse_lives("result.status").offset == "0"  # dyads: as they always were
+    assert kinds.DYAD.parse_lives("result.status").offset == "0"  # dyads: as they always were
 
 
 def test_unmodified_drive_copy_is_accepted(tmp_path):
@@ -1184,14 +1187,14 @@ def test_unmodified_drive_copy_is_accepted(tmp_path):
     write_toml(raw, table)
     proc = run_generator(table, "--out", tmp_path / "out")
     assert proc.returncode == 0, proc.stderr
-    assert generate.load_table(table).token == generate.load_table(DRIVE_TABLE).token
+    assert pipeline.load_table(table).token == pipeline.load_table(DRIVE_TABLE).token
 
 
 def _write_generic_tables():
     out = Path(tempfile.mkdtemp(prefix="dyadfmu_tables_"))
     for t in TYPES:
         path = out / f"dyad_{t.lower()}.toml"
-        write_toml(scene.generic_data(scene.load_scene(SCENES_DIR / path.name)), path)
+        write_toml(kinds.generic_data(pipeline.load_scene(SCENES_DIR / path.name)), path)
         TABLE_OF[t] = path
 
 

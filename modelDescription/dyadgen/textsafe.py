@@ -52,7 +52,7 @@ def _char_name(ch: str) -> str:
     return f"{shown(ch)} ({name})" if name else shown(ch)
 
 
-def description_problem(text) -> str | None:
+def description_problem(text: object) -> str | None:
     """Why `text` is not a valid description, or None. A description is one non-empty line
     of printable text: no control characters (U+0000-U+001F, U+007F-U+009F, tab and newline
     included), no format or bidi characters (U+202A-U+202E, U+2066-U+2069, U+200E, U+200F,
@@ -63,15 +63,21 @@ def description_problem(text) -> str | None:
         return "must be one non-empty line"
     for position, ch in enumerate(text, start=1):
         if hidden(ch):
-            what = ("a line break" if ch in "\n\r\u2028\u2029\x85\x0b\x0c" else
-                    "a control character" if unicodedata.category(ch) == "Cc" else
-                    "a bidi or format character" if unicodedata.category(ch) == "Cf" else
-                    "not printable text")
-            return (f"has {what}, {_char_name(ch)}, at character {position}; a description is "
-                    "one line of printable text")
+            what = (
+                "a line break"
+                if ch in "\n\r\u2028\u2029\x85\x0b\x0c"
+                else "a control character"
+                if unicodedata.category(ch) == "Cc"
+                else "a bidi or format character"
+                if unicodedata.category(ch) == "Cf"
+                else "not printable text"
+            )
+            return (
+                f"has {what}, {_char_name(ch)}, at character {position}; a description is "
+                "one line of printable text"
+            )
     if "*/" in text:
-        return ("must not contain '*/' (it is copied into a C comment, which '*/' would "
-                "end)")
+        return "must not contain '*/' (it is copied into a C comment, which '*/' would end)"
     return None
 
 
@@ -107,11 +113,15 @@ def c_string(text: str) -> str:
 def _xml_char(ch: str) -> bool:
     """The XML 1.0 Char production."""
     c = ord(ch)
-    return (c in (0x9, 0xA, 0xD) or 0x20 <= c <= 0xD7FF or 0xE000 <= c <= 0xFFFD or
-            0x10000 <= c <= 0x10FFFF)
+    return (
+        c in (0x9, 0xA, 0xD)
+        or 0x20 <= c <= 0xD7FF
+        or 0xE000 <= c <= 0xFFFD
+        or 0x10000 <= c <= 0x10FFFF
+    )
 
 
-def xml_attribute(text) -> str:
+def xml_attribute(text: object) -> str:
     """`text` for an XML attribute value in double quotes: markup characters as entities,
     hidden characters XML allows as character references (so that the value reads back
     unchanged, tab and newline included), characters XML cannot carry at all as
@@ -152,14 +162,13 @@ def xml_comment(text: str) -> str:
     return safe
 
 
-def html(text) -> str:
+def html(text: object) -> str:
     """`text` for HTML text or a double-quoted attribute value: markup characters as
     entities, hidden characters as visible <U+XXXX>."""
-    return _html.escape("".join(shown(ch) if hidden(ch) else ch for ch in str(text)),
-                        quote=True)
+    return _html.escape("".join(shown(ch) if hidden(ch) else ch for ch in str(text)), quote=True)
 
 
-def plain(text) -> str:
+def plain(text: object) -> str:
     """`text` as one line for a terminal or a log: hidden characters (escape sequences,
     newlines, bidi controls) as <U+XXXX>."""
     return "".join(shown(ch) if hidden(ch) else ch for ch in str(text))

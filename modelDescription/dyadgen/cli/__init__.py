@@ -1,0 +1,1 @@
+"""The command lines of modelDescription/generate.py and modelDescription/scene.py."""

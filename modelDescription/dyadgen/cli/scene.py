@@ -1,0 +1,58 @@
+"""scene.py: check a scene, or generate the files of its FMU."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from dyadgen.pipeline import build_table, load_scene, outputs_of, write_files
+from dyadgen.scenefile.problems import SceneError
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        description="Generate a tailored FMU's model descriptions, C model and documentation "
+        "from a scene (see scenes/README.md)."
+    )
+    parser.add_argument("scene", type=Path, help="the scene file (TOML)")
+    what = parser.add_mutually_exclusive_group(required=True)
+    what.add_argument("--out", type=Path, help="directory to write the generated files to")
+    what.add_argument(
+        "--check",
+        action="store_true",
+        help="validate the scene and print its variable counts; write nothing",
+    )
+    what.add_argument(
+        "--cmake-info",
+        action="store_true",
+        help="print 'identifier;type;...' (its dyad types, lower case) for CMake",
+    )
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """scene.py SCENE --out DIR | --check | --cmake-info."""
+    args = _parser().parse_args(argv)
+    try:
+        scene = load_scene(args.scene)
+        table = build_table(scene)
+    except SceneError as exc:
+        for problem in exc.args[0]:
+            print(f"error: {problem}", file=sys.stderr)
+        print(f"{args.scene}: rejected, nothing written", file=sys.stderr)
+        return 1
+    kind = table.kind
+    if args.cmake_info:
+        types = sorted({d.type.lower() for d in scene.dyads})
+        print(";".join([scene.identifier, kind.realisation] + types))
+        return 0
+    if args.check:
+        n = table.counts()
+        print(
+            f"{scene.identifier} ({kind.label}): {n['input']} inputs, {n['parameter']} "
+            f"parameters, {n['output']} outputs"
+        )
+        return 0
+    write_files(args.out, outputs_of(table))
+    return 0

@@ -1,0 +1,195 @@
+"""The documentation page of an FMU (documentation/index.html), one template per kind of
+model (templates/*.html, string.Template). Every text of the table or the scene is
+escaped for HTML (textsafe.html) before it is substituted; the templates hold the
+prose."""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+from string import Template
+
+from dyadgen import textsafe
+from dyadgen.dyadtypes import MAY_BE_ZERO, PAIRS, TYPE_NOTES
+from dyadgen.emit.xmltext import num
+from dyadgen.model import Attachment, Param, Scene
+from dyadgen.table import Table, Variable
+
+TEMPLATES = Path(__file__).resolve().parent / "templates"
+h = textsafe.html
+
+
+@functools.cache
+def template(name: str) -> Template:
+    """A template file of templates/."""
+    return Template((TEMPLATES / name).read_text(encoding="utf-8"))
+
+
+@functools.cache
+def stylesheet() -> str:
+    """The style every page embeds (templates/style.css)."""
+    return (TEMPLATES / "style.css").read_text(encoding="utf-8")
+
+
+def _fmt_bounds(v: Variable) -> str:
+    if v.min is None and v.max is None:
+        return ""
+    lo = ("(" if v.min_exclusive else "[") if v.min is not None else "("
+    hi = (")" if v.max_exclusive else "]") if v.max is not None else ")"
+    lo_v = num(v.min) if v.min is not None else "-inf"
+    hi_v = num(v.max) if v.max is not None else "inf"
+    return f"{lo}{lo_v}, {hi_v}{hi}"
+
+
+def variable_rows(table: Table) -> str:
+    """The table of every variable."""
+    o = [
+        "<table>",
+        "<tr><th>vr</th><th>name</th><th>causality</th><th>type</th><th>unit</th>"
+        "<th>start</th><th>range</th><th>description</th></tr>",
+    ]
+    for v in table.variables:
+        start = num(v.start) if v.start is not None else ""
+        o.append(
+            f'<tr><td class="num">{v.vr}</td><td><code>{h(v.name)}</code></td>'
+            f"<td>{v.causality}</td><td>{v.type}</td><td>{h(v.unit or '-')}</td>"
+            f'<td class="num">{start}</td><td class="num">{h(_fmt_bounds(v))}</td>'
+            f"<td>{h(v.description)}</td></tr>"
+        )
+    o.append("</table>")
+    return "\n".join(o)
+
+
+def page(name: str, table: Table, **values: object) -> str:
+    """Template `name` filled with the table's identity, its variables and `values`
+    (already HTML)."""
+    identity = template("identity.html").substitute(
+        identifier=h(table.identifier), token=h(table.token), table_file=h(table.path.name)
+    )
+    return template(name).substitute(
+        css=stylesheet(),
+        identity=identity,
+        identifier=h(table.identifier),
+        description=h(table.description),
+        variables=variable_rows(table),
+        **values,
+    )
+
+
+def dyad_page(table: Table) -> str:
+    """The page of a generic dyad FMU."""
+    t = table.type
+    d_m, e, d_n = PAIRS[t]
+    conditioning, singular, typical = TYPE_NOTES[t]
+    guides = []
+    if d_m == "T":
+        guides.append("<code>i_k</code> (input <code>guide_k.angle</code>) at D_m")
+    if e == "T":
+        guides.append("<code>i_m</code> (link m itself) at E")
+    if d_n == "T":
+        guides.append("<code>i_p</code> (input <code>guide_p.angle</code>) at D_n")
+    zero = [f"l_{g}" for g, ok in zip("mn", MAY_BE_ZERO[t], strict=True) if ok]
+    sliders = [v.name for v in table.of("input") if v.name.endswith(".length")]
+    sliding = ""
+    if sliders:
+        sliding = (
+            "\n<p>Because the pair E slides along link m, the length l_m = |D_m E| "
+            f"changes with the motion and is an input (<code>{h(sliders[0])}</code>); "
+            "every other length is a fixed parameter.</p>"
+        )
+    return page(
+        "dyad.html",
+        table,
+        type=t,
+        d_m=d_m,
+        e=e,
+        d_n=d_n,
+        guides=", ".join(guides) or "none",
+        zero=", ".join(zero) or "none",
+        sliders=sliding,
+        typical=h(typical),
+        singular=h(singular),
+        conditioning=h(conditioning),
+    )
+
+
+def drive_page(table: Table) -> str:
+    """The page of the crank drive (fmu/models/fmu_drive.c)."""
+    return page("drive.html", table)
+
+
+def _param_text(prm: Param) -> str:
+    return f"<code>{prm.name}</code>" if prm.tunable else repr(prm.value)
+
+
+def _attachment_text(att: Attachment) -> str:
+    if att.kind == "frame":
+        return "the frame" + (f" (guide at {h(_param_text(att.guide))} rad)" if att.guide else "")
+    if att.guide is not None:
+        return (
+            f"a guide on <code>{h(att.link)}</code> at {h(_param_text(att.guide))} rad from its "
+            f"i, through ({h(_param_text(att.at[0]))}, {h(_param_text(att.at[1]))}) m in its frame"
+        )
+    if att.kind == "external":
+        return "an external link whose motion is an input"
+    if att.at is None:
+        return f"the pin of the crank <code>{h(att.link)}</code>"
+    return (
+        f"<code>{h(att.link)}</code> at ({h(_param_text(att.at[0]))}, "
+        f"{h(_param_text(att.at[1]))}) m in its frame"
+    )
+
+
+def _scene_sections(scene: Scene) -> dict[str, str]:
+    """The parts of a scene's page that depend on its mechanism."""
+    loaded = [f"{g} (force)" for g, link in scene.links.items() if link.force]
+    loaded += [f"{g} (moment)" for g, link in scene.links.items() if link.moment]
+    crank = ""
+    if scene.crank:
+        crank = (
+            f"\n<p>Crank <code>{h(scene.crank.name)}</code> about the fixed pivot O; its "
+            "pin A lies at (length, 0) in its frame. Its driving torque and the force of "
+            "the frame at O follow from its equilibrium once every dyad is solved.</p>"
+        )
+    dyads = "".join(
+        f"\n<tr><td><code>{h(d.name or '-')}</code></td><td>{d.type}</td>"
+        f"<td><code>{h(d.m)}</code></td><td><code>{h(d.n)}</code></td>"
+        f"<td>{_attachment_text(d.k)}</td><td>{_attachment_text(d.p)}</td></tr>"
+        for d in scene.dyads
+    )
+    baked = [prm for prm in scene.parameters() if not prm.tunable]
+    constants = ""
+    if baked:
+        constants = (
+            "\n<h2>Constants</h2>\n<p>Fixed by the scene and compiled in:</p>"
+            "\n<table><tr><th>name</th><th>value</th><th>unit</th></tr>"
+        )
+        constants += "".join(
+            f'\n<tr><td><code>{h(prm.name)}</code></td><td class="num">'
+            f"{prm.value!r}</td><td>{h(prm.unit or '-')}</td></tr>"
+            for prm in baked
+        )
+        constants += "\n</table>"
+    return {
+        "loads": h(", ".join(loaded) or "none"),
+        "crank": crank,
+        "dyads": dyads,
+        "constants": constants,
+    }
+
+
+def scene_page(table: Table) -> str:
+    """The page of a tailored scene's FMU."""
+    scene = table.scene
+    n = table.counts()
+    return page(
+        "scene.html",
+        table,
+        scene_file=h(scene.path.name),
+        inputs=n["input"],
+        parameters=n["parameter"],
+        outputs=n["output"],
+        inertia="yes" if scene.inertia else "no",
+        gravity="yes" if scene.gravity else "no",
+        **_scene_sections(scene),
+    )

@@ -1,0 +1,96 @@
+"""The FMI 2.0 model description."""
+
+from __future__ import annotations
+
+from dyadgen.emit.xmltext import (
+    GENERATION_TOOL,
+    common_tail,
+    element,
+    header,
+    typed_attributes,
+    unit_definitions,
+    variable_attributes,
+)
+from dyadgen.table import Table
+
+
+def _cosimulation(table: Table) -> list[str]:
+    lines = [
+        element(
+            1,
+            "CoSimulation",
+            [
+                ("modelIdentifier", table.identifier),
+                ("canHandleVariableCommunicationStepSize", "true"),
+                ("canInterpolateInputs", "false"),
+                ("canBeInstantiatedOnlyOncePerProcess", "false"),
+                ("canGetAndSetFMUstate", "false"),
+                ("canSerializeFMUstate", "false"),
+                ("providesDirectionalDerivative", table.kind.directional_derivatives),
+            ],
+            close=False,
+            wrap=True,
+        )
+    ]
+    lines.append("    <SourceFiles>")
+    lines += [element(3, "File", [("name", f)]) for f in table.kind.source_files(table, 2)]
+    lines.append("    </SourceFiles>")
+    lines.append("  </CoSimulation>")
+    return lines
+
+
+def _variables(table: Table) -> list[str]:
+    lines = ["  <ModelVariables>"]
+    for v in table.variables:
+        lines.append(element(2, "ScalarVariable", variable_attributes(v), close=False))
+        if v.type == "Integer":
+            lines.append("      <Integer/>")
+        else:
+            lines.append(element(3, "Real", typed_attributes(v, unit_first=False)))
+        lines.append("    </ScalarVariable>")
+    lines.append("  </ModelVariables>")
+    return lines
+
+
+def _structure(table: Table) -> list[str]:
+    index = {v.name: v.index + 1 for v in table.variables}  # 1-based, FMI 2
+    lines = ["  <ModelStructure>", "    <Outputs>"]
+    for v in table.of("output"):
+        deps = " ".join(str(i) for i in sorted(index[d] for d in v.depends))
+        lines.append(element(3, "Unknown", [("index", index[v.name]), ("dependencies", deps)]))
+    lines.append("    </Outputs>")
+    lines.append("    <InitialUnknowns>")
+    for v in table.of("output"):
+        lines.append(element(3, "Unknown", [("index", index[v.name])]))
+    lines.append("    </InitialUnknowns>")
+    lines.append("  </ModelStructure>")
+    return lines
+
+
+def model_description(table: Table) -> str:
+    """fmi2/modelDescription.xml."""
+    lines = header(table)
+    lines.append(
+        element(
+            0,
+            "fmiModelDescription",
+            [
+                ("fmiVersion", "2.0"),
+                ("modelName", table.identifier),
+                ("guid", table.token),
+                ("description", table.description),
+                ("generationTool", GENERATION_TOOL),
+                ("variableNamingConvention", "structured"),
+                ("numberOfEventIndicators", "0"),
+            ],
+            close=False,
+            wrap=True,
+        )
+    )
+    lines += _cosimulation(table)
+    lines += unit_definitions(table)
+    lines += common_tail(table)
+    lines += _variables(table)
+    lines += _structure(table)
+    lines.append("</fmiModelDescription>")
+    return "\n".join(lines) + "\n"

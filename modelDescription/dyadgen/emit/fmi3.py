@@ -1,0 +1,110 @@
+"""The FMI 3.0 model description and build description."""
+
+from __future__ import annotations
+
+from dyadgen.emit.xmltext import (
+    GENERATION_TOOL,
+    common_tail,
+    element,
+    header,
+    typed_attributes,
+    unit_definitions,
+    variable_attributes,
+)
+from dyadgen.table import Table
+
+
+def _cosimulation(table: Table) -> str:
+    return element(
+        1,
+        "CoSimulation",
+        [
+            ("modelIdentifier", table.identifier),
+            ("canHandleVariableCommunicationStepSize", "true"),
+            ("canBeInstantiatedOnlyOncePerProcess", "false"),
+            ("canGetAndSetFMUState", "false"),
+            ("canSerializeFMUState", "false"),
+            ("providesDirectionalDerivatives", table.kind.directional_derivatives),
+            ("hasEventMode", "false"),
+            ("canReturnEarlyAfterIntermediateUpdate", "false"),
+            ("providesIntermediateUpdate", "false"),
+        ],
+        wrap=True,
+    )
+
+
+def _variables(table: Table) -> list[str]:
+    lines = ["  <ModelVariables>"]
+    lines.append(
+        element(
+            2,
+            "Float64",
+            [
+                ("name", "time"),
+                ("valueReference", 0),
+                ("description", "Simulation time (s), the independent variable"),
+                ("causality", "independent"),
+                ("variability", "continuous"),
+            ],
+        )
+    )
+    for v in table.variables:
+        attrs = variable_attributes(v) + typed_attributes(v, unit_first=True)
+        lines.append(element(2, "Int32" if v.type == "Integer" else "Float64", attrs))
+    lines.append("  </ModelVariables>")
+    return lines
+
+
+def _structure(table: Table) -> list[str]:
+    vr_of = {v.name: v.vr for v in table.variables}
+    lines = ["  <ModelStructure>"]
+    for v in table.of("output"):
+        deps = " ".join(str(r) for r in sorted(vr_of[d] for d in v.depends))
+        lines.append(element(2, "Output", [("valueReference", v.vr), ("dependencies", deps)]))
+    for v in table.of("output"):
+        lines.append(element(2, "InitialUnknown", [("valueReference", v.vr)]))
+    lines.append("  </ModelStructure>")
+    return lines
+
+
+def model_description(table: Table) -> str:
+    """fmi3/modelDescription.xml."""
+    lines = header(table)
+    lines.append(
+        element(
+            0,
+            "fmiModelDescription",
+            [
+                ("fmiVersion", "3.0"),
+                ("modelName", table.identifier),
+                ("instantiationToken", table.token),
+                ("description", table.description),
+                ("generationTool", GENERATION_TOOL),
+                ("variableNamingConvention", "structured"),
+            ],
+            close=False,
+            wrap=True,
+        )
+    )
+    lines.append(_cosimulation(table))
+    lines += unit_definitions(table)
+    lines += common_tail(table)
+    lines += _variables(table)
+    lines += _structure(table)
+    lines.append("</fmiModelDescription>")
+    return "\n".join(lines) + "\n"
+
+
+def build_description(table: Table) -> str:
+    """fmi3/buildDescription.xml: the C files an importer compiles."""
+    lines = header(table)
+    lines.append('<fmiBuildDescription fmiVersion="3.0">')
+    lines.append(
+        element(1, "BuildConfiguration", [("modelIdentifier", table.identifier)], close=False)
+    )
+    lines.append('    <SourceFileSet language="C99">')
+    lines += [element(3, "SourceFile", [("name", f)]) for f in table.kind.source_files(table, 3)]
+    lines.append("    </SourceFileSet>")
+    lines.append("  </BuildConfiguration>")
+    lines.append("</fmiBuildDescription>")
+    return "\n".join(lines) + "\n"

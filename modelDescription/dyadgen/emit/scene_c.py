@@ -1,0 +1,545 @@
+"""A tailored scene's C: its header (the flat input and output blocks) and the code that
+computes only what the scene needs.
+
+Each link's resultant load is written out term by term, and a term that the scene
+leaves out (no inertia, no gravity, a centre of mass baked at the pair, a mass baked
+at 0) is not generated at all. The chain is solved from the last dyad back to the
+first: the reaction of a later dyad on a link of an earlier one enters that link's
+resultant as a force at the pair point, and the crank's driving torque and pivot
+reaction come last. The closed forms are the core's dyad_react_<type>
+(src/include/dyadfmu/loaded.h).
+
+The emitter first makes a plan (which dyads the wanted outputs need, which links move)
+and then writes the function body in passes: frames, accelerations of the pairs D,
+resultants, the chain, the crank, the outputs. A last pass drops the constants nothing
+reads; the body goes into templates/scene.c.in.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import re
+from pathlib import Path
+from string import Template
+
+from dyadgen import textsafe
+from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, loaders, member
+from dyadgen.table import Table
+
+TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c.in"
+
+
+def _vec(x: str, y: str) -> str:
+    return f"dyad_vec2_make({x}, {y})"
+
+
+def _sum(terms: list) -> str:
+    """The C sum of vector terms (0 if none)."""
+    if not terms:
+        return "dyad_vec2_make(0.0, 0.0)"
+    expr = terms[0]
+    for t in terms[1:]:
+        expr = f"dyad_add({expr}, {t})"
+    return expr
+
+
+def _unit_vector(angle: float) -> str:
+    return _vec(c_num(math.cos(angle)), c_num(math.sin(angle)))
+
+
+class _Code:
+    """The lines of the function body, indented one level."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def __call__(self, text: str = "") -> None:
+        self.lines.append(("    " + text) if text else "")
+
+
+class Plan:
+    """What the code of a scene computes: the dyads the wanted outputs need (their own,
+    the dyads loading those, and for the crank's outputs every dyad on the crank), the
+    links whose resultants it forms, and the C names of their pairs' accelerations."""
+
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self.crank = scene.crank
+        self.names = {i.name: i for i in scene.inputs}
+        self.crank_needed = any(o.source == "crank" for o in scene.outputs)
+        needed = {int(o.source) for o in scene.outputs if o.source not in ("", "crank")}
+        if self.crank_needed:
+            needed |= {d.index for d in scene.dyads if any(a.kind == "crank" for a in (d.k, d.p))}
+        for d in list(scene.dyads):
+            if d.index in needed:
+                needed |= {other.index for other in loaders(scene, d)}
+        self.solved = [d for d in scene.dyads if d.index in needed]
+        crank = [self.crank.name] if self.crank else []
+        self.everything = crank + [g for d in scene.dyads for g in (d.m, d.n)]
+        self.moving = (crank if self.crank_needed else []) + [
+            g for d in self.solved for g in (d.m, d.n)
+        ]
+        self.accel: dict[str, str | None] = {}  # link -> C name of a_D or None for zero
+        self.accel_size: dict[str, str] = {}  # link -> C expression of the size of a_D's terms
+
+    def inp(self, name: str) -> str:
+        """The input block's member of an input."""
+        return f"in->{self.names[name].member}"
+
+    def has(self, name: str) -> bool:
+        """Whether the scene has the input."""
+        return name in self.names
+
+    def omega(self, g: str) -> str | None:
+        """A link's angular velocity, where it is an input."""
+        return self.inp(g + ".omega") if self.has(g + ".omega") else None
+
+    def epsilon(self, g: str) -> str | None:
+        """A link's angular acceleration, where it is an input."""
+        return self.inp(g + ".epsilon") if self.has(g + ".epsilon") else None
+
+    def point(self, g: str, at: tuple[Param, Param]) -> str | None:
+        """C expression of a point's offset from D_g (O for the crank) given (Param, Param)."""
+        c = member(g)
+        x, y = at
+        if x.is_zero() and y.is_zero():
+            return None
+        if y.is_zero():
+            return f"dyad_scale({x.c()}, {c}_i)"
+        if x.is_zero():
+            return f"dyad_scale({y.c()}, {c}_j)"
+        return f"dyad_combine({x.c()}, {c}_i, {y.c()}, {c}_j)"
+
+    def attachment_point(self, att: Attachment) -> str | None:
+        """The pair's point (for a sliding pair: the guide's point) from the carrier's D."""
+        if att.kind == "crank" and att.at is None:
+            length = self.crank.params["length"]
+            return self.point(att.link, (length, Param("", 0.0, "m", "")))
+        return self.point(att.link, att.at)
+
+    def has_com(self, g: str) -> bool:
+        """Whether a link's centre of mass lies off its pair D (O for the crank)."""
+        params = self.scene.params_of(g)
+        com_x = params.get("com.x")
+        return com_x is not None and not (com_x.is_zero() and params["com.y"].is_zero())
+
+
+# ---------------------------------------------------------------------------
+# Passes
+# ---------------------------------------------------------------------------
+def _frames(plan: Plan, code: _Code) -> None:
+    code("/* Link frames: i from D towards E, j = k0 x i. */")
+    for g in plan.everything:
+        c = member(g)
+        link = plan.scene.links.get(g)
+        if link is not None and link.translating:
+            a = link.params["angle"]
+            value = f"dyad_dir_from_angle({a.c()})" if a.tunable else _unit_vector(a.value)
+            code(f"const dyad_vec2 {c}_i = {value};")
+        elif plan.has(g + ".angle"):
+            code(f"const dyad_vec2 {c}_i = {plan.inp(g + '.angle')};")
+        else:
+            continue  # a link the requested outputs do not involve
+        code(f"const dyad_vec2 {c}_j = dyad_perp({c}_i);")
+
+
+def _carried_accel(plan: Plan, code: _Code, g: str, att: Attachment) -> None:
+    """a_D of a link whose pair D sits on a moving link: from that link's motion."""
+    c = member(g)
+    carrier = att.link
+    r = plan.attachment_point(att)
+    terms = []
+    sizes = []
+    if plan.accel.get(carrier):
+        terms.append(plan.accel[carrier])
+        sizes.append(plan.accel_size[carrier])
+    if r is not None:
+        code(f"const dyad_vec2 {c}_r_d = {r};")
+        w, e = plan.omega(carrier), plan.epsilon(carrier)
+        if e:
+            terms.append(f"dyad_scale({e}, dyad_perp({c}_r_d))")
+            sizes.append(f"fabs({e}) * dyad_norm1({c}_r_d)")
+        if w:
+            terms.append(f"dyad_scale(-{w} * {w}, {c}_r_d)")
+            sizes.append(f"{w} * {w} * dyad_norm1({c}_r_d)")
+    if not terms:
+        plan.accel[g] = None
+        return
+    code(f"const dyad_vec2 {c}_a_d = {_sum(terms)};")
+    plan.accel[g] = f"{c}_a_d"
+    code(f"const double {c}_a_d_size = {' + '.join(sizes)};")
+    plan.accel_size[g] = f"{c}_a_d_size"
+
+
+def _accelerations(plan: Plan, code: _Code) -> None:
+    if not plan.scene.inertia:
+        return
+    code()
+    code("/* Accelerations of the pairs D: 0 on a fixed pivot, an input on a guide or an")
+    code(" * external link, and from the carrying link's motion on a moving link. */")
+    if plan.crank:
+        plan.accel[plan.crank.name] = None
+    for d in plan.solved:
+        for g, att in ((d.m, d.k), (d.n, d.p)):
+            c = member(g)
+            if plan.has(g + ".accel_d.x"):
+                given = _vec(plan.inp(g + ".accel_d.x"), plan.inp(g + ".accel_d.y"))
+                code(f"const dyad_vec2 {c}_a_d = {given};")
+                plan.accel[g] = f"{c}_a_d"
+                plan.accel_size[g] = f"dyad_norm1({c}_a_d)"
+            elif att.kind in ("crank", "link"):
+                _carried_accel(plan, code, g, att)
+            else:
+                plan.accel[g] = None
+
+
+def _mass_terms(plan: Plan, g: str, r: str | None) -> tuple[list, list]:
+    """The terms the mass multiplies: gravity, minus the acceleration of the centre of
+    mass (without the centripetal term), and their sizes."""
+    scene = plan.scene
+    c = member(g)
+    inner = []
+    inner_sizes = []
+    if scene.gravity:
+        gx, gy = scene.gravity_params
+        inner.append(_vec(gx.c(), gy.c()))
+        inner_sizes.append(f"dyad_norm1({inner[-1]})")
+    if scene.inertia:
+        tang = []
+        if plan.accel.get(g):
+            tang.append(plan.accel[g])
+            inner_sizes.append(plan.accel_size[g])
+        e = plan.epsilon(g)
+        if e and r is not None:
+            tang.append(f"dyad_scale({e}, dyad_perp({c}_r))")
+            inner_sizes.append(f"fabs({e}) * dyad_norm1({c}_r)")
+        inner += [f"dyad_neg({t})" for t in tang]
+    return inner, inner_sizes
+
+
+def _force_terms(plan: Plan, g: str, r: str | None) -> tuple[list, list]:
+    """The terms of a link's resultant force and their sizes (dyadfmu/loaded.h), as the
+    core forms them."""
+    link = plan.scene.links.get(g)
+    mass = plan.scene.params_of(g).get("mass")
+    terms = []
+    sizes = []
+    if link is not None and link.force:
+        terms.append(_vec(plan.inp(g + ".force.x"), plan.inp(g + ".force.y")))
+        sizes.append(f"dyad_norm1({terms[-1]})")
+    if mass is not None and not mass.is_zero():
+        inner, inner_sizes = _mass_terms(plan, g, r)
+        if inner:
+            terms.append(f"dyad_scale({mass.c()}, {_sum(inner)})")
+            sizes.append(f"{mass.c()} * ({' + '.join(inner_sizes)})")
+    return terms, sizes
+
+
+def _moment_terms(plan: Plan, g: str) -> tuple[list, list]:
+    link = plan.scene.links.get(g)
+    inert = plan.scene.params_of(g).get("inertia")
+    e = plan.epsilon(g)
+    terms = []
+    sizes = []
+    if link is not None and link.moment:
+        terms.append(plan.inp(g + ".moment"))
+        sizes.append(f"fabs({terms[-1]})")
+    if plan.scene.inertia and inert is not None and not inert.is_zero() and e:
+        terms.append(f"-{inert.c()} * {e}")
+        sizes.append(f"{inert.c()} * fabs({e})")
+    return terms, sizes
+
+
+def _resultant(plan: Plan, code: _Code, g: str) -> None:
+    c = member(g)
+    r = None
+    if plan.has_com(g):
+        params = plan.scene.params_of(g)
+        r = plan.point(g, (params["com.x"], params["com.y"]))
+        code(f"const dyad_vec2 {c}_r = {r};")
+    force_terms, force_sizes = _force_terms(plan, g, r)
+    code(f"dyad_vec2 {c}_f = {_sum(force_terms)};")
+    moment_terms, moment_sizes = _moment_terms(plan, g)
+    code(f"double {c}_m = {' + '.join(moment_terms) if moment_terms else '0.0'};")
+    if r is not None and force_terms:
+        code(f"double {c}_m_d = {c}_m + dyad_cross({c}_r, {c}_f);")
+        moment_sizes.append(f"dyad_norm1({c}_r) * {c}_f_size")
+    else:
+        code(f"double {c}_m_d = {c}_m;")
+    code(f"double {c}_f_size = {' + '.join(force_sizes) or '0.0'};")
+    code(f"double {c}_m_d_size = {' + '.join(moment_sizes) or '0.0'};")
+    mass = plan.scene.params_of(g).get("mass")
+    w = plan.omega(g)
+    if plan.scene.inertia and mass is not None and not mass.is_zero() and r is not None and w:
+        code(f"{c}_f = dyad_add({c}_f, dyad_scale({mass.c()} * {w} * {w}, {c}_r));")
+        code(f"{c}_f_size += {mass.c()} * {w} * {w} * dyad_norm1({c}_r);")
+    code(f"(void){c}_m;")
+    code(f"(void){c}_f_size;")
+    code(f"(void){c}_m_d_size;")
+
+
+def _resultants(plan: Plan, code: _Code) -> None:
+    code()
+    code("/* Resultant of each link's active load, weight and inertia at its centre of mass:")
+    code(" * force f, moment m about the centre of mass, moment m_d about D (without the")
+    code(" * centripetal force, which points at D). Only the scene's terms are written. */")
+    for g in plan.moving:
+        _resultant(plan, code, g)
+
+
+def _guide(plan: Plan, d: Dyad, side: str, att: Attachment) -> str:
+    """The direction i_k or i_p of the guide a translational outer pair slides on."""
+    if att.kind == "external":
+        return plan.inp(f"{d.prefix()}guide_{side}.angle")
+    guide = att.guide
+    if att.kind == "frame":
+        return f"dyad_dir_from_angle({guide.c()})" if guide.tunable else _unit_vector(guide.value)
+    carrier = member(att.link)
+    if guide.is_zero():
+        return f"{carrier}_i"
+    if guide.tunable:
+        return f"dyad_combine(cos({guide.c()}), {carrier}_i, sin({guide.c()}), {carrier}_j)"
+    cos, sin = c_num(math.cos(guide.value)), c_num(math.sin(guide.value))
+    return f"dyad_combine({cos}, {carrier}_i, {sin}, {carrier}_j)"
+
+
+def _load(plan: Plan, code: _Code, d: Dyad) -> None:
+    """dyad_loaded of one dyad: its links' frames, lengths and resultants, its guides."""
+    code("    dyad_loaded load;")
+    for side, g in (("m", d.m), ("n", d.n)):
+        c = member(g)
+        link = plan.scene.links[g]
+        length = plan.inp(g + ".length") if link.sliding else link.params["length"].c()
+        code(f"    load.{side}.i = {c}_i;")
+        code(f"    load.{side}.j = {c}_j;")
+        code(f"    load.{side}.l = {length};")
+        for part in ("f", "m", "m_d", "f_size", "m_d_size"):
+            code(f"    load.{side}.{part} = {c}_{part};")
+    for side, att in (("k", d.k), ("p", d.p)):
+        if d.pair_kind("mk" if side == "k" else "np") == "T":
+            code(f"    load.i_{side} = {_guide(plan, d, side, att)};")
+        else:
+            code(f"    load.i_{side} = dyad_vec2_make(1.0, 0.0);")
+        code(f"    load.j_{side} = dyad_perp(load.i_{side});")
+
+
+def _feedback(plan: Plan, code: _Code, d: Dyad, side: str, att: Attachment) -> None:
+    """The dyad's reaction on the moving link its outer pair sits on."""
+    if att.kind not in ("crank", "link") or att.link not in plan.moving:
+        return
+    dn = member(d.name or "dyad")
+    pair_force = "r_mk" if side == "k" else "r_np"
+    carrier = member(att.link)
+    r = plan.attachment_point(att)
+    reactive = ""
+    if att.guide is not None:
+        # the pair point slides along the guide; the pair also carries a moment
+        slide = f"dyad_scale({plan.inp(d.prefix() + 'slide_' + side)}, load.i_{side})"
+        r = slide if r is None else f"dyad_add({r}, {slide})"
+        reactive = f" - {dn}.m_{pair_force[2:]}"
+    also = " and the reactive moment" if reactive else ""
+    code(f"    /* on {att.link}: -{pair_force.upper()} at the pair{also} */")
+    code(f"    {carrier}_f = dyad_sub({carrier}_f, {dn}.{pair_force});")
+    code(f"    {carrier}_f_size += dyad_force_size(&{dn});")
+    if r is None:
+        return
+    moment_size = f" + dyad_moment_size(&{dn})" if reactive else ""
+    code(f"    {{ const dyad_real moment = -dyad_cross({r}, {dn}.{pair_force}){reactive};")
+    code(f"      {carrier}_m_d += moment;")
+    code(f"      {carrier}_m_d_size += dyad_norm1({r}) * dyad_force_size(&{dn}){moment_size};")
+    if plan.has_com(att.link):
+        code(f"      {carrier}_m += moment + dyad_cross({carrier}_r, {dn}.{pair_force}); }}")
+    else:
+        code(f"      {carrier}_m += moment; }}")
+
+
+def _chain(plan: Plan, code: _Code) -> None:
+    threshold = plan.scene.threshold.c()
+    code()
+    code("/* The dyads from the last to the first: each one's reactions load the links")
+    code(" * it is attached to, as forces at its pair points. */")
+    for d in reversed(plan.solved):
+        dn = member(d.name or "dyad")
+        code(f"{{ /* dyad {d.name or ''} ({d.type}) */")
+        _load(plan, code, d)
+        code(f"    load.singular_threshold = {threshold};")
+        code(f"    if (dyad_react_{d.type.lower()}(&load, &{dn}) != DYAD_STATUS_OK) {{")
+        code(
+            f"        fail(out, &{dn}, {textsafe.c_string(d.name or d.type)}, "
+            f"{threshold}, evaluation);"
+        )
+        code("        return;")
+        code("    }")
+        _feedback(plan, code, d, "k", d.k)
+        _feedback(plan, code, d, "p", d.p)
+        code("}")
+
+
+def _crank_outputs(plan: Plan) -> tuple[bool, bool]:
+    """Whether the crank's torque and its R_O are wanted."""
+    c = member(plan.crank.name)
+    outputs = plan.scene.outputs
+    return (
+        any(o.member == f"{c}_torque" for o in outputs),
+        any(o.member.startswith(f"{c}_r_o_") for o in outputs),
+    )
+
+
+def _crank(plan: Plan, code: _Code) -> None:
+    if not plan.crank_needed:
+        return
+    c = member(plan.crank.name)
+    torque, r_o = _crank_outputs(plan)
+    code()
+    code("/* The crank: the driving torque balances the moments about O, R_O the forces. */")
+    if torque:
+        code(f"{c}_torque = -{c}_m_d;")
+    if r_o:
+        code(f"{c}_r_o = dyad_neg({c}_f);")
+    code(f"(void){c}_m_d;")
+
+
+def _output_exprs(scene: Scene) -> dict[str, str]:
+    """The C expression of every output's value, by output member."""
+    exprs = {}
+    if scene.crank:
+        c = member(scene.crank.name)
+        exprs[f"{c}_torque"] = f"{c}_torque"
+        exprs[f"{c}_r_o_x"] = f"{c}_r_o.x"
+        exprs[f"{c}_r_o_y"] = f"{c}_r_o.y"
+    for d in scene.dyads:
+        pre = member(d.prefix())
+        dn = member(d.name or "dyad")
+        for pair in ("mk", "np", "mn"):
+            for c in "xy":
+                exprs[f"{pre}r_{pair}_{c}"] = f"{dn}.r_{pair}.{c}"
+            for kind in "nm":
+                exprs[f"{pre}{kind}_{pair}"] = f"{dn}.{kind}_{pair}"
+        for rest in ("conditioning", "amplification"):
+            exprs[f"{pre}{rest}"] = f"{dn}.{rest}"
+    return exprs
+
+
+def _outputs(plan: Plan, code: _Code) -> None:
+    code()
+    code("/* Outputs */")
+    exprs = _output_exprs(plan.scene)
+    for o in plan.scene.outputs:
+        if not o.integer:
+            code(f"out->{o.member} = {exprs[o.member]};")
+    code("out->status = 0;")
+    code("check(out, evaluation);")
+
+
+def drop_unused_constants(lines: list) -> list:
+    """Remove `const ... name = ...;` lines whose name nothing else reads (a frame vector j
+    that no term of the scene needs, say), until none is left. Each identifier's uses are
+    counted once; removing a line takes its uses off the counts, which may free the
+    constants it read in turn."""
+    declaration = re.compile(r"^\s*const [A-Za-z0-9_]+ ([A-Za-z0-9_]+) = .*;$")
+    word = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+    uses: dict[str, int] = {}
+    declared: dict[str, int] = {}  # constant -> its line
+    for k, line in enumerate(lines):
+        for w in word.findall(line):
+            uses[w] = uses.get(w, 0) + 1
+        m = declaration.match(line)
+        if m:
+            declared[m.group(1)] = k
+    removed: set[int] = set()
+    pending = [name for name in declared if uses[name] == 1]
+    while pending:
+        name = pending.pop()
+        k = declared[name]
+        if k in removed or uses[name] != 1:
+            continue
+        removed.add(k)
+        for w in word.findall(lines[k]):
+            uses[w] -= 1
+            if w != name and w in declared and uses[w] == 1:
+                pending.append(w)
+    return [line for k, line in enumerate(lines) if k not in removed]
+
+
+PASSES = (_frames, _accelerations, _resultants, _chain, _crank, _outputs)
+
+
+def _declarations(plan: Plan) -> tuple[list[str], list[str]]:
+    dyads = [f"    dyad_result {member(d.name or 'dyad')};" for d in plan.solved]
+    crank = []
+    if plan.crank_needed:
+        c = member(plan.crank.name)
+        torque, r_o = _crank_outputs(plan)
+        if torque:
+            crank.append(f"    double {c}_torque;")
+        if r_o:
+            crank.append(f"    dyad_vec2 {c}_r_o;")
+    return dyads, crank
+
+
+@functools.cache
+def _template() -> Template:
+    return Template(TEMPLATE.read_text(encoding="utf-8"))
+
+
+def scene_c(scene: Scene) -> str:
+    """<identifier>_scene.c: the computation of the scene (of its current outputs)."""
+    plan = Plan(scene)
+    code = _Code()
+    for write in PASSES:
+        write(plan, code)
+    dyad_decls, crank_decls = _declarations(plan)
+    reals = [o.member for o in scene.outputs if not o.integer]
+    return _template().substitute(
+        ident=scene.identifier,
+        scene_file=textsafe.c_comment(scene.path.name),
+        description=textsafe.c_comment(scene.description),
+        inertia="on" if scene.inertia else "off",
+        gravity="on" if scene.gravity else "off",
+        nan_lines="\n".join(f"    out->{m} = NAN;" for m in reals),
+        check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
+        dyad_decls="\n".join(dyad_decls),
+        crank_decls="\n".join(crank_decls),
+        body="\n".join(drop_unused_constants(code.lines)),
+    )
+
+
+def scene_header(table: Table) -> str:
+    """<identifier>_scene.h: the input and output blocks of the scene."""
+    scene = table.scene
+    ident = scene.identifier
+    guard = f"DYADFMU_SCENE_{ident.upper()}_H"
+    lines = [
+        f"/* {ident}_scene.h: the input and output blocks of the scene {ident}.",
+        f" * Generated by modelDescription/scene.py from "
+        f"{textsafe.c_comment(scene.path.name)}; do not edit. */",
+        f"#ifndef {guard}",
+        f"#define {guard}",
+        "",
+        '#include "dyadfmu/vec2.h"',
+        '#include "fmu_model.h"',
+        "",
+        "/* Inputs and tunable parameters; an angle is kept as its unit vector. */",
+        f"typedef struct {ident}_input {{",
+    ]
+    units = {v.lives.path: v.unit for v in table.variables}
+    for name, leaf in table.kind.input_members.items():
+        ctype = "dyad_vec2" if leaf == "dir" else "double"
+        lines.append(f"    {ctype} {name}; /* {units.get(name) or '-'} */")
+    if not table.kind.input_members:
+        lines.append("    double unused; /* the scene has no inputs */")
+    lines += [f"}} {ident}_input;", "", f"typedef struct {ident}_output {{"]
+    for name, leaf in table.kind.output_members.items():
+        if leaf == "status":
+            lines.append(f"    int {name}; /* 0 ok, 1 singular, 3 out of range */")
+        else:
+            lines.append(f"    double {name}; /* {units.get(name) or '-'} */")
+    lines += [
+        f"}} {ident}_output;",
+        "",
+        f"extern const fmu_behaviour {ident}_behaviour;",
+        "",
+        f"#endif /* {guard} */",
+    ]
+    return "\n".join(lines) + "\n"

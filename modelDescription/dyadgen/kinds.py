@@ -1,0 +1,513 @@
+"""One object per kind of model, each with its own structures, table, source files, C
+and documentation:
+
+    dyad    (the default of a table) the kinetostatic solver of one Assur dyad, whose
+            ``type`` (RRR, RRT, RTR, TRT, RTT) fixes its variables; it lives in
+            dyad_input and dyad_result (src/include/dyadfmu/types.h), behaviour
+            fmu_dyad.c. A scene that is one whole dyad is realised by it (generic).
+    drive   the crank drive, a DC motor with states (crank angle and speed)
+            integrated inside doStep; no ``type``; it lives in fmu_drive_input and
+            fmu_drive_output (fmu/models/fmu_drive.h), behaviour fmu_drive.c.
+    scene   a tailored scene: flat input and output blocks and the code computing
+            them, both generated from the scene (emit/scene_c.py).
+"""
+
+from __future__ import annotations
+
+from dyadgen.catalogue import (
+    Entry,
+    drive_absence_reason,
+    drive_catalogue,
+    dyad_absence_reason,
+    dyad_catalogue,
+)
+from dyadgen.dyadtypes import PAIRS
+from dyadgen.emit import documentation, fmi2, fmi3
+from dyadgen.emit.c_table import model_c
+from dyadgen.emit.scene_c import scene_c, scene_header
+from dyadgen.model import Scene
+from dyadgen.scenefile.problems import SceneError
+from dyadgen.structs import (
+    DRIVE_INPUT_MEMBERS,
+    DRIVE_OUTPUT_MEMBERS,
+    INPUT_MEMBERS,
+    LINK_FIELD,
+    RESULT_MEMBERS,
+    Lives,
+    Structs,
+    check_dyad_member,
+)
+from dyadgen.table import Table, TableError, table_from_data
+
+#: The FMI shim's C files per FMI version (fmu/).
+SHIM_FILES = {2: ["fmi2_functions.c"], 3: ["fmi3_functions.c", "fmi3_unsupported.c"]}
+
+LOG_CATEGORIES = (
+    (
+        "logStatusError",
+        "Errors: illegal call sequences, bad arguments, inputs the solver "
+        "rejects (the offending variable is named)",
+    ),
+    ("logStatusWarning", "Warnings, e.g. a singular configuration at exitInitializationMode"),
+    (
+        "logStatusDiscard",
+        "Discarded steps: singular configuration or overflowing reactions (reaction outputs NaN)",
+    ),
+    ("logCalls", "Calls into the FMU"),
+)
+#: The same categories (fmu_instance.c knows them by name) as the drive uses them.
+DRIVE_LOG_CATEGORIES = (
+    (
+        "logStatusError",
+        "Errors: illegal call sequences, bad arguments, inputs the model "
+        "rejects (the offending variable is named, e.g. load.inertia when inertia + "
+        "load.inertia is not positive)",
+    ),
+    ("logStatusWarning", "Warnings"),
+    (
+        "logStatusDiscard",
+        "Discarded steps: a step that would need more than 1e7 integrator "
+        "substeps, or a crank state that is no longer finite (the state stays at the step's "
+        "start)",
+    ),
+    ("logCalls", "Calls into the FMU"),
+)
+#: The same categories as a scene uses them.
+SCENE_LOG_CATEGORIES = (
+    (
+        "logStatusError",
+        "Errors: illegal call sequences, bad arguments, values outside a "
+        "variable's range (the variable is named)",
+    ),
+    ("logStatusWarning", "Warnings, e.g. a singular dyad at exitInitializationMode"),
+    (
+        "logStatusDiscard",
+        "Discarded steps: a singular dyad (named) or overflowing reactions (outputs NaN)",
+    ),
+    ("logCalls", "Calls into the FMU"),
+)
+
+
+class Kind(Structs):
+    """A kind of model: its structures (structs.Structs), and what an FMU of it is made
+    of: its source files, its C variable table's model data, its documentation and its
+    generated files; for a kind whose tables are written by hand, the catalogue they
+    are checked against."""
+
+    #: Whether its FMUs give directional derivatives (the model descriptions' flag).
+    directional_derivatives = "false"
+    log_categories: tuple = ()
+    #: How a scene of this kind is realised (scene.py --cmake-info) and named (--check).
+    realisation = ""
+    label = ""
+
+    def source_files(self, table: Table, version: int) -> list[str]:
+        """The C files an importer compiles to rebuild the FMI `version` binary."""
+        raise NotImplementedError
+
+    def subject(self, table: Table) -> str:
+        """What the FMU is, for the C variable table's comment."""
+        raise NotImplementedError
+
+    def table_source(self, table: Table) -> str:
+        """Where the table comes from, for the C variable table's comment."""
+        return f"modelDescription/{table.path.name}"
+
+    def model_data(self, table: Table) -> tuple[list[str], str]:
+        """The C lines of the model data the behaviour needs, and its address."""
+        return [], "NULL"
+
+    def documentation(self, table: Table) -> str:
+        """documentation/index.html."""
+        raise NotImplementedError
+
+    def own_sources(self, table: Table) -> dict[str, str]:
+        """Generated C sources beyond the variable table: file name -> text."""
+        return {}
+
+    def files(self, table: Table) -> dict[str, str]:
+        """Relative path -> text of every generated file."""
+        files = {
+            "fmi2/modelDescription.xml": fmi2.model_description(table),
+            "fmi3/modelDescription.xml": fmi3.model_description(table),
+            "fmi3/buildDescription.xml": fmi3.build_description(table),
+            f"{table.identifier}_model.c": model_c(table),
+        }
+        files.update(self.own_sources(table))
+        files["documentation/index.html"] = self.documentation(table)
+        return files
+
+    # ---- a table written by hand, checked against the kind's catalogue
+    def catalogue_for(self, model: dict) -> dict[str, Entry]:
+        """Every variable a table of this [model] must have; ValueError if there is none."""
+        raise ValueError(f"kind '{self.name}' has no table of its own")
+
+    def model_problems(self, model: dict) -> list[str]:
+        """What is wrong with [model] for this kind."""
+        return []
+
+    def owner(self, model: dict) -> str:
+        """The model, as messages name it."""
+        return self.name
+
+    def absence_reason(self, model: dict, lives: str) -> str:
+        """Why a well-formed `lives` is not a variable of this model."""
+        raise NotImplementedError
+
+    def table_of_scene(self, scene: Scene) -> Table:
+        """The variable table of a scene this kind realises."""
+        raise NotImplementedError
+
+
+class DyadKind(Kind):
+    """The generic dyad FMU of one type, on the core's validating solver and its exact
+    directional derivatives."""
+
+    directional_derivatives = "true"
+    log_categories = LOG_CATEGORIES
+    realisation = "generic"
+    label = "generic dyad"
+
+    def lives_syntax(self) -> str:
+        """What a `lives` of a dyad looks like."""
+        return "expected 'input.<member path>[@angle]' or 'result.<member path>'"
+
+    def resolve_lives(self, struct: str, path: str, angle: bool) -> Lives:
+        """A member path of dyad_input or dyad_result."""
+        check_dyad_member(struct, path, angle)
+        return Lives(struct, path, angle, self)
+
+    def lives_offset(self, lives: Lives) -> str:
+        """offsetof() of the member; dyad_result.status is its first member."""
+        if lives.struct == "result" and lives.path == "status":
+            return "0"
+        return super().lives_offset(lives)
+
+    def lives_field(self, lives: Lives) -> str:
+        """The dyad_field of an input member."""
+        if lives.struct == "result":
+            return "DYAD_FIELD_NONE"
+        parts = lives.path.split(".")
+        if parts[0] in ("m", "n"):
+            return f"DYAD_FIELD_{parts[0].upper()}_{LINK_FIELD[parts[1]]}"
+        return f"DYAD_FIELD_{parts[0].upper()}"
+
+    def source_files(self, table: Table, version: int) -> list[str]:
+        """The dyad's solver, its derivatives and the dyad behaviour."""
+        return [
+            "dyad_common.c",
+            f"dyad_{table.type.lower()}.c",
+            "dyad_tangent.c",
+            "fmu_dyad.c",
+            "fmu_instance.c",
+            *SHIM_FILES[version],
+            f"{table.identifier}_model.c",
+        ]
+
+    def subject(self, table: Table) -> str:
+        """The dyad FMU of its type."""
+        return f"the {table.type} dyad FMU"
+
+    def model_data(self, table: Table) -> tuple[list[str], str]:
+        """fmu_dyad_data: the type's solver and tangent, and the variable that feeds each
+        of the core's input fields (the one an invalid input is blamed on)."""
+        t = table.type.lower()
+        feeds = [
+            f"    {{{v.lives.field}, {v.index}}},"
+            for v in table.variables
+            if v.causality != "output" and v.lives.field != "DYAD_FIELD_NONE"
+        ]
+        return [
+            "/* The variable that feeds each input field of the core, for errors. */",
+            "static const fmu_dyad_feed feeds[] = {",
+            *feeds,
+            "};",
+            "",
+            f"static const fmu_dyad_data dyad = {{dyad_solve_{t}, &dyad_tangent_{t}, "
+            f"feeds, {len(feeds)}}};",
+            "",
+        ], "&dyad"
+
+    def documentation(self, table: Table) -> str:
+        """The page of the dyad type."""
+        return documentation.dyad_page(table)
+
+    def catalogue_for(self, model: dict) -> dict[str, Entry]:
+        """The variables of the table's dyad type."""
+        dyad_type = model.get("type")
+        if dyad_type not in PAIRS:
+            raise ValueError(f"type {dyad_type!r} is not one of {', '.join(PAIRS)}")
+        return dyad_catalogue(dyad_type)
+
+    def owner(self, model: dict) -> str:
+        """'RRT dyad'."""
+        return f"{model.get('type')} dyad"
+
+    def absence_reason(self, model: dict, lives: str) -> str:
+        """Why the type has no such variable."""
+        return dyad_absence_reason(model["type"], lives)
+
+    def table_of_scene(self, scene: Scene) -> Table:
+        """The table of a generic scene (is_generic), checked as a table file is."""
+        try:
+            return table_from_data(generic_data(scene), scene.path, KINDS)
+        except TableError as exc:
+            raise SceneError(exc.args[0]) from None
+
+
+class DriveKind(Kind):
+    """The crank drive (fmu/models/fmu_drive.c), from its table interface/drive.toml."""
+
+    log_categories = DRIVE_LOG_CATEGORIES
+
+    def source_files(self, table: Table, version: int) -> list[str]:
+        """The drive's behaviour."""
+        return [
+            "fmu_drive.c",
+            "fmu_instance.c",
+            *SHIM_FILES[version],
+            f"{table.identifier}_model.c",
+        ]
+
+    def subject(self, table: Table) -> str:
+        """The crank drive."""
+        return "the crank drive FMU"
+
+    def table_source(self, table: Table) -> str:
+        """The drive's table, among the interface data."""
+        return f"modelDescription/interface/{table.path.name}"
+
+    def documentation(self, table: Table) -> str:
+        """The page of the drive."""
+        return documentation.drive_page(table)
+
+    def catalogue_for(self, model: dict) -> dict[str, Entry]:
+        """The drive's variables."""
+        return drive_catalogue()
+
+    def model_problems(self, model: dict) -> list[str]:
+        """A drive has no dyad type."""
+        if "type" in model:
+            return [
+                f"type {model['type']!r} given, but only a dyad has a type "
+                f"(this table is of kind '{self.name}')"
+            ]
+        return []
+
+    def absence_reason(self, model: dict, lives: str) -> str:
+        """The drive has no such variable."""
+        return drive_absence_reason(lives)
+
+
+class SceneKind(Kind):
+    """A tailored scene: flat input and output blocks generated with the scene's C."""
+
+    realisation = "tailored"
+    label = "tailored"
+    log_categories = SCENE_LOG_CATEGORIES
+
+    def __init__(self, scene: Scene) -> None:
+        ident = scene.identifier
+        inputs = {i.member: "dir" if i.angle else "real" for i in scene.inputs}
+        inputs.update((prm.member, "real") for prm in scene.parameters() if prm.tunable)
+        outputs = {o.member: "status" if o.integer else "real" for o in scene.outputs}
+        super().__init__(
+            "scene",
+            f"{ident}_input",
+            f"{ident}_output",
+            inputs,
+            outputs,
+            f"{ident}_scene.h",
+            f"{ident}_behaviour",
+        )
+        self.scene = scene
+
+    def source_files(self, table: Table, version: int) -> list[str]:
+        """The closed forms of the scene's dyad types and its generated code."""
+        types = sorted({d.type.lower() for d in table.scene.dyads})
+        return (
+            ["dyad_common.c"]
+            + [f"dyad_{t}.c" for t in types]
+            + [
+                f"{table.identifier}_scene.c",
+                "fmu_instance.c",
+                *SHIM_FILES[version],
+                f"{table.identifier}_model.c",
+            ]
+        )
+
+    def subject(self, table: Table) -> str:
+        """The scene."""
+        return f"the scene {table.identifier}"
+
+    def table_source(self, table: Table) -> str:
+        """The scene file."""
+        return f"scene {table.path.name}"
+
+    def own_sources(self, table: Table) -> dict[str, str]:
+        """The scene's C and header."""
+        return {
+            f"{table.identifier}_scene.c": scene_c(table.scene),
+            f"{table.identifier}_scene.h": scene_header(table),
+        }
+
+    def documentation(self, table: Table) -> str:
+        """The page of the scene."""
+        return documentation.scene_page(table)
+
+    def table_of_scene(self, scene: Scene) -> Table:
+        """The scene's table, valid by construction."""
+        return SceneTable(scene, _scene_rows(scene), self)
+
+
+DYAD = DyadKind(
+    "dyad",
+    "dyad_input",
+    "dyad_result",
+    INPUT_MEMBERS,
+    RESULT_MEMBERS,
+    "fmu_dyad.h",
+    "fmu_dyad_behaviour",
+)
+DRIVE = DriveKind(
+    "drive",
+    "fmu_drive_input",
+    "fmu_drive_output",
+    DRIVE_INPUT_MEMBERS,
+    DRIVE_OUTPUT_MEMBERS,
+    "fmu_drive.h",
+    "fmu_drive_behaviour",
+)
+#: The kinds a table file may name in [model] kind.
+KINDS = {"dyad": DYAD, "drive": DRIVE}
+
+
+class SceneTable(Table):
+    """The table of a tailored scene, valid by construction."""
+
+    def __init__(self, scene: Scene, rows: list[dict], kind: SceneKind) -> None:
+        model = {"kind": "scene", "identifier": scene.identifier, "description": scene.description}
+        super().__init__(scene.path, model, rows, kind)
+        self.scene = scene
+
+
+def _bounds(raw: dict, domain: dict) -> None:
+    for key in ("min", "max"):
+        if key in domain:
+            raw[key] = domain[key]
+    for key in ("min_exclusive", "max_exclusive"):
+        if domain.get(key):
+            raw[key] = True
+
+
+def _row(rows: list, name: str, causality: str, unit: str | None, **values: object) -> dict:
+    raw = {"name": name, "vr": len(rows) + 1, "causality": causality, **values}
+    if unit:
+        raw["unit"] = unit
+    rows.append(raw)
+    return raw
+
+
+def _scene_rows(scene: Scene) -> list[dict]:
+    """The rows of a tailored scene's table: its inputs, tunable parameters, outputs."""
+    rows: list[dict] = []
+    for i in scene.inputs:
+        lives = f"input.{i.member}{'@angle' if i.angle else ''}"
+        raw = _row(
+            rows,
+            i.name,
+            "input",
+            i.unit,
+            type="Real",
+            start=i.start,
+            description=i.description,
+            lives=lives,
+        )
+        _bounds(raw, i.domain)
+    for prm in scene.parameters():
+        if prm.tunable:
+            raw = _row(
+                rows,
+                prm.name,
+                "parameter",
+                prm.unit,
+                type="Real",
+                start=prm.value,
+                description=prm.description,
+                lives=f"input.{prm.member}",
+            )
+            _bounds(raw, prm.domain)
+    for o in scene.outputs:
+        _row(
+            rows,
+            o.name,
+            "output",
+            o.unit,
+            type="Integer" if o.integer else "Real",
+            description=o.description,
+            lives=f"result.{o.member}",
+            depends=list(o.depends),
+        )
+    return rows
+
+
+def is_generic(scene: Scene) -> bool:
+    """A scene that is one whole dyad: every variable of its type, every parameter tunable,
+    both external links free. It is realised by the generic dyad FMU (the core's validating
+    solver with its exact directional derivatives) rather than by generated code."""
+    if len(scene.dyads) != 1 or scene.crank is not None:
+        return False
+    d = scene.dyads[0]
+    links = [scene.links[d.m], scene.links[d.n]]
+    offered = 2 * 3 + 2 * sum(k == "T" for k in PAIRS[d.type]) + 2 + 1
+    return (
+        d.name == ""
+        and d.m == "link_m"
+        and d.n == "link_n"
+        and d.k.kind == "external"
+        and d.p.kind == "external"
+        and scene.inertia
+        and scene.gravity
+        and all(link.force and link.moment for link in links)
+        and len(scene.outputs) == offered
+        and all(prm.tunable for prm in scene.parameters())
+    )
+
+
+def generic_data(scene: Scene) -> dict:
+    """The variable table (as a table file holds it) of a generic scene."""
+    d = scene.dyads[0]
+    params = {prm.name: prm for prm in scene.parameters()}
+    starts = {i.name: i.start for i in scene.inputs}
+    rows = []
+    for entry in dyad_catalogue(d.type).values():
+        raw = {
+            "name": entry.name,
+            "vr": len(rows) + 1,
+            "causality": entry.causality,
+            "type": entry.value_type,
+        }
+        if entry.unit:
+            raw["unit"] = entry.unit
+        if entry.causality == "input":
+            raw["start"] = starts[entry.name]
+        elif entry.causality == "parameter":
+            raw["start"] = params[entry.name].value
+        raw.update((key, value) for key, value in entry.domain.items() if value is not False)
+        raw["description"] = entry.description
+        raw["lives"] = entry.lives
+        if entry.causality == "output":
+            raw["depends"] = list(entry.depends)
+        rows.append(raw)
+    model = {"type": d.type, "identifier": scene.identifier, "description": scene.description}
+    return {"model": model, "variable": rows}
+
+
+def kind_of_scene(scene: Scene) -> Kind:
+    """The kind that realises a scene: the generic dyad, or the scene's own."""
+    return DYAD if is_generic(scene) else SceneKind(scene)
+
+
+def build_table(scene: Scene) -> Table:
+    """The scene's variable table: generic (of kind dyad) or tailored."""
+    return kind_of_scene(scene).table_of_scene(scene)

@@ -1,0 +1,27 @@
+"""Where the generator's data and the project's folders are."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+#: modelDescription/, the generator's home.
+MODEL_DESCRIPTION = Path(__file__).resolve().parent.parent
+#: The checkout.
+ROOT = MODEL_DESCRIPTION.parent
+#: The interface data: the drive's table, the generic dyads' descriptions, the C names
+#: probe scene and the golden model descriptions.
+INTERFACE_DIR = MODEL_DESCRIPTION / "interface"
+GOLDEN_DIR = INTERFACE_DIR / "golden"
+SCENES_DIR = ROOT / "scenes"
+#: A scene with every feature of the generated code (see the file and scenefile.c_names).
+C_NAMES_PROBE = INTERFACE_DIR / "c_names_probe.toml"
+#: Where the headers the generated code includes are found.
+HEADER_DIRS = (ROOT / "src" / "include", ROOT / "src", ROOT / "fmu")
+
+
+def relative_to_checkout(path: Path) -> str:
+    """A path relative to the checkout where it lies inside it."""
+    try:
+        return str(path.relative_to(ROOT))
+    except ValueError:
+        return str(path)

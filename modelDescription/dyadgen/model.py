@@ -1,0 +1,228 @@
+"""The model of a scene: an optional crank and a chain of Assur dyads, each dyad's links
+m and n and how its outer pairs meet their external links k and p (the frame, the
+crank, a link of an earlier dyad, or an external link whose motion is an input), the
+scene's numbers (baked into the code, or tunable parameters), and its derived inputs
+and outputs (needs.py fills them in)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from dyadgen.dyadtypes import PAIR_NAMES, PAIRS
+
+
+def c_num(x: float) -> str:
+    """A double as a C constant that reads back to the same double."""
+    text = repr(float(x))
+    return text if ("." in text or "e" in text or "inf" in text or "nan" in text) else text + ".0"
+
+
+def member(name: str) -> str:
+    """The C member of a structured name: dots as underscores."""
+    return name.replace(".", "_")
+
+
+@dataclass
+class Param:
+    """A number of the scene: baked into the code, or an FMU parameter."""
+
+    name: str  # FMU name, e.g. "lever.mass"
+    value: float
+    unit: str | None
+    description: str
+    domain: dict = field(default_factory=dict)
+    tunable: bool = False
+    member: str = ""  # C member of the input block when tunable
+
+    def c(self) -> str:
+        """The value in C: the input block's member, or the constant."""
+        return f"in->{self.member}" if self.tunable else c_num(self.value)
+
+    def is_zero(self) -> bool:
+        """Baked at 0: a term it multiplies is not written."""
+        return not self.tunable and self.value == 0.0
+
+
+@dataclass
+class Attachment:
+    """Where a dyad's outer pair meets its external link."""
+
+    kind: str  # "frame", "external", "crank", "link"
+    link: str | None = None  # the moving link (crank or dyad link) it is on
+    at: tuple[Param, Param] | None = None  # the point in that link's frame
+    guide: Param | None = None  # guide angle on the frame, for a translational pair
+
+
+@dataclass(eq=False)
+class Link:
+    """A link of a dyad (m or n), its numbers and its active loads."""
+
+    name: str
+    dyad: Dyad
+    side: str  # "m" or "n"
+    line: int | None
+    sliding: bool  # its length varies (link m of RTR, RTT)
+    translating: bool  # it cannot turn: its outer pair slides on the frame
+    params: dict = field(default_factory=dict)  # key -> Param (length, angle, com.x, ...)
+    force: bool = False
+    moment: bool = False
+
+    def attachment(self) -> Attachment:
+        """The attachment of its outer pair D: k for link m, p for link n."""
+        return self.dyad.k if self.side == "m" else self.dyad.p
+
+
+@dataclass(eq=False)
+class Dyad:
+    """A dyad of the chain: its type, links and outer attachments."""
+
+    name: str
+    type: str
+    index: int
+    line: int | None
+    m: str = ""
+    n: str = ""
+    k: Attachment | None = None
+    p: Attachment | None = None
+
+    def prefix(self) -> str:
+        """The prefix of its variables' names: 'name.', or none for an unnamed dyad."""
+        return f"{self.name}." if self.name else ""
+
+    def pair_kind(self, pair: str) -> str:
+        """R or T of the pair a reaction suffix (mk, np, mn) names."""
+        return PAIRS[self.type][dict(PAIR_NAMES)[pair]]
+
+
+@dataclass
+class Crank:
+    """The crank about the fixed pivot O."""
+
+    name: str
+    line: int | None
+    params: dict = field(default_factory=dict)
+
+
+@dataclass(eq=False)
+class Output:
+    """An output the scene offers: its name, C member and dependencies."""
+
+    name: str
+    unit: str | None
+    description: str
+    member: str
+    integer: bool = False
+    depends: list = field(default_factory=list)
+    source: str = ""  # the dyad (by index, as text) or "crank" it comes from
+
+
+@dataclass
+class Input:
+    """An input of the scene: a link's motion or active load, or a guide's direction."""
+
+    name: str
+    unit: str | None
+    description: str
+    member: str
+    angle: bool = False
+    start: float = 0.0
+    domain: dict = field(default_factory=dict)
+    owner: str = ""  # link the input belongs to ("" for a dyad's guide)
+
+
+@dataclass
+class Scene:
+    """A checked scene: the mechanism, its effects and numbers, and (once derived) its
+    inputs and outputs."""
+
+    path: Path
+    identifier: str
+    description: str
+    inertia: bool
+    gravity: bool
+    crank: Crank | None
+    dyads: list
+    links: dict  # name -> Link
+    gravity_params: tuple | None  # (Param, Param)
+    threshold: Param
+    outputs: list = field(default_factory=list)  # Output
+    inputs: list = field(default_factory=list)  # Input, in table order
+    #: dyad index -> the dyads that load it (see loaders), computed once
+    loaders: dict = field(default_factory=dict, repr=False)
+
+    def parameters(self) -> list:
+        """Every Param of the scene in table order."""
+        out = []
+        if self.crank:
+            out += self.crank.params.values()
+        for d in self.dyads:
+            for g in (d.m, d.n):
+                out += self.links[g].params.values()
+            for a in (d.k, d.p):
+                if a.at:
+                    out += a.at
+                if a.guide:
+                    out.append(a.guide)
+        if self.gravity_params:
+            out += self.gravity_params
+        out.append(self.threshold)
+        return out
+
+    def params_of(self, g: str) -> dict:
+        """The numbers of a moving link: the crank's or a dyad link's."""
+        return self.crank.params if self.crank and g == self.crank.name else self.links[g].params
+
+
+def carriers(scene: Scene) -> dict:
+    """Link name -> the moving link (crank or dyad link) its pair D sits on, or None."""
+    out = {}
+    for name, link in scene.links.items():
+        att = link.attachment()
+        out[name] = att.link if att.kind in ("crank", "link") else None
+    if scene.crank:
+        out[scene.crank.name] = None
+    return out
+
+
+def ancestors(carrier_of: dict, names: set) -> set:
+    """The moving links whose motion the accelerations of the links `names`' pairs D
+    derive from: their carriers, the carriers' carriers, and so on (`carrier_of` from
+    carriers). Each link is visited once."""
+    found: set = set()
+    for name in names:
+        carrier = carrier_of[name]
+        while carrier is not None and carrier not in found:
+            found.add(carrier)
+            carrier = carrier_of[carrier]
+    return found
+
+
+def loaders(scene: Scene, dyad: Dyad) -> list:
+    """Dyads whose reactions load this dyad's links, directly or through others."""
+    if not scene.loaders:
+        # a dyad hangs only on links of earlier dyads: from the last dyad back, each one's
+        # loaders are the dyads on its links and their loaders
+        on_link: dict[str, list] = {}
+        for d in scene.dyads:
+            for a in (d.k, d.p):
+                if a.kind == "link":
+                    on_link.setdefault(a.link, []).append(d)
+        for d in reversed(scene.dyads):
+            found: dict[int, Dyad] = {}
+            for g in (d.m, d.n):
+                for child in on_link.get(g, []):
+                    found[child.index] = child
+                    found.update((o.index, o) for o in scene.loaders[child.index])
+            found.pop(d.index, None)
+            scene.loaders[d.index] = list(found.values())
+    return scene.loaders[dyad.index]
+
+
+def own_accel(link: Link) -> bool:
+    """Whether the acceleration of D_g is an input: where D_g slides on a guide (of the frame
+    or of a moving link) or sits on an external link. On a fixed pivot it is 0; on a point
+    of the crank or of an earlier link the generated code derives it from that link's
+    motion."""
+    att = link.attachment()
+    return att.kind == "external" or att.guide is not None

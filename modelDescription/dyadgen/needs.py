@@ -1,0 +1,390 @@
+"""What a scene needs: its inputs (the motion and active loads of the links the wanted
+outputs involve) and its outputs with their dependencies.
+
+Inputs are derived as candidates first; once it is known what the generated code
+computes (scenefile.read prunes the candidates the code never reads), the outputs'
+dependencies follow from the inputs that are left."""
+
+from __future__ import annotations
+
+import re
+
+from dyadgen.dyadtypes import PAIR_NAMES, PAIRS, pair_label
+from dyadgen.model import (
+    Dyad,
+    Input,
+    Link,
+    Output,
+    Scene,
+    ancestors,
+    carriers,
+    loaders,
+    member,
+    own_accel,
+)
+
+#: What a dyad's amplification output means (README, "Status, conditioning, amplification").
+AMPLIFICATION_TEXT = (
+    "Data factor / conditioning: eps x amplification bounds the error of each "
+    "reaction relative to the largest reaction of its unit (N or N.m)"
+)
+
+
+# ---------------------------------------------------------------------------
+# Inputs
+# ---------------------------------------------------------------------------
+def _motion_inputs(scene: Scene, link: Link) -> list[Input]:
+    g = link.name
+    out = []
+    if not link.translating:
+        out.append(
+            Input(
+                f"{g}.angle",
+                "rad",
+                f"Direction of {g}: angle of i from D towards E, counter-clockwise from x",
+                member(g) + "_dir",
+                True,
+                owner=g,
+            )
+        )
+        if scene.inertia:
+            out.append(
+                Input(
+                    f"{g}.omega", "rad/s", f"Angular velocity of {g}", member(g) + "_omega", owner=g
+                )
+            )
+            out.append(
+                Input(
+                    f"{g}.epsilon",
+                    "rad/s2",
+                    f"Angular acceleration of {g}",
+                    member(g) + "_epsilon",
+                    owner=g,
+                )
+            )
+    if scene.inertia and own_accel(link):
+        for c in "xy":
+            out.append(
+                Input(
+                    f"{g}.accel_d.{c}",
+                    "m/s2",
+                    f"Acceleration of {g} at its outer pair D, global {c}",
+                    f"{member(g)}_accel_d_{c}",
+                    owner=g,
+                )
+            )
+    return out
+
+
+def _link_inputs(scene: Scene, link: Link) -> list[Input]:
+    g = link.name
+    out = _motion_inputs(scene, link)
+    if link.force:
+        for c in "xy":
+            out.append(
+                Input(
+                    f"{g}.force.{c}",
+                    "N",
+                    f"Active force on {g} at its centre of mass, global {c}",
+                    f"{member(g)}_force_{c}",
+                    owner=g,
+                )
+            )
+    if link.moment:
+        out.append(
+            Input(
+                f"{g}.moment",
+                "N.m",
+                f"Active moment on {g}, counter-clockwise",
+                member(g) + "_moment",
+                owner=g,
+            )
+        )
+    if link.sliding:
+        out.append(
+            Input(
+                f"{g}.length",
+                "m",
+                f"Current length |D E| of {g} (pair E slides along it)",
+                member(g) + "_length",
+                start=1.0,
+                domain={"min": 0.0, "min_exclusive": True},
+                owner=g,
+            )
+        )
+    return out
+
+
+def _crank_inputs(scene: Scene) -> list[Input]:
+    c = scene.crank.name
+    inputs = [
+        Input(
+            f"{c}.angle",
+            "rad",
+            "Crank angle phi (i_c from O towards A)",
+            member(c) + "_dir",
+            True,
+            owner=c,
+        )
+    ]
+    if scene.inertia:
+        inputs.append(
+            Input(f"{c}.omega", "rad/s", "Crank angular velocity", member(c) + "_omega", owner=c)
+        )
+        inputs.append(
+            Input(
+                f"{c}.epsilon",
+                "rad/s2",
+                "Crank angular acceleration",
+                member(c) + "_epsilon",
+                owner=c,
+            )
+        )
+    return inputs
+
+
+def _guide_inputs(d: Dyad) -> list[Input]:
+    inputs = []
+    for side, pair in (("k", "D_m"), ("p", "D_n")):
+        att = getattr(d, side)
+        if att.kind in ("crank", "link") and att.guide is not None:
+            slider = d.m if side == "k" else d.n
+            inputs.append(
+                Input(
+                    f"{d.prefix()}slide_{side}",
+                    "m",
+                    f"Position of {pair} along the guide on {att.link}, "
+                    "from the guide's point 'at'",
+                    f"{member(d.prefix())}slide_{side}",
+                    owner=slider,
+                )
+            )
+        if att.kind == "external" and d.pair_kind("mk" if side == "k" else "np") == "T":
+            inputs.append(
+                Input(
+                    f"{d.prefix()}guide_{side}.angle",
+                    "rad",
+                    f"Direction of the guide of the external link at {pair}",
+                    f"{member(d.prefix())}guide_{side}",
+                    True,
+                )
+            )
+    return inputs
+
+
+def derive_inputs(scene: Scene) -> None:
+    """Every candidate input of the scene, in table order."""
+    inputs = _crank_inputs(scene) if scene.crank else []
+    for d in scene.dyads:
+        for g in (d.m, d.n):
+            inputs += _link_inputs(scene, scene.links[g])
+        inputs += _guide_inputs(d)
+    scene.inputs = inputs
+
+
+# ---------------------------------------------------------------------------
+# Outputs
+# ---------------------------------------------------------------------------
+class _Offer:
+    """The outputs a scene offers, in order, and by the names a scene may ask for."""
+
+    def __init__(self) -> None:
+        self.offered: list[Output] = []
+        self.by_name: dict[str, list[Output]] = {}
+
+    def add(self, name: str, group: list[Output]) -> None:
+        self.by_name[name] = group
+        self.offered += group
+
+
+class _Index:
+    """What the dependencies of every dyad's outputs are picked from, found once."""
+
+    def __init__(self, scene: Scene) -> None:
+        self.carrier_of = carriers(scene)
+        self.geometry = {
+            i.name
+            for i in scene.inputs
+            if i.unit in ("rad", "m") and not i.name.endswith(".moment")
+        }
+        self.owner_of = {i.name: i.owner for i in scene.inputs}
+        # the inputs of no link: the guides of external links, DYAD.guide_k.angle
+        self.unowned = [i.name for i in scene.inputs if i.owner == ""]
+
+
+def _dependencies(scene: Scene, d: Dyad, index: _Index) -> tuple[list, list]:
+    """The inputs of a dyad's reactions, and of its conditioning: the dyad's own
+    directions and lengths, and the direction of a guide it slides on (an input, or a
+    moving carrier's angle)."""
+    involved = {d.m, d.n}
+    for other in loaders(scene, d):
+        involved |= {other.m, other.n}
+    involved |= ancestors(index.carrier_of, involved)
+    guides = [n for n in index.unowned if n.startswith(d.prefix())]
+    deps = [i.name for i in scene.inputs if i.owner in involved] + guides
+    own = {d.m, d.n} | {a.link for a in (d.k, d.p) if a.guide is not None and a.link}
+    own_geometry = [
+        n for n in deps if n in index.geometry and (index.owner_of[n] in own or n in guides)
+    ]
+    return deps, own_geometry
+
+
+def reaction_text(d: Dyad, pair: str) -> str:
+    """The description of a reaction output."""
+    other = {"mk": "k", "np": "p"}.get(pair)
+    if pair == "mn":
+        return f"Force on {d.m} from {d.n} at E"
+    link = d.m if pair == "mk" else d.n
+    att = d.k if pair == "mk" else d.p
+    source = att.link if att.kind in ("crank", "link") else att.kind
+    return f"Force on {link} from {source} ({other}) at {pair_label(pair)}"
+
+
+def _dyad_outputs(offer: _Offer, d: Dyad, deps: list, own_geometry: list) -> None:
+    pre = d.prefix()
+    source = str(d.index)
+    named = d.name or "the dyad"
+    for pair, idx in PAIR_NAMES:
+        group = [
+            Output(
+                f"{pre}R_{pair}.{c}",
+                "N",
+                reaction_text(d, pair) + f", global {c}",
+                f"{member(pre)}r_{pair}_{c}",
+                depends=deps,
+                source=source,
+            )
+            for c in "xy"
+        ]
+        offer.add(f"{pre}R_{pair}", group)
+        if PAIRS[d.type][idx] == "T":
+            label = f"the sliding pair {pair_label(pair)} of {named}"
+            n_out = Output(
+                f"{pre}N_{pair}",
+                "N",
+                f"Normal force of {label}",
+                f"{member(pre)}n_{pair}",
+                depends=deps,
+                source=source,
+            )
+            m_out = Output(
+                f"{pre}M_{pair}",
+                "N.m",
+                f"Reactive moment of {label}",
+                f"{member(pre)}m_{pair}",
+                depends=deps,
+                source=source,
+            )
+            offer.add(n_out.name, [n_out])
+            offer.add(m_out.name, [m_out])
+    cond = Output(
+        f"{pre}conditioning",
+        None,
+        f"Conditioning of {named} in [0, 1]; below singular_threshold the dyad is singular",
+        f"{member(pre)}conditioning",
+        depends=own_geometry,
+        source=source,
+    )
+    amp = Output(
+        f"{pre}amplification",
+        None,
+        AMPLIFICATION_TEXT,
+        f"{member(pre)}amplification",
+        depends=deps,
+        source=source,
+    )
+    offer.add(cond.name, [cond])
+    offer.add(amp.name, [amp])
+
+
+def _crank_outputs(offer: _Offer, scene: Scene) -> None:
+    c = scene.crank.name
+    every = [i.name for i in scene.inputs]
+    torque = Output(
+        f"{c}.torque",
+        "N.m",
+        "Driving torque on the crank about O, counter-clockwise",
+        f"{member(c)}_torque",
+        depends=every,
+        source="crank",
+    )
+    r_o = [
+        Output(
+            f"{c}.R_O.{x}",
+            "N",
+            f"Force on the crank from the frame at O, global {x}",
+            f"{member(c)}_r_o_{x}",
+            depends=every,
+            source="crank",
+        )
+        for x in "xy"
+    ]
+    offer.add(torque.name, [torque])
+    offer.add(f"{c}.R_O", r_o)
+
+
+def why_not(scene: Scene, wanted: str) -> str:
+    """Why a scene has no output of the name `wanted`."""
+    head, _, tail = wanted.rpartition(".")
+    for d in scene.dyads:
+        if head == d.name or (not d.name and not head):
+            m = re.fullmatch(r"(N|M)_(mk|np|mn)", tail)
+            if m and d.pair_kind(m.group(2)) == "R":
+                return (
+                    f"no pair provides it: {pair_label(m.group(2))} of the {d.type} "
+                    f"dyad '{d.name}' is revolute (no normal force or reactive moment)"
+                )
+            return (
+                f"dyad '{d.name}' has no output '{tail}' (it has R_mk, R_np, R_mn, "
+                "conditioning, amplification and N_/M_ of its sliding pairs)"
+            )
+    if scene.crank and head == scene.crank.name:
+        return "the crank has only 'torque' and 'R_O'"
+    names = [d.name for d in scene.dyads] + ([scene.crank.name] if scene.crank else [])
+    return f"no dyad or crank is named '{head}' (known: {', '.join(names)})"
+
+
+def _choose(offer: _Offer, scene: Scene, wanted: list[str]) -> tuple[list[Output], list[str]]:
+    chosen: list[Output] = []
+    problems = []
+    picked: set[int] = set()
+    for w in wanted:
+        if w == "all":
+            group = offer.offered
+        elif w in offer.by_name:
+            group = offer.by_name[w]
+        else:
+            group = [o for o in offer.offered if o.name == w][-1:] or None
+            if group is None:
+                problems.append(f"output '{w}': {why_not(scene, w)}")
+                continue
+        for o in group:
+            if id(o) not in picked:
+                picked.add(id(o))
+                chosen.append(o)
+    position = {id(o): k for k, o in enumerate(offer.offered)}
+    chosen.sort(key=lambda o: position[id(o)])
+    return chosen, problems
+
+
+def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
+    """The scene's outputs: those `wanted` (names, groups such as R_mk, or "all") and
+    the status; returns why a wanted name is no output, one message each."""
+    offer = _Offer()
+    index = _Index(scene)
+    for d in scene.dyads:
+        deps, own_geometry = _dependencies(scene, d, index)
+        _dyad_outputs(offer, d, deps, own_geometry)
+    if scene.crank:
+        _crank_outputs(offer, scene)
+    chosen, problems = _choose(offer, scene, wanted)
+    status = Output(
+        "status",
+        None,
+        "0 ok, 1 a dyad is singular, 3 a reaction overflows",
+        "status",
+        integer=True,
+        depends=[i.name for i in scene.inputs],
+    )
+    scene.outputs = chosen + [status]
+    return problems

@@ -1,0 +1,361 @@
+"""The parsers of a scene's mechanism: the [[link]] tables, the [[dyad]] tables with the
+attachments of their outer pairs k and p, and each link's numbers."""
+
+from __future__ import annotations
+
+from dyadgen.dyadtypes import MAY_BE_ZERO, PAIRS, TYPES
+from dyadgen.model import Attachment, Crank, Dyad, Link, Param
+from dyadgen.scenefile.names import name_problem
+from dyadgen.scenefile.problems import Problems, number, pair_of_numbers, real, unknown_keys
+
+DYAD_KEYS = {"name", "type", "m", "n", "k", "p"}
+LINK_KEYS = {"name", "length", "angle", "com", "mass", "inertia"}
+ATTACHMENT_KEYS = ("link", "at", "guide")
+
+
+def link_tables(p: Problems, data: dict, crank: Crank | None) -> dict[str, tuple[dict, int]]:
+    """The [[link]] tables by name (tables first, so that dyads can refer to them)."""
+    tables: dict[str, tuple[dict, int]] = {}
+    rows = data.get("link", [])
+    if not isinstance(rows, list):
+        p.add("[[link]] must be an array of tables", "link", 0)
+        rows = []
+    for i, row in enumerate(rows):
+        if not isinstance(row, dict):
+            continue
+        name = row.get("name")
+        label = f"link '{name}'" if isinstance(name, str) else f"link #{i + 1}"
+        unknown_keys(p, row, LINK_KEYS, label, "link", i)
+        problem = name_problem(name)
+        if problem:
+            p.add(f"link #{i + 1}: name {problem}", "link", i, "name")
+        elif name in tables:
+            also = p.loc.line("link", tables[name][1])
+            p.add(f"link '{name}' is described twice (also line {also})", "link", i, "name")
+        elif crank and name == crank.name:
+            p.add(f"link '{name}' has the crank's name", "link", i, "name")
+        else:
+            tables[name] = (row, i)
+    return tables
+
+
+class _Attaching:
+    """The parse of one outer pair's attachment (k at D_m, or p at D_n) of a dyad."""
+
+    def __init__(self, p: Problems, dyad: Dyad, side: str, label: str, crank: Crank | None) -> None:
+        self.p = p
+        self.side = side
+        self.pair = "D_m" if side == "k" else "D_n"
+        self.sliding = dyad.pair_kind("mk" if side == "k" else "np") == "T"
+        self.label = label
+        self.index = dyad.index
+        self.prefix = dyad.prefix()
+        self.crank = crank
+
+    def problem(self, message: str, key: bool = True) -> None:
+        if key:
+            self.p.add(f"{self.label}: {message}", "dyad", self.index, self.side)
+        else:
+            self.p.add(f"{self.label}: {message}", "dyad", self.index)
+
+    def spec(self, spec: object) -> dict | None:
+        """The attachment as a table (a bare name is its link), its keys checked."""
+        if spec is None:
+            self.problem(
+                f"missing '{self.side}', the external link at {self.pair} ('frame', "
+                f"'external', the crank's name or {{ link = ..., at = [x, y] }})",
+                key=False,
+            )
+            return None
+        if isinstance(spec, str):
+            spec = {"link": spec}
+        if not isinstance(spec, dict):
+            self.problem(f"'{self.side}' must be a link name or a table")
+            return None
+        for key in spec:
+            if key not in ATTACHMENT_KEYS:
+                self.problem(f"'{self.side}' has unknown key '{key}' (expected link, at, guide)")
+                return None
+        return spec
+
+    def target(self, spec: dict, links: dict) -> str | None:
+        """The link the pair is on, if it is one the dyad may hang on."""
+        target = spec.get("link")
+        if not isinstance(target, str):
+            self.problem(f"'{self.side}' needs link = <name>")
+            return None
+        crank = self.crank
+        moving = (crank is not None and target == crank.name) or target in links
+        if target not in ("frame", "external") and not moving:
+            later = (
+                " (a link of a later dyad or of this one: dyads are listed from the crank outwards)"
+                if target
+                else ""
+            )
+            self.problem(
+                f"'{self.side}' names unknown link {target!r}{later}; expected 'frame', "
+                f"'external'{', the crank' if crank else ''} or a link of an earlier dyad"
+            )
+            return None
+        return target
+
+    def parse(self, spec: object, links: dict) -> Attachment | None:
+        """The attachment, or None (and a problem)."""
+        spec = self.spec(spec)
+        target = None if spec is None else self.target(spec, links)
+        if target is None:
+            return None
+        if not self.sliding and "guide" in spec:
+            self.problem(f"{self.pair} is a revolute pair and has no guide")
+            return None
+        if target in ("frame", "external") and "at" in spec:
+            self.problem(f"'{self.side}': a pair on the {target} takes no 'at'")
+            return None
+        if target == "external":
+            if "guide" in spec:
+                self.problem(f"'{self.side}': an external link's guide is an input; drop 'guide'")
+                return None
+            return Attachment("external")
+        if target == "frame" and not self.sliding:
+            return Attachment("frame")
+        crank = self.crank
+        kind = (
+            "frame" if target == "frame" else "crank" if crank and target == crank.name else "link"
+        )
+        guide = None
+        if self.sliding:
+            guide = self.guide(spec, target, kind)
+            if guide is None:
+                return None
+            if kind == "frame":
+                return Attachment("frame", guide=guide)
+        return self.point(spec, target, kind, guide)
+
+    def guide(self, spec: dict, target: str, kind: str) -> Param | None:
+        """The angle of the guide a sliding pair runs on, on the frame or a moving link."""
+        angle = spec.get("guide")
+        side, pair = self.side, self.pair
+        if real(angle) is None:
+            on = "the frame" if kind == "frame" else f"'{target}'"
+            example = "0.0" if kind == "frame" else "0.0, at = [0.0, 0.0]"
+            self.problem(
+                f"{pair} slides on {on}: '{side}' needs guide = <angle in rad> "
+                f'(e.g. {side} = {{ link = "{target}", guide = {example} }})'
+            )
+            return None
+        if kind == "frame":
+            text = f"Direction of the frame guide at {pair} (angle of i_{side} from x)"
+        else:
+            text = (
+                f"Direction of the guide at {pair} on {target}: angle of i_{side} from {target}'s i"
+            )
+        return Param(f"{self.prefix}guide_{side}.angle", real(angle), "rad", text)
+
+    def point(self, spec: dict, target: str, kind: str, guide: Param | None) -> Attachment | None:
+        """The pair's point on a moving link (for a sliding pair: a point of its guide)."""
+        at = spec.get("at")
+        if at is None:
+            if self.sliding:
+                at = [0.0, 0.0]  # the guide passes through the carrier's D (O)
+            elif kind == "crank":
+                return Attachment("crank", self.crank.name)  # the crank's pin
+            else:
+                self.problem(
+                    f"'{self.side}' on link '{target}' needs at = [x, y], the pair's point "
+                    f"in that link's frame (m)"
+                )
+                return None
+        if not isinstance(at, list) or len(at) != 2 or not all(real(v) is not None for v in at):
+            self.problem(f"'{self.side}': at must be [x, y], two finite numbers (m)")
+            return None
+        frame = f"{target}'s frame"
+        if self.sliding:
+            pname, what = (
+                f"{self.prefix}guide_{self.side}.at",
+                f"A point of the guide at {self.pair} on {target}",
+            )
+        else:
+            pname, what = f"{self.prefix}{self.pair}", f"Pair {self.pair} on {target}"
+        x = Param(f"{pname}.x", real(at[0]), "m", f"{what}: x in the {frame}")
+        y = Param(f"{pname}.y", real(at[1]), "m", f"{what}: y in the {frame}")
+        return Attachment(kind, target, (x, y), guide)
+
+
+class Mechanism:
+    """The [[dyad]] tables parsed in order: the dyads, their links, and which dyad owns
+    each link name."""
+
+    def __init__(self, p: Problems, crank: Crank | None, tables: dict) -> None:
+        self.p = p
+        self.crank = crank
+        self.tables = tables
+        self.dyads: list[Dyad] = []
+        self.links: dict[str, Link] = {}
+        self.owner: dict[str, str] = {}  # link name -> "dyad 'x' as m"
+        self.names_seen: set = set()
+
+    def parse(self, data: dict) -> None:
+        """Every [[dyad]] table."""
+        rows = data.get("dyad", [])
+        if not isinstance(rows, list) or not rows:
+            self.p.add("no [[dyad]] tables: a scene has at least one dyad", "scene", 0)
+            rows = []
+        for i, row in enumerate(rows):
+            if not isinstance(row, dict):
+                self.p.add(f"dyad #{i + 1} must be a table", "dyad", i)
+                continue
+            self.dyad(i, row, several=len(rows) > 1)
+
+    def name(self, i: int, row: dict, several: bool) -> str:
+        """The dyad's name (a stand-in where it is invalid)."""
+        p = self.p
+        unknown_keys(p, row, DYAD_KEYS, f"dyad #{i + 1}", "dyad", i)
+        name = row.get("name", "")
+        if name == "" and several:
+            p.add(f"dyad #{i + 1}: a scene with several dyads must name each one", "dyad", i)
+        elif name != "" and name_problem(name):
+            p.add(f"dyad #{i + 1}: name {name_problem(name)}", "dyad", i, "name")
+            name = f"dyad{i + 1}"
+        elif name in self.names_seen:
+            p.add(f"dyad '{name}' is named twice", "dyad", i, "name")
+        self.names_seen.add(name)
+        return name
+
+    def dyad(self, i: int, row: dict, several: bool) -> None:
+        """One [[dyad]] table."""
+        name = self.name(i, row, several)
+        label = f"dyad '{name}'" if name else f"dyad #{i + 1}"
+        dtype = row.get("type")
+        if dtype not in TYPES:
+            self.p.add(
+                f"{label}: unknown dyad type {dtype!r} (expected one of {', '.join(TYPES)})",
+                "dyad",
+                i,
+                "type",
+            )
+            for side in ("m", "n"):  # its links are not orphans
+                if isinstance(row.get(side), str):
+                    self.owner.setdefault(row[side], f"link {side} of {label}")
+            return
+        dyad = Dyad(name, dtype, i, self.p.loc.line("dyad", i))
+        if not all([self.link(dyad, row, side, label) for side in ("m", "n")]):
+            return
+        for side in ("k", "p"):
+            attaching = _Attaching(self.p, dyad, side, label, self.crank)
+            setattr(dyad, side, attaching.parse(row.get(side, None), self.links))
+        if dyad.k is None or dyad.p is None:
+            return
+        d_m, e, d_n = PAIRS[dtype]
+        for side, outer, attached in (("m", d_m, dyad.k), ("n", d_n, dyad.p)):
+            lname = getattr(dyad, side)
+            translating = outer == "T" and attached.kind == "frame"
+            sliding = side == "m" and e == "T"
+            line = self.p.loc.line("link", self.tables[lname][1])
+            self.links[lname] = Link(lname, dyad, side, line, sliding, translating)
+        self.dyads.append(dyad)
+
+    def link_numbers(self, inertia: bool, needs_mass: bool) -> None:
+        """Every described link's numbers; a link of no dyad is a problem."""
+        for lname, (row, i) in self.tables.items():
+            if lname in self.links:
+                link_params(self.p, self.links[lname], row, i, inertia, needs_mass)
+            elif lname not in self.owner:
+                self.p.add(f"link '{lname}' belongs to no dyad", "link", i)
+
+    def link(self, dyad: Dyad, row: dict, side: str, label: str) -> bool:
+        """Link m or n of a dyad: whether it names a described link no other dyad has."""
+        p, i = self.p, dyad.index
+        lname = row.get(side)
+        if not isinstance(lname, str):
+            p.add(f"{label}: missing link '{side}' (the name of its link {side})", "dyad", i)
+            return False
+        if lname in self.owner:
+            p.add(
+                f"{label}: link '{lname}' is connected twice: it is already {self.owner[lname]}",
+                "dyad",
+                i,
+                side,
+            )
+            return False
+        if self.crank and lname == self.crank.name:
+            p.add(
+                f"{label}: link '{lname}' is the crank, which no dyad may contain", "dyad", i, side
+            )
+            return False
+        if lname not in self.tables:
+            p.add(
+                f"{label}: link '{lname}' has no [[link]] table (its length, centre of "
+                "mass, mass and inertia)",
+                "dyad",
+                i,
+                side,
+            )
+            return False
+        self.owner[lname] = f"link {side} of {label}"
+        setattr(dyad, side, lname)
+        return True
+
+
+def _length_and_angle(p: Problems, link: Link, row: dict, i: int) -> None:
+    where = f"link '{link.name}'"
+    may_be_zero = MAY_BE_ZERO[link.dyad.type]["mn".index(link.side)]
+    if link.sliding:
+        if "length" in row:
+            p.add(
+                f"{where}: its length varies (pair E of the {link.dyad.type} dyad slides "
+                f"along it), so it is an input, not a parameter; drop 'length'",
+                "link",
+                i,
+                "length",
+            )
+    else:
+        length = number(
+            p, row, "length", where, "link", i, nonnegative=may_be_zero, positive=not may_be_zero
+        )
+        if length is not None:
+            text = "may be 0" if may_be_zero else "positive"
+            link.params["length"] = Param(
+                f"{link.name}.length",
+                length,
+                "m",
+                f"Length |D E| of link {link.name} ({text})",
+                {"min": 0.0, "min_exclusive": not may_be_zero},
+            )
+    if link.translating:
+        angle = number(p, row, "angle", where + " (it translates on its frame guide)", "link", i)
+        if angle is not None:
+            link.params["angle"] = Param(
+                f"{link.name}.angle", angle, "rad", f"Direction of link {link.name} (it translates)"
+            )
+    elif "angle" in row:
+        p.add(f"{where}: its angle is an input (the link turns); drop 'angle'", "link", i, "angle")
+
+
+def link_params(
+    p: Problems, link: Link, row: dict, i: int, inertia: bool, needs_mass: bool
+) -> None:
+    """A link's numbers: length (unless it slides), angle (if it translates), centre of
+    mass, and mass and inertia where the effects need them."""
+    _length_and_angle(p, link, row, i)
+    g = link.name
+    where = f"link '{g}'"
+    com = pair_of_numbers(p, row, "com", where, "link", i, required=True)
+    if com is not None:
+        link.params["com.x"] = Param(
+            f"{g}.com.x", com[0], "m", f"Centre of mass of {g}, x in its frame"
+        )
+        link.params["com.y"] = Param(
+            f"{g}.com.y", com[1], "m", f"Centre of mass of {g}, y in its frame"
+        )
+    mass = number(p, row, "mass", where, "link", i, nonnegative=True, required=needs_mass)
+    if mass is not None and needs_mass:
+        link.params["mass"] = Param(f"{g}.mass", mass, "kg", f"Mass of {g}", {"min": 0.0})
+    inert = number(p, row, "inertia", where, "link", i, nonnegative=True, required=inertia)
+    if inert is not None and inertia:
+        link.params["inertia"] = Param(
+            f"{g}.inertia",
+            inert,
+            "kg.m2",
+            f"Moment of inertia of {g} about its centre of mass",
+            {"min": 0.0},
+        )

@@ -1,0 +1,112 @@
+"""Read and check a scene, then derive what it needs: the stages of scenefile joined.
+
+The sections are parsed in file order of dependence (the scene, its effects, the crank,
+the links, the dyads, the loads, the tunable parameters); every problem is recorded,
+and the inputs and outputs are derived only from a scene without problems. Which
+inputs the scene keeps is known only once it is known what its code computes: the
+candidates the generated C never reads are dropped, and the outputs' dependencies
+follow from the inputs that are left."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+from dyadgen.emit.scene_c import scene_c
+from dyadgen.model import Scene
+from dyadgen.needs import derive_inputs, derive_outputs
+from dyadgen.scenefile import mechanism, sections
+from dyadgen.scenefile.locator import Locator
+from dyadgen.scenefile.names import CNames, c_name_clashes, identifier_problem
+from dyadgen.scenefile.problems import Problems, SceneError
+
+
+def _named_objects(identifier: str, found: mechanism.Mechanism, crank_name: str | None) -> list:
+    """(kind, name, label, where) of every name of the scene, in file order."""
+    objects = []
+    if not identifier_problem(identifier):
+        objects.append(
+            (
+                "identifier",
+                identifier,
+                f"[scene]: identifier '{identifier}'",
+                ("scene", 0, "identifier"),
+            )
+        )
+    if crank_name is not None:
+        objects.append(("crank", crank_name, f"crank '{crank_name}'", ("crank", 0, "name")))
+    objects += [
+        ("dyad", d.name, f"dyad '{d.name}'", ("dyad", d.index, "name"))
+        for d in found.dyads
+        if d.name
+    ]
+    objects += [
+        ("link", g, f"link '{g}'", ("link", i, "name")) for g, (row, i) in found.tables.items()
+    ]
+    return objects
+
+
+def prune_inputs(scene: Scene) -> None:
+    """Drop the candidate inputs the generated code never reads: a link's angular velocity
+    where nothing of it lies off its pair D (its centripetal terms vanish), and the like."""
+    used = set(re.findall(r"\bin->([A-Za-z0-9_]+)", scene_c(scene)))
+    scene.inputs = [i for i in scene.inputs if i.member in used]
+
+
+def _derive(p: Problems, scene: Scene, scene_t: dict, data: dict) -> None:
+    derive_inputs(scene)
+    candidates = {i.name for i in scene.inputs}
+    wanted = sections.outputs(p, scene_t)
+    if wanted is None:
+        return
+    for problem in derive_outputs(scene, wanted):
+        p.add(f"[scene]: {problem}", "scene", 0, "outputs")
+    if p.items:
+        return
+    # only now is it known what the code computes, and so which inputs it reads;
+    # the outputs' dependencies follow from those inputs
+    prune_inputs(scene)
+    derive_outputs(scene, wanted)
+    sections.starts(p, scene, data.get("start", {}), candidates)
+
+
+def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene:
+    """Read and validate a scene; raises SceneError listing every problem.
+    `c_names`: the C names of generated code, to refuse names whose C names clash
+    (None only for the C names probe, from which the clashes are learnt)."""
+    path = Path(path)
+    text, data = sections.read_text(path)
+    p = Problems(path, Locator(text))
+    scene_t, identifier, description = sections.scene_section(p, data)
+    effects = sections.effects(p, data)
+    inertia, gravity = effects["inertia"], effects["gravity"]
+    needs_mass = inertia or gravity
+    gravity_params = sections.gravity(p, data, gravity)
+    threshold = sections.threshold(p, scene_t)
+    crank = sections.crank(p, data, inertia, needs_mass)
+    found = mechanism.Mechanism(p, crank, mechanism.link_tables(p, data, crank))
+    found.parse(data)
+    found.link_numbers(inertia, needs_mass)
+    if c_names is not None:
+        objects = _named_objects(identifier, found, crank.name if crank else None)
+        c_name_clashes(p, objects, c_names())
+    sections.loads(p, data, found.links)
+    scene = Scene(
+        path=path,
+        identifier=identifier,
+        description=description,
+        inertia=inertia,
+        gravity=gravity,
+        crank=crank,
+        dyads=found.dyads,
+        links=found.links,
+        gravity_params=gravity_params,
+        threshold=threshold,
+    )
+    sections.tunable(p, scene_t, scene)
+    if not p.items:
+        _derive(p, scene, scene_t, data)
+    if p.items:
+        raise SceneError(p.items)
+    return scene

@@ -1,0 +1,303 @@
+"""One parser per section of a scene file that is not the mechanism ([scene], [effects],
+[gravity], [crank], [loads], the tunable parameters, [start]); mechanism.py parses the
+links and dyads. Each parser records every problem it finds and returns what is valid."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from pathlib import Path
+
+from dyadgen import textsafe
+from dyadgen.model import Crank, Param, Scene, member
+from dyadgen.scenefile.names import identifier_problem, name_problem
+from dyadgen.scenefile.problems import (
+    Problems,
+    SceneError,
+    number,
+    pair_of_numbers,
+    real,
+    shown,
+    unknown_keys,
+)
+
+SCENE_KEYS = {"identifier", "description", "outputs", "tunable", "singular_threshold"}
+EFFECT_KEYS = {"inertia", "gravity"}
+CRANK_KEYS = {"name", "length", "com", "mass", "inertia"}
+LOAD_KEYS = {"force", "moment"}
+TOP_KEYS = {"scene", "effects", "gravity", "crank", "dyad", "link", "loads", "start"}
+#: sqrt(DBL_EPSILON), where round-off still leaves half of the digits.
+DEFAULT_THRESHOLD = 1.4901161193847656e-8
+
+
+def read_text(path: Path) -> tuple[str, dict]:
+    """The text of a scene file and its TOML; raises SceneError where it is no TOML text."""
+    shown_name = textsafe.plain(path.name)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise SceneError([f"{shown_name}: cannot read: {exc.strerror}"]) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise SceneError([f"{shown_name}:{line}: not UTF-8 text (byte {exc.start + 1})"]) from None
+    try:
+        return text, tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        line = re.search(r"at line (\d+)", str(exc))
+        where = f"{shown_name}:{line.group(1)}" if line else shown_name
+        raise SceneError([f"{where}: invalid TOML: {textsafe.plain(exc)}"]) from None
+
+
+def scene_section(p: Problems, data: dict) -> tuple[dict, str, str]:
+    """The top-level tables, and [scene]: the table, the identifier and the description
+    (stand-ins where they are invalid); raises SceneError where [scene] is missing."""
+    for key in data:
+        if key not in TOP_KEYS:
+            p.add(f"unknown table '{key}' (expected {', '.join(sorted(TOP_KEYS))})", key, 0)
+    scene_t = data.get("scene")
+    if not isinstance(scene_t, dict):
+        p.add("missing [scene] table (identifier, description, outputs)", "scene", 0)
+        raise SceneError(p.items)
+    unknown_keys(p, scene_t, SCENE_KEYS, "[scene]", "scene", 0)
+    identifier = scene_t.get("identifier")
+    problem = identifier_problem(identifier)
+    if problem:
+        p.add(f"[scene]: identifier {problem}", "scene", 0, "identifier")
+        identifier = "scene"
+    description = scene_t.get("description")
+    problem = textsafe.description_problem(description)
+    if problem:
+        p.add(f"[scene]: description {problem}", "scene", 0, "description")
+        description = ""
+    return scene_t, identifier, description
+
+
+def effects(p: Problems, data: dict) -> dict[str, bool]:
+    """[effects]: inertia and gravity, each on or off."""
+    effects_t = data.get("effects", {})
+    if not isinstance(effects_t, dict):
+        p.add("[effects] must be a table", "effects", 0)
+        effects_t = {}
+    unknown_keys(p, effects_t, EFFECT_KEYS, "[effects]", "effects", 0)
+    found = {}
+    for key in EFFECT_KEYS:
+        value = effects_t.get(key, False)
+        if not isinstance(value, bool):
+            p.add(f"[effects]: '{key}' must be true or false, not {value!r}", "effects", 0, key)
+            value = False
+        found[key] = value
+    return found
+
+
+def gravity(p: Problems, data: dict, on: bool) -> tuple[Param, Param] | None:
+    """[gravity]: its x and y (m/s2), where gravity is on."""
+    gravity_t = data.get("gravity")
+    if not on:
+        if gravity_t is not None:
+            p.add(
+                "[gravity] is given, but [effects] gravity is not true: set it or remove the table",
+                "gravity",
+                0,
+            )
+        return None
+    if not isinstance(gravity_t, dict):
+        p.add(
+            "[effects]: gravity = true, but there is no [gravity] table with x and y (m/s2)",
+            "effects",
+            0,
+            "gravity",
+        )
+        return None
+    unknown_keys(p, gravity_t, {"x", "y"}, "[gravity]", "gravity", 0)
+    gx = number(p, gravity_t, "x", "[gravity]", "gravity", 0)
+    gy = number(p, gravity_t, "y", "[gravity]", "gravity", 0)
+    if gx is None or gy is None:
+        return None
+    return (
+        Param("gravity.x", gx, "m/s2", "Gravitational acceleration, global x component"),
+        Param("gravity.y", gy, "m/s2", "Gravitational acceleration, global y component"),
+    )
+
+
+def threshold(p: Problems, scene_t: dict) -> Param:
+    """[scene] singular_threshold, in (0, 1)."""
+    value = real(scene_t.get("singular_threshold", DEFAULT_THRESHOLD))
+    if value is None or not 0 < value < 1:
+        p.add(
+            f"[scene]: singular_threshold must be in (0, 1), not "
+            f"{shown(scene_t.get('singular_threshold'))}",
+            "scene",
+            0,
+            "singular_threshold",
+        )
+        value = DEFAULT_THRESHOLD
+    return Param(
+        "singular_threshold",
+        value,
+        None,
+        "Conditioning below which a dyad is reported singular (default sqrt(eps) = 1.49e-8)",
+        {"min": 0.0, "max": 1.0, "min_exclusive": True, "max_exclusive": True},
+    )
+
+
+def _crank_params(
+    p: Problems, crank: Crank, crank_t: dict, inertia: bool, needs_mass: bool
+) -> None:
+    cname = crank.name
+    where = f"crank '{cname}'"
+    length = number(p, crank_t, "length", where, "crank", 0, positive=True)
+    if length is not None:
+        crank.params["length"] = Param(
+            f"{cname}.length",
+            length,
+            "m",
+            "Crank radius |O A|: the crank pin A lies at (length, 0) in the crank frame",
+            {"min": 0.0, "min_exclusive": True},
+        )
+    com = pair_of_numbers(p, crank_t, "com", where, "crank", 0, required=needs_mass)
+    if com is not None and needs_mass:
+        crank.params["com.x"] = Param(
+            f"{cname}.com.x",
+            com[0],
+            "m",
+            "Crank's centre of mass, x in the crank frame {O; i_c, j_c}",
+        )
+        crank.params["com.y"] = Param(
+            f"{cname}.com.y", com[1], "m", "Crank's centre of mass, y in the crank frame"
+        )
+    mass = number(p, crank_t, "mass", where, "crank", 0, nonnegative=True, required=needs_mass)
+    if mass is not None and needs_mass:
+        crank.params["mass"] = Param(f"{cname}.mass", mass, "kg", "Crank's mass", {"min": 0.0})
+    inert = number(p, crank_t, "inertia", where, "crank", 0, nonnegative=True, required=inertia)
+    if inert is not None and inertia:
+        crank.params["inertia"] = Param(
+            f"{cname}.inertia",
+            inert,
+            "kg.m2",
+            "Crank's moment of inertia about its centre of mass",
+            {"min": 0.0},
+        )
+
+
+def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool) -> Crank | None:
+    """[crank], if any: its name and numbers."""
+    crank_t = data.get("crank")
+    if crank_t is None:
+        return None
+    if not isinstance(crank_t, dict):
+        p.add("[crank] must be a table", "crank", 0)
+        return None
+    unknown_keys(p, crank_t, CRANK_KEYS, "[crank]", "crank", 0)
+    cname = crank_t.get("name", "crank")
+    problem = name_problem(cname)
+    if problem:
+        p.add(f"[crank]: name {problem}", "crank", 0, "name")
+        cname = "crank"
+    found = Crank(cname, p.loc.line("crank"))
+    _crank_params(p, found, crank_t, inertia, needs_mass)
+    return found
+
+
+def loads(p: Problems, data: dict, links: dict) -> None:
+    """[loads]: the links an active force or moment acts on (an input each)."""
+    loads_t = data.get("loads", {})
+    if not isinstance(loads_t, dict):
+        p.add("[loads] must be a table", "loads", 0)
+        loads_t = {}
+    unknown_keys(p, loads_t, LOAD_KEYS, "[loads]", "loads", 0)
+    for key in LOAD_KEYS:
+        value = loads_t.get(key, [])
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            p.add(f"[loads]: '{key}' must be a list of link names", "loads", 0, key)
+            continue
+        for lname in value:
+            if lname not in links:
+                p.add(
+                    f"[loads]: {key} on unknown link '{lname}' (links: "
+                    f"{', '.join(links) or 'none'})",
+                    "loads",
+                    0,
+                    key,
+                )
+            elif getattr(links[lname], key):
+                p.add(f"[loads]: {key} on '{lname}' is listed twice", "loads", 0, key)
+            else:
+                setattr(links[lname], key, True)
+
+
+def tunable(p: Problems, scene_t: dict, scene: Scene) -> None:
+    """[scene] tunable: the parameters that stay FMU parameters (all others are baked)."""
+    entries = scene_t.get("tunable", [])
+    params = {prm.name: prm for prm in scene.parameters()}
+    if not isinstance(entries, list) or not all(isinstance(t, str) for t in entries):
+        p.add("[scene]: tunable must be a list of parameter names", "scene", 0, "tunable")
+        entries = []
+    for entry in entries:
+        if entry == "all":
+            chosen = list(params)
+        else:
+            chosen = [n for n in params if n == entry or n.startswith(entry + ".")]
+        if not chosen:
+            p.add(
+                f"[scene]: tunable '{entry}' is no parameter of this scene (parameters: "
+                f"{', '.join(params)})",
+                "scene",
+                0,
+                "tunable",
+            )
+        for n in chosen:
+            params[n].tunable = True
+            params[n].member = member(n)
+
+
+def outputs(p: Problems, scene_t: dict) -> list[str] | None:
+    """[scene] outputs: the names of the wanted outputs, or None where it is malformed."""
+    wanted = scene_t.get("outputs")
+    if wanted is None:
+        p.add(
+            '[scene]: missing \'outputs\' (a list such as ["all"] or ["ram.R_np", "crank.torque"])',
+            "scene",
+            0,
+        )
+        return None
+    if not isinstance(wanted, list) or not all(isinstance(w, str) for w in wanted) or not wanted:
+        p.add("[scene]: outputs must be a non-empty list of output names", "scene", 0, "outputs")
+        return None
+    return wanted
+
+
+def starts(p: Problems, scene: Scene, starts_t: object, candidates: set) -> None:
+    """[start]: start values of inputs (default 0, and 1 m for a sliding length). A start
+    value of an input the scene's outputs turned out not to need is ignored."""
+    if not isinstance(starts_t, dict):
+        p.add("[start] must be a table of input names and values", "start", 0)
+        return
+    by_name = {i.name: i for i in scene.inputs}
+    for name, value in starts_t.items():
+        target = by_name.get(name)
+        if target is None and name in candidates:
+            continue
+        if target is None:
+            p.add(
+                f"[start]: '{name}' is no input of this scene (inputs: {', '.join(by_name)})",
+                "start",
+                0,
+                name,
+            )
+            continue
+        found = real(value)
+        if found is None:
+            p.add(
+                f"[start]: '{name}' must be a finite number (within the range of a double), "
+                f"not {shown(value)}",
+                "start",
+                0,
+                name,
+            )
+            continue
+        if "min" in target.domain and not found > target.domain["min"]:
+            p.add(f"[start]: '{name}' must be positive, not {shown(value)}", "start", 0, name)
+            continue
+        target.start = found
