@@ -9,13 +9,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import read_model_description, simulate_fmu
-from fmpy.fmi1 import FMICallException
-from fmpy.validation import validate_fmu
-
 from dyadfmu.core import Core
 from dyadfmu.cosim.harness import OUTPUTS, links_from_values
 from dyadfmu.fmi.slave import Slave
+from fmpy import read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.validation import validate_fmu
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILD = Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
@@ -38,6 +37,7 @@ def core():
 
 # ---- validation ------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("dyad,version", ALL)
 def test_fmu_validates(dyad, version):
     path = fmu_path(dyad, version)
@@ -52,15 +52,24 @@ def test_fmu_validates(dyad, version):
     if version == 3:
         assert "sources/buildDescription.xml" in names
         with zipfile.ZipFile(path) as archive:
-            assert archive.read("modelDescription.xml") == \
-                (ROOT / "modelDescription" / "interface" / "golden" / f"dyad_{dyad}_fmi3.xml").read_bytes()
+            assert (
+                archive.read("modelDescription.xml")
+                == (
+                    ROOT / "modelDescription" / "interface" / "golden" / f"dyad_{dyad}_fmi3.xml"
+                ).read_bytes()
+            )
     else:
         with zipfile.ZipFile(path) as archive:
-            assert archive.read("modelDescription.xml") == \
-                (ROOT / "modelDescription" / "interface" / "golden" / f"dyad_{dyad}_fmi2.xml").read_bytes()
+            assert (
+                archive.read("modelDescription.xml")
+                == (
+                    ROOT / "modelDescription" / "interface" / "golden" / f"dyad_{dyad}_fmi2.xml"
+                ).read_bytes()
+            )
 
 
 # ---- co-simulation against the core ----------------------------------------------
+
 
 def input_signals(md, revolutions=1.0, samples=200):
     """Smooth time-varying values for every input over one crank revolution
@@ -73,9 +82,9 @@ def input_signals(md, revolutions=1.0, samples=200):
     for k, v in enumerate(inputs):
         start = float(v.start)
         if v.name.endswith("angle"):
-            value = start + 0.35 * np.sin(phase + 0.7 * k)        # rad
+            value = start + 0.35 * np.sin(phase + 0.7 * k)  # rad
         elif v.name.endswith("length"):
-            value = start * (1 + 0.3 * np.sin(phase))             # m, stays positive
+            value = start * (1 + 0.3 * np.sin(phase))  # m, stays positive
         else:
             value = start + (1 + k) * 10 * np.cos(phase + 0.3 * k)
         rows[v.name] = value
@@ -93,8 +102,14 @@ def test_cosimulation_reproduces_core(core, dyad, version):
     inputs = [n for n in signals.dtype.names if n != "time"]
     outputs = [v.name for v in md.modelVariables if v.causality == "output"]
     params = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
-    result = simulate_fmu(str(path), start_time=0, stop_time=1, step_size=0.005,
-                          input=signals, output=inputs + outputs)
+    result = simulate_fmu(
+        str(path),
+        start_time=0,
+        stop_time=1,
+        step_size=0.005,
+        input=signals,
+        output=inputs + outputs,
+    )
     assert len(result) >= 200
     assert np.all(result["status"] == 0)
     worst = 0.0
@@ -102,8 +117,15 @@ def test_cosimulation_reproduces_core(core, dyad, version):
         values = dict(params)
         values.update({name: row[name] for name in inputs})
         m, n, guide_k, guide_p, gravity = links_from_values(values, dyad.upper())
-        want = core.solve(dyad.upper(), m, n, guide_k, guide_p, gravity,
-                          singular_threshold=params["singular_threshold"])
+        want = core.solve(
+            dyad.upper(),
+            m,
+            n,
+            guide_k,
+            guide_p,
+            gravity,
+            singular_threshold=params["singular_threshold"],
+        )
         assert want["status"] == "ok"
         for name in outputs:
             if name == "status":
@@ -113,12 +135,15 @@ def test_cosimulation_reproduces_core(core, dyad, version):
             got = float(row[name])
             scale = max(abs(expected), 1e-300)
             worst = max(worst, abs(got - expected) / scale)
-    print(f"dyad_{dyad}_fmi{version}: {len(result)} steps, worst relative difference to the "
-          f"core {worst:.1e}")
+    print(
+        f"dyad_{dyad}_fmi{version}: {len(result)} steps, worst relative difference to the "
+        f"core {worst:.1e}"
+    )
     assert worst <= 1e-15
 
 
 # ---- misuse through the low-level classes ------------------------------------------
+
 
 def slave(dyad, version, name="instance"):
     """An instantiated generic dyad FMU of either version (dyadfmu's fmpy wrapper)."""
@@ -129,14 +154,14 @@ def slave(dyad, version, name="instance"):
 def test_wrong_call_order_is_an_error(tmp_path, version):
     s = slave("rrt", version)
     with pytest.raises(FMICallException):
-        s.do_step(0, 0.01)                       # before initialization
+        s.do_step(0, 0.01)  # before initialization
     with pytest.raises(FMICallException):
-        s.get("R_np.x")                 # outputs need initialization
+        s.get("R_np.x")  # outputs need initialization
     s.initialize()
     with pytest.raises(FMICallException):
         s.fmu.enterInitializationMode()
     with pytest.raises(FMICallException):
-        s.set("link_m.mass", 3.0)       # fixed parameter after initialization
+        s.set("link_m.mass", 3.0)  # fixed parameter after initialization
     s.do_step(0, 0.01)
     s.fmu.terminate()
     with pytest.raises(FMICallException):
@@ -145,8 +170,7 @@ def test_wrong_call_order_is_an_error(tmp_path, version):
 
 
 @pytest.mark.parametrize("version", VERSIONS)
-@pytest.mark.parametrize("t, h", ((1.7976931348623157e308, 1e300), (1e300, 1e-300),
-                                  (1e9, 1e-9)))
+@pytest.mark.parametrize("t, h", ((1.7976931348623157e308, 1e300), (1e300, 1e-300), (1e9, 1e-9)))
 def test_step_must_end_at_a_later_finite_time(tmp_path, version, t, h):
     """t + h that overflows (or rounds back to t) is an Error, and the instance steps on."""
     s = slave("rrt", version)
@@ -162,13 +186,17 @@ def test_step_must_end_at_a_later_finite_time(tmp_path, version, t, h):
 @pytest.mark.parametrize("version", VERSIONS)
 def test_bad_inputs_and_parameters_are_rejected(tmp_path, version):
     s = slave("rrr", version)
-    for name, value in (("link_m.force.x", math.nan), ("link_n.omega", math.inf),
-                        ("link_m.mass", -1.0), ("link_n.length", 0.0),
-                        ("singular_threshold", 1.5)):
+    for name, value in (
+        ("link_m.force.x", math.nan),
+        ("link_n.omega", math.inf),
+        ("link_m.mass", -1.0),
+        ("link_n.length", 0.0),
+        ("singular_threshold", 1.5),
+    ):
         with pytest.raises(FMICallException):
             s.set(name, value)
     s.initialize()
-    s.do_step(0, 0.01)                           # still usable, with the start values
+    s.do_step(0, 0.01)  # still usable, with the start values
     assert s.get("status") == 0
     assert math.isfinite(s.get("R_mk.x"))
     assert s.get("link_m.force.x") == 0.0
@@ -180,14 +208,14 @@ def test_singular_configuration(tmp_path, version):
     s = slave("rrr", version)
     s.initialize()
     s.do_step(0, 0.01)
-    s.set("link_n.angle", s.get("link_m.angle") + math.pi)   # links aligned
+    s.set("link_n.angle", s.get("link_m.angle") + math.pi)  # links aligned
     with pytest.raises(FMICallException) as error:
         s.do_step(0.01, 0.01)
-    assert error.value.status == 2                           # discard
+    assert error.value.status == 2  # discard
     assert s.get("status") == 1
     assert math.isnan(s.get("R_mn.x")) and math.isnan(s.get("R_np.y"))
     assert s.get("conditioning") < 1e-12
-    s.set("link_n.angle", 2.0)                               # leave the singular position
+    s.set("link_n.angle", 2.0)  # leave the singular position
     s.do_step(0.01, 0.01)
     assert s.get("status") == 0 and math.isfinite(s.get("R_mn.x"))
     s.close()
@@ -221,7 +249,7 @@ def test_reset_restores_start_values(tmp_path, version):
     s.do_step(0.01, 0.01)
     assert s.get("R_mk.y") != first
     s.fmu.reset()
-    s.set("link_m.mass", 2.5)                                # parameters settable again
+    s.set("link_m.mass", 2.5)  # parameters settable again
     s.set("link_m.mass", 2.0)
     s.initialize()
     s.do_step(0, 0.01)
@@ -231,6 +259,7 @@ def test_reset_restores_start_values(tmp_path, version):
 
 
 # ---- rebuild from sources ----------------------------------------------------------
+
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_source_fmu_rebuilds(tmp_path, version):
@@ -250,15 +279,14 @@ def test_source_fmu_rebuilds(tmp_path, version):
     md = read_model_description(str(path))
     signals = input_signals(md, samples=20)
     outputs = ["R_mk.y", "R_np.x", "R_np.y", "R_mn.x", "N_mk", "M_mk", "status"]
-    original = simulate_fmu(str(path), stop_time=1, step_size=0.05, input=signals,
-                            output=outputs)
-    again = simulate_fmu(str(rebuilt), stop_time=1, step_size=0.05, input=signals,
-                         output=outputs)
+    original = simulate_fmu(str(path), stop_time=1, step_size=0.05, input=signals, output=outputs)
+    again = simulate_fmu(str(rebuilt), stop_time=1, step_size=0.05, input=signals, output=outputs)
     for name in outputs:
         np.testing.assert_allclose(again[name], original[name], rtol=1e-13, atol=0)
 
 
 # ---- directional derivatives ---------------------------------------------------------
+
 
 @pytest.mark.parametrize("dyad,version", ALL)
 def test_directional_derivatives_match_finite_differences(tmp_path, dyad, version):
@@ -267,8 +295,11 @@ def test_directional_derivatives_match_finite_differences(tmp_path, dyad, versio
     s = slave(dyad, version)
     s.initialize()
     inputs = [v for v in s.md.modelVariables if v.causality == "input"]
-    outputs = [v.name for v in s.md.modelVariables
-               if v.causality == "output" and v.type in ("Real", "Float64")]
+    outputs = [
+        v.name
+        for v in s.md.modelVariables
+        if v.causality == "output" and v.type in ("Real", "Float64")
+    ]
     rng = np.random.default_rng(11)
     state = {}
     for v in inputs:
@@ -300,6 +331,6 @@ def test_directional_derivatives_match_finite_differences(tmp_path, dyad, versio
         worst = max(worst, error)
         assert error < 1e-5, (v.name, exact, central)
     print(f"dyad_{dyad}_fmi{version}: directional derivatives vs central differences {worst:.1e}")
-    with pytest.raises(FMICallException):   # a parameter is no known
+    with pytest.raises(FMICallException):  # a parameter is no known
         s.fmu.getDirectionalDerivative(out_vrs, [s.vr["link_m.mass"]], [1.0])
     s.close()

@@ -58,15 +58,17 @@ C_FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror"]
 
 
 def run_tool(*args):
-    return subprocess.run([sys.executable, str(SCENE_TOOL), *map(str, args)],
-                          capture_output=True, text=True)
+    return subprocess.run(
+        [sys.executable, str(SCENE_TOOL), *map(str, args)], capture_output=True, text=True
+    )
 
 
 def sixbar_with(tmp_path, name="sixbar.toml", **scene_keys) -> Path:
     """The six-bar scene with keys of its [scene] table replaced, written to tmp_path."""
     text = SIXBAR.read_text(encoding="utf-8")
     for key, value in scene_keys.items():
-        text, count = re.subn(rf"(?m)^{key} = .*$", lambda _: f"{key} = {value}", text)
+        line = f"{key} = {value}"
+        text, count = re.subn(rf"(?m)^{key} = .*$", lambda _, line=line: line, text)
         assert count == 1, key
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
@@ -80,8 +82,14 @@ def toml_string(text: str) -> str:
 
 def include_flags(generated: Path) -> list[str]:
     from fmpy import __file__ as fmpy_init
-    return [f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'src'}", f"-I{ROOT / 'fmu'}",
-            f"-I{generated}", f"-I{Path(fmpy_init).parent / 'c-code'}"]
+
+    return [
+        f"-I{ROOT / 'src' / 'include'}",
+        f"-I{ROOT / 'src'}",
+        f"-I{ROOT / 'fmu'}",
+        f"-I{generated}",
+        f"-I{Path(fmpy_init).parent / 'c-code'}",
+    ]
 
 
 # ---------------------------------------------------------------------------
@@ -89,11 +97,18 @@ def include_flags(generated: Path) -> list[str]:
 # ---------------------------------------------------------------------------
 def test_the_hostile_examples_cover_the_findings():
     kinds = {p.stem for p in HOSTILE}
-    assert {"hostile_description_comment_end", "hostile_description_control",
-            "hostile_description_bidi", "hostile_number_beyond_double",
-            "hostile_name_trailing_newline", "hostile_identifier_too_long", "hostile_dyad_in",
-            "hostile_dyad_keyword", "hostile_dyad_crank_torque",
-            "hostile_dyad_core_name"} <= kinds
+    assert {
+        "hostile_description_comment_end",
+        "hostile_description_control",
+        "hostile_description_bidi",
+        "hostile_number_beyond_double",
+        "hostile_name_trailing_newline",
+        "hostile_identifier_too_long",
+        "hostile_dyad_in",
+        "hostile_dyad_keyword",
+        "hostile_dyad_crank_torque",
+        "hostile_dyad_core_name",
+    } <= kinds
 
 
 @pytest.mark.parametrize("path", HOSTILE, ids=lambda p: p.stem)
@@ -138,32 +153,48 @@ def test_every_name_the_generated_code_uses_is_refused_as_a_dyad_name(tmp_path):
     line = base.splitlines().index('name = "second"') + 1
     candidates = sorted(n for n in names.reserved if scene_names.NAME.fullmatch(n))
     # the examples of the issue, and the macros a C program must leave alone
-    assert {"in", "out", "load", "check", "model", "evaluation", "cos", "snprintf", "memset",
-            "errno", "int", "double"} <= set(candidates)
+    assert {
+        "in",
+        "out",
+        "load",
+        "check",
+        "model",
+        "evaluation",
+        "cos",
+        "snprintf",
+        "memset",
+        "errno",
+        "int",
+        "double",
+    } <= set(candidates)
     assert {"NULL", "EOF", "INFINITY", "NAN", "errno"} <= names.reserved
-    assert len(candidates) > 300                      # C, math.h, stdio.h, string.h, ...
+    assert len(candidates) > 300  # C, math.h, stdio.h, string.h, ...
     for name in candidates + ["crank_torque", "dyad_cross", "fmu_instance", "dyad"]:
         problems = _refusal(tmp_path, base.replace('name = "second"', f'name = "{name}"'))
-        assert any(p.startswith(f"named.toml:{line}: dyad ") and f"'{name}'" in p
-                   for p in problems), (name, problems)
+        assert any(
+            p.startswith(f"named.toml:{line}: dyad ") and f"'{name}'" in p for p in problems
+        ), (name, problems)
 
 
-@pytest.mark.parametrize("name", ("NULL", "EOF", "INFINITY", "NAN", "errno", "main", "int",
-                                  "dyad"))
+@pytest.mark.parametrize("name", ("NULL", "EOF", "INFINITY", "NAN", "errno", "main", "int", "dyad"))
 def test_an_identifier_named_after_c_or_the_core_is_refused(name, tmp_path):
-    problems = _refusal(tmp_path, SIXBAR.read_text().replace('identifier = "sixbar"',
-                                                             f'identifier = "{name}"'))
-    assert any(p.startswith("named.toml:") and "identifier" in p and f"'{name}" in p
-               for p in problems), problems
+    problems = _refusal(
+        tmp_path, SIXBAR.read_text().replace('identifier = "sixbar"', f'identifier = "{name}"')
+    )
+    assert any(
+        p.startswith("named.toml:") and "identifier" in p and f"'{name}" in p for p in problems
+    ), problems
 
 
-@pytest.mark.parametrize("keyword", sorted(k for k in cnames.C_KEYWORDS
-                                           if scene_names.NAME.fullmatch(k)))
+@pytest.mark.parametrize(
+    "keyword", sorted(k for k in cnames.C_KEYWORDS if scene_names.NAME.fullmatch(k))
+)
 def test_a_c_keyword_is_refused_as_a_link_name(keyword, tmp_path):
     text = SIXBAR.read_text().replace('"connector"', f'"{keyword}"')
     line = text.splitlines().index(f'name = "{keyword}"') + 1
-    assert f"named.toml:{line}: link #3: name '{keyword}' is a C keyword" in \
-        _refusal(tmp_path, text)
+    assert f"named.toml:{line}: link #3: name '{keyword}' is a C keyword" in _refusal(
+        tmp_path, text
+    )
 
 
 def _scene_objects(sc) -> list[tuple[str, str]]:
@@ -205,8 +236,11 @@ def test_the_refused_names_cover_the_generated_code(path):
 def test_generated_names_stay_within_c99_significance():
     """MAX_NAME keeps every derived C name within the 63 characters C99 guarantees."""
     names = c_names()
-    longest = max(len(c) for kind in names.patterns
-                  for _, c in names.derived(kind, "x" * scene_names.MAX_NAME))
+    longest = max(
+        len(c)
+        for kind in names.patterns
+        for _, c in names.derived(kind, "x" * scene_names.MAX_NAME)
+    )
     assert longest <= 63
 
 
@@ -223,10 +257,17 @@ AWKWARD_DESCRIPTIONS = (
     '<b>leakmark</b> & "x" -- y -->',
     "leakmark // a line comment, / * apart, ??= and ??( trigraphs",
 )
-AWKWARD_FILE_NAMES = ("my--press.toml", "leak-->mark.toml", "leak*mark.toml",
-                      "leak\\mark.toml", "leak??=mark.toml", "-leakmark-.toml",
-                      "leak--.toml", "leak\u202emark.toml",
-                      "leak\x07mark.toml")
+AWKWARD_FILE_NAMES = (
+    "my--press.toml",
+    "leak-->mark.toml",
+    "leak*mark.toml",
+    "leak\\mark.toml",
+    "leak??=mark.toml",
+    "-leakmark-.toml",
+    "leak--.toml",
+    "leak\u202emark.toml",
+    "leak\x07mark.toml",
+)
 
 
 def _generate(tmp_path, description="A six-bar", file_name="sixbar.toml") -> Path:
@@ -246,21 +287,25 @@ def _no_scene_text_in_code(out: Path, marker: str):
 
 def _compiles(out: Path, tmp_path):
     for source in sorted(out.glob("*.c")):
-        done = subprocess.run([GCC, *C_FLAGS, "-fsyntax-only", *include_flags(out),
-                               str(source)], capture_output=True, text=True)
+        done = subprocess.run(
+            [GCC, *C_FLAGS, "-fsyntax-only", *include_flags(out), str(source)],
+            capture_output=True,
+            text=True,
+        )
         assert done.returncode == 0, (source.name, done.stderr)
 
 
 def _valid_model_descriptions(out: Path, tmp_path, description: str):
     from fmpy import read_model_description
+
     layout = tmp_path / "fmu3"
     (layout / "sources").mkdir(parents=True)
     shutil.copy(out / "fmi3" / "modelDescription.xml", layout / "modelDescription.xml")
-    shutil.copy(out / "fmi3" / "buildDescription.xml",
-                layout / "sources" / "buildDescription.xml")
+    shutil.copy(out / "fmi3" / "buildDescription.xml", layout / "sources" / "buildDescription.xml")
     for where in (out / "fmi2" / "modelDescription.xml", layout):
-        md = read_model_description(str(where), validate=True, validate_variable_names=True,
-                                    validate_model_structure=True)
+        md = read_model_description(
+            str(where), validate=True, validate_variable_names=True, validate_model_structure=True
+        )
         assert md.description == description
         assert len(md.modelVariables) > 30
 
@@ -315,7 +360,7 @@ def _read_c_string(literal: str) -> bytes:
     while k < len(body):
         if body[k] == "\\":
             if body[k + 1] in "01234567":
-                out.append(int(body[k + 1:k + 4], 8))
+                out.append(int(body[k + 1 : k + 4], 8))
                 k += 4
             else:
                 out += body[k + 1].encode()
@@ -330,8 +375,10 @@ def _read_c_string(literal: str) -> bytes:
 # a constructor planted in the description
 # ---------------------------------------------------------------------------
 #: A constructor with a side effect (gcc drops an empty one), and a global it sets.
-PLANT = ("x */ volatile int dyadfmu_planted_flag; __attribute__((constructor)) static void "
-         "dyadfmu_planted(void) { dyadfmu_planted_flag = 1; } /* y")
+PLANT = (
+    "x */ volatile int dyadfmu_planted_flag; __attribute__((constructor)) static void "
+    "dyadfmu_planted(void) { dyadfmu_planted_flag = 1; } /* y"
+)
 
 
 def test_a_planted_constructor_is_refused(tmp_path):
@@ -339,8 +386,10 @@ def test_a_planted_constructor_is_refused(tmp_path):
     line = path.read_text().splitlines().index(f"description = {toml_string(PLANT)}") + 1
     done = run_tool(path, "--check")
     assert done.returncode == 1
-    assert (f"error: sixbar.toml:{line}: [scene]: description must not contain '*/' (it is "
-            "copied into a C comment, which '*/' would end)") in done.stderr.splitlines()
+    assert (
+        f"error: sixbar.toml:{line}: [scene]: description must not contain '*/' (it is "
+        "copied into a C comment, which '*/' would end)"
+    ) in done.stderr.splitlines()
 
 
 def _build_fmu(table, tmp_path, name) -> Path:
@@ -354,14 +403,37 @@ def _build_fmu(table, tmp_path, name) -> Path:
     library = gen / "binaries" / "linux64" / f"{ident}.so"
     library.parent.mkdir(parents=True)
     types = sorted({d.type.lower() for d in table.scene.dyads})
-    sources = ([ROOT / "src" / "dyad_common.c"] + [ROOT / "src" / f"dyad_{t}.c" for t in types]
-               + [gen / f"{ident}_scene.c", ROOT / "fmu" / "fmu_instance.c",
-                  ROOT / "fmu" / "fmi2_functions.c", gen / f"{ident}_model.c"])
+    sources = (
+        [ROOT / "src" / "dyad_common.c"]
+        + [ROOT / "src" / f"dyad_{t}.c" for t in types]
+        + [
+            gen / f"{ident}_scene.c",
+            ROOT / "fmu" / "fmu_instance.c",
+            ROOT / "fmu" / "fmi2_functions.c",
+            gen / f"{ident}_model.c",
+        ]
+    )
     done = subprocess.run(
-        [GCC, *C_FLAGS, "-O1", "-fPIC", "-shared", "-fvisibility=hidden",
-         "-ffunction-sections", "-fdata-sections", "-Wl,--gc-sections",
-         f"-Wl,--version-script={ROOT / 'fmu' / 'exports.map'}", *include_flags(gen),
-         *map(str, sources), "-o", str(library), "-lm"], capture_output=True, text=True)
+        [
+            GCC,
+            *C_FLAGS,
+            "-O1",
+            "-fPIC",
+            "-shared",
+            "-fvisibility=hidden",
+            "-ffunction-sections",
+            "-fdata-sections",
+            "-Wl,--gc-sections",
+            f"-Wl,--version-script={ROOT / 'fmu' / 'exports.map'}",
+            *include_flags(gen),
+            *map(str, sources),
+            "-o",
+            str(library),
+            "-lm",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode == 0, done.stderr
     fmu = tmp_path / f"{name}.fmu"
     with zipfile.ZipFile(fmu, "w") as archive:
@@ -378,21 +450,24 @@ def _symbols_and_constructors(fmu: Path, tmp_path) -> tuple[list, int]:
         library.write_bytes(archive.read(name))
     nm = subprocess.run(["nm", "--defined-only", str(library)], capture_output=True, text=True)
     symbols = sorted(line.split()[-1] for line in nm.stdout.splitlines())
-    sections = subprocess.run(["objdump", "-h", str(library)], capture_output=True,
-                              text=True).stdout
+    sections = subprocess.run(
+        ["objdump", "-h", str(library)], capture_output=True, text=True
+    ).stdout
     init = re.search(r"\.init_array\s+([0-9a-f]+)", sections)
     return symbols, int(init.group(1), 16) if init else 0
 
 
 @needs_gcc
-@pytest.mark.skipif(shutil.which("nm") is None or shutil.which("objdump") is None,
-                    reason="binutils not available")
+@pytest.mark.skipif(
+    shutil.which("nm") is None or shutil.which("objdump") is None, reason="binutils not available"
+)
 def test_a_planted_constructor_stays_a_comment_even_past_the_check(tmp_path):
     """With the description check bypassed, the escaping of the C comment alone keeps the
     planted code out: the FMU has the same symbols and constructors as with a plain
     description, and fmpy validates and runs it."""
     from fmpy import simulate_fmu
     from fmpy.validation import validate_fmu
+
     plain = pipeline.build_table(pipeline.load_scene(SIXBAR))
     planted_scene = pipeline.load_scene(SIXBAR)
     planted_scene.description = PLANT
@@ -405,8 +480,7 @@ def test_a_planted_constructor_stays_a_comment_even_past_the_check(tmp_path):
     assert not any("planted" in s for s in got[0])
     assert got == want
     assert validate_fmu(str(planted_fmu)) == []
-    result = simulate_fmu(str(planted_fmu), stop_time=0.01, step_size=0.005,
-                          output=["status"])
+    result = simulate_fmu(str(planted_fmu), stop_time=0.01, step_size=0.005, output=["status"])
     assert len(result) >= 2
 
 
@@ -447,8 +521,9 @@ def test_a_tunable_pair_point_is_a_parameter_that_works(tunable, tmp_path):
     source = scenes.Source("sixbar")
     motion = source.motion("varying", 1.0)
     kin = source.kinematics(np.array([0.37 * motion.duration]), motion)
-    inputs = {v.name: float(np.asarray(kin[v.name])[0])
-              for v in baked.variables if v.causality == "input"}
+    inputs = {
+        v.name: float(np.asarray(kin[v.name])[0]) for v in baked.variables if v.causality == "input"
+    }
     names = [v.name for v in baked.variables if v.causality == "output" and v.type == "Real"]
     want = _Slave(_build_fmu(baked, tmp_path, "baked"), tmp_path, "baked")
     want.start({})
@@ -465,12 +540,54 @@ def test_a_tunable_pair_point_is_a_parameter_that_works(tunable, tmp_path):
 # ---------------------------------------------------------------------------
 # every failure a message
 # ---------------------------------------------------------------------------
-_NASTY = [10 ** 400, -10 ** 400, math.nan, math.inf, 0, -1, 1e308, True, "", "x", "\u202e",
-          "a*/b", "in", "load", "dyad_x", "crank", "frame", "external", "all", [], [1, 2],
-          [10 ** 400, 0], ["all"], {}, {"link": "frame"}, {"link": {"name": "crank"}},
-          {"link": "crank", "at": [0.0, 0.0]}, {"link": "crank", "guide": 0.1}, "RRR", "RTT",
-          "TRT", "a" * 41, "rocker", "coupler", "first", "link_m", [[1]], 0.5, {"x": 1},
-          "status", "first.D_m", "crank.torque", "int", "rod_f", "crank_torque", "x\n"]
+_NASTY = [
+    10**400,
+    -(10**400),
+    math.nan,
+    math.inf,
+    0,
+    -1,
+    1e308,
+    True,
+    "",
+    "x",
+    "\u202e",
+    "a*/b",
+    "in",
+    "load",
+    "dyad_x",
+    "crank",
+    "frame",
+    "external",
+    "all",
+    [],
+    [1, 2],
+    [10**400, 0],
+    ["all"],
+    {},
+    {"link": "frame"},
+    {"link": {"name": "crank"}},
+    {"link": "crank", "at": [0.0, 0.0]},
+    {"link": "crank", "guide": 0.1},
+    "RRR",
+    "RTT",
+    "TRT",
+    "a" * 41,
+    "rocker",
+    "coupler",
+    "first",
+    "link_m",
+    [[1]],
+    0.5,
+    {"x": 1},
+    "status",
+    "first.D_m",
+    "crank.torque",
+    "int",
+    "rod_f",
+    "crank_torque",
+    "x\n",
+]
 
 
 def _toml_value(v) -> str:
@@ -490,16 +607,20 @@ def _toml_value(v) -> str:
 def _toml(data: dict) -> str:
     lines = []
     for key, value in data.items():
-        rows = value if isinstance(value, list) and value and \
-            all(isinstance(r, dict) for r in value) else None
+        rows = (
+            value
+            if isinstance(value, list) and value and all(isinstance(r, dict) for r in value)
+            else None
+        )
         if isinstance(value, dict):
             rows = [value]
         if rows is None:
             lines.insert(0, f"{toml_string(key)} = {_toml_value(value)}")
             continue
         for row in rows:
-            lines.append(f"[{toml_string(key)}]" if isinstance(value, dict) else
-                         f"[[{toml_string(key)}]]")
+            lines.append(
+                f"[{toml_string(key)}]" if isinstance(value, dict) else f"[[{toml_string(key)}]]"
+            )
             lines += [f"{toml_string(k)} = {_toml_value(v)}" for k, v in row.items()]
     return "\n".join(lines) + "\n"
 
@@ -513,8 +634,9 @@ def _mutate(rng, node, depth=0):
         elif r < 0.5:
             del node[key]
         elif r < 0.6:
-            node[rng.choice(["name", "at", "guide", "link", "k", "p", "type", "x"])] = \
-                rng.choice(_NASTY)
+            node[rng.choice(["name", "at", "guide", "link", "k", "p", "type", "x"])] = rng.choice(
+                _NASTY
+            )
         else:
             _mutate(rng, node[key], depth + 1)
     elif isinstance(node, list) and node:
@@ -581,7 +703,7 @@ def _calls_to_check(path: Path) -> int:
 def test_checking_a_chain_grows_linearly_with_its_dyads(tmp_path):
     """Function calls, not time: twice the dyads may cost a little more than twice the
     calls (the dependency lists are longer), not four or eight times."""
-    c_names()                                   # learnt once per process
+    c_names()  # learnt once per process
     small = _calls_to_check(long_chain.write_chain(50, tmp_path))
     large = _calls_to_check(long_chain.write_chain(100, tmp_path))
     print(f"calls to check 50 dyads: {small}, 100 dyads: {large} ({large / small:.2f} x)")
@@ -607,10 +729,22 @@ def test_a_chain_of_200_dyads_is_checked_generated_and_compiles(tmp_path):
 def test_cmake_stops_on_a_planted_description(tmp_path):
     bad = SCENES_DIR / "malformed" / "hostile_description_comment_end.toml"
     done = subprocess.run(
-        ["cmake", "-S", str(ROOT), "-B", str(tmp_path / "build"), "-DDYADFMU_BUILD_TESTS=OFF",
-         "-DDYADFMU_BUILD_BENCH=OFF", f"-DPython3_EXECUTABLE={sys.executable}",
-         f"-DDYADFMU_SCENES={bad}"], capture_output=True, text=True)
+        [
+            "cmake",
+            "-S",
+            str(ROOT),
+            "-B",
+            str(tmp_path / "build"),
+            "-DDYADFMU_BUILD_TESTS=OFF",
+            "-DDYADFMU_BUILD_BENCH=OFF",
+            f"-DPython3_EXECUTABLE={sys.executable}",
+            f"-DDYADFMU_SCENES={bad}",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert done.returncode != 0
-    message = " ".join(done.stderr.split())           # CMake wraps long lines
-    assert "hostile_description_comment_end.toml:4: [scene]: description must not contain" \
-        in message, done.stderr
+    message = " ".join(done.stderr.split())  # CMake wraps long lines
+    assert (
+        "hostile_description_comment_end.toml:4: [scene]: description must not contain" in message
+    ), done.stderr

@@ -21,10 +21,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import matplotlib
 import numpy as np
 import pytest
-
-import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -102,8 +101,16 @@ def test_names_and_unknown():
 def test_attributes(name):
     mech = mechanisms.load(name)
     assert mech.name == name
-    assert mech.dyad == {"slider-crank": "RRT", "four-bar": "RRR", "quick-return": "RTR",
-                         "scotch-yoke": "RTT", "trt-slot": "TRT"}[name]
+    assert (
+        mech.dyad
+        == {
+            "slider-crank": "RRT",
+            "four-bar": "RRR",
+            "quick-return": "RTR",
+            "scotch-yoke": "RTT",
+            "trt-slot": "TRT",
+        }[name]
+    )
     assert mech.description
     assert mech.gravity == (0.0, -9.81)
     c = mech.crank
@@ -124,16 +131,19 @@ def test_data_overrides():
     assert mechanisms.load("slider-crank", whole).fmu_parameters()["link_n.length"] == 0.2
 
 
-@pytest.mark.parametrize("name, bad, match", [
-    ("four-bar", {"crank": {"radius": 0.13}}, "Grashof"),
-    ("slider-crank", {"link_n": {"length": 0.05}}, "rod"),
-    ("quick-return", {"geometry": {"O2": [0.0, -0.09]}}, "O2"),
-    ("scotch-yoke", {"geometry": {"h": 0.05}}, "h"),
-    ("trt-slot", {"motion": {"amplitude": 1.5}}, "sin"),
-    ("trt-slot", {"crank": {"radius": 0.12}}, "slot"),
-    ("four-bar", {"link_m": {"mass": -1.0}}, "mass"),
-    ("four-bar", {"dyad": "RRT"}, "dyad"),
-])
+@pytest.mark.parametrize(
+    "name, bad, match",
+    [
+        ("four-bar", {"crank": {"radius": 0.13}}, "Grashof"),
+        ("slider-crank", {"link_n": {"length": 0.05}}, "rod"),
+        ("quick-return", {"geometry": {"O2": [0.0, -0.09]}}, "O2"),
+        ("scotch-yoke", {"geometry": {"h": 0.05}}, "h"),
+        ("trt-slot", {"motion": {"amplitude": 1.5}}, "sin"),
+        ("trt-slot", {"crank": {"radius": 0.12}}, "slot"),
+        ("four-bar", {"link_m": {"mass": -1.0}}, "mass"),
+        ("four-bar", {"dyad": "RRT"}, "dyad"),
+    ],
+)
 def test_bad_data(name, bad, match):
     with pytest.raises(ValueError, match=match):
         mechanisms.load(name, bad)
@@ -191,43 +201,11 @@ def link_point(kin, g, P):
     return kin[f"v_D_{g}"] + w * rot90(rel), kin[f"{g}.accel_d"] + e * rot90(rel) - w * w * rel
 
 
-@pytest.mark.parametrize("name, kind", CASES)
-def test_positions_and_guides(name, kind):
-    mech, motion, t = setup(name, kind)
-    kin = mech.kinematics(t, motion)
-    L, W = scales(mech, motion, t)
-    N = len(t)
-    for key in ("O", "A", "D_m", "E", "D_n", "S_m", "S_n", "S_c", "v_S_m", "v_S_n", "v_S_c",
-                "a_S_c", "m.accel_d", "n.accel_d", "m.force", "n.force"):
-        assert kin[key].shape == (N, 2), key
-        assert np.all(np.isfinite(kin[key])), key
-    for key in ("t", "crank.angle", "crank.omega", "crank.epsilon", "m.angle", "m.omega",
-                "m.epsilon", "m.length", "n.angle", "n.omega", "n.epsilon", "n.length",
-                "m.moment", "n.moment"):
-        assert kin[key].shape == (N,), key
-        assert np.all(np.isfinite(kin[key])), key
-    tol = 1e-12 * L
-    assert np.max(np.abs(kin["O"])) == 0.0
-    assert np.max(np.abs(norm(kin["A"]) - mech.crank["radius"])) <= tol
-    assert_close(unit(kin["crank.angle"]) * mech.crank["radius"], kin["A"], L, 1e-12, "A")
-    E = kin["E"]
-    assert_close(kin["D_m"] + col(kin["m.length"]) * unit(kin["m.angle"]), E, L, 1e-12, "E from m")
-    assert_close(kin["D_n"] + col(kin["n.length"]) * unit(kin["n.angle"]), E, L, 1e-12, "E from n")
-    assert np.all(kin["m.length"] >= 0) and np.all(kin["n.length"] >= 0)
-    params = mech.fmu_parameters()
-    for g in ("m", "n"):
-        i, j = unit(kin[f"{g}.angle"]), rot90(unit(kin[f"{g}.angle"]))
-        S = kin[f"D_{g}"] + params[f"link_{g}.com.x"] * i + params[f"link_{g}.com.y"] * j
-        assert_close(kin[f"S_{g}"], S, L, 1e-12, f"S_{g}")
-        if f"link_{g}.length" in params:           # a constant length
-            assert np.all(kin[f"{g}.length"] == params[f"link_{g}.length"])
-    cx, cy = mech.crank["com"]
-    ic = unit(kin["crank.angle"])
-    assert_close(kin["S_c"], cx * ic + cy * rot90(ic), L, 1e-12, "S_c")
-
-    kinds = KIND_OF[mech.dyad]
+def _check_pairs_on_their_guides(kin, kinds, tol, L):
+    """D_m, D_n and E where the kinds of their pairs keep them: on a fixed guide or a
+    fixed pivot, on the crank's guide or pin, in the slot of link m."""
     frame = kin["frame"]
-    for p in frame["pivots"].values():              # fixed pivots do not move
+    for p in frame["pivots"].values():  # fixed pivots do not move
         assert np.isfinite(p).all()
     if kinds[0] == "T":
         # D_m stays on the fixed guide k: a fixed line through D_m[0] along i_k
@@ -236,10 +214,10 @@ def test_positions_and_guides(name, kind):
         jk = rot90(unit(ak))
         assert np.max(np.abs(dot(kin["D_m"] - kin["D_m"][0], jk))) <= tol
         seg = np.asarray(frame["guides"]["k"])
-        assert abs(cross(seg[1] - seg[0], unit(ak[0]))) <= tol   # drawn guide along i_k
-        assert abs(dot(seg[0] - kin["D_m"][0], jk[0])) <= tol    # and through D_m
+        assert abs(cross(seg[1] - seg[0], unit(ak[0]))) <= tol  # drawn guide along i_k
+        assert abs(dot(seg[0] - kin["D_m"][0], jk[0])) <= tol  # and through D_m
     else:
-        assert np.ptp(kin["D_m"], axis=0).max() == 0.0        # D_m is a fixed pivot
+        assert np.ptp(kin["D_m"], axis=0).max() == 0.0  # D_m is a fixed pivot
         assert any(np.allclose(p, kin["D_m"][0]) for p in frame["pivots"].values())
     if kinds[2] == "T":
         # the guide p turns with the crank, and D_n keeps its offset from it
@@ -256,6 +234,72 @@ def test_positions_and_guides(name, kind):
         assert np.max(np.abs(np.sin(kin["n.angle"] - kin["m.angle"]))) <= 1e-12
         jm = rot90(unit(kin["m.angle"]))
         assert np.ptp(dot(kin["D_n"] - kin["D_m"], jm)) <= tol
+
+
+@pytest.mark.parametrize("name, kind", CASES)
+def test_positions_and_guides(name, kind):
+    mech, motion, t = setup(name, kind)
+    kin = mech.kinematics(t, motion)
+    L, W = scales(mech, motion, t)
+    N = len(t)
+    for key in (
+        "O",
+        "A",
+        "D_m",
+        "E",
+        "D_n",
+        "S_m",
+        "S_n",
+        "S_c",
+        "v_S_m",
+        "v_S_n",
+        "v_S_c",
+        "a_S_c",
+        "m.accel_d",
+        "n.accel_d",
+        "m.force",
+        "n.force",
+    ):
+        assert kin[key].shape == (N, 2), key
+        assert np.all(np.isfinite(kin[key])), key
+    for key in (
+        "t",
+        "crank.angle",
+        "crank.omega",
+        "crank.epsilon",
+        "m.angle",
+        "m.omega",
+        "m.epsilon",
+        "m.length",
+        "n.angle",
+        "n.omega",
+        "n.epsilon",
+        "n.length",
+        "m.moment",
+        "n.moment",
+    ):
+        assert kin[key].shape == (N,), key
+        assert np.all(np.isfinite(kin[key])), key
+    tol = 1e-12 * L
+    assert np.max(np.abs(kin["O"])) == 0.0
+    assert np.max(np.abs(norm(kin["A"]) - mech.crank["radius"])) <= tol
+    assert_close(unit(kin["crank.angle"]) * mech.crank["radius"], kin["A"], L, 1e-12, "A")
+    E = kin["E"]
+    assert_close(kin["D_m"] + col(kin["m.length"]) * unit(kin["m.angle"]), E, L, 1e-12, "E from m")
+    assert_close(kin["D_n"] + col(kin["n.length"]) * unit(kin["n.angle"]), E, L, 1e-12, "E from n")
+    assert np.all(kin["m.length"] >= 0) and np.all(kin["n.length"] >= 0)
+    params = mech.fmu_parameters()
+    for g in ("m", "n"):
+        i, j = unit(kin[f"{g}.angle"]), rot90(unit(kin[f"{g}.angle"]))
+        S = kin[f"D_{g}"] + params[f"link_{g}.com.x"] * i + params[f"link_{g}.com.y"] * j
+        assert_close(kin[f"S_{g}"], S, L, 1e-12, f"S_{g}")
+        if f"link_{g}.length" in params:  # a constant length
+            assert np.all(kin[f"{g}.length"] == params[f"link_{g}.length"])
+    cx, cy = mech.crank["com"]
+    ic = unit(kin["crank.angle"])
+    assert_close(kin["S_c"], cx * ic + cy * rot90(ic), L, 1e-12, "S_c")
+
+    _check_pairs_on_their_guides(kin, KIND_OF[mech.dyad], tol, L)
     # mechanism-specific geometry
     if name == "slider-crank":
         assert np.all(kin["D_m"][:, 1] == mech.e) and np.all(kin["D_m"][:, 0] > 0)
@@ -277,9 +321,9 @@ def test_positions_and_guides(name, kind):
         assert_close(kin["m.length"], kin["A"][:, 1] + mech.h, L, 1e-12, "l_m")
     elif name == "trt-slot":
         assert np.allclose(E[:, 1], mech.h, rtol=0, atol=tol)
-        assert np.max(np.abs(cross(unit(kin["crank.angle"]), E))) <= tol   # E in the slot
-        assert np.all(dot(E, unit(kin["crank.angle"])) > 0)                # in front of O
-        assert np.all(norm(E) < mech.crank["radius"])                      # within the arm
+        assert np.max(np.abs(cross(unit(kin["crank.angle"]), E))) <= tol  # E in the slot
+        assert np.all(dot(E, unit(kin["crank.angle"])) > 0)  # in front of O
+        assert np.all(norm(E) < mech.crank["radius"])  # within the arm
 
 
 @pytest.mark.parametrize("name, kind", CASES)
@@ -303,24 +347,62 @@ def test_pairs(name, kind):
             v_rel = v1 - v2
             assert_close(dot(v_rel, j), 0 * w1, V, rel, f"{what}: relative velocity off the guide")
             coriolis = 2.0 * col(w2) * rot90(v_rel)
-            assert_close(dot(a1 - a2 - coriolis, j), 0 * w1, Acc, rel,
-                         f"{what}: relative acceleration off the guide")
+            assert_close(
+                dot(a1 - a2 - coriolis, j),
+                0 * w1,
+                Acc,
+                rel,
+                f"{what}: relative acceleration off the guide",
+            )
 
     zeros = np.zeros(len(t))
     # D_m: link m against the frame k
     v1, a1 = link_point(kin, "m", kin["D_m"])
-    check(k_dm, v1, a1, kin["m.omega"], zero, zero, zeros, kin["m.epsilon"], zeros,
-          kin.get("guide_k.angle"), "D_m")
+    check(
+        k_dm,
+        v1,
+        a1,
+        kin["m.omega"],
+        zero,
+        zero,
+        zeros,
+        kin["m.epsilon"],
+        zeros,
+        kin.get("guide_k.angle"),
+        "D_m",
+    )
     # D_n: link n against the crank p
     v1, a1 = link_point(kin, "n", kin["D_n"])
     v2, a2 = crank_point(kin, kin["D_n"])
-    check(k_dn, v1, a1, kin["n.omega"], v2, a2, kin["crank.omega"], kin["n.epsilon"],
-          kin["crank.epsilon"], kin.get("guide_p.angle"), "D_n")
+    check(
+        k_dn,
+        v1,
+        a1,
+        kin["n.omega"],
+        v2,
+        a2,
+        kin["crank.omega"],
+        kin["n.epsilon"],
+        kin["crank.epsilon"],
+        kin.get("guide_p.angle"),
+        "D_n",
+    )
     # E: link n against link m (the guide of a T pair at E is i_m)
     v1, a1 = link_point(kin, "n", kin["E"])
     v2, a2 = link_point(kin, "m", kin["E"])
-    check(k_e, v1, a1, kin["n.omega"], v2, a2, kin["m.omega"], kin["n.epsilon"],
-          kin["m.epsilon"], kin["m.angle"], "E")
+    check(
+        k_e,
+        v1,
+        a1,
+        kin["n.omega"],
+        v2,
+        a2,
+        kin["m.omega"],
+        kin["n.epsilon"],
+        kin["m.epsilon"],
+        kin["m.angle"],
+        "E",
+    )
     # the centres of mass move with their links
     for g in ("m", "n"):
         v, a = link_point(kin, g, kin[f"S_{g}"])
@@ -357,8 +439,8 @@ def test_stencils_detect_errors():
     """The finite-difference stencils are 4th order (and so can tell a wrong derivative)."""
     t = np.linspace(0.1, 1.0, 7)
     for h in (1e-2, 5e-3):
-        assert np.max(np.abs(fd1(np.sin, t, h) - np.cos(t))) < 2 * h ** 4
-        assert np.max(np.abs(fd2(np.sin, t, h) + np.sin(t))) < 2 * h ** 4
+        assert np.max(np.abs(fd1(np.sin, t, h) - np.cos(t))) < 2 * h**4
+        assert np.max(np.abs(fd2(np.sin, t, h) + np.sin(t))) < 2 * h**4
     assert np.max(np.abs(fd1(np.sin, t, 1e-3) - 1.000001 * np.cos(t))) > 1e-7
 
 
@@ -373,7 +455,7 @@ def test_finite_differences(name, kind):
 
     def series(key, angle=False):
         base = kins[0][key]
-        if angle:   # unwrap each shifted angle next to the centre sample
+        if angle:  # unwrap each shifted angle next to the centre sample
             return {k: base + np.angle(np.exp(1j * (v[key] - base))) for k, v in kins.items()}
         return {k: v[key] for k, v in kins.items()}
 
@@ -388,8 +470,9 @@ def test_finite_differences(name, kind):
     for g in ("crank", "m", "n"):
         assert_close(d1(f"{g}.angle", True), kin[f"{g}.omega"], W, rel, f"{g}: angle -> omega")
         assert_close(d1(f"{g}.omega"), kin[f"{g}.epsilon"], W * W, rel, f"{g}: omega -> epsilon")
-        assert_close(d2(f"{g}.angle", True), kin[f"{g}.epsilon"], W * W, rel,
-                     f"{g}: angle -> epsilon")
+        assert_close(
+            d2(f"{g}.angle", True), kin[f"{g}.epsilon"], W * W, rel, f"{g}: angle -> epsilon"
+        )
     for g in ("m", "n"):
         assert_close(d1(f"{g}.length"), kin[f"{g}.length_rate"], L * W, rel, f"l_{g} rate")
         assert_close(d2(f"{g}.length"), kin[f"{g}.length_accel"], L * W * W, rel, f"l_{g} accel")
@@ -432,9 +515,9 @@ def test_loads(name, kind):
     elif name in ("four-bar", "quick-return"):
         assert np.all(fm == 0)
         w = kin["m.omega"]
-        assert np.all(mm * w <= 0) and np.max(np.abs(mm)) > 0      # resists the rocker/lever
+        assert np.all(mm * w <= 0) and np.max(np.abs(mm)) > 0  # resists the rocker/lever
         if name == "quick-return":
-            work, back = w > 0, w < 0                                 # slow and quick strokes
+            work, back = w > 0, w < 0  # slow and quick strokes
             assert work.mean() > back.mean() if kind == "constant" else True
             assert np.max(np.abs(mm[back])) < 0.2 * np.max(np.abs(mm[work]))
             assert np.max(np.abs(mm[work])) > 0.9 * mech.M0
@@ -497,8 +580,12 @@ def crank_torque(mech, kin, out):
     g = np.asarray(mech.gravity)
     f_c = c["mass"] * (g - kin["a_S_c"])
     m_np = np.nan_to_num(out["m_np"])
-    return -(cross(kin["D_n"] - kin["O"], -out["r_np"]) - m_np
-             + cross(kin["S_c"] - kin["O"], f_c) - c["inertia"] * kin["crank.epsilon"])
+    return -(
+        cross(kin["D_n"] - kin["O"], -out["r_np"])
+        - m_np
+        + cross(kin["S_c"] - kin["O"], f_c)
+        - c["inertia"] * kin["crank.epsilon"]
+    )
 
 
 @pytest.mark.parametrize("name, kind", CASES)
@@ -523,24 +610,35 @@ def test_reference_solve(name, kind):
     params = mech.fmu_parameters()
     g = np.asarray(mech.gravity)
     c = mech.crank
-    dTdt = c["mass"] * dot(kin["v_S_c"], kin["a_S_c"]) + c["inertia"] * kin["crank.omega"] * kin["crank.epsilon"]
+    dTdt = (
+        c["mass"] * dot(kin["v_S_c"], kin["a_S_c"])
+        + c["inertia"] * kin["crank.omega"] * kin["crank.epsilon"]
+    )
     power = crank_torque(mech, kin, out) * kin["crank.omega"] + c["mass"] * dot(kin["v_S_c"], g)
     for link in ("m", "n"):
         mass, inertia = params[f"link_{link}.mass"], params[f"link_{link}.inertia"]
-        dTdt = dTdt + mass * dot(kin[f"v_S_{link}"], kin[f"a_S_{link}"]) \
+        dTdt = (
+            dTdt
+            + mass * dot(kin[f"v_S_{link}"], kin[f"a_S_{link}"])
             + inertia * kin[f"{link}.omega"] * kin[f"{link}.epsilon"]
-        power = power + dot(kin[f"{link}.force"], kin[f"v_S_{link}"]) \
-            + kin[f"{link}.moment"] * kin[f"{link}.omega"] + mass * dot(kin[f"v_S_{link}"], g)
+        )
+        power = (
+            power
+            + dot(kin[f"{link}.force"], kin[f"v_S_{link}"])
+            + kin[f"{link}.moment"] * kin[f"{link}.omega"]
+            + mass * dot(kin[f"v_S_{link}"], g)
+        )
     assert_close(power, dTdt, 0.0, 1e-9, "power balance")
 
 
 def test_conditioning_matches_reference_singularity():
     """The conditioning falls towards the singular position (slot parallel to the guide)
     and the reference's system grows ill-conditioned with it."""
-    mech = mechanisms.load("trt-slot", {"crank": {"radius": 2.0},
-                                        "motion": {"amplitude": 1.35, "harmonic2": 0.0}})
+    mech = mechanisms.load(
+        "trt-slot", {"crank": {"radius": 2.0}, "motion": {"amplitude": 1.35, "harmonic2": 0.0}}
+    )
     motion = mech.motion("constant", 1.0)
-    t = np.linspace(0.0, motion.duration / 4, 200)     # phi from pi/2 up to pi/2 + 1.35
+    t = np.linspace(0.0, motion.duration / 4, 200)  # phi from pi/2 up to pi/2 + 1.35
     kin = mech.kinematics(t, motion)
     out = reference.solve(mech.dyad, *mech.reference_inputs(kin))
     cond = kin["conditioning"]
@@ -564,8 +662,7 @@ def test_drawing(name, tmp_path):
     out = reference.solve(mech.dyad, *mech.reference_inputs(kin))
     i = 10
     r_o = out["r_np"][i] - mech.crank["mass"] * (np.asarray(mech.gravity) - kin["a_S_c"][i])
-    reactions = {"R_mk": out["r_mk"][i], "R_np": out["r_np"][i], "R_mn": out["r_mn"][i],
-                 "R_O": r_o}
+    reactions = {"R_mk": out["r_mk"][i], "R_np": out["r_np"][i], "R_mn": out["r_mn"][i], "R_O": r_o}
     fig, ax = plt.subplots()
     scale = drawing.draw(ax, mech, kin, i, reactions)
     largest = max(np.hypot(*v) for v in reactions.values())

@@ -98,12 +98,17 @@ def reference_args(values):
     for g in "mn":
         p = f"link_{g}."
         links[g] = dict(
-            dir=_dir(values[p + "angle"]), length=values[p + "length"],
-            omega=values[p + "omega"], epsilon=values[p + "epsilon"],
+            dir=_dir(values[p + "angle"]),
+            length=values[p + "length"],
+            omega=values[p + "omega"],
+            epsilon=values[p + "epsilon"],
             accel_d=(values[p + "accel_d.x"], values[p + "accel_d.y"]),
             com=(values[p + "com.x"], values[p + "com.y"]),
-            mass=values[p + "mass"], inertia=values[p + "inertia"],
-            force=(values[p + "force.x"], values[p + "force.y"]), moment=values[p + "moment"])
+            mass=values[p + "mass"],
+            inertia=values[p + "inertia"],
+            force=(values[p + "force.x"], values[p + "force.y"]),
+            moment=values[p + "moment"],
+        )
     gk = _dir(values["guide_k.angle"]) if "guide_k.angle" in values else (1.0, 0.0)
     gp = _dir(values["guide_p.angle"]) if "guide_p.angle" in values else (1.0, 0.0)
     return links["m"], links["n"], gk, gp, (values["gravity.x"], values["gravity.y"])
@@ -115,12 +120,14 @@ _CORE = []
 def core_amplification(dyad_type, m, n, gk, gp, gravity, threshold):
     """The C core's amplification output, NaN where the core is not built."""
     from dyadfmu.core import Core, library_path
+
     if not _CORE:
         _CORE.append(Core() if library_path().is_file() else None)
     if _CORE[0] is None:
         return math.nan
-    return _CORE[0].solve(dyad_type, m, n, gk, gp, gravity,
-                          singular_threshold=threshold)["amplification"]
+    return _CORE[0].solve(dyad_type, m, n, gk, gp, gravity, singular_threshold=threshold)[
+        "amplification"
+    ]
 
 
 def evaluate(dyad_type, values):
@@ -136,8 +143,9 @@ def evaluate(dyad_type, values):
         result[f"M_{pair}"] = float(out[f"m_{pair}"][0])
     cond = conditioning(dyad_type, m, n, gk, gp)
     result["conditioning"] = cond
-    result["amplification"] = core_amplification(dyad_type, m, n, gk, gp, gravity,
-                                                 values["singular_threshold"])
+    result["amplification"] = core_amplification(
+        dyad_type, m, n, gk, gp, gravity, values["singular_threshold"]
+    )
     result["status"] = 0 if cond >= values["singular_threshold"] else 1
     return result
 
@@ -146,13 +154,23 @@ def random_value(name, rng):
     """A random value of a variable, by its name: generic, nonzero, well inside its domain."""
     leaf = name.split(".", 1)[1] if name.startswith("link_") else name
     ranges = {
-        "angle": (0.0, 2 * math.pi), "guide_k.angle": (0.0, 2 * math.pi),
-        "guide_p.angle": (0.0, 2 * math.pi), "length": (0.3, 2.0),
-        "omega": (-10.0, 10.0), "epsilon": (-100.0, 100.0),
-        "accel_d.x": (-50.0, 50.0), "accel_d.y": (-50.0, 50.0),
-        "force.x": (-200.0, 200.0), "force.y": (-200.0, 200.0), "moment": (-50.0, 50.0),
-        "com.x": (-0.5, 1.0), "com.y": (-0.5, 0.5), "mass": (0.5, 5.0), "inertia": (0.01, 0.5),
-        "gravity.x": (-10.0, 10.0), "gravity.y": (-10.0, 10.0),
+        "angle": (0.0, 2 * math.pi),
+        "guide_k.angle": (0.0, 2 * math.pi),
+        "guide_p.angle": (0.0, 2 * math.pi),
+        "length": (0.3, 2.0),
+        "omega": (-10.0, 10.0),
+        "epsilon": (-100.0, 100.0),
+        "accel_d.x": (-50.0, 50.0),
+        "accel_d.y": (-50.0, 50.0),
+        "force.x": (-200.0, 200.0),
+        "force.y": (-200.0, 200.0),
+        "moment": (-50.0, 50.0),
+        "com.x": (-0.5, 1.0),
+        "com.y": (-0.5, 0.5),
+        "mass": (0.5, 5.0),
+        "inertia": (0.01, 0.5),
+        "gravity.x": (-10.0, 10.0),
+        "gravity.y": (-10.0, 10.0),
     }
     if leaf == "singular_threshold":
         return 1.4901161193847656e-08
@@ -169,8 +187,12 @@ def random_configuration(dyad_type, names, rng, min_conditioning=0.2):
 
 def changed_outputs(base, other, output_names):
     """Outputs that differ by more than round-off between two evaluations."""
-    loads = [abs(r[k]) for r in (base, other) for k in output_names
-             if k[0] in "RNM" and math.isfinite(r[k])]
+    loads = [
+        abs(r[k])
+        for r in (base, other)
+        for k in output_names
+        if k[0] in "RNM" and math.isfinite(r[k])
+    ]
     scale = max(loads) if loads else 1.0
     changed = set()
     for k in output_names:
@@ -228,14 +250,16 @@ def test_declared_dependencies_are_the_true_ones(dyad_type):
     for v in raw["variable"]:
         if v["causality"] != "output":
             continue
-        if v["name"] == "amplification" and math.isnan(evaluate(dyad_type, start_values(raw))
-                                                       ["amplification"]):
-            continue   # the C core is not built: nothing to derive it with
+        if v["name"] == "amplification" and math.isnan(
+            evaluate(dyad_type, start_values(raw))["amplification"]
+        ):
+            continue  # the C core is not built: nothing to derive it with
         declared = set(v["depends"])
         want = derived[v["name"]]
         if declared != want:
-            problems.append(f"{v['name']}: missing {sorted(want - declared)}, "
-                            f"extra {sorted(declared - want)}")
+            problems.append(
+                f"{v['name']}: missing {sorted(want - declared)}, extra {sorted(declared - want)}"
+            )
     assert not problems, f"{TABLE_OF[dyad_type].name}:\n" + "\n".join(problems)
 
 
@@ -257,8 +281,12 @@ def test_dependencies_do_not_depend_on_the_sample(dyad_type):
 # generating
 # ---------------------------------------------------------------------------
 def run_generator(*args):
-    return subprocess.run([sys.executable, str(GENERATOR), *map(str, args)],
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [sys.executable, str(GENERATOR), *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -279,9 +307,13 @@ def identifier(dyad_type):
 
 def test_generator_writes_every_file(generated):
     for t, d in generated.items():
-        for rel in ("fmi2/modelDescription.xml", "fmi3/modelDescription.xml",
-                    "fmi3/buildDescription.xml", f"{identifier(t)}_model.c",
-                    "documentation/index.html"):
+        for rel in (
+            "fmi2/modelDescription.xml",
+            "fmi3/modelDescription.xml",
+            "fmi3/buildDescription.xml",
+            f"{identifier(t)}_model.c",
+            "documentation/index.html",
+        ):
             assert (d / rel).is_file(), f"{t}: {rel} missing"
 
 
@@ -296,7 +328,8 @@ def test_generated_xml_equals_golden(generated, dyad_type):
         assert golden.is_file(), f"{golden} missing: run generate.py --update-golden"
         assert produced.read_bytes() == golden.read_bytes(), (
             f"{produced.name} ({version}) differs from {golden.name}; review the change and run "
-            "modelDescription/generate.py --update-golden")
+            "modelDescription/generate.py --update-golden"
+        )
 
 
 def test_check_golden_passes():
@@ -327,16 +360,28 @@ def test_output_is_deterministic(generated, tmp_path):
 # (c) fmpy validation, units, causalities, counts, structure
 # ---------------------------------------------------------------------------
 EXPECTED_UNIT = [  # by name pattern, independent of the generator's catalogue
-    (r"link_[mn]\.angle|guide_[kp]\.angle", "rad"), (r"link_[mn]\.omega", "rad/s"),
-    (r"link_[mn]\.epsilon", "rad/s2"), (r"link_[mn]\.accel_d\.[xy]|gravity\.[xy]", "m/s2"),
-    (r"link_[mn]\.force\.[xy]|R_\w\w\.[xy]|N_\w\w", "N"), (r"link_[mn]\.moment|M_\w\w", "N.m"),
-    (r"link_[mn]\.(length|com\.[xy])", "m"), (r"link_[mn]\.mass", "kg"),
-    (r"link_[mn]\.inertia", "kg.m2"), (r"singular_threshold|conditioning|amplification|status",
-                                       None),
+    (r"link_[mn]\.angle|guide_[kp]\.angle", "rad"),
+    (r"link_[mn]\.omega", "rad/s"),
+    (r"link_[mn]\.epsilon", "rad/s2"),
+    (r"link_[mn]\.accel_d\.[xy]|gravity\.[xy]", "m/s2"),
+    (r"link_[mn]\.force\.[xy]|R_\w\w\.[xy]|N_\w\w", "N"),
+    (r"link_[mn]\.moment|M_\w\w", "N.m"),
+    (r"link_[mn]\.(length|com\.[xy])", "m"),
+    (r"link_[mn]\.mass", "kg"),
+    (r"link_[mn]\.inertia", "kg.m2"),
+    (r"singular_threshold|conditioning|amplification|status", None),
 ]
-BASE_UNITS = {"rad": {"rad": 1}, "rad/s": {"rad": 1, "s": -1}, "rad/s2": {"rad": 1, "s": -2},
-              "m": {"m": 1}, "m/s2": {"m": 1, "s": -2}, "N": {"kg": 1, "m": 1, "s": -2},
-              "N.m": {"kg": 1, "m": 2, "s": -2}, "kg": {"kg": 1}, "kg.m2": {"kg": 1, "m": 2}}
+BASE_UNITS = {
+    "rad": {"rad": 1},
+    "rad/s": {"rad": 1, "s": -1},
+    "rad/s2": {"rad": 1, "s": -2},
+    "m": {"m": 1},
+    "m/s2": {"m": 1, "s": -2},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+    "kg": {"kg": 1},
+    "kg.m2": {"kg": 1, "m": 2},
+}
 
 
 def expected_unit(name):
@@ -351,8 +396,19 @@ def expected_names(dyad_type):
     d_m, e, d_n = PAIRS[dyad_type]
     inputs, params = [], []
     for g in "mn":
-        inputs += [f"link_{g}.{x}" for x in ("angle", "omega", "epsilon", "accel_d.x",
-                                            "accel_d.y", "force.x", "force.y", "moment")]
+        inputs += [
+            f"link_{g}.{x}"
+            for x in (
+                "angle",
+                "omega",
+                "epsilon",
+                "accel_d.x",
+                "accel_d.y",
+                "force.x",
+                "force.y",
+                "moment",
+            )
+        ]
         if g == "m" and e == "T":
             inputs.append("link_m.length")
         if not (g == "m" and e == "T"):
@@ -373,21 +429,26 @@ def expected_names(dyad_type):
 
 def read_fmi2(path):
     from fmpy import read_model_description
-    return read_model_description(str(path), validate=True, validate_variable_names=True,
-                                  validate_model_structure=True)
+
+    return read_model_description(
+        str(path), validate=True, validate_variable_names=True, validate_model_structure=True
+    )
 
 
 def read_fmi3(generated_dir, tmp_path):
     """FMI 3 description read from an extracted-FMU layout, so that fmpy also validates
     sources/buildDescription.xml against its schema."""
     from fmpy import read_model_description
+
     fmu = tmp_path / "fmu3"
     (fmu / "sources").mkdir(parents=True, exist_ok=True)
     shutil.copy(generated_dir / "fmi3" / "modelDescription.xml", fmu / "modelDescription.xml")
-    shutil.copy(generated_dir / "fmi3" / "buildDescription.xml",
-                fmu / "sources" / "buildDescription.xml")
-    return read_model_description(str(fmu), validate=True, validate_variable_names=True,
-                                  validate_model_structure=True)
+    shutil.copy(
+        generated_dir / "fmi3" / "buildDescription.xml", fmu / "sources" / "buildDescription.xml"
+    )
+    return read_model_description(
+        str(fmu), validate=True, validate_variable_names=True, validate_model_structure=True
+    )
 
 
 @pytest.mark.parametrize("dyad_type", TYPES)
@@ -407,26 +468,39 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
     assert f'"{ident}"' in c_text and f"dyad_solve_{dyad_type.lower()}" in c_text
 
     # co-simulation interface and sources
-    for md, shim in ((md2, ["fmi2_functions.c"]),
-                     (md3, ["fmi3_functions.c", "fmi3_unsupported.c"])):
+    for md, shim in (
+        (md2, ["fmi2_functions.c"]),
+        (md3, ["fmi3_functions.c", "fmi3_unsupported.c"]),
+    ):
         assert md.coSimulation is not None and md.modelExchange is None
         assert md.coSimulation.modelIdentifier == ident
         assert md.variableNamingConvention == "structured"
         assert md.defaultExperiment.stopTime == "1" or float(md.defaultExperiment.stopTime) == 1
         assert [c.name for c in md.logCategories] == [
-            "logStatusError", "logStatusWarning", "logStatusDiscard", "logCalls"]
+            "logStatusError",
+            "logStatusWarning",
+            "logStatusDiscard",
+            "logCalls",
+        ]
         (config,) = md.buildConfigurations
         assert config.modelIdentifier == ident
         assert config.sourceFileSets[0].sourceFiles == [
-            "dyad_common.c", f"dyad_{dyad_type.lower()}.c", "dyad_tangent.c", "fmu_dyad.c",
+            "dyad_common.c",
+            f"dyad_{dyad_type.lower()}.c",
+            "dyad_tangent.c",
+            "fmu_dyad.c",
             "fmu_instance.c",
             *shim,
-            f"{ident}_model.c"]
+            f"{ident}_model.c",
+        ]
         units = {u.name: u.baseUnit for u in md.unitDefinitions}
         assert set(units) == set(BASE_UNITS)
         for name, exps in BASE_UNITS.items():
-            got = {k: getattr(units[name], k) for k in ("kg", "m", "s", "A", "K", "mol", "cd",
-                                                        "rad") if getattr(units[name], k)}
+            got = {
+                k: getattr(units[name], k)
+                for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+                if getattr(units[name], k)
+            }
             assert got == exps, name
 
     # variables: names, causalities, units, counts, value references
@@ -435,8 +509,10 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
     (time,) = [v for v in md3.modelVariables if v.causality == "independent"]
     assert time.name == "time" and time.valueReference == 0
     for variables in (variables2, variables3):
-        by_causality = {c: [v.name for v in variables if v.causality == c]
-                        for c in ("input", "parameter", "output")}
+        by_causality = {
+            c: [v.name for v in variables if v.causality == c]
+            for c in ("input", "parameter", "output")
+        }
         assert by_causality == {"input": inputs, "parameter": params, "output": outputs}
         assert len(variables) == len(inputs) + len(params) + len(outputs)
         assert [v.valueReference for v in variables] == list(range(1, len(variables) + 1))
@@ -471,8 +547,7 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
         assert float(by_name[f"link_{g}.length"].min) == 0
 
     # model structure: outputs, their dependencies as declared, initial unknowns
-    declared = {v["name"]: set(v["depends"]) for v in raw["variable"]
-                if v["causality"] == "output"}
+    declared = {v["name"]: set(v["depends"]) for v in raw["variable"] if v["causality"] == "output"}
     for md in (md2, md3):
         assert [u.variable.name for u in md.outputs] == outputs
         for unknown in md.outputs:
@@ -499,8 +574,15 @@ def test_documentation_is_complete(generated):
         assert "http" not in page  # self-contained: no external resources
         for v in raw["variable"]:
             assert f"<code>{v['name']}</code>" in page
-        for word in ("singular", "invalid input", "out of range", "Discard", "Error", "NaN",
-                     "counter-clockwise"):
+        for word in (
+            "singular",
+            "invalid input",
+            "out of range",
+            "Discard",
+            "Error",
+            "NaN",
+            "counter-clockwise",
+        ):
             assert word in page, (t, word)
 
 
@@ -512,10 +594,24 @@ def test_documentation_is_complete(generated):
 def test_c_table_compiles(generated, dyad_type, tmp_path):
     source = generated[dyad_type] / f"{identifier(dyad_type)}_model.c"
     proc = subprocess.run(
-        ["gcc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
-         f"-I{ROOT / 'src' / 'include'}", f"-I{ROOT / 'fmu'}", f"-I{ROOT / 'fmu' / 'models'}",
-         "-c", str(source),
-         "-o", str(tmp_path / "model.o")], capture_output=True, text=True)
+        [
+            "gcc",
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Wpedantic",
+            "-Werror",
+            f"-I{ROOT / 'src' / 'include'}",
+            f"-I{ROOT / 'fmu'}",
+            f"-I{ROOT / 'fmu' / 'models'}",
+            "-c",
+            str(source),
+            "-o",
+            str(tmp_path / "model.o"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 0, proc.stderr
 
 
@@ -523,13 +619,16 @@ def test_c_table_compiles(generated, dyad_type, tmp_path):
 def test_c_table_matches_the_table(generated, dyad_type):
     raw = load_raw(dyad_type)
     c_text = (generated[dyad_type] / f"{identifier(dyad_type)}_model.c").read_text()
-    rows = re.findall(r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
-                      r'(offsetof\(\w+, [\w.]+\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+)\}',
-                      c_text)
-    feeds = {int(index): field
-             for field, index in re.findall(r"\{(DYAD_FIELD_\w+), (\d+)\}", c_text)}
+    rows = re.findall(
+        r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
+        r"(offsetof\(\w+, [\w.]+\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+)\}",
+        c_text,
+    )
+    feeds = {
+        int(index): field for field, index in re.findall(r"\{(DYAD_FIELD_\w+), (\d+)\}", c_text)
+    }
     assert len(rows) == len(raw["variable"])
-    for index, (row, v) in enumerate(zip(rows, raw["variable"])):
+    for index, (row, v) in enumerate(zip(rows, raw["variable"], strict=True)):
         vr, name, unit, causality, _, target, offset, start = row[:8]
         assert (int(vr), name, unit) == (v["vr"], v["name"], v.get("unit", ""))
         assert causality == "FMU_" + v["causality"].upper()
@@ -566,12 +665,14 @@ def test_start_values_are_valid_and_far_from_singular(dyad_type):
 @pytest.mark.parametrize("dyad_type", TYPES)
 def test_start_values_solve_ok_in_the_c_core(dyad_type):
     from dyadfmu.core import Core, library_path
+
     if not library_path().is_file():
         pytest.skip(f"C core not built at {library_path()}")
     values = start_values(load_raw(dyad_type))
     m, n, gk, gp, gravity = reference_args(values)
-    got = Core().solve(dyad_type, m, n, gk, gp, gravity,
-                       singular_threshold=values["singular_threshold"])
+    got = Core().solve(
+        dyad_type, m, n, gk, gp, gravity, singular_threshold=values["singular_threshold"]
+    )
     assert got["status"] == "ok", got
     assert got["conditioning"] > 0.9
 
@@ -586,8 +687,10 @@ def test_token_follows_the_table():
     changed = [dict(v) for v in raw["variable"]]
     changed[0]["description"] += "."
     assert instantiation_token(raw["model"], changed) != token
-    as_int = [dict(v, start=int(v["start"])) if v.get("start") == int(v.get("start", 0.5))
-              else v for v in raw["variable"]]
+    as_int = [
+        dict(v, start=int(v["start"])) if v.get("start") == int(v.get("start", 0.5)) else v
+        for v in raw["variable"]
+    ]
     assert instantiation_token(raw["model"], as_int) == token  # 0 and 0.0 agree
     tokens = {pipeline.load_table(TABLE_OF[t]).token for t in TYPES}
     assert len(tokens) == len(TYPES)
@@ -636,8 +739,12 @@ def _no_start(raw):
 
 
 def _append_guide_p(raw):
-    guide_k = dict(_var(raw, "guide_k.angle"), name="guide_p.angle", lives="input.guide_p@angle",
-                   description="Guide at D_n")
+    guide_k = dict(
+        _var(raw, "guide_k.angle"),
+        name="guide_p.angle",
+        lives="input.guide_p@angle",
+        description="Guide at D_n",
+    )
     raw["variable"].insert(raw["variable"].index(_var(raw, "guide_k.angle")) + 1, guide_k)
     for k, v in enumerate(raw["variable"]):
         v["vr"] = k + 1
@@ -648,53 +755,119 @@ MALFORMED = [
     ("duplicate name", _rename_omega, "link_m.angle", "duplicate name"),
     ("duplicate vr", _vr_twice, "link_n.mass", "duplicate vr"),
     ("vr not consecutive", _vr_gap, "link_n.moment", "not consecutive"),
-    ("unknown causality", lambda r: _var(r, "link_m.mass").update(causality="local"),
-     "link_m.mass", "unknown causality"),
-    ("unknown type", lambda r: _var(r, "link_m.mass").update(type="Boolean"),
-     "link_m.mass", "unknown type"),
-    ("unknown unit", lambda r: _var(r, "link_m.omega").update(unit="rpm"),
-     "link_m.omega", "unknown unit"),
-    ("wrong unit", lambda r: _var(r, "link_m.omega").update(unit="rad/s2"),
-     "link_m.omega", "unit"),
+    (
+        "unknown causality",
+        lambda r: _var(r, "link_m.mass").update(causality="local"),
+        "link_m.mass",
+        "unknown causality",
+    ),
+    (
+        "unknown type",
+        lambda r: _var(r, "link_m.mass").update(type="Boolean"),
+        "link_m.mass",
+        "unknown type",
+    ),
+    (
+        "unknown unit",
+        lambda r: _var(r, "link_m.omega").update(unit="rpm"),
+        "link_m.omega",
+        "unknown unit",
+    ),
+    ("wrong unit", lambda r: _var(r, "link_m.omega").update(unit="rad/s2"), "link_m.omega", "unit"),
     ("start missing", _no_start, "link_n.inertia", "start is missing"),
-    ("start on an output", lambda r: _var(r, "R_mk.x").update(start=0.0),
-     "R_mk.x", "must not have one"),
-    ("start below min", lambda r: _var(r, "link_n.mass").update(start=-1.0),
-     "link_n.mass", "below min"),
-    ("start on an exclusive min", lambda r: _var(r, "link_n.length").update(start=0.0),
-     "link_n.length", "below min"),
-    ("start above max", lambda r: _var(r, "singular_threshold").update(start=1.0),
-     "singular_threshold", "above max"),
-    ("bounds off the domain", lambda r: _var(r, "link_m.mass").pop("min"),
-     "link_m.mass", "domain"),
-    ("depends on a parameter", lambda r: _var(r, "R_mk.x")["depends"].append("link_m.mass"),
-     "R_mk.x", "not an input"),
-    ("depends on an unknown name", lambda r: _var(r, "N_mk")["depends"].append("link_q.angle"),
-     "N_mk", "unknown variable 'link_q.angle'"),
-    ("depends missing", lambda r: _var(r, "conditioning").pop("depends"),
-     "conditioning", "depends is missing"),
-    ("bad lives member", lambda r: _var(r, "link_m.omega").update(lives="input.m.omgea"),
-     "link_m.omega", "no member"),
-    ("bad lives grammar", lambda r: _var(r, "link_m.omega").update(lives="m.omega"),
-     "link_m.omega", "bad lives"),
-    ("angle without @angle", lambda r: _var(r, "link_m.angle").update(lives="input.m.dir"),
-     "link_m.angle", "@angle"),
-    ("lives of another variable", lambda r: _var(r, "link_m.omega").update(lives="input.m.epsilon"),
-     "link_m.omega", "also the home of"),
+    (
+        "start on an output",
+        lambda r: _var(r, "R_mk.x").update(start=0.0),
+        "R_mk.x",
+        "must not have one",
+    ),
+    (
+        "start below min",
+        lambda r: _var(r, "link_n.mass").update(start=-1.0),
+        "link_n.mass",
+        "below min",
+    ),
+    (
+        "start on an exclusive min",
+        lambda r: _var(r, "link_n.length").update(start=0.0),
+        "link_n.length",
+        "below min",
+    ),
+    (
+        "start above max",
+        lambda r: _var(r, "singular_threshold").update(start=1.0),
+        "singular_threshold",
+        "above max",
+    ),
+    ("bounds off the domain", lambda r: _var(r, "link_m.mass").pop("min"), "link_m.mass", "domain"),
+    (
+        "depends on a parameter",
+        lambda r: _var(r, "R_mk.x")["depends"].append("link_m.mass"),
+        "R_mk.x",
+        "not an input",
+    ),
+    (
+        "depends on an unknown name",
+        lambda r: _var(r, "N_mk")["depends"].append("link_q.angle"),
+        "N_mk",
+        "unknown variable 'link_q.angle'",
+    ),
+    (
+        "depends missing",
+        lambda r: _var(r, "conditioning").pop("depends"),
+        "conditioning",
+        "depends is missing",
+    ),
+    (
+        "bad lives member",
+        lambda r: _var(r, "link_m.omega").update(lives="input.m.omgea"),
+        "link_m.omega",
+        "no member",
+    ),
+    (
+        "bad lives grammar",
+        lambda r: _var(r, "link_m.omega").update(lives="m.omega"),
+        "link_m.omega",
+        "bad lives",
+    ),
+    (
+        "angle without @angle",
+        lambda r: _var(r, "link_m.angle").update(lives="input.m.dir"),
+        "link_m.angle",
+        "@angle",
+    ),
+    (
+        "lives of another variable",
+        lambda r: _var(r, "link_m.omega").update(lives="input.m.epsilon"),
+        "link_m.omega",
+        "also the home of",
+    ),
     ("field the type lacks", _append_guide_p, "guide_p.angle", "no guide i_p"),
-    ("output the type lacks", lambda r: _var(r, "M_mk").update(name="M_np", lives="result.m_np"),
-     "M_np", "revolute"),
-    ("fixed length as an input",
-     lambda r: _var(r, "link_m.length").update(causality="input"),
-     "link_m.length", "is a parameter"),
-    ("unknown key", lambda r: _var(r, "link_m.mass").update(colour="red"),
-     "link_m.mass", "unknown key 'colour'"),
+    (
+        "output the type lacks",
+        lambda r: _var(r, "M_mk").update(name="M_np", lives="result.m_np"),
+        "M_np",
+        "revolute",
+    ),
+    (
+        "fixed length as an input",
+        lambda r: _var(r, "link_m.length").update(causality="input"),
+        "link_m.length",
+        "is a parameter",
+    ),
+    (
+        "unknown key",
+        lambda r: _var(r, "link_m.mass").update(colour="red"),
+        "link_m.mass",
+        "unknown key 'colour'",
+    ),
     ("missing variable", lambda r: r["variable"].pop(), "status", "missing variable"),
 ]
 
 
-@pytest.mark.parametrize("mutation,name,fragment", [m[1:] for m in MALFORMED],
-                         ids=[m[0] for m in MALFORMED])
+@pytest.mark.parametrize(
+    "mutation,name,fragment", [m[1:] for m in MALFORMED], ids=[m[0] for m in MALFORMED]
+)
 def test_malformed_table_is_refused(tmp_path, mutation, name, fragment):
     raw = load_raw("RRT")
     mutation(raw)
@@ -743,13 +916,27 @@ DRIVE_VARIABLES = {
     "motor.torque": ("output", "N.m", "result.motor_torque"),
     "status": ("output", None, "result.status"),
 }
-DRIVE_STARTS = {"load.torque": 0.0, "load.inertia": 0.0, "motor.stall_torque": 12.0,
-                "motor.no_load_speed": 36.0, "inertia": 2e-3, "crank.mass": 0.25,
-                "crank.com.x": 0.02, "crank.com.y": 0.003, "gravity.x": 0.0,
-                "gravity.y": -9.81, "start.angle": 0.0, "start.speed": 30.0}
-DRIVE_DEPENDS = {"crank.angle": set(), "crank.omega": set(),
-                 "crank.epsilon": {"load.torque", "load.inertia"}, "motor.torque": set(),
-                 "status": {"load.torque", "load.inertia"}}
+DRIVE_STARTS = {
+    "load.torque": 0.0,
+    "load.inertia": 0.0,
+    "motor.stall_torque": 12.0,
+    "motor.no_load_speed": 36.0,
+    "inertia": 2e-3,
+    "crank.mass": 0.25,
+    "crank.com.x": 0.02,
+    "crank.com.y": 0.003,
+    "gravity.x": 0.0,
+    "gravity.y": -9.81,
+    "start.angle": 0.0,
+    "start.speed": 30.0,
+}
+DRIVE_DEPENDS = {
+    "crank.angle": set(),
+    "crank.omega": set(),
+    "crank.epsilon": {"load.torque", "load.inertia"},
+    "motor.torque": set(),
+    "status": {"load.torque", "load.inertia"},
+}
 DRIVE_UNITS = {"rad", "rad/s", "rad/s2", "m", "m/s2", "N.m", "kg", "kg.m2"}  # no N
 
 
@@ -785,8 +972,13 @@ def test_tables_are_the_drive_and_the_scenes_of_the_five_dyads():
 
 
 def test_drive_generator_writes_every_file(generated_drive):
-    for rel in ("fmi2/modelDescription.xml", "fmi3/modelDescription.xml",
-                "fmi3/buildDescription.xml", "drive_model.c", "documentation/index.html"):
+    for rel in (
+        "fmi2/modelDescription.xml",
+        "fmi3/modelDescription.xml",
+        "fmi3/buildDescription.xml",
+        "drive_model.c",
+        "documentation/index.html",
+    ):
         assert (generated_drive / rel).is_file(), rel
 
 
@@ -797,7 +989,8 @@ def test_drive_xml_equals_golden(generated_drive):
         assert golden.is_file(), f"{golden} missing: run generate.py --update-golden"
         assert produced.read_bytes() == golden.read_bytes(), (
             f"drive {version} description differs from {golden.name}; review the change and "
-            "run modelDescription/generate.py --update-golden")
+            "run modelDescription/generate.py --update-golden"
+        )
 
 
 def test_drive_output_is_deterministic(generated_drive, tmp_path):
@@ -811,8 +1004,11 @@ def test_drive_output_is_deterministic(generated_drive, tmp_path):
 
 def test_drive_table_is_as_specified():
     raw = load_drive_raw()
-    assert raw["model"] == {"kind": "drive", "identifier": "drive",
-                            "description": raw["model"]["description"]}
+    assert raw["model"] == {
+        "kind": "drive",
+        "identifier": "drive",
+        "description": raw["model"]["description"],
+    }
     assert [v["name"] for v in raw["variable"]] == list(DRIVE_VARIABLES)
     for k, v in enumerate(raw["variable"]):
         causality, unit, lives = DRIVE_VARIABLES[v["name"]]
@@ -823,11 +1019,17 @@ def test_drive_table_is_as_specified():
             assert float(v["start"]) == DRIVE_STARTS[v["name"]], v["name"]
         else:
             assert set(v["depends"]) == DRIVE_DEPENDS[v["name"]], v["name"]
-    bounds = {v["name"]: (v.get("min"), v.get("min_exclusive", False), v.get("max"))
-              for v in raw["variable"] if "min" in v or "max" in v}
-    assert bounds == {"motor.stall_torque": (0.0, True, None),
-                      "motor.no_load_speed": (0.0, True, None),
-                      "inertia": (0.0, True, None), "crank.mass": (0.0, False, None)}
+    bounds = {
+        v["name"]: (v.get("min"), v.get("min_exclusive", False), v.get("max"))
+        for v in raw["variable"]
+        if "min" in v or "max" in v
+    }
+    assert bounds == {
+        "motor.stall_torque": (0.0, True, None),
+        "motor.no_load_speed": (0.0, True, None),
+        "inertia": (0.0, True, None),
+        "crank.mass": (0.0, False, None),
+    }
 
 
 def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
@@ -838,8 +1040,10 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
     assert md3.instantiationToken == token
     assert token not in {pipeline.load_table(TABLE_OF[t]).token for t in TYPES}
 
-    for md, shim in ((md2, ["fmi2_functions.c"]),
-                     (md3, ["fmi3_functions.c", "fmi3_unsupported.c"])):
+    for md, shim in (
+        (md2, ["fmi2_functions.c"]),
+        (md3, ["fmi3_functions.c", "fmi3_unsupported.c"]),
+    ):
         assert md.coSimulation is not None and md.modelExchange is None
         assert md.coSimulation.modelIdentifier == "drive"
         assert md.variableNamingConvention == "structured"
@@ -851,16 +1055,27 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
         assert float(md.defaultExperiment.stopTime) == 1
         assert float(md.defaultExperiment.stepSize) == 0.001
         assert [c.name for c in md.logCategories] == [
-            "logStatusError", "logStatusWarning", "logStatusDiscard", "logCalls"]
+            "logStatusError",
+            "logStatusWarning",
+            "logStatusDiscard",
+            "logCalls",
+        ]
         (config,) = md.buildConfigurations
         assert config.modelIdentifier == "drive"
         assert config.sourceFileSets[0].sourceFiles == [
-            "fmu_drive.c", "fmu_instance.c", *shim, "drive_model.c"]
+            "fmu_drive.c",
+            "fmu_instance.c",
+            *shim,
+            "drive_model.c",
+        ]
         units = {u.name: u.baseUnit for u in md.unitDefinitions}
         assert set(units) == DRIVE_UNITS
         for name in DRIVE_UNITS:
-            got = {k: getattr(units[name], k) for k in ("kg", "m", "s", "A", "K", "mol", "cd",
-                                                        "rad") if getattr(units[name], k)}
+            got = {
+                k: getattr(units[name], k)
+                for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+                if getattr(units[name], k)
+            }
             assert got == BASE_UNITS[name], name
     assert md2.coSimulation.providesDirectionalDerivative is False
 
@@ -932,10 +1147,23 @@ def test_drive_members_match_the_header():
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available")
 def test_drive_c_table_compiles(generated_drive, tmp_path):
     proc = subprocess.run(
-        ["gcc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
-         f"-I{ROOT / 'fmu'}", f"-I{ROOT / 'fmu' / 'models'}", "-c",
-         str(generated_drive / "drive_model.c"), "-o", str(tmp_path / "drive_model.o")],
-        capture_output=True, text=True)
+        [
+            "gcc",
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Wpedantic",
+            "-Werror",
+            f"-I{ROOT / 'fmu'}",
+            f"-I{ROOT / 'fmu' / 'models'}",
+            "-c",
+            str(generated_drive / "drive_model.c"),
+            "-o",
+            str(tmp_path / "drive_model.o"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 0, proc.stderr
 
 
@@ -945,11 +1173,13 @@ def test_drive_c_table_matches_the_table(generated_drive):
     c_text = (generated_drive / "drive_model.c").read_text()
     assert '#include "fmu_drive.h"' in c_text and "fmu_dyad" not in c_text
     assert "dyad_solve" not in c_text and "DYAD_FIELD" not in c_text
-    rows = re.findall(r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
-                      r'(offsetof\((\w+), ([\w.]+)\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+)\}',
-                      c_text)
+    rows = re.findall(
+        r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
+        r"(offsetof\((\w+), ([\w.]+)\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+)\}",
+        c_text,
+    )
     assert len(rows) == len(raw["variable"])
-    for row, v in zip(rows, raw["variable"]):
+    for row, v in zip(rows, raw["variable"], strict=True):
         vr, name, unit, causality, value_type, target, _, struct, member, start = row[:10]
         assert (int(vr), name, unit) == (v["vr"], v["name"], v.get("unit", ""))
         assert causality == "FMU_" + v["causality"].upper()
@@ -968,9 +1198,11 @@ def test_drive_c_table_matches_the_table(generated_drive):
     assert "FMU_TARGET_INPUT_ANGLE" not in c_text
     assert re.search(r"FMU_HAS_MIN \| FMU_MIN_EXCLUSIVE\}", c_text)
     vr_limit = len(raw["variable"]) + 1
-    assert (f'const fmu_model fmu_this_model = {{"drive", "{token}",\n'
-            f"                                  variables, {len(raw['variable'])}, "
-            f"index_of_vr, {vr_limit}, &fmu_drive_behaviour, NULL}};") in c_text
+    assert (
+        f'const fmu_model fmu_this_model = {{"drive", "{token}",\n'
+        f"                                  variables, {len(raw['variable'])}, "
+        f"index_of_vr, {vr_limit}, &fmu_drive_behaviour, NULL}};"
+    ) in c_text
 
 
 def test_drive_documentation_is_complete(generated_drive):
@@ -980,12 +1212,25 @@ def test_drive_documentation_is_complete(generated_drive):
     assert "http" not in page
     for v in raw["variable"]:
         assert f"<code>{v['name']}</code>" in page
-    for phrase in ("(inertia + load.inertia) eps = T_stall (1 - omega / omega_0) + load.torque "
-                   "+ r_c x m_c g",
-                   "Runge-Kutta", "RK4", "substeps", "time constant", "0.005 rad",
-                   "Explicit", "Stabilised", "directional derivatives", "J_eff",
-                   "invalid input", "Discard", "Error", "NaN", "counter-clockwise",
-                   "providesDirectionalDerivative", pipeline.load_table(DRIVE_TABLE).token):
+    for phrase in (
+        "(inertia + load.inertia) eps = T_stall (1 - omega / omega_0) + load.torque + r_c x m_c g",
+        "Runge-Kutta",
+        "RK4",
+        "substeps",
+        "time constant",
+        "0.005 rad",
+        "Explicit",
+        "Stabilised",
+        "directional derivatives",
+        "J_eff",
+        "invalid input",
+        "Discard",
+        "Error",
+        "NaN",
+        "counter-clockwise",
+        "providesDirectionalDerivative",
+        pipeline.load_table(DRIVE_TABLE).token,
+    ):
         assert phrase in page, phrase
     assert "dyad_solve" not in page
 
@@ -996,18 +1241,33 @@ def drive_outputs(values, angle, speed):
     total = values["inertia"] + values["load.inertia"]
     motor = values["motor.stall_torque"] * (1 - speed / values["motor.no_load_speed"])
     if not total > 0:
-        return {"crank.angle": angle, "crank.omega": speed, "crank.epsilon": math.nan,
-                "motor.torque": math.nan, "status": 2}
+        return {
+            "crank.angle": angle,
+            "crank.omega": speed,
+            "crank.epsilon": math.nan,
+            "motor.torque": math.nan,
+            "status": 2,
+        }
     c, s = math.cos(angle), math.sin(angle)
     rx = c * values["crank.com.x"] - s * values["crank.com.y"]
     ry = s * values["crank.com.x"] + c * values["crank.com.y"]
     gravity = values["crank.mass"] * (rx * values["gravity.y"] - ry * values["gravity.x"])
     epsilon = (motor + values["load.torque"] + gravity) / total
     if not (math.isfinite(epsilon) and math.isfinite(motor)):
-        return {"crank.angle": angle, "crank.omega": speed, "crank.epsilon": math.nan,
-                "motor.torque": motor if math.isfinite(motor) else math.nan, "status": 3}
-    return {"crank.angle": angle, "crank.omega": speed, "crank.epsilon": epsilon,
-            "motor.torque": motor, "status": 0}
+        return {
+            "crank.angle": angle,
+            "crank.omega": speed,
+            "crank.epsilon": math.nan,
+            "motor.torque": motor if math.isfinite(motor) else math.nan,
+            "status": 3,
+        }
+    return {
+        "crank.angle": angle,
+        "crank.omega": speed,
+        "crank.epsilon": epsilon,
+        "motor.torque": motor,
+        "status": 0,
+    }
 
 
 def test_drive_declared_dependencies_are_the_true_ones():
@@ -1034,10 +1294,13 @@ def test_drive_declared_dependencies_are_the_true_ones():
     # validity: inertia (a parameter) + load.inertia > 0, and a finite acceleration
     derived["status"] = {"load.inertia", "load.torque"}
     assert drive_outputs(dict(DRIVE_STARTS, **{"load.inertia": -1.0}), 0.0, 0.0)["status"] == 2
-    assert drive_outputs(dict(DRIVE_STARTS, **{"load.torque": -1.7976931348623157e308}),
-                         0.0, 0.0)["status"] == 3
-    declared = {v["name"]: set(v["depends"]) for v in raw["variable"]
-                if v["causality"] == "output"}
+    assert (
+        drive_outputs(dict(DRIVE_STARTS, **{"load.torque": -1.7976931348623157e308}), 0.0, 0.0)[
+            "status"
+        ]
+        == 3
+    )
+    declared = {v["name"]: set(v["depends"]) for v in raw["variable"] if v["causality"] == "output"}
     assert declared == derived == DRIVE_DEPENDS
 
 
@@ -1070,65 +1333,144 @@ def _drop_drive_variable(raw, name):
 
 
 MALFORMED_DRIVE = [
-    ("lives to no member",
-     lambda r: _drive_var(r, "load.torque").update(lives="input.load_torq"),
-     "load.torque", "fmu_drive_input has no member 'load_torq'"),
-    ("lives to no output member",
-     lambda r: _drive_var(r, "crank.omega").update(lives="result.omega"),
-     "crank.omega", "fmu_drive_output has no member 'omega'"),
-    ("lives to a dyad member",
-     lambda r: _drive_var(r, "gravity.x").update(lives="input.gravity.x"),
-     "gravity.x", "bad lives"),
-    ("lives to a state",
-     lambda r: _drive_var(r, "start.angle").update(lives="input.angle"),
-     "start.angle", "is a state of the drive"),
-    ("lives with @angle",
-     lambda r: _drive_var(r, "start.angle").update(lives="input.start_angle@angle"),
-     "start.angle", "@angle"),
-    ("lives of another variable",
-     lambda r: _drive_var(r, "motor.torque").update(lives="result.acceleration"),
-     "motor.torque", "also the home of"),
-    ("missing stall torque", lambda r: _drop_drive_variable(r, "motor.stall_torque"),
-     "motor.stall_torque", "missing variable"),
-    ("missing load inertia", lambda r: _drop_drive_variable(r, "load.inertia"),
-     "load.inertia", "missing variable"),
-    ("wrong name for lives",
-     lambda r: _drive_var(r, "crank.omega").update(name="crank.speed"),
-     "crank.speed", "expected 'crank.omega'"),
-    ("wrong unit", lambda r: _drive_var(r, "load.torque").update(unit="N"),
-     "load.torque", "unit"),
-    ("unknown unit", lambda r: _drive_var(r, "start.speed").update(unit="rpm"),
-     "start.speed", "unknown unit"),
-    ("input as a parameter", lambda r: _drive_var(r, "load.inertia").update(causality="parameter"),
-     "load.inertia", "is an input of the drive"),
-    ("start on the exclusive min", lambda r: _drive_var(r, "inertia").update(start=0.0),
-     "inertia", "below min"),
-    ("bounds off the domain", lambda r: _drive_var(r, "crank.mass").pop("min"),
-     "crank.mass", "domain"),
-    ("bounds on an unbounded input", lambda r: _drive_var(r, "load.inertia").update(min=0.0),
-     "load.inertia", "domain"),
-    ("start missing", lambda r: _drive_var(r, "start.speed").pop("start"),
-     "start.speed", "start is missing"),
-    ("vr out of order", lambda r: _drive_var(r, "inertia").update(vr=9),
-     "inertia", "not consecutive"),
-    ("parameter after an output",
-     lambda r: r["variable"].append(r["variable"].pop(r["variable"].index(
-         _drive_var(r, "start.speed")))) or [v.update(vr=k + 1) for k, v in
-                                              enumerate(r["variable"])],
-     "start.speed", "parameter after outputs"),
-    ("a dependency too few", lambda r: _drive_var(r, "crank.epsilon")["depends"].pop(),
-     "crank.epsilon", "true dependencies"),
-    ("a dependency too many", lambda r: _drive_var(r, "crank.angle")["depends"].append(
-        "load.torque"), "crank.angle", "true dependencies"),
-    ("depends missing", lambda r: _drive_var(r, "motor.torque").pop("depends"),
-     "motor.torque", "depends is missing"),
-    ("unknown key", lambda r: _drive_var(r, "inertia").update(colour="red"),
-     "inertia", "unknown key 'colour'"),
+    (
+        "lives to no member",
+        lambda r: _drive_var(r, "load.torque").update(lives="input.load_torq"),
+        "load.torque",
+        "fmu_drive_input has no member 'load_torq'",
+    ),
+    (
+        "lives to no output member",
+        lambda r: _drive_var(r, "crank.omega").update(lives="result.omega"),
+        "crank.omega",
+        "fmu_drive_output has no member 'omega'",
+    ),
+    (
+        "lives to a dyad member",
+        lambda r: _drive_var(r, "gravity.x").update(lives="input.gravity.x"),
+        "gravity.x",
+        "bad lives",
+    ),
+    (
+        "lives to a state",
+        lambda r: _drive_var(r, "start.angle").update(lives="input.angle"),
+        "start.angle",
+        "is a state of the drive",
+    ),
+    (
+        "lives with @angle",
+        lambda r: _drive_var(r, "start.angle").update(lives="input.start_angle@angle"),
+        "start.angle",
+        "@angle",
+    ),
+    (
+        "lives of another variable",
+        lambda r: _drive_var(r, "motor.torque").update(lives="result.acceleration"),
+        "motor.torque",
+        "also the home of",
+    ),
+    (
+        "missing stall torque",
+        lambda r: _drop_drive_variable(r, "motor.stall_torque"),
+        "motor.stall_torque",
+        "missing variable",
+    ),
+    (
+        "missing load inertia",
+        lambda r: _drop_drive_variable(r, "load.inertia"),
+        "load.inertia",
+        "missing variable",
+    ),
+    (
+        "wrong name for lives",
+        lambda r: _drive_var(r, "crank.omega").update(name="crank.speed"),
+        "crank.speed",
+        "expected 'crank.omega'",
+    ),
+    ("wrong unit", lambda r: _drive_var(r, "load.torque").update(unit="N"), "load.torque", "unit"),
+    (
+        "unknown unit",
+        lambda r: _drive_var(r, "start.speed").update(unit="rpm"),
+        "start.speed",
+        "unknown unit",
+    ),
+    (
+        "input as a parameter",
+        lambda r: _drive_var(r, "load.inertia").update(causality="parameter"),
+        "load.inertia",
+        "is an input of the drive",
+    ),
+    (
+        "start on the exclusive min",
+        lambda r: _drive_var(r, "inertia").update(start=0.0),
+        "inertia",
+        "below min",
+    ),
+    (
+        "bounds off the domain",
+        lambda r: _drive_var(r, "crank.mass").pop("min"),
+        "crank.mass",
+        "domain",
+    ),
+    (
+        "bounds on an unbounded input",
+        lambda r: _drive_var(r, "load.inertia").update(min=0.0),
+        "load.inertia",
+        "domain",
+    ),
+    (
+        "start missing",
+        lambda r: _drive_var(r, "start.speed").pop("start"),
+        "start.speed",
+        "start is missing",
+    ),
+    (
+        "vr out of order",
+        lambda r: _drive_var(r, "inertia").update(vr=9),
+        "inertia",
+        "not consecutive",
+    ),
+    (
+        "parameter after an output",
+        lambda r: (
+            r["variable"].append(
+                r["variable"].pop(r["variable"].index(_drive_var(r, "start.speed")))
+            )
+            or [v.update(vr=k + 1) for k, v in enumerate(r["variable"])]
+        ),
+        "start.speed",
+        "parameter after outputs",
+    ),
+    (
+        "a dependency too few",
+        lambda r: _drive_var(r, "crank.epsilon")["depends"].pop(),
+        "crank.epsilon",
+        "true dependencies",
+    ),
+    (
+        "a dependency too many",
+        lambda r: _drive_var(r, "crank.angle")["depends"].append("load.torque"),
+        "crank.angle",
+        "true dependencies",
+    ),
+    (
+        "depends missing",
+        lambda r: _drive_var(r, "motor.torque").pop("depends"),
+        "motor.torque",
+        "depends is missing",
+    ),
+    (
+        "unknown key",
+        lambda r: _drive_var(r, "inertia").update(colour="red"),
+        "inertia",
+        "unknown key 'colour'",
+    ),
 ]
 
 
-@pytest.mark.parametrize("mutation,name,fragment", [m[1:] for m in MALFORMED_DRIVE],
-                         ids=[m[0] for m in MALFORMED_DRIVE])
+@pytest.mark.parametrize(
+    "mutation,name,fragment", [m[1:] for m in MALFORMED_DRIVE], ids=[m[0] for m in MALFORMED_DRIVE]
+)
 def test_malformed_drive_table_is_refused(tmp_path, mutation, name, fragment):
     raw = load_drive_raw()
     mutation(raw)
@@ -1142,12 +1484,16 @@ def test_malformed_drive_table_is_refused(tmp_path, mutation, name, fragment):
     assert any("broken_drive.toml" in ln and f"'{name}'" in ln for ln in lines), proc.stderr
 
 
-@pytest.mark.parametrize("model,fragment", [
-    ({"kind": "drive", "type": "RRT"}, "only a dyad has a type"),
-    ({"kind": "motor"}, "kind 'motor' is not one of dyad, drive"),
-    ({"kind": "dyad"}, "type None is not one of"),
-    ({"kind": "drive", "colour": "red"}, "[model]: unknown key 'colour'"),
-], ids=["drive with a type", "unknown kind", "dyad kind without a type", "unknown model key"])
+@pytest.mark.parametrize(
+    "model,fragment",
+    [
+        ({"kind": "drive", "type": "RRT"}, "only a dyad has a type"),
+        ({"kind": "motor"}, "kind 'motor' is not one of dyad, drive"),
+        ({"kind": "dyad"}, "type None is not one of"),
+        ({"kind": "drive", "colour": "red"}, "[model]: unknown key 'colour'"),
+    ],
+    ids=["drive with a type", "unknown kind", "dyad kind without a type", "unknown model key"],
+)
 def test_malformed_drive_model_is_refused(tmp_path, model, fragment):
     raw = load_drive_raw()
     raw["model"] = dict({k: v for k, v in raw["model"].items() if k != "kind"}, **model)
@@ -1156,8 +1502,9 @@ def test_malformed_drive_model_is_refused(tmp_path, model, fragment):
     proc = run_generator(table, "--out", tmp_path / "out")
     assert proc.returncode != 0
     assert not (tmp_path / "out").exists()
-    assert any("broken_drive.toml" in ln and fragment in ln
-               for ln in proc.stderr.splitlines()), proc.stderr
+    assert any("broken_drive.toml" in ln and fragment in ln for ln in proc.stderr.splitlines()), (
+        proc.stderr
+    )
 
 
 def test_dyad_table_may_name_its_kind(tmp_path):
@@ -1177,7 +1524,10 @@ def test_drive_lives_must_not_name_dyad_structs():
         kinds.DYAD.parse_lives("input.load_torque")  # a dyad's lives
     lives = kinds.DRIVE.parse_lives("result.status")
     assert (lives.target, lives.offset, lives.field) == (
-        "FMU_TARGET_RESULT_STATUS", "offsetof(fmu_drive_output, status)", "DYAD_FIELD_NONE")
+        "FMU_TARGET_RESULT_STATUS",
+        "offsetof(fmu_drive_output, status)",
+        "DYAD_FIELD_NONE",
+    )
     assert kinds.DYAD.parse_lives("result.status").offset == "0"  # dyads: as they always were
 
 
