@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 from dyadgen.emit.xmltext import (
-    GENERATION_TOOL,
-    common_tail,
     element,
-    header,
+    model_description_text,
+    root_attributes,
     typed_attributes,
-    unit_definitions,
     variable_attributes,
 )
 from dyadgen.table import Table
@@ -69,28 +67,7 @@ def _structure(table: Table) -> list[str]:
 
 def model_description(table: Table) -> str:
     """fmi2/modelDescription.xml."""
-    lines = header(table)
-    lines.append(
-        element(
-            0,
-            "fmiModelDescription",
-            [
-                ("fmiVersion", "2.0"),
-                ("modelName", table.identifier),
-                ("guid", table.token),
-                ("description", table.description),
-                ("generationTool", GENERATION_TOOL),
-                ("variableNamingConvention", "structured"),
-                ("numberOfEventIndicators", "0"),
-            ],
-            close=False,
-            wrap=True,
-        )
-    )
-    lines += _cosimulation(table)
-    lines += unit_definitions(table)
-    lines += common_tail(table)
-    lines += _variables(table)
-    lines += _structure(table)
-    lines.append("</fmiModelDescription>")
-    return "\n".join(lines) + "\n"
+    root = root_attributes(table, "2.0", "guid")
+    root.append(("numberOfEventIndicators", "0"))
+    model = _variables(table) + _structure(table)
+    return model_description_text(table, root, _cosimulation(table), model)

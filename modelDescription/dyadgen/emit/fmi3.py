@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 from dyadgen.emit.xmltext import (
-    GENERATION_TOOL,
-    common_tail,
     element,
     header,
+    model_description_text,
+    root_attributes,
     typed_attributes,
-    unit_definitions,
     variable_attributes,
 )
 from dyadgen.table import Table
@@ -69,30 +68,9 @@ def _structure(table: Table) -> list[str]:
 
 def model_description(table: Table) -> str:
     """fmi3/modelDescription.xml."""
-    lines = header(table)
-    lines.append(
-        element(
-            0,
-            "fmiModelDescription",
-            [
-                ("fmiVersion", "3.0"),
-                ("modelName", table.identifier),
-                ("instantiationToken", table.token),
-                ("description", table.description),
-                ("generationTool", GENERATION_TOOL),
-                ("variableNamingConvention", "structured"),
-            ],
-            close=False,
-            wrap=True,
-        )
-    )
-    lines.append(_cosimulation(table))
-    lines += unit_definitions(table)
-    lines += common_tail(table)
-    lines += _variables(table)
-    lines += _structure(table)
-    lines.append("</fmiModelDescription>")
-    return "\n".join(lines) + "\n"
+    root = root_attributes(table, "3.0", "instantiationToken")
+    model = _variables(table) + _structure(table)
+    return model_description_text(table, root, [_cosimulation(table)], model)
 
 
 def build_description(table: Table) -> str:
