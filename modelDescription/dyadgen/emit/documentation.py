@@ -61,17 +61,21 @@ def variable_rows(table: Table) -> str:
 
 
 def page(name: str, table: Table, **values: object) -> str:
-    """Template `name` filled with the table's identity, its variables and `values`
-    (already HTML)."""
+    """Template `name` filled with the table's identity, its variables (the table alone, or
+    the whole section) and `values` (already HTML)."""
     identity = template("identity.html").substitute(
         identifier=h(table.identifier), token=h(table.token), table_file=h(table.path.name)
     )
+    variables = variable_rows(table)
+    # the Variables section the drive's and the dyads' pages share (templates/variables.html)
+    section = template("variables.html").substitute(variables=variables).removesuffix("\n")
     return template(name).substitute(
         css=stylesheet(),
         identity=identity,
         identifier=h(table.identifier),
         description=h(table.description),
-        variables=variable_rows(table),
+        variables=variables,
+        variable_section=section,
         **values,
     )
 
