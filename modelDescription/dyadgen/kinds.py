@@ -25,7 +25,7 @@ from dyadgen.dyadtypes import PAIRS
 from dyadgen.emit import documentation, fmi2, fmi3
 from dyadgen.emit.c_table import model_c
 from dyadgen.emit.scene_c import scene_c, scene_header
-from dyadgen.model import Scene
+from dyadgen.model import Input, Param, Scene
 from dyadgen.scenefile.problems import SceneError
 from dyadgen.structs import (
     DRIVE_INPUT_MEMBERS,
@@ -408,35 +408,31 @@ def _row(rows: list, name: str, causality: str, unit: str | None, **values: obje
     return raw
 
 
+def _settable_row(
+    rows: list, settable: Input | Param, causality: str, start: float, lives: str
+) -> None:
+    """The row of an input or a tunable parameter: a Real with the bounds of its domain."""
+    raw = _row(
+        rows,
+        settable.name,
+        causality,
+        settable.unit,
+        type="Real",
+        start=start,
+        description=settable.description,
+        lives=lives,
+    )
+    _bounds(raw, settable.domain)
+
+
 def _scene_rows(scene: Scene) -> list[dict]:
     """The rows of a tailored scene's table: its inputs, tunable parameters, outputs."""
     rows: list[dict] = []
     for i in scene.inputs:
-        lives = f"input.{i.member}{'@angle' if i.angle else ''}"
-        raw = _row(
-            rows,
-            i.name,
-            "input",
-            i.unit,
-            type="Real",
-            start=i.start,
-            description=i.description,
-            lives=lives,
-        )
-        _bounds(raw, i.domain)
+        _settable_row(rows, i, "input", i.start, f"input.{i.member}{'@angle' if i.angle else ''}")
     for prm in scene.parameters():
         if prm.tunable:
-            raw = _row(
-                rows,
-                prm.name,
-                "parameter",
-                prm.unit,
-                type="Real",
-                start=prm.value,
-                description=prm.description,
-                lives=f"input.{prm.member}",
-            )
-            _bounds(raw, prm.domain)
+            _settable_row(rows, prm, "parameter", prm.value, f"input.{prm.member}")
     for o in scene.outputs:
         _row(
             rows,
