@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 from .cosim import harness, scenes
@@ -244,15 +245,14 @@ def _mechanism_outputs(args: argparse.Namespace, result: harness.MechanismResult
     return written
 
 
-def _run(args: argparse.Namespace) -> int:
-    names = _chosen(args.mechanisms, builtin.NAMES, "mechanism")
-    if names is None:
-        return 2
+def _run_each(args: argparse.Namespace, names: list[str], run: Callable, outputs: Callable) -> int:
+    """Run each of `names` in each FMI version with `run`, write its outputs with
+    `outputs`, then print the worst error and the files written."""
     written, worst = [], 0.0
     for name in names:
         for version in _versions(args):
             try:
-                result = harness.run_mechanism(
+                result = run(
                     name,
                     version,
                     args.revolutions,
@@ -265,9 +265,16 @@ def _run(args: argparse.Namespace) -> int:
                 print(f"dyadfmu: {error}", file=sys.stderr)
                 return 2
             worst = max(worst, result.worst_relative)
-            written += _mechanism_outputs(args, result)
+            written += outputs(args, result)
     _print_written(worst, written)
     return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    names = _chosen(args.mechanisms, builtin.NAMES, "mechanism")
+    if names is None:
+        return 2
+    return _run_each(args, names, harness.run_mechanism, _mechanism_outputs)
 
 
 def scenes_names() -> tuple[str, ...]:
@@ -303,26 +310,7 @@ def _scene(args: argparse.Namespace) -> int:
     if names is None:
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
-    written, worst = [], 0.0
-    for name in names:
-        for version in _versions(args):
-            try:
-                result = scenes.run(
-                    name,
-                    version,
-                    args.revolutions,
-                    args.steps,
-                    args.motion,
-                    args.build,
-                    progress=True,
-                )
-            except FileNotFoundError as error:
-                print(f"dyadfmu: {error}", file=sys.stderr)
-                return 2
-            worst = max(worst, result.worst_relative)
-            written += _scene_outputs(args, result)
-    _print_written(worst, written)
-    return 0
+    return _run_each(args, names, scenes.run, _scene_outputs)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,14 +1,17 @@
 """What the harness and the scenes share when they check a recorded co-simulation against
 a reference: the communication grid, the progress bar, matching recorded rows to input
-samples, and the error of each output relative to its peak."""
+samples, the timed co-simulation, and the error of each output relative to its peak."""
 
 from __future__ import annotations
 
 import math
 import sys
+import time as clock
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..fmi.simulate import CoSimSetup, simulate
 
 #: Below this conditioning a sample counts as near-singular and is left out of
 #: the error figures (its amplification exceeds 1e6, 1 / conditioning).
@@ -93,3 +96,17 @@ def match_samples(recorded: dict, inputs: dict, names: list[str], t: np.ndarray)
             )
         index[k] = candidates[np.argmin(np.abs(t[candidates] - recorded["time"][k]))]
     return index
+
+
+def simulate_matched(
+    setup: CoSimSetup, label: str, duration: float, progress: bool
+) -> tuple[dict, np.ndarray, float]:
+    """Co-simulate `setup` under a progress bar: (recorded variables, the kinematic sample
+    of each recorded row, wall seconds of the co-simulation)."""
+    bar = Progress(label, duration, progress)
+    started = clock.perf_counter()
+    fmu = simulate(setup, step_finished=bar)
+    seconds = clock.perf_counter() - started
+    bar.close()
+    sample = match_samples(fmu, setup.inputs, list(setup.inputs), setup.time)
+    return fmu, sample, seconds

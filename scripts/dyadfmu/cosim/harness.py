@@ -16,17 +16,16 @@ from pathlib import Path
 import numpy as np
 
 from .. import paths
-from ..fmi.simulate import CoSimSetup, setup_for, simulate
+from ..fmi.simulate import CoSimSetup, setup_for
 from ..mechanisms import builtin, crank
 from ..reference import newton_euler
 from .compare import (
     NEAR_SINGULAR,
     OutputError,
-    Progress,
     communication_grid,
-    match_samples,
     output_error,
     rows_of,
+    simulate_matched,
 )
 
 #: FMU output name -> (reference key, component or None).
@@ -168,13 +167,9 @@ def run_mechanism(
         name, fmi_version, revolutions, steps, motion, build
     )
     t, names = setup.time, list(setup.inputs)
-
-    bar = Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
-    started = clock.perf_counter()
-    fmu = simulate(setup, step_finished=bar)
-    seconds_fmu = clock.perf_counter() - started
-    bar.close()
-    sample = match_samples(fmu, setup.inputs, names, t)
+    fmu, sample, seconds_fmu = simulate_matched(
+        setup, f"{name} FMI {fmi_version}", crank_motion.duration, progress
+    )
 
     started = clock.perf_counter()
     values = dict(setup.start_values)

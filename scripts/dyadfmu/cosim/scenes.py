@@ -21,7 +21,6 @@ balance of the whole mechanism: M omega + P_loads = d(T + V)/dt.
 from __future__ import annotations
 
 import math
-import time as clock
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,18 +29,17 @@ import numpy as np
 from fmpy import read_model_description
 
 from .. import paths
-from ..fmi.simulate import setup_for, simulate
+from ..fmi.simulate import setup_for
 from ..mechanisms import builtin, chains
 from ..mechanisms import geometry as geo
 from ..mechanisms.motion import CrankMotion
 from ..reference import newton_euler
 from .compare import (
     NEAR_SINGULAR,
-    Progress,
     communication_grid,
-    match_samples,
     output_error,
     rows_of,
+    simulate_matched,
 )
 
 SCENES_DIR = paths.SCENES_DIR
@@ -276,14 +274,10 @@ def run(
     """Co-simulate a scene's tailored FMU over `revolutions` crank turns at `steps`
     communication steps per turn and compare every output with the reference."""
     co, source, crank_motion, kin = setup(name, fmi_version, revolutions, steps, motion, build)
-    t, inputs, outputs, units, names = co.time, co.inputs, co.outputs, co.units, list(co.inputs)
-
-    bar = Progress(f"{name} FMI {fmi_version}", crank_motion.duration, progress)
-    started = clock.perf_counter()
-    fmu = simulate(co, step_finished=bar)
-    seconds = clock.perf_counter() - started
-    bar.close()
-    sample = match_samples(fmu, inputs, names, t)
+    t, outputs, units = co.time, co.outputs, co.units
+    fmu, sample, seconds = simulate_matched(
+        co, f"{name} FMI {fmi_version}", crank_motion.duration, progress
+    )
     rows = rows_of(kin, sample, t)
     full_ref = source.reference(rows)
     full_ref.update(source.conditioning(rows))

@@ -58,7 +58,6 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import tomllib
 from collections.abc import Mapping
 from importlib import resources
@@ -214,12 +213,7 @@ class Mechanism:
         ``conditioning`` (the dyad's, as the FMU computes it). Non-array entries:
         ``frame`` (fixed pivots and fixed guides for drawing), ``mechanism`` (the name).
         """
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        if t.ndim != 1:
-            raise ValueError(f"t: expected shape (N,), got {t.shape}")
-        phi = np.broadcast_to(motion.phi(t), t.shape).astype(float)
-        w = np.broadcast_to(motion.omega(t), t.shape).astype(float)
-        eps = np.broadcast_to(motion.epsilon(t), t.shape).astype(float)
+        t, phi, w, eps = motion.sampled(t)
         r = self.crank["radius"]
         i_c = geo.unit(phi)
         j_c = geo.rot90(i_c)
@@ -821,15 +815,5 @@ def load(name: str, data: Mapping | None = None) -> Mechanism:
     """
     if name not in NAMES:
         raise ValueError(f"unknown mechanism {name!r}; expected one of: {', '.join(NAMES)}")
-    table = default_data()[name]
-    if data is not None:
-        if isinstance(data, (str, os.PathLike)):
-            with open(data, "rb") as f:
-                data = tomllib.load(f)
-        if not isinstance(data, Mapping):
-            raise ValueError(f"data: expected a mapping or a TOML path, got {type(data).__name__}")
-        over = data[name] if name in data else data
-        if not isinstance(over, Mapping):
-            raise ValueError(f"data[{name!r}]: expected a table")
-        table = geo.merge(table, over)
+    table = geo.overridden(default_data()[name], name, data)
     return _CLASSES[name](name, table)

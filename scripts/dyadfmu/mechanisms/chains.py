@@ -65,7 +65,6 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import tomllib
 from collections.abc import Callable, Mapping
 from importlib import resources
@@ -259,19 +258,20 @@ class Chain:
         self._phi0 = geo.number(md, "phi0", wm, default=0.0)
 
     # ---- resolution of the scene ------------------------------------------
-    def _frame_pivot(self, frame: Mapping | None, dyad: str, pair: str) -> dict:
+    def _frame_table(
+        self, frame: Mapping | None, dyad: str, pair: str, what: str, on: str
+    ) -> tuple[str, str]:
+        """Where the frame's table for ``dyad.pair`` stands, and its label; an error if
+        it is missing."""
+        where = f"{self.name}.frame.{dyad}.{pair}"
         if not isinstance(frame, Mapping):
-            raise ValueError(
-                f"{self.name}.frame.{dyad}.{pair}: missing fixed pivot "
-                f"(the scene puts {dyad}.{pair} on the frame)"
-            )
-        pos = geo.pair(frame, "position", f"{self.name}.frame.{dyad}.{pair}")
-        return {
-            "kind": "pivot",
-            "body": None,
-            "position": pos,
-            "label": str(frame.get("label", f"{dyad}.{pair}")),
-        }
+            raise ValueError(f"{where}: missing {what} (the scene puts {dyad}.{pair} on {on})")
+        return where, str(frame.get("label", f"{dyad}.{pair}"))
+
+    def _frame_pivot(self, frame: Mapping | None, dyad: str, pair: str) -> dict:
+        where, label = self._frame_table(frame, dyad, pair, "fixed pivot", "the frame")
+        pos = geo.pair(frame, "position", where)
+        return {"kind": "pivot", "body": None, "position": pos, "label": label}
 
     def _frame_guide(
         self, spec: Mapping, frame: Mapping | None, dyad: str, pair: str, where: str
@@ -279,19 +279,9 @@ class Chain:
         if "guide" not in spec:
             raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
         angle = geo.number(spec, "guide", where)
-        if not isinstance(frame, Mapping):
-            raise ValueError(
-                f"{self.name}.frame.{dyad}.{pair}: missing guide height "
-                f"(the scene puts {dyad}.{pair} on a frame guide)"
-            )
-        h = geo.number(frame, "height", f"{self.name}.frame.{dyad}.{pair}")
-        return {
-            "kind": "guide",
-            "body": None,
-            "angle": angle,
-            "height": h,
-            "label": str(frame.get("label", f"{dyad}.{pair}")),
-        }
+        at, label = self._frame_table(frame, dyad, pair, "guide height", "a frame guide")
+        h = geo.number(frame, "height", at)
+        return {"kind": "guide", "body": None, "angle": angle, "height": h, "label": label}
 
     def _attachment(self, spec: Mapping, dyad: str, pair: str, done: dict):
         """The external link carrying pair ``pair`` ("D_m" or "D_n") of ``dyad``."""
@@ -560,12 +550,7 @@ class Chain:
         ((x0, y0), (x1, y1))}}, and "link_guides" with guides on moving links, see
         :meth:`_frame`) and ``mechanism`` (the name).
         """
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        if t.ndim != 1:
-            raise ValueError(f"t: expected shape (N,), got {t.shape}")
-        phi = np.broadcast_to(motion.phi(t), t.shape).astype(float)
-        w = np.broadcast_to(motion.omega(t), t.shape).astype(float)
-        eps = np.broadcast_to(motion.epsilon(t), t.shape).astype(float)
+        t, phi, w, eps = motion.sampled(t)
         kin = self._solve(t, phi, w, eps)
         kin["frame"] = self.frame()
         kin["mechanism"] = self.name
@@ -1151,17 +1136,7 @@ def load(name: str, data: Mapping | None = None) -> Chain:
     mechanism's own table, or the path of a TOML file of the same form."""
     if name not in NAMES:
         raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
-    table = default_data()[name]
-    if data is not None:
-        if isinstance(data, (str, os.PathLike)):
-            with open(data, "rb") as f:
-                data = tomllib.load(f)
-        if not isinstance(data, Mapping):
-            raise ValueError(f"data: expected a mapping or a TOML path, got {type(data).__name__}")
-        over = data[name] if name in data else data
-        if not isinstance(over, Mapping):
-            raise ValueError(f"data[{name!r}]: expected a table")
-        table = geo.merge(table, over)
+    table = geo.overridden(default_data()[name], name, data)
     with open(scene_path(name), "rb") as f:
         scene = tomllib.load(f)
     return Chain(name, scene, table)

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import copy
 import math
+import os
+import tomllib
 from collections.abc import Mapping
 
 import numpy as np
@@ -51,6 +53,22 @@ def merge(base: Mapping, over: Mapping) -> dict:
         else:
             out[key] = copy.deepcopy(value)
     return out
+
+
+def overridden(table: Mapping, name: str, data: Mapping | str | os.PathLike | None) -> dict:
+    """``table`` with ``data`` merged in key by key: a mapping, either the whole document
+    (with a table ``name``) or ``name``'s own table, or the path of a TOML file of that form."""
+    if data is None:
+        return table
+    if isinstance(data, (str, os.PathLike)):
+        with open(data, "rb") as f:
+            data = tomllib.load(f)
+    if not isinstance(data, Mapping):
+        raise ValueError(f"data: expected a mapping or a TOML path, got {type(data).__name__}")
+    over = data[name] if name in data else data
+    if not isinstance(over, Mapping):
+        raise ValueError(f"data[{name!r}]: expected a table")
+    return merge(table, over)
 
 
 def number(

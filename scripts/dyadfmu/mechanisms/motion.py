@@ -24,6 +24,17 @@ class CrankMotion:
     cycles: float
     description: str = ""
 
+    def sampled(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The times ``t`` as a float array of shape (N,), and the crank's angle, angular
+        velocity and angular acceleration at them, each a float array of that shape."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if t.ndim != 1:
+            raise ValueError(f"t: expected shape (N,), got {t.shape}")
+        phi = np.broadcast_to(self.phi(t), t.shape).astype(float)
+        w = np.broadcast_to(self.omega(t), t.shape).astype(float)
+        eps = np.broadcast_to(self.epsilon(t), t.shape).astype(float)
+        return t, phi, w, eps
+
 
 def rotating(
     kind: str, w0: float, variation: float, phi0: float, revolutions: float

@@ -308,14 +308,6 @@ def _label_points(c: _Canvas, names: dict) -> dict:
     return shown
 
 
-def _checked_scale(scale: float | None) -> float | None:
-    if scale is not None:
-        scale = float(scale)
-        if not (scale > 0 and math.isfinite(scale)):
-            raise ValueError(f"scale must be a positive number (N/m), got {scale!r}")
-    return scale
-
-
 def _draw_reactions(c: _Canvas, vectors: list, scale: float, labels: dict) -> dict:
     """Every pair force as an arrow from its point of application, with a legend."""
     u, arrows = c.u, {}
@@ -354,15 +346,6 @@ def _draw_reactions(c: _Canvas, vectors: list, scale: float, labels: dict) -> di
     return arrows
 
 
-def _finish_axes(ax: Axes) -> None:
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.autoscale_view()
-    ax.margins(0.06)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.grid(True, lw=0.3, alpha=0.5)
-
-
 def draw(
     ax: Axes,
     chain: Chain,
@@ -380,14 +363,7 @@ def draw(
     chosen so that the largest arrow is 40 % of the mechanism's size. Returns
     {"scale": N/m, "arrows": {output name: arrow patch}}.
     """
-    n_samples = len(np.atleast_1d(kin["t"]))
-    if not -n_samples <= index < n_samples:
-        raise IndexError(f"index {index} out of range for {n_samples} samples")
-    index = int(index) % n_samples
-
-    def at(key: str) -> np.ndarray:
-        return np.asarray(kin[key][index], dtype=float)
-
+    index, at = sketch.sample_at(kin, index)
     size = chain_size(chain, kin)
     colours = {chain.crank_name: _CRANK_COLOUR}
     for i, g in enumerate(chain.links):
@@ -401,7 +377,7 @@ def draw(
     shown = _label_points(c, names)
     for b, p in c.link_label_at.items():
         sketch.label(ax, p, b, (0.0, 0.0), colour=colours[b], size=9, weight="bold", box=False)
-    scale = _checked_scale(scale)
+    scale = sketch.checked_scale(scale)
     arrows = {}
     if reactions:
         vectors = reaction_vectors(chain, reactions, index)
@@ -412,7 +388,7 @@ def draw(
         arrows = _draw_reactions(c, vectors, scale, labels)
     elif scale is None:
         scale = 1.0
-    _finish_axes(ax)
+    sketch.finish_axes(ax, 0.06)
     return {"scale": scale, "arrows": arrows}
 
 

@@ -264,23 +264,6 @@ def _draw_reactions(
         )
 
 
-def _finish_axes(ax: Axes) -> None:
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.autoscale_view()
-    ax.margins(0.08)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.grid(True, lw=0.3, alpha=0.5)
-
-
-def _checked_scale(scale: float | None) -> float | None:
-    if scale is not None:
-        scale = float(scale)
-        if not (scale > 0 and math.isfinite(scale)):
-            raise ValueError(f"scale must be a positive number (N/m), got {scale!r}")
-    return scale
-
-
 def draw(
     ax: Axes,
     mechanism: Mechanism,
@@ -298,14 +281,7 @@ def draw(
     N per m of drawing: ``scale`` if given, else chosen so that the largest arrow is
     40 % of the mechanism's size. Returns the scale used (N/m).
     """
-    n_samples = len(kin["t"])
-    if not -n_samples <= index < n_samples:
-        raise IndexError(f"index {index} out of range for {n_samples} samples")
-    index = int(index) % n_samples
-
-    def at(key: str) -> np.ndarray:
-        return np.asarray(kin[key][index], dtype=float)
-
+    _, at = sketch.sample_at(kin, index)
     size = mechanism_size(mechanism, kin)
     u = 0.035 * size  # size of the symbols
     p_label = _draw_crank(ax, mechanism, at, u)
@@ -328,7 +304,7 @@ def draw(
             weight="bold",
             box=False,
         )
-    scale = _checked_scale(scale)
+    scale = sketch.checked_scale(scale)
     if reactions:
         forces = _finite_forces(reactions)
         largest = max((float(np.hypot(*f)) for f in forces.values()), default=0.0)
@@ -337,5 +313,5 @@ def draw(
         _draw_reactions(ax, at, u, size, forces, scale)
     elif scale is None:
         scale = 1.0
-    _finish_axes(ax)
+    sketch.finish_axes(ax, 0.08)
     return scale

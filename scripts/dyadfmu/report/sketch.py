@@ -4,6 +4,7 @@ blocks, hatched ground, fixed pivots and labels; ``u`` is the drawing's unit len
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -162,3 +163,36 @@ def away(
     if n < 1e-12:
         d, n = np.asarray(default, dtype=float), float(np.hypot(*default))
     return d / n
+
+
+def sample_at(kin: dict, index: int) -> tuple[int, Callable[[str], np.ndarray]]:
+    """Sample ``index`` of ``kin`` (negative counts from the end): the index made
+    non-negative and a function key -> that sample's value as a float array."""
+    n_samples = len(np.atleast_1d(kin["t"]))
+    if not -n_samples <= index < n_samples:
+        raise IndexError(f"index {index} out of range for {n_samples} samples")
+    index = int(index) % n_samples
+
+    def at(key: str) -> np.ndarray:
+        return np.asarray(kin[key][index], dtype=float)
+
+    return index, at
+
+
+def checked_scale(scale: float | None) -> float | None:
+    """A force scale (N/m) as a float, or None; a ValueError unless positive and finite."""
+    if scale is not None:
+        scale = float(scale)
+        if not (scale > 0 and math.isfinite(scale)):
+            raise ValueError(f"scale must be a positive number (N/m), got {scale!r}")
+    return scale
+
+
+def finish_axes(ax: Axes, margin: float) -> None:
+    """Equal aspect, autoscaled with ``margin``, axes in metres, a light grid."""
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.autoscale_view()
+    ax.margins(margin)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.grid(True, lw=0.3, alpha=0.5)

@@ -272,50 +272,41 @@ def run(
     return results
 
 
-def _write_points(path: Path, points: list[tuple]) -> None:
+def _write_csv(path: Path, header: list[str], rows: list[list]) -> None:
     with open(path, "w", newline="") as handle:
         writer = csv.writer(handle)
-        writer.writerow(
-            [
-                "set",
-                "type",
-                "method",
-                "index",
-                "amplification",
-                "error",
-                "componentwise_error",
-                "status",
-            ]
-        )
-        for p in points:
-            writer.writerow(
-                [p[0], p[1], p[2], p[3], f"{p[4]:.6e}", f"{p[5]:.6e}", f"{p[6]:.6e}", p[7]]
-            )
+        writer.writerow(header)
+        writer.writerows(rows)
+
+
+def _write_points(path: Path, points: list[tuple]) -> None:
+    header = "set type method index amplification error componentwise_error status".split()
+    rows = [
+        [p[0], p[1], p[2], p[3], f"{p[4]:.6e}", f"{p[5]:.6e}", f"{p[6]:.6e}", p[7]] for p in points
+    ]
+    _write_csv(path, header, rows)
 
 
 def _write_summary_csv(path: Path, summary: list[dict]) -> None:
-    with open(path, "w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(
-            [
-                "method",
-                "type",
-                "median_error",
-                "worst_error",
-                "worst_componentwise_error",
-                "seconds_per_config",
-                "instructions_per_solve",
-            ]
-        )
-        for s in summary:
-            writer.writerow(
-                [
-                    s["method"],
-                    s["type"],
-                    f"{s['median']:.3e}",
-                    f"{s['worst']:.3e}",
-                    f"{s['componentwise']:.3e}",
-                    f"{s['seconds']:.4e}",
-                    f"{s.get('instructions', math.nan):.0f}",
-                ]
-            )
+    header = [
+        "method",
+        "type",
+        "median_error",
+        "worst_error",
+        "worst_componentwise_error",
+        "seconds_per_config",
+        "instructions_per_solve",
+    ]
+    rows = [
+        [
+            s["method"],
+            s["type"],
+            f"{s['median']:.3e}",
+            f"{s['worst']:.3e}",
+            f"{s['componentwise']:.3e}",
+            f"{s['seconds']:.4e}",
+            f"{s.get('instructions', math.nan):.0f}",
+        ]
+        for s in summary
+    ]
+    _write_csv(path, header, rows)
