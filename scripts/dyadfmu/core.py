@@ -19,6 +19,8 @@ if TYPE_CHECKING:
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 STATUS = {0: "ok", 1: "singular", 2: "invalid input", 3: "out of range"}
+#: The scalar reactions of a solve: joint-normal forces and moments.
+REACTION_SCALARS = ("n_mk", "n_np", "n_mn", "m_mk", "m_np", "m_mn")
 LINK_KEYS = (
     "dir",
     "length",
@@ -155,17 +157,7 @@ class Core:
         out = {
             name: (getattr(res, name).x, getattr(res, name).y) for name in ("r_mk", "r_np", "r_mn")
         }
-        for name in (
-            "n_mk",
-            "n_np",
-            "n_mn",
-            "m_mk",
-            "m_np",
-            "m_mn",
-            "denominator",
-            "conditioning",
-            "amplification",
-        ):
+        for name in (*REACTION_SCALARS, "denominator", "conditioning", "amplification"):
             out[name] = getattr(res, name)
         out["status"] = STATUS.get(res.status, "?")
         out["field"] = self._lib.dyad_field_name(res.field).decode()

@@ -60,6 +60,7 @@ import copy
 import math
 import tomllib
 from collections.abc import Mapping
+from dataclasses import dataclass
 from importlib import resources
 
 import numpy as np
@@ -68,7 +69,7 @@ from . import geometry as geo
 from . import motion as motion_
 from .motion import CrankMotion
 
-__all__ = ["NAMES", "CrankMotion", "Mechanism", "load", "default_data"]
+__all__ = ["NAMES", "CrankMotion", "CrankSample", "Mechanism", "load", "default_data"]
 
 #: The mechanisms, in the order of the documentation.
 NAMES = ("slider-crank", "four-bar", "quick-return", "scotch-yoke", "trt-slot")
@@ -87,6 +88,28 @@ _SLIDING_M = ("RTR", "RTT")
 #: Types with a translational pair at D_m (guide_k) and at D_n (guide_p).
 _GUIDE_K = ("RRT", "TRT", "RTT")
 _GUIDE_P = ("TRT",)
+
+
+@dataclass(frozen=True)
+class CrankSample:
+    """The crank's motion at the sample times: angle, speed and acceleration (N,) and
+    its pin A's position, velocity and acceleration (N, 2)."""
+
+    phi: np.ndarray
+    w: np.ndarray
+    eps: np.ndarray
+    A: np.ndarray
+    vA: np.ndarray
+    aA: np.ndarray
+
+    def pin_origin(self, link: str) -> dict:
+        """Kinematics entries of a link whose origin D is the crank pin A: copies of A,
+        v_A and a_A as ``D_<link>``, ``v_D_<link>`` and ``<link>.accel_d``."""
+        return {
+            f"D_{link}": self.A.copy(),
+            f"v_D_{link}": self.vA.copy(),
+            f"{link}.accel_d": self.aA.copy(),
+        }
 
 
 # ---------------------------------------------------------------------------
@@ -160,15 +183,7 @@ class Mechanism:
     def _setup(self, where: str):  # pragma: no cover - overridden
         raise NotImplementedError
 
-    def _dyad_kinematics(
-        self,
-        phi: np.ndarray,
-        w: np.ndarray,
-        eps: np.ndarray,
-        A: np.ndarray,
-        vA: np.ndarray,
-        aA: np.ndarray,
-    ) -> dict:  # pragma: no cover
+    def _dyad_kinematics(self, crank: CrankSample) -> dict:  # pragma: no cover
         raise NotImplementedError
 
     def _loads(self, kin: dict) -> dict:  # pragma: no cover
@@ -231,7 +246,7 @@ class Mechanism:
             "v_A": vA,
             "a_A": aA,
         }
-        kin.update(self._dyad_kinematics(phi, w, eps, A, vA, aA))
+        kin.update(self._dyad_kinematics(CrankSample(phi, w, eps, A, vA, aA)))
 
         self._point_e(kin)
         self._centres_of_mass(kin, w, eps)
@@ -426,15 +441,8 @@ class SliderCrank(Mechanism):
         pulse = np.exp(self.kappa * (np.cos(psi) - 1.0))
         return self.area * (self.p_base + (self.p_peak - self.p_base) * pulse)
 
-    def _dyad_kinematics(
-        self,
-        phi: np.ndarray,
-        w: np.ndarray,
-        eps: np.ndarray,
-        A: np.ndarray,
-        vA: np.ndarray,
-        aA: np.ndarray,
-    ):
+    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+        phi, A, vA, aA = crank.phi, crank.A, crank.vA, crank.aA
         rod, e = self.l, self.e
         sn = (e - A[:, 1]) / rod  # E_y = e = A_y + rod sin(theta_n)
         cn = np.sqrt(1.0 - sn * sn)  # piston to the right of the crank pin
@@ -449,9 +457,7 @@ class SliderCrank(Mechanism):
             "D_m": B,
             "v_D_m": vB,
             "m.accel_d": aB,
-            "D_n": A.copy(),
-            "v_D_n": vA.copy(),
-            "n.accel_d": aA.copy(),
+            **crank.pin_origin("n"),
             "guide_k.angle": zero.copy(),
         }
         out.update(_link("m", zero, zero, zero, zero))
@@ -500,15 +506,8 @@ class FourBar(Mechanism):
         self.w_ref = geo.number(ld, "w_ref", w, positive=True)
         self.c_visc = geo.number(ld, "c", w)
 
-    def _dyad_kinematics(
-        self,
-        phi: np.ndarray,
-        w: np.ndarray,
-        eps: np.ndarray,
-        A: np.ndarray,
-        vA: np.ndarray,
-        aA: np.ndarray,
-    ):
+    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+        A, vA, aA = crank.A, crank.vA, crank.aA
         b, c = self.links["n"]["length"], self.links["m"]["length"]
         O4 = np.broadcast_to(np.asarray(self.O4, dtype=float), A.shape)
         dv = A - O4
@@ -533,9 +532,7 @@ class FourBar(Mechanism):
             "D_m": O4.copy(),
             "v_D_m": zero.copy(),
             "m.accel_d": zero.copy(),
-            "D_n": A.copy(),
-            "v_D_n": vA.copy(),
-            "n.accel_d": aA.copy(),
+            **crank.pin_origin("n"),
         }
         out.update(_link("m", tm, wm, em, c))
         out.update(_link("n", tn, wn, en, b))
@@ -583,15 +580,8 @@ class QuickReturn(Mechanism):
         self.M0 = geo.number(ld, "M0", wl)
         self.w_ref = geo.number(ld, "w_ref", wl, positive=True)
 
-    def _dyad_kinematics(
-        self,
-        phi: np.ndarray,
-        w: np.ndarray,
-        eps: np.ndarray,
-        A: np.ndarray,
-        vA: np.ndarray,
-        aA: np.ndarray,
-    ):
+    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+        A, vA, aA = crank.A, crank.vA, crank.aA
         O2 = np.broadcast_to(np.asarray(self.O2, dtype=float), A.shape)
         dv = A - O2
         lm = np.hypot(dv[:, 0], dv[:, 1])
@@ -607,9 +597,7 @@ class QuickReturn(Mechanism):
             "D_m": O2.copy(),
             "v_D_m": zero.copy(),
             "m.accel_d": zero.copy(),
-            "D_n": A.copy(),
-            "v_D_n": vA.copy(),
-            "n.accel_d": aA.copy(),
+            **crank.pin_origin("n"),
         }
         out.update(_link("m", tm, wm, em, lm, dlm, ddlm))
         out.update(_link("n", tm, wm, em, 0.0 * lm))  # the block turns with the lever
@@ -664,15 +652,8 @@ class ScotchYoke(Mechanism):
         self.v_ref = geo.number(ld, "v_ref", w, positive=True)
         self.c_visc = geo.number(ld, "c", w)
 
-    def _dyad_kinematics(
-        self,
-        phi: np.ndarray,
-        w: np.ndarray,
-        eps: np.ndarray,
-        A: np.ndarray,
-        vA: np.ndarray,
-        aA: np.ndarray,
-    ):
+    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+        phi, A, vA, aA = crank.phi, crank.A, crank.vA, crank.aA
         h = self.h
         up = np.full_like(phi, math.pi / 2.0)
         zero = np.zeros_like(phi)
@@ -680,9 +661,7 @@ class ScotchYoke(Mechanism):
             "D_m": geo.vec(A[:, 0], -h + zero),
             "v_D_m": geo.vec(vA[:, 0], zero),
             "m.accel_d": geo.vec(aA[:, 0], zero),
-            "D_n": A.copy(),
-            "v_D_n": vA.copy(),
-            "n.accel_d": aA.copy(),
+            **crank.pin_origin("n"),
             "guide_k.angle": zero.copy(),
         }
         out.update(_link("m", up, zero, zero, A[:, 1] + h, vA[:, 1], aA[:, 1]))
@@ -753,15 +732,8 @@ class TRTSlot(Mechanism):
                     f"guide at the extreme angle ({h / s:.4g} m)"
                 )
 
-    def _dyad_kinematics(
-        self,
-        phi: np.ndarray,
-        w: np.ndarray,
-        eps: np.ndarray,
-        A: np.ndarray,
-        vA: np.ndarray,
-        aA: np.ndarray,
-    ):
+    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+        phi, w, eps = crank.phi, crank.w, crank.eps
         h = self.h
         c, s = np.cos(phi), np.sin(phi)
         x = h * c / s

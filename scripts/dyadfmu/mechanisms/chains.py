@@ -132,6 +132,12 @@ def _sign(table: Mapping, key: str, where: str):
     return value
 
 
+def _require_listed(listed: list, lname: str, what: str, where: str) -> None:
+    """A load model on a link needs the scene's [loads] to list a `what` on it."""
+    if lname not in listed:
+        raise ValueError(f"{where}: the scene lists no {what} on {lname!r} ([loads].{what})")
+
+
 # ---------------------------------------------------------------------------
 # the chains
 # ---------------------------------------------------------------------------
@@ -422,10 +428,7 @@ class Chain:
                 raise ValueError(f"{where}: unknown link {lname!r}")
             kind = model.get("model")
             if kind == "cutting":
-                if lname not in forces:
-                    raise ValueError(
-                        f"{where}: the scene lists no force on {lname!r} ([loads].force)"
-                    )
+                _require_listed(forces, lname, "force", where)
                 self._loads[lname] = {
                     "model": kind,
                     "F0": geo.number(model, "F0", where),
@@ -433,10 +436,7 @@ class Chain:
                     "s": _sign(model, "s", where) if "s" in model else 1.0,
                 }
             elif kind == "resisting-torque":
-                if lname not in moments:
-                    raise ValueError(
-                        f"{where}: the scene lists no moment on {lname!r} ([loads].moment)"
-                    )
+                _require_listed(moments, lname, "moment", where)
                 self._loads[lname] = {
                     "model": kind,
                     "T0": geo.number(model, "T0", where),
@@ -444,10 +444,7 @@ class Chain:
                     "c": geo.number(model, "c", where),
                 }
             elif kind == "resisting-force":
-                if lname not in forces:
-                    raise ValueError(
-                        f"{where}: the scene lists no force on {lname!r} ([loads].force)"
-                    )
+                _require_listed(forces, lname, "force", where)
                 dyad = next((e for e in self.plan if e["type"] == "RRT" and e["m"] == lname), None)
                 if dyad is None:
                     raise ValueError(
@@ -1008,6 +1005,21 @@ def _rrr(
     return sm, sn, E
 
 
+def _along_guide(
+    along: np.ndarray, across: np.ndarray, ln: np.ndarray, branch: float, name: str
+) -> np.ndarray:
+    """Where the rod (length ``ln``) from P meets the guide line: the offset s of E along
+    the line from its origin, given P's offsets ``along`` and ``across`` the line from that
+    origin; ``branch`` +1: E ahead of the foot of P."""
+    root2 = ln * ln - across * across
+    if np.any(~(root2 > 0.0)):
+        raise ValueError(
+            f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
+            f"crank angle (distance up to {np.abs(across).max():.4g} m)"
+        )
+    return along + branch * np.sqrt(root2)
+
+
 def _rrt(
     guide: np.ndarray,
     height: float,
@@ -1030,13 +1042,7 @@ def _rrt(
     line = base + lm * i_m  # E = line + s i_k
     d = P - line
     along, across = d @ i_k, d @ j_k
-    root2 = ln * ln - across * across
-    if np.any(~(root2 > 0.0)):
-        raise ValueError(
-            f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
-            f"crank angle (distance up to {np.abs(across).max():.4g} m)"
-        )
-    s = along + branch * np.sqrt(root2)
+    s = _along_guide(along, across, ln, branch, name)
     E = line + geo.col(s) * i_k
     i_n = (E - P) / ln
     j_n = geo.rot90(i_n)
@@ -1075,13 +1081,7 @@ def _rrt_on_link(
     j_k = geo.rot90(i_k)
     d = P - (Q + lm * i_k)  # E = Q + (s + lm) i_k
     along, across = geo.dot(d, i_k), geo.dot(d, j_k)
-    root2 = ln * ln - across * across
-    if np.any(~(root2 > 0.0)):
-        raise ValueError(
-            f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
-            f"crank angle (distance up to {np.abs(across).max():.4g} m)"
-        )
-    s = along + branch * np.sqrt(root2)
+    s = _along_guide(along, across, ln, branch, name)
     Dm = Q + geo.col(s) * i_k
     E = Dm + lm * i_k
     i_n = (E - P) / ln

@@ -155,17 +155,7 @@ def study_points(
         for ratio in ratios:
             s = cosim.setup(name, ratio)
             # warm-up: one step, untimed, so that no run pays for the first library load
-            cosim.run(
-                s.mech,
-                "stabilised",
-                s.t_end,
-                s.t_end,
-                s.motor,
-                s.phi0,
-                s.omega0,
-                fmi_version,
-                drive=drive,
-            )
+            cosim.run_setup(s, "stabilised", s.t_end, fmi_version, drive=drive)
             ref = cosim.reference_for(s, min(steps), rtol=rtol, atol=atol)
             refs[(name, ratio)] = ref
             _log(verbose, f"{name} ratio {ratio:g}: reference in {ref.wall_time:.1f} s")

@@ -102,6 +102,11 @@ def ground_pivot(ax: Axes, p: np.ndarray, u: float) -> None:
     hatch(ax, base - np.array([1.4 * u, 0.0]), base + np.array([1.4 * u, 0.0]), (0.0, -1.0), u)
 
 
+def _side(d: float, r: float, negative: str, positive: str) -> str:
+    """The alignment of text offset by d (of length r) along one axis: it grows away."""
+    return positive if d > 0.35 * r else negative if d < -0.35 * r else "center"
+
+
 def label(
     ax: Axes,
     p: np.ndarray,
@@ -114,20 +119,8 @@ def label(
 ) -> None:
     """Text near p, ``offset`` in points; aligned so that it grows away from p."""
     dx, dy = offset
-    ha = (
-        "left"
-        if dx > 0.35 * math.hypot(dx, dy)
-        else "right"
-        if dx < -0.35 * math.hypot(dx, dy)
-        else "center"
-    )
-    va = (
-        "bottom"
-        if dy > 0.35 * math.hypot(dx, dy)
-        else "top"
-        if dy < -0.35 * math.hypot(dx, dy)
-        else "center"
-    )
+    r = math.hypot(dx, dy)
+    ha, va = _side(dx, r, "right", "left"), _side(dy, r, "top", "bottom")
     bbox = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75) if box else None
     ax.annotate(
         text,

@@ -36,6 +36,13 @@ def bench_binary(build: Path, real: str) -> Path:
     return path
 
 
+def bench_arguments(dyad: str, method: str, inputs: Path) -> list[str]:
+    """The benchmark program's arguments naming the dyad, the method and the inputs file
+    (``core_float`` is the ``core`` method of the float program)."""
+    method = "core" if method == "core_float" else method
+    return ["--type", dyad, "--method", method, "--inputs", str(inputs)]
+
+
 def run_bench(binary: Path, args: list[str]) -> dict:
     """Run the benchmark program; its last line of output as JSON."""
     done = subprocess.run([str(binary), *args], capture_output=True, text=True)
@@ -59,14 +66,7 @@ def bench_method(
     binary = bench_binary(build, real)
     inputs, outputs = work / "inputs.bin", work / "outputs.bin"
     rows.astype("<f8").tofile(inputs)
-    args = [
-        "--type",
-        dyad,
-        "--method",
-        "core" if real == "float" else method,
-        "--inputs",
-        str(inputs),
-    ]
+    args = bench_arguments(dyad, method, inputs)
     run_bench(binary, args + ["--outputs", str(outputs), "--repeat", "1"])
     result = np.fromfile(outputs, dtype="<f8").reshape(len(rows), 16)
     if repeat == 0:
@@ -91,12 +91,7 @@ def instructions(build: Path, method: str, dyad: str, rows: np.ndarray, work: Pa
             "--toggle-collect=bench_loop_*",
             f"--callgrind-out-file={work / 'callgrind.out'}",
             str(bench_binary(build, real)),
-            "--type",
-            dyad,
-            "--method",
-            "core" if real == "float" else method,
-            "--inputs",
-            str(inputs),
+            *bench_arguments(dyad, method, inputs),
             "--repeat",
             "1",
         ],

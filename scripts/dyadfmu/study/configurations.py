@@ -17,6 +17,8 @@ import math
 import mpmath
 import numpy as np
 
+from ..core import REACTION_SCALARS
+
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}
 # Lengths that may be zero (m, n), as the paper states.
@@ -67,12 +69,7 @@ OUTPUT_COLUMNS = (
     "r_np.y",
     "r_mn.x",
     "r_mn.y",
-    "n_mk",
-    "n_np",
-    "n_mn",
-    "m_mk",
-    "m_np",
-    "m_mn",
+    *REACTION_SCALARS,
 )
 
 #: Threshold given to the solvers in the study: low enough that the core
