@@ -193,11 +193,7 @@ class Mechanism:
     def motion(self, kind: str = "constant", revolutions: float = 2.0) -> CrankMotion:
         """The crank's motion over ``revolutions`` revolutions (kind "constant": constant
         speed; "varying": omega = w0 (1 + a sin(w0 t)), phi integrated exactly)."""
-        if kind not in ("constant", "varying"):
-            raise ValueError(f"unknown motion kind {kind!r}; expected 'constant' or 'varying'")
-        revolutions = float(revolutions)
-        if not (revolutions > 0 and math.isfinite(revolutions)):
-            raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
+        revolutions = motion_.checked_request(kind, revolutions)
         md, w = self._motion_data, f"{self.name}.motion"
         return motion_.rotating(
             kind,
@@ -699,11 +695,7 @@ class TRTSlot(Mechanism):
         sin(omega t) (kind "varying" adds harmonic2 sin(2 omega t)). A full turn is
         impossible: at phi = 0 and pi the slot is parallel to the guide (E at infinity,
         conditioning sin phi = 0)."""
-        if kind not in ("constant", "varying"):
-            raise ValueError(f"unknown motion kind {kind!r}; expected 'constant' or 'varying'")
-        revolutions = float(revolutions)
-        if not (revolutions > 0 and math.isfinite(revolutions)):
-            raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
+        revolutions = motion_.checked_request(kind, revolutions)
         md, w = self._motion_data, f"{self.name}.motion"
         return motion_.oscillating(
             kind,

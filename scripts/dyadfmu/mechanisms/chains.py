@@ -522,11 +522,7 @@ class Chain:
     def motion(self, kind: str = "constant", revolutions: float = 2.0) -> CrankMotion:
         """The crank's motion over ``revolutions`` full turns (counter-clockwise). kind
         "constant": omega = w0; "varying": omega = w0 (1 + a sin(w0 t)), phi exact."""
-        if kind not in ("constant", "varying"):
-            raise ValueError(f"unknown motion kind {kind!r}; expected 'constant' or 'varying'")
-        revolutions = float(revolutions)
-        if not (revolutions > 0 and math.isfinite(revolutions)):
-            raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
+        revolutions = motion_.checked_request(kind, revolutions)
         return motion_.rotating(kind, self._w0, self._variation, self._phi0, revolutions)
 
     # ---- kinematics -------------------------------------------------------

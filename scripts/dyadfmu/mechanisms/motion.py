@@ -36,6 +36,17 @@ class CrankMotion:
         return t, phi, w, eps
 
 
+def checked_request(kind: str, revolutions: float) -> float:
+    """The number of revolutions (or cycles) asked of a motion of ``kind``, checked:
+    kind "constant" or "varying", revolutions a positive finite number."""
+    if kind not in ("constant", "varying"):
+        raise ValueError(f"unknown motion kind {kind!r}; expected 'constant' or 'varying'")
+    revolutions = float(revolutions)
+    if not (revolutions > 0 and math.isfinite(revolutions)):
+        raise ValueError(f"revolutions must be a positive number, got {revolutions!r}")
+    return revolutions
+
+
 def rotating(
     kind: str, w0: float, variation: float, phi0: float, revolutions: float
 ) -> CrankMotion:
