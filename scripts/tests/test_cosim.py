@@ -349,7 +349,7 @@ def test_drive_fmu_acceleration_is_for_the_current_inputs(version):
         for slave in (fmu, stand_in):
             slave.do_step(0.0, 1e-3)
         np.testing.assert_allclose(
-            fmu.get(cosim._DRIVE_OUTPUTS), stand_in.get(cosim._DRIVE_OUTPUTS), rtol=1e-7
+            fmu.get(cosim.DRIVE_OUTPUTS), stand_in.get(cosim.DRIVE_OUTPUTS), rtol=1e-7
         )
         assert fmu.get_status() == 0
         fmu.set(("load.inertia",), (-1.0,))  # inertia + load.inertia < 0

@@ -209,13 +209,13 @@ def test_monolithic_energy_balance_detects_a_wrong_equation(monkeypatch):
     """Drop J' from the equation of motion: the energy balance breaks."""
     mech = mechanisms.load("slider-crank")
     motor = machine.default_motor(mech)
-    right = machine._machine_terms
+    right = machine.machine_terms
 
     def wrong(mech_, phi, omega):
         J, dJ, Q = right(mech_, phi, omega)
         return J, 0.0 * dJ, Q
 
-    monkeypatch.setattr(machine, "_machine_terms", wrong)
+    monkeypatch.setattr(machine, "machine_terms", wrong)
     run = machine.monolithic(mech, motor, 0.03, 0.0, 0.0, rtol=1e-6, atol=1e-8)
     assert _energy_error(run) > 1e-3
 

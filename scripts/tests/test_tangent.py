@@ -54,11 +54,11 @@ def _reference_scalar(dyad, m, n, gk, gp, grav):
     """The reference's Newton-Euler solve for one configuration, in whatever
     number type the inputs carry (complex for the complex step)."""
     kinds = tuple(reference.PAIRS[dyad])
-    a_rows, b_rows = reference._system(kinds, m, n, gk, gp, grav)
+    a_rows, b_rows = reference.equilibrium_system(kinds, m, n, gk, gp, grav)
     a = np.array([[complex(x) for x in row] for row in a_rows])
     b = np.array([complex(x) for x in b_rows])
     u = list(np.linalg.solve(a, b))
-    out = reference._unpack(kinds, u, gk, gp, m["dir"], 0j, 0j)
+    out = reference.reactions_of_unknowns(kinds, u, gk, gp, m["dir"], 0j, 0j)
     flat = []
     for name in OUTPUTS:
         v = out[name]

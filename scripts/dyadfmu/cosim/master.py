@@ -76,6 +76,7 @@ __all__ = [
     "DURATIONS",
     "START_ANGLE",
     "DIVERGENCE_SPEED_FACTOR",
+    "DRIVE_OUTPUTS",
     "drive_fmu_path",
     "drive_available",
     "crank_inertia_about_pivot",
@@ -106,7 +107,8 @@ START_ANGLE = 0.5
 #: A run has diverged once |omega| exceeds this many times the motor's no-load speed.
 DIVERGENCE_SPEED_FACTOR = 20.0
 
-_DRIVE_OUTPUTS = ("crank.angle", "crank.omega", "crank.epsilon", "motor.torque")
+#: The drive FMU's outputs the master reads after each step (crank state, motor torque).
+DRIVE_OUTPUTS = ("crank.angle", "crank.omega", "crank.epsilon", "motor.torque")
 _DRIVE_INPUTS = ("load.torque", "load.inertia")
 _DYAD_STATUS = {0: "ok", 1: "singular", 2: "invalid input", 3: "out of range"}
 
@@ -301,7 +303,7 @@ class _Coupling:
         self.residual = 0.0
 
     def _crank_state(self, t: float) -> tuple:
-        phi, omega, eps_prev, _ = self.d.get(_DRIVE_OUTPUTS)
+        phi, omega, eps_prev, _ = self.d.get(DRIVE_OUTPUTS)
         if not math.isfinite(omega) or not math.isfinite(phi):
             raise _Diverged(
                 t,

@@ -58,6 +58,7 @@ __all__ = [
     "state_kinematics",
     "reduced_inertia",
     "generalized_load",
+    "machine_terms",
     "crank_torque_from_kinetostatics",
     "phi_range",
     "mean_reduced_inertia",
@@ -222,7 +223,9 @@ def _load_term(mech: Mechanism, kin1: dict, kin_w: dict):
     return crank_balance.load_power(mech, merged)
 
 
-def _machine_terms(mech: Mechanism, phi: np.ndarray, omega: np.ndarray):
+def machine_terms(
+    mech: Mechanism, phi: np.ndarray, omega: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """J, J', Q at 1-D arrays phi, omega with one kinematics call of 2N samples."""
     n = phi.size
     kin = _state_kinematics_flat(
@@ -355,7 +358,7 @@ def _rhs_factory(mech: Mechanism, motor: Motor):
     Jr = motor.rotor_inertia
 
     def accel(phi: np.ndarray, omega: np.ndarray):
-        J, dJ, Q = _machine_terms(mech, phi, omega)
+        J, dJ, Q = machine_terms(mech, phi, omega)
         T = motor.torque(omega)
         eps = (T + Q - 0.5 * dJ * omega * omega) / (Jr + J)
         return eps, T, Q, J

@@ -53,7 +53,16 @@ try:  # mpmath is needed only by solve_mp
 except ImportError:  # pragma: no cover
     mpmath = None
 
-__all__ = ["PAIRS", "LINK_KEYS", "UNKNOWNS", "assemble", "solve", "solve_mp"]
+__all__ = [
+    "PAIRS",
+    "LINK_KEYS",
+    "UNKNOWNS",
+    "assemble",
+    "equilibrium_system",
+    "reactions_of_unknowns",
+    "solve",
+    "solve_mp",
+]
 
 #: Pair kinds (D_m, E, D_n) of each dyad type.
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}
@@ -137,9 +146,9 @@ def _known_loads(L: dict, grav: np.ndarray):
     return F, M
 
 
-def _system(
+def equilibrium_system(
     kinds: tuple, m: dict, n: dict, gk: np.ndarray | None, gp: np.ndarray | None, grav: np.ndarray
-):
+) -> tuple[list, list]:
     """Assemble A (6x6 nested list) and b (list of 6) of the dyad equations."""
     A = [[0] * 6 for _ in range(6)]
     k_dm, k_e, k_dn = kinds
@@ -173,7 +182,7 @@ def _system(
     return A, b
 
 
-def _unpack(
+def reactions_of_unknowns(
     kinds: tuple,
     u: np.ndarray,
     gk: np.ndarray | None,
@@ -181,7 +190,7 @@ def _unpack(
     dir_m: np.ndarray,
     nan: np.ndarray,
     zero: np.ndarray,
-):
+) -> dict:
     """Map the unknown vector u (indexable, 6 entries) to the output dict."""
     out = {}
     for pair, kind, col, guide in (
@@ -290,7 +299,7 @@ def _assemble_np(
     gp: np.ndarray | None,
     grav: np.ndarray,
 ):
-    A_l, b_l = _system(kinds, mm, nn, gk, gp, grav)
+    A_l, b_l = equilibrium_system(kinds, mm, nn, gk, gp, grav)
     A = np.empty((N, 6, 6))
     for r in range(6):
         for c in range(6):
@@ -329,7 +338,7 @@ def solve(
             except np.linalg.LinAlgError:
                 pass
     cols = [u[:, c] for c in range(6)]
-    raw = _unpack(kinds, cols, gk, gp, mm["dir"], np.full(N, np.nan), np.zeros(N))
+    raw = reactions_of_unknowns(kinds, cols, gk, gp, mm["dir"], np.full(N, np.nan), np.zeros(N))
     out = {}
     for k, v in raw.items():
         out[k] = np.stack(v, axis=-1) if k.startswith("r_") else np.asarray(v, dtype=float)
@@ -384,14 +393,14 @@ def solve_mp(
         ]
         gk = vec(guide_k, "guide_k") if guide_k is not None else None
         gp = vec(guide_p, "guide_p") if guide_p is not None else None
-        A_l, b_l = _system(kinds, links[0], links[1], gk, gp, vec(gravity, "gravity"))
+        A_l, b_l = equilibrium_system(kinds, links[0], links[1], gk, gp, vec(gravity, "gravity"))
         A = mpmath.matrix([[mpmath.mpf(x) for x in row] for row in A_l])
         try:
             u = mpmath.lu_solve(A, mpmath.matrix([mpmath.mpf(x) for x in b_l]))
         except ZeroDivisionError as exc:
             raise np.linalg.LinAlgError(f"singular {key} dyad configuration") from exc
         u = [u[c] for c in range(6)]
-        mp_out = _unpack(kinds, u, gk, gp, links[0]["dir"], mpmath.nan, mpmath.mpf(0))
+        mp_out = reactions_of_unknowns(kinds, u, gk, gp, links[0]["dir"], mpmath.nan, mpmath.mpf(0))
         A_float = np.array([[float(x) for x in row] for row in A_l])
 
     out = {}
