@@ -1557,6 +1557,54 @@ static size_t real_outputs(unsigned vrs[])
     return n;
 }
 
+/* The name without a trailing ".x" or ".y": the variables of one vector field. */
+static size_t field_stem_length(const char* name)
+{
+    const size_t n = strlen(name);
+    return n > 2 && name[n - 2] == '.' && (name[n - 1] == 'x' || name[n - 1] == 'y') ? n - 2 : n;
+}
+
+/* Every input and parameter made non-finite in turn, straight in the input block:
+ * the model refuses it and blames a variable of the same field (the variable
+ * itself, or the x of its vector), whatever the core's field numbering. */
+static int test_rrt_bad_input_names_its_variable(void)
+{
+    int fails = 0;
+    size_t k;
+    for (k = 0; k < fmu_this_model.variable_count; ++k) {
+        const fmu_variable* v = &fmu_this_model.variables[k];
+        dyad_input in = dyad_input_default();
+        dyad_result out;
+        fmu_evaluation evaluation;
+        size_t j;
+        if (v->causality == FMU_OUTPUT) {
+            continue;
+        }
+        for (j = 0; j < fmu_this_model.variable_count; ++j) {
+            const fmu_variable* w = &fmu_this_model.variables[j];
+            char* member = (char*)&in + w->offset;
+            const double value = j == k ? (double)NAN : w->start;
+            if (w->target == FMU_TARGET_INPUT_ANGLE) {
+                ((dyad_vec2*)(void*)member)->x = cos(value);
+                ((dyad_vec2*)(void*)member)->y = sin(value);
+            } else if (w->target == FMU_TARGET_INPUT_REAL) {
+                *(double*)(void*)member = value;
+            }
+        }
+        fmu_this_model.behaviour->evaluate(&fmu_this_model, &in, &out, &evaluation);
+        CHECK(evaluation.status == FMU_ERROR && evaluation.bad_variable >= 0,
+              "%s = NaN: status %d, blamed variable %d", v->name, (int)evaluation.status,
+              evaluation.bad_variable);
+        if (evaluation.status == FMU_ERROR && evaluation.bad_variable >= 0) {
+            const char* blamed = fmu_this_model.variables[evaluation.bad_variable].name;
+            const size_t stem = field_stem_length(v->name);
+            CHECK(field_stem_length(blamed) == stem && strncmp(blamed, v->name, stem) == 0,
+                  "%s = NaN blames %s", v->name, blamed);
+        }
+    }
+    return fails;
+}
+
 static int test_rrt_fmi2_core(void)
 {
     int fails = 0;
@@ -1994,6 +2042,7 @@ static const named_test generic_tests[] = {
 /* Tests of one model, run when the FMUs are that model. */
 static const named_test rrt_tests[] = {
     {"rrt_fmi2_core", test_rrt_fmi2_core},
+    {"rrt_bad_input_names_its_variable", test_rrt_bad_input_names_its_variable},
     {"rrt_fmi2_singular", test_rrt_fmi2_singular},
     {"rrt_fmi3_core", test_rrt_fmi3_core},
     {"rrt_fmi3_singular", test_rrt_fmi3_singular},
