@@ -106,6 +106,7 @@ const char* dyad_status_name(dyad_status status)
     case DYAD_STATUS_SINGULAR: return "singular";
     case DYAD_STATUS_INVALID_INPUT: return "invalid input";
     case DYAD_STATUS_OUT_OF_RANGE: return "out of range";
+    case DYAD_STATUS_CANNOT_ASSEMBLE: return "cannot assemble";
     }
     return "?";
 }

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     import numpy as np
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
-STATUS = {0: "ok", 1: "singular", 2: "invalid input", 3: "out of range"}
+STATUS = {0: "ok", 1: "singular", 2: "invalid input", 3: "out of range", 4: "cannot assemble"}
 #: The scalar reactions of a solve: joint-normal forces and moments.
 REACTION_SCALARS = ("n_mk", "n_np", "n_mn", "m_mk", "m_np", "m_mn")
 LINK_KEYS = (

@@ -78,7 +78,7 @@ int dyad_length_may_be_zero(dyad_type type, dyad_link_id link);
 /** "RRR", "RRT", ...; "?" for an unknown type. */
 const char* dyad_type_name(dyad_type type);
 
-/** "ok", "singular", "invalid input", "out of range". */
+/** "ok", "singular", "invalid input", "out of range", "cannot assemble". */
 const char* dyad_status_name(dyad_status status);
 
 /** Dotted field name, e.g. "link_m.length", "guide_k"; "" for NONE. */

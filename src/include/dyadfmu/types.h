@@ -82,7 +82,11 @@ typedef enum dyad_status {
     DYAD_STATUS_INVALID_INPUT,
     /** Inputs were valid and conditioned, but a load or reaction overflows the
      *  scalar type. Outputs are NaN. */
-    DYAD_STATUS_OUT_OF_RANGE
+    DYAD_STATUS_OUT_OF_RANGE,
+    /** Kinematics only (kinematics.h): the dyad cannot close at this motion of
+     *  its external links; dyad_kin_result.failure names the figure and .gap
+     *  says by how much (m). Outputs are NaN. */
+    DYAD_STATUS_CANNOT_ASSEMBLE
 } dyad_status;
 
 /** Input fields, to name the one that made a call invalid. */
