@@ -321,13 +321,21 @@ class SceneKind(Kind):
             f"{ident}_behaviour",
         )
         self.scene = scene
+        if scene.internal():
+            # a mechanism FMU: the kinematics are solved inside, from the driver's motion
+            self.realisation = "mechanism"
+            self.label = "mechanism"
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The closed forms of the scene's dyad types and its generated code."""
         types = sorted({d.type.lower() for d in table.scene.dyads})
+        kinematics = []
+        if table.scene.internal():
+            kinematics = ["dyad_kinematics.c"] + [f"dyad_kin_{t}.c" for t in types]
         return (
             ["dyad_common.c"]
             + [f"dyad_{t}.c" for t in types]
+            + kinematics
             + [
                 f"{table.identifier}_scene.c",
                 "fmu_instance.c",

@@ -6,6 +6,7 @@ and outputs (needs.py fills them in)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -16,6 +17,13 @@ def c_num(x: float) -> str:
     """A double as a C constant that reads back to the same double."""
     text = repr(float(x))
     return text if ("." in text or "e" in text or "inf" in text or "nan" in text) else text + ".0"
+
+
+def unit_vector_c(angle: Param) -> str:
+    """The unit vector at an angle (rad) in C: a constant, or computed where it is tunable."""
+    if angle.tunable:
+        return f"dyad_dir_from_angle({angle.c()})"
+    return f"dyad_vec2_make({c_num(math.cos(angle.value))}, {c_num(math.sin(angle.value))})"
 
 
 def member(name: str) -> str:
@@ -50,7 +58,9 @@ class Attachment:
 
     kind: str  # "frame", "external", "crank", "link"
     link: str | None = None  # the moving link (crank or dyad link) it is on
-    at: tuple[Param, Param] | None = None  # the point in that link's frame
+    #: the point in that link's frame; on the frame (internal kinematics) the fixed pivot
+    #: or a point of the guide's line, global
+    at: tuple[Param, Param] | None = None
     guide: Param | None = None  # guide angle on the frame, for a translational pair
 
 
@@ -85,6 +95,8 @@ class Dyad:
     n: str = ""
     k: Attachment | None = None
     p: Attachment | None = None
+    branch: Param | None = None  # the assembly branch (+1 or -1), internal kinematics
+    internal: bool = False  # its kinematics are solved in the generated code
 
     def prefix(self) -> str:
         """The prefix of its variables' names: 'name.', or none for an unnamed dyad."""
@@ -97,11 +109,17 @@ class Dyad:
 
 @dataclass
 class Crank:
-    """The crank about the fixed pivot O."""
+    """The driver: a crank turning about the frame pivot O, or a ram (a linear actuator)
+    sliding on a frame guide (kind "ram")."""
 
     name: str
     line: int | None
     params: dict = field(default_factory=dict)
+    kind: str = "crank"
+
+    def is_ram(self) -> bool:
+        """Whether the driver is a ram: it translates, and balances with a force."""
+        return self.kind == "ram"
 
 
 @dataclass(eq=False)
@@ -146,6 +164,12 @@ class Scene:
     links: dict  # name -> Link
     gravity_params: tuple | None  # (Param, Param)
     threshold: Param
+    #: "internal": the kinematics are solved in the generated code from the driver's
+    #: motion; "external": every link's motion is an input
+    kinematics: str = "external"
+    #: internal kinematics: the name of a link's motion (as an input would be named,
+    #: "rod.angle") -> the C expression that computes it
+    computed: dict = field(default_factory=dict)
     outputs: list = field(default_factory=list)  # Output
     inputs: list = field(default_factory=list)  # Input, in table order
     #: dyad index -> the dyads that load it (see loaders), computed once
@@ -164,10 +188,16 @@ class Scene:
                     out += a.at
                 if a.guide:
                     out.append(a.guide)
+            if d.branch:
+                out.append(d.branch)
         if self.gravity_params:
             out += self.gravity_params
         out.append(self.threshold)
         return out
+
+    def internal(self) -> bool:
+        """Whether the generated code solves the kinematics from the driver's motion."""
+        return self.kinematics == "internal"
 
     def params_of(self, g: str) -> dict:
         """The numbers of a moving link: the crank's or a dyad link's."""

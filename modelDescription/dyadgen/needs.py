@@ -21,6 +21,7 @@ from dyadgen.model import (
     loaders,
     member,
     own_accel,
+    unit_vector_c,
 )
 
 #: What a dyad's amplification output means (README, "Status, conditioning, amplification").
@@ -76,9 +77,10 @@ def _motion_inputs(scene: Scene, link: Link) -> list[Input]:
     return out
 
 
-def _link_inputs(scene: Scene, link: Link) -> list[Input]:
+def _load_inputs(link: Link) -> list[Input]:
+    """A link's active force and moment inputs, where [loads] lists them."""
     g = link.name
-    out = _motion_inputs(scene, link)
+    out = []
     if link.force:
         for c in "xy":
             out.append(
@@ -100,6 +102,12 @@ def _link_inputs(scene: Scene, link: Link) -> list[Input]:
                 owner=g,
             )
         )
+    return out
+
+
+def _link_inputs(scene: Scene, link: Link) -> list[Input]:
+    g = link.name
+    out = _motion_inputs(scene, link) + _load_inputs(link)
     if link.sliding:
         out.append(
             Input(
@@ -172,14 +180,72 @@ def _guide_inputs(d: Dyad) -> list[Input]:
     return inputs
 
 
+def _ram_inputs(scene: Scene) -> list[Input]:
+    r = scene.crank.name
+    inputs = [
+        Input(
+            f"{r}.position",
+            "m",
+            "Ram displacement x along its guide: its origin R is at + x i_r",
+            member(r) + "_position",
+            owner=r,
+        )
+    ]
+    if scene.inertia:
+        for key, unit, text in (
+            ("velocity", "m/s", "Ram velocity along its guide"),
+            ("acceleration", "m/s2", "Ram acceleration along its guide"),
+        ):
+            inputs.append(Input(f"{r}.{key}", unit, text, f"{member(r)}_{key}", owner=r))
+    return inputs
+
+
 def derive_inputs(scene: Scene) -> None:
-    """Every candidate input of the scene, in table order."""
+    """Every candidate input of the scene, in table order. With internal kinematics they
+    are the driver's motion and the loads; every link's motion is computed (its C
+    expressions are in scene.computed)."""
+    if scene.internal():
+        inputs = _ram_inputs(scene) if scene.crank.is_ram() else _crank_inputs(scene)
+        for d in scene.dyads:
+            for g in (d.m, d.n):
+                inputs += _load_inputs(scene.links[g])
+        scene.inputs = inputs
+        scene.computed = computed_motion(scene)
+        return
     inputs = _crank_inputs(scene) if scene.crank else []
     for d in scene.dyads:
         for g in (d.m, d.n):
             inputs += _link_inputs(scene, scene.links[g])
         inputs += _guide_inputs(d)
     scene.inputs = inputs
+
+
+def kin_name(d: Dyad) -> str:
+    """The member of the generated kinematics block that holds a dyad's result."""
+    return member(d.name or "dyad")
+
+
+def computed_motion(scene: Scene) -> dict[str, str]:
+    """Internal kinematics: every link motion the kinetostatics read, by the name its
+    input would have, as a C expression on the kinematics block `kin`."""
+    out = {}
+    for d in scene.dyads:
+        dn = kin_name(d)
+        for side, g in (("m", d.m), ("n", d.n)):
+            res = f"kin.{dn}.{side}"
+            out[f"{g}.angle"] = f"{res}.dir"
+            out[f"{g}.omega"] = f"{res}.omega"
+            out[f"{g}.epsilon"] = f"{res}.epsilon"
+            out[f"{g}.accel_d.x"] = f"{res}.d.acceleration.x"
+            out[f"{g}.accel_d.y"] = f"{res}.d.acceleration.y"
+            if scene.links[g].sliding:
+                out[f"{g}.length"] = f"{res}.length"
+        for side in "kp":
+            out[f"{d.prefix()}slide_{side}"] = f"kin.{dn}.slide_{side}.s"
+    if scene.crank.is_ram():
+        guide = scene.crank.params["guide"]
+        out[f"{scene.crank.name}.angle"] = unit_vector_c(guide)
+    return out
 
 
 # ---------------------------------------------------------------------------
@@ -212,10 +278,20 @@ class _Index:
         self.unowned = [i.name for i in scene.inputs if i.owner == ""]
 
 
+def _driver_inputs(scene: Scene, upto: int) -> list[str]:
+    """The first `upto` inputs of the driver's motion: its position, velocity, acceleration."""
+    return [i.name for i in scene.inputs if i.owner == scene.crank.name][:upto]
+
+
 def _dependencies(scene: Scene, d: Dyad, index: _Index) -> tuple[list, list]:
     """The inputs of a dyad's reactions, and of its conditioning: the dyad's own
     directions and lengths, and the direction of a guide it slides on (an input, or a
-    moving carrier's angle)."""
+    moving carrier's angle). With internal kinematics: the driver's motion and the loads
+    of the links involved; the conditioning follows the driver's position."""
+    if scene.internal():
+        involved = {d.m, d.n} | {g for o in loaders(scene, d) for g in (o.m, o.n)}
+        loads = [i.name for i in scene.inputs if i.owner in involved]
+        return _driver_inputs(scene, 3) + loads, _driver_inputs(scene, 1)
     involved = {d.m, d.n}
     for other in loaders(scene, d):
         involved |= {other.m, other.n}
@@ -297,6 +373,96 @@ def _dyad_outputs(offer: _Offer, d: Dyad, deps: list, own_geometry: list) -> Non
     offer.add(amp.name, [amp])
 
 
+def _motion_output(
+    offer: _Offer, name: str, unit: str, text: str, c_member: str, depends: list, source: str
+) -> Output:
+    out = Output(name, unit, text, c_member, depends=depends, source=source)
+    offer.add(name, [out])
+    return out
+
+
+def _link_motion_outputs(offer: _Offer, scene: Scene, g: str, source: str) -> None:
+    """A link's angle and, with inertia, its rates; a sliding length."""
+    link = scene.links[g]
+    c = member(g)
+    if not link.translating:
+        text = f"Direction of {g}: angle of i from D towards E, in (-pi, pi]"
+        _motion_output(
+            offer, f"{g}.angle", "rad", text, f"{c}_angle", _driver_inputs(scene, 1), source
+        )
+        if scene.inertia:
+            for key, unit, text, upto in (
+                ("omega", "rad/s", f"Angular velocity of {g}", 2),
+                ("epsilon", "rad/s2", f"Angular acceleration of {g}", 3),
+            ):
+                depends = _driver_inputs(scene, upto)
+                _motion_output(offer, f"{g}.{key}", unit, text, f"{c}_{key}", depends, source)
+    if link.sliding:
+        text = f"Current length |D E| of {g} (pair E slides along it)"
+        _motion_output(
+            offer, f"{g}.length", "m", text, f"{c}_length", _driver_inputs(scene, 1), source
+        )
+
+
+def _kinematic_outputs(offer: _Offer, scene: Scene, d: Dyad) -> None:
+    """Internal kinematics: where a dyad's links and pair points are."""
+    source = f"kin{d.index}"
+    pre = d.prefix()
+    position = _driver_inputs(scene, 1)
+    for g in (d.m, d.n):
+        _link_motion_outputs(offer, scene, g, source)
+    for pair in ("D_m", "E", "D_n"):
+        group = [
+            Output(
+                f"{pre}{pair}.{c}",
+                "m",
+                f"Position of pair {pair} of {d.name or 'the dyad'}, global {c}",
+                f"{member(pre)}{pair.lower()}_{c}",
+                depends=position,
+                source=source,
+            )
+            for c in "xy"
+        ]
+        offer.add(f"{pre}{pair}", group)
+    for side, pair in (("k", "D_m"), ("p", "D_n")):
+        if d.pair_kind("mk" if side == "k" else "np") == "T":
+            text = f"Position of {pair} along its guide, from the guide's point 'at'"
+            name = f"{pre}slide_{side}"
+            _motion_output(offer, name, "m", text, member(name), position, source)
+
+
+def _driver_inertia_outputs(offer: _Offer, scene: Scene) -> None:
+    """Internal kinematics with inertia: the effective inertia at the driver and the
+    balancing torque (force) at zero driver acceleration."""
+    c = scene.crank.name
+    ram = scene.crank.is_ram()
+    unit, rate = ("kg", "m") if ram else ("kg.m2", "rad")
+    balance, bunit = ("force", "N") if ram else ("torque", "N.m")
+    every = [i.name for i in scene.inputs]
+    position = _driver_inputs(scene, 1)
+    texts = (
+        ("J", unit, f"Effective inertia at the driver: {balance} = J q'' + {balance}0", position),
+        ("dJdq", f"{unit}/{rate}", "Derivative of J along the driver's position q", position),
+        (f"{balance}0", bunit, f"Driving {balance} at zero driver acceleration", every),
+    )
+    for key, u, text, depends in texts:
+        source = "crank" if key.endswith("0") else "driver"
+        _motion_output(offer, f"{c}.{key}", u, text, f"{member(c)}_{key.lower()}", depends, source)
+
+
+def _ram_outputs(offer: _Offer, scene: Scene) -> None:
+    c = scene.crank.name
+    every = [i.name for i in scene.inputs]
+    for key, unit, text in (
+        ("force", "N", "Actuator force on the ram along its guide i_r"),
+        ("N", "N", "Normal force on the ram from its guide, along j_r"),
+        ("M", "N.m", "Reactive moment on the ram from its guide, counter-clockwise"),
+    ):
+        _motion_output(
+            offer, f"{c}.{key}", unit, text, f"{member(c)}_{key.lower()}", every, "crank"
+        )
+
+
 def _crank_outputs(offer: _Offer, scene: Scene) -> None:
     c = scene.crank.name
     every = [i.name for i in scene.inputs]
@@ -373,15 +539,24 @@ def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
     offer = _Offer()
     index = _Index(scene)
     for d in scene.dyads:
+        if scene.internal():
+            _kinematic_outputs(offer, scene, d)
         deps, own_geometry = _dependencies(scene, d, index)
         _dyad_outputs(offer, d, deps, own_geometry)
-    if scene.crank:
+    if scene.crank and scene.crank.is_ram():
+        _ram_outputs(offer, scene)
+    elif scene.crank:
         _crank_outputs(offer, scene)
+    if scene.internal() and scene.inertia:
+        _driver_inertia_outputs(offer, scene)
     chosen, problems = _choose(offer, scene, wanted)
+    status_text = "0 ok, 1 a dyad is singular, 3 a reaction overflows"
+    if scene.internal():
+        status_text += ", 4 a dyad cannot assemble"
     status = Output(
         "status",
         None,
-        "0 ok, 1 a dyad is singular, 3 a reaction overflows",
+        status_text,
         "status",
         integer=True,
         depends=[i.name for i in scene.inputs],

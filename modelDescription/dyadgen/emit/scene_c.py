@@ -24,10 +24,12 @@ from pathlib import Path
 from string import Template
 
 from dyadgen import textsafe
+from dyadgen.emit import kinematics_c
 from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, loaders, member
 from dyadgen.table import Table
 
 TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c.in"
+KINEMATICS_TEMPLATE = TEMPLATE.with_name("scene_kinematics.c.in")
 
 
 def _vec(x: str, y: str) -> str:
@@ -68,7 +70,7 @@ class Plan:
         self.crank = scene.crank
         self.names = {i.name: i for i in scene.inputs}
         self.crank_needed = any(o.source == "crank" for o in scene.outputs)
-        needed = {int(o.source) for o in scene.outputs if o.source not in ("", "crank")}
+        needed = {int(o.source) for o in scene.outputs if o.source.isdigit()}
         if self.crank_needed:
             needed |= {d.index for d in scene.dyads if any(a.kind == "crank" for a in (d.k, d.p))}
         for d in list(scene.dyads):
@@ -80,16 +82,29 @@ class Plan:
         self.moving = (crank if self.crank_needed else []) + [
             g for d in self.solved for g in (d.m, d.n)
         ]
+        #: internal kinematics: the effective inertia's outputs, the dyads whose kinematics
+        #: the code solves
+        self.inertia_needed = any(o.source == "driver" for o in scene.outputs) or any(
+            o.name.endswith(("torque0", "force0")) and o.source == "crank" for o in scene.outputs
+        )
+        self.kinematic = (
+            kinematics_c.needed_dyads(scene, self.solved, self.inertia_needed)
+            if scene.internal()
+            else []
+        )
         self.accel: dict[str, str | None] = {}  # link -> C name of a_D or None for zero
         self.accel_size: dict[str, str] = {}  # link -> C expression of the size of a_D's terms
 
     def inp(self, name: str) -> str:
-        """The input block's member of an input."""
-        return f"in->{self.names[name].member}"
+        """The input block's member of an input, or the C expression that computes it
+        (internal kinematics)."""
+        if name in self.names:
+            return f"in->{self.names[name].member}"
+        return self.scene.computed[name]
 
     def has(self, name: str) -> bool:
-        """Whether the scene has the input."""
-        return name in self.names
+        """Whether the scene has the input, or computes it."""
+        return name in self.names or name in self.scene.computed
 
     def omega(self, g: str) -> str | None:
         """A link's angular velocity, where it is an input."""
@@ -113,6 +128,8 @@ class Plan:
 
     def attachment_point(self, att: Attachment) -> str | None:
         """The pair's point (for a sliding pair: the guide's point) from the carrier's D."""
+        if att.kind == "crank" and att.at is None and self.crank.is_ram():
+            return None  # the ram's origin R
         if att.kind == "crank" and att.at is None:
             length = self.crank.params["length"]
             return self.point(att.link, (length, Param("", 0.0, "m", "")))
@@ -128,6 +145,26 @@ class Plan:
 # ---------------------------------------------------------------------------
 # Passes
 # ---------------------------------------------------------------------------
+def _kinematics(plan: Plan, code: _Code) -> None:
+    """Internal kinematics: the chain's motion from the driver's, first."""
+    if not plan.kinematic:
+        return
+    scene = plan.scene
+    rate, accel = kinematics_c.driver_rates(scene)
+    code("/* The kinematics from the driver outwards; a dyad that cannot close (or is at a")
+    code(" * dead centre) stops here with every output NaN. */")
+    code(f"{scene.identifier}_kinematics kin;")
+    code("{")
+    code("    int failed = 0;")
+    code(f"    const dyad_kin_result* bad = kinematics(in, {rate}, {accel}, &kin, &failed);")
+    code("    if (bad != NULL) {")
+    code(f"        fail_kinematics(out, bad, failed, {scene.threshold.c()}, evaluation);")
+    code("        return;")
+    code("    }")
+    code("}")
+    code()
+
+
 def _frames(plan: Plan, code: _Code) -> None:
     code("/* Link frames: i from D towards E, j = k0 x i. */")
     for g in plan.everything:
@@ -180,6 +217,11 @@ def _accelerations(plan: Plan, code: _Code) -> None:
     code(" * external link, and from the carrying link's motion on a moving link. */")
     if plan.crank:
         plan.accel[plan.crank.name] = None
+    if plan.crank and plan.crank.is_ram() and plan.crank_needed:
+        c = member(plan.crank.name)
+        code(f"const dyad_vec2 {c}_a_d = dyad_scale(in->{c}_acceleration, {c}_i);")
+        plan.accel[plan.crank.name] = f"{c}_a_d"
+        plan.accel_size[plan.crank.name] = f"fabs(in->{c}_acceleration)"
     for d in plan.solved:
         for g, att in ((d.m, d.k), (d.n, d.p)):
             c = member(g)
@@ -386,18 +428,91 @@ def _crank_outputs(plan: Plan) -> tuple[bool, bool]:
     )
 
 
+def _wanted(plan: Plan, key: str) -> bool:
+    """Whether the driver's output `key` (its member's suffix) is wanted."""
+    return any(o.member == f"{member(plan.crank.name)}_{key}" for o in plan.scene.outputs)
+
+
+def _ram(plan: Plan, code: _Code) -> None:
+    """The ram: the actuator force balances the forces along the guide, the guide's
+    normal force those across it and its reactive moment the moments about R."""
+    c = member(plan.crank.name)
+    code()
+    code("/* The ram: the actuator force balances the forces along its guide, the guide's")
+    code(" * normal force those across it, its reactive moment the moments about R. */")
+    code(f"{c}_force = -dyad_dot({c}_f, {c}_i);")
+    code(f"{c}_n = -dyad_dot({c}_f, dyad_perp({c}_i));")
+    code(f"{c}_m = -{c}_m_d;")
+
+
 def _crank(plan: Plan, code: _Code) -> None:
     if not plan.crank_needed:
+        return
+    if plan.crank.is_ram():
+        _ram(plan, code)
         return
     c = member(plan.crank.name)
     torque, r_o = _crank_outputs(plan)
     code()
     code("/* The crank: the driving torque balances the moments about O, R_O the forces. */")
-    if torque:
+    if torque or _wanted(plan, "torque0"):
         code(f"{c}_torque = -{c}_m_d;")
     if r_o:
         code(f"{c}_r_o = dyad_neg({c}_f);")
     code(f"(void){c}_m_d;")
+
+
+def _driver_inertia(plan: Plan, code: _Code) -> None:
+    """J(q), dJ/dq and the balance at zero driver acceleration (internal kinematics)."""
+    if not plan.inertia_needed:
+        return
+    scene = plan.scene
+    c = member(scene.crank.name)
+    j_terms, dj_terms = kinematics_c.inertia_terms(scene, plan.kinematic)
+    code()
+    code("/* The effective inertia at the driver: at unit rate and zero acceleration the")
+    code(" * kinematics give each centre of mass's velocity per unit driver rate V and its")
+    code(" * derivative along the driver V', each link's W and W': J = sum m V.V + I W^2,")
+    code(" * dJ/dq = 2 sum (m V.V' + I W W'). */")
+    code(f"{scene.identifier}_kinematics unit;")
+    code("{")
+    code("    int failed = 0;")
+    code("    const dyad_kin_result* bad = kinematics(in, 1.0, 0.0, &unit, &failed);")
+    code("    if (bad != NULL) {")
+    code(f"        fail_kinematics(out, bad, failed, {scene.threshold.c()}, evaluation);")
+    code("        return;")
+    code("    }")
+    code("}")
+    code(f"const double {c}_j = {' + '.join(j_terms) or '0.0'};")
+    code(f"const double {c}_djdq = 2.0 * ({' + '.join(dj_terms) or '0.0'});")
+    _, accel = kinematics_c.driver_rates(scene)
+    balance = "force" if scene.crank.is_ram() else "torque"
+    if _wanted(plan, f"{balance}0"):
+        code(f"const double {c}_{balance}0 = {c}_{balance} - {c}_j * {accel};")
+
+
+def _kinematic_exprs(scene: Scene) -> dict[str, str]:
+    """The C expressions of the kinematic outputs (internal kinematics)."""
+    exprs = {}
+    for d in scene.dyads:
+        kin = f"kin.{member(d.name or 'dyad')}"
+        pre = member(d.prefix())
+        for side, g in (("m", d.m), ("n", d.n)):
+            c = member(g)
+            exprs[f"{c}_angle"] = f"atan2({kin}.{side}.dir.y, {kin}.{side}.dir.x)"
+            exprs[f"{c}_omega"] = f"{kin}.{side}.omega"
+            exprs[f"{c}_epsilon"] = f"{kin}.{side}.epsilon"
+            exprs[f"{c}_length"] = f"{kin}.{side}.length"
+        for pair, point in (("d_m", "m.d"), ("e", "e"), ("d_n", "n.d")):
+            for x in "xy":
+                exprs[f"{pre}{pair}_{x}"] = f"{kin}.{point}.position.{x}"
+        for side in "kp":
+            exprs[f"{pre}slide_{side}"] = f"{kin}.slide_{side}.s"
+    if scene.crank is not None:
+        c = member(scene.crank.name)
+        for key in ("force", "n", "m", "j", "djdq", "torque0", "force0"):
+            exprs[f"{c}_{key}"] = f"{c}_{key}"
+    return exprs
 
 
 def _output_exprs(scene: Scene) -> dict[str, str]:
@@ -418,6 +533,8 @@ def _output_exprs(scene: Scene) -> dict[str, str]:
                 exprs[f"{pre}{kind}_{pair}"] = f"{dn}.{kind}_{pair}"
         for rest in ("conditioning", "amplification"):
             exprs[f"{pre}{rest}"] = f"{dn}.{rest}"
+    if scene.internal():
+        exprs.update(_kinematic_exprs(scene))
     return exprs
 
 
@@ -462,16 +579,28 @@ def drop_unused_constants(lines: list) -> list:
     return [line for k, line in enumerate(lines) if k not in removed]
 
 
-PASSES = (_frames, _accelerations, _resultants, _chain, _crank, _outputs)
+PASSES = (
+    _kinematics,
+    _frames,
+    _accelerations,
+    _resultants,
+    _chain,
+    _crank,
+    _driver_inertia,
+    _outputs,
+)
 
 
 def _declarations(plan: Plan) -> tuple[list[str], list[str]]:
     dyads = [f"    dyad_result {member(d.name or 'dyad')};" for d in plan.solved]
     crank = []
-    if plan.crank_needed:
+    if plan.crank_needed and plan.crank.is_ram():
+        c = member(plan.crank.name)
+        crank += [f"    double {c}_{key};" for key in ("force", "n", "m")]
+    elif plan.crank_needed:
         c = member(plan.crank.name)
         torque, r_o = _crank_outputs(plan)
-        if torque:
+        if torque or _wanted(plan, "torque0"):
             crank.append(f"    double {c}_torque;")
         if r_o:
             crank.append(f"    dyad_vec2 {c}_r_o;")
@@ -479,8 +608,20 @@ def _declarations(plan: Plan) -> tuple[list[str], list[str]]:
 
 
 @functools.cache
-def _template() -> Template:
-    return Template(TEMPLATE.read_text(encoding="utf-8"))
+def _template(path: Path = TEMPLATE) -> Template:
+    return Template(path.read_text(encoding="utf-8"))
+
+
+def _kinematics_code(plan: Plan) -> str:
+    """The kinematics function and its failure report, for internal kinematics."""
+    if not plan.kinematic:
+        return ""
+    scene = plan.scene
+    return _template(KINEMATICS_TEMPLATE).substitute(
+        ident=scene.identifier,
+        kinematics_function=kinematics_c.kinematics_function(scene, plan.kinematic),
+        names=kinematics_c.failure_names(scene),
+    )
 
 
 def scene_c(scene: Scene) -> str:
@@ -501,6 +642,8 @@ def scene_c(scene: Scene) -> str:
         check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
         dyad_decls="\n".join(dyad_decls),
         crank_decls="\n".join(crank_decls),
+        kinematics_include='#include "dyadfmu/kinematics.h"\n' if plan.kinematic else "",
+        kinematics_code=_kinematics_code(plan),
         body="\n".join(drop_unused_constants(code.lines)),
     )
 

@@ -11,7 +11,7 @@ from dyadgen import cnames
 from dyadgen.emit.c_table import model_c
 from dyadgen.emit.scene_c import scene_c, scene_header
 from dyadgen.kinds import SceneKind
-from dyadgen.locations import C_NAMES_PROBE, HEADER_DIRS
+from dyadgen.locations import C_NAMES_PROBES, HEADER_DIRS
 from dyadgen.scenefile.names import CNames
 from dyadgen.scenefile.read import read_scene
 
@@ -27,18 +27,26 @@ def c_names() -> CNames:
 
 
 def _learn_c_names() -> CNames:
-    probe = read_scene(C_NAMES_PROBE, c_names=None)
+    reserved = set(cnames.C_KEYWORDS) | cnames.COMMON_MACROS
+    patterns: dict[str, set] = {kind: set() for kind in ("identifier", "crank", "dyad", "link")}
+    for path in C_NAMES_PROBES:
+        _learn_from(path, reserved, patterns)
+    reserved = {n for n in reserved if not _PROBE_NAME.search(n)}
+    return CNames(frozenset(reserved), {k: frozenset(v) for k, v in patterns.items()})
+
+
+def _learn_from(path: object, reserved: set, patterns: dict) -> None:
+    """The names and patterns of one probe's generated code, added to the sets."""
+    probe = read_scene(path, c_names=None)
     table = SceneKind(probe).table_of_scene(probe)
     header = f"{probe.identifier}_scene.h"
     files = {"scene.c": scene_c(probe), "scene.h": scene_header(table), "model.c": model_c(table)}
     kind_of = {probe.identifier: "identifier", probe.crank.name: "crank"}
     kind_of.update({d.name: "dyad" for d in probe.dyads})
     kind_of.update({g: "link" for g in probe.links})
-    reserved = set(cnames.C_KEYWORDS) | cnames.COMMON_MACROS
     reserved |= cnames.headers_names(
         "\n".join(files.values()), list(HEADER_DIRS), {header: files["scene.h"]}
     )
-    patterns: dict[str, set] = {kind: set() for kind in ("identifier", "crank", "dyad", "link")}
     for file, code in files.items():
         for t in cnames.identifiers(code):
             found = _PROBE_NAME.search(t.text)
@@ -60,5 +68,3 @@ def _learn_c_names() -> CNames:
                     found.group().isupper(),
                 )
             )
-    reserved = {n for n in reserved if not _PROBE_NAME.search(n)}
-    return CNames(frozenset(reserved), {k: frozenset(v) for k, v in patterns.items()})

@@ -8,8 +8,10 @@ from dyadgen.model import Attachment, Crank, Dyad, Link, Param
 from dyadgen.scenefile.names import name_problem
 from dyadgen.scenefile.problems import Problems, number, pair_of_numbers, real, unknown_keys
 
-DYAD_KEYS = {"name", "type", "m", "n", "k", "p"}
-LINK_KEYS = {"name", "length", "angle", "com", "mass", "inertia"}
+DYAD_KEYS = {"name", "type", "m", "n", "k", "p", "branch"}
+LINK_KEYS = {"name", "length", "angle", "turn", "com", "mass", "inertia"}
+#: the types that close in two ways, so that the scene says which
+TWO_BRANCHES = ("RRR", "RRT", "RTR")
 ATTACHMENT_KEYS = ("link", "at", "guide")
 
 
@@ -42,8 +44,11 @@ def link_tables(p: Problems, data: dict, crank: Crank | None) -> dict[str, tuple
 class _Attaching:
     """The parse of one outer pair's attachment (k at D_m, or p at D_n) of a dyad."""
 
-    def __init__(self, p: Problems, dyad: Dyad, side: str, label: str, crank: Crank | None) -> None:
+    def __init__(
+        self, p: Problems, dyad: Dyad, side: str, label: str, crank: Crank | None, internal: bool
+    ) -> None:
         self.p = p
+        self.internal = internal
         self.side = side
         self.pair = "D_m" if side == "k" else "D_n"
         self.sliding = dyad.pair_kind("mk" if side == "k" else "np") == "T"
@@ -108,10 +113,18 @@ class _Attaching:
         if not self.sliding and "guide" in spec:
             self.problem(f"{self.pair} is a revolute pair and has no guide")
             return None
+        if target == "frame" and self.internal:
+            return self.on_frame(spec)
         if target in ("frame", "external") and "at" in spec:
             self.problem(f"'{self.side}': a pair on the {target} takes no 'at'")
             return None
         if target == "external":
+            if self.internal:
+                self.problem(
+                    f"'{self.side}': with kinematics = 'internal' every link's motion follows "
+                    "from the driver's; an external link needs kinematics = 'external'"
+                )
+                return None
             if "guide" in spec:
                 self.problem(f"'{self.side}': an external link's guide is an input; drop 'guide'")
                 return None
@@ -130,6 +143,33 @@ class _Attaching:
             if kind == "frame":
                 return Attachment("frame", guide=guide)
         return self.point(spec, target, kind, guide)
+
+    def on_frame(self, spec: dict) -> Attachment | None:
+        """Internal kinematics: a fixed pivot where it is, or a frame guide and a point of
+        its line (default the origin), global."""
+        guide = self.guide(spec, "frame", "frame") if self.sliding else None
+        if self.sliding and guide is None:
+            return None
+        at = spec.get("at", [0.0, 0.0] if self.sliding else None)
+        if at is None:
+            self.problem(
+                f"{self.pair} is a fixed pivot: with kinematics = 'internal' '{self.side}' "
+                f'says where it is, {self.side} = {{ link = "frame", at = [x, y] }} (m)'
+            )
+            return None
+        if not isinstance(at, list) or len(at) != 2 or not all(real(v) is not None for v in at):
+            self.problem(f"'{self.side}': at must be [x, y], two finite numbers (m)")
+            return None
+        if self.sliding:
+            pname, what = (
+                f"{self.prefix}guide_{self.side}.at",
+                f"A point of the frame guide at {self.pair}",
+            )
+        else:
+            pname, what = f"{self.prefix}{self.pair}", f"The fixed pivot {self.pair}"
+        x = Param(f"{pname}.x", real(at[0]), "m", f"{what}, global x")
+        y = Param(f"{pname}.y", real(at[1]), "m", f"{what}, global y")
+        return Attachment("frame", None, (x, y), guide)
 
     def guide(self, spec: dict, target: str, kind: str) -> Param | None:
         """The angle of the guide a sliding pair runs on, on the frame or a moving link."""
@@ -185,9 +225,10 @@ class Mechanism:
     """The [[dyad]] tables parsed in order: the dyads, their links, and which dyad owns
     each link name."""
 
-    def __init__(self, p: Problems, crank: Crank | None, tables: dict) -> None:
+    def __init__(self, p: Problems, crank: Crank | None, tables: dict, internal: bool) -> None:
         self.p = p
         self.crank = crank
+        self.internal = internal
         self.tables = tables
         self.dyads: list[Dyad] = []
         self.links: dict[str, Link] = {}
@@ -237,14 +278,15 @@ class Mechanism:
                 if isinstance(row.get(side), str):
                     self.owner.setdefault(row[side], f"link {side} of {label}")
             return
-        dyad = Dyad(name, dtype, i, self.p.loc.line("dyad", i))
+        dyad = Dyad(name, dtype, i, self.p.loc.line("dyad", i), internal=self.internal)
         if not all([self.link(dyad, row, side, label) for side in ("m", "n")]):
             return
         for side in ("k", "p"):
-            attaching = _Attaching(self.p, dyad, side, label, self.crank)
+            attaching = _Attaching(self.p, dyad, side, label, self.crank, self.internal)
             setattr(dyad, side, attaching.parse(row.get(side, None), self.links))
         if dyad.k is None or dyad.p is None:
             return
+        dyad.branch = self.branch(dyad, row, label)
         d_m, e, d_n = PAIRS[dtype]
         for side, outer, attached in (("m", d_m, dyad.k), ("n", d_n, dyad.p)):
             lname = getattr(dyad, side)
@@ -253,6 +295,41 @@ class Mechanism:
             line = self.p.loc.line("link", self.tables[lname][1])
             self.links[lname] = Link(lname, dyad, side, line, sliding, translating)
         self.dyads.append(dyad)
+
+    def branch(self, dyad: Dyad, row: dict, label: str) -> Param | None:
+        """The assembly branch of a dyad that closes in two ways (internal kinematics)."""
+        value = row.get("branch")
+        closes_twice = dyad.type in TWO_BRANCHES
+        if not self.internal or not closes_twice:
+            if value is not None:
+                why = (
+                    "only internal kinematics read it"
+                    if closes_twice
+                    else f"a {dyad.type} dyad closes in one way only"
+                )
+                self.p.add(f"{label}: drop 'branch': {why}", "dyad", dyad.index, "branch")
+            return None
+        if value is None and dyad.type != "RTR":
+            self.p.add(
+                f"{label}: a {dyad.type} dyad closes in two ways: say which with branch = 1 "
+                "or -1 (see scenes/README.md)",
+                "dyad",
+                dyad.index,
+            )
+            return None
+        if value is None:
+            value = 1
+        if isinstance(value, bool) or value not in (1, -1):
+            self.p.add(
+                f"{label}: branch must be 1 or -1, not {value!r}", "dyad", dyad.index, "branch"
+            )
+            return None
+        return Param(
+            f"{dyad.prefix()}branch",
+            float(value),
+            None,
+            f"Assembly branch of {dyad.name or 'the dyad'}: +1 or -1 (only the sign counts)",
+        )
 
     def link_numbers(self, inertia: bool, needs_mass: bool) -> None:
         """Every described link's numbers; a link of no dyad is a problem."""
@@ -322,13 +399,54 @@ def _length_and_angle(p: Problems, link: Link, row: dict, i: int) -> None:
                 {"min": 0.0, "min_exclusive": not may_be_zero},
             )
     if link.translating:
-        angle = number(p, row, "angle", where + " (it translates on its frame guide)", "link", i)
-        if angle is not None:
-            link.params["angle"] = Param(
-                f"{link.name}.angle", angle, "rad", f"Direction of link {link.name} (it translates)"
-            )
+        _translating_angle(p, link, row, i, where)
     elif "angle" in row:
         p.add(f"{where}: its angle is an input (the link turns); drop 'angle'", "link", i, "angle")
+    elif "turn" in row:
+        _turn(p, link, row, i, where)
+
+
+def locked_to(link: Link) -> str | None:
+    """What a link keeps its direction on: 'guide' where its outer pair slides, 'm' for
+    link n where E slides along link m, else None (it turns freely)."""
+    d_m, e, d_n = PAIRS[link.dyad.type]
+    if (d_m if link.side == "m" else d_n) == "T":
+        return "guide"
+    return "m" if link.side == "n" and e == "T" else None
+
+
+def _turn(p: Problems, link: Link, row: dict, i: int, where: str) -> None:
+    """turn: the angle of a locked link's direction from its guide's or link m's."""
+    on = locked_to(link)
+    if on is None or not link.dyad.internal:
+        why = (
+            "only internal kinematics read it"
+            if on is not None
+            else "the link turns freely: its direction follows from the chain"
+        )
+        p.add(f"{where}: drop 'turn': {why}", "link", i, "turn")
+        return
+    value = number(p, row, "turn", where, "link", i)
+    if value is not None:
+        what = "its guide's" if on == "guide" else "link m's"
+        link.params["turn"] = Param(
+            f"{link.name}.turn", value, "rad", f"Angle of {link.name}'s i from {what} direction"
+        )
+
+
+def _translating_angle(p: Problems, link: Link, row: dict, i: int, where: str) -> None:
+    """A link on a frame guide keeps its angle: 'angle' (absolute) or, with internal
+    kinematics, 'turn' from the guide."""
+    guide = link.attachment().guide
+    if "turn" in row and "angle" not in row and link.dyad.internal and guide is not None:
+        turn = number(p, row, "turn", where, "link", i)
+        angle = None if turn is None else guide.value + turn
+    else:
+        angle = number(p, row, "angle", where + " (it translates on its frame guide)", "link", i)
+    if angle is not None:
+        link.params["angle"] = Param(
+            f"{link.name}.angle", angle, "rad", f"Direction of link {link.name} (it translates)"
+        )
 
 
 def link_params(

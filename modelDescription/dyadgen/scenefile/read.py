@@ -14,7 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from dyadgen.emit.scene_c import scene_c
-from dyadgen.model import Scene
+from dyadgen.model import Crank, Scene
 from dyadgen.needs import derive_inputs, derive_outputs
 from dyadgen.scenefile import mechanism, sections
 from dyadgen.scenefile.locator import Locator
@@ -22,7 +22,7 @@ from dyadgen.scenefile.names import CNames, c_name_clashes, identifier_problem
 from dyadgen.scenefile.problems import Problems, SceneError
 
 
-def _named_objects(identifier: str, found: mechanism.Mechanism, crank_name: str | None) -> list:
+def _named_objects(identifier: str, found: mechanism.Mechanism, crank: Crank | None) -> list:
     """(kind, name, label, where) of every name of the scene, in file order."""
     objects = []
     if not identifier_problem(identifier):
@@ -34,8 +34,9 @@ def _named_objects(identifier: str, found: mechanism.Mechanism, crank_name: str 
                 ("scene", 0, "identifier"),
             )
         )
-    if crank_name is not None:
-        objects.append(("crank", crank_name, f"crank '{crank_name}'", ("crank", 0, "name")))
+    if crank is not None:
+        where = (crank.kind, 0, "name")
+        objects.append(("crank", crank.name, f"{crank.kind} '{crank.name}'", where))
     objects += [
         ("dyad", d.name, f"dyad '{d.name}'", ("dyad", d.index, "name"))
         for d in found.dyads
@@ -84,12 +85,16 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     needs_mass = inertia or gravity
     gravity_params = sections.gravity(p, data, gravity)
     threshold = sections.threshold(p, scene_t)
-    crank = sections.crank(p, data, inertia, needs_mass)
-    found = mechanism.Mechanism(p, crank, mechanism.link_tables(p, data, crank))
+    kinematics = sections.kinematics(p, scene_t, "crank" in data or "ram" in data)
+    internal = kinematics == "internal"
+    crank = sections.crank(p, data, inertia, needs_mass, internal) or sections.ram(
+        p, data, needs_mass, internal
+    )
+    found = mechanism.Mechanism(p, crank, mechanism.link_tables(p, data, crank), internal)
     found.parse(data)
     found.link_numbers(inertia, needs_mass)
     if c_names is not None:
-        objects = _named_objects(identifier, found, crank.name if crank else None)
+        objects = _named_objects(identifier, found, crank)
         c_name_clashes(p, objects, c_names())
     sections.loads(p, data, found.links)
     scene = Scene(
@@ -103,6 +108,7 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
         links=found.links,
         gravity_params=gravity_params,
         threshold=threshold,
+        kinematics=kinematics,
     )
     sections.tunable(p, scene_t, scene)
     if not p.items:

@@ -21,11 +21,20 @@ from dyadgen.scenefile.problems import (
     unknown_keys,
 )
 
-SCENE_KEYS = {"identifier", "description", "outputs", "tunable", "singular_threshold"}
+SCENE_KEYS = {
+    "identifier",
+    "description",
+    "outputs",
+    "tunable",
+    "singular_threshold",
+    "kinematics",
+}
 EFFECT_KEYS = {"inertia", "gravity"}
-CRANK_KEYS = {"name", "length", "com", "mass", "inertia"}
+CRANK_KEYS = {"name", "length", "com", "mass", "inertia", "at"}
+RAM_KEYS = {"name", "guide", "at", "com", "mass", "inertia"}
 LOAD_KEYS = {"force", "moment"}
-TOP_KEYS = {"scene", "effects", "gravity", "crank", "dyad", "link", "loads", "start"}
+TOP_KEYS = {"scene", "effects", "gravity", "crank", "ram", "dyad", "link", "loads", "start"}
+KINEMATICS = ("internal", "external")
 #: sqrt(DBL_EPSILON), where round-off still leaves half of the digits.
 DEFAULT_THRESHOLD = 1.4901161193847656e-8
 
@@ -142,6 +151,38 @@ def threshold(p: Problems, scene_t: dict) -> Param:
     )
 
 
+def kinematics(p: Problems, scene_t: dict, driven: bool) -> str:
+    """[scene] kinematics: "internal" (the default with a driver) or "external"."""
+    value = scene_t.get("kinematics", "internal" if driven else "external")
+    if value not in KINEMATICS:
+        p.add(
+            f"[scene]: kinematics must be 'internal' or 'external', not {shown(value)}",
+            "scene",
+            0,
+            "kinematics",
+        )
+        return "external"
+    if value == "internal" and not driven:
+        p.add(
+            "[scene]: kinematics = 'internal' needs a driver ([crank] or [ram]) whose motion "
+            "the chain follows; without one every link's motion is an input ('external')",
+            "scene",
+            0,
+            "kinematics",
+        )
+        return "external"
+    return value
+
+
+def _pivot(p: Problems, driver: Crank, table: dict, section: str, text: str) -> None:
+    """The driver's point on the frame, `at` (m, global; default the origin)."""
+    at = pair_of_numbers(p, table, "at", f"[{section}]", section, 0, required=False)
+    x, y = at if at is not None else (0.0, 0.0)
+    name = driver.name
+    driver.params["at.x"] = Param(f"{name}.at.x", x, "m", f"{text}, global x")
+    driver.params["at.y"] = Param(f"{name}.at.y", y, "m", f"{text}, global y")
+
+
 def _crank_params(
     p: Problems, crank: Crank, crank_t: dict, inertia: bool, needs_mass: bool
 ) -> None:
@@ -181,8 +222,8 @@ def _crank_params(
         )
 
 
-def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool) -> Crank | None:
-    """[crank], if any: its name and numbers."""
+def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool) -> Crank | None:
+    """[crank], if any: its name and numbers (and its pivot, for internal kinematics)."""
     crank_t = data.get("crank")
     if crank_t is None:
         return None
@@ -196,7 +237,68 @@ def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool) -> Crank | N
         p.add(f"[crank]: name {problem}", "crank", 0, "name")
         cname = "crank"
     found = Crank(cname, p.loc.line("crank"))
+    if internal:
+        _pivot(p, found, crank_t, "crank", "The crank's pivot O on the frame")
+    elif "at" in crank_t:
+        p.add(
+            "[crank]: 'at' places the crank for internal kinematics; with kinematics = "
+            "'external' nothing reads it",
+            "crank",
+            0,
+            "at",
+        )
     _crank_params(p, found, crank_t, inertia, needs_mass)
+    return found
+
+
+def _ram_params(p: Problems, ram_t: dict, found: Crank, needs_mass: bool) -> None:
+    name = found.name
+    where = f"ram '{name}'"
+    angle = number(p, ram_t, "guide", where, "ram", 0)
+    if angle is not None:
+        found.params["guide"] = Param(
+            f"{name}.guide",
+            angle,
+            "rad",
+            "Direction of the ram's frame guide (angle of i_r from x)",
+        )
+    _pivot(p, found, ram_t, "ram", "The ram's origin R at zero displacement")
+    com = pair_of_numbers(p, ram_t, "com", where, "ram", 0, required=needs_mass)
+    if com is not None and needs_mass:
+        found.params["com.x"] = Param(
+            f"{name}.com.x", com[0], "m", "Ram's centre of mass, x in the ram frame {R; i_r, j_r}"
+        )
+        found.params["com.y"] = Param(
+            f"{name}.com.y", com[1], "m", "Ram's centre of mass, y in the ram frame"
+        )
+    mass = number(p, ram_t, "mass", where, "ram", 0, nonnegative=True, required=needs_mass)
+    if mass is not None and needs_mass:
+        found.params["mass"] = Param(f"{name}.mass", mass, "kg", "Ram's mass", {"min": 0.0})
+    number(p, ram_t, "inertia", where, "ram", 0, nonnegative=True, required=False)
+
+
+def ram(p: Problems, data: dict, needs_mass: bool, internal: bool) -> Crank | None:
+    """[ram], if any: a linear actuator sliding on a frame guide, the driver."""
+    ram_t = data.get("ram")
+    if ram_t is None:
+        return None
+    if not isinstance(ram_t, dict):
+        p.add("[ram] must be a table", "ram", 0)
+        return None
+    unknown_keys(p, ram_t, RAM_KEYS, "[ram]", "ram", 0)
+    if "crank" in data:
+        p.add("[ram]: a scene has one driver, a [crank] or a [ram], not both", "ram", 0)
+        return None
+    if not internal:
+        p.add("[ram]: a ram drives the chain only with kinematics = 'internal'", "ram", 0)
+        return None
+    name = ram_t.get("name", "ram")
+    problem = name_problem(name)
+    if problem:
+        p.add(f"[ram]: name {problem}", "ram", 0, "name")
+        name = "ram"
+    found = Crank(name, p.loc.line("ram"), kind="ram")
+    _ram_params(p, ram_t, found, needs_mass)
     return found
 
 

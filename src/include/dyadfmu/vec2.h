@@ -68,6 +68,13 @@ static inline dyad_vec2 dyad_perp(dyad_vec2 a)
     return dyad_vec2_make(-a.y, a.x);
 }
 
+/** The direction a turned by the unit vector t = (cos d, sin d): a turned by d,
+ *  the complex product a t. */
+static inline dyad_vec2 dyad_turn(dyad_vec2 a, dyad_vec2 t)
+{
+    return dyad_vec2_make(a.x * t.x - a.y * t.y, a.x * t.y + a.y * t.x);
+}
+
 static inline dyad_real dyad_length(dyad_vec2 a)
 {
 #ifdef DYAD_REAL_FLOAT
