@@ -675,7 +675,8 @@ def scene_header(table: Table) -> str:
     lines += [f"}} {ident}_input;", "", f"typedef struct {ident}_output {{"]
     for name, leaf in table.kind.output_members.items():
         if leaf == "status":
-            lines.append(f"    int {name}; /* 0 ok, 1 singular, 3 out of range */")
+            cannot = ", 4 cannot assemble" if scene.internal() else ""
+            lines.append(f"    int {name}; /* 0 ok, 1 singular, 3 out of range{cannot} */")
         else:
             lines.append(f"    double {name}; /* {units.get(name) or '-'} */")
     lines += [
