@@ -1,3 +1,5 @@
 """The independent references: the dyad's Newton-Euler system solved with NumPy and, for
-ground truth, with mpmath (:mod:`.newton_euler`); the motor-driven mechanism as one ODE
+ground truth, with mpmath (:mod:`.newton_euler`); the dyads' kinematics (positions, velocities,
+accelerations and their derivatives along a seed of the inputs) with mpmath
+(:mod:`.dyad_kinematics`); the motor-driven mechanism as one ODE
 (:mod:`.machine`)."""
