@@ -2083,6 +2083,35 @@ static int test_kin_invalid_pointers(void)
     return fails;
 }
 
+/* dyad_point_on_link: a point fixed on a moving link, against its jet. */
+static int test_kin_point_on_link(void)
+{
+    int fails = 0, k;
+    rng r = {0x4B500000u};
+    double worst = 0;
+    for (k = 0; k < 1000; ++k) {
+        const path x = random_path(&r, -1, 1, 2), y = random_path(&r, -1, 1, 2);
+        const path th = random_path(&r, -PI, PI, 3);
+        const double complex at = uniform(&r, -2, 2) + I * uniform(&r, -2, 2);
+        const sjet angle = path_at(&th, 0);
+        const sjet px = path_at(&x, 0), py = path_at(&y, 0);
+        vjet origin, want;
+        dyad_point_motion o, got;
+        double g[6], w[6];
+        origin.v = px.v + I * py.v, origin.d = px.d + I * py.d, origin.dd = px.dd + I * py.dd;
+        want = vadd(origin, vtimes(vpolar(angle), at));
+        o = motion_of(origin);
+        got = dyad_point_on_link(&o, cv(cexp(I * angle.v)), (dyad_real)angle.d, (dyad_real)angle.dd,
+                                 cv(at));
+        put_motion(g, 0, &got);
+        o = motion_of(want);
+        put_motion(w, 0, &o);
+        worst = worst_error(g, w, 6) > worst ? worst_error(g, w, 6) : worst;
+    }
+    CHECK(worst < KIN_LIMIT, "dyad_point_on_link off by %.3g", worst);
+    return fails;
+}
+
 /* Names: every field and failure has its own, NONE and CLOSES none. */
 static int test_kin_names(void)
 {
@@ -2131,6 +2160,7 @@ static const named_test tests[] = {
     {"kin_invalid_nonfinite", test_kin_invalid_nonfinite},
     {"kin_invalid_domain", test_kin_invalid_domain},
     {"kin_invalid_pointers", test_kin_invalid_pointers},
+    {"kin_point_on_link", test_kin_point_on_link},
     {"kin_names", test_kin_names},
 };
 
