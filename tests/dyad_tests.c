@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "dyadfmu/dyad.h"
+#include "dyadfmu/kinematics.h"
 #include "dyadfmu/loaded.h"
 #include "dyadfmu/vec2.h"
 #include "named_tests.h"
@@ -1044,6 +1045,1096 @@ static int test_tangent_of_each_type(void)
     return fails;
 }
 
+/* ---- kinematics (dyadfmu/kinematics.h) -------------------------------------------------------
+ * Each configuration is built from the dyad outwards: smooth paths in time t of
+ * E, the link angles, the slides and the guides' angles, from which the mounts
+ * follow (D_m = E - l_m i_m, a guide's point G = D - s i, ...). Every path is
+ * carried as a jet (value, first and second derivative in t) in double complex
+ * arithmetic, here and independently of the core: the mounts' velocities and
+ * accelerations are then exact inputs, and the dyad's own jets are the
+ * expected outputs. */
+
+#ifdef DYAD_REAL_FLOAT
+/* Inputs rounded to float: the configuration is closed to 6e-8, and its
+ * outputs move by that times the amplification. */
+#define KIN_LIMIT 2e-3
+/* Finite differences in float: steps large enough that the rounding of the
+ * positions (eps / h, eps / h^2) stays below the tolerance. */
+#define KIN_FD_STEP      0.02
+#define KIN_TANGENT_STEP 5e-4
+#define KIN_FD_LIMIT     3e-2
+#else
+#define KIN_LIMIT        1e-10
+#define KIN_FD_STEP      4e-3
+/* A random seed moves every input at once: a shorter step keeps the
+ * samples inside the region where the dyad closes. */
+#define KIN_TANGENT_STEP 2e-5
+#define KIN_FD_LIMIT     1e-7
+#endif
+#define KIN_SAMPLES 2000
+
+/* A scalar and a planar (complex) quantity with their first two time derivatives. */
+typedef struct sjet {
+    double v, d, dd;
+} sjet;
+typedef struct vjet {
+    double complex v, d, dd;
+} vjet;
+
+/* a + b t + c t^2 + amp sin(freq t + phase): a smooth path in time. */
+typedef struct path {
+    double a, b, c, amp, freq, phase;
+} path;
+
+static sjet path_at(const path* p, double t)
+{
+    const double s = sin(p->freq * t + p->phase), c = cos(p->freq * t + p->phase);
+    sjet j;
+    j.v = p->a + p->b * t + p->c * t * t + p->amp * s;
+    j.d = p->b + 2 * p->c * t + p->amp * p->freq * c;
+    j.dd = 2 * p->c - p->amp * p->freq * p->freq * s;
+    return j;
+}
+
+static path random_path(rng* r, double lo, double hi, double rate)
+{
+    path p;
+    p.a = uniform(r, lo, hi);
+    p.b = uniform(r, -rate, rate);
+    p.c = uniform(r, -rate, rate) / 2;
+    p.amp = uniform(r, -rate, rate) / 4;
+    p.freq = uniform(r, 0.5, 2);
+    p.phase = uniform(r, -PI, PI);
+    return p;
+}
+
+static sjet sconst(double v)
+{
+    sjet j = {v, 0, 0};
+    return j;
+}
+
+/* e^(i theta) */
+static vjet vpolar(sjet th)
+{
+    vjet j;
+    j.v = cexp(I * th.v);
+    j.d = I * th.d * j.v;
+    j.dd = (I * th.dd - th.d * th.d) * j.v;
+    return j;
+}
+
+/* a u, a scalar jet times a planar one */
+static vjet vscale(sjet a, vjet u)
+{
+    vjet j;
+    j.v = a.v * u.v;
+    j.d = a.d * u.v + a.v * u.d;
+    j.dd = a.dd * u.v + 2 * a.d * u.d + a.v * u.dd;
+    return j;
+}
+
+/* u times a constant complex number */
+static vjet vtimes(vjet u, double complex c)
+{
+    vjet j = {u.v * c, u.d * c, u.dd * c};
+    return j;
+}
+
+static vjet vsub(vjet a, vjet b)
+{
+    vjet j = {a.v - b.v, a.d - b.d, a.dd - b.dd};
+    return j;
+}
+
+static vjet vadd(vjet a, vjet b)
+{
+    vjet j = {a.v + b.v, a.d + b.d, a.dd + b.dd};
+    return j;
+}
+
+static dyad_vec2 cv(double complex z)
+{
+    return vec(creal(z), cimag(z));
+}
+
+static dyad_point_motion motion_of(vjet j)
+{
+    dyad_point_motion m;
+    m.position = cv(j.v);
+    m.velocity = cv(j.d);
+    m.acceleration = cv(j.dd);
+    return m;
+}
+
+/* The random parameters of one configuration's motion. */
+typedef struct kin_case {
+    dyad_type type;
+    path ex, ey;        /* E */
+    path th_m, th_n;    /* link angles, where free */
+    path phi_k, phi_p;  /* guide angles */
+    path s_k, s_p, l_m; /* slides; l_m where E slides on m */
+    double l_m0, l_n;   /* constant lengths */
+    double delta_m, delta_n;
+    double complex com_m, com_n;
+} kin_case;
+
+/* The built dyad at time t: what the core should find. */
+typedef struct kin_built {
+    vjet e, d_m, d_n, g_k, g_p, i_m, i_n, i_k, i_p;
+    sjet th_m, th_n, phi_k, phi_p, s_k, s_p, l_m;
+    double l_n;
+    int branch;
+} kin_built;
+
+static kin_case random_kin_case(rng* r, dyad_type type)
+{
+    kin_case c;
+    c.type = type;
+    c.ex = random_path(r, -1, 1, 1);
+    c.ey = random_path(r, -1, 1, 1);
+    c.th_m = random_path(r, -PI, PI, 2);
+    c.th_n = random_path(r, -PI, PI, 2);
+    c.phi_k = random_path(r, -PI, PI, 1);
+    c.phi_p = random_path(r, -PI, PI, 1);
+    c.s_k = random_path(r, -1, 1, 1);
+    c.s_p = random_path(r, -1, 1, 1);
+    c.l_m = random_path(r, 0.8, 2, 0.3);
+    c.l_m0 = uniform(r, 0.3, 2);
+    c.l_n = uniform(r, 0.3, 2);
+    c.delta_m = uniform(r, -PI, PI);
+    c.delta_n = uniform(r, -PI, PI);
+    c.com_m = uniform(r, -1, 1) + I * uniform(r, -1, 1);
+    c.com_n = uniform(r, -1, 1) + I * uniform(r, -1, 1);
+    if (type == DYAD_TRT || type == DYAD_RRT) {
+        c.l_m0 = uniform(r, 0, 1) < 0.2 ? 0 : c.l_m0; /* a pin on the guide */
+    }
+    if (type != DYAD_RRR && type != DYAD_RRT && uniform(r, 0, 1) < 0.2) {
+        c.l_n = 0;
+    }
+    return c;
+}
+
+static int sign_of(double x)
+{
+    return x < 0 ? -1 : 1;
+}
+
+/* The link angles, guides and lengths of the type at t. */
+static void build_angles(const kin_case* c, double t, kin_built* b)
+{
+    const int d_m_slides = c->type == DYAD_RRT || c->type == DYAD_TRT || c->type == DYAD_RTT;
+    b->phi_k = path_at(&c->phi_k, t);
+    b->phi_p = path_at(&c->phi_p, t);
+    b->th_m = path_at(&c->th_m, t);
+    b->th_n = path_at(&c->th_n, t);
+    if (d_m_slides) {
+        b->th_m = b->phi_k;
+        b->th_m.v += c->delta_m;
+    }
+    if (c->type == DYAD_TRT) {
+        b->th_n = b->phi_p;
+        b->th_n.v += c->delta_n;
+    } else if (c->type == DYAD_RTR || c->type == DYAD_RTT) {
+        b->th_n = b->th_m;
+        b->th_n.v += c->delta_n;
+    }
+    b->l_m = c->type == DYAD_RTR || c->type == DYAD_RTT ? path_at(&c->l_m, t) : sconst(c->l_m0);
+    b->l_n = c->l_n;
+    b->i_m = vpolar(b->th_m);
+    b->i_n = vpolar(b->th_n);
+    b->i_k = vpolar(b->phi_k);
+    b->i_p = vpolar(b->phi_p);
+}
+
+static kin_built build(const kin_case* c, double t)
+{
+    kin_built b;
+    vjet e;
+    build_angles(c, t, &b);
+    e.v = path_at(&c->ex, t).v + I * path_at(&c->ey, t).v;
+    e.d = path_at(&c->ex, t).d + I * path_at(&c->ey, t).d;
+    e.dd = path_at(&c->ex, t).dd + I * path_at(&c->ey, t).dd;
+    b.e = e;
+    b.d_m = vsub(e, vscale(b.l_m, b.i_m));
+    b.d_n = vsub(e, vscale(sconst(b.l_n), b.i_n));
+    b.s_k = b.s_p = sconst(0);
+    if (c->type == DYAD_RRT || c->type == DYAD_TRT || c->type == DYAD_RTT) {
+        b.s_k = path_at(&c->s_k, t);
+    }
+    if (c->type == DYAD_TRT) {
+        b.s_p = path_at(&c->s_p, t);
+    }
+    b.g_k = vsub(b.d_m, vscale(b.s_k, b.i_k));
+    b.g_p = vsub(b.d_n, vscale(b.s_p, b.i_p));
+    switch (c->type) {
+    case DYAD_RRR: b.branch = sign_of(cimag((e.v - b.d_m.v) * conj(b.d_n.v - b.d_m.v))); break;
+    case DYAD_RRT: b.branch = sign_of(creal((e.v - b.d_n.v) * conj(b.i_k.v))); break;
+    case DYAD_RTR: b.branch = sign_of(b.l_m.v - b.l_n * cos(c->delta_n)); break;
+    default: b.branch = 1; break;
+    }
+    return b;
+}
+
+static void set_mount(dyad_mount* m, vjet point, vjet guide, sjet angle, int slides)
+{
+    m->point = motion_of(point);
+    if (slides) {
+        m->guide = cv(guide.v);
+        m->omega = (dyad_real)angle.d;
+        m->epsilon = (dyad_real)angle.dd;
+    }
+}
+
+/* The core's input at t (branch as built). */
+static dyad_kin_input kin_input_at(const kin_case* c, double t, kin_built* out)
+{
+    const kin_built b = build(c, t);
+    const int slides_k = c->type == DYAD_RRT || c->type == DYAD_TRT || c->type == DYAD_RTT;
+    const int slides_p = c->type == DYAD_TRT;
+    dyad_kin_input in = dyad_kin_input_default();
+    set_mount(&in.k, slides_k ? b.g_k : b.d_m, b.i_k, b.phi_k, slides_k);
+    set_mount(&in.p, slides_p ? b.g_p : b.d_n, b.i_p, b.phi_p, slides_p);
+    in.length_m = (dyad_real)c->l_m0;
+    in.length_n = (dyad_real)c->l_n;
+    in.turn_m = cv(cexp(I * c->delta_m));
+    in.turn_n = cv(cexp(I * c->delta_n));
+    in.com_m = cv(c->com_m);
+    in.com_n = cv(c->com_n);
+    in.branch = b.branch;
+    if (out != NULL) {
+        *out = b;
+    }
+    return in;
+}
+
+/* The header's conditioning, from the built directions. */
+static double built_conditioning(dyad_type type, const kin_built* b)
+{
+    const double complex i_m = b->i_m.v, i_n = b->i_n.v, i_k = b->i_k.v, i_p = b->i_p.v;
+    switch (type) {
+    case DYAD_RRR: return fabs(cimag(i_n * conj(i_m)));
+    case DYAD_RRT: return fabs(creal(i_n * conj(i_k)));
+    case DYAD_TRT: return fabs(cimag(i_p * conj(i_k)));
+    case DYAD_RTT: return fabs(cimag(i_m * conj(i_k)));
+    default: {
+        const double complex d = b->d_n.v - b->d_m.v;
+        const double slant = fabs(creal(d * conj(i_m))) / cabs(d);
+        const double spread = cabs(d) / (b->l_m.v + b->l_n);
+        return slant < spread ? slant : spread;
+    }
+    }
+}
+
+/* Every output of a result, raw, in a fixed order (KIN_RAW numbers). */
+#define KIN_RAW 52
+
+static int put_motion(double* v, int k, const dyad_point_motion* p)
+{
+    v[k] = p->position.x, v[k + 1] = p->position.y;
+    v[k + 2] = p->velocity.x, v[k + 3] = p->velocity.y;
+    v[k + 4] = p->acceleration.x, v[k + 5] = p->acceleration.y;
+    return k + 6;
+}
+
+static int put_link(double* v, int k, const dyad_kin_link* g)
+{
+    v[k] = g->dir.x, v[k + 1] = g->dir.y, v[k + 2] = g->omega, v[k + 3] = g->epsilon;
+    v[k + 4] = g->length, v[k + 5] = g->length_rate, v[k + 6] = g->length_accel;
+    return put_motion(v, put_motion(v, k + 7, &g->d), &g->com);
+}
+
+static void kin_raw(const dyad_kin_result* r, double v[KIN_RAW])
+{
+    int k = put_link(v, put_link(v, 0, &r->m), &r->n);
+    k = put_motion(v, k, &r->e);
+    v[k] = r->slide_k.s, v[k + 1] = r->slide_k.rate, v[k + 2] = r->slide_k.accel;
+    v[k + 3] = r->slide_p.s, v[k + 4] = r->slide_p.rate, v[k + 5] = r->slide_p.accel;
+    v[k + 6] = r->conditioning, v[k + 7] = r->amplification;
+}
+
+/* 1 if two results hold the same outputs, bit for bit (NaN as NaN). */
+static int kin_same(const dyad_kin_result* a, const dyad_kin_result* b)
+{
+    double x[KIN_RAW], y[KIN_RAW];
+    int k;
+    kin_raw(a, x);
+    kin_raw(b, y);
+    for (k = 0; k < KIN_RAW; ++k) {
+        if (!(x[k] == y[k] || (isnan(x[k]) && isnan(y[k])))) {
+            return 0;
+        }
+    }
+    return a->status == b->status && a->field == b->field && a->failure == b->failure &&
+           (a->gap == b->gap || (isnan(a->gap) && isnan(b->gap)));
+}
+
+static void jet_motion(dyad_point_motion* p, vjet j)
+{
+    *p = motion_of(j);
+}
+
+static void jet_link(dyad_kin_link* g, vjet dir, sjet angle, sjet length, vjet d,
+                     double complex com)
+{
+    g->dir = cv(dir.v);
+    g->omega = (dyad_real)angle.d;
+    g->epsilon = (dyad_real)angle.dd;
+    g->length = (dyad_real)length.v;
+    g->length_rate = (dyad_real)length.d;
+    g->length_accel = (dyad_real)length.dd;
+    jet_motion(&g->d, d);
+    jet_motion(&g->com, vadd(d, vtimes(dir, com)));
+}
+
+/* The result the built dyad should give, in the raw order (in double). */
+static void expected_raw(const kin_case* c, const kin_built* b, double v[KIN_RAW])
+{
+    dyad_kin_result r;
+    double cond = built_conditioning(c->type, b);
+    jet_link(&r.m, b->i_m, b->th_m, b->l_m, b->d_m, c->com_m);
+    jet_link(&r.n, b->i_n, b->th_n, sconst(b->l_n), b->d_n, c->com_n);
+    jet_motion(&r.e, b->e);
+    r.slide_k.s = (dyad_real)b->s_k.v, r.slide_k.rate = (dyad_real)b->s_k.d;
+    r.slide_k.accel = (dyad_real)b->s_k.dd;
+    r.slide_p.s = (dyad_real)b->s_p.v, r.slide_p.rate = (dyad_real)b->s_p.d;
+    r.slide_p.accel = (dyad_real)b->s_p.dd;
+    r.conditioning = (dyad_real)cond;
+    r.amplification = (dyad_real)(1 / cond);
+    kin_raw(&r, v);
+    /* the narrowing above is undone where double matters */
+    v[KIN_RAW - 2] = cond;
+    v[KIN_RAW - 1] = 1 / cond;
+}
+
+/* Worst of |got - want| / (1 + |want|) over n numbers. */
+static double worst_error(const double* got, const double* want, int n)
+{
+    double worst = 0;
+    int k;
+    for (k = 0; k < n; ++k) {
+        const double e = fabs(got[k] - want[k]) / (1 + fabs(want[k]));
+        worst = e > worst || e != e ? e : worst;
+    }
+    return worst;
+}
+
+/* A random closed configuration of the type, conditioned at least `least`. */
+static kin_case conditioned_case(rng* r, dyad_type type, double least, dyad_kin_input* in,
+                                 kin_built* b)
+{
+    for (;;) {
+        const kin_case c = random_kin_case(r, type);
+        *in = kin_input_at(&c, 0, b);
+        if (built_conditioning(type, b) >= least) {
+            return c;
+        }
+    }
+}
+
+/* (a) E closes from both links, the pair points sit on their guides, the
+ * locked directions are locked; (b) the result is the built dyad, rates and
+ * accelerations included (the jets are exact). */
+static int test_kin_reproduces_built(void)
+{
+    int fails = 0, t, k;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x4B490000u + (uint64_t)t};
+        double worst = 0, closure = 0;
+        for (k = 0; k < KIN_SAMPLES; ++k) {
+            dyad_kin_input in;
+            kin_built b;
+            dyad_kin_result out;
+            double got[KIN_RAW], want[KIN_RAW];
+            const kin_case c = conditioned_case(&r, type, 0.05, &in, &b);
+            const dyad_status s = dyad_kinematics(type, &in, &out);
+            if (s != DYAD_STATUS_OK) {
+                CHECK(0, "%s sample %d: status %s", dyad_type_name(type), k, dyad_status_name(s));
+                continue;
+            }
+            {
+                const double complex e_m = cvec(out.m.d.position) + out.m.length * cvec(out.m.dir);
+                const double complex e_n = cvec(out.n.d.position) + out.n.length * cvec(out.n.dir);
+                double gap = cabs(e_m - e_n) + cabs(e_n - cvec(out.e.position));
+                if (type == DYAD_RRT || type == DYAD_TRT || type == DYAD_RTT) {
+                    gap += cabs(cvec(in.k.point.position) + out.slide_k.s * unit(in.k.guide) -
+                                cvec(out.m.d.position));
+                    gap += cabs(cvec(out.m.dir) - unit(in.turn_m) * unit(in.k.guide));
+                }
+                if (type == DYAD_TRT) {
+                    gap += cabs(cvec(in.p.point.position) + out.slide_p.s * unit(in.p.guide) -
+                                cvec(out.n.d.position));
+                    gap += cabs(cvec(out.n.dir) - unit(in.turn_n) * unit(in.p.guide));
+                }
+                if (type == DYAD_RTR || type == DYAD_RTT) {
+                    gap += cabs(cvec(out.n.dir) - unit(in.turn_n) * cvec(out.m.dir));
+                }
+                closure = gap > closure ? gap : closure;
+            }
+            kin_raw(&out, got);
+            expected_raw(&c, &b, want);
+            {
+                const double e = worst_error(got, want, KIN_RAW) * out.conditioning;
+                worst = e > worst ? e : worst;
+                CHECK(e < KIN_LIMIT, "%s sample %d: off the built dyad by %.3g",
+                      dyad_type_name(type), k, e);
+            }
+        }
+        CHECK(closure < 40 * KIN_LIMIT, "%s: closure off by %.3g", dyad_type_name(type), closure);
+        printf("    %s: worst closure %.3g, worst error x conditioning %.3g\n",
+               dyad_type_name(type), closure, worst);
+    }
+    return fails;
+}
+
+/* The positions of a result and their time derivatives as the result states
+ * them: dir (by omega k0 x dir, epsilon k0 x dir - omega^2 dir), lengths, D_m,
+ * D_n, E, the centres of mass and the slides (KIN_POS numbers each). */
+#define KIN_POS 18
+
+static int put_dir(double* v, int k, const dyad_kin_link* g, int order)
+{
+    const double complex i = cvec(g->dir);
+    const double complex z = order == 0   ? i
+                             : order == 1 ? I * g->omega * i
+                                          : (I * g->epsilon - g->omega * g->omega) * i;
+    v[k] = creal(z), v[k + 1] = cimag(z);
+    return k + 2;
+}
+
+static int put_point(double* v, int k, const dyad_point_motion* p, int order)
+{
+    const dyad_vec2 z = order == 0 ? p->position : order == 1 ? p->velocity : p->acceleration;
+    v[k] = z.x, v[k + 1] = z.y;
+    return k + 2;
+}
+
+static double order_of(double q, double rate, double accel, int order)
+{
+    return order == 0 ? q : order == 1 ? rate : accel;
+}
+
+/* order 0: positions; 1: their velocities; 2: their accelerations. */
+static void kin_positions(const dyad_kin_result* r, int order, double v[KIN_POS])
+{
+    int k = put_dir(v, put_dir(v, 0, &r->m, order), &r->n, order);
+    v[k++] = order_of(r->m.length, r->m.length_rate, r->m.length_accel, order);
+    v[k++] = order_of(r->n.length, r->n.length_rate, r->n.length_accel, order);
+    k = put_point(v, put_point(v, put_point(v, k, &r->m.d, order), &r->n.d, order), &r->e, order);
+    k = put_point(v, put_point(v, k, &r->m.com, order), &r->n.com, order);
+    v[k++] = order_of(r->slide_k.s, r->slide_k.rate, r->slide_k.accel, order);
+    v[k] = order_of(r->slide_p.s, r->slide_p.rate, r->slide_p.accel, order);
+}
+
+/* First and second derivative at 0 of f, sampled at -h, -h/2, 0, h/2, h, by
+ * central differences with one Richardson step: errors O(h^4). */
+static void richardson(const double f[5][KIN_RAW], int n, double h, double* d1, double* d2)
+{
+    int k;
+    for (k = 0; k < n; ++k) {
+        const double c1 = (f[4][k] - f[0][k]) / (2 * h);
+        const double c1_half = (f[3][k] - f[1][k]) / h;
+        const double c2 = (f[4][k] - 2 * f[2][k] + f[0][k]) / (h * h);
+        const double c2_half = (f[3][k] - 2 * f[2][k] + f[1][k]) / (h * h / 4);
+        d1[k] = (4 * c1_half - c1) / 3;
+        d2[k] = (4 * c2_half - c2) / 3;
+    }
+}
+
+static const double fd_steps[5] = {-1, -0.5, 0, 0.5, 1};
+
+/* (c) The velocities and accelerations the core states are the time
+ * derivatives of the positions it finds along the mounts' motion. A dropped
+ * Coriolis, centripetal or tangential term fails this. */
+static int test_kin_rates_finite_differences(void)
+{
+    int fails = 0, t, k, j;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x4B520000u + (uint64_t)t};
+        double worst = 0;
+        for (k = 0; k < KIN_SAMPLES / 10; ++k) {
+            dyad_kin_input in;
+            kin_built b;
+            dyad_kin_result out;
+            double f[5][KIN_RAW], d1[KIN_RAW], d2[KIN_RAW], v[KIN_POS], a[KIN_POS];
+            const kin_case c = conditioned_case(&r, type, 0.05, &in, &b);
+            int ok = dyad_kinematics(type, &in, &out) == DYAD_STATUS_OK;
+            kin_positions(&out, 1, v);
+            kin_positions(&out, 2, a);
+            for (j = 0; j < 5; ++j) {
+                dyad_kin_input at = kin_input_at(&c, fd_steps[j] * KIN_FD_STEP, NULL);
+                dyad_kin_result o;
+                at.branch = in.branch;
+                ok &= dyad_kinematics(type, &at, &o) == DYAD_STATUS_OK;
+                kin_positions(&o, 0, f[j]);
+            }
+            CHECK(ok, "%s sample %d: not solved", dyad_type_name(type), k);
+            richardson((const double (*)[KIN_RAW])f, KIN_POS, KIN_FD_STEP, d1, d2);
+            {
+                const double e1 = worst_error(v, d1, KIN_POS) * out.conditioning;
+                const double e2 = worst_error(a, d2, KIN_POS) * out.conditioning;
+                const double e = e1 > e2 ? e1 : e2;
+                worst = e > worst ? e : worst;
+                CHECK(e < KIN_FD_LIMIT, "%s sample %d: velocities off by %.3g, accelerations %.3g",
+                      dyad_type_name(type), k, e1, e2);
+            }
+        }
+        printf("    %s: worst x conditioning %.3g\n", dyad_type_name(type), worst);
+    }
+    return fails;
+}
+
+static dyad_vec2 move_vec(dyad_vec2 v, dyad_vec2 s, double tau)
+{
+    return vec(v.x + tau * s.x, v.y + tau * s.y);
+}
+
+/* A unit vector turned by tau times the angle rate its seed gives. */
+static dyad_vec2 turn_unit(dyad_vec2 u, dyad_vec2 s, double tau)
+{
+    const double complex z = unit(u);
+    return cv(z * cexp(I * tau * cimag(conj(z) * cvec(s))));
+}
+
+static void move_mount(dyad_mount* m, const dyad_mount* s, double tau)
+{
+    m->point.position = move_vec(m->point.position, s->point.position, tau);
+    m->point.velocity = move_vec(m->point.velocity, s->point.velocity, tau);
+    m->point.acceleration = move_vec(m->point.acceleration, s->point.acceleration, tau);
+    m->guide = turn_unit(m->guide, s->guide, tau);
+    m->omega = (dyad_real)(m->omega + tau * s->omega);
+    m->epsilon = (dyad_real)(m->epsilon + tau * s->epsilon);
+}
+
+/* The input moved by tau along the seed. */
+static dyad_kin_input kin_moved(const dyad_kin_input* in, const dyad_kin_input* seed, double tau)
+{
+    dyad_kin_input x = *in;
+    move_mount(&x.k, &seed->k, tau);
+    move_mount(&x.p, &seed->p, tau);
+    x.length_m = (dyad_real)(x.length_m + tau * seed->length_m);
+    x.length_n = (dyad_real)(x.length_n + tau * seed->length_n);
+    x.turn_m = turn_unit(x.turn_m, seed->turn_m, tau);
+    x.turn_n = turn_unit(x.turn_n, seed->turn_n, tau);
+    x.com_m = move_vec(x.com_m, seed->com_m, tau);
+    x.com_n = move_vec(x.com_n, seed->com_n, tau);
+    return x;
+}
+
+static dyad_vec2 random_vec(rng* r)
+{
+    return vec(uniform(r, -1, 1), uniform(r, -1, 1));
+}
+
+static void random_mount_seed(rng* r, dyad_mount* m)
+{
+    m->point.position = random_vec(r);
+    m->point.velocity = random_vec(r);
+    m->point.acceleration = random_vec(r);
+    m->guide = random_vec(r);
+    m->omega = (dyad_real)uniform(r, -1, 1);
+    m->epsilon = (dyad_real)uniform(r, -1, 1);
+}
+
+/* A random seed; a length at 0 (its lower bound) stays. */
+static dyad_kin_input random_seed(rng* r, const dyad_kin_input* in)
+{
+    static const dyad_kin_input zero;
+    dyad_kin_input s = zero;
+    random_mount_seed(r, &s.k);
+    random_mount_seed(r, &s.p);
+    s.length_m = in->length_m > 0 ? (dyad_real)uniform(r, -1, 1) : 0;
+    s.length_n = in->length_n > 0 ? (dyad_real)uniform(r, -1, 1) : 0;
+    s.turn_m = random_vec(r);
+    s.turn_n = random_vec(r);
+    s.com_m = random_vec(r);
+    s.com_n = random_vec(r);
+    return s;
+}
+
+/* (d) The tangent along random seeds is the derivative of the values. */
+static int test_kin_tangent_finite_differences(void)
+{
+    int fails = 0, t, k, j;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x4B540000u + (uint64_t)t};
+        double worst = 0;
+        for (k = 0; k < KIN_SAMPLES / 10; ++k) {
+            dyad_kin_input in;
+            kin_built b;
+            dyad_kin_result value, rate, plain;
+            double f[5][KIN_RAW], d1[KIN_RAW], d2[KIN_RAW], got[KIN_RAW];
+            int ok;
+            (void)conditioned_case(&r, type, 0.05, &in, &b);
+            {
+                const dyad_kin_input seed = random_seed(&r, &in);
+                ok = dyad_kinematics_tangent(type, &in, &seed, &value, &rate) == DYAD_STATUS_OK;
+                ok &= dyad_kinematics(type, &in, &plain) == DYAD_STATUS_OK;
+                CHECK(kin_same(&plain, &value),
+                      "%s sample %d: the tangent's value differs from dyad_kinematics",
+                      dyad_type_name(type), k);
+                for (j = 0; j < 5; ++j) {
+                    const dyad_kin_input at = kin_moved(&in, &seed, fd_steps[j] * KIN_TANGENT_STEP);
+                    dyad_kin_result o;
+                    ok &= dyad_kinematics(type, &at, &o) == DYAD_STATUS_OK;
+                    kin_raw(&o, f[j]);
+                }
+            }
+            CHECK(ok, "%s sample %d: not solved", dyad_type_name(type), k);
+            richardson((const double (*)[KIN_RAW])f, KIN_RAW, KIN_TANGENT_STEP, d1, d2);
+            kin_raw(&rate, got);
+            {
+                const double e = worst_error(got, d1, KIN_RAW) * value.conditioning;
+                worst = e > worst ? e : worst;
+                CHECK(e < KIN_FD_LIMIT, "%s sample %d: tangent off by %.3g", dyad_type_name(type),
+                      k, e);
+            }
+        }
+        printf("    %s: worst x conditioning %.3g\n", dyad_type_name(type), worst);
+    }
+    return fails;
+}
+
+/* The seed that moves the mounts as they move in time: positions by their
+ * velocities, velocities by their accelerations, a guide by omega, omega by
+ * epsilon. */
+static dyad_kin_input motion_seed(const dyad_kin_input* in)
+{
+    static const dyad_kin_input zero;
+    dyad_kin_input s = zero;
+    const dyad_mount* from[2] = {&in->k, &in->p};
+    dyad_mount* to[2] = {&s.k, &s.p};
+    int g;
+    for (g = 0; g < 2; ++g) {
+        to[g]->point.position = from[g]->point.velocity;
+        to[g]->point.velocity = from[g]->point.acceleration;
+        to[g]->guide = dyad_scale(from[g]->omega, dyad_perp(from[g]->guide));
+        to[g]->omega = from[g]->epsilon;
+    }
+    return s;
+}
+
+/* The velocity-level outputs (accel 0) or their acceleration-level
+ * counterparts (accel 1), in matching order: KIN_VEL numbers. */
+#define KIN_VEL 16
+
+static int put_rate_level(double* v, int k, const dyad_kin_link* g, int accel)
+{
+    const dyad_vec2 d = accel ? g->d.acceleration : g->d.velocity;
+    const dyad_vec2 s = accel ? g->com.acceleration : g->com.velocity;
+    v[k] = accel ? g->epsilon : g->omega;
+    v[k + 1] = accel ? g->length_accel : g->length_rate;
+    v[k + 2] = d.x, v[k + 3] = d.y, v[k + 4] = s.x, v[k + 5] = s.y;
+    return k + 6;
+}
+
+static void kin_rate_level(const dyad_kin_result* r, int accel, double v[KIN_VEL])
+{
+    const int k = put_rate_level(v, put_rate_level(v, 0, &r->m, accel), &r->n, accel);
+    const dyad_vec2 e = accel ? r->e.acceleration : r->e.velocity;
+    v[k] = e.x, v[k + 1] = e.y;
+    v[k + 2] = accel ? r->slide_k.accel : r->slide_k.rate;
+    v[k + 3] = accel ? r->slide_p.accel : r->slide_p.rate;
+}
+
+/* (d) Along the motion seed, the tangent of each position is the velocity the
+ * core states, and that of each velocity the acceleration, to round-off. */
+static int test_kin_tangent_along_motion(void)
+{
+    int fails = 0, t, k;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x4B4D0000u + (uint64_t)t};
+        double worst = 0;
+        for (k = 0; k < KIN_SAMPLES; ++k) {
+            dyad_kin_input in, seed;
+            kin_built b;
+            dyad_kin_result value, rate;
+            double p1[KIN_POS], v0[KIN_POS], v1[KIN_VEL], a0[KIN_VEL], e1, e2;
+            (void)conditioned_case(&r, type, 0.05, &in, &b);
+            seed = motion_seed(&in);
+            CHECK(dyad_kinematics_tangent(type, &in, &seed, &value, &rate) == DYAD_STATUS_OK,
+                  "%s sample %d: not solved", dyad_type_name(type), k);
+            kin_positions(&rate, 0, p1);
+            kin_positions(&value, 1, v0);
+            kin_rate_level(&rate, 0, v1);
+            kin_rate_level(&value, 1, a0);
+            e1 = worst_error(p1, v0, KIN_POS) * value.conditioning;
+            e2 = worst_error(v1, a0, KIN_VEL) * value.conditioning;
+            e1 = e1 > e2 ? e1 : e2;
+            worst = e1 > worst ? e1 : worst;
+            CHECK(e1 < KIN_LIMIT, "%s sample %d: rates off by %.3g", dyad_type_name(type), k, e1);
+        }
+        printf("    %s: worst x conditioning %.3g\n", dyad_type_name(type), worst);
+    }
+    return fails;
+}
+
+/* 1 if every motion output is NaN (and, with conditioning, also those two). */
+static int kin_all_nan(const dyad_kin_result* r, int with_conditioning)
+{
+    double v[KIN_RAW];
+    int k;
+    kin_raw(r, v);
+    for (k = 0; k < KIN_RAW - (with_conditioning ? 0 : 2); ++k) {
+        if (!isnan(v[k])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* A dyad with D_m at the origin and D_n at (x, y); guides along x. */
+static dyad_kin_input kin_plain_input(double x, double y, double l_m, double l_n)
+{
+    dyad_kin_input in = dyad_kin_input_default();
+    in.p.point.position = vec(x, y);
+    in.length_m = (dyad_real)l_m;
+    in.length_n = (dyad_real)l_n;
+    return in;
+}
+
+typedef struct kin_failure_case {
+    dyad_type type;
+    double x, y, l_m, l_n, delta_m, delta_n;
+    int branch;
+    dyad_kin_failure failure;
+    double gap;
+    double gap_rate; /* of the gap as D_n moves along +x */
+} kin_failure_case;
+
+/* (e) Each failure figure, with its gap and the gap's rate. */
+static int test_kin_failures(void)
+{
+    static const kin_failure_case cases[] = {
+        {DYAD_RRR, 5, 0, 1, 2, 0, 0, 1, DYAD_KIN_TOO_FAR, 2, 1},
+        {DYAD_RRR, 0, -4, 1, 2, 0, 0, -1, DYAD_KIN_TOO_FAR, 1, 0},
+        {DYAD_RRR, 0.5, 0, 3, 1, 0, 0, 1, DYAD_KIN_TOO_CLOSE, 1.5, -1},
+        {DYAD_RRR, 0, 0.25, 1, 2, 0, 0, 1, DYAD_KIN_TOO_CLOSE, 0.75, 0},
+        {DYAD_RRT, 0.3, 3, 0, 1, 0, 0, 1, DYAD_KIN_OFF_LINE, 2, 0},
+        {DYAD_RRT, 0.3, -3, 0.5, 1, PI / 2, 0, -1, DYAD_KIN_OFF_LINE, 2.5, 0},
+        {DYAD_RTR, 0.5, 0, 0, 1, 0, PI / 2, 1, DYAD_KIN_OFF_SLOT, 0.5, -1},
+        {DYAD_RTR, 3, 0, 0, 1, 0, 0, -1, DYAD_KIN_BEHIND_PIVOT, 2, 1},
+        {DYAD_RTR, -1, 0, 0, 3, 0, PI, 1, DYAD_KIN_BEHIND_PIVOT, 2, 1},
+    };
+    int fails = 0;
+    size_t k;
+    for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        const kin_failure_case* c = &cases[k];
+        static const dyad_kin_input zero;
+        dyad_kin_input in = kin_plain_input(c->x, c->y, c->l_m, c->l_n);
+        dyad_kin_input seed = zero;
+        dyad_kin_result out, value, rate;
+        in.turn_m = cv(cexp(I * c->delta_m));
+        in.turn_n = cv(cexp(I * c->delta_n));
+        in.branch = c->branch;
+        seed.p.point.position = vec(1, 0);
+        CHECK(dyad_kinematics(c->type, &in, &out) == DYAD_STATUS_CANNOT_ASSEMBLE &&
+                  out.status == DYAD_STATUS_CANNOT_ASSEMBLE,
+              "case %zu: status %s", k, dyad_status_name(out.status));
+        CHECK(out.failure == c->failure, "case %zu: failure %d (%s), want %d", k, out.failure,
+              dyad_kin_failure_name(out.failure), c->failure);
+        CHECK(fabs(out.gap - c->gap) <= 1e-6 * c->gap, "case %zu: gap %.17g, want %g", k,
+              (double)out.gap, c->gap);
+        CHECK(kin_all_nan(&out, 1), "case %zu: an output is not NaN", k);
+        CHECK(out.field == DYAD_KIN_FIELD_NONE && strlen(dyad_kin_failure_name(out.failure)) > 0,
+              "case %zu: field or failure name", k);
+        CHECK(dyad_kinematics_tangent(c->type, &in, &seed, &value, &rate) ==
+                      DYAD_STATUS_CANNOT_ASSEMBLE &&
+                  kin_same(&value, &out),
+              "case %zu: the tangent's value differs", k);
+        CHECK(rate.failure == c->failure && fabs(rate.gap - c->gap_rate) <= 1e-6 &&
+                  kin_all_nan(&rate, 1),
+              "case %zu: gap rate %g, want %g", k, (double)rate.gap, c->gap_rate);
+    }
+    return fails;
+}
+
+/* (e) At a singular position the result is singular, the conditioning
+ * stated, the outputs NaN. */
+static int test_kin_singular(void)
+{
+    int fails = 0;
+    size_t k;
+    struct {
+        dyad_type type;
+        dyad_kin_input in;
+    } cases[8];
+    size_t count = 0;
+    cases[count].type = DYAD_RRR, cases[count++].in = kin_plain_input(3, 0, 1, 2); /* stretched */
+    cases[count].type = DYAD_RRR, cases[count++].in = kin_plain_input(0, 1, 3, 2); /* folded */
+    cases[count].type = DYAD_RRR, cases[count++].in = kin_plain_input(0, 0, 2, 2); /* coincident */
+    cases[count].type = DYAD_RRT, cases[count++].in = kin_plain_input(0.5, 1, 0, 1);
+    cases[count].type = DYAD_RTR, cases[count++].in = kin_plain_input(0, 0, 0, 1);
+    cases[count].type = DYAD_TRT, cases[count].in = kin_plain_input(2, 1, 1, 1);
+    cases[count++].in.p.guide = vec(-1, 0); /* parallel guides */
+    cases[count].type = DYAD_RTT, cases[count++].in = kin_plain_input(2, 1, 1, 1); /* i_m = i_k */
+    cases[count].type = DYAD_RTT, cases[count].in = kin_plain_input(2, 1, 1, 1);
+    cases[count++].in.turn_m = vec(-1, 0);
+    for (k = 0; k < count; ++k) {
+        const dyad_type type = cases[k].type;
+        dyad_kin_result out, value, rate;
+        static const dyad_kin_input zero;
+        const dyad_status s = dyad_kinematics(type, &cases[k].in, &out);
+        CHECK(s == DYAD_STATUS_SINGULAR && out.status == s, "%s case %zu: status %s",
+              dyad_type_name(type), k, dyad_status_name(s));
+        CHECK(out.conditioning >= 0 && out.conditioning < cases[k].in.singular_threshold &&
+                  out.amplification == 1 / out.conditioning,
+              "%s case %zu: conditioning %g, amplification %g", dyad_type_name(type), k,
+              (double)out.conditioning, (double)out.amplification);
+        CHECK(kin_all_nan(&out, 0) && out.failure == DYAD_KIN_CLOSES && out.gap == 0,
+              "%s case %zu: outputs not NaN", dyad_type_name(type), k);
+        CHECK(dyad_kinematics_tangent(type, &cases[k].in, &zero, &value, &rate) == s &&
+                  kin_same(&value, &out) && kin_all_nan(&rate, 0),
+              "%s case %zu: the tangent differs", dyad_type_name(type), k);
+    }
+    return fails;
+}
+
+/* One number of the input, the field it belongs to, and the types that read it. */
+typedef struct kin_real_field {
+    size_t offset;
+    dyad_kin_field field;
+    unsigned types; /* bit t: type t reads it */
+} kin_real_field;
+
+#define KIN_ALL   0x1Fu
+#define KIN_DM_T  ((1u << DYAD_RRT) | (1u << DYAD_TRT) | (1u << DYAD_RTT))
+#define KIN_DN_T  (1u << DYAD_TRT)
+#define KIN_LM    ((1u << DYAD_RRR) | (1u << DYAD_RRT) | (1u << DYAD_TRT))
+#define KIN_TN    ((1u << DYAD_RTR) | (1u << DYAD_TRT) | (1u << DYAD_RTT))
+#define KIN_AT(f) offsetof(dyad_kin_input, f)
+
+static const kin_real_field kin_real_fields[] = {
+    {KIN_AT(k.point.position.x), DYAD_KIN_FIELD_K_POSITION, KIN_ALL},
+    {KIN_AT(k.point.position.y), DYAD_KIN_FIELD_K_POSITION, KIN_ALL},
+    {KIN_AT(k.point.velocity.x), DYAD_KIN_FIELD_K_VELOCITY, KIN_ALL},
+    {KIN_AT(k.point.acceleration.y), DYAD_KIN_FIELD_K_ACCELERATION, KIN_ALL},
+    {KIN_AT(k.guide.x), DYAD_KIN_FIELD_K_GUIDE, KIN_DM_T},
+    {KIN_AT(k.guide.y), DYAD_KIN_FIELD_K_GUIDE, KIN_DM_T},
+    {KIN_AT(k.omega), DYAD_KIN_FIELD_K_OMEGA, KIN_DM_T},
+    {KIN_AT(k.epsilon), DYAD_KIN_FIELD_K_EPSILON, KIN_DM_T},
+    {KIN_AT(p.point.position.y), DYAD_KIN_FIELD_P_POSITION, KIN_ALL},
+    {KIN_AT(p.point.velocity.x), DYAD_KIN_FIELD_P_VELOCITY, KIN_ALL},
+    {KIN_AT(p.point.acceleration.x), DYAD_KIN_FIELD_P_ACCELERATION, KIN_ALL},
+    {KIN_AT(p.guide.y), DYAD_KIN_FIELD_P_GUIDE, KIN_DN_T},
+    {KIN_AT(p.omega), DYAD_KIN_FIELD_P_OMEGA, KIN_DN_T},
+    {KIN_AT(p.epsilon), DYAD_KIN_FIELD_P_EPSILON, KIN_DN_T},
+    {KIN_AT(length_m), DYAD_KIN_FIELD_LENGTH_M, KIN_LM},
+    {KIN_AT(length_n), DYAD_KIN_FIELD_LENGTH_N, KIN_ALL},
+    {KIN_AT(turn_m.x), DYAD_KIN_FIELD_TURN_M, KIN_DM_T},
+    {KIN_AT(turn_n.y), DYAD_KIN_FIELD_TURN_N, KIN_TN},
+    {KIN_AT(com_m.x), DYAD_KIN_FIELD_COM_M, KIN_ALL},
+    {KIN_AT(com_n.y), DYAD_KIN_FIELD_COM_N, KIN_ALL},
+    {KIN_AT(singular_threshold), DYAD_KIN_FIELD_SINGULAR_THRESHOLD, KIN_ALL},
+};
+
+static dyad_real* kin_real_at(dyad_kin_input* in, size_t offset)
+{
+    return (dyad_real*)(void*)((char*)in + offset);
+}
+
+/* The call is refused, naming `field`, with NaN outputs, in both entries. */
+static int expect_kin_invalid(dyad_type type, const dyad_kin_input* in, dyad_kin_field field,
+                              const char* what)
+{
+    int fails = 0;
+    dyad_kin_result out, value, rate;
+    const dyad_kin_input seed = *in;
+    const dyad_status s = dyad_kinematics(type, in, &out);
+    CHECK(s == DYAD_STATUS_INVALID_INPUT && out.field == field && kin_all_nan(&out, 1),
+          "%s, %s: status %s, field '%s', want '%s'", dyad_type_name(type), what,
+          dyad_status_name(s), dyad_kin_field_name(out.field), dyad_kin_field_name(field));
+    CHECK(dyad_kinematics_tangent(type, in, &seed, &value, &rate) == DYAD_STATUS_INVALID_INPUT &&
+              value.field == field && rate.field == field && kin_all_nan(&rate, 1),
+          "%s, %s: the tangent names '%s'", dyad_type_name(type), what,
+          dyad_kin_field_name(value.field));
+    return fails;
+}
+
+/* (e) A non-finite number in each field a type reads is named; in a field it
+ * does not read it is ignored. */
+static int test_kin_invalid_nonfinite(void)
+{
+    int fails = 0, t;
+    size_t f;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x4B560000u + (uint64_t)t};
+        dyad_kin_input base;
+        kin_built b;
+        dyad_kin_result good;
+        (void)conditioned_case(&r, type, 0.05, &base, &b);
+        CHECK(dyad_kinematics(type, &base, &good) == DYAD_STATUS_OK, "%s: base not solved",
+              dyad_type_name(type));
+        for (f = 0; f < sizeof kin_real_fields / sizeof kin_real_fields[0]; ++f) {
+            const kin_real_field* field = &kin_real_fields[f];
+            const double poisons[2] = {NAN, INFINITY};
+            int p;
+            for (p = 0; p < 2; ++p) {
+                dyad_kin_input in = base;
+                dyad_kin_result out;
+                *kin_real_at(&in, field->offset) = (dyad_real)poisons[p];
+                if (field->types & (1u << type)) {
+                    fails += expect_kin_invalid(type, &in, field->field,
+                                                dyad_kin_field_name(field->field));
+                } else {
+                    CHECK(dyad_kinematics(type, &in, &out) == DYAD_STATUS_OK &&
+                              kin_same(&out, &good),
+                          "%s: '%s' is not read, yet changes the result", dyad_type_name(type),
+                          dyad_kin_field_name(field->field));
+                }
+            }
+        }
+    }
+    return fails;
+}
+
+/* (e) Out-of-domain directions, lengths, branch and threshold are named; the
+ * first in the order of dyad_kin_field wins. */
+static int test_kin_invalid_domain(void)
+{
+    int fails = 0, t;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        const unsigned bit = 1u << type;
+        rng r = {0x4B440000u + (uint64_t)t};
+        dyad_kin_input base, in;
+        kin_built b;
+        dyad_kin_result out;
+        (void)conditioned_case(&r, type, 0.05, &base, &b);
+        if (bit & KIN_DM_T) {
+            in = base, in.k.guide = dyad_scale((dyad_real)1.01, in.k.guide);
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_K_GUIDE, "long guide k");
+            in = base, in.turn_m = dyad_scale((dyad_real)0.99, in.turn_m);
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_TURN_M, "short turn_m");
+            in = base, in.k.guide = dyad_scale((dyad_real)(1 + 1e-7), in.k.guide);
+            CHECK(dyad_kinematics(type, &in, &out) == DYAD_STATUS_OK,
+                  "%s: a guide unit within the tolerance is refused", dyad_type_name(type));
+        }
+        if (bit & KIN_DN_T) {
+            in = base, in.p.guide = vec(0, 0);
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_P_GUIDE, "zero guide p");
+        }
+        if (bit & KIN_TN) {
+            in = base, in.turn_n = dyad_scale(2, in.turn_n);
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_TURN_N, "long turn_n");
+        }
+        in = base, in.length_n = -1;
+        fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_LENGTH_N, "negative l_n");
+        if (type == DYAD_RRR || type == DYAD_RRT) {
+            in = base, in.length_n = 0;
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_LENGTH_N, "zero l_n");
+        }
+        if (bit & KIN_LM) {
+            in = base, in.length_m = type == DYAD_RRR ? 0 : (dyad_real)-0.5;
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_LENGTH_M, "l_m out of domain");
+        }
+        in = base, in.branch = 0;
+        if (type == DYAD_RRR || type == DYAD_RRT || type == DYAD_RTR) {
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_BRANCH, "branch 0");
+            in.branch = 2;
+            fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_BRANCH, "branch 2");
+        } else {
+            CHECK(dyad_kinematics(type, &in, &out) == DYAD_STATUS_OK, "%s: branch is read",
+                  dyad_type_name(type));
+        }
+        in = base, in.singular_threshold = 0;
+        fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_SINGULAR_THRESHOLD, "threshold 0");
+        in.singular_threshold = 1;
+        fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_SINGULAR_THRESHOLD, "threshold 1");
+        in.k.point.velocity.x = (dyad_real)NAN;
+        fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_K_VELOCITY, "two bad fields");
+    }
+    return fails;
+}
+
+/* (e) NULL pointers and a bad type. */
+static int test_kin_invalid_pointers(void)
+{
+    int fails = 0, t;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        const dyad_kin_input base = dyad_kin_input_default();
+        dyad_kin_result out;
+        CHECK(dyad_kinematics(type, NULL, &out) == DYAD_STATUS_INVALID_INPUT &&
+                  out.field == DYAD_KIN_FIELD_INPUT && kin_all_nan(&out, 1),
+              "%s: a NULL input is not named", dyad_type_name(type));
+        CHECK(dyad_kinematics(type, &base, NULL) == DYAD_STATUS_INVALID_INPUT,
+              "%s: a NULL result is not refused", dyad_type_name(type));
+        CHECK(dyad_kinematics_tangent(type, &base, NULL, &out, &out) == DYAD_STATUS_INVALID_INPUT &&
+                  out.field == DYAD_KIN_FIELD_INPUT,
+              "%s: a NULL seed is not named", dyad_type_name(type));
+    }
+    {
+        const dyad_kin_input in = dyad_kin_input_default();
+        dyad_kin_result out;
+        CHECK(dyad_kinematics(DYAD_TYPE_COUNT, &in, &out) == DYAD_STATUS_INVALID_INPUT &&
+                  out.field == DYAD_KIN_FIELD_TYPE && kin_all_nan(&out, 1),
+              "a bad type is not named");
+        CHECK(dyad_kinematics_tangent(DYAD_TYPE_COUNT, &in, &in, &out, &out) ==
+                      DYAD_STATUS_INVALID_INPUT &&
+                  out.field == DYAD_KIN_FIELD_TYPE,
+              "the tangent: a bad type is not named");
+    }
+    return fails;
+}
+
+/* dyad_point_on_link: a point fixed on a moving link, against its jet. */
+static int test_kin_point_on_link(void)
+{
+    int fails = 0, k;
+    rng r = {0x4B500000u};
+    double worst = 0;
+    for (k = 0; k < 1000; ++k) {
+        const path x = random_path(&r, -1, 1, 2), y = random_path(&r, -1, 1, 2);
+        const path th = random_path(&r, -PI, PI, 3);
+        const double complex at = uniform(&r, -2, 2) + I * uniform(&r, -2, 2);
+        const sjet angle = path_at(&th, 0);
+        const sjet px = path_at(&x, 0), py = path_at(&y, 0);
+        vjet origin, want;
+        dyad_point_motion o, got;
+        double g[6], w[6];
+        origin.v = px.v + I * py.v, origin.d = px.d + I * py.d, origin.dd = px.dd + I * py.dd;
+        want = vadd(origin, vtimes(vpolar(angle), at));
+        o = motion_of(origin);
+        got = dyad_point_on_link(&o, cv(cexp(I * angle.v)), (dyad_real)angle.d, (dyad_real)angle.dd,
+                                 cv(at));
+        put_motion(g, 0, &got);
+        o = motion_of(want);
+        put_motion(w, 0, &o);
+        worst = worst_error(g, w, 6) > worst ? worst_error(g, w, 6) : worst;
+    }
+    CHECK(worst < KIN_LIMIT, "dyad_point_on_link off by %.3g", worst);
+    return fails;
+}
+
+/* Names: every field and failure has its own, NONE and CLOSES none. */
+static int test_kin_names(void)
+{
+    int fails = 0, a, b;
+    for (a = 1; a < DYAD_KIN_FIELD_COUNT; ++a) {
+        CHECK(strlen(dyad_kin_field_name((dyad_kin_field)a)) > 0, "field %d has no name", a);
+        for (b = 1; b < a; ++b) {
+            CHECK(strcmp(dyad_kin_field_name((dyad_kin_field)a),
+                         dyad_kin_field_name((dyad_kin_field)b)) != 0,
+                  "fields %d and %d share a name", a, b);
+        }
+    }
+    for (a = 1; a < DYAD_KIN_FAILURE_COUNT; ++a) {
+        CHECK(strlen(dyad_kin_failure_name((dyad_kin_failure)a)) > 0, "failure %d has no name", a);
+    }
+    CHECK(dyad_kin_field_name(DYAD_KIN_FIELD_NONE)[0] == 0 &&
+              dyad_kin_failure_name(DYAD_KIN_CLOSES)[0] == 0 &&
+              strcmp(dyad_kin_field_name(DYAD_KIN_FIELD_K_GUIDE), "k.guide") == 0 &&
+              strcmp(dyad_status_name(DYAD_STATUS_CANNOT_ASSEMBLE), "cannot assemble") == 0,
+          "names of NONE, CLOSES, k.guide, cannot assemble");
+    return fails;
+}
+
 static const named_test tests[] = {
     {"equilibrium_random", test_equilibrium_random},
     {"rrr_symmetric_truss", test_rrr_symmetric_truss},
@@ -1060,6 +2151,17 @@ static const named_test tests[] = {
     {"invalid_before_singular", test_invalid_before_singular},
     {"react_loaded", test_react_loaded},
     {"tangent_of_each_type", test_tangent_of_each_type},
+    {"kin_reproduces_built", test_kin_reproduces_built},
+    {"kin_rates_finite_differences", test_kin_rates_finite_differences},
+    {"kin_tangent_finite_differences", test_kin_tangent_finite_differences},
+    {"kin_tangent_along_motion", test_kin_tangent_along_motion},
+    {"kin_failures", test_kin_failures},
+    {"kin_singular", test_kin_singular},
+    {"kin_invalid_nonfinite", test_kin_invalid_nonfinite},
+    {"kin_invalid_domain", test_kin_invalid_domain},
+    {"kin_invalid_pointers", test_kin_invalid_pointers},
+    {"kin_point_on_link", test_kin_point_on_link},
+    {"kin_names", test_kin_names},
 };
 
 int main(int argc, char** argv)

@@ -3,11 +3,17 @@
 The inputs are the dicts of :mod:`dyadfmu.reference.newton_euler` (same keys, same units), so
 one configuration can be given to both. The library is looked up in
 ``$DYADFMU_LIB``, else in ``build/`` beside ``scripts/``.
+
+The kinematics (``dyadfmu/kinematics.h``) take a dict shaped like ``dyad_kin_input``:
+``{"k": {"position", "velocity", "acceleration", "guide", "omega", "epsilon"}, "p": {...},
+"length_m", "length_n", "turn_m", "turn_n", "com_m", "com_n", "branch",
+"singular_threshold"}``; a missing key keeps the value of ``dyad_kin_input_default()``.
 """
 
 from __future__ import annotations
 
 import ctypes
+import math
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,6 +27,12 @@ TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 STATUS = {0: "ok", 1: "singular", 2: "invalid input", 3: "out of range", 4: "cannot assemble"}
 #: The scalar reactions of a solve: joint-normal forces and moments.
 REACTION_SCALARS = ("n_mk", "n_np", "n_mn", "m_mk", "m_np", "m_mn")
+#: Keys of a mount (external link k or p) in a kinematics input.
+MOUNT_POINT_KEYS = ("position", "velocity", "acceleration")
+MOUNT_KEYS = (*MOUNT_POINT_KEYS, "guide", "omega", "epsilon")
+#: Vector and scalar keys of a kinematics input besides the mounts.
+KIN_VECTORS = ("turn_m", "turn_n", "com_m", "com_n")
+KIN_SCALARS = ("length_m", "length_n", "singular_threshold")
 LINK_KEYS = (
     "dir",
     "length",
@@ -84,6 +96,106 @@ class _Result(ctypes.Structure):
     ]
 
 
+class _PointMotion(ctypes.Structure):
+    _fields_ = [("position", _Vec2), ("velocity", _Vec2), ("acceleration", _Vec2)]
+
+
+class _Mount(ctypes.Structure):
+    _fields_ = [
+        ("point", _PointMotion),
+        ("guide", _Vec2),
+        ("omega", ctypes.c_double),
+        ("epsilon", ctypes.c_double),
+    ]
+
+
+class _KinInput(ctypes.Structure):
+    _fields_ = [
+        ("k", _Mount),
+        ("p", _Mount),
+        ("length_m", ctypes.c_double),
+        ("length_n", ctypes.c_double),
+        ("turn_m", _Vec2),
+        ("turn_n", _Vec2),
+        ("com_m", _Vec2),
+        ("com_n", _Vec2),
+        ("branch", ctypes.c_int),
+        ("singular_threshold", ctypes.c_double),
+    ]
+
+
+class _KinLink(ctypes.Structure):
+    _fields_ = [
+        ("dir", _Vec2),
+        ("omega", ctypes.c_double),
+        ("epsilon", ctypes.c_double),
+        ("length", ctypes.c_double),
+        ("length_rate", ctypes.c_double),
+        ("length_accel", ctypes.c_double),
+        ("d", _PointMotion),
+        ("com", _PointMotion),
+    ]
+
+
+class _Slide(ctypes.Structure):
+    _fields_ = [("s", ctypes.c_double), ("rate", ctypes.c_double), ("accel", ctypes.c_double)]
+
+
+class _KinResult(ctypes.Structure):
+    _fields_ = [
+        ("status", ctypes.c_int),
+        ("field", ctypes.c_int),
+        ("failure", ctypes.c_int),
+        ("gap", ctypes.c_double),
+        ("m", _KinLink),
+        ("n", _KinLink),
+        ("e", _PointMotion),
+        ("slide_k", _Slide),
+        ("slide_p", _Slide),
+        ("conditioning", ctypes.c_double),
+        ("amplification", ctypes.c_double),
+    ]
+
+
+def _pair(v: _Vec2) -> tuple[float, float]:
+    return (v.x, v.y)
+
+
+def _point_motion(p: _PointMotion) -> dict:
+    return {key: _pair(getattr(p, key)) for key in MOUNT_POINT_KEYS}
+
+
+def _kin_link(link: _KinLink, angle: float) -> dict:
+    out = {"dir": _pair(link.dir), "angle": angle}
+    for key in ("omega", "epsilon", "length", "length_rate", "length_accel"):
+        out[key] = getattr(link, key)
+    out["d"] = _point_motion(link.d)
+    out["com"] = _point_motion(link.com)
+    return out
+
+
+def _fill_kin_input(dst: _KinInput, src: dict) -> None:
+    """Writes the keys present in `src` into `dst` (the rest keep their values)."""
+    for name in ("k", "p"):
+        mount = getattr(dst, name)
+        for key, value in src.get(name, {}).items():
+            if key not in MOUNT_KEYS:
+                raise KeyError(f"unknown key {name}.{key!r}; expected one of {MOUNT_KEYS}")
+            target = mount.point if key in MOUNT_POINT_KEYS else mount
+            if key in ("omega", "epsilon"):
+                setattr(target, key, float(value))
+            else:
+                setattr(target, key, _Vec2(float(value[0]), float(value[1])))
+    for key in KIN_VECTORS:
+        if key in src:
+            setattr(dst, key, _Vec2(float(src[key][0]), float(src[key][1])))
+    for key in KIN_SCALARS:
+        if key in src:
+            setattr(dst, key, float(src[key]))
+    if "branch" in src:
+        dst.branch = int(src["branch"])
+
+
 def library_path() -> Path:
     """Where the shared core is expected."""
     env = os.environ.get("DYADFMU_LIB")
@@ -122,6 +234,28 @@ class Core:
         self._lib.dyad_solve_tangent.restype = ctypes.c_int
         self._lib.dyad_field_name.argtypes = [ctypes.c_int]
         self._lib.dyad_field_name.restype = ctypes.c_char_p
+        self._bind_kinematics()
+
+    def _bind_kinematics(self) -> None:
+        lib = self._lib
+        lib.dyad_kin_input_default.restype = _KinInput
+        lib.dyad_kinematics.argtypes = [
+            ctypes.c_int,
+            ctypes.POINTER(_KinInput),
+            ctypes.POINTER(_KinResult),
+        ]
+        lib.dyad_kinematics.restype = ctypes.c_int
+        lib.dyad_kinematics_tangent.argtypes = [
+            ctypes.c_int,
+            ctypes.POINTER(_KinInput),
+            ctypes.POINTER(_KinInput),
+            ctypes.POINTER(_KinResult),
+            ctypes.POINTER(_KinResult),
+        ]
+        lib.dyad_kinematics_tangent.restype = ctypes.c_int
+        for name in ("dyad_kin_field_name", "dyad_kin_failure_name"):
+            getattr(lib, name).argtypes = [ctypes.c_int]
+            getattr(lib, name).restype = ctypes.c_char_p
 
     @staticmethod
     def _fill_link(dst: _Link, src: dict) -> None:
@@ -205,3 +339,67 @@ class Core:
             ctypes.byref(derivative),
         )
         return self._output(value), self._output(derivative)
+
+    # ---- kinematics (dyadfmu/kinematics.h) ------------------------------------------------
+
+    def _kin_output(self, res: _KinResult, rate_of: _KinResult | None = None) -> dict:
+        """A result as a dict. With `rate_of` (the value of a tangent), `res` holds rates and
+        each link's "angle" is the angle's rate, dir x d(dir); else atan2 of dir."""
+
+        def angle(link: str) -> float:
+            d = getattr(res, link).dir
+            if rate_of is None:
+                return math.atan2(d.y, d.x)
+            v = getattr(rate_of, link).dir
+            return v.x * d.y - v.y * d.x
+
+        return {
+            "status": STATUS.get(res.status, "?"),
+            "field": self._lib.dyad_kin_field_name(res.field).decode(),
+            "failure": self._lib.dyad_kin_failure_name(res.failure).decode(),
+            "gap": res.gap,
+            "m": _kin_link(res.m, angle("m")),
+            "n": _kin_link(res.n, angle("n")),
+            "e": _point_motion(res.e),
+            "slide_k": {key: getattr(res.slide_k, key) for key in ("s", "rate", "accel")},
+            "slide_p": {key: getattr(res.slide_p, key) for key in ("s", "rate", "accel")},
+            "conditioning": res.conditioning,
+            "amplification": res.amplification,
+        }
+
+    def kin_input(self, inputs: dict, base: _KinInput | None = None) -> _KinInput:
+        """The C input of a kinematics dict: `base` (default dyad_kin_input_default())
+        with the keys of `inputs` written over it."""
+        inp = base if base is not None else self._lib.dyad_kin_input_default()
+        _fill_kin_input(inp, inputs)
+        return inp
+
+    def kinematics(self, dyad_type: str, inputs: dict) -> dict:
+        """The closed-form kinematics of one dyad: status, field and failure names, gap,
+        links m and n (dir, angle, omega, epsilon, length with its rates, D_g and centre of
+        mass with position, velocity, acceleration), E, the slides, conditioning and
+        amplification. Units as in kinematics.h (m, s, rad)."""
+        if dyad_type not in TYPES:
+            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        inp = self.kin_input(inputs)
+        res = _KinResult()
+        self._lib.dyad_kinematics(TYPES.index(dyad_type), ctypes.byref(inp), ctypes.byref(res))
+        return self._kin_output(res)
+
+    def kinematics_tangent(self, dyad_type: str, inputs: dict, seed: dict) -> tuple[dict, dict]:
+        """The kinematics and their exact directional derivative along `seed`, a dict of the
+        same shape as `inputs` holding each field's rate (missing keys: 0; a unit vector's
+        rate counts by its part normal to it). Returns (value, derivative)."""
+        if dyad_type not in TYPES:
+            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        inp = self.kin_input(inputs)
+        rate = self.kin_input(seed, base=_KinInput())
+        value, derivative = _KinResult(), _KinResult()
+        self._lib.dyad_kinematics_tangent(
+            TYPES.index(dyad_type),
+            ctypes.byref(inp),
+            ctypes.byref(rate),
+            ctypes.byref(value),
+            ctypes.byref(derivative),
+        )
+        return self._kin_output(value), self._kin_output(derivative, rate_of=value)

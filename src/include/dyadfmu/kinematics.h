@@ -154,7 +154,9 @@ typedef struct dyad_kin_result {
     /** With DYAD_STATUS_CANNOT_ASSEMBLE: which figure failed, else CLOSES. */
     dyad_kin_failure failure;
     /** With DYAD_STATUS_CANNOT_ASSEMBLE: by how much it failed (m), > 0, e.g.
-     *  |D_m D_n| - (l_m + l_n) for DYAD_KIN_TOO_FAR. Else 0. */
+     *  |D_m D_n| - (l_m + l_n) for DYAD_KIN_TOO_FAR (0 only for
+     *  DYAD_KIN_BEHIND_PIVOT with l_m = 0 exactly). Else 0. With the tangent,
+     *  the derivative's gap is the gap's rate. */
     dyad_real gap;
 
     dyad_kin_link m; /**< link m */
@@ -182,7 +184,9 @@ dyad_kin_input dyad_kin_input_default(void);
 dyad_status dyad_kinematics(dyad_type type, const dyad_kin_input* input, dyad_kin_result* result);
 
 /** RRR: E at distance l_m from D_m and l_n from D_n; branch +1 puts E to the
- *  left of the line from D_m to D_n (k0 . (D_n - D_m) x (E - D_m) > 0). */
+ *  left of the line from D_m to D_n (k0 . (D_n - D_m) x (E - D_m) > 0).
+ *  D_m = D_n with l_m = l_n (E anywhere, the links folded) is singular with
+ *  conditioning 0. */
 dyad_status dyad_kinematics_rrr(const dyad_kin_input* input, dyad_kin_result* result);
 /** RRT: D_m slides on guide k; branch +1 takes the larger slide s_k. */
 dyad_status dyad_kinematics_rrt(const dyad_kin_input* input, dyad_kin_result* result);
@@ -190,7 +194,8 @@ dyad_status dyad_kinematics_rrt(const dyad_kin_input* input, dyad_kin_result* re
 dyad_status dyad_kinematics_rtr(const dyad_kin_input* input, dyad_kin_result* result);
 /** TRT: D_m slides on guide k and D_n on guide p; one assembly. */
 dyad_status dyad_kinematics_trt(const dyad_kin_input* input, dyad_kin_result* result);
-/** RTT: D_m slides on guide k and E along link m; one assembly. */
+/** RTT: D_m slides on guide k and E along link m; one assembly. l_m is the
+ *  signed coordinate of E along i_m: negative puts E behind D_m, not a failure. */
 dyad_status dyad_kinematics_rtt(const dyad_kin_input* input, dyad_kin_result* result);
 
 /** The kinematics and their directional derivative along `seed`, exactly (no
