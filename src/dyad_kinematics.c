@@ -220,37 +220,3 @@ int dyad_kin_outputs_finite(const dyad_kin_result* r)
                               (r->slide_p.accel - r->slide_p.accel);
     return residue == 0;
 }
-
-/* ---- dispatch -----------------------------------------------------------------------------------
- */
-
-dyad_status dyad_kinematics(dyad_type type, const dyad_kin_input* input, dyad_kin_result* result)
-{
-    switch (type) {
-    case DYAD_RRR: return dyad_kinematics_rrr(input, result);
-    case DYAD_RRT: return dyad_kinematics_rrt(input, result);
-    case DYAD_RTR: return dyad_kinematics_rtr(input, result);
-    case DYAD_TRT: return dyad_kinematics_trt(input, result);
-    case DYAD_RTT: return dyad_kinematics_rtt(input, result);
-    case DYAD_TYPE_COUNT: break;
-    }
-    return dyad_kin_reject(result, NULL, DYAD_STATUS_INVALID_INPUT,
-                           result == NULL ? DYAD_KIN_FIELD_INPUT : DYAD_KIN_FIELD_TYPE);
-}
-
-dyad_status dyad_kinematics_tangent(dyad_type type, const dyad_kin_input* input,
-                                    const dyad_kin_input* seed, dyad_kin_result* value,
-                                    dyad_kin_result* derivative)
-{
-    switch (type) {
-    case DYAD_RRR: return dyad_kin_tangent_rrr(input, seed, value, derivative);
-    case DYAD_RRT: return dyad_kin_tangent_rrt(input, seed, value, derivative);
-    case DYAD_RTR: return dyad_kin_tangent_rtr(input, seed, value, derivative);
-    case DYAD_TRT: return dyad_kin_tangent_trt(input, seed, value, derivative);
-    case DYAD_RTT: return dyad_kin_tangent_rtt(input, seed, value, derivative);
-    case DYAD_TYPE_COUNT: break;
-    }
-    return dyad_kin_reject(value, derivative, DYAD_STATUS_INVALID_INPUT,
-                           value == NULL || derivative == NULL ? DYAD_KIN_FIELD_INPUT
-                                                               : DYAD_KIN_FIELD_TYPE);
-}

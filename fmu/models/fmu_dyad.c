@@ -43,6 +43,11 @@ static void report(const fmu_model* model, const dyad_input* input, const dyad_r
         snprintf(evaluation->reason, sizeof evaluation->reason, "not valid for this dyad (%s)",
                  dyad_field_name(result->field));
         break;
+    case DYAD_STATUS_CANNOT_ASSEMBLE: /* the kinematics' status: no solver returns it */
+        evaluation->status = FMU_ERROR;
+        snprintf(evaluation->reason, sizeof evaluation->reason, "unexpected status %s",
+                 dyad_status_name(result->status));
+        break;
     }
 }
 

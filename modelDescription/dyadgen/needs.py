@@ -447,7 +447,10 @@ def _driver_inertia_outputs(offer: _Offer, scene: Scene) -> None:
     )
     for key, u, text, depends in texts:
         source = "crank" if key.endswith("0") else "driver"
-        _motion_output(offer, f"{c}.{key}", u, text, f"{member(c)}_{key.lower()}", depends, source)
+        c_member = f"{member(c)}_{key.lower()}"
+        if not key.endswith("0"):
+            c_member = f"{member(c)}_reduced_{key.lower()}"  # not the frame's local c_j
+        _motion_output(offer, f"{c}.{key}", u, text, c_member, depends, source)
 
 
 def _ram_outputs(offer: _Offer, scene: Scene) -> None:

@@ -483,12 +483,12 @@ def _driver_inertia(plan: Plan, code: _Code) -> None:
     code("        return;")
     code("    }")
     code("}")
-    code(f"const double {c}_j = {' + '.join(j_terms) or '0.0'};")
-    code(f"const double {c}_djdq = 2.0 * ({' + '.join(dj_terms) or '0.0'});")
+    code(f"const double {c}_reduced_j = {' + '.join(j_terms) or '0.0'};")
+    code(f"const double {c}_reduced_djdq = 2.0 * ({' + '.join(dj_terms) or '0.0'});")
     _, accel = kinematics_c.driver_rates(scene)
     balance = "force" if scene.crank.is_ram() else "torque"
     if _wanted(plan, f"{balance}0"):
-        code(f"const double {c}_{balance}0 = {c}_{balance} - {c}_j * {accel};")
+        code(f"const double {c}_{balance}0 = {c}_{balance} - {c}_reduced_j * {accel};")
 
 
 def _kinematic_exprs(scene: Scene) -> dict[str, str]:
@@ -510,8 +510,10 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
             exprs[f"{pre}slide_{side}"] = f"{kin}.slide_{side}.s"
     if scene.crank is not None:
         c = member(scene.crank.name)
-        for key in ("force", "n", "m", "j", "djdq", "torque0", "force0"):
+        for key in ("force", "n", "m", "torque0", "force0"):
             exprs[f"{c}_{key}"] = f"{c}_{key}"
+        exprs[f"{c}_reduced_j"] = f"{c}_reduced_j"
+        exprs[f"{c}_reduced_djdq"] = f"{c}_reduced_djdq"
     return exprs
 
 
@@ -642,7 +644,9 @@ def scene_c(scene: Scene) -> str:
         check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
         dyad_decls="\n".join(dyad_decls),
         crank_decls="\n".join(crank_decls),
-        kinematics_include='#include "dyadfmu/kinematics.h"\n' if plan.kinematic else "",
+        kinematics_include=(
+            '#include "dyadfmu/dyad.h"\n#include "dyadfmu/kinematics.h"\n' if plan.kinematic else ""
+        ),
         kinematics_code=_kinematics_code(plan),
         body="\n".join(drop_unused_constants(code.lines)),
     )
