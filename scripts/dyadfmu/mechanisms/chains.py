@@ -1022,6 +1022,11 @@ class Chain:
             return self._crank_mass, self._crank_inertia
         return self.links[b]["mass"], self.links[b]["inertia"]
 
+    def mass_properties(self, body: str) -> tuple[float, float]:
+        """(mass [kg], inertia about the centre of mass [kg m2]) of a moving body: the
+        driver (crank or ram) or a link."""
+        return self._mass(body)
+
     def kinetic_energy(self, kin: dict) -> np.ndarray:
         """Kinetic energy [J] of all moving bodies, crank included."""
         total = 0.0
