@@ -227,7 +227,10 @@ def driver_motion_inputs(
     names = _RAM if ram else _CRANK
     keys = [f"{driver}.{k}" for k in names] if ram else [f"crank.{k}" for k in _CRANK]
     q, _, ddq = (np.asarray(kin[k], dtype=float) for k in keys)
-    inputs = {f"{driver}.{k}": np.asarray(kin[key], dtype=float) for k, key in zip(names, keys, strict=True)}
+    inputs = {
+        f"{driver}.{k}": np.asarray(kin[key], dtype=float)
+        for k, key in zip(names, keys, strict=True)
+    }
     inputs.update(_loads_in(scene, kin, role))
     J, dJ = effective_inertia(mechanism, q, branch)
     out[f"{driver}.J"], out[f"{driver}.dJdq"] = J, dJ
