@@ -19,7 +19,6 @@ import math
 
 import numpy as np
 import pytest
-
 from dyadfmu.mechanisms import builtin
 from dyadfmu.mechanisms import crank as crank_balance
 from dyadfmu.reference import newton_euler
@@ -98,8 +97,8 @@ def test_other_branch_is_the_mirror_image(name, kind):
     up, down = mech.kinematics(t, motion, 1), mech.kinematics(t, motion, -1)
     A = up["A"]
     if name == "slider-crank":
-        l, e = mech.data["link_n"]["length"], mech.data["geometry"]["offset"]
-        x = A[:, 0] - np.sqrt(l * l - (e - A[:, 1]) ** 2)  # by hand, behind the pin
+        rod, e = mech.data["link_n"]["length"], mech.data["geometry"]["offset"]
+        x = A[:, 0] - np.sqrt(rod * rod - (e - A[:, 1]) ** 2)  # by hand, behind the pin
         assert np.max(np.abs(down["E"][:, 0] - x)) < 1e-15
         assert np.max(np.abs(down["E"][:, 0] - (2 * A[:, 0] - up["E"][:, 0]))) < 1e-15
         turn = np.mod(down["n.angle"] + up["n.angle"] - math.pi, 2 * math.pi)

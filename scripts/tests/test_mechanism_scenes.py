@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from dyadfmu.mechanisms import builtin
 
 ROOT = Path(__file__).resolve().parents[2]
