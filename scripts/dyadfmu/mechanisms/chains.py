@@ -15,14 +15,31 @@ rocker_slider  crank; dyad ``first`` (RRR) as in sixbar; dyad ``second`` (RRT): 
                a guide carried by the rocker (along the rocker, through its pivot C), held
                by a rod from the frame pivot G. Resisting force on the slider along its
                guide.
+lift           a ram (hydraulic cylinder) on a horizontal frame guide; dyad ``lever`` (RRR):
+               an arm pivoted on the frame and a strut from the ram's pin; dyad ``hoist``
+               (RRT): a platform on a vertical frame guide held by a rod from the arm's tip.
+               Payload on the platform.
 =============  ============================================================================
 
 The scene file gives the topology, lengths, mass properties, points of attachment on
 links and which links carry loads; ``chains.toml`` next to this module gives the rest
-(fixed pivots and guides, assembly branches, crank motion, load model constants).
+(crank or ram motion, load model constants, drawing labels) and, where the scene does not
+state them, the fixed pivots and guides and the assembly branches. A scene states a fixed
+pivot as ``{ link = "frame", at = [x, y] }``, a point of a frame guide's line as
+``{ link = "frame", guide = angle, at = [x, y] }``, a dyad's branch as ``branch = +-1``,
+the crank's pivot as ``[crank] at`` (default (0, 0)), and a translating link's direction
+as ``turn`` from its guide (or ``angle``, absolute).
+
+The driver is a crank (``[crank]``) or a ram (``[ram]``: ``guide`` angle, ``at`` = its
+point R at displacement 0, R = at + x i_guide, ``com`` in {R; i_guide, j_guide},
+``mass``). A ram translates: its angle is the guide's, its omega and epsilon are 0. The
+guide acts on it with a normal force N (along j_guide) and a moment M (about R),
+``<ram>.N`` and ``<ram>.M``; its actuator force along the guide at R, ``<ram>.force``,
+takes the place of the crank's driving torque. ``k`` or ``p = "ram"`` attaches a dyad at
+R; ``{ link = "ram", at = [x, y] }`` at another point of the ram.
 
 Conventions (those of the FMUs): global frame x, y, z out of the plane; angles
-counter-clockwise from +x; moments are z components. The crank turns about O = (0, 0),
+counter-clockwise from +x; moments are z components. The crank turns about O (default (0, 0)),
 its frame is {O; i_c, j_c} with i_c = (cos phi, sin phi), j_c = k x i_c, its pin is
 A = O + r i_c. Link g of a dyad has the frame {D_g; i_g, j_g}, i_g from D_g towards E,
 E = D_m + l_m i_m = D_n + l_n i_n; all these frames are fixed in their links. Its centre
