@@ -88,6 +88,17 @@ _SLIDING_M = ("RTR", "RTT")
 #: Types with a translational pair at D_m (guide_k) and at D_n (guide_p).
 _GUIDE_K = ("RRT", "TRT", "RTT")
 _GUIDE_P = ("TRT",)
+#: What the conditioning is computed from.
+_CONDITIONING_KEYS = ("m.angle", "n.angle", "guide_k.angle", "guide_p.angle", "m.length")
+_CONDITIONING_KEYS += ("n.length", "D_m", "D_n")
+
+
+def _branch(table: Mapping, where: str) -> float:
+    """The assembly branch table["branch"]: +1 (the default) or -1."""
+    value = geo.number(table, "branch", where, default=1.0)
+    if value not in (1.0, -1.0):
+        raise ValueError(f"{where}.branch: expected +1 or -1, got {value!r}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -137,6 +148,9 @@ class Mechanism:
 
     dyad = ""
     _constant_length = {"m": True, "n": True}
+    #: the assembly branches of the mechanism; :attr:`branch` is the one it is built on
+    branches: tuple[float, ...] = (1.0,)
+    branch = 1.0
 
     def __init__(self, name: str, table: Mapping):
         where = name
@@ -183,7 +197,7 @@ class Mechanism:
     def _setup(self, where: str):  # pragma: no cover - overridden
         raise NotImplementedError
 
-    def _dyad_kinematics(self, crank: CrankSample) -> dict:  # pragma: no cover
+    def _dyad_kinematics(self, crank: CrankSample, branch: float) -> dict:  # pragma: no cover
         raise NotImplementedError
 
     def _loads(self, kin: dict) -> dict:  # pragma: no cover
@@ -210,8 +224,12 @@ class Mechanism:
         self.motion("constant", 1.0)
 
     # ---- kinematics -------------------------------------------------------
-    def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
-        """Positions, velocities, accelerations and active loads at the times ``t`` (N,).
+    def kinematics(self, t: np.ndarray, motion: CrankMotion, branch: float | None = None) -> dict:
+        """Positions, velocities, accelerations and active loads at the times ``t`` (N,),
+        on the assembly ``branch`` (default: the mechanism's, :attr:`branch`; the
+        slider-crank and the four-bar have two, +1 and -1, the others one, +1). A
+        complex ``t`` gives complex kinematics, analytic in t (for complex-step
+        derivatives); the conditioning is then that of the real parts.
 
         Keys (arrays over the N samples; points and vectors (N, 2), scalars (N,)):
         ``t``; ``crank.angle``, ``crank.omega``, ``crank.epsilon``; points ``O``, ``A``,
@@ -222,8 +240,10 @@ class Mechanism:
         ``g.length_rate``, ``g.length_accel``; ``guide_k.angle`` / ``guide_p.angle`` where
         the type has them; loads ``m.force``, ``m.moment``, ``n.force``, ``n.moment``;
         ``conditioning`` (the dyad's, as the FMU computes it). Non-array entries:
-        ``frame`` (fixed pivots and fixed guides for drawing), ``mechanism`` (the name).
+        ``frame`` (fixed pivots and fixed guides for drawing), ``mechanism`` (the name),
+        ``branch`` (the assembly branch).
         """
+        branch = self._checked_branch(branch)
         t, phi, w, eps = motion.sampled(t)
         r = self.crank["radius"]
         i_c = geo.unit(phi)
@@ -241,14 +261,15 @@ class Mechanism:
             "A": A,
             "v_A": vA,
             "a_A": aA,
+            "branch": branch,
         }
-        kin.update(self._dyad_kinematics(CrankSample(phi, w, eps, A, vA, aA)))
+        kin.update(self._dyad_kinematics(CrankSample(phi, w, eps, A, vA, aA), branch))
 
         self._point_e(kin)
         self._centres_of_mass(kin, w, eps)
         kin.update(self._loads(kin))
         kin["conditioning"] = self.conditioning(kin)
-        kin["frame"] = self.frame()
+        kin["frame"] = self.frame() if branch == self.branch else self._frame_of(branch)
         kin["mechanism"] = self.name
         return kin
 
@@ -292,8 +313,27 @@ class Mechanism:
         """Fixed pivots {label: (x, y)} and fixed guides {label: ((x0, y0), (x1, y1))}."""
         return {"pivots": {"O": (0.0, 0.0)}, "guides": {}}
 
+    def _frame_of(self, branch: float) -> dict:
+        """The frame drawn for another assembly branch than the mechanism's."""
+        other = copy.copy(self)
+        other.branch = branch
+        return other.frame()
+
+    def _checked_branch(self, branch: float | None) -> float:
+        """The assembly branch asked for (None: the mechanism's), checked against the
+        branches the mechanism has."""
+        if branch is None:
+            return self.branch
+        if branch not in self.branches:
+            raise ValueError(
+                f"{self.name}: assembly branch {branch!r}; expected one of {self.branches}"
+            )
+        return float(branch)
+
     def conditioning(self, kin: dict) -> np.ndarray:
-        """The dyad's conditioning per sample, as the C core computes it (README)."""
+        """The dyad's conditioning per sample, as the C core computes it (README); of the
+        real parts where the kinematics are complex."""
+        kin = {k: np.real(kin[k]) for k in _CONDITIONING_KEYS if k in kin}
         i_m, i_n = geo.unit(kin["m.angle"]), geo.unit(kin["n.angle"])
         if self.dyad == "RRR":
             return np.abs(geo.dot(i_m, geo.rot90(i_n)))
@@ -302,7 +342,7 @@ class Mechanism:
         if self.dyad == "RTR":
             lm, ln = kin["m.length"], kin["n.length"]
             d = kin["D_n"] - kin["D_m"]
-            dist = np.hypot(d[:, 0], d[:, 1])
+            dist = geo.norm(d)
             i_beta = d / geo.col(np.where(dist > 0, dist, 1.0))
             c = np.abs(geo.dot(i_beta, i_m))
             return np.minimum(c, np.minimum(1.0, dist / (lm + ln)))
@@ -385,21 +425,17 @@ def _link(
 ):
     """Per-link entries; rate/accel of the length default to 0 (constant length)."""
     n = np.shape(angle)
+
+    def full(x: object) -> np.ndarray:
+        return np.broadcast_to(geo.inexact(0.0 if x is None else x), n).copy()
+
     return {
-        f"{prefix}.angle": np.broadcast_to(np.asarray(angle, dtype=float), n).copy(),
-        f"{prefix}.omega": np.broadcast_to(np.asarray(omega, dtype=float), n).copy(),
-        f"{prefix}.epsilon": np.broadcast_to(np.asarray(epsilon, dtype=float), n).copy(),
-        f"{prefix}.length": np.broadcast_to(np.asarray(length, dtype=float), n).copy(),
-        f"{prefix}.length_rate": (
-            np.zeros(n)
-            if rate is None
-            else np.broadcast_to(np.asarray(rate, dtype=float), n).copy()
-        ),
-        f"{prefix}.length_accel": (
-            np.zeros(n)
-            if accel is None
-            else np.broadcast_to(np.asarray(accel, dtype=float), n).copy()
-        ),
+        f"{prefix}.angle": full(angle),
+        f"{prefix}.omega": full(omega),
+        f"{prefix}.epsilon": full(epsilon),
+        f"{prefix}.length": full(length),
+        f"{prefix}.length_rate": full(rate),
+        f"{prefix}.length_accel": full(accel),
     }
 
 
@@ -409,12 +445,14 @@ class SliderCrank(Mechanism):
 
     dyad = "RRT"
     _constant_length = {"m": False, "n": True}
+    branches = (1.0, -1.0)
 
     def _fixed_lengths(self):
         return {"m": 0.0}
 
     def _setup(self, where: str):
         self.e = geo.number(self.geometry, "offset", f"{where}.geometry")
+        self.branch = _branch(self.geometry, f"{where}.geometry")
         self.l = self.links["n"]["length"]
         r = self.crank["radius"]
         if not self.l > r + abs(self.e):
@@ -429,20 +467,31 @@ class SliderCrank(Mechanism):
         self.psi_peak = geo.number(ld, "psi_peak", w)
         self.kappa = geo.number(ld, "kappa", w, nonnegative=True)
         #: crank angle of top dead centre (crank and rod in line, piston farthest out)
-        self.phi_tdc = math.asin(self.e / (self.l + r))
+        self.phi_tdc = self.top_dead_centre(self.branch)
 
-    def gas_force(self, phi: np.ndarray):
-        """Magnitude [N] of the gas force on the piston (it acts along -x)."""
-        psi = np.asarray(phi, dtype=float) - self.phi_tdc - self.psi_peak
+    def top_dead_centre(self, branch: float) -> float:
+        """The crank angle (rad) of top dead centre on the assembly ``branch``: crank and
+        rod in line, the piston farthest from O (on branch -1 it runs on the guide's
+        other side of O, and the angle is pi minus that of branch +1)."""
+        base = math.asin(self.e / (self.l + self.crank["radius"]))
+        return base if branch > 0 else math.pi - base
+
+    def gas_force(self, phi: np.ndarray, branch: float | None = None) -> np.ndarray:
+        """Magnitude [N] of the gas force on the piston: it acts along -x on branch +1
+        and along +x on branch -1 (towards the crank), peaking ``psi_peak`` after top
+        dead centre of that branch (default: the mechanism's branch)."""
+        tdc = self.phi_tdc if branch is None else self.top_dead_centre(branch)
+        psi = geo.inexact(phi) - tdc - self.psi_peak
         pulse = np.exp(self.kappa * (np.cos(psi) - 1.0))
         return self.area * (self.p_base + (self.p_peak - self.p_base) * pulse)
 
-    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+    def _dyad_kinematics(self, crank: CrankSample, branch: float) -> dict:
         phi, A, vA, aA = crank.phi, crank.A, crank.vA, crank.aA
         rod, e = self.l, self.e
         sn = (e - A[:, 1]) / rod  # E_y = e = A_y + rod sin(theta_n)
-        cn = np.sqrt(1.0 - sn * sn)  # piston to the right of the crank pin
-        tn = np.arctan2(sn, cn)
+        # branch +1: the piston to the right of the crank pin (ahead of A's foot along +x)
+        cn = branch * np.sqrt(1.0 - sn * sn)
+        tn = geo.angle(geo.vec(cn, sn))
         wn = -vA[:, 1] / (rod * cn)
         en = (rod * wn * wn * sn - aA[:, 1]) / (rod * cn)
         B = geo.vec(A[:, 0] + rod * cn, np.full_like(cn, e))
@@ -461,10 +510,11 @@ class SliderCrank(Mechanism):
         return out
 
     def _loads(self, kin: dict):
-        f = self.gas_force(kin["crank.angle"])
+        branch = kin.get("branch", self.branch)
+        f = self.gas_force(kin["crank.angle"], branch)
         zero = np.zeros_like(f)
         return {
-            "m.force": geo.vec(-f, zero),
+            "m.force": geo.vec(-branch * f, zero),
             "m.moment": zero.copy(),
             "n.force": geo.vec(zero, zero),
             "n.moment": zero.copy(),
@@ -473,6 +523,8 @@ class SliderCrank(Mechanism):
     def frame(self) -> dict:
         r, rod, e = self.crank["radius"], self.l, self.e
         x0, x1 = math.sqrt((rod - r) ** 2 - e * e), math.sqrt((rod + r) ** 2 - e * e)
+        if self.branch < 0:
+            x0, x1 = -x1, -x0
         pad = 0.25 * r
         return {"pivots": {"O": (0.0, 0.0)}, "guides": {"k": ((x0 - pad, e), (x1 + pad, e))}}
 
@@ -482,11 +534,12 @@ class FourBar(Mechanism):
     O4 (D_m) to E. Resisting torque on the rocker."""
 
     dyad = "RRR"
+    branches = (1.0, -1.0)
 
     def _setup(self, where: str):
         g = self.geometry
         self.O4 = geo.pair(g, "O4", f"{where}.geometry")
-        self.branch = 1.0 if geo.number(g, "branch", f"{where}.geometry") >= 0 else -1.0
+        self.branch = _branch(g, f"{where}.geometry")
         a = self.crank["radius"]
         b, c = self.links["n"]["length"], self.links["m"]["length"]
         d = math.hypot(*self.O4)
@@ -502,21 +555,21 @@ class FourBar(Mechanism):
         self.w_ref = geo.number(ld, "w_ref", w, positive=True)
         self.c_visc = geo.number(ld, "c", w)
 
-    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+    def _dyad_kinematics(self, crank: CrankSample, branch: float) -> dict:
         A, vA, aA = crank.A, crank.vA, crank.aA
         b, c = self.links["n"]["length"], self.links["m"]["length"]
         O4 = np.broadcast_to(np.asarray(self.O4, dtype=float), A.shape)
         dv = A - O4
-        dist = np.hypot(dv[:, 0], dv[:, 1])
+        dist = geo.norm(dv)
         u = dv / geo.col(dist)
         along = (c * c - b * b + dist * dist) / (2.0 * dist)
         height = np.sqrt(c * c - along * along)
         # branch +1: E on the left of the directed line A -> O4, i.e. on the right of O4 -> A
-        E = O4 + geo.col(along) * u - self.branch * geo.col(height) * geo.rot90(u)
+        E = O4 + geo.col(along) * u - branch * geo.col(height) * geo.rot90(u)
         i_m = (E - O4) / c
         i_n = (E - A) / b
-        tm = np.arctan2(i_m[:, 1], i_m[:, 0])
-        tn = np.arctan2(i_n[:, 1], i_n[:, 0])
+        tm = geo.angle(i_m)
+        tn = geo.angle(i_n)
         s_mn = geo.cross(i_n, i_m)  # sin(theta_m - theta_n)
         wn = -geo.dot(vA, i_m) / (b * s_mn)
         wm = -geo.dot(vA, i_n) / (c * s_mn)
@@ -576,14 +629,14 @@ class QuickReturn(Mechanism):
         self.M0 = geo.number(ld, "M0", wl)
         self.w_ref = geo.number(ld, "w_ref", wl, positive=True)
 
-    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+    def _dyad_kinematics(self, crank: CrankSample, branch: float) -> dict:
         A, vA, aA = crank.A, crank.vA, crank.aA
         O2 = np.broadcast_to(np.asarray(self.O2, dtype=float), A.shape)
         dv = A - O2
-        lm = np.hypot(dv[:, 0], dv[:, 1])
+        lm = geo.norm(dv)
         i_m = dv / geo.col(lm)
         j_m = geo.rot90(i_m)
-        tm = np.arctan2(i_m[:, 1], i_m[:, 0])
+        tm = geo.angle(i_m)
         dlm = geo.dot(vA, i_m)  # A = O2 + l_m i_m
         wm = geo.dot(vA, j_m) / lm
         ddlm = geo.dot(aA, i_m) + lm * wm * wm
@@ -648,7 +701,7 @@ class ScotchYoke(Mechanism):
         self.v_ref = geo.number(ld, "v_ref", w, positive=True)
         self.c_visc = geo.number(ld, "c", w)
 
-    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+    def _dyad_kinematics(self, crank: CrankSample, branch: float) -> dict:
         phi, A, vA, aA = crank.phi, crank.A, crank.vA, crank.aA
         h = self.h
         up = np.full_like(phi, math.pi / 2.0)
@@ -724,7 +777,7 @@ class TRTSlot(Mechanism):
                     f"guide at the extreme angle ({h / s:.4g} m)"
                 )
 
-    def _dyad_kinematics(self, crank: CrankSample) -> dict:
+    def _dyad_kinematics(self, crank: CrankSample, branch: float) -> dict:
         phi, w, eps = crank.phi, crank.w, crank.eps
         h = self.h
         c, s = np.cos(phi), np.sin(phi)
@@ -743,7 +796,7 @@ class TRTSlot(Mechanism):
             "v_D_n": vE.copy(),
             "n.accel_d": aE.copy(),
             "guide_k.angle": zero.copy(),
-            "guide_p.angle": np.asarray(phi, dtype=float).copy(),
+            "guide_p.angle": geo.inexact(phi).copy(),
         }
         out.update(_link("m", zero, zero, zero, zero))
         out.update(_link("n", phi, w, eps, zero))

@@ -15,14 +15,31 @@ rocker_slider  crank; dyad ``first`` (RRR) as in sixbar; dyad ``second`` (RRT): 
                a guide carried by the rocker (along the rocker, through its pivot C), held
                by a rod from the frame pivot G. Resisting force on the slider along its
                guide.
+lift           a ram (hydraulic cylinder) on a horizontal frame guide; dyad ``lever`` (RRR):
+               an arm pivoted on the frame and a strut from the ram's pin; dyad ``hoist``
+               (RRT): a platform on a vertical frame guide held by a rod from the arm's tip.
+               Payload on the platform.
 =============  ============================================================================
 
 The scene file gives the topology, lengths, mass properties, points of attachment on
 links and which links carry loads; ``chains.toml`` next to this module gives the rest
-(fixed pivots and guides, assembly branches, crank motion, load model constants).
+(crank or ram motion, load model constants, drawing labels) and, where the scene does not
+state them, the fixed pivots and guides and the assembly branches. A scene states a fixed
+pivot as ``{ link = "frame", at = [x, y] }``, a point of a frame guide's line as
+``{ link = "frame", guide = angle, at = [x, y] }``, a dyad's branch as ``branch = +-1``,
+the crank's pivot as ``[crank] at`` (default (0, 0)), and a translating link's direction
+as ``turn`` from its guide (or ``angle``, absolute).
+
+The driver is a crank (``[crank]``) or a ram (``[ram]``: ``guide`` angle, ``at`` = its
+point R at displacement 0, R = at + x i_guide, ``com`` in {R; i_guide, j_guide},
+``mass``). A ram translates: its angle is the guide's, its omega and epsilon are 0. The
+guide acts on it with a normal force N (along j_guide) and a moment M (about R),
+``<ram>.N`` and ``<ram>.M``; its actuator force along the guide at R, ``<ram>.force``,
+takes the place of the crank's driving torque. ``k`` or ``p = "ram"`` attaches a dyad at
+R; ``{ link = "ram", at = [x, y] }`` at another point of the ram.
 
 Conventions (those of the FMUs): global frame x, y, z out of the plane; angles
-counter-clockwise from +x; moments are z components. The crank turns about O = (0, 0),
+counter-clockwise from +x; moments are z components. The crank turns about O (default (0, 0)),
 its frame is {O; i_c, j_c} with i_c = (cos phi, sin phi), j_c = k x i_c, its pin is
 A = O + r i_c. Link g of a dyad has the frame {D_g; i_g, j_g}, i_g from D_g towards E,
 E = D_m + l_m i_m = D_n + l_n i_n; all these frames are fixed in their links. Its centre
@@ -77,10 +94,13 @@ from . import geometry as geo
 from . import motion as motion_
 from .motion import CrankMotion
 
-__all__ = ["NAMES", "Chain", "load", "scene_path", "default_data"]
+__all__ = ["NAMES", "RAM_NAMES", "Chain", "load", "scene_path", "default_data"]
 
-#: The chain mechanisms.
+#: The chain mechanisms driven by a crank.
 NAMES = ("shaper", "sixbar", "rocker_slider")
+#: The chain mechanisms driven by a ram (a linear actuator on a frame guide).
+RAM_NAMES = ("lift",)
+_ALL_NAMES = NAMES + RAM_NAMES
 
 #: The attachments that are guides (a translational pair at the dyad's outer pair).
 _GUIDES = ("guide", "link_guide")
@@ -95,12 +115,8 @@ _TAGS = (("D_m", "mk"), ("E", "mn"), ("D_n", "np"))
 # ---------------------------------------------------------------------------
 # vector helpers on arrays of shape (..., 2)
 # ---------------------------------------------------------------------------
-def _norm(v: np.ndarray):
-    return np.hypot(v[..., 0], v[..., 1])
-
-
-def _angle(v: np.ndarray):
-    return np.arctan2(v[..., 1], v[..., 0])
+_norm = geo.norm
+_angle = geo.angle
 
 
 def _solve2(c1: np.ndarray, c2: np.ndarray, rhs: np.ndarray):
@@ -114,8 +130,10 @@ def _solve2(c1: np.ndarray, c2: np.ndarray, rhs: np.ndarray):
 # ---------------------------------------------------------------------------
 def scene_path(name: str) -> Path:
     """The scene file of mechanism ``name``: ``scenes/<name>.toml`` of the project."""
-    if name not in NAMES:
-        raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
+    if name not in _ALL_NAMES:
+        raise ValueError(
+            f"unknown chain mechanism {name!r}; expected one of: {', '.join(_ALL_NAMES)}"
+        )
     return SCENES_DIR / f"{name}.toml"
 
 
@@ -199,7 +217,7 @@ class Chain:
         self.description = str(self.data.get("description", name))
         where = f"scene {name}"
 
-        self._read_crank(where)
+        self._read_driver(where)
         grav = self.scene.get("gravity", {})
         self.gravity = (
             geo.number(grav, "x", f"{where}.gravity"),
@@ -229,17 +247,30 @@ class Chain:
         # every dyad must assemble over a full crank turn
         self._sweep()
 
-    def _read_crank(self, where: str) -> None:
-        crank = self.scene.get("crank")
-        if not isinstance(crank, Mapping):
-            raise ValueError(f"{where}: missing table [crank]")
-        self.crank = dict(crank)
-        self.crank_name = str(crank.get("name", "crank"))
-        w = f"{where}.crank"
-        self._r = geo.number(crank, "length", w, positive=True)
-        self._crank_mass = geo.number(crank, "mass", w, nonnegative=True)
-        self._crank_inertia = geo.number(crank, "inertia", w, nonnegative=True)
-        self._crank_com = geo.pair(crank, "com", w)
+    def _read_driver(self, where: str) -> None:
+        """The driver: [crank] (pivot ``at``, default O = (0, 0)) or [ram] (a slider on
+        the frame guide at angle ``guide`` through ``at``, its point R = at + x i_guide)."""
+        crank, ram = self.scene.get("crank"), self.scene.get("ram")
+        if (crank is None) == (ram is None):
+            raise ValueError(f"{where}: expected one table [crank] or [ram]")
+        table = crank if ram is None else ram
+        if not isinstance(table, Mapping):
+            raise ValueError(f"{where}: [crank] / [ram] must be a table")
+        self.driver = "crank" if ram is None else "ram"
+        self.crank = dict(table)
+        self.crank_name = str(table.get("name", self.driver))
+        w = f"{where}.{self.driver}"
+        self._crank_mass = geo.number(table, "mass", w, nonnegative=True)
+        self._crank_com = geo.pair(table, "com", w)
+        self._O = geo.pair(table, "at", w) if "at" in table or ram is not None else (0.0, 0.0)
+        if ram is None:
+            self._r = geo.number(table, "length", w, positive=True)
+            self._crank_inertia = geo.number(table, "inertia", w, nonnegative=True)
+            self._pin, self._guide = (self._r, 0.0), 0.0
+        else:  # the ram translates: its inertia never enters
+            self._crank_inertia = geo.number(table, "inertia", w, nonnegative=True, default=0.0)
+            self._guide = geo.number(table, "guide", w)
+            self._pin = (0.0, 0.0)
 
     def _read_links(self, where: str) -> None:
         self.links = {}
@@ -261,7 +292,13 @@ class Chain:
         self._variation = geo.number(md, "variation", wm, default=0.3)
         if not 0.0 <= self._variation < 1.0:
             raise ValueError(f"{wm}.variation: must be in [0, 1), got {self._variation!r}")
-        self._phi0 = geo.number(md, "phi0", wm, default=0.0)
+        if self.driver == "crank":
+            self._phi0 = geo.number(md, "phi0", wm, default=0.0)
+            self._scale = self._r
+        else:
+            self._x0 = geo.number(md, "x0", wm)
+            self._stroke = geo.number(md, "stroke", wm, positive=True)
+            self._scale = self._stroke
 
     # ---- resolution of the scene ------------------------------------------
     def _frame_table(
@@ -274,34 +311,53 @@ class Chain:
             raise ValueError(f"{where}: missing {what} (the scene puts {dyad}.{pair} on {on})")
         return where, str(frame.get("label", f"{dyad}.{pair}"))
 
-    def _frame_pivot(self, frame: Mapping | None, dyad: str, pair: str) -> dict:
-        where, label = self._frame_table(frame, dyad, pair, "fixed pivot", "the frame")
-        pos = geo.pair(frame, "position", where)
+    def _frame_label(self, frame: Mapping | None, dyad: str, pair: str) -> str:
+        """The label of a frame part the scene places itself: chains.toml's frame table,
+        else its [labels], else ``dyad.pair``."""
+        if isinstance(frame, Mapping) and "label" in frame:
+            return str(frame["label"])
+        return str((self.data.get("labels") or {}).get(f"{dyad}.{pair}", f"{dyad}.{pair}"))
+
+    def _frame_pivot(self, spec: object, frame: Mapping | None, dyad: str, pair: str) -> dict:
+        """A fixed pivot: where the scene says (``at``), else chains.toml's ``position``."""
+        if isinstance(spec, Mapping):
+            where = f"scene {self.name}.dyad[{dyad}].{'k' if pair == 'D_m' else 'p'}"
+            pos = geo.pair(spec, "at", where)
+            label = self._frame_label(frame, dyad, pair)
+        else:
+            where, label = self._frame_table(frame, dyad, pair, "fixed pivot", "the frame")
+            pos = geo.pair(frame, "position", where)
         return {"kind": "pivot", "body": None, "position": pos, "label": label}
 
     def _frame_guide(
         self, spec: Mapping, frame: Mapping | None, dyad: str, pair: str, where: str
     ) -> dict:
-        if "guide" not in spec:
-            raise ValueError(f"{where}: a frame attachment given as a table needs 'guide'")
+        """A frame guide: its angle from the scene, its point from the scene's ``at`` or
+        else (0, chains.toml's ``height``)."""
         angle = geo.number(spec, "guide", where)
-        at, label = self._frame_table(frame, dyad, pair, "guide height", "a frame guide")
-        h = geo.number(frame, "height", at)
-        return {"kind": "guide", "body": None, "angle": angle, "height": h, "label": label}
+        if "at" in spec:
+            point, label = geo.pair(spec, "at", where), self._frame_label(frame, dyad, pair)
+        else:
+            at, label = self._frame_table(frame, dyad, pair, "guide height", "a frame guide")
+            point = (0.0, geo.number(frame, "height", at))
+        return {"kind": "guide", "body": None, "angle": angle, "point": point, "label": label}
 
     def _attachment(self, spec: Mapping, dyad: str, pair: str, done: dict):
         """The external link carrying pair ``pair`` ("D_m" or "D_n") of ``dyad``."""
         where = f"scene {self.name}.dyad[{dyad}].{'k' if pair == 'D_m' else 'p'}"
         frame = (self.data.get("frame") or {}).get(dyad, {}).get(pair)
         if spec == "frame":
-            return self._frame_pivot(frame, dyad, pair)
-        if spec == "crank" or spec == self.crank_name:
-            return {"kind": "point", "body": self.crank_name, "at": (self._r, 0.0), "label": "A"}
+            return self._frame_pivot(spec, frame, dyad, pair)
+        pin = "A" if self.driver == "crank" else "R"
+        if spec == self.crank_name or (spec == "crank" and self.driver == "crank"):
+            return {"kind": "point", "body": self.crank_name, "at": self._pin, "label": pin}
         if isinstance(spec, Mapping):
             body = spec.get("link")
-            if body == "frame":
+            if body == "frame" and "guide" in spec:
                 return self._frame_guide(spec, frame, dyad, pair, where)
-            if body == "crank":
+            if body == "frame":
+                return self._frame_pivot(spec, frame, dyad, pair)
+            if body == "crank" and self.driver == "crank":
                 body = self.crank_name
             if body != self.crank_name and body not in done:
                 raise ValueError(
@@ -350,7 +406,13 @@ class Chain:
             raise ValueError(f"{where}: an RRR dyad has revolute pairs at D_m and D_n")
         entry["lm"] = geo.number(self.links[m], "length", f"{where}.{m}", positive=True)
         entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", positive=True)
-        entry["branch"] = _sign(branches, entry["name"], f"{self.name}.branches")
+        entry["branch"] = self._branch(entry, where, branches)
+
+    def _branch(self, entry: dict, where: str, branches: Mapping) -> float:
+        """A dyad's assembly branch: the scene's ``branch``, else chains.toml's."""
+        if "branch" in entry["spec"]:
+            return _sign(entry["spec"], "branch", where)
+        return _sign(branches, entry["name"], f"{self.name}.branches")
 
     def _rrt_entry(self, entry: dict, where: str, branches: Mapping) -> None:
         k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
@@ -364,19 +426,25 @@ class Chain:
             raise ValueError(f"{where}: an RRT dyad has a revolute pair at D_n")
         entry["lm"] = geo.number(lm_t, "length", f"{where}.{m}", nonnegative=True)
         entry["ln"] = geo.number(self.links[n], "length", f"{where}.{n}", positive=True)
+        if "angle" in lm_t and "turn" in lm_t:
+            raise ValueError(f"{where}.{m}: give its 'angle' or its 'turn', not both")
         if k["kind"] == "guide":
-            # the slider translates on the fixed guide: its angle is constant
-            entry["m_angle"] = geo.number(lm_t, "angle", f"{where}.{m}", default=k["angle"])
+            # the slider translates on the fixed guide: its angle is constant, given
+            # absolute (angle) or from the guide (turn)
+            turn = geo.number(lm_t, "turn", f"{where}.{m}", default=0.0)
+            entry["m_angle"] = geo.number(lm_t, "angle", f"{where}.{m}", default=k["angle"] + turn)
         elif "angle" in lm_t:
             raise ValueError(
                 f"{where}.{m}.angle: the slider turns with link "
                 f"{k['body']!r} (its angle is {k['body']}.angle + guide); "
                 f"remove its 'angle'"
             )
-        entry["branch"] = _sign(branches, entry["name"], f"{self.name}.branches")
+        entry["branch"] = self._branch(entry, where, branches)
 
     def _rtr_entry(self, entry: dict, where: str) -> None:
         k, p, m, n = entry["k"], entry["p"], entry["m"], entry["n"]
+        if "branch" in entry["spec"] and _sign(entry["spec"], "branch", where) != 1.0:
+            raise ValueError(f"{where}.branch: only branch +1 (l_m > 0) is handled")
         if k["kind"] in _GUIDES or p["kind"] in _GUIDES:
             raise ValueError(f"{where}: an RTR dyad has revolute pairs at D_m and D_n")
         if "length" in self.links[m]:
@@ -398,7 +466,7 @@ class Chain:
             dname, kind, m, n, where = self._checked_dyad(d, done)
             k = self._attachment(d.get("k"), dname, "D_m", done)
             p = self._attachment(d.get("p"), dname, "D_n", done)
-            entry = {"name": dname, "type": kind, "m": m, "n": n, "k": k, "p": p}
+            entry = {"name": dname, "type": kind, "m": m, "n": n, "k": k, "p": p, "spec": d}
             if kind == "RRR":
                 self._rrr_entry(entry, where, branches)
             elif kind == "RRT":
@@ -443,6 +511,9 @@ class Chain:
                     "w_ref": geo.number(model, "w_ref", where, positive=True),
                     "c": geo.number(model, "c", where),
                 }
+            elif kind == "payload":
+                _require_listed(forces, lname, "force", where)
+                self._loads[lname] = {"model": kind, "force": geo.pair(model, "force", where)}
             elif kind == "resisting-force":
                 _require_listed(forces, lname, "force", where)
                 dyad = next((e for e in self.plan if e["type"] == "RRT" and e["m"] == lname), None)
@@ -459,8 +530,8 @@ class Chain:
                 }
             else:
                 raise ValueError(
-                    f"{where}.model: expected 'cutting', 'resisting-torque' or "
-                    f"'resisting-force', got {kind!r}"
+                    f"{where}.model: expected 'cutting', 'resisting-torque', "
+                    f"'resisting-force' or 'payload', got {kind!r}"
                 )
         for lname in forces + moments:
             if lname not in self._loads:
@@ -474,18 +545,23 @@ class Chain:
         body (None: the frame), kin key of its point, and for a translational pair the
         kin key of its guide's angle."""
         c = self.crank_name
-        self.pairs = [
-            {
-                "key": f"{c}.R_O",
-                "kind": "R",
-                "first": c,
-                "second": None,
-                "point": "O",
-                "guide": None,
-                "dyad": None,
-                "tag": "O",
-            }
-        ]
+        if self.driver == "crank":
+            self.pairs = [{"key": f"{c}.R_O", "kind": "R", "first": c, "point": "O", "tag": "O"}]
+        else:  # the ram on its frame guide: the guide's force N j at R and couple M
+            self.pairs = [
+                {
+                    "key": f"{c}.R_G",
+                    "kind": "T",
+                    "first": c,
+                    "point": "R",
+                    "guide": f"{c}.angle",
+                    "tag": "G",
+                    "n_name": f"{c}.N",
+                    "m_name": f"{c}.M",
+                }
+            ]
+        for pr in self.pairs:
+            pr.update(second=None, dyad=None)
         for e in self.plan:
             kinds = PAIR_KINDS[e["type"]]
             others = {"D_m": e["k"]["body"], "E": e["n"], "D_n": e["p"]["body"]}
@@ -505,6 +581,8 @@ class Chain:
                         "guide": guide,
                         "dyad": e["name"],
                         "tag": tag,
+                        "n_name": f"{e['name']}.N_{tag}",
+                        "m_name": f"{e['name']}.M_{tag}",
                     }
                 )
 
@@ -514,23 +592,40 @@ class Chain:
         for pr in self.pairs:
             names += [f"{pr['key']}.x", f"{pr['key']}.y"]
             if pr["kind"] == "T":
-                names += [f"{pr['dyad']}.N_{pr['tag']}", f"{pr['dyad']}.M_{pr['tag']}"]
-        names.append(f"{self.crank_name}.torque")
+                names += [pr["n_name"], pr["m_name"]]
+        names.append(self.drive_output)
         return names
 
+    @property
+    def drive_output(self) -> str:
+        """The name of the driver's effort: ``<crank>.torque`` (N m) or ``<ram>.force``
+        (N, along the ram's guide)."""
+        return f"{self.crank_name}.{'torque' if self.driver == 'crank' else 'force'}"
+
     # ---- motion -----------------------------------------------------------
-    def motion(self, kind: str = "constant", revolutions: float = 2.0) -> CrankMotion:
-        """The crank's motion over ``revolutions`` full turns (counter-clockwise). kind
-        "constant": omega = w0; "varying": omega = w0 (1 + a sin(w0 t)), phi exact."""
+    def motion(
+        self, kind: str = "constant", revolutions: float = 2.0
+    ) -> CrankMotion | motion_.RamMotion:
+        """The driver's motion. A crank: ``revolutions`` full turns (counter-clockwise);
+        kind "constant": omega = w0; "varying": omega = w0 (1 + a sin(w0 t)), phi exact. A
+        ram: ``revolutions`` strokes out and back (:func:`.motion.stroke`)."""
         revolutions = motion_.checked_request(kind, revolutions)
+        if self.driver == "ram":
+            return motion_.stroke(
+                kind, self._x0, self._stroke, self._w0, self._variation, revolutions
+            )
         return motion_.rotating(kind, self._w0, self._variation, self._phi0, revolutions)
 
     # ---- kinematics -------------------------------------------------------
-    def kinematics(self, t: np.ndarray, motion: CrankMotion) -> dict:
-        """Positions, velocities, accelerations and active loads at the times ``t`` (N,).
+    def kinematics(self, t: np.ndarray, motion: CrankMotion | motion_.RamMotion) -> dict:
+        """Positions, velocities, accelerations and active loads at the times ``t`` (N,)
+        (complex ``t``: complex kinematics, analytic in t, for complex-step derivatives;
+        the conditioning is then that of the real parts).
 
         Keys (arrays over the N samples; points and vectors (N, 2), scalars (N,)):
-        ``t``; ``crank.angle``, ``crank.omega``, ``crank.epsilon``; per link L of the
+        ``t``; ``crank.angle``, ``crank.omega``, ``crank.epsilon`` (a ram: ``ram.position``,
+        ``ram.velocity``, ``ram.acceleration``, its point ``R`` with ``v_R``, ``a_R``, and
+        ``ram.angle`` = its guide's angle, ``ram.omega`` = ``ram.epsilon`` = 0); per link L of the
         scene: ``L.angle``, ``L.omega``, ``L.epsilon``, ``L.accel_d`` (and ``.x``, ``.y``),
         ``L.vel_d`` (velocity of the material point at D_L), ``L.length``,
         ``L.length_rate``, ``L.length_accel``, ``L.force`` (and ``.x``, ``.y``),
@@ -543,8 +638,8 @@ class Chain:
         ((x0, y0), (x1, y1))}}, and "link_guides" with guides on moving links, see
         :meth:`_frame`) and ``mechanism`` (the name).
         """
-        t, phi, w, eps = motion.sampled(t)
-        kin = self._solve(t, phi, w, eps)
+        t, q, dq, ddq = motion.sampled(t)
+        kin = self._solve(t, q, dq, ddq)
         kin["frame"] = self.frame()
         kin["mechanism"] = self.name
         return kin
@@ -586,7 +681,7 @@ class Chain:
         if e["type"] == "RRT":
             sm, sn, E = _rrt(
                 e["k"]["angle"],
-                e["k"]["height"],
+                e["k"]["point"],
                 e["lm"],
                 e["m_angle"],
                 P,
@@ -607,19 +702,18 @@ class Chain:
         dn = e["name"]
         kin[f"{dn}.D_m"], kin[f"{dn}.E"], kin[f"{dn}.D_n"] = sm["D"], E, sn["D"]
         for g, st in ((e["m"], sm), (e["n"], sn)):
-            kin[f"{g}.angle"] = np.broadcast_to(st["angle"], shape).astype(float)
-            kin[f"{g}.omega"] = np.broadcast_to(st["omega"], shape).astype(float)
-            kin[f"{g}.epsilon"] = np.broadcast_to(st["epsilon"], shape).astype(float)
+            for key in ("angle", "omega", "epsilon", "length", "length_rate", "length_accel"):
+                kin[f"{g}.{key}"] = np.broadcast_to(geo.inexact(st[key]), shape).copy()
             kin[f"{g}.accel_d"] = st["aD"]
             kin[f"{g}.vel_d"] = st["vD"]
-            for key in ("length", "length_rate", "length_accel"):
-                kin[f"{g}.{key}"] = np.broadcast_to(st[key], shape).astype(float)
 
     def _active_load(self, g: str, kin: dict, zero: np.ndarray, z2: np.ndarray) -> tuple:
         """(force at S, moment) of link g's load model over the samples."""
         force, moment = z2.copy(), zero.copy()
         model = self._loads.get(g)
-        if model and model["model"] == "cutting":
+        if model and model["model"] == "payload":
+            force = z2 + np.asarray(model["force"])
+        elif model and model["model"] == "cutting":
             v, s = kin[f"v_S_{g}"][:, 0], model["s"]
             force[:, 0] = -s * model["F0"] * 0.5 * (1.0 + np.tanh(s * v / model["v_ref"]))
         elif model and model["model"] == "resisting-torque":
@@ -635,24 +729,37 @@ class Chain:
             force = geo.col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
         return force, moment
 
-    def _solve(self, t: np.ndarray, phi: np.ndarray, w: np.ndarray, eps: np.ndarray) -> dict:
-        shape = phi.shape
-        zero = np.zeros(shape)
-        z2 = np.zeros(shape + (2,))
+    def _driver(self, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple:
+        """The driver's state (as a body) and its kinematics entries, from its coordinate
+        q (crank angle or ram position) and its first two time derivatives."""
         c = self.crank_name
-        crank_state = {"angle": phi, "omega": w, "epsilon": eps, "D": z2, "vD": z2, "aD": z2}
-        A, vA, aA = self._material(crank_state, (self._r, 0.0))
-        kin = {
-            "t": t,
-            f"{c}.angle": phi,
-            f"{c}.omega": w,
-            f"{c}.epsilon": eps,
-            "O": z2.copy(),
-            "A": A,
-            "v_A": vA,
-            "a_A": aA,
-        }
-        states = {c: crank_state}
+        z2 = np.zeros(q.shape + (2,))
+        pivot = z2 + np.asarray(self._O)
+        if self.driver == "crank":
+            state = {"angle": q, "omega": dq, "epsilon": ddq, "D": pivot, "vD": z2, "aD": z2}
+            pin = self._material(state, self._pin)
+            kin = {f"{c}.angle": q, f"{c}.omega": dq, f"{c}.epsilon": ddq, "O": pivot}
+            kin.update(zip(("A", "v_A", "a_A"), pin, strict=True))
+        else:
+            i_g = geo.unit(self._guide)
+            zero = np.zeros(q.shape)
+            R, vR, aR = pivot + geo.col(q) * i_g, geo.col(dq) * i_g, geo.col(ddq) * i_g
+            state = {"angle": zero + self._guide, "omega": zero, "epsilon": zero}
+            state.update(D=R, vD=vR, aD=aR)
+            kin = {f"{c}.position": q, f"{c}.velocity": dq, f"{c}.acceleration": ddq}
+            kin.update({f"{c}.angle": state["angle"], f"{c}.omega": zero, f"{c}.epsilon": zero})
+            kin.update(R=R, v_R=vR, a_R=aR)
+        kin["t"] = t
+        kin[f"{c}.accel_d"] = state["aD"]
+        return state, kin
+
+    def _solve(self, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> dict:
+        shape = q.shape
+        zero = np.zeros(shape, dtype=np.result_type(q, dq, ddq, float))
+        z2 = np.zeros(shape + (2,), dtype=zero.dtype)
+        c = self.crank_name
+        driver_state, kin = self._driver(t, q, dq, ddq)
+        states = {c: driver_state}
         for e in self.plan:
             sm, sn, E = self._dyad_states(e, states, shape, kin)
             states[e["m"]], states[e["n"]] = sm, sn
@@ -672,6 +779,8 @@ class Chain:
         return kin
 
     def _conditioning(self, e: dict, kin: dict) -> np.ndarray:
+        """A dyad's conditioning, as the C core computes it, of the real parts."""
+        kin = {key: np.real(v) for key, v in kin.items() if not isinstance(v, (str, dict))}
         i_m, i_n = geo.unit(kin[f"{e['m']}.angle"]), geo.unit(kin[f"{e['n']}.angle"])
         if e["type"] == "RRR":
             return np.abs(geo.dot(i_m, geo.rot90(i_n)))
@@ -685,16 +794,31 @@ class Chain:
         i_beta = beta / geo.col(np.where(dist > 0, dist, 1.0))
         return np.minimum(np.abs(geo.dot(i_beta, i_m)), dist / (lm + ln))
 
+    def sweep_coordinates(self, count: int = 720) -> np.ndarray:
+        """The driver's coordinate over its whole range: a full crank turn, or the ram's
+        stroke (both ends included)."""
+        if self.driver == "crank":
+            return self._phi0 + np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
+        return self._x0 + np.linspace(0.0, self._stroke, count)
+
+    def positions(self, q: np.ndarray, dq: np.ndarray | None = None) -> dict:
+        """The kinematics at the driver coordinates ``q`` (N,) with the driver's speed
+        ``dq`` (default 1) and no acceleration: at unit speed the velocities are the
+        derivatives in q and the accelerations the second derivatives."""
+        q = geo.inexact(np.atleast_1d(q))
+        dq = np.ones_like(q) if dq is None else np.broadcast_to(geo.inexact(dq), q.shape)
+        return self._solve(np.zeros(q.shape), q, dq, np.zeros_like(q))
+
     def _sweep(self, count: int = 720):
-        """Positions over one full crank turn (the motion does not matter for them)."""
-        phi = self._phi0 + np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
-        zero = np.zeros_like(phi)
+        """Positions over the driver's whole range (the motion does not matter for them)."""
+        q = self.sweep_coordinates(count)
+        zero = np.zeros_like(q)
         try:
             with np.errstate(invalid="raise", divide="raise"):
-                return self._solve(zero, phi, zero + self._w0, zero)
+                return self._solve(zero, q, zero + self._w0, zero)
         except FloatingPointError:  # pragma: no cover - _rrr/_rrt raise first
             raise ValueError(
-                f"{self.name}: a dyad does not assemble over a full crank turn"
+                f"{self.name}: a dyad does not assemble over the driver's range"
             ) from None
 
     def frame(self) -> dict:
@@ -703,7 +827,15 @@ class Chain:
         "angle": guide, "range": (s0, s1)}}: the part s0 <= slide_k <= s1 of the guide
         that the slider uses over a crank turn, with some margin."""
         if self._frame_cache is None:
-            pivots, guides, link_guides = {"O": (0.0, 0.0)}, {}, {}
+            pivots, guides, link_guides = {}, {}, {}
+            if self.driver == "crank":
+                pivots["O"] = tuple(self._O)
+            else:  # the ram's guide over its stroke
+                i = np.array([math.cos(self._guide), math.sin(self._guide)])
+                pad = 0.25 * self._stroke
+                span = (self._x0 - pad, self._x0 + self._stroke + pad)
+                ends = [np.asarray(self._O) + x * i for x in span]
+                guides[self.crank_name] = tuple(tuple(map(float, p)) for p in ends)
             sweep = None
             for e in self.plan:
                 for att, pair in ((e["k"], "D_m"), (e["p"], "D_n")):
@@ -714,15 +846,15 @@ class Chain:
                         pts = sweep[f"{e['name']}.{pair}"]
                         i = np.array([math.cos(att["angle"]), math.sin(att["angle"])])
                         s = pts @ i
-                        pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
-                        base = np.array([0.0, att["height"]])
+                        pad = 0.25 * float(np.ptp(s)) + 0.5 * self._scale
+                        base = np.asarray(att["point"], dtype=float)
                         base = base - (base @ i) * i  # foot of O on the guide line
                         x0, x1 = base + (s.min() - pad) * i, base + (s.max() + pad) * i
                         guides[att["label"]] = (tuple(map(float, x0)), tuple(map(float, x1)))
                     elif att["kind"] == "link_guide":
                         sweep = self._sweep() if sweep is None else sweep
                         s = sweep[f"{e['name']}.slide_k"]
-                        pad = 0.25 * float(np.ptp(s)) + 0.5 * self._r
+                        pad = 0.25 * float(np.ptp(s)) + 0.5 * self._scale
                         link_guides[att["label"]] = {
                             "link": att["body"],
                             "at": tuple(att["at"]),
@@ -743,7 +875,7 @@ class Chain:
         for b in self.bodies:
             if b == c:
                 mass, inertia, com = self._crank_mass, self._crank_inertia, self._crank_com
-                a_d = np.zeros_like(kin["A"])  # O is fixed
+                a_d = np.asarray(kin[f"{c}.accel_d"], dtype=float)  # 0: O is fixed
             else:
                 link = self.links[b]
                 mass, inertia, com = link["mass"], link["inertia"], link["com"]
@@ -826,7 +958,11 @@ class Chain:
                 put(col, pr["first"], P, f, mu, 1.0)
                 put(col, pr["second"], P, f, mu, -1.0)
                 col += 1
-        K[:, row[self.crank_name] + 2, col] = 1.0  # driving torque
+        if self.driver == "crank":  # the driving torque
+            K[:, row[self.crank_name] + 2, col] = 1.0
+        else:  # the actuator's force along the guide, at R
+            i_g = np.broadcast_to(geo.unit(self._guide), (count, 2))
+            put(col, self.crank_name, np.asarray(kin["R"], dtype=float), i_g, zero, 1.0)
         col += 1
         assert col == n_eq
         for b, bd in bodies.items():
@@ -849,9 +985,9 @@ class Chain:
                 j = geo.rot90(geo.unit(kin[pr["guide"]]))
                 N, M = x[:, col].copy(), x[:, col + 1].copy()
                 out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = N * j[:, 0], N * j[:, 1]
-                out[f"{pr['dyad']}.N_{pr['tag']}"], out[f"{pr['dyad']}.M_{pr['tag']}"] = N, M
+                out[pr["n_name"]], out[pr["m_name"]] = N, M
             col += 2
-        out[f"{self.crank_name}.torque"] = x[:, col].copy()
+        out[self.drive_output] = x[:, col].copy()
         return out
 
     def residuals(self, kin: dict, out: dict) -> np.ndarray:
@@ -881,15 +1017,20 @@ class Chain:
             balance.force(pr["second"], P, -R)
             if pr["kind"] == "T":
                 i = geo.unit(kin[pr["guide"]])
-                N = np.asarray(out[f"{pr['dyad']}.N_{pr['tag']}"], float)
-                M = np.asarray(out[f"{pr['dyad']}.M_{pr['tag']}"], float)
+                N = np.asarray(out[pr["n_name"]], float)
+                M = np.asarray(out[pr["m_name"]], float)
                 balance.couple(pr["first"], M)
                 balance.couple(pr["second"], -M)
                 balance.tangential = np.maximum(
                     balance.tangential,
                     np.maximum(np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))),
                 )
-        balance.couple(self.crank_name, np.asarray(out[f"{self.crank_name}.torque"], float))
+        drive = np.asarray(out[self.drive_output], float)
+        if self.driver == "crank":
+            balance.couple(self.crank_name, drive)
+        else:
+            R = np.asarray(kin["R"], dtype=float)
+            balance.force(self.crank_name, R, geo.col(drive) * geo.unit(self._guide))
         return balance.worst()
 
     # ---- energy -----------------------------------------------------------
@@ -898,15 +1039,20 @@ class Chain:
             return self._crank_mass, self._crank_inertia
         return self.links[b]["mass"], self.links[b]["inertia"]
 
+    def mass_properties(self, body: str) -> tuple[float, float]:
+        """(mass [kg], inertia about the centre of mass [kg m2]) of a moving body: the
+        driver (crank or ram) or a link."""
+        return self._mass(body)
+
     def kinetic_energy(self, kin: dict) -> np.ndarray:
         """Kinetic energy [J] of all moving bodies, crank included."""
         total = 0.0
         for b in self.bodies:
             m, J = self._mass(b)
-            v = np.asarray(kin[f"v_S_{b}"], float)
-            w = np.asarray(kin[f"{b}.omega"], float)
+            v = geo.inexact(kin[f"v_S_{b}"])
+            w = geo.inexact(kin[f"{b}.omega"])
             total = total + 0.5 * m * geo.dot(v, v) + 0.5 * J * w * w
-        return np.asarray(total, dtype=float)
+        return geo.inexact(total)
 
     def potential_energy(self, kin: dict) -> np.ndarray:
         """Potential energy [J] of the weights of all moving bodies (crank included),
@@ -914,20 +1060,16 @@ class Chain:
         total = 0.0
         for b in self.bodies:
             m, _ = self._mass(b)
-            total = total - m * (np.asarray(kin[f"S_{b}"], float) @ self._g)
-        return np.asarray(total, dtype=float)
+            total = total - m * (geo.inexact(kin[f"S_{b}"]) @ self._g)
+        return geo.inexact(total)
 
     def load_power(self, kin: dict) -> np.ndarray:
         """Power [W] of the active loads (weights excluded): sum F . v_S + M omega."""
         total = 0.0
         for g in self.links:
-            total = total + geo.dot(
-                np.asarray(kin[f"{g}.force"], float), np.asarray(kin[f"v_S_{g}"], float)
-            )
-            total = total + np.asarray(kin[f"{g}.moment"], float) * np.asarray(
-                kin[f"{g}.omega"], float
-            )
-        return np.asarray(total, dtype=float)
+            total = total + geo.dot(geo.inexact(kin[f"{g}.force"]), geo.inexact(kin[f"v_S_{g}"]))
+            total = total + geo.inexact(kin[f"{g}.moment"]) * geo.inexact(kin[f"{g}.omega"])
+        return geo.inexact(total)
 
     def __repr__(self):
         return (
@@ -983,7 +1125,7 @@ def _rrr(
     u = d / geo.col(dist)
     a = (lm * lm - ln * ln + dist * dist) / (2.0 * dist)  # along u from K to the chord
     h2 = lm * lm - a * a
-    if np.any(~(h2 > 0.0)):
+    if np.any(~(np.real(h2) > 0.0)):
         raise ValueError(
             f"dyad {name}: the circles about D_m ({lm} m) and D_n ({ln} m) do not "
             f"intersect at every crank angle (|D_m D_n| from {dist.min():.4g} to "
@@ -1008,7 +1150,7 @@ def _along_guide(
     the line from its origin, given P's offsets ``along`` and ``across`` the line from that
     origin; ``branch`` +1: E ahead of the foot of P."""
     root2 = ln * ln - across * across
-    if np.any(~(root2 > 0.0)):
+    if np.any(~(np.real(root2) > 0.0)):
         raise ValueError(
             f"dyad {name}: the rod ({ln} m) does not reach the guide line at every "
             f"crank angle (distance up to {np.abs(across).max():.4g} m)"
@@ -1018,7 +1160,7 @@ def _along_guide(
 
 def _rrt(
     guide: np.ndarray,
-    height: float,
+    point: tuple[float, float],
     lm: np.ndarray,
     m_angle: np.ndarray,
     P: np.ndarray,
@@ -1028,13 +1170,13 @@ def _rrt(
     branch: float,
     name: str,
 ):
-    """RRT: slider m on the fixed guide (direction ``guide``, through (0, height)), its
+    """RRT: slider m on the fixed guide (direction ``guide``, through ``point``), its
     pin E = D_m + lm i_m; rod n from D_n = P (on link p) to E. ``branch`` +1: E ahead
     of the foot of P on E's line along the guide direction."""
     i_k = np.array([math.cos(guide), math.sin(guide)])
     j_k = np.array([-i_k[1], i_k[0]])
     i_m = np.array([math.cos(m_angle), math.sin(m_angle)])
-    base = np.array([0.0, height])
+    base = np.asarray(point, dtype=float)
     line = base + lm * i_m  # E = line + s i_k
     d = P - line
     along, across = d @ i_k, d @ j_k
@@ -1071,8 +1213,8 @@ def _rrt_on_link(
     rod n from D_n = P (on link p) to E. ``branch`` +1: E ahead of the foot of P on the
     guide line along i_k. Returns the states of m and n, E and (s, s', s'')."""
     Q, vQ, aQ = Chain._material(ks, at)
-    angle = np.asarray(ks["angle"], dtype=float) + guide
-    w, e = np.asarray(ks["omega"], dtype=float), np.asarray(ks["epsilon"], dtype=float)
+    angle = geo.inexact(ks["angle"]) + guide
+    w, e = geo.inexact(ks["omega"]), geo.inexact(ks["epsilon"])
     i_k = geo.unit(angle)
     j_k = geo.rot90(i_k)
     d = P - (Q + lm * i_k)  # E = Q + (s + lm) i_k
@@ -1130,8 +1272,10 @@ def load(name: str, data: Mapping | None = None) -> Chain:
     packaged ``chains.toml``. ``data`` overrides that table key by key (nested tables
     merged): a mapping, either the whole document (with a table ``name``) or the
     mechanism's own table, or the path of a TOML file of the same form."""
-    if name not in NAMES:
-        raise ValueError(f"unknown chain mechanism {name!r}; expected one of: {', '.join(NAMES)}")
+    if name not in _ALL_NAMES:
+        raise ValueError(
+            f"unknown chain mechanism {name!r}; expected one of: {', '.join(_ALL_NAMES)}"
+        )
     table = geo.overridden(default_data()[name], name, data)
     with open(scene_path(name), "rb") as f:
         scene = tomllib.load(f)

@@ -12,10 +12,37 @@ from collections.abc import Mapping
 import numpy as np
 
 
+def inexact(x: object) -> np.ndarray:
+    """x as a float array, or as a complex one where x is complex (so that the
+    kinematics carry a complex step through)."""
+    x = np.asarray(x)
+    return x.astype(np.result_type(x.dtype, float), copy=False)
+
+
 def unit(angle: float) -> np.ndarray:
-    """Unit vectors at the given angles (rad)."""
-    angle = np.asarray(angle, dtype=float)
+    """Unit vectors at the given angles (rad); complex angles give complex vectors."""
+    angle = inexact(angle)
     return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+
+
+def norm(v: np.ndarray) -> np.ndarray:
+    """The lengths of the vectors: hypot for real ones, the analytic sqrt(v . v) for
+    complex ones (a complex step passes through)."""
+    v = inexact(v)
+    if np.iscomplexobj(v):
+        return np.sqrt(v[..., 0] * v[..., 0] + v[..., 1] * v[..., 1])
+    return np.hypot(v[..., 0], v[..., 1])
+
+
+def angle(v: np.ndarray) -> np.ndarray:
+    """The angles (rad) of the vectors: atan2 for real ones; for complex ones atan2 of
+    the real parts plus the analytic rest, atan((v0 x v) / (v0 . v)), v0 = Re v."""
+    v = inexact(v)
+    if not np.iscomplexobj(v):
+        return np.arctan2(v[..., 1], v[..., 0])
+    v0 = v.real
+    base = np.arctan2(v0[..., 1], v0[..., 0])
+    return base + np.arctan(cross(v0, v) / dot(v0, v))
 
 
 def rot90(v: np.ndarray) -> np.ndarray:
@@ -33,14 +60,15 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
-def col(x: str) -> np.ndarray:
-    """The values as a column (a trailing axis of length 1)."""
-    return np.asarray(x, dtype=float)[..., None]
+def col(x: object) -> np.ndarray:
+    """The values as a column (a trailing axis of length 1); float, or complex where x is."""
+    return inexact(x)[..., None]
 
 
-def vec(x: str, y: str) -> np.ndarray:
-    """Vectors from their x and y components, broadcast together."""
-    x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+def vec(x: object, y: object) -> np.ndarray:
+    """Vectors from their x and y components, broadcast together (float, or complex
+    where a component is)."""
+    x, y = np.broadcast_arrays(inexact(x), inexact(y))
     return np.stack([x, y], axis=-1)
 
 

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import inexact
+
 
 @dataclass(frozen=True)
 class CrankMotion:
@@ -26,13 +28,14 @@ class CrankMotion:
 
     def sampled(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The times ``t`` as a float array of shape (N,), and the crank's angle, angular
-        velocity and angular acceleration at them, each a float array of that shape."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+        velocity and angular acceleration at them, each a float array of that shape
+        (complex arrays where ``t`` is complex: a complex step in time passes through)."""
+        t = np.atleast_1d(inexact(t))
         if t.ndim != 1:
             raise ValueError(f"t: expected shape (N,), got {t.shape}")
-        phi = np.broadcast_to(self.phi(t), t.shape).astype(float)
-        w = np.broadcast_to(self.omega(t), t.shape).astype(float)
-        eps = np.broadcast_to(self.epsilon(t), t.shape).astype(float)
+        phi = np.broadcast_to(self.phi(t), t.shape).astype(t.dtype)
+        w = np.broadcast_to(self.omega(t), t.shape).astype(t.dtype)
+        eps = np.broadcast_to(self.epsilon(t), t.shape).astype(t.dtype)
         return t, phi, w, eps
 
 
@@ -55,15 +58,15 @@ def rotating(
     a = variation if kind == "varying" else 0.0
 
     def phi(t: np.ndarray):
-        t = np.asarray(t, dtype=float)
+        t = inexact(t)
         return phi0 + w0 * t + a * (1.0 - np.cos(w0 * t))
 
     def omega(t: np.ndarray):
-        t = np.asarray(t, dtype=float)
+        t = inexact(t)
         return w0 * (1.0 + a * np.sin(w0 * t))
 
     def epsilon(t: np.ndarray):
-        t = np.asarray(t, dtype=float)
+        t = inexact(t)
         return a * w0 * w0 * np.cos(w0 * t)
 
     # duration: phi(T) - phi0 = 2 pi N; exact for integer N, Newton otherwise
@@ -92,15 +95,15 @@ def oscillating(
     a2 = harmonic2 if kind == "varying" else 0.0
 
     def phi(t: np.ndarray):
-        t = np.asarray(t, dtype=float)
+        t = inexact(t)
         return centre + amplitude * np.sin(w * t) + a2 * np.sin(2.0 * w * t)
 
     def omega(t: np.ndarray):
-        t = np.asarray(t, dtype=float)
+        t = inexact(t)
         return amplitude * w * np.cos(w * t) + 2.0 * a2 * w * np.cos(2.0 * w * t)
 
     def epsilon(t: np.ndarray):
-        t = np.asarray(t, dtype=float)
+        t = inexact(t)
         return -amplitude * w * w * np.sin(w * t) - 4.0 * a2 * w * w * np.sin(2.0 * w * t)
 
     text = (
@@ -109,3 +112,63 @@ def oscillating(
         + " rad"
     )
     return CrankMotion(kind, phi, omega, epsilon, cycles * 2.0 * math.pi / w, float(cycles), text)
+
+
+@dataclass(frozen=True)
+class RamMotion:
+    """A linear actuator's (ram's) motion along its guide: position x(t) [m], velocity
+    [m/s] and acceleration [m/s2] as vectorised callables, consistent with each other in
+    closed form, and ``duration`` [s] covering the requested number of strokes out and
+    back (``cycles``)."""
+
+    kind: str
+    position: Callable[[np.ndarray], np.ndarray]
+    velocity: Callable[[np.ndarray], np.ndarray]
+    acceleration: Callable[[np.ndarray], np.ndarray]
+    duration: float
+    cycles: float
+    description: str = ""
+
+    def sampled(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The times ``t`` as an array of shape (N,), and the ram's position, velocity and
+        acceleration at them (float, or complex where ``t`` is complex)."""
+        t = np.atleast_1d(inexact(t))
+        if t.ndim != 1:
+            raise ValueError(f"t: expected shape (N,), got {t.shape}")
+        x = np.broadcast_to(self.position(t), t.shape).astype(t.dtype)
+        v = np.broadcast_to(self.velocity(t), t.shape).astype(t.dtype)
+        a = np.broadcast_to(self.acceleration(t), t.shape).astype(t.dtype)
+        return t, x, v, a
+
+
+def stroke(
+    kind: str, x0: float, length: float, w: float, variation: float, cycles: float
+) -> RamMotion:
+    """A ram's strokes out and back: x = x0 + length (1 - cos theta) / 2 with the phase
+    theta = w t (kind "constant") or theta = w t + a sin(w t) (kind "varying", a =
+    ``variation`` in [0, 1), so that theta keeps increasing). x runs from x0 to x0 + length
+    and back once per period 2 pi / w, at rest at both ends."""
+    a = variation if kind == "varying" else 0.0
+    half = 0.5 * length
+
+    def phase(t: np.ndarray) -> tuple:
+        wt = w * inexact(t)
+        return wt + a * np.sin(wt), w * (1.0 + a * np.cos(wt)), -a * w * w * np.sin(wt)
+
+    def position(t: np.ndarray) -> np.ndarray:
+        return x0 + half * (1.0 - np.cos(phase(t)[0]))
+
+    def velocity(t: np.ndarray) -> np.ndarray:
+        th, dth, _ = phase(t)
+        return half * np.sin(th) * dth
+
+    def acceleration(t: np.ndarray) -> np.ndarray:
+        th, dth, ddth = phase(t)
+        return half * (np.cos(th) * dth * dth + np.sin(th) * ddth)
+
+    text = f"x = {x0:.4g} + {length:.4g} (1 - cos theta) / 2 m, theta = {w:.6g} t" + (
+        f" + {a:g} sin({w:.6g} t)" if a else ""
+    )
+    return RamMotion(
+        kind, position, velocity, acceleration, cycles * 2.0 * math.pi / w, float(cycles), text
+    )
