@@ -461,9 +461,8 @@ def _ram_outputs(offer: _Offer, scene: Scene) -> None:
         ("N", "N", "Normal force on the ram from its guide, along j_r"),
         ("M", "N.m", "Reactive moment on the ram from its guide, counter-clockwise"),
     ):
-        _motion_output(
-            offer, f"{c}.{key}", unit, text, f"{member(c)}_{key.lower()}", every, "crank"
-        )
+        c_member = f"{member(c)}_{'force' if key == 'force' else 'guide_' + key.lower()}"
+        _motion_output(offer, f"{c}.{key}", unit, text, c_member, every, "crank")
 
 
 def _crank_outputs(offer: _Offer, scene: Scene) -> None:

@@ -441,8 +441,8 @@ def _ram(plan: Plan, code: _Code) -> None:
     code("/* The ram: the actuator force balances the forces along its guide, the guide's")
     code(" * normal force those across it, its reactive moment the moments about R. */")
     code(f"{c}_force = -dyad_dot({c}_f, {c}_i);")
-    code(f"{c}_n = -dyad_dot({c}_f, dyad_perp({c}_i));")
-    code(f"{c}_m = -{c}_m_d;")
+    code(f"{c}_guide_n = -dyad_dot({c}_f, dyad_perp({c}_i));")
+    code(f"{c}_guide_m = -{c}_m_d;")
 
 
 def _crank(plan: Plan, code: _Code) -> None:
@@ -510,7 +510,7 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
             exprs[f"{pre}slide_{side}"] = f"{kin}.slide_{side}.s"
     if scene.crank is not None:
         c = member(scene.crank.name)
-        for key in ("force", "n", "m", "torque0", "force0"):
+        for key in ("force", "guide_n", "guide_m", "torque0", "force0"):
             exprs[f"{c}_{key}"] = f"{c}_{key}"
         exprs[f"{c}_reduced_j"] = f"{c}_reduced_j"
         exprs[f"{c}_reduced_djdq"] = f"{c}_reduced_djdq"
@@ -598,7 +598,7 @@ def _declarations(plan: Plan) -> tuple[list[str], list[str]]:
     crank = []
     if plan.crank_needed and plan.crank.is_ram():
         c = member(plan.crank.name)
-        crank += [f"    double {c}_{key};" for key in ("force", "n", "m")]
+        crank += [f"    double {c}_{key};" for key in ("force", "guide_n", "guide_m")]
     elif plan.crank_needed:
         c = member(plan.crank.name)
         torque, r_o = _crank_outputs(plan)
