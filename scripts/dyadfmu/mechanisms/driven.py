@@ -192,6 +192,43 @@ def _chain_outputs(chain: chains.Chain, kin: dict) -> dict:
 
 _POINTS = ("D_m", "E", "D_n")
 
+#: Which outer pairs slide, by dyad type: (D_m, D_n).
+_SLIDING = {"RRR": (0, 0), "RRT": (1, 0), "RTR": (0, 0), "TRT": (1, 1), "RTT": (1, 0)}
+
+
+def _slide(scene: Mapping, spec: Mapping, out: dict, point: str, kin: dict, key: str) -> np.ndarray:
+    """Where a sliding outer pair sits on its guide, from the guide's point 'at': on a
+    frame guide or the crank's from the pair's position, on a link's from the kinematics."""
+    at = np.asarray(spec.get("at", (0.0, 0.0)), dtype=float)
+    crank = scene.get("crank", {})
+    if spec.get("link") == "frame":
+        origin, turn = np.zeros(2), 0.0
+    elif spec.get("link") == crank.get("name", "crank"):
+        origin, turn = np.asarray(crank.get("at", (0.0, 0.0)), dtype=float), kin["crank.angle"]
+    else:
+        return np.asarray(kin[key], dtype=float).copy()
+    i, j = geo.unit(turn), geo.rot90(geo.unit(turn))
+    g = geo.unit(turn + float(spec["guide"]))
+    guide_x = origin[0] + at[0] * i[..., 0] + at[1] * j[..., 0]
+    guide_y = origin[1] + at[0] * i[..., 1] + at[1] * j[..., 1]
+    return (out[f"{point}.x"] - guide_x) * g[..., 0] + (out[f"{point}.y"] - guide_y) * g[..., 1]
+
+
+def _dyad_extras(scene: Mapping, kin: dict, out: dict, role: Mapping, conditioning: dict) -> None:
+    """The sliding lengths, the slides of sliding outer pairs and each dyad's
+    conditioning, under the FMU's names (added to ``out``)."""
+    for dyad in scene["dyad"]:
+        d = dyad.get("name", "")
+        pre = f"{d}." if d else ""
+        out[f"{pre}conditioning"] = np.asarray(conditioning[d], dtype=float)
+        if dyad["type"] in ("RTR", "RTT"):  # E slides along link m: its length varies
+            link = dyad["m"]
+            out[f"{link}.length"] = np.asarray(kin[f"{role[link]}.length"], dtype=float).copy()
+        for side, pair, slides in zip("kp", ("D_m", "D_n"), _SLIDING[dyad["type"]], strict=True):
+            if slides:
+                key = f"{pre}slide_{side}"
+                out[key] = _slide(scene, dyad[side], out, f"{pre}{pair}", kin, key)
+
 
 def driver_motion_inputs(
     mechanism: Driven,
@@ -217,6 +254,7 @@ def driver_motion_inputs(
         role = {g: g for g in mechanism.links}
         out = _chain_outputs(mechanism, kin)
         effort = mechanism.drive_output
+        conditioning = {d["name"]: kin[f"{d['name']}.conditioning"] for d in scene["dyad"]}
     else:
         kin = mechanism.kinematics(t, motion, branch)
         driver, ram = scene.get("crank", {}).get("name", "crank"), False
@@ -224,6 +262,7 @@ def driver_motion_inputs(
         role = {dyad["m"]: "m", dyad["n"]: "n"}
         out = _builtin_outputs(mechanism, kin, scene)
         effort = f"{driver}.torque"
+        conditioning = {dyad.get("name", ""): mechanism.conditioning(kin)}
     names = _RAM if ram else _CRANK
     keys = [f"{driver}.{k}" for k in names] if ram else [f"crank.{k}" for k in _CRANK]
     q, _, ddq = (np.asarray(kin[k], dtype=float) for k in keys)
@@ -232,6 +271,7 @@ def driver_motion_inputs(
         for k, key in zip(names, keys, strict=True)
     }
     inputs.update(_loads_in(scene, kin, role))
+    _dyad_extras(scene, kin, out, role, conditioning)
     J, dJ = effective_inertia(mechanism, q, branch)
     out[f"{driver}.J"], out[f"{driver}.dJdq"] = J, dJ
     out[f"{effort}0"] = out[effort] - J * ddq
