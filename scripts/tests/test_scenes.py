@@ -107,7 +107,7 @@ def test_cmake_stops_on_a_malformed_scene(tmp_path):
         text=True,
     )
     assert done.returncode != 0
-    assert "link_twice.toml:42:" in done.stderr and "connected twice" in done.stderr
+    assert "link_twice.toml:43:" in done.stderr and "connected twice" in done.stderr
 
 
 # ---------------------------------------------------------------------------
