@@ -414,16 +414,16 @@ def _kinematic_outputs(offer: _Offer, scene: Scene, d: Dyad) -> None:
     for pair in ("D_m", "E", "D_n"):
         group = [
             Output(
-                f"{pre}{pair}.{c}",
+                f"{pre}{pair}.position.{c}",
                 "m",
                 f"Position of pair {pair} of {d.name or 'the dyad'}, global {c}",
-                f"{member(pre)}{pair.lower()}_{c}",
+                f"{member(pre)}{pair.lower()}_position_{c}",
                 depends=position,
                 source=source,
             )
             for c in "xy"
         ]
-        offer.add(f"{pre}{pair}", group)
+        offer.add(f"{pre}{pair}.position", group)
     for side, pair in (("k", "D_m"), ("p", "D_n")):
         if d.pair_kind("mk" if side == "k" else "np") == "T":
             text = f"Position of {pair} along its guide, from the guide's point 'at'"

@@ -50,6 +50,10 @@ def driver_names(sc):
     return name, ("angle", "omega", "epsilon"), "torque"
 
 
+#: The outer pairs that slide, by dyad type (k at D_m, p at D_n).
+SLIDES = {"RRR": "", "RRT": "k", "RTR": "", "TRT": "kp", "RTT": "k"}
+
+
 @pytest.mark.parametrize(("kind", "name"), CASES)
 def test_inputs(kind, name):
     mech, motion, t, series = setup(kind, name)
@@ -84,7 +88,11 @@ def test_output_names(kind, name):
         want |= {f"{link['name']}.{k}" for k in ("angle", "omega", "epsilon")}
     for d in sc["dyad"]:
         for point in ("D_m", "E", "D_n"):
-            want |= {f"{d['name']}.{point}.x", f"{d['name']}.{point}.y"}
+            want |= {f"{d['name']}.{point}.position.x", f"{d['name']}.{point}.position.y"}
+        want.add(f"{d['name']}.conditioning")
+        if d["type"] in ("RTR", "RTT"):
+            want.add(f"{d['m']}.length")
+        want |= {f"{d['name']}.slide_{side}" for side in SLIDES[d["type"]]}
         for pair in ("mk", "mn", "np"):
             want |= {f"{d['name']}.R_{pair}.x", f"{d['name']}.R_{pair}.y"}
         for pair in SLIDING[d["type"]]:
@@ -108,10 +116,12 @@ def test_outputs_are_the_kinematics(kind, name):
     d = sc["dyad"][0]
     if kind == "builtin":
         role = {d["m"]: "m", d["n"]: "n"}
-        points = {f"{d['name']}.{p}": p for p in ("D_m", "E", "D_n")}
+        points = {f"{d['name']}.{p}.position": p for p in ("D_m", "E", "D_n")}
     else:
         role = {g: g for g in mech.links}
-        points = {f"{e['name']}.{p}": f"{e['name']}.{p}" for e in mech.plan for p in ("D_m", "E")}
+        points = {
+            f"{e['name']}.{p}.position": f"{e['name']}.{p}" for e in mech.plan for p in ("D_m", "E")
+        }
     for link, key in role.items():
         for what in ("angle", "omega", "epsilon"):
             assert np.array_equal(series.outputs[f"{link}.{what}"], kin[f"{key}.{what}"])

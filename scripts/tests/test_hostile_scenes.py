@@ -403,9 +403,14 @@ def _build_fmu(table, tmp_path, name) -> Path:
     library = gen / "binaries" / "linux64" / f"{ident}.so"
     library.parent.mkdir(parents=True)
     types = sorted({d.type.lower() for d in table.scene.dyads})
+    kinematics = []
+    if table.scene.internal():  # a mechanism FMU: the types' kinematics too
+        kinematics = [ROOT / "src" / "dyad_kinematics.c"]
+        kinematics += [ROOT / "src" / f"dyad_kin_{t}.c" for t in types]
     sources = (
         [ROOT / "src" / "dyad_common.c"]
         + [ROOT / "src" / f"dyad_{t}.c" for t in types]
+        + kinematics
         + [
             gen / f"{ident}_scene.c",
             ROOT / "fmu" / "fmu_instance.c",
@@ -746,5 +751,5 @@ def test_cmake_stops_on_a_planted_description(tmp_path):
     assert done.returncode != 0
     message = " ".join(done.stderr.split())  # CMake wraps long lines
     assert (
-        "hostile_description_comment_end.toml:4: [scene]: description must not contain" in message
+        "hostile_description_comment_end.toml:5: [scene]: description must not contain" in message
     ), done.stderr

@@ -220,10 +220,20 @@ def frame_in_scene(sc, table, shift):
     frame = table.pop("frame")
     for d in sc["dyad"]:
         for key, pair in (("k", "D_m"), ("p", "D_n")):
-            if d[key] == "frame":
+            spec = d[key]
+            if spec == "frame" or (isinstance(spec, dict) and spec.get("link") == "frame"):
                 at = np.asarray(frame[d["name"]][pair]["position"]) + shift
                 d[key] = {"link": "frame", "at": [float(c) for c in at]}
     sc["crank"]["at"] = [float(c) for c in shift]
+
+
+def frame_nowhere(sc, table, shift):
+    """Neither the scene nor the harness table says where the frame pivots are."""
+    table.pop("frame")
+    for d in sc["dyad"]:
+        for key in ("k", "p"):
+            if isinstance(d[key], dict) and d[key].get("link") == "frame":
+                d[key] = "frame"
 
 
 def test_scene_frame_pivots_and_crank_pivot():
@@ -244,7 +254,7 @@ def test_scene_frame_pivots_and_crank_pivot():
         assert np.max(np.abs(r1[name] - r0[name])) < 1e-10 * scale, name
     # without the frame in chains.toml or in the scene: an error naming what is missing
     with pytest.raises(ValueError, match="fixed pivot"):
-        sixbar(table_edit=lambda table: table.pop("frame"))
+        sixbar(scene_edit=frame_nowhere)
 
 
 def test_scene_branch_overrides_the_table():

@@ -959,7 +959,13 @@ def test_tables_are_the_drive_and_the_scenes_of_the_five_dyads():
     tests (dependency derivation, reference solve)."""
     on_disk = {p.name for p in (MD_DIR / "interface").glob("*.toml")}
     # (c_names_probe.toml is a scene the scene generator learns its C names from)
-    assert on_disk == {"drive.toml", "dyad_interface.toml", "c_names_probe.toml"}
+    assert on_disk == {
+        "drive.toml",
+        "dyad_interface.toml",
+        "c_names_probe.toml",
+        "c_names_probe_internal.toml",
+        "c_names_probe_ram.toml",
+    }
     assert golden_module.TABLES == ("drive.toml",)
     assert {p.name for p in TABLE_OF.values()} == set(golden_module.GOLDEN_SCENES)
     assert all((SCENES_DIR / name).is_file() for name in golden_module.GOLDEN_SCENES)

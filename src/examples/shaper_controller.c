@@ -110,7 +110,7 @@ int main(int argc, char** argv)
             continue;
         }
         ram_x_before = ram_x_now;
-        ram_x_now = out.ram_d_m_x;
+        ram_x_now = out.ram_d_m_position_x;
         peak_torque = fmax(peak_torque, fabs(out.crank_torque));
         peak_o = fmax(peak_o, magnitude(out.crank_r_o_x, out.crank_r_o_y));
         peak_o2 = fmax(peak_o2, magnitude(out.slot_r_mk_x, out.slot_r_mk_y));

@@ -505,7 +505,7 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
             exprs[f"{c}_length"] = f"{kin}.{side}.length"
         for pair, point in (("d_m", "m.d"), ("e", "e"), ("d_n", "n.d")):
             for x in "xy":
-                exprs[f"{pre}{pair}_{x}"] = f"{kin}.{point}.position.{x}"
+                exprs[f"{pre}{pair}_position_{x}"] = f"{kin}.{point}.position.{x}"
         for side in "kp":
             exprs[f"{pre}slide_{side}"] = f"{kin}.slide_{side}.s"
     if scene.crank is not None:

@@ -9,7 +9,6 @@ Each output's error is measured against its own peak over the run: max |FMU - re
 
 from __future__ import annotations
 
-
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -80,8 +79,8 @@ def is_kinematic(output: str) -> bool:
     head, _, last = output.rpartition(".")
     return (
         last in ("angle", "omega", "epsilon", "length")
-        or head.endswith((".D_m", ".E", ".D_n"))
-        or head in ("D_m", "E", "D_n")
+        or head.endswith(".position")
+        or head == "position"
         or last.startswith("slide_")
     )
 

@@ -5,8 +5,8 @@ A mechanism FMU (a scene with ``kinematics = "internal"``) takes only the driver
 motion, ``crank.angle``, ``crank.omega``, ``crank.epsilon`` or ``ram.position``,
 ``ram.velocity``, ``ram.acceleration``, and the loads the scene lists
 (``LINK.force.x/.y``, ``LINK.moment``), and solves the kinematics itself. Its outputs:
-``LINK.angle``, ``LINK.omega``, ``LINK.epsilon``; ``DYAD.D_m.x/.y``, ``DYAD.E.x/.y``,
-``DYAD.D_n.x/.y`` (pair points, m); the reactions ``DYAD.R_mk.x/.y`` ... and
+``LINK.angle``, ``LINK.omega``, ``LINK.epsilon``; ``DYAD.D_m.position.x/.y``,
+``DYAD.E.position.x/.y``, ``DYAD.D_n.position.x/.y`` (pair points, m); the reactions ``DYAD.R_mk.x/.y`` ... and
 ``DYAD.N_..``, ``DYAD.M_..`` of the sliding pairs; for a crank ``crank.torque``,
 ``crank.R_O.x/.y``; for a ram ``ram.force`` (along the guide), ``ram.N`` (the guide's
 normal force, along j_guide), ``ram.M`` (the guide's moment about R); and the driver's
@@ -167,7 +167,7 @@ def _builtin_outputs(mech: builtin.Mechanism, kin: dict, scene: Mapping) -> dict
     dyad = scene["dyad"][0]
     d, c = dyad["name"], scene.get("crank", {}).get("name", "crank")
     links = {dyad["m"]: "m", dyad["n"]: "n"}
-    points = {f"{d}.D_m": "D_m", f"{d}.E": "E", f"{d}.D_n": "D_n"}
+    points = {f"{d}.{p}.position": p for p in _POINTS}
     out = _link_and_points(kin, links, points)
     r = newton_euler.solve(mech.dyad, *mech.reference_inputs(kin))
     for pair in ("mk", "np", "mn"):
@@ -182,7 +182,7 @@ def _builtin_outputs(mech: builtin.Mechanism, kin: dict, scene: Mapping) -> dict
 
 def _chain_outputs(chain: chains.Chain, kin: dict) -> dict:
     """The reference outputs of a chain under its scene's names."""
-    points = {f"{e['name']}.{p}": f"{e['name']}.{p}" for e in chain.plan for p in _POINTS}
+    points = {f"{e['name']}.{p}.position": f"{e['name']}.{p}" for e in chain.plan for p in _POINTS}
     out = _link_and_points(kin, {g: g for g in chain.links}, points)
     ref = chain.reference(kin)
     skip = (f"{chain.crank_name}.R_G.x", f"{chain.crank_name}.R_G.y")  # not an FMU output
@@ -227,7 +227,7 @@ def _dyad_extras(scene: Mapping, kin: dict, out: dict, role: Mapping, conditioni
         for side, pair, slides in zip("kp", ("D_m", "D_n"), _SLIDING[dyad["type"]], strict=True):
             if slides:
                 key = f"{pre}slide_{side}"
-                out[key] = _slide(scene, dyad[side], out, f"{pre}{pair}", kin, key)
+                out[key] = _slide(scene, dyad[side], out, f"{pre}{pair}.position", kin, key)
 
 
 def driver_motion_inputs(

@@ -39,6 +39,7 @@ def chain_scene(dyads: int, identifier: str | None = None) -> str:
         "[scene]",
         f'identifier = "{ident}"',
         f'description = "A crank and a chain of {dyads} RRR dyads"',
+        'kinematics = "external"',
         'outputs = ["all"]',
         'tunable = ["gravity", "rocker1.mass"]',
         "",
