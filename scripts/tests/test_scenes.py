@@ -151,10 +151,11 @@ def test_outputs_of_one_dyad_solve_only_what_loads_it(tmp_path):
     assert run_tool(scene, "--out", out).returncode == 0
     code = (out / "sixbar_second_scene.c").read_text()
     assert "dyad_react_rrr(&load, &second)" in code
-    assert "&first)" not in code
+    assert "dyad_react_rrr(&load, &first)" not in code  # no reactions of the first dyad
+    assert "dyad_kinematics_rrr(&k, &kin->first)" in code  # but its motion carries D
     md = (out / "fmi2" / "modelDescription.xml").read_text()
-    assert 'name="coupler.angle"' not in md  # the first dyad's links are not inputs
-    assert 'name="connector.angle"' in md
+    inputs = re.findall(r'name="([^"]+)"[^>]*causality="input"', md)
+    assert inputs == ["crank.angle", "crank.omega", "crank.epsilon", "output.moment"]
 
 
 def test_the_generic_scenes_are_the_per_type_fmus():
@@ -163,7 +164,8 @@ def test_the_generic_scenes_are_the_per_type_fmus():
         assert done.returncode == 0 and done.stdout.split(";")[:2] == [f"dyad_{t}", "generic"]
     for name in scenes.NAMES:
         done = run_tool(SCENES_DIR / f"{name}.toml", "--cmake-info")
-        assert done.stdout.split(";")[1] == "tailored"
+        # the press is the tailored example of external kinematics; the rest solve their own
+        assert done.stdout.split(";")[1] == ("tailored" if name == "press" else "mechanism")
 
 
 # ---------------------------------------------------------------------------
@@ -232,6 +234,9 @@ class Slave:
     def status(self):
         return self.slave.get_status()
 
+    def log_text(self):
+        return "\n".join(self.slave.messages)
+
     def step(self):
         self.slave.do_step(self.t, 1e-3)
         self.t += 1e-3
@@ -266,8 +271,9 @@ def test_declared_dependencies_cover_every_true_one(name, tmp_path):
 
 @pytest.mark.parametrize("version", VERSIONS)
 def test_a_singular_dyad_discards_and_names_itself(version, tmp_path):
-    s = Slave("sixbar", version, tmp_path)
-    source = scenes.Source("sixbar")
+    """External kinematics (the press): a rod normal to the guide is singular."""
+    s = Slave("press", version, tmp_path)
+    source = scenes.Source("press")
     motion = source.motion("constant", 1.0)
     kin = source.kinematics(np.array([0.1]), motion)
     inputs = [v.name for v in s.md.modelVariables if v.causality == "input"]
@@ -275,15 +281,57 @@ def test_a_singular_dyad_discards_and_names_itself(version, tmp_path):
     s.set(base)
     s.step()
     assert s.status() == 0
-    s.set({"rocker.angle": base["coupler.angle"] + math.pi})  # coupler and rocker aligned
+    s.set({"rod.angle": math.pi / 2})  # rod normal to the guide: i_n . i_k = 0
     with pytest.raises(FMICallException) as error:
         s.step()
     assert error.value.status == 2  # discard
     assert s.status() == 1
-    assert all(math.isnan(x) for x in s.get(["first.R_mk.x", "crank.torque", "second.R_np.y"]))
+    assert all(math.isnan(x) for x in s.get(["crank.torque", "press.R_np.x", "press.N_mk"]))
     s.set(base)
     s.step()
     assert s.status() == 0 and math.isfinite(s.get(["crank.torque"])[0])
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_a_mechanism_that_cannot_assemble_discards_names_the_gap_and_recovers(version, tmp_path):
+    """The lift's ram pushed beyond reach: doStep discards, status 4, the log names the
+    dyad, the failed figure and the gap in metres, every output is NaN; back in reach it
+    works again."""
+    s = Slave("lift", version, tmp_path)
+    outputs = [
+        v.name for v in s.md.modelVariables if v.causality == "output" and v.name != "status"
+    ]
+    s.set({"ram.position": 0.2})
+    s.step()
+    assert s.status() == 0
+    s.set({"ram.position": 1.5})
+    with pytest.raises(FMICallException) as error:
+        s.step()
+    assert error.value.status == 2  # discard
+    assert s.status() == 4
+    assert all(math.isnan(x) for x in s.get(outputs))
+    found = re.search(
+        r"dyad lever cannot assemble at this driver position: \|D_m D_n\| > l_m \+ l_n "
+        r"by ([0-9.e+-]+) m",
+        s.log_text(),
+    )
+    assert found, s.log_text()
+    # the gap, from the scene's geometry: O1 = (0.2, 0.4), R = (1.5, 0), arm 0.25, strut 0.4
+    assert float(found.group(1)) == pytest.approx(math.hypot(1.3, 0.4) - 0.65, rel=1e-5)
+    s.set({"ram.position": 0.2})
+    s.step()
+    assert s.status() == 0 and all(math.isfinite(x) for x in s.get(outputs))
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_a_mechanism_at_a_dead_point_is_singular(version, tmp_path):
+    """The TRT slot's crank along the guide: slot and guide parallel, conditioning 0."""
+    s = Slave("trt_slot", version, tmp_path)
+    s.set({"crank.angle": 0.0})
+    with pytest.raises(FMICallException):
+        s.step()
+    assert s.status() == 1
+    assert "dead centre or branch point" in s.log_text()
 
 
 @pytest.mark.parametrize("version", VERSIONS)
@@ -310,7 +358,7 @@ def test_the_readme_scene_builds_as_described(tmp_path):
     scene.write_text(found.group(1) + "\n")
     done = run_tool(scene, "--check")
     assert done.returncode == 0, done.stderr
-    assert "4 inputs, 0 parameters, 3 outputs" in done.stdout
+    assert "3 inputs, 0 parameters, 3 outputs" in done.stdout
     assert "scripts/build-scene my_press.toml" in readme
 
 

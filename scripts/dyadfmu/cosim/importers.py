@@ -28,7 +28,7 @@ from lxml import etree
 
 from .. import paths
 from ..fmi.simulate import CoSimSetup, setup_for, simulate
-from . import harness, scenes
+from . import harness, mechanism_fmus, scenes
 
 DYADS = ("rrr", "rrt", "rtr", "trt", "rtt")
 #: The generic dyad FMUs run over the harness mechanism of their type.
@@ -97,7 +97,10 @@ def _quiet_env() -> dict:
 # ---------------------------------------------------------------------------
 def fmu_names() -> list[str]:
     """Every FMU the build makes, without the _fmi<v> suffix."""
-    return [f"dyad_{d}" for d in DYADS] + list(scenes.NAMES) + list(TAILORED) + ["drive"]
+    mechanisms = [n for n in mechanism_fmus.MECHANISM_FMUS if n not in scenes.NAMES]
+    return (
+        [f"dyad_{d}" for d in DYADS] + list(scenes.NAMES) + mechanisms + list(TAILORED) + ["drive"]
+    )
 
 
 def drive_setup(version: int, build: Path | None = None) -> CoSimSetup:
@@ -133,6 +136,8 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
         )[0]
         path = (build or paths.build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
         return setup_for(path, generic.time, generic.inputs)
+    if name not in scenes.NAMES:  # a mechanism FMU of a built-in mechanism, or the lift
+        return mechanism_fmus.setup(name, version, revolutions=1.0, steps=steps, build=build)[0]
     return scenes.setup(name, version, 1.0, steps, build=build)[0]
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import paths
-from ..fmi.simulate import setup_for
+from ..fmi.simulate import CoSimSetup, setup_for
 from ..mechanisms import builtin, chains, driven
 from .compare import communication_grid, simulate_matched
 
@@ -106,7 +106,7 @@ def relative_error(output: str, got: np.ndarray, want: np.ndarray) -> float:
     return float(np.max(np.abs(diff)) / (peak if peak > 0 else 1.0))
 
 
-def run(
+def setup(
     name: str,
     fmi_version: int = 2,
     branch: int = 1,
@@ -114,10 +114,10 @@ def run(
     revolutions: float = 2.0,
     steps: int = 360,
     build: Path | None = None,
-) -> MechanismRun:
-    """Co-simulate the mechanism FMU `name` over `revolutions` driver cycles at `steps`
-    communication steps per cycle, on the harness's assembly `branch`, from the driver's
-    motion and the loads alone; compare every output but the amplifications."""
+) -> tuple[CoSimSetup, driven.DrivenSeries, float]:
+    """The co-simulation of the mechanism FMU `name` from the driver's motion and the
+    loads alone, on the harness's assembly `branch`: (setup, the harness's series, the
+    duration)."""
     if branch != 1 and name not in BRANCHES:
         raise ValueError(f"{name} closes in one way only: branch must be 1, not {branch}")
     mechanism = mechanism_of(name)
@@ -132,19 +132,32 @@ def run(
         parameter, sign = BRANCHES[name]
         start[parameter] = float(sign * branch)
     path = paths.built_fmu(name, fmi_version, build, how="scripts/run-tests")
-    setup = setup_for(path, t, series.inputs, start)
-    fmu, sample, seconds = simulate_matched(
-        setup, f"{name} FMI {fmi_version}", drive.duration, False
-    )
-    compared = [o for o in setup.outputs if o != "status" and not o.endswith("amplification")]
+    return setup_for(path, t, series.inputs, start), series, drive.duration
+
+
+def run(
+    name: str,
+    fmi_version: int = 2,
+    branch: int = 1,
+    motion: str = "constant",
+    revolutions: float = 2.0,
+    steps: int = 360,
+    build: Path | None = None,
+) -> MechanismRun:
+    """Co-simulate the mechanism FMU `name` over `revolutions` driver cycles at `steps`
+    communication steps per cycle (see setup) and compare every output but the
+    amplifications with the reference."""
+    co, series, duration = setup(name, fmi_version, branch, motion, revolutions, steps, build)
+    fmu, sample, seconds = simulate_matched(co, f"{name} FMI {fmi_version}", duration, False)
+    compared = [o for o in co.outputs if o != "status" and not o.endswith("amplification")]
     want = {o: np.asarray(series.outputs[o])[sample] for o in compared}
     errors = {o: relative_error(o, fmu[o], want[o]) for o in compared}
     peaks: dict[str, float] = {}
     for o in compared:
-        unit = setup.units.get(o, "")
+        unit = co.units.get(o, "")
         peaks[unit] = max(peaks.get(unit, 0.0), float(np.max(np.abs(want[o]))))
     unit_errors = {
-        o: errors[o] * float(np.max(np.abs(want[o]))) / (peaks[setup.units.get(o, "")] or 1.0)
+        o: errors[o] * float(np.max(np.abs(want[o]))) / (peaks[co.units.get(o, "")] or 1.0)
         for o in compared
     }
     return MechanismRun(
@@ -157,7 +170,7 @@ def run(
         fmu,
         {k: np.asarray(v)[sample] for k, v in series.outputs.items()},
         list(series.inputs),
-        len(t) - 1,
+        len(co.time) - 1,
         seconds,
         set(np.unique(fmu["status"]).tolist()),
     )
@@ -184,5 +197,6 @@ __all__ = [
     "mechanism_of",
     "relative_error",
     "run",
+    "setup",
     "summary",
 ]

@@ -30,7 +30,7 @@ from fmpy import read_model_description
 
 from .. import paths
 from ..fmi.simulate import setup_for
-from ..mechanisms import builtin, chains
+from ..mechanisms import builtin, chains, driven
 from ..mechanisms import geometry as geo
 from ..mechanisms.motion import CrankMotion
 from ..reference import newton_euler
@@ -281,6 +281,14 @@ def run(
     rows = rows_of(kin, sample, t)
     full_ref = source.reference(rows)
     full_ref.update(source.conditioning(rows))
+    if any(n not in full_ref and n != "status" for n in outputs):
+        # a mechanism FMU: its link motion, pair points, slides and the driver's
+        # effective inertia, from the same kinematics
+        series = driven.driver_motion_inputs(
+            source.chain or source.mechanism, t, crank_motion, scene=SCENES_DIR / f"{name}.toml"
+        )
+        for key, value in series.outputs.items():
+            full_ref.setdefault(key, np.asarray(value)[sample])
     ref = {n: np.asarray(full_ref[n]) for n in outputs if n in full_ref}
 
     cond = [fmu[n] for n in outputs if n.endswith("conditioning")]

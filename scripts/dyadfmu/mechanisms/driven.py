@@ -6,7 +6,8 @@ motion, ``crank.angle``, ``crank.omega``, ``crank.epsilon`` or ``ram.position``,
 ``ram.velocity``, ``ram.acceleration``, and the loads the scene lists
 (``LINK.force.x/.y``, ``LINK.moment``), and solves the kinematics itself. Its outputs:
 ``LINK.angle``, ``LINK.omega``, ``LINK.epsilon``; ``DYAD.D_m.position.x/.y``,
-``DYAD.E.position.x/.y``, ``DYAD.D_n.position.x/.y`` (pair points, m); the reactions ``DYAD.R_mk.x/.y`` ... and
+``DYAD.E.position.x/.y``, ``DYAD.D_n.position.x/.y`` (pair points, m); the reactions
+``DYAD.R_mk.x/.y`` ... and
 ``DYAD.N_..``, ``DYAD.M_..`` of the sliding pairs; for a crank ``crank.torque``,
 ``crank.R_O.x/.y``; for a ram ``ram.force`` (along the guide), ``ram.N`` (the guide's
 normal force, along j_guide), ``ram.M`` (the guide's moment about R); and the driver's
