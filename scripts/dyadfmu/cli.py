@@ -274,7 +274,14 @@ def _run(args: argparse.Namespace) -> int:
     names = _chosen(args.mechanisms, builtin.NAMES, "mechanism")
     if names is None:
         return 2
-    return _run_each(args, names, harness.run_mechanism, _mechanism_outputs)
+    status = _run_each(args, names, harness.run_mechanism, _mechanism_outputs)
+    if status == 0 and "slider-crank" in names:
+        # the same engine as a mechanism FMU: the crank's motion and the gas force in, the
+        # kinematics solved inside
+        print("\nThe slider-crank as a mechanism FMU (scenes/engine.toml), driven by the crank:")
+        args.out.mkdir(parents=True, exist_ok=True)
+        status = _run_each(args, ["engine"], scenes.run, _scene_outputs)
+    return status
 
 
 def scenes_names() -> tuple[str, ...]:
