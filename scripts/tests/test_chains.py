@@ -164,27 +164,60 @@ def test_attributes(name):
         assert all(ch.links[g]["length"] > 0 for g in ch.links)
 
 
+def with_scene(name, edit):
+    """The chain `name` with its scene file edited by `edit(scene)`."""
+    sc = copy.deepcopy(scene(name))
+    edit(sc)
+    return chains.Chain(name, sc, copy.deepcopy(harness(name)))
+
+
+def _set(dyad, side, value):
+    def edit(sc):
+        for d in sc["dyad"]:
+            if d["name"] == dyad:
+                d[side] = value
+
+    return edit
+
+
 def test_overrides_and_bad_data():
-    moved = chains.load("sixbar", {"frame": {"second": {"D_n": {"position": [0.12, -0.28]}}}})
-    assert moved.data["frame"]["second"]["D_n"]["position"] == [0.12, -0.28]
-    assert moved.data["motion"] == chain("sixbar").data["motion"]
+    moved = with_scene("sixbar", _set("second", "p", {"link": "frame", "at": [0.12, -0.28]}))
+    assert moved.plan[1]["p"]["position"] == (0.12, -0.28)
     assert chains.load(
         "shaper", {"shaper": {"motion": {"omega": 3.0}}}
     ).motion().duration == pytest.approx(2 * 2 * math.pi / 3.0)
     with pytest.raises(ValueError, match="intersect"):
-        chains.load("sixbar", {"frame": {"second": {"D_n": {"position": [0.12, -0.6]}}}})
+        with_scene("sixbar", _set("second", "p", {"link": "frame", "at": [0.12, -0.6]}))
     with pytest.raises(ValueError, match="reach"):
-        chains.load("shaper", {"frame": {"ram": {"D_m": {"height": 0.4}}}})
-    with pytest.raises(ValueError, match="branches"):
-        chains.load("sixbar", {"branches": {"first": 0}})
+        with_scene("shaper", _set("ram", "k", {"link": "frame", "guide": 0.0, "at": [0.0, 0.4]}))
+    with pytest.raises(ValueError, match="branch"):
+        with_scene("sixbar", _set("first", "branch", 0))
     with pytest.raises(ValueError, match="variation"):
         chains.load("shaper", {"motion": {"variation": 1.2}})
     with pytest.raises(ValueError, match="motion kind"):
         chain("shaper").motion("jerky")
     with pytest.raises(ValueError, match="reach"):
-        chains.load("rocker_slider", {"frame": {"second": {"D_n": {"position": [0.4, -0.3]}}}})
-    with pytest.raises(ValueError, match="branches"):
-        chains.load("rocker_slider", {"branches": {"second": 2}})
+        with_scene("rocker_slider", _set("second", "p", {"link": "frame", "at": [0.4, -0.3]}))
+    with pytest.raises(ValueError, match="branch"):
+        with_scene("rocker_slider", _set("second", "branch", 2))
+
+
+def test_the_harness_frame_agrees_with_the_scenes():
+    """chains.toml still holds the frame pivots, guide heights and branches the scene files
+    now state (the tests' independent geometry reads them): they must agree."""
+    for name in ("shaper", "sixbar", "rocker_slider"):
+        table = harness(name)
+        for d in scene(name)["dyad"]:
+            assert table["branches"].get(d["name"], 1) == d.get("branch", 1), (name, d["name"])
+            for side, pair in (("k", "D_m"), ("p", "D_n")):
+                spec = d[side]
+                if not (isinstance(spec, dict) and spec.get("link") == "frame"):
+                    continue
+                frame = table["frame"][d["name"]][pair]
+                if "guide" in spec:
+                    assert spec["at"][1] == frame["height"] and spec["at"][0] == 0.0
+                else:
+                    assert tuple(spec["at"]) == tuple(frame["position"]), (name, d["name"])
 
 
 def test_bad_guides_on_links():
@@ -273,6 +306,8 @@ def external_point(name, dyad, pair, spec, kin, origins):
     frame = harness(name)["frame"]
     if spec == "frame":
         return np.broadcast_to(np.asarray(frame[dyad][pair]["position"], float), kin["A"].shape)
+    if isinstance(spec, dict) and spec.get("link") == "frame" and "guide" not in spec:
+        return np.broadcast_to(np.asarray(spec["at"], float), kin["A"].shape)  # the scene's pivot
     if spec == "crank":
         return scene(name)["crank"]["length"] * unit(kin["crank.angle"])
     if spec["link"] == "frame" or "guide" in spec:
