@@ -212,7 +212,9 @@ def derive_inputs(scene: Scene) -> None:
         scene.inputs = inputs
         scene.computed = computed_motion(scene)
         return
-    inputs = _crank_inputs(scene) if scene.crank else []
+    inputs = []
+    if scene.crank:
+        inputs = _ram_inputs(scene) if scene.crank.is_ram() else _crank_inputs(scene)
     for d in scene.dyads:
         for g in (d.m, d.n):
             inputs += _link_inputs(scene, scene.links[g])

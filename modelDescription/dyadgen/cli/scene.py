@@ -8,6 +8,7 @@ from pathlib import Path
 
 from dyadgen.pipeline import build_table, load_scene, outputs_of, write_files
 from dyadgen.scenefile.problems import SceneError
+from dyadgen.scenefile.read import inputs_with_external_kinematics
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -24,6 +25,12 @@ def _parser() -> argparse.ArgumentParser:
         help="validate the scene and print its variable counts; write nothing",
     )
     what.add_argument(
+        "--external-inputs",
+        action="store_true",
+        help="print the inputs the scene's FMU would take with kinematics = 'external', "
+        "one per line",
+    )
+    what.add_argument(
         "--cmake-info",
         action="store_true",
         help="print 'identifier;type;...' (its dyad types, lower case) for CMake",
@@ -32,7 +39,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """scene.py SCENE --out DIR | --check | --cmake-info."""
+    """scene.py SCENE --out DIR | --check | --external-inputs | --cmake-info."""
     args = _parser().parse_args(argv)
     try:
         scene = load_scene(args.scene)
@@ -46,6 +53,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.cmake_info:
         types = sorted({d.type.lower() for d in scene.dyads})
         print(";".join([scene.identifier, kind.realisation] + types))
+        return 0
+    if args.external_inputs:
+        print("\n".join(inputs_with_external_kinematics(scene)))
         return 0
     if args.check:
         n = table.counts()

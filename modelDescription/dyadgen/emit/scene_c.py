@@ -508,12 +508,9 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
                 exprs[f"{pre}{pair}_position_{x}"] = f"{kin}.{point}.position.{x}"
         for side in "kp":
             exprs[f"{pre}slide_{side}"] = f"{kin}.slide_{side}.s"
-    if scene.crank is not None:
-        c = member(scene.crank.name)
-        for key in ("force", "guide_n", "guide_m", "torque0", "force0"):
-            exprs[f"{c}_{key}"] = f"{c}_{key}"
-        exprs[f"{c}_reduced_j"] = f"{c}_reduced_j"
-        exprs[f"{c}_reduced_djdq"] = f"{c}_reduced_djdq"
+    c = member(scene.crank.name)
+    for key in ("torque0", "force0", "reduced_j", "reduced_djdq"):
+        exprs[f"{c}_{key}"] = f"{c}_{key}"
     return exprs
 
 
@@ -525,6 +522,8 @@ def _output_exprs(scene: Scene) -> dict[str, str]:
         exprs[f"{c}_torque"] = f"{c}_torque"
         exprs[f"{c}_r_o_x"] = f"{c}_r_o.x"
         exprs[f"{c}_r_o_y"] = f"{c}_r_o.y"
+        for key in ("force", "guide_n", "guide_m"):  # a ram's balance
+            exprs[f"{c}_{key}"] = f"{c}_{key}"
     for d in scene.dyads:
         pre = member(d.prefix())
         dn = member(d.name or "dyad")

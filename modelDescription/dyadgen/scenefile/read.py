@@ -9,6 +9,7 @@ follow from the inputs that are left."""
 
 from __future__ import annotations
 
+import copy
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -116,3 +117,17 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     if p.items:
         raise SceneError(p.items)
     return scene
+
+
+def inputs_with_external_kinematics(scene: Scene) -> list[str]:
+    """The inputs a mechanism scene's FMU would take if every link's motion were an input
+    (kinematics = "external", every output of that kind): what the kinematics inside save
+    its user from computing."""
+    other = copy.deepcopy(scene)
+    other.kinematics, other.computed, other.loaders = "external", {}, {}
+    for d in other.dyads:
+        d.internal = False
+    derive_inputs(other)
+    derive_outputs(other, ["all"])
+    prune_inputs(other)
+    return [i.name for i in other.inputs]

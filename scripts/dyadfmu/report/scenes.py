@@ -21,6 +21,7 @@ from pathlib import Path
 from .. import paths
 from ..cosim import scenes
 from ..study.footprint import measure
+from . import mechanisms
 from .tables import format_markdown, format_text
 
 
@@ -178,7 +179,7 @@ def _drawings(runs: list, out: Path) -> list[Path]:
     ]
 
 
-def _report_text(acc: list, foot: list, quick: bool) -> list[str]:
+def _report_text(acc: list, foot: list, quick: bool, moving: list) -> list[str]:
     """The report: the accuracy table, the footprint table, what they leave out."""
     return [
         "# Scenes: tailored FMUs against the generic per-type FMUs",
@@ -205,6 +206,12 @@ def _report_text(acc: list, foot: list, quick: bool) -> list[str]:
         "links it is attached to and to balance the crank; that work is not counted "
         "above.",
         "",
+        "## Mechanism FMUs",
+        "",
+        mechanisms.REPORT_TEXT,
+        "",
+        format_markdown(moving),
+        "",
     ]
 
 
@@ -229,7 +236,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     acc = accuracy_rows(runs)
     foot = footprint_rows(results)
-    text = _report_text(acc, foot, args.quick)
+    moving = mechanisms.rows(build, args.quick, log=_log)
+    text = _report_text(acc, foot, args.quick, moving)
     if drawings:
         text += ["Drawings with every reaction: " + ", ".join(f"`{p.name}`" for p in drawings), ""]
     report = out / "report.md"
@@ -237,6 +245,8 @@ def main(argv: list[str] | None = None) -> int:
     print(format_text(acc))
     print()
     print(format_text(foot))
+    print()
+    print(format_text(moving))
     print(f"\nreport: {report}")
     return 0
 

@@ -1,0 +1,164 @@
+"""What the kinematics inside buy: for each mechanism FMU, the inputs its user must give
+before (every link's motion, ``kinematics = "external"``) and after (the driver's motion
+and the loads), its worst errors against the reference on each assembly branch, and its
+work per doStep with the kinematics and without them.
+
+Work per doStep is counted by ``valgrind --tool=callgrind`` around the stepping loop of
+``tests/bench/dyad_bench --method fmu`` (set the inputs, doStep, get the real outputs). The
+kinematics' share is the inclusive count of the generated ``kinematics`` function (both of
+its passes: the motion, and the unit-rate pass behind J and dJ/dq), or where the compiler
+inlined it, of its calls into the core; "without" is the rest.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+
+from .. import paths
+from ..cosim import mechanism_fmus as mf
+from ..study import bench
+
+GENERATOR = paths.ROOT / "modelDescription" / "scene.py"
+
+
+def inputs_before(name: str) -> list[str]:
+    """The inputs the scene's FMU would take with every link's motion an input."""
+    done = subprocess.run(
+        [
+            sys.executable,
+            str(GENERATOR),
+            str(paths.SCENES_DIR / f"{name}.toml"),
+            "--external-inputs",
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return done.stdout.split()
+
+
+def _callgrind(args: list[str], work: Path) -> tuple[int, int]:
+    """(instructions of the stepping loop, of them the generated kinematics)."""
+    out = work / "callgrind.out"
+    done = subprocess.run(
+        [
+            "valgrind",
+            "--tool=callgrind",
+            "--toggle-collect=bench_loop_*",
+            f"--callgrind-out-file={out}",
+            *args,
+        ],
+        capture_output=True,
+        text=True,
+    )
+    total = re.search(r"Collected\s*:\s*(\d+)", done.stderr)
+    annotated = subprocess.run(
+        ["callgrind_annotate", "--inclusive=yes", "--threshold=100", str(out)],
+        capture_output=True,
+        text=True,
+    ).stdout
+    inside = re.findall(r"^\s*([\d,]+)\s.*\?\?\?:kinematics[.\s]", annotated, re.MULTILINE)
+    if not inside:  # the generated function inlined into evaluate: its calls into the core
+        pattern = r"^\s*([\d,]+)\s.*\?\?\?:(?:dyad_kinematics_|dyad_point_on_link)"
+        inside = re.findall(pattern, annotated, re.MULTILINE)
+    kinematics = sum(int(x.replace(",", "")) for x in inside)
+    return (int(total.group(1)) if total else 0), kinematics
+
+
+def instructions(name: str, build: Path, work: Path, rows: int = 200) -> tuple[float, float]:
+    """(instructions per doStep, of them the kinematics) of the FMI 2 mechanism FMU."""
+    if shutil.which("valgrind") is None or shutil.which("callgrind_annotate") is None:
+        return math.nan, math.nan
+    co, series, _ = mf.setup(name, 2, revolutions=1.0, steps=rows, build=build)
+    md = read_model_description(str(co.path))
+    inputs = [v for v in md.modelVariables if v.causality == "input"]
+    outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    data = np.stack([series.inputs[v.name] for v in inputs], axis=1)
+    file = work / f"{name}.bin"
+    data.astype("<f8").tofile(file)
+    args = [
+        str(bench.bench_binary(build, "double")),
+        "--method",
+        "fmu",
+        "--fmu",
+        str(paths.stage_binary(build, name, 2)),
+        "--fmi",
+        "2",
+        "--token",
+        md.guid,
+        "--fmu-inputs",
+        str(file),
+        "--in-vrs",
+        ",".join(str(v.valueReference) for v in inputs),
+        "--out-vrs",
+        ",".join(str(v.valueReference) for v in outputs),
+        "--repeat",
+        "1",
+    ]
+    total, kinematics = _callgrind(args, work)
+    return total / len(data), kinematics / len(data)
+
+
+def rows(build: Path, quick: bool = False, log: Callable = print) -> list:
+    """The mechanism FMUs' table: a header row, then one row per FMU and branch."""
+    table = [
+        [
+            "mechanism FMU",
+            "branch",
+            "inputs before",
+            "inputs after",
+            "worst kinematic error",
+            "worst other error",
+            "instr./doStep",
+            "with kinematics",
+            "without",
+        ]
+    ]
+    revolutions, steps = (1.0, 180) if quick else (2.0, 360)
+    with tempfile.TemporaryDirectory(prefix="dyadfmu_mechanisms_") as tmp:
+        for name in mf.MECHANISM_FMUS:
+            log(f"mechanism FMU {name}")
+            before = len(inputs_before(name))
+            total, inside = instructions(name, build, Path(tmp))
+            for branch in (1, -1) if name in mf.BRANCHES else (1,):
+                run = mf.run(name, 2, branch, "varying", revolutions, steps, build)
+                kin = run.worst_of(True) if any(map(mf.is_kinematic, run.errors)) else ("-", 0.0)
+                other = run.worst_of(False)
+                table.append(
+                    [
+                        name,
+                        f"{branch:+d}",
+                        str(before),
+                        str(len(run.inputs)),
+                        f"{kin[1]:.1e} ({kin[0]})",
+                        f"{other[1]:.1e} ({other[0]})",
+                        f"{total:.0f}",
+                        f"{inside:.0f}",
+                        f"{total - inside:.0f}",
+                    ]
+                )
+    return table
+
+
+REPORT_TEXT = (
+    'Mechanism FMUs (`kinematics = "internal"`): the inputs a user gives before (every '
+    'link\'s motion, as the scene with `kinematics = "external"` takes them) and after (the '
+    "driver's motion and the loads), the worst error over two driver cycles at a varying "
+    "speed against the NumPy kinematics and Newton-Euler reference (kinematic outputs "
+    "relative to their own peak, the others to the largest peak of their unit), on each "
+    "assembly branch, and callgrind's instructions per doStep (FMI 2, set the inputs, "
+    "doStep, get the real outputs): in all, in the generated kinematics (both passes: the "
+    "motion, and the unit-rate pass behind J and dJ/dq) and without them:"
+)
+
+__all__ = ["REPORT_TEXT", "inputs_before", "instructions", "rows"]
