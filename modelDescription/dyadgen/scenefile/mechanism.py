@@ -311,7 +311,7 @@ class Mechanism:
             return None
         if value is None and dyad.type != "RTR":
             self.p.add(
-                f"{label}: a {dyad.type} dyad closes in two ways: say which with branch = 1 "
+                f"{label}: an {dyad.type} dyad closes in two ways: say which with branch = 1 "
                 "or -1 (see scenes/README.md)",
                 "dyad",
                 dyad.index,

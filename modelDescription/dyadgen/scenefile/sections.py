@@ -222,20 +222,30 @@ def _crank_params(
         )
 
 
+def _driver_table(p: Problems, data: dict, section: str, keys: set) -> tuple[dict, str] | None:
+    """A driver's table ([crank] or [ram]), its keys checked, and its name (the section's
+    name where it is left out or invalid); None where there is none."""
+    table = data.get(section)
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        p.add(f"[{section}] must be a table", section, 0)
+        return None
+    unknown_keys(p, table, keys, f"[{section}]", section, 0)
+    name = table.get("name", section)
+    problem = name_problem(name)
+    if problem:
+        p.add(f"[{section}]: name {problem}", section, 0, "name")
+        name = section
+    return table, name
+
+
 def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool) -> Crank | None:
     """[crank], if any: its name and numbers (and its pivot, for internal kinematics)."""
-    crank_t = data.get("crank")
-    if crank_t is None:
+    found_table = _driver_table(p, data, "crank", CRANK_KEYS)
+    if found_table is None:
         return None
-    if not isinstance(crank_t, dict):
-        p.add("[crank] must be a table", "crank", 0)
-        return None
-    unknown_keys(p, crank_t, CRANK_KEYS, "[crank]", "crank", 0)
-    cname = crank_t.get("name", "crank")
-    problem = name_problem(cname)
-    if problem:
-        p.add(f"[crank]: name {problem}", "crank", 0, "name")
-        cname = "crank"
+    crank_t, cname = found_table
     found = Crank(cname, p.loc.line("crank"))
     if internal:
         _pivot(p, found, crank_t, "crank", "The crank's pivot O on the frame")
@@ -279,24 +289,16 @@ def _ram_params(p: Problems, ram_t: dict, found: Crank, needs_mass: bool) -> Non
 
 def ram(p: Problems, data: dict, needs_mass: bool, internal: bool) -> Crank | None:
     """[ram], if any: a linear actuator sliding on a frame guide, the driver."""
-    ram_t = data.get("ram")
-    if ram_t is None:
+    found_table = _driver_table(p, data, "ram", RAM_KEYS)
+    if found_table is None:
         return None
-    if not isinstance(ram_t, dict):
-        p.add("[ram] must be a table", "ram", 0)
-        return None
-    unknown_keys(p, ram_t, RAM_KEYS, "[ram]", "ram", 0)
+    ram_t, name = found_table
     if "crank" in data:
         p.add("[ram]: a scene has one driver, a [crank] or a [ram], not both", "ram", 0)
         return None
     if not internal:
         p.add("[ram]: a ram drives the chain only with kinematics = 'internal'", "ram", 0)
         return None
-    name = ram_t.get("name", "ram")
-    problem = name_problem(name)
-    if problem:
-        p.add(f"[ram]: name {problem}", "ram", 0, "name")
-        name = "ram"
     found = Crank(name, p.loc.line("ram"), kind="ram")
     _ram_params(p, ram_t, found, needs_mass)
     return found
