@@ -108,7 +108,7 @@ def test_fmi_sim_gives_fmpys_outputs(name, version, fmi_sim, tmp_path):
 
 @pytest.mark.parametrize(
     "name,version,column",
-    [("dyad_rrt", 3, "link_m.force.x"), ("shaper", 2, "crank.omega"), ("drive", 2, "load.torque")],
+    [("dyad_rrt", 3, "link_m.force.x"), ("shaper", 2, "crank.angle"), ("drive", 2, "load.torque")],
 )
 def test_the_comparison_fails_on_a_perturbed_input(name, version, column, fmi_sim, tmp_path):
     """One input column scaled by 1 + 1e-9 for fmi-sim only: both checks above fail."""
