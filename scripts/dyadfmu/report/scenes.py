@@ -123,7 +123,9 @@ def _parser() -> argparse.ArgumentParser:
         description="Co-simulate every example scene's tailored FMU against its reference, "
         "draw the chains with their reactions, and measure each tailored FMU "
         "against the generic per-type FMUs it replaces (variables, binary size, "
-        "callgrind instructions and time per doStep); writes report.md.",
+        "callgrind instructions and time per doStep), and every mechanism FMU from the "
+        "driver's motion alone (inputs before and after, worst errors, instructions with "
+        "and without the kinematics); writes report.md.",
     )
     parser.add_argument(
         "--out",
