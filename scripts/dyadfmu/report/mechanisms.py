@@ -86,25 +86,10 @@ def instructions(name: str, build: Path, work: Path, rows: int = 200) -> tuple[f
     data = np.stack([series.inputs[v.name] for v in inputs], axis=1)
     file = work / f"{name}.bin"
     data.astype("<f8").tofile(file)
-    args = [
-        str(bench.bench_binary(build, "double")),
-        "--method",
-        "fmu",
-        "--fmu",
-        str(paths.stage_binary(build, name, 2)),
-        "--fmi",
-        "2",
-        "--token",
-        md.guid,
-        "--fmu-inputs",
-        str(file),
-        "--in-vrs",
-        ",".join(str(v.valueReference) for v in inputs),
-        "--out-vrs",
-        ",".join(str(v.valueReference) for v in outputs),
-        "--repeat",
-        "1",
-    ]
+    binary = paths.stage_binary(build, name, 2)
+    args = [str(bench.bench_binary(build, "double"))]
+    args += bench.fmu_step_arguments(binary, 2, md.guid, file, inputs, outputs)
+    args += ["--repeat", "1"]
     total, kinematics = _callgrind(args, work)
     return total / len(data), kinematics / len(data)
 

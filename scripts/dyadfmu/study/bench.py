@@ -122,32 +122,36 @@ def fmu_rows(dyad: str, count: int, seed: int) -> tuple:
     return md, inputs, outputs, rows
 
 
+def fmu_step_arguments(
+    binary: Path, version: int, token: str, data: Path, inputs: list, outputs: list
+) -> list[str]:
+    """The benchmark's arguments that step an FMU binary from C (--method fmu): one doStep
+    per row of `data` (rows of the `inputs` variables), reading back the `outputs`."""
+    return [
+        "--method",
+        "fmu",
+        "--fmu",
+        str(binary),
+        "--fmi",
+        str(version),
+        "--token",
+        token,
+        "--fmu-inputs",
+        str(data),
+        "--in-vrs",
+        ",".join(str(v.valueReference) for v in inputs),
+        "--out-vrs",
+        ",".join(str(v.valueReference) for v in outputs),
+    ]
+
+
 def fmu_from_c(build: Path, dyad: str, version: int, count: int, work: Path) -> float:
     """Seconds per doStep of the dyad FMU's binary stepped from C by the benchmark."""
     md, inputs, outputs, rows = fmu_rows(dyad, count, seed=version)
     binary = paths.stage_binary(build, f"dyad_{dyad.lower()}", version)
     rows.astype("<f8").tofile(work / "fmu_inputs.bin")
-    info = run_bench(
-        bench_binary(build, "double"),
-        [
-            "--method",
-            "fmu",
-            "--fmu",
-            str(binary),
-            "--fmi",
-            str(version),
-            "--token",
-            md.guid,
-            "--fmu-inputs",
-            str(work / "fmu_inputs.bin"),
-            "--in-vrs",
-            ",".join(str(v.valueReference) for v in inputs),
-            "--out-vrs",
-            ",".join(str(v.valueReference) for v in outputs),
-            "--repeat",
-            "3",
-        ],
-    )
+    args = fmu_step_arguments(binary, version, md.guid, work / "fmu_inputs.bin", inputs, outputs)
+    info = run_bench(bench_binary(build, "double"), args + ["--repeat", "3"])
     return float(info["seconds_per_config"])
 
 

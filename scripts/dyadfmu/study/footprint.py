@@ -75,22 +75,8 @@ def _step(
     ]
     data = work / f"{identifier}_{version}.bin"
     rows.astype("<f8").tofile(data)
-    args = [
-        "--method",
-        "fmu",
-        "--fmu",
-        str(paths.stage_binary(build, identifier, version)),
-        "--fmi",
-        str(version),
-        "--token",
-        md.guid,
-        "--fmu-inputs",
-        str(data),
-        "--in-vrs",
-        ",".join(str(v.valueReference) for v in inputs),
-        "--out-vrs",
-        ",".join(str(v.valueReference) for v in outputs),
-    ]
+    binary = paths.stage_binary(build, identifier, version)
+    args = bench.fmu_step_arguments(binary, version, md.guid, data, inputs, outputs)
     program = bench.bench_binary(build, "double")
     info = bench.run_bench(program, args + ["--repeat", str(repeat)])
     instructions = math.nan
