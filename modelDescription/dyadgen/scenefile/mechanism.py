@@ -157,19 +157,37 @@ class _Attaching:
                 f'says where it is, {self.side} = {{ link = "frame", at = [x, y] }} (m)'
             )
             return None
+        what = (
+            f"A point of the frame guide at {self.pair}"
+            if self.sliding
+            else f"The fixed pivot {self.pair}"
+        )
+        point = self.point_params(at, what, None)
+        return None if point is None else Attachment("frame", None, point, guide)
+
+    def point_params(
+        self, at: object, what: str, carrier: str | None
+    ) -> tuple[Param, Param] | None:
+        """`at` checked, as the two parameters of the pair's point (for a sliding pair a
+        point of its guide), described as `what`: global on the frame (`carrier` None),
+        else in the carrier's frame."""
         if not isinstance(at, list) or len(at) != 2 or not all(real(v) is not None for v in at):
             self.problem(f"'{self.side}': at must be [x, y], two finite numbers (m)")
             return None
-        if self.sliding:
-            pname, what = (
-                f"{self.prefix}guide_{self.side}.at",
-                f"A point of the frame guide at {self.pair}",
+        pname = (
+            f"{self.prefix}guide_{self.side}.at" if self.sliding else f"{self.prefix}{self.pair}"
+        )
+        x, y = real(at[0]), real(at[1])
+        if carrier is None:
+            return (
+                Param(f"{pname}.x", x, "m", f"{what}, global x"),
+                Param(f"{pname}.y", y, "m", f"{what}, global y"),
             )
-        else:
-            pname, what = f"{self.prefix}{self.pair}", f"The fixed pivot {self.pair}"
-        x = Param(f"{pname}.x", real(at[0]), "m", f"{what}, global x")
-        y = Param(f"{pname}.y", real(at[1]), "m", f"{what}, global y")
-        return Attachment("frame", None, (x, y), guide)
+        frame = f"{carrier}'s frame"
+        return (
+            Param(f"{pname}.x", x, "m", f"{what}: x in the {frame}"),
+            Param(f"{pname}.y", y, "m", f"{what}: y in the {frame}"),
+        )
 
     def guide(self, spec: dict, target: str, kind: str) -> Param | None:
         """The angle of the guide a sliding pair runs on, on the frame or a moving link."""
@@ -205,20 +223,13 @@ class _Attaching:
                     f"in that link's frame (m)"
                 )
                 return None
-        if not isinstance(at, list) or len(at) != 2 or not all(real(v) is not None for v in at):
-            self.problem(f"'{self.side}': at must be [x, y], two finite numbers (m)")
-            return None
-        frame = f"{target}'s frame"
-        if self.sliding:
-            pname, what = (
-                f"{self.prefix}guide_{self.side}.at",
-                f"A point of the guide at {self.pair} on {target}",
-            )
-        else:
-            pname, what = f"{self.prefix}{self.pair}", f"Pair {self.pair} on {target}"
-        x = Param(f"{pname}.x", real(at[0]), "m", f"{what}: x in the {frame}")
-        y = Param(f"{pname}.y", real(at[1]), "m", f"{what}: y in the {frame}")
-        return Attachment(kind, target, (x, y), guide)
+        what = (
+            f"A point of the guide at {self.pair} on {target}"
+            if self.sliding
+            else f"Pair {self.pair} on {target}"
+        )
+        point = self.point_params(at, what, target)
+        return None if point is None else Attachment(kind, target, point, guide)
 
 
 class Mechanism:
