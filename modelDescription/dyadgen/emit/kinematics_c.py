@@ -187,8 +187,6 @@ def kinematics_function(scene: Scene, dyads: list[Dyad]) -> str:
         f"                                         double accel, {ident}_kinematics* kin,",
         "                                         int* failed)",
         "{",
-        "    (void)rate;",
-        "    (void)accel;",
     ]
     lines += [f"    {line}" for line in body]
     lines.append("}")

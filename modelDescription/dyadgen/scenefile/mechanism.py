@@ -6,7 +6,7 @@ from __future__ import annotations
 from dyadgen.dyadtypes import MAY_BE_ZERO, PAIRS, TYPES
 from dyadgen.model import Attachment, Crank, Dyad, Link, Param
 from dyadgen.scenefile.names import name_problem
-from dyadgen.scenefile.problems import Problems, number, pair_of_numbers, real, unknown_keys
+from dyadgen.scenefile.problems import Problems, number, pair_of_numbers, real, shown, unknown_keys
 
 DYAD_KEYS = {"name", "type", "m", "n", "k", "p", "branch"}
 LINK_KEYS = {"name", "length", "angle", "turn", "com", "mass", "inertia"}
@@ -332,7 +332,7 @@ class Mechanism:
             value = 1
         if isinstance(value, bool) or value not in (1, -1):
             self.p.add(
-                f"{label}: branch must be 1 or -1, not {value!r}", "dyad", dyad.index, "branch"
+                f"{label}: branch must be 1 or -1, not {shown(value)}", "dyad", dyad.index, "branch"
             )
             return None
         return Param(
