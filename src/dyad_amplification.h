@@ -45,58 +45,10 @@
 #ifndef DYADFMU_AMPLIFICATION_H
 #define DYADFMU_AMPLIFICATION_H
 
+#include "dyadfmu/dual.h"
 #include "dyadfmu/types.h"
 
 #include <math.h>
-
-/* |x| as one instruction (x < 0 ? -x : x is a compare and a branch, since it
- * must keep the sign of -0 and NaN). */
-#ifdef DYAD_REAL_FLOAT
-#define DYAD_FABS fabsf
-#else
-#define DYAD_FABS fabs
-#endif
-
-/* A value and its rate along a seed. */
-typedef struct dyad_dual {
-    dyad_real v;
-    dyad_real d;
-} dyad_dual;
-
-static inline dyad_dual dyad_dual_make(dyad_real v, dyad_real d)
-{
-    dyad_dual r;
-    r.v = v;
-    r.d = d;
-    return r;
-}
-
-static inline dyad_dual dyad_dual_const(dyad_real v)
-{
-    return dyad_dual_make(v, 0);
-}
-
-static inline dyad_dual dyad_dual_add(dyad_dual a, dyad_dual b)
-{
-    return dyad_dual_make(a.v + b.v, a.d + b.d);
-}
-
-static inline dyad_dual dyad_dual_mul(dyad_dual a, dyad_dual b)
-{
-    return dyad_dual_make(a.v * b.v, a.d * b.v + a.v * b.d);
-}
-
-static inline dyad_dual dyad_dual_div(dyad_dual a, dyad_dual b)
-{
-    const dyad_real q = a.v / b.v;
-    return dyad_dual_make(q, (a.d - q * b.d) / b.v);
-}
-
-/* |a| and its rate: the one-sided rate is taken as 0 at a = 0. */
-static inline dyad_dual dyad_dual_abs(dyad_real a, dyad_real da)
-{
-    return dyad_dual_make(DYAD_FABS(a), a > 0 ? da : a < 0 ? -da : 0);
-}
 
 /* |v.x| + |v.y| and its rate. */
 static inline dyad_dual dyad_dual_norm1(dyad_vec2 v, dyad_vec2 dv)

@@ -97,39 +97,6 @@
 #define kv_in_unit(v, s)    dyad_kdv_in_unit((v), (s))
 #define kv_put(a, to, rate) dyad_kdv_put((a), (to), (rate))
 
-#ifndef DYADFMU_KIN_DUAL_IO
-#define DYADFMU_KIN_DUAL_IO
-/* An input with its seed; a unit vector's seed counts by its part normal to
- * it (the angle rate u x s, as in dyad_tangent.c). */
-static inline dyad_dual_vec2 dyad_kdv_in(dyad_vec2 v, dyad_vec2 s)
-{
-    dyad_dual_vec2 r;
-    r.v = v;
-    r.d = s;
-    return r;
-}
-
-static inline dyad_dual_vec2 dyad_kdv_in_unit(dyad_vec2 v, dyad_vec2 s)
-{
-    dyad_dual_vec2 r;
-    r.v = dyad_unit_of(v);
-    r.d = dyad_scale(dyad_cross(r.v, s), dyad_perp(r.v));
-    return r;
-}
-
-static inline void dyad_kd_put(dyad_dual a, dyad_real* to, dyad_real* rate)
-{
-    *to = a.v;
-    *rate = a.d;
-}
-
-static inline void dyad_kdv_put(dyad_dual_vec2 a, dyad_vec2* to, dyad_vec2* rate)
-{
-    *to = a.v;
-    *rate = a.d;
-}
-#endif
-
 #else
 #define DYAD_KIN(name)      name##_plain
 #define DYAD_KIN_IS_DUAL    0

@@ -46,8 +46,8 @@ dyad_status dyad_kinematics_rrt(const dyad_kin_input* input, dyad_kin_result* re
                               result);
 }
 
-dyad_status dyad_kin_tangent_rrt(const dyad_kin_input* input, const dyad_kin_input* seed,
-                                 dyad_kin_result* value, dyad_kin_result* derivative)
+dyad_status dyad_kinematics_tangent_rrt(const dyad_kin_input* input, const dyad_kin_input* seed,
+                                        dyad_kin_result* value, dyad_kin_result* derivative)
 {
     return dyad_kin_run_dual(DYAD_RRT, rrt_position_dual, rrt_motion_dual, input, seed, value,
                              derivative);

@@ -42,8 +42,8 @@ dyad_status dyad_kinematics_trt(const dyad_kin_input* input, dyad_kin_result* re
                               result);
 }
 
-dyad_status dyad_kin_tangent_trt(const dyad_kin_input* input, const dyad_kin_input* seed,
-                                 dyad_kin_result* value, dyad_kin_result* derivative)
+dyad_status dyad_kinematics_tangent_trt(const dyad_kin_input* input, const dyad_kin_input* seed,
+                                        dyad_kin_result* value, dyad_kin_result* derivative)
 {
     return dyad_kin_run_dual(DYAD_TRT, trt_position_dual, trt_motion_dual, input, seed, value,
                              derivative);

@@ -4,6 +4,8 @@
  * the formulas they share in dyad_kin_generic.h. */
 #include "dyad_kin_internal.h"
 #include "dyad_kin_generic.h"
+#define DYAD_KIN_DUAL
+#include "dyad_kin_generic.h"
 
 static const char* const kin_field_names[DYAD_KIN_FIELD_COUNT] = {
     [DYAD_KIN_FIELD_NONE] = "",
@@ -66,7 +68,7 @@ const char* dyad_kin_failure_name(dyad_kin_failure failure)
 dyad_point_motion dyad_point_on_link(const dyad_point_motion* origin, dyad_vec2 dir,
                                      dyad_real omega, dyad_real epsilon, dyad_vec2 at)
 {
-    kin_motion o, p;
+    dyad_kin_motion_plain o, p;
     dyad_point_motion r;
     o.pos = origin->position;
     o.vel = origin->velocity;
@@ -75,6 +77,25 @@ dyad_point_motion dyad_point_on_link(const dyad_point_motion* origin, dyad_vec2 
     r.position = p.pos;
     r.velocity = p.vel;
     r.acceleration = p.acc;
+    return r;
+}
+
+dyad_dual_point_motion dyad_point_on_link_dual(dyad_dual_point_motion origin, dyad_dual_vec2 dir,
+                                               dyad_dual omega, dyad_dual epsilon,
+                                               dyad_dual_vec2 at)
+{
+    dyad_kin_motion_dual o, p;
+    dyad_dual_point_motion r;
+    o.pos = dyad_kdv_in(origin.v.position, origin.d.position);
+    o.vel = dyad_kdv_in(origin.v.velocity, origin.d.velocity);
+    o.acc = dyad_kdv_in(origin.v.acceleration, origin.d.acceleration);
+    p = dyad_kin_on_link_dual(&o, dir, omega, epsilon, at);
+    r.v.position = p.pos.v;
+    r.d.position = p.pos.d;
+    r.v.velocity = p.vel.v;
+    r.d.velocity = p.vel.d;
+    r.v.acceleration = p.acc.v;
+    r.d.acceleration = p.acc.d;
     return r;
 }
 

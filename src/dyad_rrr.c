@@ -84,5 +84,11 @@ static dyad_dual rrr_conditioning_rate(const dyad_input* input, const dyad_input
     return dyad_denominator_rate(value, dc, derivative);
 }
 
-const dyad_tangent_type dyad_tangent_rrr = {DYAD_RRR, dyad_solve_rrr, dyad_sizes_rrr,
-                                            rrr_conditioning_rate};
+const dyad_tangent_type dyad_tangent_rrr = {DYAD_RRR, dyad_solve_rrr, dyad_react_rrr,
+                                            dyad_sizes_rrr, rrr_conditioning_rate};
+
+dyad_status dyad_react_tangent_rrr(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative)
+{
+    return dyad_react_tangent_of(&dyad_tangent_rrr, dyad, seed, value, derivative);
+}

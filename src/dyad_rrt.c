@@ -85,5 +85,11 @@ static dyad_dual rrt_conditioning_rate(const dyad_input* input, const dyad_input
     return dyad_denominator_rate(value, dc, derivative);
 }
 
-const dyad_tangent_type dyad_tangent_rrt = {DYAD_RRT, dyad_solve_rrt, dyad_sizes_rrt,
-                                            rrt_conditioning_rate};
+const dyad_tangent_type dyad_tangent_rrt = {DYAD_RRT, dyad_solve_rrt, dyad_react_rrt,
+                                            dyad_sizes_rrt, rrt_conditioning_rate};
+
+dyad_status dyad_react_tangent_rrt(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative)
+{
+    return dyad_react_tangent_of(&dyad_tangent_rrt, dyad, seed, value, derivative);
+}

@@ -124,5 +124,11 @@ static dyad_dual rtr_conditioning_rate(const dyad_input* input, const dyad_input
     return dyad_dual_mul(dyad_dual_make(dist, ddist), dyad_dual_abs(slant, dslant));
 }
 
-const dyad_tangent_type dyad_tangent_rtr = {DYAD_RTR, dyad_solve_rtr, dyad_sizes_rtr,
-                                            rtr_conditioning_rate};
+const dyad_tangent_type dyad_tangent_rtr = {DYAD_RTR, dyad_solve_rtr, dyad_react_rtr,
+                                            dyad_sizes_rtr, rtr_conditioning_rate};
+
+dyad_status dyad_react_tangent_rtr(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative)
+{
+    return dyad_react_tangent_of(&dyad_tangent_rtr, dyad, seed, value, derivative);
+}

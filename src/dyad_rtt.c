@@ -96,5 +96,11 @@ static dyad_dual rtt_conditioning_rate(const dyad_input* input, const dyad_input
     return dyad_denominator_rate(value, dc, derivative);
 }
 
-const dyad_tangent_type dyad_tangent_rtt = {DYAD_RTT, dyad_solve_rtt, dyad_sizes_rtt,
-                                            rtt_conditioning_rate};
+const dyad_tangent_type dyad_tangent_rtt = {DYAD_RTT, dyad_solve_rtt, dyad_react_rtt,
+                                            dyad_sizes_rtt, rtt_conditioning_rate};
+
+dyad_status dyad_react_tangent_rtt(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative)
+{
+    return dyad_react_tangent_of(&dyad_tangent_rtt, dyad, seed, value, derivative);
+}

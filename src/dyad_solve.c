@@ -61,11 +61,11 @@ dyad_status dyad_kinematics_tangent(dyad_type type, const dyad_kin_input* input,
                                     dyad_kin_result* derivative)
 {
     switch (type) {
-    case DYAD_RRR: return dyad_kin_tangent_rrr(input, seed, value, derivative);
-    case DYAD_RRT: return dyad_kin_tangent_rrt(input, seed, value, derivative);
-    case DYAD_RTR: return dyad_kin_tangent_rtr(input, seed, value, derivative);
-    case DYAD_TRT: return dyad_kin_tangent_trt(input, seed, value, derivative);
-    case DYAD_RTT: return dyad_kin_tangent_rtt(input, seed, value, derivative);
+    case DYAD_RRR: return dyad_kinematics_tangent_rrr(input, seed, value, derivative);
+    case DYAD_RRT: return dyad_kinematics_tangent_rrt(input, seed, value, derivative);
+    case DYAD_RTR: return dyad_kinematics_tangent_rtr(input, seed, value, derivative);
+    case DYAD_TRT: return dyad_kinematics_tangent_trt(input, seed, value, derivative);
+    case DYAD_RTT: return dyad_kinematics_tangent_rtt(input, seed, value, derivative);
     case DYAD_TYPE_COUNT: break;
     }
     return dyad_kin_reject(value, derivative, DYAD_STATUS_INVALID_INPUT,

@@ -108,6 +108,41 @@ static dyad_turning turning_of(dyad_type type, const dyad_input* input, const dy
     return t;
 }
 
+/* What the reactions held at `value` add to the links' equilibrium sums when
+ * the geometry moves along the seed: a turning guide turns its normal force
+ * (d(N j) = -N i dtheta), R_mn turns with a translational pair E
+ * (dr_mn_turn), and R_mn's lever l_g i_g about D_g changes (dl_g: the
+ * lengths' rates). Added to df_g and dmd_g. */
+static void add_held_reactions(dyad_type type, const dyad_turning* t, const dyad_result* value,
+                               dyad_vec2 dr_mn_turn, dyad_dual l_m, dyad_dual l_n, dyad_vec2* df_m,
+                               dyad_vec2* df_n, dyad_real* dmd_m, dyad_real* dmd_n)
+{
+    const dyad_vec2 lever_m = dyad_scale(l_m.v, t->i_m);
+    const dyad_vec2 lever_n = dyad_scale(l_n.v, t->i_n);
+    const dyad_vec2 dlever_m = dyad_combine(l_m.d, t->i_m, l_m.v * t->dth_m, dyad_perp(t->i_m));
+    const dyad_vec2 dlever_n = dyad_combine(l_n.d, t->i_n, l_n.v * t->dth_n, dyad_perp(t->i_n));
+    if (dyad_guide_used(type, DYAD_PAIR_DM)) {
+        *df_m = dyad_add(*df_m, dyad_scale(-value->n_mk * t->dth_k, t->i_k));
+    }
+    if (dyad_guide_used(type, DYAD_PAIR_DN)) {
+        *df_n = dyad_add(*df_n, dyad_scale(-value->n_np * t->dth_p, t->i_p));
+    }
+    *df_m = dyad_add(*df_m, dr_mn_turn);
+    *df_n = dyad_sub(*df_n, dr_mn_turn);
+    *dmd_m += dyad_cross(dlever_m, value->r_mn) + dyad_cross(lever_m, dr_mn_turn);
+    *dmd_n -= dyad_cross(dlever_n, value->r_mn) + dyad_cross(lever_n, dr_mn_turn);
+}
+
+/* A dyad under the loads (force at D_g, moment about D_g) alone: the shape of
+ * the derivative's solve. */
+static void load_at_d(dyad_loaded_link* link, dyad_vec2 force, dyad_real moment)
+{
+    link->f = force;
+    link->m = link->m_d = moment;
+    link->f_size = dyad_norm1(force);
+    link->m_d_size = DYAD_FABS(moment);
+}
+
 /* The loads of the derivative's solve: the change of each link's equilibrium
  * sums when the inputs move along the seed and the reactions are held, applied
  * at D_g (com at the origin, no mass). dr_mn_turn: how R_mn turns with a
@@ -124,27 +159,9 @@ static dyad_input held_reaction_loads(dyad_type type, const dyad_input* input,
                    &dmd_m, sizes_m);
     resultant_rate(&input->n, &seed->n, t->i_n, t->dth_n, input->gravity, seed->gravity, &df_n,
                    &dmd_n, sizes_n);
-
-    /* A turning guide turns its normal force (d(N j) = -N i dtheta), and R_mn's
-     * lever l_g i_g about D_g changes. */
-    if (dyad_guide_used(type, DYAD_PAIR_DM)) {
-        df_m = dyad_add(df_m, dyad_scale(-value->n_mk * t->dth_k, t->i_k));
-    }
-    if (dyad_guide_used(type, DYAD_PAIR_DN)) {
-        df_n = dyad_add(df_n, dyad_scale(-value->n_np * t->dth_p, t->i_p));
-    }
-    df_m = dyad_add(df_m, dr_mn_turn);
-    df_n = dyad_sub(df_n, dr_mn_turn);
-    {
-        const dyad_vec2 lever_m = dyad_scale(input->m.length, t->i_m);
-        const dyad_vec2 lever_n = dyad_scale(input->n.length, t->i_n);
-        const dyad_vec2 dlever_m =
-            dyad_combine(seed->m.length, t->i_m, input->m.length * t->dth_m, dyad_perp(t->i_m));
-        const dyad_vec2 dlever_n =
-            dyad_combine(seed->n.length, t->i_n, input->n.length * t->dth_n, dyad_perp(t->i_n));
-        dmd_m += dyad_cross(dlever_m, value->r_mn) + dyad_cross(lever_m, dr_mn_turn);
-        dmd_n -= dyad_cross(dlever_n, value->r_mn) + dyad_cross(lever_n, dr_mn_turn);
-    }
+    add_held_reactions(type, t, value, dr_mn_turn, dyad_dual_make(input->m.length, seed->m.length),
+                       dyad_dual_make(input->n.length, seed->n.length), &df_m, &df_n, &dmd_m,
+                       &dmd_n);
 
     loads.m.com = loads.n.com = dyad_vec2_make(0, 0);
     loads.m.mass = loads.n.mass = loads.m.inertia = loads.n.inertia = 0;
@@ -157,22 +174,50 @@ static dyad_input held_reaction_loads(dyad_type type, const dyad_input* input,
     return loads;
 }
 
+/* The derivative's last step, shared by both entries: a translational pair's
+ * force N j turns with its guide, R_mn with a sliding E; then the
+ * conditioning's rate from its definition in the type's file and the
+ * amplification's from the sizes' rates. */
+static void finish_tangent(const dyad_tangent_type* kind, const dyad_input* input,
+                           const dyad_input* seed, const dyad_turning* t, dyad_vec2 dr_mn_turn,
+                           const dyad_link_sizes* sizes_m, const dyad_link_sizes* sizes_n,
+                           const dyad_result* value, dyad_result* derivative)
+{
+    dyad_dual divisor; /* the type's divisor |d| (RTR: |D_m D_n| |d|) and its rate */
+    if (dyad_guide_used(kind->type, DYAD_PAIR_DM)) {
+        derivative->r_mk = dyad_add(derivative->r_mk, dyad_scale(-value->n_mk * t->dth_k, t->i_k));
+    }
+    if (dyad_guide_used(kind->type, DYAD_PAIR_DN)) {
+        derivative->r_np = dyad_add(derivative->r_np, dyad_scale(-value->n_np * t->dth_p, t->i_p));
+    }
+    derivative->r_mn = dyad_add(derivative->r_mn, dr_mn_turn);
+    divisor = kind->conditioning_rate(input, seed, t, value, derivative);
+    derivative->amplification =
+        amplification_rate(kind, input, seed, sizes_m, sizes_n,
+                           dyad_dual_div(dyad_dual_const(1), divisor), value, derivative);
+}
+
+/* How R_mn turns along the seed: with link m where E slides along it. */
+static dyad_vec2 mn_turn(dyad_type type, const dyad_turning* t, const dyad_result* value)
+{
+    return dyad_pair_kind_of(type, DYAD_PAIR_E) == DYAD_PAIR_TRANSLATIONAL
+               ? dyad_scale(-value->n_mn * t->dth_m, t->i_m)
+               : dyad_vec2_make(0, 0);
+}
+
 dyad_status dyad_solve_tangent_of(const dyad_tangent_type* kind, const dyad_input* input,
                                   const dyad_input* seed, dyad_result* value,
                                   dyad_result* derivative)
 {
-    dyad_type type;
     dyad_status status;
     dyad_turning t;
     dyad_input loads;
     dyad_vec2 dr_mn_turn;
     dyad_link_sizes sizes_m, sizes_n;
-    dyad_dual divisor; /* the type's divisor |d| (RTR: |D_m D_n| |d|) and its rate */
 
     if (kind == NULL || value == NULL || derivative == NULL) {
         return DYAD_STATUS_INVALID_INPUT;
     }
-    type = kind->type;
     status = kind->solve(input, value);
     if (status != DYAD_STATUS_OK) {
         *derivative = *value;
@@ -183,28 +228,97 @@ dyad_status dyad_solve_tangent_of(const dyad_tangent_type* kind, const dyad_inpu
         return dyad_reject(derivative, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_INPUT);
     }
 
-    t = turning_of(type, input, seed);
-    dr_mn_turn = dyad_pair_kind_of(type, DYAD_PAIR_E) == DYAD_PAIR_TRANSLATIONAL
-                     ? dyad_scale(-value->n_mn * t.dth_m, t.i_m)
-                     : dyad_vec2_make(0, 0);
-    loads = held_reaction_loads(type, input, seed, &t, value, dr_mn_turn, &sizes_m, &sizes_n);
+    t = turning_of(kind->type, input, seed);
+    dr_mn_turn = mn_turn(kind->type, &t, value);
+    loads = held_reaction_loads(kind->type, input, seed, &t, value, dr_mn_turn, &sizes_m, &sizes_n);
     status = kind->solve(&loads, derivative);
     if (status != DYAD_STATUS_OK) {
         return status;
     }
-    /* A translational pair's force N j turns with its guide. */
-    if (dyad_guide_used(type, DYAD_PAIR_DM)) {
-        derivative->r_mk = dyad_add(derivative->r_mk, dyad_scale(-value->n_mk * t.dth_k, t.i_k));
-    }
-    if (dyad_guide_used(type, DYAD_PAIR_DN)) {
-        derivative->r_np = dyad_add(derivative->r_np, dyad_scale(-value->n_np * t.dth_p, t.i_p));
-    }
-    derivative->r_mn = dyad_add(derivative->r_mn, dr_mn_turn);
-
-    /* The conditioning's own rate, from its definition in the type's file. */
-    divisor = kind->conditioning_rate(input, seed, &t, value, derivative);
-    derivative->amplification =
-        amplification_rate(kind, input, seed, &sizes_m, &sizes_n,
-                           dyad_dual_div(dyad_dual_const(1), divisor), value, derivative);
+    finish_tangent(kind, input, seed, &t, dr_mn_turn, &sizes_m, &sizes_n, value, derivative);
     return DYAD_STATUS_OK;
+}
+
+/* The geometry of a loaded dyad as a dyad_input (directions, lengths, guides):
+ * what the conditioning's and the amplification's rates read. */
+static dyad_input geometry_of(const dyad_loaded* dyad)
+{
+    dyad_input g = dyad_input_default();
+    g.m.dir = dyad->m.i;
+    g.n.dir = dyad->n.i;
+    g.m.length = dyad->m.l;
+    g.n.length = dyad->n.l;
+    g.guide_k = dyad->i_k;
+    g.guide_p = dyad->i_p;
+    return g;
+}
+
+dyad_status dyad_react_tangent_of(const dyad_tangent_type* kind, const dyad_loaded* dyad,
+                                  const dyad_loaded* seed, dyad_result* value,
+                                  dyad_result* derivative)
+{
+    dyad_status status;
+    dyad_input geometry, rate;
+    dyad_turning t;
+    dyad_loaded loads;
+    dyad_vec2 dr_mn_turn, df_m, df_n;
+    dyad_real dmd_m, dmd_n;
+    dyad_link_sizes sizes_m, sizes_n;
+
+    if (kind == NULL || dyad == NULL || value == NULL || derivative == NULL) {
+        return DYAD_STATUS_INVALID_INPUT;
+    }
+    status = kind->react(dyad, value);
+    if (status != DYAD_STATUS_OK || seed == NULL) {
+        *derivative = *value;
+        return seed == NULL ? dyad_reject(derivative, DYAD_STATUS_INVALID_INPUT, DYAD_FIELD_INPUT)
+                            : status;
+    }
+    geometry = geometry_of(dyad);
+    rate = geometry_of(seed);
+    t = turning_of(kind->type, &geometry, &rate);
+    dr_mn_turn = mn_turn(kind->type, &t, value);
+    df_m = seed->m.f;
+    df_n = seed->n.f;
+    dmd_m = seed->m.m_d;
+    dmd_n = seed->n.m_d;
+    add_held_reactions(kind->type, &t, value, dr_mn_turn, dyad_dual_make(dyad->m.l, seed->m.l),
+                       dyad_dual_make(dyad->n.l, seed->n.l), &df_m, &df_n, &dmd_m, &dmd_n);
+    loads = *dyad;
+    load_at_d(&loads.m, df_m, dmd_m);
+    load_at_d(&loads.n, df_n, dmd_n);
+    status = kind->react(&loads, derivative);
+    if (status != DYAD_STATUS_OK) {
+        return status;
+    }
+    sizes_m.f = dyad_dual_make(dyad->m.f_size, seed->m.f_size);
+    sizes_m.m_d = dyad_dual_make(dyad->m.m_d_size, seed->m.m_d_size);
+    sizes_n.f = dyad_dual_make(dyad->n.f_size, seed->n.f_size);
+    sizes_n.m_d = dyad_dual_make(dyad->n.m_d_size, seed->n.m_d_size);
+    finish_tangent(kind, &geometry, &rate, &t, dr_mn_turn, &sizes_m, &sizes_n, value, derivative);
+    return DYAD_STATUS_OK;
+}
+
+/* The rate of dyad_force_size and dyad_moment_size: amplification x the
+ * largest of three magnitudes, compared as they are (ties to the later). */
+static dyad_real error_scale_rate(const dyad_result* value, const dyad_result* derivative,
+                                  dyad_dual mk, dyad_dual np, dyad_dual mn)
+{
+    const dyad_dual largest = mk.v > np.v ? (mk.v > mn.v ? mk : mn) : (np.v > mn.v ? np : mn);
+    return dyad_dual_mul(dyad_dual_make(value->amplification, derivative->amplification), largest)
+        .d;
+}
+
+dyad_real dyad_force_size_rate(const dyad_result* value, const dyad_result* derivative)
+{
+    return error_scale_rate(value, derivative, dyad_dual_norm1(value->r_mk, derivative->r_mk),
+                            dyad_dual_norm1(value->r_np, derivative->r_np),
+                            dyad_dual_norm1(value->r_mn, derivative->r_mn));
+}
+
+dyad_real dyad_moment_size_rate(const dyad_result* value, const dyad_result* derivative)
+{
+    return error_scale_rate(value, derivative, dyad_dual_abs(value->m_mk, derivative->m_mk),
+                            dyad_dual_abs(value->m_np, derivative->m_np),
+                            dyad_dual_abs(value->m_mn, derivative->m_mn));
 }

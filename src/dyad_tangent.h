@@ -2,7 +2,8 @@
  * type. The derivation is shared; three things differ by type and live in the
  * type's own file: its solver, the sizes of its outputs (the amplification's
  * formulas) and the rate of its conditioning: the dyad_tangent_<type> of the
- * type's file. Not part of the public API. */
+ * type's file. Its reactions on reduced loads (react) serve the tangent of
+ * dyad_react_<type>. Not part of the public API. */
 #ifndef DYADFMU_TANGENT_H
 #define DYADFMU_TANGENT_H
 
@@ -26,6 +27,7 @@ typedef dyad_dual (*dyad_conditioning_rate)(const dyad_input* input, const dyad_
 struct dyad_tangent_type {
     dyad_type type;
     dyad_solver solve;
+    dyad_status (*react)(const dyad_loaded* dyad, dyad_result* result);
     dyad_output_sizes (*sizes)(const dyad_size_terms* terms);
     dyad_conditioning_rate conditioning_rate;
 };
@@ -39,5 +41,10 @@ static inline dyad_dual dyad_denominator_rate(const dyad_result* value, dyad_rea
     derivative->conditioning = value->denominator < 0 ? -dc : dc;
     return dyad_dual_abs(value->denominator, dc);
 }
+
+/* dyad_react_tangent_<type>: the tangent of the closed forms on reduced loads. */
+dyad_status dyad_react_tangent_of(const dyad_tangent_type* kind, const dyad_loaded* dyad,
+                                  const dyad_loaded* seed, dyad_result* value,
+                                  dyad_result* derivative);
 
 #endif /* DYADFMU_TANGENT_H */

@@ -78,5 +78,11 @@ static dyad_dual trt_conditioning_rate(const dyad_input* input, const dyad_input
     return dyad_denominator_rate(value, dc, derivative);
 }
 
-const dyad_tangent_type dyad_tangent_trt = {DYAD_TRT, dyad_solve_trt, dyad_sizes_trt,
-                                            trt_conditioning_rate};
+const dyad_tangent_type dyad_tangent_trt = {DYAD_TRT, dyad_solve_trt, dyad_react_trt,
+                                            dyad_sizes_trt, trt_conditioning_rate};
+
+dyad_status dyad_react_tangent_trt(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative)
+{
+    return dyad_react_tangent_of(&dyad_tangent_trt, dyad, seed, value, derivative);
+}

@@ -1045,6 +1045,166 @@ static int test_tangent_of_each_type(void)
     return fails;
 }
 
+/* ---- the tangent of the closed forms on reduced loads (dyad_react_tangent_<type>) ----------- */
+
+#ifdef DYAD_REAL_FLOAT
+#define REACT_FD_STEP  2e-2
+#define REACT_FD_LIMIT 3e-2
+#else
+#define REACT_FD_STEP  1e-3
+#define REACT_FD_LIMIT 1e-7
+#endif
+
+/* The reactions, conditioning and amplification of a result, as numbers. */
+#define REACT_OUTPUTS 14
+static void react_outputs(const dyad_result* r, double v[REACT_OUTPUTS])
+{
+    const double all[REACT_OUTPUTS] = {
+        r->r_mk.x, r->r_mk.y, r->r_np.x, r->r_np.y, r->r_mn.x, r->r_mn.y,       r->n_mk,
+        r->n_np,   r->n_mn,   r->m_mk,   r->m_np,   r->m_mn,   r->conditioning, r->amplification};
+    memcpy(v, all, sizeof all);
+}
+
+/* A unit vector turned at the rate its seed's normal part gives, by tau. */
+static dyad_vec2 turned_by(dyad_vec2 i, dyad_vec2 di, double tau)
+{
+    return polar(1, atan2((double)i.y, (double)i.x) + tau * dyad_cross(i, di));
+}
+
+static void move_loaded_link(dyad_loaded_link* to, const dyad_loaded_link* a,
+                             const dyad_loaded_link* s, double tau)
+{
+    to->i = turned_by(a->i, s->i, tau);
+    to->j = dyad_perp(to->i);
+    to->l = (dyad_real)(a->l + tau * s->l);
+    to->f = vec(a->f.x + tau * s->f.x, a->f.y + tau * s->f.y);
+    to->m = (dyad_real)(a->m + tau * s->m);
+    to->m_d = (dyad_real)(a->m_d + tau * s->m_d);
+    to->f_size = (dyad_real)(a->f_size + tau * s->f_size);
+    to->m_d_size = (dyad_real)(a->m_d_size + tau * s->m_d_size);
+}
+
+static dyad_loaded moved_loaded(const dyad_loaded* a, const dyad_loaded* s, double tau)
+{
+    dyad_loaded b = *a;
+    move_loaded_link(&b.m, &a->m, &s->m, tau);
+    move_loaded_link(&b.n, &a->n, &s->n, tau);
+    b.i_k = turned_by(a->i_k, s->i_k, tau);
+    b.j_k = dyad_perp(b.i_k);
+    b.i_p = turned_by(a->i_p, s->i_p, tau);
+    b.j_p = dyad_perp(b.i_p);
+    return b;
+}
+
+/* A seed of a loaded link: every field moves, in proportion to its size. */
+static dyad_loaded_link random_loaded_seed(rng* r, const dyad_loaded_link* a)
+{
+    dyad_loaded_link s;
+    s.i = dyad_scale((dyad_real)uniform(r, -1, 1), a->i);
+    s.i = dyad_add(s.i, dyad_scale((dyad_real)uniform(r, -1, 1), a->j));
+    s.j = dyad_perp(s.i);
+    s.l = (dyad_real)(a->l * uniform(r, -0.5, 0.5));
+    s.f = vec(uniform(r, -1, 1) * dyad_norm1(a->f), uniform(r, -1, 1) * dyad_norm1(a->f));
+    s.m = (dyad_real)(uniform(r, -1, 1) * fabs((double)a->m));
+    s.m_d = (dyad_real)(uniform(r, -1, 1) * fabs((double)a->m_d));
+    s.f_size = (dyad_real)(uniform(r, -0.5, 0.5) * a->f_size);
+    s.m_d_size = (dyad_real)(uniform(r, -0.5, 0.5) * a->m_d_size);
+    return s;
+}
+
+/* dyad_react_tangent_<type> against fourth-order central differences of
+ * dyad_react_<type> along the same seed: every reaction, the conditioning
+ * and the amplification; the value bit for bit the plain solve's. */
+static int test_react_tangent_finite_differences(void)
+{
+    static dyad_status (*const react[DYAD_TYPE_COUNT])(const dyad_loaded*, dyad_result*) = {
+        dyad_react_rrr, dyad_react_rrt, dyad_react_rtr, dyad_react_trt, dyad_react_rtt};
+    static dyad_status (*const tangent[DYAD_TYPE_COUNT])(const dyad_loaded*, const dyad_loaded*,
+                                                         dyad_result*, dyad_result*) = {
+        dyad_react_tangent_rrr, dyad_react_tangent_rrt, dyad_react_tangent_rtr,
+        dyad_react_tangent_trt, dyad_react_tangent_rtt};
+    static const double taus[4] = {-2, -1, 1, 2};
+    int fails = 0;
+    int t, k, j;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        rng r = {0x7A46E47u + (uint64_t)t};
+        double worst = 0;
+        int solved = 0, smooth = 0;
+        while (solved < 500) {
+            const dyad_input in = random_input(&r, type);
+            dyad_loaded a, s;
+            dyad_result plain, value, rate, moved[4];
+            double v[4][REACT_OUTPUTS], d[REACT_OUTPUTS], scale = 0, level = 0;
+            int ok = 1;
+            a.m = loaded_link_of(&in.m, in.gravity);
+            a.n = loaded_link_of(&in.n, in.gravity);
+            a.i_k = in.guide_k;
+            a.j_k = dyad_perp(in.guide_k);
+            a.i_p = in.guide_p;
+            a.j_p = dyad_perp(in.guide_p);
+            a.singular_threshold = in.singular_threshold;
+            s = a;
+            s.m = random_loaded_seed(&r, &a.m);
+            s.n = random_loaded_seed(&r, &a.n);
+            s.i_k = dyad_scale((dyad_real)uniform(&r, -1, 1), a.j_k);
+            s.i_p = dyad_scale((dyad_real)uniform(&r, -1, 1), a.j_p);
+            if (tangent[t](&a, &s, &value, &rate) != DYAD_STATUS_OK ||
+                value.conditioning < WELL_CONDITIONED) {
+                continue;
+            }
+            react[t](&a, &plain);
+            CHECK(memcmp(&plain, &value, sizeof plain) == 0, "%s: the value is not dyad_react's",
+                  dyad_type_name(type));
+            for (k = 0; k < 4; ++k) {
+                const dyad_loaded b = moved_loaded(&a, &s, taus[k] * REACT_FD_STEP);
+                ok &= react[t](&b, &moved[k]) == DYAD_STATUS_OK;
+                react_outputs(&moved[k], v[k]);
+            }
+            if (!ok) {
+                continue;
+            }
+            ++solved;
+            react_outputs(&rate, d);
+            for (j = 0; j < 12; ++j) {
+                const double fd =
+                    (8 * (v[2][j] - v[1][j]) - (v[3][j] - v[0][j])) / (12 * REACT_FD_STEP);
+                scale = fabs(fd) > scale ? fabs(fd) : scale;
+                level = fabs(v[1][j]) > level ? fabs(v[1][j]) : level;
+                d[j] -= fd;
+            }
+            for (j = 12; j < REACT_OUTPUTS; ++j) {
+                /* the conditioning and amplification have kinks (|x|, the larger of
+                 * two sizes) that a difference may straddle: most samples agree */
+                const double fd =
+                    (8 * (v[2][j] - v[1][j]) - (v[3][j] - v[0][j])) / (12 * REACT_FD_STEP);
+                smooth += fabs(d[j] - fd) <= REACT_FD_LIMIT * (fabs(fd) + fabs(v[1][j]));
+            }
+            for (j = 0; j < 12; ++j) {
+                /* against the rate's own scale and the reactions' (a zero rate) */
+                const double error = fabs(d[j]) / (scale + level) / (double)value.amplification;
+                worst = error > worst ? error : worst;
+            }
+        }
+        printf("    %s %s: %d samples; worst difference of the reactions from central "
+               "differences %.3e; conditioning and amplification agree in %d of %d\n",
+               dyad_type_name(type), REAL_NAME, solved, worst, smooth, 2 * solved);
+        CHECK(smooth >= 2 * solved * 95 / 100,
+              "%s: the conditioning's or amplification's rate "
+              "differs in %d of %d",
+              dyad_type_name(type), 2 * solved - smooth, 2 * solved);
+        CHECK(worst < REACT_FD_LIMIT, "%s: dyad_react_tangent differs by %.3e",
+              dyad_type_name(type), worst);
+    }
+    {
+        const dyad_loaded* none = NULL;
+        dyad_result value, rate;
+        CHECK(dyad_react_tangent_rrt(none, none, &value, &rate) == DYAD_STATUS_INVALID_INPUT,
+              "a NULL dyad is not refused");
+    }
+    return fails;
+}
+
 /* ---- kinematics (dyadfmu/kinematics.h) -------------------------------------------------------
  * Each configuration is built from the dyad outwards: smooth paths in time t of
  * E, the link angles, the slides and the guides' angles, from which the mounts
@@ -2151,6 +2311,7 @@ static const named_test tests[] = {
     {"invalid_before_singular", test_invalid_before_singular},
     {"react_loaded", test_react_loaded},
     {"tangent_of_each_type", test_tangent_of_each_type},
+    {"react_tangent_finite_differences", test_react_tangent_finite_differences},
     {"kin_reproduces_built", test_kin_reproduces_built},
     {"kin_rates_finite_differences", test_kin_rates_finite_differences},
     {"kin_tangent_finite_differences", test_kin_tangent_finite_differences},

@@ -302,6 +302,7 @@ class DriveKind(Kind):
 class SceneKind(Kind):
     """A tailored scene: flat input and output blocks generated with the scene's C."""
 
+    directional_derivatives = "true"
     realisation = "tailored"
     label = "tailored"
     log_categories = SCENE_LOG_CATEGORIES
@@ -336,6 +337,7 @@ class SceneKind(Kind):
             ["dyad_common.c"]
             + [f"dyad_{t}.c" for t in types]
             + kinematics
+            + ["dyad_tangent.c"]
             + [
                 f"{table.identifier}_scene.c",
                 "fmu_instance.c",

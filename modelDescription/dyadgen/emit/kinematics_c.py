@@ -168,15 +168,21 @@ def _driver_lines(scene: Scene) -> list[str]:
     ]
 
 
-def kinematics_function(scene: Scene, dyads: list[Dyad]) -> str:
-    """The kinematics block type and the function that fills it."""
-    ident = scene.identifier
+def kinematics_body(scene: Scene, dyads: list[Dyad]) -> list[str]:
+    """The statements of the function `kinematics`."""
     mounts = _Mounts(scene)
-    members = [f"    dyad_kin_result {kin_name(d)};" for d in scene.dyads]
     body = _driver_lines(scene) + ["dyad_kin_input k;"]
     for d in dyads:
         body += _dyad_lines(scene, mounts, d)
     body.append("return NULL;")
+    return body
+
+
+def kinematics_function(scene: Scene, dyads: list[Dyad]) -> str:
+    """The kinematics block type and the function that fills it."""
+    ident = scene.identifier
+    members = [f"    dyad_kin_result {kin_name(d)};" for d in scene.dyads]
+    body = kinematics_body(scene, dyads)
     lines = [f"typedef struct {ident}_kinematics {{", *members, f"}} {ident}_kinematics;", ""]
     lines += [
         "/* The chain's kinematics from the driver outwards, the driver at its position in",

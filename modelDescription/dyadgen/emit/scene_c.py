@@ -24,7 +24,7 @@ from pathlib import Path
 from string import Template
 
 from dyadgen import textsafe
-from dyadgen.emit import kinematics_c
+from dyadgen.emit import kinematics_c, tangent_c
 from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, loaders, member
 from dyadgen.table import Table
 
@@ -633,6 +633,8 @@ def scene_c(scene: Scene) -> str:
         write(plan, code)
     dyad_decls, crank_decls = _declarations(plan)
     reals = [o.member for o in scene.outputs if not o.integer]
+    body = drop_unused_constants(code.lines)
+    tangent = tangent_c.scene_tangent(scene, plan.kinematic, dyad_decls + crank_decls + body)
     return _template().substitute(
         ident=scene.identifier,
         scene_file=textsafe.c_comment(scene.path.name),
@@ -647,7 +649,8 @@ def scene_c(scene: Scene) -> str:
             '#include "dyadfmu/dyad.h"\n#include "dyadfmu/kinematics.h"\n' if plan.kinematic else ""
         ),
         kinematics_code=_kinematics_code(plan),
-        body="\n".join(drop_unused_constants(code.lines)),
+        body="\n".join(body),
+        tangent_code=tangent,
     )
 
 

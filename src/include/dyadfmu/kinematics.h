@@ -27,6 +27,7 @@
 #ifndef DYADFMU_KINEMATICS_H
 #define DYADFMU_KINEMATICS_H
 
+#include "dyadfmu/dual.h"
 #include "dyadfmu/types.h"
 
 #ifdef __cplusplus
@@ -209,6 +210,19 @@ dyad_status dyad_kinematics_tangent(dyad_type type, const dyad_kin_input* input,
                                     const dyad_kin_input* seed, dyad_kin_result* value,
                                     dyad_kin_result* derivative);
 
+/** dyad_kinematics_tangent for one type, so that a program using one type
+ *  links only its kinematics. */
+dyad_status dyad_kinematics_tangent_rrr(const dyad_kin_input* input, const dyad_kin_input* seed,
+                                        dyad_kin_result* value, dyad_kin_result* derivative);
+dyad_status dyad_kinematics_tangent_rrt(const dyad_kin_input* input, const dyad_kin_input* seed,
+                                        dyad_kin_result* value, dyad_kin_result* derivative);
+dyad_status dyad_kinematics_tangent_rtr(const dyad_kin_input* input, const dyad_kin_input* seed,
+                                        dyad_kin_result* value, dyad_kin_result* derivative);
+dyad_status dyad_kinematics_tangent_trt(const dyad_kin_input* input, const dyad_kin_input* seed,
+                                        dyad_kin_result* value, dyad_kin_result* derivative);
+dyad_status dyad_kinematics_tangent_rtt(const dyad_kin_input* input, const dyad_kin_input* seed,
+                                        dyad_kin_result* value, dyad_kin_result* derivative);
+
 /** Dotted input field name, e.g. "k.guide", "length_m"; "" for NONE. */
 const char* dyad_kin_field_name(dyad_kin_field field);
 
@@ -221,6 +235,19 @@ const char* dyad_kin_failure_name(dyad_kin_failure failure);
  *  guide's point from a solved link to the next dyad. */
 dyad_point_motion dyad_point_on_link(const dyad_point_motion* origin, dyad_vec2 dir,
                                      dyad_real omega, dyad_real epsilon, dyad_vec2 at);
+
+/** A point's motion with its rate along a seed (dyadfmu/dual.h): v the motion,
+ *  d the rate of each of its vectors. */
+typedef struct dyad_dual_point_motion {
+    dyad_point_motion v;
+    dyad_point_motion d;
+} dyad_dual_point_motion;
+
+/** dyad_point_on_link on dual numbers: the motion of the point and its rate
+ *  along the seed that every argument carries. */
+dyad_dual_point_motion dyad_point_on_link_dual(dyad_dual_point_motion origin, dyad_dual_vec2 dir,
+                                               dyad_dual omega, dyad_dual epsilon,
+                                               dyad_dual_vec2 at);
 
 #ifdef __cplusplus
 }

@@ -58,6 +58,25 @@ dyad_status dyad_react_rtr(const dyad_loaded* dyad, dyad_result* result);
 dyad_status dyad_react_trt(const dyad_loaded* dyad, dyad_result* result);
 dyad_status dyad_react_rtt(const dyad_loaded* dyad, dyad_result* result);
 
+/** The reactions and their directional derivative along `seed`, exactly (no
+ *  finite differences): `seed` has the layout of `dyad` and holds the rate of
+ *  each field (a unit vector's rate is its derivative, of which only the part
+ *  normal to it counts; the threshold is not differentiated); `derivative`
+ *  receives the rate of every output of `value`, the conditioning and the
+ *  amplification included. The derivative solves the same closed forms under
+ *  the change of the equilibrium sums with the reactions held (see
+ *  dyad_tangent.c). Status as dyad_react_<type>; outputs NaN unless ok. */
+dyad_status dyad_react_tangent_rrr(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative);
+dyad_status dyad_react_tangent_rrt(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative);
+dyad_status dyad_react_tangent_rtr(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative);
+dyad_status dyad_react_tangent_trt(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative);
+dyad_status dyad_react_tangent_rtt(const dyad_loaded* dyad, const dyad_loaded* seed,
+                                   dyad_result* value, dyad_result* derivative);
+
 /** The size of a solved dyad's reaction forces as a term of another link's
  *  load (N): amplification x the largest |x| + |y| of R_mk, R_np, R_mn. It
  *  bounds each of them, and a few eps times it bounds their error; a chain
@@ -68,6 +87,11 @@ dyad_real dyad_force_size(const dyad_result* result);
 /** The same for the reactive moments (N m): amplification x the largest
  *  |m_mk|, |m_np|, |m_mn|. */
 dyad_real dyad_moment_size(const dyad_result* result);
+
+/** The rates of dyad_force_size and dyad_moment_size (N and N m per unit of
+ *  the seed) from a result and its derivative (dyad_react_tangent_<type>). */
+dyad_real dyad_force_size_rate(const dyad_result* value, const dyad_result* derivative);
+dyad_real dyad_moment_size_rate(const dyad_result* value, const dyad_result* derivative);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,170 @@
+"""Directional derivatives of the tailored and mechanism FMUs (the generated `derivative`,
+the scene's code differentiated on dual numbers): against fourth-order central differences
+of the FMU's own outputs, against identities that hold exactly (J = d(effort)/d(q''),
+dJ/dq, a link's angle moves at its velocity ratio), zero where the model description
+declares no dependency, and NaN with Discard where the chain cannot close."""
+
+import math
+
+import numpy as np
+import pytest
+from dyadfmu import paths
+from dyadfmu.cosim import mechanism_fmus as mf
+from dyadfmu.fmi import slave as fmi_slave
+
+SCENE_FMUS = [*mf.MECHANISM_FMUS, "press"]
+#: central differences of steps h and 2h: their truncation and round-off stay below this
+#: share of the largest rate of a known
+DIFFERENCE_LIMIT = 1e-7
+
+
+def _slave(name, version=2):
+    path = paths.built_fmu(name, version, None, how="scripts/run-tests")
+    s = fmi_slave.Slave(path, instance_name=name)
+    s.initialize()
+    return s
+
+
+def _names(s):
+    variables = s.md.modelVariables
+    inputs = [v.name for v in variables if v.causality == "input"]
+    reals = [v.name for v in variables if v.causality == "output" and v.type in ("Real", "Float64")]
+    return inputs, reals
+
+
+def _state(name, k):
+    """Inputs at sample k of the harness's driver motion (a state where the chain closes);
+    the press, with its kinematics outside, at its start values with loads."""
+    if name == "press":
+        return {}
+    series = mf.setup(name, 2, motion="varying", steps=24, revolutions=1.0)[1]
+    return {n: float(v[k]) for n, v in series.inputs.items()}
+
+
+def _outputs(s, values, outputs):
+    s.set(tuple(values), list(values.values()))
+    return np.array(s.get(tuple(outputs)), dtype=float)
+
+
+def _central(s, values, known, outputs):
+    base = values[known]
+    h = 1e-4 * max(1.0, abs(base))
+
+    def at(x):
+        return _outputs(s, {**values, known: x}, outputs)
+
+    fd = (8 * (at(base + h) - at(base - h)) - (at(base + 2 * h) - at(base - 2 * h))) / (12 * h)
+    _outputs(s, values, outputs)
+    return fd
+
+
+@pytest.mark.parametrize("name", SCENE_FMUS)
+def test_against_central_differences(name):
+    """Every Real output along every input, at three states of a driver cycle."""
+    s = _slave(name)
+    inputs, outputs = _names(s)
+    worst = 0.0
+    for k in (2, 9, 17):
+        values = {n: float(s.get(n)) for n in inputs} | _state(name, k)
+        values = {
+            n: v + (3.0 if n.endswith((".x", ".y", "moment")) else 0.0) for n, v in values.items()
+        }
+        _outputs(s, values, outputs)
+        for known in inputs:
+            exact = np.array(s.directional_derivative(tuple(outputs), (known,), [1.0]))
+            fd = _central(s, values, known, outputs)
+            error = np.max(np.abs(exact - fd)) / max(np.max(np.abs(fd)), 1e-300)
+            worst = max(worst, error)
+            assert error < DIFFERENCE_LIMIT, (name, known, k, error)
+    print(f"{name}: worst difference {worst:.2e} of the largest rate")
+    s.close()
+
+
+def _driver(name):
+    if name == "lift":
+        return "ram", "force", "position", "velocity", "acceleration"
+    return "crank", "torque", "angle", "omega", "epsilon"
+
+
+# the monitor offers only its bearing loads: no effort, J or link motion to relate
+@pytest.mark.parametrize("name", [n for n in mf.MECHANISM_FMUS if n != "monitor"])
+def test_exact_identities(name):
+    """J = d(effort)/d(q'') and dJ/dq = d(J)/dq, to round-off; every link angle moves
+    with its velocity ratio, d(angle)/dq q' = omega, and omega is linear in q'."""
+    driver, effort, q, rate, accel = _driver(name)
+    s = _slave(name)
+    inputs, outputs = _names(s)
+    for k in (3, 11, 20):
+        values = {n: float(s.get(n)) for n in inputs} | _state(name, k)
+        out = dict(zip(outputs, _outputs(s, values, outputs), strict=True))
+
+        def along(known, wanted):
+            return np.array(s.directional_derivative(tuple(wanted), (f"{driver}.{known}",), [1.0]))
+
+        (d_effort,) = along(accel, [f"{driver}.{effort}"])
+        assert d_effort == pytest.approx(out[f"{driver}.J"], rel=1e-13)
+        (d_j,) = along(q, [f"{driver}.J"])
+        assert d_j == pytest.approx(
+            out[f"{driver}.dJdq"], rel=1e-12, abs=1e-14 * out[f"{driver}.J"]
+        )
+        angles = [o for o in outputs if o.endswith(".angle")]
+        omegas = [o[: -len("angle")] + "omega" for o in angles]
+        if not angles:
+            continue
+        ratio = along(q, angles) * values[f"{driver}.{rate}"]
+        scale = max(abs(values[f"{driver}.{rate}"]), *(abs(out[o]) for o in omegas))
+        assert np.max(np.abs(ratio - [out[o] for o in omegas])) <= 1e-13 * scale
+        d_omega = along(rate, omegas)
+        linear = np.array([out[o] for o in omegas]) / values[f"{driver}.{rate}"]
+        assert np.max(np.abs(d_omega - linear)) <= 1e-13 * np.max(np.abs(linear))
+    s.close()
+
+
+@pytest.mark.parametrize("name", SCENE_FMUS)
+def test_zero_where_no_dependency_is_declared(name):
+    """An output's rate along an input its ModelStructure entry does not list is exactly 0
+    (a dependency the description leaves out would mislead an importer's solver)."""
+    s = _slave(name)
+    inputs, outputs = _names(s)
+    values = {n: float(s.get(n)) for n in inputs} | _state(name, 7)
+    _outputs(s, values, outputs)
+    declared = {u.variable.name: {d.name for d in u.dependencies or []} for u in s.md.outputs}
+    for known in inputs:
+        rates = s.directional_derivative(tuple(outputs), (known,), [1.0])
+        stray = [
+            o for o, r in zip(outputs, rates, strict=True) if r != 0 and known not in declared[o]
+        ]
+        assert not stray, f"{name}: {stray} move with {known} but do not declare it"
+    s.close()
+
+
+def test_fmi3_gives_the_fmi2_rates():
+    """The same generated derivative behind both FMI versions, to the bit."""
+    rates = []
+    for version in (2, 3):
+        s = _slave("shaper", version)
+        inputs, outputs = _names(s)
+        values = {n: float(s.get(n)) for n in inputs} | _state("shaper", 5)
+        _outputs(s, values, outputs)
+        rates.append(s.directional_derivative(tuple(outputs), tuple(inputs), [1.0] * len(inputs)))
+        s.close()
+    assert rates[0] == rates[1]
+
+
+def test_no_rate_where_the_chain_cannot_close():
+    """The lift's ram beyond reach: Discard, every rate NaN, the log names the dyad and
+    the gap; back within reach, the rates return."""
+    s = _slave("lift")
+    inputs, outputs = _names(s)
+    values = {n: float(s.get(n)) for n in inputs} | _state("lift", 4)
+    _outputs(s, values, outputs)
+    good = s.directional_derivative(tuple(outputs), ("ram.position",), [1.0])
+    s.set(("ram.position",), [1.5])
+    with pytest.raises(fmi_slave.SlaveError) as failure:
+        s.directional_derivative(tuple(outputs), ("ram.position",), [1.0])
+    assert failure.value.status == 2
+    assert "cannot assemble" in failure.value.message and " m;" in failure.value.message
+    _outputs(s, values, outputs)
+    again = s.directional_derivative(tuple(outputs), ("ram.position",), [1.0])
+    assert again == good and all(math.isfinite(r) for r in again)
+    s.close()
