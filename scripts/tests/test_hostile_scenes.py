@@ -201,7 +201,8 @@ def _scene_objects(sc) -> list[tuple[str, str]]:
     objects = [("identifier", sc.identifier)]
     if sc.crank:
         objects.append(("crank", sc.crank.name))
-    objects += [("dyad", d.name) for d in sc.dyads if d.name]
+    # an unnamed dyad is "dyad" in the generated C (its result, and d_dyad its rate)
+    objects += [("dyad", d.name or "dyad") for d in sc.dyads]
     objects += [("link", g) for g in sc.links]
     return objects
 
@@ -411,6 +412,7 @@ def _build_fmu(table, tmp_path, name) -> Path:
         [ROOT / "src" / "dyad_common.c"]
         + [ROOT / "src" / f"dyad_{t}.c" for t in types]
         + kinematics
+        + [ROOT / "src" / "dyad_tangent.c"]  # the closed forms' tangents (the derivative)
         + [
             gen / f"{ident}_scene.c",
             ROOT / "fmu" / "fmu_instance.c",

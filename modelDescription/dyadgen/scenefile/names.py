@@ -92,10 +92,14 @@ class CNames:
     patterns: dict
 
     def derived(self, kind: str, name: str) -> list[tuple[str, str]]:
-        """(scope, C name) of every C name derived from `name`, a name of `kind`."""
+        """(scope, C name) of every C name derived from `name`, a name of `kind`; in each
+        scope the name itself first, so that a clash of the name as it is is the one told."""
         return sorted(
-            (scope, prefix + (name.upper() if upper else name) + suffix)
-            for scope, prefix, suffix, upper in self.patterns[kind]
+            (
+                (scope, prefix + (name.upper() if upper else name) + suffix)
+                for scope, prefix, suffix, upper in self.patterns[kind]
+            ),
+            key=lambda c: (c[0], c[1] != name, c[1]),
         )
 
 

@@ -138,6 +138,26 @@ def effective_inertia(
     return np.broadcast_to(J, q.shape).copy(), np.broadcast_to(dJ, q.shape).copy()
 
 
+def generalized_gravity(
+    mechanism: Driven, q: np.ndarray, branch: float | None = None
+) -> np.ndarray:
+    """Q_g (N m for a crank, N for a ram) at the driver coordinates ``q`` (N,): the
+    generalised force of the weights, sum m g . V_S with V_S every centre of mass's
+    velocity per unit driver rate (-dV/dq, V the potential energy)."""
+    q = np.atleast_1d(geo.inexact(q))
+    if isinstance(mechanism, chains.Chain):
+        kin = mechanism.positions(q)
+        gravity = mechanism.gravity if mechanism.effects["gravity"] else (0.0, 0.0)
+    else:
+        kin = mechanism.kinematics(q, _unit_motion(q, False), branch)
+        gravity = mechanism.gravity
+    g = np.asarray(gravity, dtype=float)
+    Q = 0.0
+    for mass, _inertia, v, _w, _a, _e in _bodies(mechanism, kin):
+        Q = Q + mass * geo.dot(v, g)
+    return np.broadcast_to(np.real(Q), q.shape).copy()
+
+
 def _loads_in(scene: Mapping, kin: dict, role: Mapping) -> dict:
     """The load inputs the scene lists, by FMU name; ``role`` maps a scene link to its
     key prefix in ``kin``."""
