@@ -611,7 +611,8 @@ fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size
 }
 
 /* The seed block from the knowns' rates: an angle's rate as the derivative of
- * its (cos, sin). FMU_ERROR where a known is not an input. */
+ * its (cos, sin). FMU_ERROR where a known is not an input or its seed is not
+ * finite; nothing is evaluated then. */
 static fmu_status seed_knowns(fmu_instance* instance, const unsigned int knowns[], size_t n_knowns,
                               const double seed[], const char* function)
 {
@@ -625,6 +626,11 @@ static fmu_status seed_knowns(fmu_instance* instance, const unsigned int knowns[
         }
         if (v->causality != FMU_INPUT) {
             fmu_log(instance, FMU_ERROR, "%s: known %s is not an input", function, v->name);
+            return FMU_ERROR;
+        }
+        if (!isfinite(seed[k])) {
+            fmu_log(instance, FMU_ERROR, "%s: the seed of known %s is not finite", function,
+                    v->name);
             return FMU_ERROR;
         }
         rate = (double*)(void*)((char*)instance->seed + v->offset);

@@ -917,6 +917,20 @@ static dyad_loaded_link loaded_link_of(const dyad_link* link, dyad_vec2 gravity)
     return out;
 }
 
+/* The dyad of an input with its links' loads reduced independently of the core. */
+static dyad_loaded loaded_of(const dyad_input* in)
+{
+    dyad_loaded loaded;
+    loaded.m = loaded_link_of(&in->m, in->gravity);
+    loaded.n = loaded_link_of(&in->n, in->gravity);
+    loaded.i_k = in->guide_k;
+    loaded.j_k = vec(-in->guide_k.y, in->guide_k.x);
+    loaded.i_p = in->guide_p;
+    loaded.j_p = vec(-in->guide_p.y, in->guide_p.x);
+    loaded.singular_threshold = in->singular_threshold;
+    return loaded;
+}
+
 static double result_distance(const dyad_result* a, const dyad_result* b)
 {
     const double d[] = {a->r_mk.x - b->r_mk.x, a->r_mk.y - b->r_mk.y, a->r_np.x - b->r_np.x,
@@ -947,14 +961,8 @@ static int test_react_loaded(void)
         int solved = 0, singular = 0;
         while (solved < 2000) {
             const dyad_input in = random_input(&r, type);
-            dyad_loaded loaded;
+            dyad_loaded loaded = loaded_of(&in);
             dyad_result want, got;
-            loaded.m = loaded_link_of(&in.m, in.gravity);
-            loaded.n = loaded_link_of(&in.n, in.gravity);
-            loaded.i_k = in.guide_k;
-            loaded.j_k = vec(-in.guide_k.y, in.guide_k.x);
-            loaded.i_p = in.guide_p;
-            loaded.j_p = vec(-in.guide_p.y, in.guide_p.x);
             loaded.singular_threshold = independent_conditioning(type, &in) < WELL_CONDITIONED
                                             ? (dyad_real)0.99
                                             : in.singular_threshold;
@@ -1137,13 +1145,7 @@ static int test_react_tangent_finite_differences(void)
             dyad_result plain, value, rate, moved[4];
             double v[4][REACT_OUTPUTS], d[REACT_OUTPUTS], scale = 0, level = 0;
             int ok = 1;
-            a.m = loaded_link_of(&in.m, in.gravity);
-            a.n = loaded_link_of(&in.n, in.gravity);
-            a.i_k = in.guide_k;
-            a.j_k = dyad_perp(in.guide_k);
-            a.i_p = in.guide_p;
-            a.j_p = dyad_perp(in.guide_p);
-            a.singular_threshold = in.singular_threshold;
+            a = loaded_of(&in);
             s = a;
             s.m = random_loaded_seed(&r, &a.m);
             s.n = random_loaded_seed(&r, &a.n);

@@ -173,3 +173,18 @@ def test_no_rate_where_the_chain_cannot_close():
     again = s.directional_derivative(tuple(outputs), ("ram.position",), [1.0])
     assert again == good and all(math.isfinite(r) for r in again)
     s.close()
+
+
+@pytest.mark.parametrize("name", ["slider_crank", "dyad_rrt"])
+def test_a_seed_that_is_not_finite_is_refused_and_changes_nothing(name):
+    """Error naming the known; the outputs read afterwards are those before the call."""
+    s = _slave(name)
+    inputs, outputs = _names(s)
+    before = s.get(tuple(outputs))
+    for bad in (math.nan, math.inf):
+        with pytest.raises(fmi_slave.SlaveError) as failure:
+            s.directional_derivative(tuple(outputs), (inputs[0],), [bad])
+        assert failure.value.status == 3
+        assert f"the seed of known {inputs[0]} is not finite" in failure.value.message
+        assert s.get(tuple(outputs)) == before
+    s.close()
