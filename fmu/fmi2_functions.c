@@ -60,7 +60,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL;
     }
     return fmu_instantiate(&fmu_this_model, instanceName, fmuGUID, logger, loggingOn,
-                           functions->allocateMemory, functions->freeMemory);
+                           functions->allocateMemory, functions->freeMemory, 0);
 }
 
 void fmi2FreeInstance(fmi2Component c)

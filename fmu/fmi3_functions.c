@@ -112,7 +112,7 @@ fmi3Instance fmi3InstantiateCoSimulation(
         return NULL;
     }
     return fmu_instantiate(&fmu_this_model, instanceName, instantiationToken, logger, loggingOn,
-                           NULL, NULL);
+                           NULL, NULL, 1);
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(
@@ -172,46 +172,15 @@ fmi3Status fmi3GetFloat32(fmi3Instance instance, const fmi3ValueReference valueR
                                             nValueReferences, "fmi3GetFloat32"));
 }
 
-/* FMI 3 declares the independent variable `time` at this value reference. */
-enum { TIME_VR = 0 };
-
+/* The time at value reference 0 is served by the FMU layer (fmu_instantiate). */
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                           size_t nValueReferences, fmi3Float64 values[], size_t nValues)
 {
     fmu_instance* fmu = (fmu_instance*)instance;
-    fmu_status worst = FMU_OK;
-    size_t k;
     if (!scalar_counts(fmu, nValueReferences, nValues, "fmi3GetFloat64")) {
         return fmi3Error;
     }
-    for (k = 0; valueReferences != NULL && k < nValueReferences; ++k) {
-        if (valueReferences[k] == TIME_VR) {
-            break;
-        }
-    }
-    if (valueReferences == NULL || values == NULL || k == nValueReferences) {
-        /* No time among them: one call, like FMI 2. */
-        return to_fmi3(
-            fmu_get_real(fmu, valueReferences, nValueReferences, values, "fmi3GetFloat64"));
-    }
-    for (k = 0; k < nValueReferences; ++k) {
-        fmu_status status;
-        if (valueReferences[k] == TIME_VR) {
-            status = fmu_check_call(fmu, FMU_OP_GET, "fmi3GetFloat64");
-            if (status == FMU_OK) {
-                values[k] = fmu->time;
-            }
-        } else {
-            status = fmu_get_real(fmu, &valueReferences[k], 1, &values[k], "fmi3GetFloat64");
-        }
-        if (status > worst) {
-            worst = status;
-        }
-        if (worst >= FMU_ERROR) {
-            break;
-        }
-    }
-    return to_fmi3(worst);
+    return to_fmi3(fmu_get_real(fmu, valueReferences, nValueReferences, values, "fmi3GetFloat64"));
 }
 
 fmi3Status fmi3GetInt8(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -337,17 +306,8 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
                           size_t nValueReferences, const fmi3Float64 values[], size_t nValues)
 {
     fmu_instance* fmu = (fmu_instance*)instance;
-    size_t k;
     if (!scalar_counts(fmu, nValueReferences, nValues, "fmi3SetFloat64")) {
         return fmi3Error;
-    }
-    for (k = 0; fmu != NULL && valueReferences != NULL && k < nValueReferences; ++k) {
-        if (valueReferences[k] == TIME_VR) {
-            fmu_log(fmu, FMU_ERROR,
-                    "fmi3SetFloat64: time (value reference 0) is the "
-                    "independent variable and cannot be set");
-            return fmi3Error;
-        }
     }
     return to_fmi3(fmu_set_real(fmu, valueReferences, nValueReferences, values, "fmi3SetFloat64"));
 }

@@ -1,6 +1,7 @@
 /* dyadfmu FMU layer: the version-neutral instance (see fmu_instance.h). */
 #include "fmu_instance.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -94,19 +95,48 @@ static void log_to(const fmu_logger* logger, fmu_status status, const char* form
     va_end(args);
 }
 
-/* Stores a value as set and where the solver reads it (an angle as its unit
- * vector), so that a solve needs no pass over the variables. */
-static void store(fmu_instance* instance, size_t index, double value)
+/* Where the value of a parameter or input is kept: in the input block if the
+ * model reads it as it is, else as set (an angle, whose unit vector the model
+ * reads). */
+static double* kept_value(fmu_instance* instance, size_t index)
 {
     const fmu_variable* v = &instance->model->variables[index];
-    double* member = (double*)(void*)((char*)instance->input + v->offset);
-    instance->values[index] = value;
-    if (v->target == FMU_TARGET_INPUT_ANGLE) {
-        member[0] = cos(value);
-        member[1] = sin(value);
-    } else if (v->target == FMU_TARGET_INPUT_REAL) {
-        member[0] = value;
+    if (v->target == FMU_TARGET_INPUT_REAL) {
+        return (double*)(void*)((char*)instance->input + v->offset);
     }
+    return &instance->values[index];
+}
+
+/* Stores a value as set and where the model reads it, so that a solve needs no
+ * pass over the variables. An angle's unit vector is brought up to date by
+ * sync_angles, once per change and only before the model reads it. */
+static void store(fmu_instance* instance, size_t index, double value)
+{
+    *kept_value(instance, index) = value;
+    if (instance->model->variables[index].target == FMU_TARGET_INPUT_ANGLE) {
+        instance->angles_pending = 1;
+    }
+}
+
+/* The (cos, sin) of every angle that changed since the model last read them. */
+static void sync_angles(fmu_instance* instance)
+{
+    size_t k;
+    if (!instance->angles_pending) {
+        return;
+    }
+    for (k = 0; k < instance->angle_count; ++k) {
+        const int index = instance->angles[k];
+        const double angle = instance->values[index];
+        if (angle != instance->converted[index]) {
+            const fmu_variable* v = &instance->model->variables[index];
+            double* member = (double*)(void*)((char*)instance->input + v->offset);
+            member[0] = cos(angle);
+            member[1] = sin(angle);
+            instance->converted[index] = angle;
+        }
+    }
+    instance->angles_pending = 0;
 }
 
 /* Sizes rounded up so that every block is aligned for any scalar. */
@@ -116,30 +146,136 @@ static size_t round_up(size_t size)
     return (size + unit - 1) / unit * unit;
 }
 
+static void build_slots(fmu_instance* instance);
+
 static void load_start_values(fmu_instance* instance)
 {
     size_t k;
     instance->model->behaviour->initialise(instance->model, instance->input);
     for (k = 0; k < instance->model->variable_count; ++k) {
+        instance->converted[k] = NAN; /* initialise overwrote every unit vector */
         store(instance, k, instance->model->variables[k].start);
     }
+    sync_angles(instance);
     if (instance->model->behaviour->start != NULL) {
         instance->model->behaviour->start(instance->model, instance->input);
     }
     instance->state = FMU_STATE_INSTANTIATED;
+    build_slots(instance);
     instance->time = 0;
     instance->last_successful_time = 0;
     instance->terminate_requested = 0;
     instance->dirty = 1;
 }
 
+/* The interval a set value must lie in: its bounds, within the finite doubles. */
+static void accepted_range(const fmu_variable* v, fmu_slot* slot)
+{
+    slot->low = -DBL_MAX;
+    slot->high = DBL_MAX;
+    if (v->bounds & FMU_HAS_MIN) {
+        const double min = (v->bounds & FMU_MIN_EXCLUSIVE) ? nextafter(v->min, INFINITY) : v->min;
+        slot->low = min > slot->low ? min : slot->low;
+    }
+    if (v->bounds & FMU_HAS_MAX) {
+        const double max = (v->bounds & FMU_MAX_EXCLUSIVE) ? nextafter(v->max, -INFINITY) : v->max;
+        slot->high = max < slot->high ? max : slot->high;
+    }
+}
+
+static void build_slot(fmu_instance* instance, unsigned int vr, fmu_slot* slot)
+{
+    const fmu_model* model = instance->model;
+    const int index = model->index_of_vr[vr];
+    const fmu_variable* v = index >= 0 ? &model->variables[index] : NULL;
+    slot->low = 1; /* empty: no set is accepted at once */
+    slot->high = 0;
+    slot->write = NULL;
+    slot->read = NULL;
+    slot->is_output = 0;
+    if (v == NULL) {
+        slot->read = vr == 0 && instance->time_at_vr_0 ? &instance->time : NULL;
+    } else if (v->causality == FMU_OUTPUT) {
+        slot->is_output = 1;
+        if (v->target == FMU_TARGET_RESULT_REAL) {
+            slot->read = (const double*)(const void*)((const char*)instance->output + v->offset);
+        }
+    } else if (v->type == FMU_REAL) {
+        slot->write = kept_value(instance, (size_t)index);
+        slot->read = slot->write;
+        if (v->causality == FMU_INPUT || ((unsigned)instance->state & PARAMETER_STATES)) {
+            accepted_range(v, slot);
+        }
+    }
+}
+
+/* The slots for the current state: a parameter is settable only before
+ * initialization ends. */
+static void build_slots(fmu_instance* instance)
+{
+    const fmu_model* model = instance->model;
+    unsigned int vr;
+    for (vr = 0; vr < model->vr_limit; ++vr) {
+        build_slot(instance, vr, &instance->slots[vr]);
+    }
+}
+
+static void find_angles(fmu_instance* instance)
+{
+    const fmu_model* model = instance->model;
+    size_t k;
+    instance->angle_count = 0;
+    for (k = 0; k < model->variable_count; ++k) {
+        if (model->variables[k].target == FMU_TARGET_INPUT_ANGLE) {
+            instance->angles[instance->angle_count++] = (int)k;
+        }
+    }
+}
+
+/* The instance and everything it owns in one block: its parts, aligned. */
+typedef struct instance_layout {
+    size_t values, slots, angles, converted, input, output, name, total;
+} instance_layout;
+
+static instance_layout layout_of(const fmu_model* model, const char* instance_name)
+{
+    instance_layout at;
+    const size_t variables = model->variable_count;
+    at.values = round_up(sizeof(fmu_instance));
+    at.slots = at.values + round_up(variables * sizeof(double));
+    at.angles = at.slots + round_up(model->vr_limit * sizeof(fmu_slot));
+    at.converted = at.angles + round_up(variables * sizeof(int));
+    at.input = at.converted + round_up(variables * sizeof(double));
+    at.output = at.input + 2 * round_up(model->behaviour->input_size);
+    at.name = at.output + 3 * round_up(model->behaviour->output_size);
+    at.total = at.name + strlen(instance_name) + 1;
+    return at;
+}
+
+static void place_parts(fmu_instance* instance, const instance_layout* at, const char* name)
+{
+    char* base = (char*)instance;
+    const size_t input_size = round_up(instance->model->behaviour->input_size);
+    const size_t output_size = round_up(instance->model->behaviour->output_size);
+    instance->values = (double*)(void*)(base + at->values);
+    instance->slots = (fmu_slot*)(void*)(base + at->slots);
+    instance->angles = (int*)(void*)(base + at->angles);
+    instance->converted = (double*)(void*)(base + at->converted);
+    instance->input = base + at->input;
+    instance->seed = base + at->input + input_size;
+    instance->output = base + at->output;
+    instance->value = base + at->output + output_size;
+    instance->rate = base + at->output + 2 * output_size;
+    memcpy(base + at->name, name, at->total - at->name);
+    instance->logger.instance_name = base + at->name;
+}
+
 fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name, const char* token,
                               fmu_logger logger, int logging_on, fmu_allocate allocate,
-                              fmu_release release)
+                              fmu_release release, int time_at_vr_0)
 {
     fmu_instance* instance;
-    size_t values_size, name_size, input_size, output_size;
-    char *block, *name;
+    instance_layout at;
 
     logger.instance_name = instance_name != NULL ? instance_name : "";
     if (instance_name == NULL || instance_name[0] == '\0') {
@@ -157,33 +293,19 @@ fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
         allocate = calloc;
         release = free;
     }
-    values_size = model->variable_count * sizeof(double);
-    name_size = strlen(instance_name) + 1;
-    input_size = round_up(model->behaviour->input_size);
-    output_size = round_up(model->behaviour->output_size);
-    instance = (fmu_instance*)allocate(1, round_up(sizeof(fmu_instance)) + values_size +
-                                              2 * input_size + 3 * output_size + name_size);
+    at = layout_of(model, instance_name);
+    instance = (fmu_instance*)allocate(1, at.total);
     if (instance == NULL) {
         log_to(&logger, FMU_ERROR, "instantiate: out of memory");
         return NULL;
     }
-    block = (char*)instance + round_up(sizeof(fmu_instance));
-    instance->values = (double*)(void*)block;
-    block += values_size;
-    instance->input = block;
-    instance->seed = block + input_size;
-    block += 2 * input_size;
-    instance->output = block;
-    instance->value = block + output_size;
-    instance->rate = block + 2 * output_size;
-    name = block + 3 * output_size;
-    memcpy(name, instance_name, name_size);
-
     instance->model = model;
     instance->logger = logger;
-    instance->logger.instance_name = name;
+    place_parts(instance, &at, instance_name);
     instance->release = release;
     instance->log_categories = logging_on ? ~0u : 0u;
+    instance->time_at_vr_0 = time_at_vr_0;
+    find_angles(instance);
     load_start_values(instance);
     fmu_log(instance, FMU_OK, "instantiated %s", model->identifier);
     return instance;
@@ -206,7 +328,9 @@ fmu_status fmu_check_call(fmu_instance* instance, fmu_operation operation, const
                 state_name(instance->state));
         return FMU_ERROR;
     }
-    fmu_log(instance, FMU_OK, "%s", function);
+    if (instance->log_categories & (1u << LOG_CALLS)) {
+        fmu_log(instance, FMU_OK, "%s", function);
+    }
     return FMU_OK;
 }
 
@@ -262,8 +386,8 @@ static void log_failure(fmu_instance* instance, fmu_status not_solvable, const c
     const fmu_evaluation* e = &instance->evaluation;
     if (e->status == FMU_ERROR && e->bad_variable >= 0) {
         fmu_log(instance, FMU_ERROR, "%s: %s = %g: %s", function,
-                instance->model->variables[e->bad_variable].name, instance->values[e->bad_variable],
-                e->reason);
+                instance->model->variables[e->bad_variable].name,
+                *kept_value(instance, (size_t)e->bad_variable), e->reason);
     } else if (e->status != FMU_OK) {
         fmu_log(instance, e->status == FMU_ERROR ? FMU_ERROR : not_solvable, "%s: at t = %g s: %s",
                 function, instance->time, e->reason);
@@ -281,6 +405,7 @@ static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const c
 {
     fmu_evaluation* e = &instance->evaluation;
     if (instance->dirty) {
+        sync_angles(instance);
         instance->model->behaviour->evaluate(instance->model, instance->input, instance->output, e);
         instance->dirty = 0;
         log_failure(instance, not_solvable, function);
@@ -317,6 +442,7 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
     status = solve(instance, FMU_WARNING, "exitInitializationMode", 1);
     if (status != FMU_ERROR) {
         instance->state = FMU_STATE_STEP;
+        build_slots(instance); /* the parameters close */
     }
     return status;
 }
@@ -511,42 +637,92 @@ static void store_at(void* values, fmu_value_type type, size_t k, double value)
     }
 }
 
-static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], size_t count,
-                             const void* values, fmu_value_type type, const char* function)
+/* The slot of a value reference, NULL beyond the table. */
+static const fmu_slot* slot_of(const fmu_instance* instance, unsigned int vr)
+{
+    return vr < instance->model->vr_limit ? &instance->slots[vr] : NULL;
+}
+
+/* Finds and logs why a set is refused, by the checks that name the variable;
+ * FMU_OK if none refuses it. */
+static fmu_status explain_refusal(const fmu_instance* instance, const unsigned int vr[],
+                                  size_t count, const void* values, fmu_value_type type,
+                                  const char* function)
 {
     size_t k;
-    fmu_status status = fmu_check_call(instance, FMU_OP_SET, function);
-    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
-        return FMU_ERROR;
-    }
-    /* All values are checked before any is stored: a rejected call changes nothing. */
     for (k = 0; k < count; ++k) {
-        const fmu_variable* v = lookup(instance, vr[k], type, function);
+        const fmu_variable* v;
+        if (vr[k] == 0 && instance->time_at_vr_0) {
+            fmu_log(instance, FMU_ERROR,
+                    "%s: time (value reference 0) is the independent variable and cannot be set",
+                    function);
+            return FMU_ERROR;
+        }
+        v = lookup(instance, vr[k], type, function);
         if (v == NULL ||
             check_settable(instance, v, value_at(values, type, k), function) != FMU_OK) {
             return FMU_ERROR;
         }
     }
+    return FMU_OK;
+}
+
+/* Until initialization ends, the states follow their start parameters. */
+static void after_set(fmu_instance* instance)
+{
+    instance->dirty = 1;
+    if (instance->model->behaviour->start != NULL &&
+        ((unsigned)instance->state & PARAMETER_STATES)) {
+        sync_angles(instance);
+        instance->model->behaviour->start(instance->model, instance->input);
+    }
+}
+
+/* Every value is checked before any is stored: a rejected call changes nothing.
+ * The caller checked that a set is legal now. */
+static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], size_t count,
+                             const void* values, fmu_value_type type, const char* function)
+{
+    size_t k;
+    if (check_arrays(instance, vr, count, values, function) != FMU_OK ||
+        explain_refusal(instance, vr, count, values, type, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
     for (k = 0; k < count; ++k) {
         store(instance, (size_t)instance->model->index_of_vr[vr[k]], value_at(values, type, k));
     }
     if (count > 0) {
-        instance->dirty = 1;
-        /* Until initialization ends, the states follow their start parameters. */
-        if (instance->model->behaviour->start != NULL &&
-            ((unsigned)instance->state & PARAMETER_STATES)) {
-            instance->model->behaviour->start(instance->model, instance->input);
-        }
+        after_set(instance);
     }
     return FMU_OK;
 }
 
+/* The common case of set_values, by the slots alone: every value valid. */
+static int set_reals_at_once(fmu_instance* instance, const unsigned int vr[], size_t count,
+                             const double values[])
+{
+    const unsigned int limit = instance->model->vr_limit;
+    const fmu_slot* slots = instance->slots;
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        const double value = values[k];
+        if (vr[k] >= limit || !(value >= slots[vr[k]].low && value <= slots[vr[k]].high)) {
+            return 0;
+        }
+    }
+    for (k = 0; k < count; ++k) {
+        *slots[vr[k]].write = values[k];
+    }
+    instance->angles_pending |= instance->angle_count > 0;
+    return 1;
+}
+
 /* The value of a variable as a double; an output as of the last evaluation. */
-static double read_variable(const fmu_instance* instance, const fmu_variable* v)
+static double read_variable(fmu_instance* instance, const fmu_variable* v)
 {
     const char* member = (const char*)instance->output + v->offset;
     if (v->causality != FMU_OUTPUT) {
-        return instance->values[v - instance->model->variables];
+        return *kept_value(instance, (size_t)(v - instance->model->variables));
     }
     if (v->target == FMU_TARGET_RESULT_STATUS) {
         return (double)*(const int*)(const void*)member;
@@ -554,7 +730,8 @@ static double read_variable(const fmu_instance* instance, const fmu_variable* v)
     return *(const double*)(const void*)member;
 }
 
-/* Reads the values, solving once before the first output. Returns FMU_ERROR
+/* Reads the values, solving once before the first output (the caller checked
+ * that a get is legal now). Returns FMU_ERROR
  * for a value reference that is not of `type`; otherwise, if `solve_counts`,
  * the status of that solve (a failed one as FMU_WARNING), else FMU_OK. */
 static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], size_t count,
@@ -564,12 +741,17 @@ static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], si
     fmu_status worst = FMU_OK;
     int solved = 0;
     size_t k;
-    fmu_status status = fmu_check_call(instance, FMU_OP_GET, function);
-    if (status != FMU_OK || check_arrays(instance, vr, count, values, function) != FMU_OK) {
+    if (check_arrays(instance, vr, count, values, function) != FMU_OK) {
         return FMU_ERROR;
     }
     for (k = 0; k < count; ++k) {
-        const fmu_variable* v = lookup(instance, vr[k], type, function);
+        const fmu_slot* slot = slot_of(instance, vr[k]);
+        const fmu_variable* v;
+        if (type == FMU_REAL && slot != NULL && slot->read == &instance->time) {
+            store_at(values, type, k, instance->time);
+            continue;
+        }
+        v = lookup(instance, vr[k], type, function);
         if (v == NULL) {
             return FMU_ERROR;
         }
@@ -583,27 +765,71 @@ static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], si
     return worst;
 }
 
+/* The common case of get_values for Reals, by the slots alone: every value
+ * reference a Real; -1 where one is not (get_values says why). */
+static int get_reals_at_once(fmu_instance* instance, const unsigned int vr[], size_t count,
+                             double values[], fmu_status* solved, const char* function)
+{
+    const unsigned int limit = instance->model->vr_limit;
+    const fmu_slot* slots = instance->slots;
+    int have_solved = 0;
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        if (vr[k] >= limit || slots[vr[k]].read == NULL) {
+            return 0;
+        }
+        if (slots[vr[k]].is_output && !have_solved) {
+            *solved = solve(instance, FMU_WARNING, function, 1);
+            have_solved = 1;
+        }
+        values[k] = *slots[vr[k]].read;
+    }
+    return 1;
+}
+
 fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         const double values[], const char* function)
 {
+    if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    if (count > 0 && vr != NULL && values != NULL &&
+        set_reals_at_once(instance, vr, count, values)) {
+        after_set(instance);
+        return FMU_OK;
+    }
     return set_values(instance, vr, count, values, FMU_REAL, function);
 }
 
 fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
                            const int values[], const char* function)
 {
+    if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
     return set_values(instance, vr, count, values, FMU_INTEGER, function);
 }
 
 fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         double values[], const char* function)
 {
+    fmu_status solved = FMU_OK;
+    if (fmu_check_call(instance, FMU_OP_GET, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    if (vr != NULL && values != NULL &&
+        get_reals_at_once(instance, vr, count, values, &solved, function)) {
+        return solved;
+    }
     return get_values(instance, vr, count, values, FMU_REAL, 1, function);
 }
 
 fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
                            int values[], const char* function)
 {
+    if (fmu_check_call(instance, FMU_OP_GET, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
     /* The status output is how the model reports a singular configuration or
      * a rejected input (logged when it was evaluated): reading it succeeds
      * whatever it says. */
@@ -682,6 +908,7 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
     if (behaviour->derivative == NULL) {
         return fmu_unsupported(instance, function, "this model has no directional derivatives");
     }
+    sync_angles(instance);
     if (seed_knowns(instance, knowns, n_knowns, seed, function) != FMU_OK ||
         check_unknowns(instance, unknowns, n_unknowns, function) != FMU_OK) {
         return FMU_ERROR;

@@ -51,6 +51,20 @@ typedef struct fmu_logger {
     const char* instance_name;
 } fmu_logger;
 
+/* What a value reference addresses, resolved when the instance is made (and when
+ * its parameters close), so that a get or set of a Real finds the value's place
+ * with one index and accepts a valid value with two comparisons. Whatever that
+ * does not accept goes to the checks that name the problem. */
+typedef struct fmu_slot {
+    /* A Real set within [low, high] is valid now: inside the variable's bounds
+     * and finite, and the variable may be set in this state. Empty (low > high)
+     * for an output, a closed parameter, an Integer and no variable at all. */
+    double low, high;
+    double* write;      /* where a Real set stores the value */
+    const double* read; /* where a Real get reads it; NULL: not a Real */
+    int is_output;      /* the value is the model's: evaluate before reading */
+} fmu_slot;
+
 typedef void* (*fmu_allocate)(size_t count, size_t size);
 typedef void (*fmu_release)(void* memory);
 
@@ -66,6 +80,12 @@ typedef struct fmu_instance {
     int dirty;                 /* inputs changed since the last evaluation */
     fmu_evaluation evaluation; /* of the last evaluation */
     double* values;            /* one per variable, as set; outputs unused */
+    fmu_slot* slots;           /* one per value reference below model->vr_limit */
+    int* angles;               /* indices of the angle variables, angle_count of them */
+    size_t angle_count;
+    double* converted;  /* per variable: the angle whose (cos, sin) the input holds */
+    int angles_pending; /* an angle may have changed since the input's (cos, sin) */
+    int time_at_vr_0;   /* value reference 0 reads the time (FMI 3) */
     /* The model's blocks (see fmu_behaviour), in the instance's own memory:
      * input kept up to date by every set, output of the last evaluation, and
      * scratch for directional derivatives. */
@@ -80,10 +100,11 @@ typedef struct fmu_instance {
 extern const char* const fmu_log_category_names[];
 extern const size_t fmu_log_category_count;
 
-/* Creates an instance with start values, or logs why not and returns NULL. */
+/* Creates an instance with start values, or logs why not and returns NULL.
+ * `time_at_vr_0`: value reference 0 reads the time (FMI 3). */
 fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name, const char* token,
                               fmu_logger logger, int logging_on, fmu_allocate allocate,
-                              fmu_release release);
+                              fmu_release release, int time_at_vr_0);
 void fmu_free(fmu_instance* instance);
 
 /* Error, with a logged reason, unless `operation` is legal in the current state. */

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "dyadfmu/batch.h"
 #include "dyadfmu/dyad.h"
 #include "dyadfmu/kinematics.h"
 #include "dyadfmu/loaded.h"
@@ -2297,6 +2298,147 @@ static int test_kin_names(void)
     return fails;
 }
 
+/* ---- the batch call ------------------------------------------------------------------------- */
+
+enum { BATCH_ROWS = 203 }; /* not a multiple of the block: the last block is short */
+
+/* The scalars of an input row, in the order of dyad_input_column (a dyad_input
+ * is those scalars, without padding). */
+typedef char input_is_its_columns[sizeof(dyad_input) == DYAD_INPUT_COLUMN_COUNT * sizeof(dyad_real)
+                                      ? 1
+                                      : -1];
+
+static dyad_real input_scalar(const dyad_input* in, int column)
+{
+    dyad_real scalars[DYAD_INPUT_COLUMN_COUNT];
+    memcpy(scalars, in, sizeof scalars);
+    return scalars[column];
+}
+
+static int same_real(dyad_real a, dyad_real b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+/* Every output of every row of a batch against dyad_solve on the row, bit for bit. */
+static int batch_rows_match(dyad_type type, const dyad_input rows[], const dyad_real out[],
+                            const unsigned char status[], const unsigned char field[], size_t ok)
+{
+    int fails = 0;
+    size_t r, solved = 0;
+    int c;
+    for (r = 0; r < BATCH_ROWS; ++r) {
+        dyad_result want;
+        solved += dyad_solve(type, &rows[r], &want) == DYAD_STATUS_OK;
+        CHECK(status[r] == (unsigned char)want.status && field[r] == (unsigned char)want.field,
+              "%s row %zu: status %d field %d, solve %d %d", dyad_type_name(type), r, status[r],
+              field[r], want.status, want.field);
+        for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+            dyad_real w[DYAD_OUTPUT_COLUMN_COUNT];
+            memcpy(w, &want.r_mk, sizeof w); /* the outputs after status and field */
+            CHECK(same_real(out[c * BATCH_ROWS + r], w[c]), "%s row %zu column %d: %g, solve %g",
+                  dyad_type_name(type), r, c, (double)out[c * BATCH_ROWS + r], (double)w[c]);
+        }
+    }
+    CHECK(ok == solved, "%s: %zu rows ok, solve %zu", dyad_type_name(type), ok, solved);
+    return fails;
+}
+
+/* Random rows, some invalid or singular; columns varying by row (contiguous and
+ * strided), given once (stride 0) and left out (the default). */
+static int test_batch_matches_solve(void)
+{
+    static dyad_input rows[BATCH_ROWS];
+    static dyad_real columns[DYAD_INPUT_COLUMN_COUNT][2 * BATCH_ROWS];
+    static dyad_real out[DYAD_OUTPUT_COLUMN_COUNT * BATCH_ROWS];
+    static unsigned char status[BATCH_ROWS], field[BATCH_ROWS];
+    int fails = 0, t, c;
+    size_t r;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = (dyad_type)t;
+        rng g = {0xBA7C0000u + (uint64_t)t};
+        dyad_batch_input in;
+        dyad_batch_output res;
+        const dyad_real once = (dyad_real)-9.81;
+        for (r = 0; r < BATCH_ROWS; ++r) {
+            rows[r] = random_input(&g, type);
+            rows[r].gravity.x = 0;    /* the left-out column: its default */
+            rows[r].gravity.y = once; /* the column given once */
+            if (r % 17 == 3) {
+                rows[r].m.mass = (dyad_real)NAN;
+            } else if (r % 19 == 5) {
+                rows[r].n.length = -1;
+            } else if (r % 23 == 7) {
+                rows[r].n.dir = rows[r].m.dir; /* aligned links or guides: often singular */
+                rows[r].guide_k = rows[r].m.dir;
+                rows[r].guide_p = rows[r].m.dir;
+            }
+        }
+        for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
+            /* odd columns strided: every other element of a twice longer array */
+            const ptrdiff_t stride = c % 2 ? 2 : 1;
+            for (r = 0; r < BATCH_ROWS; ++r) {
+                columns[c][(ptrdiff_t)r * stride] = input_scalar(&rows[r], c);
+            }
+            in.column[c].data = columns[c];
+            in.column[c].stride = stride;
+        }
+        in.column[DYAD_IN_GRAVITY_X].data = NULL;
+        in.column[DYAD_IN_GRAVITY_Y].data = &once;
+        in.column[DYAD_IN_GRAVITY_Y].stride = 0;
+        for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+            res.column[c].data = &out[c * BATCH_ROWS];
+            res.column[c].stride = 1;
+        }
+        res.status = status;
+        res.field = field;
+        fails += batch_rows_match(type, rows, out, status, field,
+                                  dyad_solve_batch(type, BATCH_ROWS, &in, &res));
+    }
+    return fails;
+}
+
+/* An unknown type or no input: every row invalid and named so, outputs NaN. */
+static int test_batch_refusals(void)
+{
+    int fails = 0;
+    dyad_batch_input in;
+    dyad_batch_output res;
+    dyad_real out[DYAD_OUTPUT_COLUMN_COUNT][11];
+    unsigned char status[11], field[11];
+    size_t r;
+    int c;
+    memset(&in, 0, sizeof in);
+    for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+        res.column[c].data = out[c];
+        res.column[c].stride = 1;
+    }
+    res.status = status;
+    res.field = field;
+    CHECK(dyad_solve_batch(DYAD_TYPE_COUNT, 11, &in, &res) == 0, "unknown type solved");
+    for (r = 0; r < 11; ++r) {
+        CHECK(status[r] == DYAD_STATUS_INVALID_INPUT && field[r] == DYAD_FIELD_TYPE &&
+                  isnan(out[0][r]) && isnan(out[DYAD_OUT_AMPLIFICATION][r]),
+              "row %zu of an unknown type: status %d field %d", r, status[r], field[r]);
+    }
+    CHECK(dyad_solve_batch(DYAD_RRR, 11, NULL, &res) == 0, "no input solved");
+    for (r = 0; r < 11; ++r) {
+        CHECK(status[r] == DYAD_STATUS_INVALID_INPUT && field[r] == DYAD_FIELD_INPUT,
+              "row %zu without input: status %d field %d", r, status[r], field[r]);
+    }
+    CHECK(dyad_solve_batch(DYAD_RRR, 11, &in, NULL) == 0, "no output");
+    {
+        /* every column left out: each row is dyad_input_default() (RRT: solvable) */
+        const dyad_input defaults = dyad_input_default();
+        dyad_result want;
+        dyad_solve(DYAD_RRT, &defaults, &want);
+        CHECK(want.status == DYAD_STATUS_OK && dyad_solve_batch(DYAD_RRT, 11, &in, &res) == 11 &&
+                  status[10] == DYAD_STATUS_OK && same_real(out[DYAD_OUT_R_MK_Y][10], want.r_mk.y),
+              "rows of defaults");
+    }
+    return fails;
+}
+
 static const named_test tests[] = {
     {"equilibrium_random", test_equilibrium_random},
     {"rrr_symmetric_truss", test_rrr_symmetric_truss},
@@ -2312,6 +2454,8 @@ static const named_test tests[] = {
     {"singular", test_singular},
     {"invalid_before_singular", test_invalid_before_singular},
     {"react_loaded", test_react_loaded},
+    {"batch_matches_solve", test_batch_matches_solve},
+    {"batch_refusals", test_batch_refusals},
     {"tangent_of_each_type", test_tangent_of_each_type},
     {"react_tangent_finite_differences", test_react_tangent_finite_differences},
     {"kin_reproduces_built", test_kin_reproduces_built},

@@ -96,6 +96,42 @@ class _Result(ctypes.Structure):
     ]
 
 
+#: The columns of dyad_solve_batch (dyadfmu/batch.h): dyad_input's scalars and
+#: dyad_result's after status and field, in their C order.
+INPUT_COLUMN_COUNT = 35
+OUTPUT_COLUMN_COUNT = 15
+
+
+class InputArray(ctypes.Structure):
+    """dyad_input_array: row r reads data[r * stride]; stride 0 repeats data[0]; NULL data
+    keeps the default."""
+
+    _fields_ = [("data", ctypes.c_void_p), ("stride", ctypes.c_ssize_t)]
+
+
+class OutputArray(ctypes.Structure):
+    """dyad_output_array: row r writes data[r * stride]; NULL data: not written."""
+
+    _fields_ = [("data", ctypes.c_void_p), ("stride", ctypes.c_ssize_t)]
+
+
+class BatchInput(ctypes.Structure):
+    """dyad_batch_input: one InputArray per input column."""
+
+    _fields_ = [("column", InputArray * INPUT_COLUMN_COUNT)]
+
+
+class BatchOutput(ctypes.Structure):
+    """dyad_batch_output: one OutputArray per output column, and per-row status and field
+    (unsigned char arrays)."""
+
+    _fields_ = [
+        ("column", OutputArray * OUTPUT_COLUMN_COUNT),
+        ("status", ctypes.c_void_p),
+        ("field", ctypes.c_void_p),
+    ]
+
+
 class _PointMotion(ctypes.Structure):
     _fields_ = [("position", _Vec2), ("velocity", _Vec2), ("acceleration", _Vec2)]
 
@@ -234,6 +270,13 @@ class Core:
         self._lib.dyad_solve_tangent.restype = ctypes.c_int
         self._lib.dyad_field_name.argtypes = [ctypes.c_int]
         self._lib.dyad_field_name.restype = ctypes.c_char_p
+        self._lib.dyad_solve_batch.argtypes = [
+            ctypes.c_int,
+            ctypes.c_size_t,
+            ctypes.POINTER(BatchInput),
+            ctypes.POINTER(BatchOutput),
+        ]
+        self._lib.dyad_solve_batch.restype = ctypes.c_size_t
         self._bind_kinematics()
 
     def _bind_kinematics(self) -> None:
@@ -315,6 +358,22 @@ class Core:
         res = _Result()
         self._lib.dyad_solve(TYPES.index(dyad_type), ctypes.byref(inp), ctypes.byref(res))
         return self._output(res)
+
+    def solve_batch(
+        self, dyad_type: str, count: int, columns: BatchInput, results: BatchOutput
+    ) -> int:
+        """dyad_solve_batch on columns the caller holds alive: `count` rows solved in one
+        call; returns how many have status ok. ``dyadfmu.solve`` builds the columns from
+        NumPy arrays."""
+        if dyad_type not in TYPES:
+            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        return self._lib.dyad_solve_batch(
+            TYPES.index(dyad_type), count, ctypes.byref(columns), ctypes.byref(results)
+        )
+
+    def field_name(self, field: int) -> str:
+        """The dotted name of a dyad_field ("link_m.mass", ...); "" for none."""
+        return self._lib.dyad_field_name(int(field)).decode()
 
     def solve_tangent(
         self, dyad_type: str, inputs: tuple, seeds: tuple, singular_threshold: float | None = None

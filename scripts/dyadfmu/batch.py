@@ -1,0 +1,188 @@
+"""The C core over NumPy arrays: ``dyadfmu.solve(type, **arrays)`` solves every
+configuration of a batch in one call of ``dyad_solve_batch`` (no per-row Python).
+
+Keywords name the fields of ``dyad_input`` (units as there): per link ``m_`` or ``n_``
+followed by ``dir``, ``length``, ``omega``, ``epsilon``, ``accel_d``, ``com``, ``mass``,
+``inertia``, ``force``, ``moment``; then ``guide_k``, ``guide_p``, ``gravity`` and
+``singular_threshold``. A vector field takes an array whose last axis has length 2, a scalar
+field any array; all broadcast together (NumPy's rules, a vector's last axis aside) to the
+batch's shape. A field left out has ``dyad_input_default()``'s value. Every row is solved
+exactly as ``dyad_solve`` solves it, bit for bit, and has its own status.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .core import (
+    INPUT_COLUMN_COUNT,
+    LINK_KEYS,
+    OUTPUT_COLUMN_COUNT,
+    STATUS,
+    TYPES,
+    BatchInput,
+    BatchOutput,
+    Core,
+)
+
+#: Fields of a link that are vectors (x, y); the others are scalars.
+_LINK_VECTORS = ("dir", "accel_d", "com", "force")
+#: Keywords in the order of dyad_input, each with its number of columns.
+FIELDS: tuple[tuple[str, int], ...] = (
+    *((f"m_{key}", 2 if key in _LINK_VECTORS else 1) for key in LINK_KEYS),
+    *((f"n_{key}", 2 if key in _LINK_VECTORS else 1) for key in LINK_KEYS),
+    ("guide_k", 2),
+    ("guide_p", 2),
+    ("gravity", 2),
+    ("singular_threshold", 1),
+)
+#: Outputs in the order of dyad_result, each with its number of columns.
+OUTPUTS: tuple[tuple[str, int], ...] = (
+    ("r_mk", 2),
+    ("r_np", 2),
+    ("r_mn", 2),
+    ("n_mk", 1),
+    ("n_np", 1),
+    ("n_mn", 1),
+    ("m_mk", 1),
+    ("m_np", 1),
+    ("m_mn", 1),
+    ("denominator", 1),
+    ("conditioning", 1),
+    ("amplification", 1),
+)
+assert sum(width for _, width in FIELDS) == INPUT_COLUMN_COUNT
+assert sum(width for _, width in OUTPUTS) == OUTPUT_COLUMN_COUNT
+
+
+@dataclass(frozen=True)
+class Reactions:
+    """The outputs of a batch, each an array of the batch's shape (vectors with a last
+    axis of 2): forces in N, moments in N m, the rest dimensionless; ``status`` per row
+    (0 ok, 1 singular, 2 invalid input, 3 out of range) and ``field``, the dyad_field an
+    invalid row names (0 otherwise). A row that is not ok has NaN reactions."""
+
+    r_mk: np.ndarray
+    r_np: np.ndarray
+    r_mn: np.ndarray
+    n_mk: np.ndarray
+    n_np: np.ndarray
+    n_mn: np.ndarray
+    m_mk: np.ndarray
+    m_np: np.ndarray
+    m_mn: np.ndarray
+    denominator: np.ndarray
+    conditioning: np.ndarray
+    amplification: np.ndarray
+    status: np.ndarray
+    field: np.ndarray
+
+    @property
+    def ok(self) -> np.ndarray:
+        """True where the row was solved."""
+        return self.status == 0
+
+    def reason(self, index: int | tuple) -> str:
+        """Why one row is not ok, in words ("invalid input: link_m.mass"); "ok" if it is."""
+        status = STATUS.get(int(self.status[index]), "?")
+        field = default_core().field_name(int(self.field[index]))
+        return f"{status}: {field}" if field else status
+
+
+@functools.lru_cache(maxsize=1)
+def default_core() -> Core:
+    """The core library ``dyadfmu.solve`` calls, loaded once."""
+    return Core()
+
+
+def _as_field(name: str, width: int, value: object) -> np.ndarray:
+    array = np.asarray(value, dtype=np.float64)
+    if width == 2 and (array.ndim == 0 or array.shape[-1] != 2):
+        raise ValueError(f"{name} is a vector: its last axis must have length 2, not {array.shape}")
+    return array
+
+
+def _checked_fields(arrays: dict) -> dict[str, np.ndarray]:
+    widths = dict(FIELDS)
+    unknown = sorted(set(arrays) - set(widths))
+    if unknown:
+        raise TypeError(
+            f"unknown field {', '.join(map(repr, unknown))}; expected some of {', '.join(widths)}"
+        )
+    return {name: _as_field(name, widths[name], value) for name, value in arrays.items()}
+
+
+def _batch_shape(fields: dict[str, np.ndarray]) -> tuple[int, ...]:
+    shapes = {
+        name: a.shape[:-1] if dict(FIELDS)[name] == 2 else a.shape for name, a in fields.items()
+    }
+    try:
+        return tuple(np.broadcast_shapes(*shapes.values())) if shapes else ()
+    except ValueError:
+        listed = ", ".join(f"{name} {shape}" for name, shape in shapes.items())
+        raise ValueError(f"the fields do not broadcast to one batch shape: {listed}") from None
+
+
+def _column_source(array: np.ndarray, width: int, shape: tuple) -> tuple[np.ndarray, int]:
+    """An array to read a field's columns from, and its stride in elements along rows:
+    the caller's own where it is contiguous and of the batch's shape, one value given once
+    (stride 0), else a broadcast copy."""
+    rows_shape = array.shape[:-1] if width == 2 else array.shape
+    if math.prod(rows_shape) == 1:
+        return np.ascontiguousarray(array.reshape(width)), 0
+    if rows_shape != shape or not array.flags.c_contiguous:
+        full = shape + ((2,) if width == 2 else ())
+        array = np.ascontiguousarray(np.broadcast_to(array, full))
+    return array, width
+
+
+def _input_columns(fields: dict[str, np.ndarray], shape: tuple) -> tuple[BatchInput, list]:
+    columns, alive, c = BatchInput(), [], 0
+    for name, width in FIELDS:
+        if name in fields:
+            source, stride = _column_source(fields[name], width, shape)
+            alive.append(source)
+            for k in range(width):
+                columns.column[c + k].data = source.ctypes.data + 8 * k
+                columns.column[c + k].stride = stride
+        c += width
+    return columns, alive
+
+
+def _output_columns(shape: tuple) -> tuple[BatchOutput, dict[str, np.ndarray]]:
+    results, arrays, c = BatchOutput(), {}, 0
+    for name, width in OUTPUTS:
+        array = np.empty(shape + ((2,) if width == 2 else ()), dtype=np.float64)
+        arrays[name] = array
+        for k in range(width):
+            results.column[c + k].data = array.ctypes.data + 8 * k
+            results.column[c + k].stride = width
+        c += width
+    for name in ("status", "field"):
+        arrays[name] = np.empty(shape, dtype=np.uint8)
+    results.status = arrays["status"].ctypes.data
+    results.field = arrays["field"].ctypes.data
+    return results, arrays
+
+
+def solve(dyad_type: str, **arrays: object) -> Reactions:
+    """Solves a batch of dyads of one type ("RRR", "RRT", "RTR", "TRT", "RTT") given as
+    arrays of their fields (see the module's help); one C call for the whole batch."""
+    kind = dyad_type.upper() if isinstance(dyad_type, str) else dyad_type
+    if kind not in TYPES:
+        raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {', '.join(TYPES)}")
+    fields = _checked_fields(arrays)
+    shape = _batch_shape(fields)
+    columns, alive = _input_columns(fields, shape)
+    results, out = _output_columns(shape)
+    count = math.prod(shape)
+    default_core().solve_batch(kind, count, columns, results)
+    del alive  # the inputs were read during the call
+    return Reactions(**out)
+
+
+__all__ = ["FIELDS", "OUTPUTS", "Reactions", "default_core", "solve"]

@@ -1,0 +1,127 @@
+"""dyadfmu.solve over NumPy arrays: every row bit for bit the scalar solve's, one status
+per row, broadcasting, and errors that name the bad field."""
+
+from __future__ import annotations
+
+import dyadfmu
+import numpy as np
+import pytest
+from dyadfmu.batch import FIELDS, default_core
+from dyadfmu.core import LINK_KEYS, TYPES, Core
+from dyadfmu.study.configurations import random_set
+
+ROWS = 300
+
+
+@pytest.fixture(scope="module")
+def core() -> Core:
+    return default_core()
+
+
+def keywords(rows: np.ndarray) -> dict[str, np.ndarray]:
+    """The study's rows (35 columns in dyad_input's order) as solve's keywords."""
+    out, c = {}, 0
+    for name, width in FIELDS:
+        out[name] = rows[:, c : c + width] if width == 2 else rows[:, c]
+        c += width
+    return out
+
+
+def scalar_inputs(fields: dict[str, np.ndarray], r: int) -> tuple:
+    """Row r as the arguments of Core.solve."""
+    links = [{key: fields[f"{g}_{key}"][r] for key in LINK_KEYS} for g in "mn"]
+    return (*links, fields["guide_k"][r], fields["guide_p"][r], fields["gravity"][r])
+
+
+def same(a: float, b: float) -> bool:
+    return a == b or (np.isnan(a) and np.isnan(b))
+
+
+@pytest.mark.parametrize("dyad", TYPES)
+def test_rows_match_the_scalar_solve_bit_for_bit(core, dyad):
+    rows = random_set(dyad, ROWS, seed=7)
+    rows[::29, 9] = np.nan  # link_m.mass: invalid rows among valid ones
+    rows[5::31, 16] = -1.0  # link_n.length
+    fields = keywords(rows)
+    got = dyadfmu.solve(dyad, **fields)
+    assert got.r_mk.shape == (ROWS, 2) and got.n_mk.shape == (ROWS,)
+    statuses = {"ok": 0, "singular": 1, "invalid input": 2, "out of range": 3}
+    for r in range(ROWS):
+        want = core.solve(dyad, *scalar_inputs(fields, r), singular_threshold=rows[r, 34])
+        assert got.status[r] == statuses[want["status"]], r
+        assert core.field_name(got.field[r]) == want["field"], r
+        for name in ("r_mk", "r_np", "r_mn"):
+            assert same(got.__dict__[name][r, 0], want[name][0]), (r, name)
+            assert same(got.__dict__[name][r, 1], want[name][1]), (r, name)
+        for name in ("n_mk", "n_np", "n_mn", "m_mk", "m_np", "m_mn", "conditioning"):
+            assert same(got.__dict__[name][r], want[name]), (r, name)
+        assert same(got.amplification[r], want["amplification"]), r
+    assert not got.ok[::29].any()
+    assert got.reason(0) == "invalid input: link_m.mass"
+    assert np.isnan(got.r_mn[0]).all()
+
+
+def test_broadcast_and_strided_inputs_give_the_same_rows():
+    rows = random_set("RRT", 60, seed=3)
+    fields = keywords(rows)
+    base = dyadfmu.solve("RRT", **fields)
+    # one value given once for all rows, a batch of shape (6, 10), a reversed view
+    once = dict(fields, gravity=np.array([0.0, -9.81]), m_mass=2.5)
+    full = dict(
+        fields,
+        gravity=np.tile([0.0, -9.81], (60, 1)),
+        m_mass=np.full(60, 2.5),
+    )
+    a, b = dyadfmu.solve("RRT", **once), dyadfmu.solve("RRT", **full)
+    np.testing.assert_array_equal(a.r_np, b.r_np)
+    assert not np.array_equal(a.r_np, base.r_np)  # the change of mass and weight shows
+    shaped = dyadfmu.solve("rrt", **{k: v.reshape((6, 10, *v.shape[1:])) for k, v in full.items()})
+    assert shaped.r_mk.shape == (6, 10, 2) and shaped.status.shape == (6, 10)
+    np.testing.assert_array_equal(shaped.r_mk.reshape(60, 2), b.r_mk)
+    reversed_rows = dyadfmu.solve("RRT", **{k: v[::-1] for k, v in full.items()})
+    np.testing.assert_array_equal(reversed_rows.m_mk[::-1], b.m_mk)
+
+
+def test_fields_left_out_keep_their_defaults(core):
+    got = dyadfmu.solve("RRT", m_mass=[1.0, 2.0], m_com=[0.5, 0.0], m_omega=3.0)
+    assert got.ok.all()
+    want = core.solve(
+        "RRT",
+        {
+            **dict.fromkeys(LINK_KEYS, 0.0),
+            "dir": (1, 0),
+            "length": 1.0,
+            "com": (0.5, 0.0),
+            "mass": 2.0,
+            "omega": 3.0,
+            "accel_d": (0, 0),
+            "force": (0, 0),
+        },
+        {
+            **dict.fromkeys(LINK_KEYS, 0.0),
+            "dir": (1, 0),
+            "length": 1.0,
+            "com": (0, 0),
+            "accel_d": (0, 0),
+            "force": (0, 0),
+        },
+        (1.0, 0.0),
+        (1.0, 0.0),
+    )
+    assert got.r_mk[1, 0] == want["r_mk"][0] and got.r_mk[1, 1] == want["r_mk"][1]
+
+
+def test_bad_calls_name_what_is_wrong():
+    with pytest.raises(ValueError, match="unknown dyad type 'RRX'"):
+        dyadfmu.solve("RRX", m_mass=1.0)
+    with pytest.raises(TypeError, match="unknown field 'm_mas'"):
+        dyadfmu.solve("RRR", m_mas=1.0)
+    with pytest.raises(ValueError, match="m_force is a vector"):
+        dyadfmu.solve("RRR", m_force=[1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match="do not broadcast.*m_mass \\(3,\\).*n_mass \\(4,\\)"):
+        dyadfmu.solve("RRR", m_mass=np.ones(3), n_mass=np.ones(4))
+
+
+def test_an_empty_batch_is_empty():
+    got = dyadfmu.solve("RTR", m_mass=np.zeros(0))
+    assert got.r_mk.shape == (0, 2) and got.status.shape == (0,)
