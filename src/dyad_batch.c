@@ -11,7 +11,7 @@
 
 #include <stddef.h>
 
-#define LINK_OFFSETS(g)                                                                          \
+#define LINK_OFFSETS(g)                                                                           \
     offsetof(dyad_input, g.dir.x), offsetof(dyad_input, g.dir.y), offsetof(dyad_input, g.length), \
         offsetof(dyad_input, g.omega), offsetof(dyad_input, g.epsilon),                           \
         offsetof(dyad_input, g.accel_d.x), offsetof(dyad_input, g.accel_d.y),                     \
