@@ -100,7 +100,10 @@ def default_core() -> Core:
 
 
 def _as_field(name: str, width: int, value: object) -> np.ndarray:
-    array = np.asarray(value, dtype=np.float64)
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name} must be real numbers: {error}") from None
     if width == 2 and (array.ndim == 0 or array.shape[-1] != 2):
         raise ValueError(f"{name} is a vector: its last axis must have length 2, not {array.shape}")
     return array

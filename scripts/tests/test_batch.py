@@ -116,6 +116,10 @@ def test_bad_calls_name_what_is_wrong():
         dyadfmu.solve("RRX", m_mass=1.0)
     with pytest.raises(TypeError, match="unknown field 'm_mas'"):
         dyadfmu.solve("RRR", m_mas=1.0)
+    with pytest.raises(ValueError, match="m_mass must be real numbers"):
+        dyadfmu.solve("RRR", m_mass="heavy")
+    with pytest.raises(ValueError, match="n_moment must be real numbers"):
+        dyadfmu.solve("RRR", n_moment=[1 + 2j])
     with pytest.raises(ValueError, match="m_force is a vector"):
         dyadfmu.solve("RRR", m_force=[1.0, 2.0, 3.0])
     with pytest.raises(ValueError, match="do not broadcast.*m_mass \\(3,\\).*n_mass \\(4,\\)"):
