@@ -1,6 +1,8 @@
 /* dyadfmu FMU layer: the version-neutral instance (see fmu_instance.h). */
 #include "fmu_instance.h"
 
+#include "dyadfmu/angle.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -121,19 +123,15 @@ static void store(fmu_instance* instance, size_t index, double value)
 /* The (cos, sin) of every angle that changed since the model last read them. */
 static void sync_angles(fmu_instance* instance)
 {
-    size_t k;
+    fmu_angle* a = instance->angles;
+    fmu_angle* const end = a + instance->angle_count;
     if (!instance->angles_pending) {
         return;
     }
-    for (k = 0; k < instance->angle_count; ++k) {
-        const int index = instance->angles[k];
-        const double angle = instance->values[index];
-        if (angle != instance->converted[index]) {
-            const fmu_variable* v = &instance->model->variables[index];
-            double* member = (double*)(void*)((char*)instance->input + v->offset);
-            member[0] = cos(angle);
-            member[1] = sin(angle);
-            instance->converted[index] = angle;
+    for (; a < end; ++a) {
+        if (*a->angle != a->converted) {
+            a->converted = *a->angle;
+            dyad_cos_sin(a->converted, &a->unit[0], &a->unit[1]);
         }
     }
     instance->angles_pending = 0;
@@ -152,8 +150,10 @@ static void load_start_values(fmu_instance* instance)
 {
     size_t k;
     instance->model->behaviour->initialise(instance->model, instance->input);
+    for (k = 0; k < instance->angle_count; ++k) {
+        instance->angles[k].converted = NAN; /* initialise overwrote every unit vector */
+    }
     for (k = 0; k < instance->model->variable_count; ++k) {
-        instance->converted[k] = NAN; /* initialise overwrote every unit vector */
         store(instance, k, instance->model->variables[k].start);
     }
     sync_angles(instance);
@@ -227,14 +227,17 @@ static void find_angles(fmu_instance* instance)
     instance->angle_count = 0;
     for (k = 0; k < model->variable_count; ++k) {
         if (model->variables[k].target == FMU_TARGET_INPUT_ANGLE) {
-            instance->angles[instance->angle_count++] = (int)k;
+            fmu_angle* a = &instance->angles[instance->angle_count++];
+            a->angle = &instance->values[k];
+            a->unit = (double*)(void*)((char*)instance->input + model->variables[k].offset);
+            a->converted = NAN;
         }
     }
 }
 
 /* The instance and everything it owns in one block: its parts, aligned. */
 typedef struct instance_layout {
-    size_t values, slots, angles, converted, input, output, name, total;
+    size_t values, slots, angles, input, output, name, total;
 } instance_layout;
 
 static instance_layout layout_of(const fmu_model* model, const char* instance_name)
@@ -244,8 +247,7 @@ static instance_layout layout_of(const fmu_model* model, const char* instance_na
     at.values = round_up(sizeof(fmu_instance));
     at.slots = at.values + round_up(variables * sizeof(double));
     at.angles = at.slots + round_up(model->vr_limit * sizeof(fmu_slot));
-    at.converted = at.angles + round_up(variables * sizeof(int));
-    at.input = at.converted + round_up(variables * sizeof(double));
+    at.input = at.angles + round_up(variables * sizeof(fmu_angle));
     at.output = at.input + 2 * round_up(model->behaviour->input_size);
     at.name = at.output + 3 * round_up(model->behaviour->output_size);
     at.total = at.name + strlen(instance_name) + 1;
@@ -259,8 +261,7 @@ static void place_parts(fmu_instance* instance, const instance_layout* at, const
     const size_t output_size = round_up(instance->model->behaviour->output_size);
     instance->values = (double*)(void*)(base + at->values);
     instance->slots = (fmu_slot*)(void*)(base + at->slots);
-    instance->angles = (int*)(void*)(base + at->angles);
-    instance->converted = (double*)(void*)(base + at->converted);
+    instance->angles = (fmu_angle*)(void*)(base + at->angles);
     instance->input = base + at->input;
     instance->seed = base + at->input + input_size;
     instance->output = base + at->output;
@@ -697,21 +698,49 @@ static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], si
     return FMU_OK;
 }
 
+/* Values set in one pass, each checked and stored at once, with the earlier
+ * ones put back if a later one is refused; a longer call checks all first. */
+enum { SET_IN_ONE_PASS = 64 };
+
 /* The common case of set_values, by the slots alone: every value valid. */
 static int set_reals_at_once(fmu_instance* instance, const unsigned int vr[], size_t count,
                              const double values[])
 {
     const unsigned int limit = instance->model->vr_limit;
     const fmu_slot* slots = instance->slots;
+    double before[SET_IN_ONE_PASS];
     size_t k;
-    for (k = 0; k < count; ++k) {
-        const double value = values[k];
-        if (vr[k] >= limit || !(value >= slots[vr[k]].low && value <= slots[vr[k]].high)) {
-            return 0;
+    if (count > SET_IN_ONE_PASS) {
+        for (k = 0; k < count; ++k) {
+            const double value = values[k];
+            if (vr[k] >= limit || !(value >= slots[vr[k]].low && value <= slots[vr[k]].high)) {
+                return 0;
+            }
         }
+        for (k = 0; k < count; ++k) {
+            *slots[vr[k]].write = values[k];
+        }
+        instance->angles_pending |= instance->angle_count > 0;
+        return 1;
     }
     for (k = 0; k < count; ++k) {
-        *slots[vr[k]].write = values[k];
+        const double value = values[k];
+        const fmu_slot* slot;
+        if (vr[k] >= limit) {
+            break;
+        }
+        slot = &slots[vr[k]];
+        if (!(value >= slot->low && value <= slot->high)) {
+            break;
+        }
+        before[k] = *slot->write;
+        *slot->write = value;
+    }
+    if (k < count) {
+        while (k-- > 0) { /* in reverse: a repeated reference ends as it began */
+            *slots[vr[k]].write = before[k];
+        }
+        return 0;
     }
     instance->angles_pending |= instance->angle_count > 0;
     return 1;
@@ -774,6 +803,16 @@ static int get_reals_at_once(fmu_instance* instance, const unsigned int vr[], si
     const fmu_slot* slots = instance->slots;
     int have_solved = 0;
     size_t k;
+    if (!instance->dirty && instance->evaluation.status == FMU_OK) {
+        /* after a step: every output is up to date, and reading one succeeds */
+        for (k = 0; k < count; ++k) {
+            if (vr[k] >= limit || slots[vr[k]].read == NULL) {
+                return 0;
+            }
+            values[k] = *slots[vr[k]].read;
+        }
+        return 1;
+    }
     for (k = 0; k < count; ++k) {
         if (vr[k] >= limit || slots[vr[k]].read == NULL) {
             return 0;

@@ -65,6 +65,13 @@ typedef struct fmu_slot {
     int is_output;      /* the value is the model's: evaluate before reading */
 } fmu_slot;
 
+/* An angle variable: kept as set, read by the model as its unit vector. */
+typedef struct fmu_angle {
+    const double* angle; /* as set (rad) */
+    double* unit;        /* (cos, sin) in the input block */
+    double converted;    /* the angle `unit` was computed from; NaN: none */
+} fmu_angle;
+
 typedef void* (*fmu_allocate)(size_t count, size_t size);
 typedef void (*fmu_release)(void* memory);
 
@@ -81,9 +88,8 @@ typedef struct fmu_instance {
     fmu_evaluation evaluation; /* of the last evaluation */
     double* values;            /* one per variable, as set; outputs unused */
     fmu_slot* slots;           /* one per value reference below model->vr_limit */
-    int* angles;               /* indices of the angle variables, angle_count of them */
+    fmu_angle* angles;         /* the angle variables, angle_count of them */
     size_t angle_count;
-    double* converted;  /* per variable: the angle whose (cos, sin) the input holds */
     int angles_pending; /* an angle may have changed since the input's (cos, sin) */
     int time_at_vr_0;   /* value reference 0 reads the time (FMI 3) */
     /* The model's blocks (see fmu_behaviour), in the instance's own memory:

@@ -2,6 +2,7 @@
  * that names a bad input field, and rejection. The steps every solver shares
  * on its hot path are inline in dyad_internal.h; dispatch is in dyad_solve.c. */
 #include "dyad_internal.h"
+#include "dyadfmu/angle.h"
 
 #include <stddef.h>
 
@@ -123,6 +124,11 @@ void dyad_link_resultant(const dyad_link* link, dyad_vec2 gravity, dyad_vec2* fo
     dyad_resultant(link, link->dir, gravity, &body);
     *force = body.f;
     *moment = body.m;
+}
+
+void dyad_angle_cos_sin(double angle, double* cos_out, double* sin_out)
+{
+    dyad_cos_sin(angle, cos_out, sin_out);
 }
 
 /* amplification x the largest of three output magnitudes, NaN unless ok. */

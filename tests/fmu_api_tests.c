@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dyadfmu/angle.h"
 #include "fmu_dyad.h"
 #include "fmu_probe.h"
 
@@ -1517,8 +1518,8 @@ static dyad_result core_result(const unsigned vrs[], const double values[], size
             }
         }
         if (v->target == FMU_TARGET_INPUT_ANGLE) {
-            ((dyad_vec2*)(void*)member)->x = cos(value);
-            ((dyad_vec2*)(void*)member)->y = sin(value);
+            /* as the FMU converts an angle */
+            dyad_cos_sin(value, &((dyad_vec2*)(void*)member)->x, &((dyad_vec2*)(void*)member)->y);
         } else if (v->target == FMU_TARGET_INPUT_REAL) {
             *(double*)(void*)member = value;
         }
@@ -1585,8 +1586,8 @@ static int test_rrt_bad_input_names_its_variable(void)
             char* member = (char*)&in + w->offset;
             const double value = j == k ? (double)NAN : w->start;
             if (w->target == FMU_TARGET_INPUT_ANGLE) {
-                ((dyad_vec2*)(void*)member)->x = cos(value);
-                ((dyad_vec2*)(void*)member)->y = sin(value);
+                dyad_cos_sin(value, &((dyad_vec2*)(void*)member)->x,
+                             &((dyad_vec2*)(void*)member)->y);
             } else if (w->target == FMU_TARGET_INPUT_REAL) {
                 *(double*)(void*)member = value;
             }

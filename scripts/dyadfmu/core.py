@@ -277,6 +277,12 @@ class Core:
             ctypes.POINTER(BatchOutput),
         ]
         self._lib.dyad_solve_batch.restype = ctypes.c_size_t
+        self._lib.dyad_angle_cos_sin.argtypes = [
+            ctypes.c_double,
+            ctypes.POINTER(ctypes.c_double),
+            ctypes.POINTER(ctypes.c_double),
+        ]
+        self._lib.dyad_angle_cos_sin.restype = None
         self._bind_kinematics()
 
     def _bind_kinematics(self) -> None:
@@ -370,6 +376,12 @@ class Core:
         return self._lib.dyad_solve_batch(
             TYPES.index(dyad_type), count, ctypes.byref(columns), ctypes.byref(results)
         )
+
+    def direction(self, angle: float) -> tuple[float, float]:
+        """(cos, sin) of `angle` (rad) as the FMUs convert a link angle."""
+        c, s = ctypes.c_double(), ctypes.c_double()
+        self._lib.dyad_angle_cos_sin(float(angle), ctypes.byref(c), ctypes.byref(s))
+        return c.value, s.value
 
     def field_name(self, field: int) -> str:
         """The dotted name of a dyad_field ("link_m.mass", ...); "" for none."""

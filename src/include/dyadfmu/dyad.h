@@ -68,6 +68,11 @@ dyad_status dyad_solve_tangent_of(const dyad_tangent_type* kind, const dyad_inpu
 void dyad_link_resultant(const dyad_link* link, dyad_vec2 gravity, dyad_vec2* force,
                          dyad_real* moment);
 
+/** cos(angle) and sin(angle) (-) of `angle` (rad) as the FMUs convert a link
+ *  angle to its direction (dyadfmu/angle.h): within about 2.2e-16 of the true
+ *  values, in double whatever the library's scalar. */
+void dyad_angle_cos_sin(double angle, double* cos_out, double* sin_out);
+
 /** Kind of a pair in a type: revolute or translational. */
 dyad_pair_kind dyad_pair_kind_of(dyad_type type, dyad_pair pair);
 
