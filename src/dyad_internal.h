@@ -111,7 +111,9 @@ static inline dyad_vec2 dyad_unit_of(dyad_vec2 v)
  * the inertia force points along r and has no moment about D_g, so it is left
  * out of that sum instead of being added and cancelled again; for a fast,
  * heavy link it would otherwise swamp the moment in round-off. And the sizes
- * of both sums (dyad_amplification.h), for the amplification. */
+ * of both sums (dyad_amplification.h), for the amplification.
+ * Flops: r 6, the tangential acceleration 4, F without its centripetal part 6,
+ * that part 6, M 2, M_D 4: 28; the sizes 17 (dyad_link_sizes_of). */
 static inline void dyad_resultant(const dyad_link* link, dyad_vec2 i, dyad_vec2 gravity,
                                   dyad_body* body)
 {

@@ -43,6 +43,15 @@
  * Conditioning: the smaller of |d| and |D_m D_n| / (l_m + l_n); the second
  * vanishes when D_m and D_n coincide, where i_beta is undefined and the lever
  * of R_np about D_m is zero.
+ *
+ * Floating-point operations of the closed forms (an add, subtract, multiply,
+ * divide or square root each; a dot or cross product 3, a vector sum 2, a
+ * combination a u + b v 6): the links' resultants 2 x 28 = 56 (dyad_resultant),
+ * the reactions above 27 (M_mn in its first form), and the amplification 51
+ * (dyad_amplification.h: the links' sizes 2 x 17, this type's output sizes
+ * 10, 1/|D_m D_n d| 2 and the two groups' data factors with the quotient by the conditioning 5).
+ * Closed forms: 134 flops. The solve adds the checks of its inputs and of
+ * its outputs (scripts/run-study counts what it executes).
  */
 #include "dyad_tangent.h"
 

@@ -2,7 +2,8 @@
  *   core     the closed-form solvers of the C core (dyad_solve),
  *   gsl_lu   the same dyad as a dense 6x6 system, LU with GSL (dense_gsl.c),
  *   gsl_svd  the same with an SVD,
- *   fmu      an FMU binary stepped from C (FMI 2 or 3), one row per doStep.
+ *   fmu      an FMU binary stepped from C (FMI 2 or 3), one row per doStep,
+ *   batch    dyad_solve_batch over the rows in place (columns of stride 35).
  *
  * Built twice from this file: dyad_bench against the double core (all methods),
  * dyad_bench_float against the float core (method core only; inputs are rounded
@@ -25,6 +26,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "dyadfmu/batch.h"
 #include "dyadfmu/dyad.h"
 
 #ifndef DYAD_REAL_FLOAT
@@ -55,9 +57,15 @@ enum {
     OUT_COLS = 16
 };
 
-typedef enum bench_method { METHOD_CORE, METHOD_GSL_LU, METHOD_GSL_SVD, METHOD_FMU } bench_method;
+typedef enum bench_method {
+    METHOD_CORE,
+    METHOD_GSL_LU,
+    METHOD_GSL_SVD,
+    METHOD_FMU,
+    METHOD_BATCH
+} bench_method;
 
-static const char* const method_names[] = {"core", "gsl_lu", "gsl_svd", "fmu"};
+static const char* const method_names[] = {"core", "gsl_lu", "gsl_svd", "fmu", "batch"};
 
 typedef struct options {
     int have_type;
@@ -79,7 +87,7 @@ typedef struct options {
 static void usage(FILE* out)
 {
     fprintf(out,
-            "usage: %s --type RRR|RRT|RTR|TRT|RTT --method core|gsl_lu|gsl_svd|fmu\n"
+            "usage: %s --type RRR|RRT|RTR|TRT|RTT --method core|gsl_lu|gsl_svd|batch\n"
             "           --inputs FILE [--outputs FILE] [--count N] [--repeat R]\n"
             "       %s --method fmu --fmu BINARY.so --fmi 2|3 --token TOKEN\n"
             "           --fmu-inputs FILE --in-vrs VR,VR,... --out-vrs VR,VR,...\n"
@@ -94,6 +102,8 @@ static void usage(FILE* out)
             "  core     dyad_solve of the C core (%s)\n"
             "  gsl_lu   the dyad's 6x6 Newton-Euler system, GSL LU (double binary only)\n"
             "  gsl_svd  the same, GSL SVD (double binary only)\n"
+            "  batch    dyad_solve_batch, one call over all rows read in place as columns\n"
+            "           (double binary only)\n"
             "  fmu      the FMU binary stepped from C, one doStep (h = 1e-3 s) per row\n"
             "           (double binary only)\n"
             "\n"
@@ -209,7 +219,8 @@ static void parse_args(int argc, char** argv, options* opt)
                 }
             }
             if (!opt->have_method) {
-                fail_usage("unknown --method (expected core, gsl_lu, gsl_svd or fmu)", value);
+                fail_usage("unknown --method (expected core, gsl_lu, gsl_svd, batch or fmu)",
+                           value);
             }
         } else if (strcmp(arg, "--inputs") == 0) {
             opt->inputs = value;
@@ -458,6 +469,51 @@ void bench_loop_core(dyad_type type, const dyad_input* in, dyad_result* out, siz
 }
 
 #ifndef DYAD_REAL_FLOAT
+__attribute__((noinline)) void bench_loop_batch(dyad_type type, const dyad_batch_input* in,
+                                                const dyad_batch_output* out, size_t count);
+
+void bench_loop_batch(dyad_type type, const dyad_batch_input* in, const dyad_batch_output* out,
+                      size_t count)
+{
+    dyad_solve_batch(type, count, in, out);
+}
+
+/* Runs batch on the inputs file: the rows are the columns, read in place. */
+static void run_batch(const options* opt)
+{
+    size_t rows, count, c;
+    long rep;
+    double* raw = read_rows(opt->inputs, IN_COLS, &rows);
+    double* per_config = xmalloc((size_t)opt->repeat, sizeof *per_config);
+    double* results;
+    unsigned char* status;
+    dyad_batch_input in;
+    dyad_batch_output out;
+    count = rows_to_use(opt, rows, opt->inputs);
+    results = xmalloc(count * DYAD_OUTPUT_COLUMN_COUNT, sizeof *results);
+    status = xmalloc(2 * count, 1);
+    for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
+        in.column[c].data = raw + c;
+        in.column[c].stride = IN_COLS;
+    }
+    for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+        out.column[c].data = results + c * count;
+        out.column[c].stride = 1;
+    }
+    out.status = status;
+    out.field = status + count;
+    for (rep = 0; rep < opt->repeat; ++rep) {
+        const double start = now_seconds();
+        bench_loop_batch(opt->type, &in, &out, count);
+        per_config[rep] = (now_seconds() - start) / (double)count;
+    }
+    print_json(opt, count, per_config);
+    free(raw);
+    free(results);
+    free(status);
+    free(per_config);
+}
+
 __attribute__((noinline)) void bench_loop_gsl_lu(dense_gsl* ws, dyad_type type,
                                                  const dyad_input* in, dyad_result* out,
                                                  size_t count);
@@ -876,6 +932,15 @@ int main(int argc, char** argv)
                 "(configure with DYADFMU_BUILD_FMUS=ON)\n",
                 BENCH_PROGRAM);
         return EXIT_USAGE;
+#endif
+    } else if (opt.method == METHOD_BATCH) {
+#ifndef DYAD_REAL_FLOAT
+        if (opt.outputs != NULL) {
+            fprintf(stderr, "%s: method batch writes no --outputs (core does, the same)\n",
+                    BENCH_PROGRAM);
+            return EXIT_USAGE;
+        }
+        run_batch(&opt);
 #endif
     } else {
         run_solver(&opt);

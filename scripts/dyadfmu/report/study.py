@@ -14,6 +14,7 @@ import numpy as np  # noqa: E402
 
 from ..study.accuracy import EPS, LABELS, SETS, Results, Sizes  # noqa: E402
 from ..study.configurations import TYPES  # noqa: E402
+from . import speed as speed_report  # noqa: E402
 
 MARKERS = {
     "core": "o",
@@ -329,6 +330,7 @@ def markdown(
     quick: bool,
     elapsed: float,
     figures: dict,
+    speed: tuple = ((), ()),
 ) -> Path:
     """The study's report.md from its summary, contract ratios and figures."""
     core_time = {s["type"]: s["seconds"] for s in summary if s["method"] == "core"}
@@ -336,6 +338,7 @@ def markdown(
     lines = _intro(sizes, quick, elapsed) + _summary_table(summary, core_time)
     lines += _contract_table(contract, silent) + _speed_findings(facts)
     lines += _limit_findings(facts, figures)
+    lines += speed_report.markdown(*speed)
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
@@ -344,6 +347,8 @@ def markdown(
 def write(out: Path, results: Results) -> Path:
     """The plots and report.md of the study's results in `out`; returns the report's path."""
     figures = plots(out, results.points, results.summary)
+    if results.speed[0]:
+        speed_report.write_csv(out / "speed.csv", *results.speed)
     return markdown(
         out,
         results.summary,
@@ -353,4 +358,5 @@ def write(out: Path, results: Results) -> Path:
         results.quick,
         results.elapsed,
         figures,
+        results.speed,
     )

@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import paths
 from ..reference import newton_euler
-from . import bench
+from . import bench, speed
 from . import configurations as cfg
 
 EPS = {"double": 2.0**-52, "float": 2.0**-23}
@@ -115,6 +115,7 @@ class Results:
     contract: dict = field(default_factory=dict)
     silent: dict = field(default_factory=dict)
     elapsed: float = 0.0
+    speed: tuple = ((), ())  # speed.measure's (per type, per scene) figures
 
 
 @dataclass
@@ -266,6 +267,7 @@ def run(
                 log(f"{dyad}: {LABELS[method]}")
                 _measure_method(results, build, method, data, sizes, work)
             _time_fmus(results, build, dyad, sizes, work, log)
+        results.speed = speed.measure(build, work, quick, log)
     results.elapsed = clock.perf_counter() - started_all
     _write_points(out / "points.csv", results.points)
     _write_summary_csv(out / "summary.csv", results.summary)

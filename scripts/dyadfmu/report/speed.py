@@ -1,0 +1,132 @@
+"""The study report's speed tables: each way of calling the core against its floor
+(:mod:`dyadfmu.study.speed`), with the targets marked met or not, and their CSV."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+from ..study.speed import (
+    FLOPS_TARGET,
+    ROWS_PER_SECOND_TARGET,
+    STEP_TARGET,
+    SceneSpeed,
+    TypeSpeed,
+)
+
+
+def _mark(met: bool) -> str:
+    return "met" if met else "**not met**"
+
+
+def _type_rows(types: list[TypeSpeed]) -> list[str]:
+    lines = [
+        "| type | closed-form flops | flops per solve (ratio) | instructions per solve "
+        "| per FMU step, FMI 2 / 3 | step / bare call | step / (call + directions) "
+        "| per batch row | NumPy time per row (rows/s) |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for t in types:
+        two, three = t.steps[2], t.steps[3]
+        lines.append(
+            f"| {t.dyad} | {t.closed_form_flops} "
+            f"| {t.solve_flops:.0f} ({t.solve_flops / t.closed_form_flops:.2f}) "
+            f"| {t.solve_instructions:.0f} | {two.step:.0f} / {three.step:.0f} "
+            f"| {two.ratio:.2f} / {three.ratio:.2f} "
+            f"| {two.ratio_with_directions:.2f} / {three.ratio_with_directions:.2f} "
+            f"| {t.batch_instructions:.0f} | {t.numpy_seconds_per_row * 1e9:.0f} ns "
+            f"({1 / t.numpy_seconds_per_row / 1e6:.1f} M) |"
+        )
+    return lines
+
+
+def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
+    lines = [
+        "| scene | per step, FMI 2 / 3 | evaluation | step / evaluation, FMI 2 / 3 |",
+        "|---|---:|---:|---:|",
+    ]
+    for s in scenes:
+        two, three = s.steps[2], s.steps[3]
+        lines.append(
+            f"| {s.scene} | {two.step:.0f} / {three.step:.0f} | {two.evaluate:.0f} "
+            f"| {two.ratio:.2f} / {three.ratio:.2f} |"
+        )
+    return lines
+
+
+def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
+    steps = [s for t in types for s in t.steps.values()]
+    steps += [s for scene in scenes for s in scene.steps.values()]
+    flops = max(t.solve_flops / t.closed_form_flops for t in types)
+    worst_step = max(s.ratio for s in steps)
+    worst_with_directions = max(s.ratio_with_directions for s in steps)
+    rrr = next(t for t in types if t.dyad == "RRR")
+    rate = 1 / rrr.numpy_seconds_per_row
+    return [
+        "",
+        f"- Solve within {FLOPS_TARGET:g}x its closed forms' operations: worst "
+        f"{flops:.2f}x, {_mark(flops <= FLOPS_TARGET)}.",
+        f"- FMU step within {STEP_TARGET:g}x the bare core call (the model's evaluation): "
+        f"worst {worst_step:.2f}x, {_mark(worst_step <= STEP_TARGET)}; counting the "
+        f"directions of the angle inputs (dyadfmu/angle.h) with the call, worst "
+        f"{worst_with_directions:.2f}x, {_mark(worst_with_directions <= STEP_TARGET)}.",
+        f"- RRR from NumPy: {rate / 1e6:.1f} M rows/s against {ROWS_PER_SECOND_TARGET / 1e6:g} M, "
+        f"{_mark(rate >= ROWS_PER_SECOND_TARGET)}.",
+    ]
+
+
+def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
+    """The report's section on speed against the floors."""
+    if not types:
+        return []
+    return [
+        "",
+        "## Speed against the floors",
+        "",
+        "Instructions are callgrind's: per solve of the core, per FMU step from C (every input "
+        "set, doStep, every Real output read; the bare call is the model's evaluation inside "
+        "it, the directions are the unit vectors of the angles that changed), per row of "
+        "`dyad_solve_batch` (one call over rows read in place). Flops: adds, "
+        "subtracts, multiplies, divides and square roots executed, against the closed forms' "
+        "count atop `src/dyad_<type>.c`. Time per row: the best of a few calls of "
+        "`dyadfmu.solve` on contiguous arrays of 10,000 rows (they fit the caches).",
+        "",
+        *_type_rows(types),
+        "",
+        *_scene_rows(scenes),
+        *_targets(types, scenes),
+    ]
+
+
+def write_csv(path: Path, types: list[TypeSpeed], scenes: list[SceneSpeed]) -> None:
+    """speed.csv: one row per type and FMI version, and per scene and FMI version."""
+    with path.open("w", newline="") as handle:
+        out = csv.writer(handle)
+        out.writerow(
+            [
+                "what",
+                "fmi",
+                "closed_form_flops",
+                "flops_per_solve",
+                "instructions_per_solve",
+                "instructions_per_step",
+                "instructions_per_evaluation",
+                "instructions_per_step_in_directions",
+                "instructions_per_batch_row",
+                "numpy_seconds_per_row",
+            ]
+        )
+        for t in types:
+            for version, s in t.steps.items():
+                out.writerow(
+                    [t.dyad, version, t.closed_form_flops, f"{t.solve_flops:.1f}"]
+                    + [f"{t.solve_instructions:.1f}", f"{s.step:.1f}", f"{s.evaluate:.1f}"]
+                    + [f"{s.directions:.1f}", f"{t.batch_instructions:.1f}"]
+                    + [f"{t.numpy_seconds_per_row:.4g}"]
+                )
+        for scene in scenes:
+            for version, s in scene.steps.items():
+                out.writerow(
+                    [scene.scene, version, "", "", "", f"{s.step:.1f}", f"{s.evaluate:.1f}"]
+                    + [f"{s.directions:.1f}", "", ""]
+                )

@@ -1,0 +1,248 @@
+"""How close each way of calling the core comes to its floor, in one run: per dyad type the
+closed forms' floating-point operations (counted atop ``src/dyad_<type>.c``) against those
+the solve executes, its instructions, those of one FMU step from C (FMI 2 and 3) against
+the bare core call inside it, those of a row of ``dyad_solve_batch``, and the time of a
+row of :func:`dyadfmu.solve` from NumPy; and the step of every built-in scene FMU against
+its model's evaluation. Instruction counts are callgrind's; times are the best of a few.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+import time as clock
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+from fmpy.model_description import ModelDescription
+
+from .. import paths
+from ..batch import FIELDS, solve
+from . import bench, flops
+from . import configurations as cfg
+
+#: The speed targets: an FMU step and the solve's operations within twice their floor,
+#: and this many rows a second from NumPy (RRR).
+STEP_TARGET = 2.0
+FLOPS_TARGET = 2.0
+ROWS_PER_SECOND_TARGET = 10e6
+#: Rows per timed call of dyadfmu.solve: inputs and outputs (about 4 MB) fit the caches,
+#: so that the solve is timed and not the memory bus (as the study times the core).
+NUMPY_ROWS = 10_000
+
+
+@dataclass
+class Step:
+    """Instructions of one FMU step from C (set every input, doStep, get every Real
+    output) and, inside it, of the model's evaluation and of its angles' directions."""
+
+    step: float
+    evaluate: float
+    directions: float
+
+    @property
+    def ratio(self) -> float:
+        """Step over the bare core call (the model's evaluation)."""
+        return self.step / self.evaluate
+
+    @property
+    def ratio_with_directions(self) -> float:
+        """Step over the core call from the FMU's own inputs: the angles' directions and
+        the evaluation."""
+        return self.step / (self.evaluate + self.directions)
+
+
+@dataclass
+class TypeSpeed:
+    """One dyad type's figures."""
+
+    dyad: str
+    closed_form_flops: int
+    solve_flops: float
+    solve_instructions: float
+    steps: dict[int, Step] = field(default_factory=dict)
+    batch_instructions: float = math.nan
+    numpy_seconds_per_row: float = math.nan
+
+
+@dataclass
+class SceneSpeed:
+    """One built-in scene FMU's step against its evaluation, per FMI version."""
+
+    scene: str
+    steps: dict[int, Step] = field(default_factory=dict)
+
+
+def closed_form_flops(dyad: str, root: Path | None = None) -> int:
+    """The closed forms' count stated atop the type's source file ("Closed forms: N flops")."""
+    source = (root or paths.ROOT) / "src" / f"dyad_{dyad.lower()}.c"
+    header = source.read_text().split("*/", 1)[0]
+    text = " ".join(line.strip().lstrip("*").strip() for line in header.splitlines())
+    match = re.search(r"Closed forms: (\d+) flops", text)
+    if match is None:
+        raise ValueError(f"{source}: no 'Closed forms: N flops' in its opening comment")
+    return int(match.group(1))
+
+
+def _callgrind(program: list[str], work: Path, toggle: str, per_instruction: bool) -> Path:
+    out = work / "speed.callgrind"
+    options = [f"--toggle-collect={toggle}"]
+    options += ["--dump-instr=yes", "--dump-line=no"] if per_instruction else []
+    done = subprocess.run(
+        [
+            "valgrind",
+            "--tool=callgrind",
+            *options,
+            f"--callgrind-out-file={out}",
+            *program,
+        ],
+        capture_output=True,
+        text=True,
+    )
+    if done.returncode != 0 or "Collected" not in done.stderr:
+        raise RuntimeError(f"callgrind of {program[0]} failed: {done.stderr[-800:]}")
+    return out
+
+
+def _collected(out: Path) -> int:
+    match = re.search(r"^(?:summary|totals):\s*(\d+)", out.read_text(), re.MULTILINE)
+    return int(match.group(1)) if match else 0
+
+
+def inclusive(out: Path, function: str) -> int:
+    """Instructions inside `function` and what it calls, over a callgrind output."""
+    done = subprocess.run(
+        ["callgrind_annotate", "--inclusive=yes", "--threshold=100", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    pattern = re.compile(r"^\s*([\d,]+)\s.*:" + re.escape(function) + r"(\.part\.\d+)? ")
+    return sum(
+        int(m.group(1).replace(",", ""))
+        for m in map(pattern.match, done.stdout.splitlines())
+        if m is not None
+    )
+
+
+def core_counts(build: Path, dyad: str, rows: np.ndarray, work: Path) -> tuple[float, float]:
+    """(floating-point operations, instructions) per solve of the core."""
+    inputs = work / "speed_core.bin"
+    rows.astype("<f8").tofile(inputs)
+    program = [str(bench.bench_binary(build, "double"))]
+    program += bench.bench_arguments(dyad, "core", inputs) + ["--repeat", "1"]
+    out = _callgrind(program, work, "bench_loop_*", per_instruction=True)
+    return flops.operations(out) / len(rows), _collected(out) / len(rows)
+
+
+def step_rows(md: ModelDescription, count: int, seed: int) -> tuple[list, list, np.ndarray]:
+    """An FMU's inputs, Real outputs and `count` rows of inputs swinging smoothly about
+    their start values (an angle by 0.3 rad, a length by 30 %, others by 20 %)."""
+    inputs = [v for v in md.modelVariables if v.causality == "input"]
+    outputs = [
+        v for v in md.modelVariables if v.causality == "output" and v.type in ("Real", "Float64")
+    ]
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 2 * math.pi, count)
+    rows = np.empty((count, len(inputs)))
+    for k, v in enumerate(inputs):
+        start = float(v.start) if v.start is not None else 0.0
+        if v.unit == "rad":
+            swing = 0.3
+        elif v.unit == "m":
+            swing = 0.3 * start
+        else:
+            swing = 0.2 * (abs(start) + 1.0)
+        rows[:, k] = start + swing * np.sin(t + rng.uniform(0, 2 * math.pi))
+    return inputs, outputs, rows
+
+
+def step_counts(build: Path, identifier: str, version: int, count: int, work: Path) -> Step:
+    """Instructions per step of an FMU's binary from C, and of its evaluation and its
+    angles' directions inside the step."""
+    md = read_model_description(str(paths.built_fmu(identifier, version, build)))
+    inputs, outputs, rows = step_rows(md, count, seed=version)
+    data = work / "speed_fmu.bin"
+    rows.astype("<f8").tofile(data)
+    binary = paths.stage_binary(build, identifier, version)
+    program = [str(bench.bench_binary(build, "double"))]
+    program += bench.fmu_step_arguments(binary, version, md.guid, data, inputs, outputs)
+    out = _callgrind(program + ["--repeat", "1"], work, "bench_loop_*", per_instruction=False)
+    return Step(
+        step=_collected(out) / count,
+        evaluate=inclusive(out, "evaluate") / count,
+        directions=inclusive(out, "sync_angles") / count,
+    )
+
+
+def batch_keywords(rows: np.ndarray) -> dict[str, np.ndarray]:
+    """The study's rows (dyad_input's 35 columns in order) as :func:`dyadfmu.solve`'s
+    keywords."""
+    out, c = {}, 0
+    for name, width in FIELDS:
+        out[name] = rows[:, c : c + width] if width == 2 else rows[:, c]
+        c += width
+    return out
+
+
+def batch_instructions(build: Path, dyad: str, rows: np.ndarray, work: Path) -> float:
+    """Instructions per row of one dyad_solve_batch call over `rows`, read in place as
+    columns (the benchmark's method batch)."""
+    inputs = work / "speed_batch.bin"
+    rows.astype("<f8").tofile(inputs)
+    program = [str(bench.bench_binary(build, "double"))]
+    program += bench.bench_arguments(dyad, "batch", inputs) + ["--repeat", "1"]
+    out = _callgrind(program, work, "bench_loop_*", per_instruction=False)
+    return _collected(out) / len(rows)
+
+
+def numpy_seconds_per_row(dyad: str, rows: np.ndarray, repeat: int) -> float:
+    """Best time per row of :func:`dyadfmu.solve` over `rows` (arrays made beforehand)."""
+    keywords = {k: np.ascontiguousarray(v) for k, v in batch_keywords(rows).items()}
+    solve(dyad, **keywords)  # warm: the library loaded, the pages touched
+    best = math.inf
+    for _ in range(repeat):
+        started = clock.perf_counter()
+        solve(dyad, **keywords)
+        best = min(best, clock.perf_counter() - started)
+    return best / len(rows)
+
+
+def builtin_scenes(root: Path | None = None) -> list[str]:
+    """The identifiers of the scene FMUs built from scenes/*.toml, the dyads excluded."""
+    folder = (root or paths.ROOT) / "scenes"
+    return sorted(p.stem for p in folder.glob("*.toml") if not p.stem.startswith("dyad_"))
+
+
+def measure(
+    build: Path, work: Path, quick: bool, log: Callable = print
+) -> tuple[list[TypeSpeed], list[SceneSpeed]]:
+    """Every figure of the speed table, per type and per built-in scene."""
+    if shutil.which("valgrind") is None:
+        raise RuntimeError("valgrind is missing (apt-get install valgrind): the speed table")
+    steps, batch_rows = (300, 2000) if quick else (2000, 20_000)
+    types = []
+    for t_index, dyad in enumerate(cfg.TYPES):
+        log(f"speed: {dyad}")
+        rows = cfg.random_set(dyad, max(batch_rows, 2000), seed=100 + t_index)
+        solve_flops, solve_instructions = core_counts(build, dyad, rows[:2000], work)
+        figures = TypeSpeed(dyad, closed_form_flops(dyad), solve_flops, solve_instructions)
+        for version in (2, 3):
+            figures.steps[version] = step_counts(
+                build, f"dyad_{dyad.lower()}", version, steps, work
+            )
+        figures.batch_instructions = batch_instructions(build, dyad, rows[:batch_rows], work)
+        many = np.resize(rows, (NUMPY_ROWS, rows.shape[1]))
+        figures.numpy_seconds_per_row = numpy_seconds_per_row(dyad, many, 21 if quick else 201)
+        types.append(figures)
+    scenes = []
+    for scene in builtin_scenes():
+        log(f"speed: scene {scene}")
+        scenes.append(
+            SceneSpeed(scene, {v: step_counts(build, scene, v, steps, work) for v in (2, 3)})
+        )
+    return types, scenes

@@ -1,0 +1,60 @@
+"""The speed table's counting: floating-point operations per mnemonic, callgrind's
+compressed per-instruction positions, and the closed forms' counts atop each type's file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from dyadfmu.study import flops
+from dyadfmu.study.configurations import TYPES
+from dyadfmu.study.speed import closed_form_flops
+
+
+@pytest.mark.parametrize(
+    ("mnemonic", "count"),
+    [
+        ("addsd", 1),
+        ("vmulsd", 1),
+        ("sqrtsd", 1),
+        ("divpd", 2),
+        ("vfmadd231sd", 2),
+        ("vfnmsub132pd", 2),
+        ("comisd", 0),
+        ("maxsd", 0),
+        ("andpd", 0),
+        ("movsd", 0),
+        ("cvtsi2sd", 0),
+    ],
+)
+def test_operations_per_mnemonic(mnemonic, count):
+    assert flops.operations_of(mnemonic) == count
+
+
+def test_executed_reads_compressed_positions_and_skips_calls(tmp_path: Path):
+    out = tmp_path / "callgrind.out"
+    out.write_text(
+        "positions: instr\nevents: Ir\n"
+        "ob=(1) /lib/a.so\nfn=(1) f\n"
+        "0x10 5\n+4 5\n"
+        "cob=(2) /lib/b.so\ncfn=(2) g\ncalls=5 0x99\n"
+        "* 1000\n"  # the call's inclusive cost, at 0x14: not f's own
+        "+3 5\n-7 2\n"
+        "ob=(2)\nfn=(2)\n0x99 5\n"
+    )
+    counts = flops.executed(out)
+    assert counts["/lib/a.so"] == {0x10: 7, 0x14: 5, 0x17: 5}
+    assert counts["/lib/b.so"] == {0x99: 5}
+
+
+@pytest.mark.parametrize("dyad", TYPES)
+def test_closed_form_count_is_stated_atop_each_type(dyad):
+    # at least the two links' resultants (56) and their sizes (34) of every type
+    assert 90 < closed_form_flops(dyad) < 400
+
+
+def test_a_missing_count_is_named(tmp_path: Path):
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "dyad_rrr.c").write_text("/* no count */\n")
+    with pytest.raises(ValueError, match="dyad_rrr.c"):
+        closed_form_flops("RRR", tmp_path)
