@@ -56,6 +56,7 @@ OUTPUTS: tuple[tuple[str, int], ...] = (
     ("amplification", 1),
 )
 assert sum(width for _, width in FIELDS) == INPUT_COLUMN_COUNT
+_WIDTHS = dict(FIELDS)
 assert sum(width for _, width in OUTPUTS) == OUTPUT_COLUMN_COUNT
 
 
@@ -110,7 +111,7 @@ def _as_field(name: str, width: int, value: object) -> np.ndarray:
 
 
 def _checked_fields(arrays: dict) -> dict[str, np.ndarray]:
-    widths = dict(FIELDS)
+    widths = _WIDTHS
     unknown = sorted(set(arrays) - set(widths))
     if unknown:
         raise TypeError(
@@ -120,9 +121,10 @@ def _checked_fields(arrays: dict) -> dict[str, np.ndarray]:
 
 
 def _batch_shape(fields: dict[str, np.ndarray]) -> tuple[int, ...]:
-    shapes = {
-        name: a.shape[:-1] if dict(FIELDS)[name] == 2 else a.shape for name, a in fields.items()
-    }
+    shapes = {name: a.shape[:-1] if _WIDTHS[name] == 2 else a.shape for name, a in fields.items()}
+    distinct = set(shapes.values())
+    if len(distinct) == 1:  # the common case, without NumPy's broadcasting rules
+        return distinct.pop()
     try:
         return tuple(np.broadcast_shapes(*shapes.values())) if shapes else ()
     except ValueError:
@@ -137,39 +139,69 @@ def _column_source(array: np.ndarray, width: int, shape: tuple) -> tuple[np.ndar
     rows_shape = array.shape[:-1] if width == 2 else array.shape
     if math.prod(rows_shape) == 1:
         return np.ascontiguousarray(array.reshape(width)), 0
+    if (
+        len(shape) == 1
+        and rows_shape == shape
+        and array.strides[0] % 8 == 0
+        and (width == 1 or array.strides[1] == 8)
+    ):
+        # one axis of rows at any stride (a column of a table, say): read in place
+        return array, array.strides[0] // 8
     if rows_shape != shape or not array.flags.c_contiguous:
         full = shape + ((2,) if width == 2 else ())
         array = np.ascontiguousarray(np.broadcast_to(array, full))
     return array, width
 
 
+def _address(array: np.ndarray) -> int:
+    return array.__array_interface__["data"][0]
+
+
+def _address(array: np.ndarray) -> int:
+    return array.__array_interface__["data"][0]
+
+
+def _table(data: list[int], strides: list[int], tail: tuple[int, ...] = ()) -> np.ndarray:
+    """(data, stride) pairs, then `tail`, as the int64 words of a C array of them."""
+    words = [w for pair in zip(data, strides, strict=True) for w in pair]
+    return np.array(words + list(tail), np.int64)
+
+
 def _input_columns(fields: dict[str, np.ndarray], shape: tuple) -> tuple[BatchInput, list]:
-    columns, alive, c = BatchInput(), [], 0
+    """dyad_batch_input over the fields' arrays, sharing one int64 table: built from plain
+    lists, it keeps a call's fixed cost far below a ctypes attribute per column."""
+    data, strides = [0] * INPUT_COLUMN_COUNT, [0] * INPUT_COLUMN_COUNT
+    alive, c = [], 0
     for name, width in FIELDS:
         if name in fields:
             source, stride = _column_source(fields[name], width, shape)
             alive.append(source)
+            address = _address(source)
             for k in range(width):
-                columns.column[c + k].data = source.ctypes.data + 8 * k
-                columns.column[c + k].stride = stride
+                data[c + k], strides[c + k] = address + 8 * k, stride
         c += width
-    return columns, alive
+    table = _table(data, strides)
+    alive.append(table)
+    return BatchInput.from_buffer(table), alive
 
 
 def _output_columns(shape: tuple) -> tuple[BatchOutput, dict[str, np.ndarray]]:
-    results, arrays, c = BatchOutput(), {}, 0
+    """dyad_batch_output over new arrays, one per output, its table as for the inputs."""
+    count = math.prod(shape)
+    scalars = np.empty((sum(w == 1 for _, w in OUTPUTS), count), dtype=np.float64)
+    flags = np.empty((2, count), dtype=np.uint8)
+    data, strides, arrays, s = [], [], {}, 0
     for name, width in OUTPUTS:
-        array = np.empty(shape + ((2,) if width == 2 else ()), dtype=np.float64)
+        if width == 2:  # a vector's components side by side
+            array = np.empty(shape + (2,), dtype=np.float64)
+        else:  # the scalars in one allocation
+            array, s = scalars[s].reshape(shape), s + 1
         arrays[name] = array
-        for k in range(width):
-            results.column[c + k].data = array.ctypes.data + 8 * k
-            results.column[c + k].stride = width
-        c += width
-    for name in ("status", "field"):
-        arrays[name] = np.empty(shape, dtype=np.uint8)
-    results.status = arrays["status"].ctypes.data
-    results.field = arrays["field"].ctypes.data
-    return results, arrays
+        data += [_address(array) + 8 * k for k in range(width)]
+        strides += [width] * width
+    arrays["status"], arrays["field"] = flags[0].reshape(shape), flags[1].reshape(shape)
+    arrays["_table"] = _table(data, strides, (_address(flags[0]), _address(flags[1])))
+    return BatchOutput.from_buffer(arrays["_table"]), arrays
 
 
 def solve(dyad_type: str, **arrays: object) -> Reactions:
@@ -185,6 +217,7 @@ def solve(dyad_type: str, **arrays: object) -> Reactions:
     count = math.prod(shape)
     default_core().solve_batch(kind, count, columns, results)
     del alive  # the inputs were read during the call
+    del out["_table"]
     return Reactions(**out)
 
 
