@@ -409,7 +409,9 @@ static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const c
         sync_angles(instance);
         instance->model->behaviour->evaluate(instance->model, instance->input, instance->output, e);
         instance->dirty = 0;
-        log_failure(instance, not_solvable, function);
+        if (e->status != FMU_OK) {
+            log_failure(instance, not_solvable, function);
+        }
     } else if (e->status == FMU_ERROR && each_error) {
         log_failure(instance, not_solvable, function);
     }
