@@ -185,40 +185,74 @@ def _input_columns(fields: dict[str, np.ndarray], shape: tuple) -> tuple[BatchIn
     return BatchInput.from_buffer(table), alive
 
 
-def _output_columns(shape: tuple) -> tuple[BatchOutput, dict[str, np.ndarray]]:
-    """dyad_batch_output over new arrays, one per output, its table as for the inputs."""
+def _new_outputs(shape: tuple) -> dict[str, np.ndarray]:
     count = math.prod(shape)
     scalars = np.empty((sum(w == 1 for _, w in OUTPUTS), count), dtype=np.float64)
     flags = np.empty((2, count), dtype=np.uint8)
-    data, strides, arrays, s = [], [], {}, 0
+    arrays, s = {}, 0
     for name, width in OUTPUTS:
         if width == 2:  # a vector's components side by side
-            array = np.empty(shape + (2,), dtype=np.float64)
+            arrays[name] = np.empty(shape + (2,), dtype=np.float64)
         else:  # the scalars in one allocation
-            array, s = scalars[s].reshape(shape), s + 1
-        arrays[name] = array
-        data += [_address(array) + 8 * k for k in range(width)]
-        strides += [width] * width
+            arrays[name], s = scalars[s].reshape(shape), s + 1
     arrays["status"], arrays["field"] = flags[0].reshape(shape), flags[1].reshape(shape)
-    arrays["_table"] = _table(data, strides, (_address(flags[0]), _address(flags[1])))
+    return arrays
+
+
+def _given_outputs(out: Reactions, shape: tuple) -> dict[str, np.ndarray]:
+    """The arrays of `out` to write into, each checked for its type, shape and layout."""
+    arrays = {}
+    kinds = [(name, width, np.float64) for name, width in OUTPUTS]
+    for name, width, dtype in kinds + [("status", 1, np.uint8), ("field", 1, np.uint8)]:
+        array = getattr(out, name, None)
+        want = shape + ((2,) if width == 2 else ())
+        if not (
+            isinstance(array, np.ndarray)
+            and array.dtype == dtype
+            and array.shape == want
+            and array.flags.c_contiguous
+            and array.flags.writeable
+        ):
+            got = f"{array.dtype} {array.shape}" if isinstance(array, np.ndarray) else type(array)
+            raise ValueError(
+                f"out.{name} must be a writable C-contiguous {np.dtype(dtype).name} array "
+                f"of shape {want}, not {got}"
+            )
+        arrays[name] = array
+    return arrays
+
+
+def _output_columns(shape: tuple, out: Reactions | None) -> tuple[BatchOutput, dict]:
+    """dyad_batch_output over `out`'s arrays or new ones, its table as for the inputs."""
+    arrays = _new_outputs(shape) if out is None else _given_outputs(out, shape)
+    data, strides = [], []
+    for name, width in OUTPUTS:
+        data += [_address(arrays[name]) + 8 * k for k in range(width)]
+        strides += [width] * width
+    flags = (_address(arrays["status"]), _address(arrays["field"]))
+    arrays["_table"] = _table(data, strides, flags)
     return BatchOutput.from_buffer(arrays["_table"]), arrays
 
 
-def solve(dyad_type: str, **arrays: object) -> Reactions:
+def solve(dyad_type: str, *, out: Reactions | None = None, **arrays: object) -> Reactions:
     """Solves a batch of dyads of one type ("RRR", "RRT", "RTR", "TRT", "RTT") given as
-    arrays of their fields (see the module's help); one C call for the whole batch."""
+    arrays of their fields (see the module's help); one C call for the whole batch. With
+    `out` (the Reactions of an earlier batch of the same shape) the results are written
+    into its arrays, which are returned: a sweep of many batches allocates nothing."""
     kind = dyad_type.upper() if isinstance(dyad_type, str) else dyad_type
     if kind not in TYPES:
         raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {', '.join(TYPES)}")
     fields = _checked_fields(arrays)
     shape = _batch_shape(fields)
     columns, alive = _input_columns(fields, shape)
-    results, out = _output_columns(shape)
+    results, written = _output_columns(shape, out)
     count = math.prod(shape)
     default_core().solve_batch(kind, count, columns, results)
     del alive  # the inputs were read during the call
-    del out["_table"]
-    return Reactions(**out)
+    if out is not None:
+        return out
+    del written["_table"]
+    return Reactions(**written)
 
 
 __all__ = ["FIELDS", "OUTPUTS", "Reactions", "default_core", "solve"]

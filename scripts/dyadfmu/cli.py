@@ -100,7 +100,7 @@ def _study_command(sub: argparse._SubParsersAction) -> None:
         "extreme and cancelling configurations; write report.md, CSVs and plots.",
     )
     study.add_argument(
-        "--quick", action="store_true", help="small input sets (for CI: under a minute)"
+        "--quick", action="store_true", help="small input sets (for CI: a few minutes)"
     )
     study.add_argument(
         "--out",
@@ -115,6 +115,26 @@ def _study_command(sub: argparse._SubParsersAction) -> None:
         help="CMake build directory with the benchmark and FMUs (default build/)",
     )
     study.set_defaults(run=_study)
+
+
+def _speed_command(sub: argparse._SubParsersAction) -> None:
+    speed = sub.add_parser(
+        "speed",
+        help="each way of calling the core against its floor (the study's speed section)",
+        description="Count under callgrind the closed forms' flops against the solve's, the "
+        "instructions per solve, per FMU step from C (FMI 2 and 3) against the model's "
+        "evaluation, per row of dyad_solve_batch, and time dyadfmu.solve per row; for "
+        "every dyad type and built-in scene. Prints the tables (Markdown); needs valgrind "
+        "and a build with the benchmark (scripts/run-study makes one).",
+    )
+    speed.add_argument("--quick", action="store_true", help="fewer steps and rows (CI)")
+    speed.add_argument(
+        "--build",
+        type=Path,
+        default=None,
+        help="CMake build directory with the benchmark and FMUs (default build/)",
+    )
+    speed.set_defaults(run=_speed)
 
 
 def _scene_command(sub: argparse._SubParsersAction) -> None:
@@ -172,6 +192,7 @@ def parser() -> argparse.ArgumentParser:
     listing.set_defaults(run=_list)
     _run_command(sub)
     _study_command(sub)
+    _speed_command(sub)
     _scene_command(sub)
     _own_commands(sub)
     return top
@@ -194,6 +215,23 @@ def _study(args: argparse.Namespace) -> int:
     _log(f"report written to {report} ({results.elapsed:.0f} s)")
     print(report.read_text())
     print(f"report: {report}")
+    return 0
+
+
+def _speed(args: argparse.Namespace) -> int:
+    import tempfile
+
+    from . import paths
+    from .report import speed as speed_report
+    from .study import speed
+
+    try:
+        with tempfile.TemporaryDirectory() as work:
+            figures = speed.measure(args.build or paths.build_dir(), Path(work), args.quick, _log)
+    except (FileNotFoundError, RuntimeError) as error:
+        print(f"dyadfmu: {error}", file=sys.stderr)
+        return 2
+    print("\n".join(speed_report.markdown(*figures)))
     return 0
 
 

@@ -129,3 +129,27 @@ def test_bad_calls_name_what_is_wrong():
 def test_an_empty_batch_is_empty():
     got = dyadfmu.solve("RTR", m_mass=np.zeros(0))
     assert got.r_mk.shape == (0, 2) and got.status.shape == (0,)
+
+
+def test_out_takes_the_results_in_place():
+    rows = random_set("RTR", 40, seed=11)
+    first = dyadfmu.solve("RTR", **keywords(rows))
+    kept = {name: getattr(first, name) for name in first.__dataclass_fields__}
+    other = random_set("RTR", 40, seed=12)
+    again = dyadfmu.solve("RTR", out=first, **keywords(other))
+    fresh = dyadfmu.solve("RTR", **keywords(other))
+    assert again is first
+    for name, array in kept.items():
+        assert getattr(again, name) is array  # the same arrays, overwritten
+        np.testing.assert_array_equal(array, getattr(fresh, name))
+
+
+def test_out_of_another_shape_is_refused_by_name():
+    rows = random_set("RRR", 10, seed=5)
+    small = dyadfmu.solve("RRR", **keywords(rows[:4]))
+    with pytest.raises(ValueError, match=r"out\.r_mk must be .* shape \(10, 2\)"):
+        dyadfmu.solve("RRR", out=small, **keywords(rows))
+    frozen = dyadfmu.solve("RRR", **keywords(rows))
+    frozen.status.flags.writeable = False
+    with pytest.raises(ValueError, match=r"out\.status must be a writable"):
+        dyadfmu.solve("RRR", out=frozen, **keywords(rows))

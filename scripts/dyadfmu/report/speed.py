@@ -19,12 +19,16 @@ def _mark(met: bool) -> str:
     return "met" if met else "**not met**"
 
 
+def _per_row(seconds: float) -> str:
+    return f"{seconds * 1e9:.0f} ns ({1 / seconds / 1e6:.1f} M/s)"
+
+
 def _type_rows(types: list[TypeSpeed]) -> list[str]:
     lines = [
         "| type | closed-form flops | flops per solve (ratio) | instructions per solve "
         "| per FMU step, FMI 2 / 3 | step / bare call | step / (call + directions) "
-        "| per batch row | NumPy time per row (rows/s) |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| per batch row | NumPy per row, new outputs | NumPy per row, out= |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for t in types:
         two, three = t.steps[2], t.steps[3]
@@ -34,8 +38,8 @@ def _type_rows(types: list[TypeSpeed]) -> list[str]:
             f"| {t.solve_instructions:.0f} | {two.step:.0f} / {three.step:.0f} "
             f"| {two.ratio:.2f} / {three.ratio:.2f} "
             f"| {two.ratio_with_directions:.2f} / {three.ratio_with_directions:.2f} "
-            f"| {t.batch_instructions:.0f} | {t.numpy_seconds_per_row * 1e9:.0f} ns "
-            f"({1 / t.numpy_seconds_per_row / 1e6:.1f} M) |"
+            f"| {t.batch_instructions:.0f} | {_per_row(t.numpy_seconds_per_row[False])} "
+            f"| {_per_row(t.numpy_seconds_per_row[True])} |"
         )
     return lines
 
@@ -61,7 +65,7 @@ def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
     worst_step = max(s.ratio for s in steps)
     worst_with_directions = max(s.ratio_with_directions for s in steps)
     rrr = next(t for t in types if t.dyad == "RRR")
-    rate = 1 / rrr.numpy_seconds_per_row
+    rate = 1 / rrr.numpy_seconds_per_row[True]
     return [
         "",
         f"- Solve within {FLOPS_TARGET:g}x its closed forms' operations: worst "
@@ -70,7 +74,8 @@ def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         f"worst {worst_step:.2f}x, {_mark(worst_step <= STEP_TARGET)}; counting the "
         f"directions of the angle inputs (dyadfmu/angle.h) with the call, worst "
         f"{worst_with_directions:.2f}x, {_mark(worst_with_directions <= STEP_TARGET)}.",
-        f"- RRR from NumPy: {rate / 1e6:.1f} M rows/s against {ROWS_PER_SECOND_TARGET / 1e6:g} M, "
+        f"- RRR from NumPy (outputs reused): {rate / 1e6:.1f} M rows/s against "
+        f"{ROWS_PER_SECOND_TARGET / 1e6:g} M, "
         f"{_mark(rate >= ROWS_PER_SECOND_TARGET)}.",
     ]
 
@@ -89,7 +94,10 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "`dyad_solve_batch` (one call over rows read in place). Flops: adds, "
         "subtracts, multiplies, divides and square roots executed, against the closed forms' "
         "count atop `src/dyad_<type>.c`. Time per row: the best of a few calls of "
-        "`dyadfmu.solve` on contiguous arrays of 10,000 rows (they fit the caches).",
+        "`dyadfmu.solve` on contiguous arrays of 10,000 rows (they fit the caches), its "
+        "outputs new on every call (each call's allocations may fault their pages in again: "
+        "the figure varies by up to 2x between runs) or written into the last call's "
+        "(`out=`).",
         "",
         *_type_rows(types),
         "",
@@ -114,6 +122,7 @@ def write_csv(path: Path, types: list[TypeSpeed], scenes: list[SceneSpeed]) -> N
                 "instructions_per_step_in_directions",
                 "instructions_per_batch_row",
                 "numpy_seconds_per_row",
+                "numpy_seconds_per_row_out",
             ]
         )
         for t in types:
@@ -122,11 +131,12 @@ def write_csv(path: Path, types: list[TypeSpeed], scenes: list[SceneSpeed]) -> N
                     [t.dyad, version, t.closed_form_flops, f"{t.solve_flops:.1f}"]
                     + [f"{t.solve_instructions:.1f}", f"{s.step:.1f}", f"{s.evaluate:.1f}"]
                     + [f"{s.directions:.1f}", f"{t.batch_instructions:.1f}"]
-                    + [f"{t.numpy_seconds_per_row:.4g}"]
+                    + [f"{t.numpy_seconds_per_row[False]:.4g}"]
+                    + [f"{t.numpy_seconds_per_row[True]:.4g}"]
                 )
         for scene in scenes:
             for version, s in scene.steps.items():
                 out.writerow(
                     [scene.scene, version, "", "", "", f"{s.step:.1f}", f"{s.evaluate:.1f}"]
-                    + [f"{s.directions:.1f}", "", ""]
+                    + [f"{s.directions:.1f}", "", "", ""]
                 )

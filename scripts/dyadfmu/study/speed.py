@@ -67,7 +67,8 @@ class TypeSpeed:
     solve_instructions: float
     steps: dict[int, Step] = field(default_factory=dict)
     batch_instructions: float = math.nan
-    numpy_seconds_per_row: float = math.nan
+    #: dyadfmu.solve's time per row, keyed by whether the outputs were reused (out=)
+    numpy_seconds_per_row: dict[bool, float] = field(default_factory=dict)
 
 
 @dataclass
@@ -200,14 +201,15 @@ def batch_instructions(build: Path, dyad: str, rows: np.ndarray, work: Path) -> 
     return _collected(out) / len(rows)
 
 
-def numpy_seconds_per_row(dyad: str, rows: np.ndarray, repeat: int) -> float:
-    """Best time per row of :func:`dyadfmu.solve` over `rows` (arrays made beforehand)."""
+def numpy_seconds_per_row(dyad: str, rows: np.ndarray, repeat: int, reuse: bool) -> float:
+    """Best time per row of :func:`dyadfmu.solve` over `rows` (arrays made beforehand), its
+    outputs new on every call or, with `reuse`, written into the last call's (``out=``)."""
     keywords = {k: np.ascontiguousarray(v) for k, v in batch_keywords(rows).items()}
-    solve(dyad, **keywords)  # warm: the library loaded, the pages touched
+    out = solve(dyad, **keywords)  # warm: the library loaded, the pages touched
     best = math.inf
     for _ in range(repeat):
         started = clock.perf_counter()
-        solve(dyad, **keywords)
+        solve(dyad, out=out if reuse else None, **keywords)
         best = min(best, clock.perf_counter() - started)
     return best / len(rows)
 
@@ -237,7 +239,10 @@ def measure(
             )
         figures.batch_instructions = batch_instructions(build, dyad, rows[:batch_rows], work)
         many = np.resize(rows, (NUMPY_ROWS, rows.shape[1]))
-        figures.numpy_seconds_per_row = numpy_seconds_per_row(dyad, many, 21 if quick else 201)
+        for reuse in (False, True):
+            figures.numpy_seconds_per_row[reuse] = numpy_seconds_per_row(
+                dyad, many, 21 if quick else 201, reuse
+            )
         types.append(figures)
     scenes = []
     for scene in builtin_scenes():
