@@ -9,6 +9,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 enum {
     ALL_STATES = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION | FMU_STATE_STEP |
@@ -218,6 +221,8 @@ static void build_slots(fmu_instance* instance)
     for (vr = 0; vr < model->vr_limit; ++vr) {
         build_slot(instance, vr, &instance->slots[vr]);
     }
+    instance->set_plan.count = 0; /* the accepted intervals changed */
+    instance->get_plan.count = 0;
 }
 
 static void find_angles(fmu_instance* instance)
@@ -235,9 +240,30 @@ static void find_angles(fmu_instance* instance)
     }
 }
 
+/* A plan's arrays for up to `capacity` values, aligned. */
+static size_t plan_size(size_t capacity)
+{
+    return round_up(capacity * sizeof(unsigned int)) + 2 * round_up(capacity * sizeof(double)) +
+           2 * round_up(capacity * sizeof(double*));
+}
+
+static void place_plan(fmu_plan* plan, char* at, size_t capacity)
+{
+    plan->count = 0;
+    plan->vr = (unsigned int*)(void*)at;
+    at += round_up(capacity * sizeof(unsigned int));
+    plan->low = (double*)(void*)at;
+    at += round_up(capacity * sizeof(double));
+    plan->high = (double*)(void*)at;
+    at += round_up(capacity * sizeof(double));
+    plan->write = (double**)(void*)at;
+    at += round_up(capacity * sizeof(double*));
+    plan->read = (const double**)(void*)at;
+}
+
 /* The instance and everything it owns in one block: its parts, aligned. */
 typedef struct instance_layout {
-    size_t values, slots, angles, input, output, name, total;
+    size_t values, slots, plans, angles, input, output, name, total;
 } instance_layout;
 
 static instance_layout layout_of(const fmu_model* model, const char* instance_name)
@@ -246,7 +272,8 @@ static instance_layout layout_of(const fmu_model* model, const char* instance_na
     const size_t variables = model->variable_count;
     at.values = round_up(sizeof(fmu_instance));
     at.slots = at.values + round_up(variables * sizeof(double));
-    at.angles = at.slots + round_up(model->vr_limit * sizeof(fmu_slot));
+    at.plans = at.slots + round_up(model->vr_limit * sizeof(fmu_slot));
+    at.angles = at.plans + 2 * plan_size(model->vr_limit);
     at.input = at.angles + round_up(variables * sizeof(fmu_angle));
     at.output = at.input + 2 * round_up(model->behaviour->input_size);
     at.name = at.output + 3 * round_up(model->behaviour->output_size);
@@ -261,6 +288,9 @@ static void place_parts(fmu_instance* instance, const instance_layout* at, const
     const size_t output_size = round_up(instance->model->behaviour->output_size);
     instance->values = (double*)(void*)(base + at->values);
     instance->slots = (fmu_slot*)(void*)(base + at->slots);
+    place_plan(&instance->set_plan, base + at->plans, instance->model->vr_limit);
+    place_plan(&instance->get_plan, base + at->plans + plan_size(instance->model->vr_limit),
+               instance->model->vr_limit);
     instance->angles = (fmu_angle*)(void*)(base + at->angles);
     instance->input = base + at->input;
     instance->seed = base + at->input + input_size;
@@ -828,16 +858,87 @@ static int get_reals_at_once(fmu_instance* instance, const unsigned int vr[], si
     return 1;
 }
 
+/* 1 if the call names the same value references as the plan's. */
+static int plan_fits(const fmu_plan* plan, const unsigned int vr[], size_t count)
+{
+    return count == plan->count && count > 0 && memcmp(vr, plan->vr, count * sizeof *vr) == 0;
+}
+
+/* 1 if low[k] <= values[k] <= high[k] for every k (never for a NaN). */
+static int all_within(const double values[], const double low[], const double high[],
+                      size_t count)
+{
+    size_t k = 0;
+    int within = 1;
+#if defined(__SSE2__)
+    __m128d ok = _mm_castsi128_pd(_mm_set1_epi32(-1));
+    for (; k + 2 <= count; k += 2) {
+        const __m128d v = _mm_loadu_pd(values + k);
+        ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpge_pd(v, _mm_loadu_pd(low + k)),
+                                       _mm_cmple_pd(v, _mm_loadu_pd(high + k))));
+    }
+    within = _mm_movemask_pd(ok) == 3;
+#endif
+    for (; k < count; ++k) {
+        within &= values[k] >= low[k] && values[k] <= high[k];
+    }
+    return within;
+}
+
+/* A set by the plan: every value checked, then every one stored. */
+static int set_by_plan(fmu_instance* instance, size_t count, const double values[])
+{
+    const fmu_plan* plan = &instance->set_plan;
+    size_t k;
+    if (!all_within(values, plan->low, plan->high, count)) {
+        return 0;
+    }
+    for (k = 0; k < count; ++k) {
+        *plan->write[k] = values[k];
+    }
+    instance->angles_pending |= instance->angle_count > 0;
+    return 1;
+}
+
+/* The plan of a set the slots accepted (every vr below vr_limit). */
+static void plan_set(fmu_instance* instance, const unsigned int vr[], size_t count)
+{
+    fmu_plan* plan = &instance->set_plan;
+    size_t k;
+    plan->count = 0;
+    if (count > instance->model->vr_limit) {
+        return;
+    }
+    for (k = 0; k < count; ++k) {
+        const fmu_slot* slot = &instance->slots[vr[k]];
+        plan->vr[k] = vr[k];
+        plan->low[k] = slot->low;
+        plan->high[k] = slot->high;
+        plan->write[k] = slot->write;
+    }
+    plan->count = count;
+}
+
 fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         const double values[], const char* function)
 {
     if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK) {
         return FMU_ERROR;
     }
-    if (count > 0 && vr != NULL && values != NULL &&
-        set_reals_at_once(instance, vr, count, values)) {
-        after_set(instance);
-        return FMU_OK;
+    if (count > 0 && vr != NULL && values != NULL) {
+        int accepted;
+        if (plan_fits(&instance->set_plan, vr, count)) {
+            accepted = set_by_plan(instance, count, values);
+        } else {
+            accepted = set_reals_at_once(instance, vr, count, values);
+            if (accepted) {
+                plan_set(instance, vr, count);
+            }
+        }
+        if (accepted) {
+            after_set(instance);
+            return FMU_OK;
+        }
     }
     return set_values(instance, vr, count, values, FMU_REAL, function);
 }
@@ -851,6 +952,22 @@ fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size
     return set_values(instance, vr, count, values, FMU_INTEGER, function);
 }
 
+/* The plan of a get the slots accepted (every vr below vr_limit, a Real). */
+static void plan_get(fmu_instance* instance, const unsigned int vr[], size_t count)
+{
+    fmu_plan* plan = &instance->get_plan;
+    size_t k;
+    plan->count = 0;
+    if (count > instance->model->vr_limit) {
+        return;
+    }
+    for (k = 0; k < count; ++k) {
+        plan->vr[k] = vr[k];
+        plan->read[k] = instance->slots[vr[k]].read;
+    }
+    plan->count = count;
+}
+
 fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         double values[], const char* function)
 {
@@ -858,8 +975,21 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
     if (fmu_check_call(instance, FMU_OP_GET, function) != FMU_OK) {
         return FMU_ERROR;
     }
-    if (vr != NULL && values != NULL &&
-        get_reals_at_once(instance, vr, count, values, &solved, function)) {
+    if (vr == NULL || values == NULL) {
+        return get_values(instance, vr, count, values, FMU_REAL, 1, function);
+    }
+    if (!instance->dirty && instance->evaluation.status == FMU_OK &&
+        plan_fits(&instance->get_plan, vr, count)) {
+        /* after a step, the same outputs again: read where the plan says */
+        const double** read = instance->get_plan.read;
+        size_t k;
+        for (k = 0; k < count; ++k) {
+            values[k] = *read[k];
+        }
+        return FMU_OK;
+    }
+    if (get_reals_at_once(instance, vr, count, values, &solved, function)) {
+        plan_get(instance, vr, count);
         return solved;
     }
     return get_values(instance, vr, count, values, FMU_REAL, 1, function);

@@ -65,6 +65,18 @@ typedef struct fmu_slot {
     int is_output;      /* the value is the model's: evaluate before reading */
 } fmu_slot;
 
+/* The places of the last Real set or get that the slots accepted, by position,
+ * so that the same call again (the same value references: an importer repeats
+ * its calls every step) is one vector check of the values and a copy. */
+typedef struct fmu_plan {
+    size_t count;        /* of the call; 0: none */
+    unsigned int* vr;    /* its value references */
+    double* low;         /* set: each value's accepted interval */
+    double* high;        /* (contiguous for a vector check) */
+    double** write;      /* set: where each value goes */
+    const double** read; /* get: where each value is read */
+} fmu_plan;
+
 /* An angle variable: kept as set, read by the model as its unit vector. */
 typedef struct fmu_angle {
     const double* angle; /* as set (rad) */
@@ -88,6 +100,8 @@ typedef struct fmu_instance {
     fmu_evaluation evaluation; /* of the last evaluation */
     double* values;            /* one per variable, as set; outputs unused */
     fmu_slot* slots;           /* one per value reference below model->vr_limit */
+    fmu_plan set_plan;         /* of at most model->vr_limit values each */
+    fmu_plan get_plan;
     fmu_angle* angles;         /* the angle variables, angle_count of them */
     size_t angle_count;
     int angles_pending; /* an angle may have changed since the input's (cos, sin) */

@@ -645,6 +645,63 @@ static int test_fmi2_invalid_values(void)
     return fails;
 }
 
+/* The same set or get again (an importer's every step) keeps every check: a parameter
+ * set in initialization is refused once it closes, an invalid value among valid ones
+ * stores none of them (a repeated reference included), and a get reads the new values. */
+static int test_fmi2_repeated_calls_keep_their_checks(void)
+{
+    int fails = 0;
+    probe_log_book book;
+    fmi2Component c = new_fmi2(&book, "repeated");
+    unsigned inputs[4], parameter = 0;
+    double values[4], got[4], before[4];
+    size_t n = 0, k;
+    int have_parameter = 0;
+    for (k = 0; k < md2.variable_count; ++k) {
+        const probe_variable* v = &md2.variables[k];
+        if (v->type == PROBE_REAL && v->causality == PROBE_INPUT && n < 3) {
+            inputs[n] = v->vr;
+            values[n++] = other_value(v);
+        } else if (v->type == PROBE_REAL && v->causality == PROBE_PARAMETER && !have_parameter) {
+            parameter = v->vr;
+            have_parameter = 1;
+        }
+    }
+    if (n < 3 || !have_parameter) {
+        api2.FreeInstance(c);
+        return fails; /* a model without three inputs and a parameter */
+    }
+    inputs[n] = inputs[0]; /* a repeated reference */
+    values[n++] = values[0];
+    CHECK(api2.SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0) == fmi2OK &&
+              api2.EnterInitializationMode(c) == fmi2OK,
+          "initialise");
+    for (k = 0; k < 2; ++k) {
+        const double value = 0.5 + (double)k;
+        CHECK(api2.SetReal(c, &parameter, 1, &value) == fmi2OK, "parameter set %zu", k);
+    }
+    CHECK(api2.ExitInitializationMode(c) <= fmi2Warning, "exit");
+    CHECK(api2.SetReal(c, &parameter, 1, &(double){2.5}) == fmi2Error,
+          "a closed parameter accepted by a repeated call");
+    CHECK(api2.GetReal(c, &parameter, 1, got) == fmi2OK && got[0] == 1.5, "parameter %g",
+          got[0]);
+    for (k = 0; k < 3; ++k) {
+        CHECK(api2.SetReal(c, inputs, n, values) == fmi2OK, "inputs set, round %zu", k);
+        CHECK(api2.GetReal(c, inputs, n, got) == fmi2OK && got[1] == values[1] &&
+                  got[n - 1] == values[0],
+              "inputs read back, round %zu", k);
+        values[1] += 0.125;
+    }
+    CHECK(api2.GetReal(c, inputs, n, before) == fmi2OK, "read");
+    values[0] += 0.25;
+    values[2] = NAN;
+    CHECK(api2.SetReal(c, inputs, n, values) == fmi2Error, "NaN among valid values accepted");
+    CHECK(api2.GetReal(c, inputs, n, got) == fmi2OK && memcmp(got, before, sizeof got) == 0,
+          "a refused set changed a value");
+    api2.FreeInstance(c);
+    return fails;
+}
+
 /* Reset brings back every start value and the Instantiated state. */
 static int test_fmi2_reset(void)
 {
@@ -2025,6 +2082,7 @@ static const named_test generic_tests[] = {
     {"fmi2_null_arguments", test_fmi2_null_arguments},
     {"fmi2_wrong_types_and_unknown_vrs", test_fmi2_wrong_types_and_unknown_vrs},
     {"fmi2_invalid_values", test_fmi2_invalid_values},
+    {"fmi2_repeated_calls_keep_their_checks", test_fmi2_repeated_calls_keep_their_checks},
     {"fmi2_reset", test_fmi2_reset},
     {"fmi2_instantiate_refusals", test_fmi2_instantiate_refusals},
     {"fmi3_state_machine", test_fmi3_state_machine},
