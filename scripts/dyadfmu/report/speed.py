@@ -46,14 +46,16 @@ def _type_rows(types: list[TypeSpeed]) -> list[str]:
 
 def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
     lines = [
-        "| scene | per step, FMI 2 / 3 | evaluation | step / evaluation, FMI 2 / 3 |",
-        "|---|---:|---:|---:|",
+        "| scene | per step, FMI 2 / 3 | evaluation | directions | step / evaluation "
+        "| step / (evaluation + directions) |",
+        "|---|---:|---:|---:|---:|---:|",
     ]
     for s in scenes:
         two, three = s.steps[2], s.steps[3]
         lines.append(
             f"| {s.scene} | {two.step:.0f} / {three.step:.0f} | {two.evaluate:.0f} "
-            f"| {two.ratio:.2f} / {three.ratio:.2f} |"
+            f"| {two.directions:.0f} | {two.ratio:.2f} / {three.ratio:.2f} "
+            f"| {two.ratio_with_directions:.2f} / {three.ratio_with_directions:.2f} |"
         )
     return lines
 
