@@ -865,8 +865,7 @@ static int plan_fits(const fmu_plan* plan, const unsigned int vr[], size_t count
 }
 
 /* 1 if low[k] <= values[k] <= high[k] for every k (never for a NaN). */
-static int all_within(const double values[], const double low[], const double high[],
-                      size_t count)
+static int all_within(const double values[], const double low[], const double high[], size_t count)
 {
     size_t k = 0;
     int within = 1;

@@ -102,7 +102,7 @@ typedef struct fmu_instance {
     fmu_slot* slots;           /* one per value reference below model->vr_limit */
     fmu_plan set_plan;         /* of at most model->vr_limit values each */
     fmu_plan get_plan;
-    fmu_angle* angles;         /* the angle variables, angle_count of them */
+    fmu_angle* angles; /* the angle variables, angle_count of them */
     size_t angle_count;
     int angles_pending; /* an angle may have changed since the input's (cos, sin) */
     int time_at_vr_0;   /* value reference 0 reads the time (FMI 3) */

@@ -683,8 +683,7 @@ static int test_fmi2_repeated_calls_keep_their_checks(void)
     CHECK(api2.ExitInitializationMode(c) <= fmi2Warning, "exit");
     CHECK(api2.SetReal(c, &parameter, 1, &(double){2.5}) == fmi2Error,
           "a closed parameter accepted by a repeated call");
-    CHECK(api2.GetReal(c, &parameter, 1, got) == fmi2OK && got[0] == 1.5, "parameter %g",
-          got[0]);
+    CHECK(api2.GetReal(c, &parameter, 1, got) == fmi2OK && got[0] == 1.5, "parameter %g", got[0]);
     for (k = 0; k < 3; ++k) {
         CHECK(api2.SetReal(c, inputs, n, values) == fmi2OK, "inputs set, round %zu", k);
         CHECK(api2.GetReal(c, inputs, n, got) == fmi2OK && got[1] == values[1] &&
