@@ -899,10 +899,11 @@ static int set_by_plan(fmu_instance* instance, size_t count, const double values
     return 1;
 }
 
-/* The plan of a set the slots accepted (every vr below vr_limit). */
-static void plan_set(fmu_instance* instance, const unsigned int vr[], size_t count)
+/* A plan of a call the slots accepted (every vr below vr_limit), none for a call
+ * longer than the table (a repeated reference: rare, and not planned). */
+static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsigned int vr[],
+                      size_t count)
 {
-    fmu_plan* plan = &instance->set_plan;
     size_t k;
     plan->count = 0;
     if (count > instance->model->vr_limit) {
@@ -914,6 +915,7 @@ static void plan_set(fmu_instance* instance, const unsigned int vr[], size_t cou
         plan->low[k] = slot->low;
         plan->high[k] = slot->high;
         plan->write[k] = slot->write;
+        plan->read[k] = slot->read;
     }
     plan->count = count;
 }
@@ -931,7 +933,7 @@ fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t 
         } else {
             accepted = set_reals_at_once(instance, vr, count, values);
             if (accepted) {
-                plan_set(instance, vr, count);
+                make_plan(instance, &instance->set_plan, vr, count);
             }
         }
         if (accepted) {
@@ -949,22 +951,6 @@ fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size
         return FMU_ERROR;
     }
     return set_values(instance, vr, count, values, FMU_INTEGER, function);
-}
-
-/* The plan of a get the slots accepted (every vr below vr_limit, a Real). */
-static void plan_get(fmu_instance* instance, const unsigned int vr[], size_t count)
-{
-    fmu_plan* plan = &instance->get_plan;
-    size_t k;
-    plan->count = 0;
-    if (count > instance->model->vr_limit) {
-        return;
-    }
-    for (k = 0; k < count; ++k) {
-        plan->vr[k] = vr[k];
-        plan->read[k] = instance->slots[vr[k]].read;
-    }
-    plan->count = count;
 }
 
 fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
@@ -988,7 +974,7 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
         return FMU_OK;
     }
     if (get_reals_at_once(instance, vr, count, values, &solved, function)) {
-        plan_get(instance, vr, count);
+        make_plan(instance, &instance->get_plan, vr, count);
         return solved;
     }
     return get_values(instance, vr, count, values, FMU_REAL, 1, function);

@@ -73,8 +73,8 @@ typedef struct fmu_plan {
     unsigned int* vr;    /* its value references */
     double* low;         /* set: each value's accepted interval */
     double* high;        /* (contiguous for a vector check) */
-    double** write;      /* set: where each value goes */
-    const double** read; /* get: where each value is read */
+    double** write;      /* where a set stores each value */
+    const double** read; /* where a get reads each value */
 } fmu_plan;
 
 /* An angle variable: kept as set, read by the model as its unit vector. */

@@ -108,13 +108,17 @@ def _study_command(sub: argparse._SubParsersAction) -> None:
         default=Path("out/study"),
         help="directory for the report (default ./out/study)",
     )
-    study.add_argument(
+    _build_argument(study)
+    study.set_defaults(run=_study)
+
+
+def _build_argument(command: argparse.ArgumentParser) -> None:
+    command.add_argument(
         "--build",
         type=Path,
         default=None,
         help="CMake build directory with the benchmark and FMUs (default build/)",
     )
-    study.set_defaults(run=_study)
 
 
 def _speed_command(sub: argparse._SubParsersAction) -> None:
@@ -128,12 +132,7 @@ def _speed_command(sub: argparse._SubParsersAction) -> None:
         "and a build with the benchmark (scripts/run-study makes one).",
     )
     speed.add_argument("--quick", action="store_true", help="fewer steps and rows (CI)")
-    speed.add_argument(
-        "--build",
-        type=Path,
-        default=None,
-        help="CMake build directory with the benchmark and FMUs (default build/)",
-    )
+    _build_argument(speed)
     speed.set_defaults(run=_speed)
 
 
