@@ -3,6 +3,9 @@ compressed per-instruction positions, and the closed forms' counts atop each typ
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -58,3 +61,16 @@ def test_a_missing_count_is_named(tmp_path: Path):
     (tmp_path / "src" / "dyad_rrr.c").write_text("/* no count */\n")
     with pytest.raises(ValueError, match="dyad_rrr.c"):
         closed_form_flops("RRR", tmp_path)
+
+
+def test_speed_command_names_a_missing_benchmark(tmp_path: Path):
+    done = subprocess.run(
+        [sys.executable, "-m", "dyadfmu.cli", "speed", "--build", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    if shutil.which("valgrind") is None:
+        assert done.returncode == 2 and "valgrind" in done.stderr
+        return
+    assert done.returncode == 2 and "dyad_bench is missing" in done.stderr, done.stderr
