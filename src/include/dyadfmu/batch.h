@@ -18,7 +18,7 @@ extern "C" {
 #endif
 
 /** Rows gathered, solved and scattered together. */
-#define DYAD_BATCH_BLOCK 8
+#define DYAD_BATCH_BLOCK 16
 
 /** The scalars of a dyad_input, in the order of its fields: link m, link n
  *  (dir.x, dir.y, length, omega, epsilon, accel_d.x, accel_d.y, com.x, com.y,
