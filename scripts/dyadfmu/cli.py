@@ -100,7 +100,7 @@ def _study_command(sub: argparse._SubParsersAction) -> None:
         "extreme and cancelling configurations; write report.md, CSVs and plots.",
     )
     study.add_argument(
-        "--quick", action="store_true", help="small input sets (for CI: a few minutes)"
+        "--quick", action="store_true", help="small input sets (for CI: under a minute)"
     )
     study.add_argument(
         "--out",

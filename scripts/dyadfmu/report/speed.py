@@ -95,11 +95,10 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "it, the directions are the unit vectors of the angles that changed), per row of "
         "`dyad_solve_batch` (one call over rows read in place). Flops: adds, "
         "subtracts, multiplies, divides and square roots executed, against the closed forms' "
-        "count atop `src/dyad_<type>.c`. Time per row: the best of a few calls of "
-        "`dyadfmu.solve` on contiguous arrays of 10,000 rows (they fit the caches), its "
-        "outputs new on every call (each call's allocations may fault their pages in again: "
-        "the figure varies by up to 2x between runs) or written into the last call's "
-        "(`out=`).",
+        "count atop `src/dyad_<type>.c`. Time per row: the best call of `dyadfmu.solve` on "
+        "contiguous arrays of 10,000 rows (they fit the caches), over rounds that visit "
+        "every type in turn (this shared machine has slow spells), its outputs new on every "
+        "call or written into the last call's (`out=`).",
         "",
         *_type_rows(types),
         "",
