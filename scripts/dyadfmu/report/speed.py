@@ -19,6 +19,11 @@ def _mark(met: bool) -> str:
     return "met" if met else "**not met**"
 
 
+def _both(two: float, three: float, digits: int = 2) -> str:
+    """An FMI 2 figure and its FMI 3 twin."""
+    return f"{two:.{digits}f} / {three:.{digits}f}"
+
+
 def _per_row(seconds: float) -> str:
     return f"{seconds * 1e9:.0f} ns ({1 / seconds / 1e6:.1f} M/s)"
 
@@ -26,21 +31,25 @@ def _per_row(seconds: float) -> str:
 def _type_rows(types: list[TypeSpeed]) -> list[str]:
     lines = [
         "| type | closed-form flops | flops per solve (ratio) | instructions per solve "
-        "| per FMU step, FMI 2 / 3 | step / bare call | step / (call + directions) "
+        "| per FMU step, FMI 2 / 3 | step / evaluation | step / (evaluation + directions) "
         "| per batch row | NumPy per row, new outputs | NumPy per row, out= |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for t in types:
         two, three = t.steps[2], t.steps[3]
-        lines.append(
-            f"| {t.dyad} | {t.closed_form_flops} "
-            f"| {t.solve_flops:.0f} ({t.solve_flops / t.closed_form_flops:.2f}) "
-            f"| {t.solve_instructions:.0f} | {two.step:.0f} / {three.step:.0f} "
-            f"| {two.ratio:.2f} / {three.ratio:.2f} "
-            f"| {two.ratio_with_directions:.2f} / {three.ratio_with_directions:.2f} "
-            f"| {t.batch_instructions:.0f} | {_per_row(t.numpy_seconds_per_row[False])} "
-            f"| {_per_row(t.numpy_seconds_per_row[True])} |"
-        )
+        cells = [
+            t.dyad,
+            str(t.closed_form_flops),
+            f"{t.solve_flops:.0f} ({t.solve_flops / t.closed_form_flops:.2f})",
+            f"{t.solve_instructions:.0f}",
+            _both(two.step, three.step, 0),
+            _both(two.ratio, three.ratio),
+            _both(two.ratio_with_directions, three.ratio_with_directions),
+            f"{t.batch_instructions:.0f}",
+            _per_row(t.numpy_seconds_per_row[False]),
+            _per_row(t.numpy_seconds_per_row[True]),
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
     return lines
 
 
@@ -52,11 +61,15 @@ def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
     ]
     for s in scenes:
         two, three = s.steps[2], s.steps[3]
-        lines.append(
-            f"| {s.scene} | {two.step:.0f} / {three.step:.0f} | {two.evaluate:.0f} "
-            f"| {two.directions:.0f} | {two.ratio:.2f} / {three.ratio:.2f} "
-            f"| {two.ratio_with_directions:.2f} / {three.ratio_with_directions:.2f} |"
-        )
+        cells = [
+            s.scene,
+            _both(two.step, three.step, 0),
+            f"{two.evaluate:.0f}",
+            f"{two.directions:.0f}",
+            _both(two.ratio, three.ratio),
+            _both(two.ratio_with_directions, three.ratio_with_directions),
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
     return lines
 
 
