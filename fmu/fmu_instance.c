@@ -730,49 +730,22 @@ static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], si
     return FMU_OK;
 }
 
-/* Values set in one pass, each checked and stored at once, with the earlier
- * ones put back if a later one is refused; a longer call checks all first. */
-enum { SET_IN_ONE_PASS = 64 };
-
-/* The common case of set_values, by the slots alone: every value valid. */
+/* The common case of set_values, by the slots alone: every value valid. A call
+ * the plan does not cover yet (its first, say) checks every value, then stores. */
 static int set_reals_at_once(fmu_instance* instance, const unsigned int vr[], size_t count,
                              const double values[])
 {
     const unsigned int limit = instance->model->vr_limit;
     const fmu_slot* slots = instance->slots;
-    double before[SET_IN_ONE_PASS];
     size_t k;
-    if (count > SET_IN_ONE_PASS) {
-        for (k = 0; k < count; ++k) {
-            const double value = values[k];
-            if (vr[k] >= limit || !(value >= slots[vr[k]].low && value <= slots[vr[k]].high)) {
-                return 0;
-            }
-        }
-        for (k = 0; k < count; ++k) {
-            *slots[vr[k]].write = values[k];
-        }
-        instance->angles_pending |= instance->angle_count > 0;
-        return 1;
-    }
     for (k = 0; k < count; ++k) {
         const double value = values[k];
-        const fmu_slot* slot;
-        if (vr[k] >= limit) {
-            break;
+        if (vr[k] >= limit || !(value >= slots[vr[k]].low && value <= slots[vr[k]].high)) {
+            return 0;
         }
-        slot = &slots[vr[k]];
-        if (!(value >= slot->low && value <= slot->high)) {
-            break;
-        }
-        before[k] = *slot->write;
-        *slot->write = value;
     }
-    if (k < count) {
-        while (k-- > 0) { /* in reverse: a repeated reference ends as it began */
-            *slots[vr[k]].write = before[k];
-        }
-        return 0;
+    for (k = 0; k < count; ++k) {
+        *slots[vr[k]].write = values[k];
     }
     instance->angles_pending |= instance->angle_count > 0;
     return 1;
@@ -835,16 +808,6 @@ static int get_reals_at_once(fmu_instance* instance, const unsigned int vr[], si
     const fmu_slot* slots = instance->slots;
     int have_solved = 0;
     size_t k;
-    if (!instance->dirty && instance->evaluation.status == FMU_OK) {
-        /* after a step: every output is up to date, and reading one succeeds */
-        for (k = 0; k < count; ++k) {
-            if (vr[k] >= limit || slots[vr[k]].read == NULL) {
-                return 0;
-            }
-            values[k] = *slots[vr[k]].read;
-        }
-        return 1;
-    }
     for (k = 0; k < count; ++k) {
         if (vr[k] >= limit || slots[vr[k]].read == NULL) {
             return 0;

@@ -167,22 +167,26 @@ def _table(data: list[int], strides: list[int], tail: tuple[int, ...] = ()) -> n
     return np.array(words + list(tail), np.int64)
 
 
-def _input_columns(fields: dict[str, np.ndarray], shape: tuple) -> tuple[BatchInput, list]:
+def _input_columns(
+    fields: dict[str, np.ndarray], shape: tuple
+) -> tuple[BatchInput, list, list[tuple[int, int]]]:
     """dyad_batch_input over the fields' arrays, sharing one int64 table: built from plain
-    lists, it keeps a call's fixed cost far below a ctypes attribute per column."""
+    lists, it keeps a call's fixed cost far below a ctypes attribute per column. Also
+    what keeps the arrays alive, and the bytes each one spans."""
     data, strides = [0] * INPUT_COLUMN_COUNT, [0] * INPUT_COLUMN_COUNT
-    alive, c = [], 0
+    alive, spans, c = [], [], 0
     for name, width in FIELDS:
         if name in fields:
             source, stride = _column_source(fields[name], width, shape)
             alive.append(source)
             address = _address(source)
+            spans.append(_span(source, address))
             for k in range(width):
                 data[c + k], strides[c + k] = address + 8 * k, stride
         c += width
     table = _table(data, strides)
     alive.append(table)
-    return BatchInput.from_buffer(table), alive
+    return BatchInput.from_buffer(table), alive, spans
 
 
 def _new_outputs(shape: tuple) -> dict[str, np.ndarray]:
@@ -222,16 +226,41 @@ def _given_outputs(out: Reactions, shape: tuple) -> dict[str, np.ndarray]:
     return arrays
 
 
-def _output_columns(shape: tuple, out: Reactions | None) -> tuple[BatchOutput, dict]:
-    """dyad_batch_output over `out`'s arrays or new ones, its table as for the inputs."""
+def _span(array: np.ndarray, address: int) -> tuple[int, int]:
+    """The bytes an array's elements occupy, first to one past the last."""
+    first = last = address
+    if array.flags.c_contiguous:
+        return first, first + array.nbytes
+    for extent, stride in zip(array.shape, array.strides, strict=True):
+        reach = (extent - 1) * stride
+        first, last = (first + reach, last) if reach < 0 else (first, last + reach)
+    return first, last + array.itemsize
+
+
+def _refuse_overlap(written: dict[str, tuple[int, int]], read: list[tuple[int, int]]) -> None:
+    """A batch's outputs (spans by name) must not share memory with its inputs (spans):
+    the rows are solved in blocks, and an earlier block's results would become a later
+    one's inputs."""
+    inputs = np.array(read, dtype=np.int64).reshape(-1, 2)
+    outputs = np.array(list(written.values()), dtype=np.int64)
+    overlap = (outputs[:, :1] < inputs[:, 1]) & (inputs[:, 0] < outputs[:, 1:])
+    if overlap.any():
+        name = list(written)[int(np.flatnonzero(overlap.any(axis=1))[0])]
+        raise ValueError(f"out.{name} shares memory with an input field: pass a copy")
+
+
+def _output_columns(shape: tuple, out: Reactions | None) -> tuple[BatchOutput, dict, dict]:
+    """dyad_batch_output over `out`'s arrays or new ones, its table as for the inputs,
+    and each array's span by name."""
     arrays = _new_outputs(shape) if out is None else _given_outputs(out, shape)
+    addresses = {name: _address(array) for name, array in arrays.items()}
     data, strides = [], []
     for name, width in OUTPUTS:
-        data += [_address(arrays[name]) + 8 * k for k in range(width)]
+        data += [addresses[name] + 8 * k for k in range(width)]
         strides += [width] * width
-    flags = (_address(arrays["status"]), _address(arrays["field"]))
-    arrays["_table"] = _table(data, strides, flags)
-    return BatchOutput.from_buffer(arrays["_table"]), arrays
+    spans = {name: (a, a + arrays[name].nbytes) for name, a in addresses.items()}
+    arrays["_table"] = _table(data, strides, (addresses["status"], addresses["field"]))
+    return BatchOutput.from_buffer(arrays["_table"]), arrays, spans
 
 
 def solve(dyad_type: str, *, out: Reactions | None = None, **arrays: object) -> Reactions:
@@ -244,8 +273,10 @@ def solve(dyad_type: str, *, out: Reactions | None = None, **arrays: object) -> 
         raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {', '.join(TYPES)}")
     fields = _checked_fields(arrays)
     shape = _batch_shape(fields)
-    columns, alive = _input_columns(fields, shape)
-    results, written = _output_columns(shape, out)
+    columns, alive, read = _input_columns(fields, shape)
+    results, written, spans = _output_columns(shape, out)
+    if out is not None and read:
+        _refuse_overlap(spans, read)
     count = math.prod(shape)
     default_core().solve_batch(kind, count, columns, results)
     del alive  # the inputs were read during the call

@@ -153,3 +153,16 @@ def test_out_of_another_shape_is_refused_by_name():
     frozen.status.flags.writeable = False
     with pytest.raises(ValueError, match=r"out\.status must be a writable"):
         dyadfmu.solve("RRR", out=frozen, **keywords(rows))
+
+
+def test_out_sharing_memory_with_an_input_is_refused():
+    rows = random_set("RRR", 30, seed=8)
+    fields = keywords(rows)
+    first = dyadfmu.solve("RRR", **fields)
+    before = first.n_mk.copy()
+    # an output fed back as an input of the batch that overwrites it
+    with pytest.raises(ValueError, match=r"out\.n_mk shares memory with an input"):
+        dyadfmu.solve("RRR", out=first, **dict(fields, m_moment=first.n_mk))
+    np.testing.assert_array_equal(first.n_mk, before)  # nothing was written
+    # a copy of it is fine
+    dyadfmu.solve("RRR", out=first, **dict(fields, m_moment=first.n_mk.copy()))

@@ -3,6 +3,7 @@ compressed per-instruction positions, and the closed forms' counts atop each typ
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -11,7 +12,7 @@ from pathlib import Path
 import pytest
 from dyadfmu.study import flops
 from dyadfmu.study.configurations import TYPES
-from dyadfmu.study.speed import closed_form_flops
+from dyadfmu.study.speed import closed_form_flops, opening_comment
 
 
 @pytest.mark.parametrize(
@@ -51,9 +52,23 @@ def test_executed_reads_compressed_positions_and_skips_calls(tmp_path: Path):
 
 
 @pytest.mark.parametrize("dyad", TYPES)
-def test_closed_form_count_is_stated_atop_each_type(dyad):
-    # at least the two links' resultants (56) and their sizes (34) of every type
-    assert 90 < closed_form_flops(dyad) < 400
+def test_closed_form_count_adds_up_its_parts(dyad):
+    """The total atop each type's file is the sum of the parts it lists: the resultants,
+    the reactions, and the amplification (the links' sizes, the type's output sizes, the
+    inverse divisor, the data factors)."""
+    _, text = opening_comment(dyad)
+    resultants = re.search(r"resultants 2 x 28 = (\d+)", text)
+    reactions = re.search(r"the reactions above (\d+)", text)
+    amplification = re.search(
+        r"the amplification (\d+) \(dyad_amplification\.h: the links' sizes 2 x 17, this "
+        r"type's output sizes (\d+), 1/\|[^|]+\| (\d+) and .*? conditioning (\d+)\)",
+        text,
+    )
+    assert resultants and reactions and amplification, text
+    total, sizes, inverse, factors = map(int, amplification.groups())
+    assert int(resultants.group(1)) == 2 * 28
+    assert total == 2 * 17 + sizes + inverse + factors
+    assert closed_form_flops(dyad) == 56 + int(reactions.group(1)) + total
 
 
 def test_a_missing_count_is_named(tmp_path: Path):

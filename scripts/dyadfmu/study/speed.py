@@ -79,11 +79,16 @@ class SceneSpeed:
     steps: dict[int, Step] = field(default_factory=dict)
 
 
-def closed_form_flops(dyad: str, root: Path | None = None) -> int:
-    """The closed forms' count stated atop the type's source file ("Closed forms: N flops")."""
+def opening_comment(dyad: str, root: Path | None = None) -> tuple[Path, str]:
+    """The type's source file and its opening comment as one line of text."""
     source = (root or paths.ROOT) / "src" / f"dyad_{dyad.lower()}.c"
     header = source.read_text().split("*/", 1)[0]
-    text = " ".join(line.strip().lstrip("*").strip() for line in header.splitlines())
+    return source, " ".join(line.strip().lstrip("*").strip() for line in header.splitlines())
+
+
+def closed_form_flops(dyad: str, root: Path | None = None) -> int:
+    """The closed forms' count stated atop the type's source file ("Closed forms: N flops")."""
+    source, text = opening_comment(dyad, root)
     match = re.search(r"Closed forms: (\d+) flops", text)
     if match is None:
         raise ValueError(f"{source}: no 'Closed forms: N flops' in its opening comment")

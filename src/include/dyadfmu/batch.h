@@ -4,7 +4,7 @@
  * at row r; it is solved by the same dyad_solve_<type> as a single call, so each
  * row's outputs are bit for bit those of dyad_solve on that row. Nothing is
  * allocated: rows are gathered and scattered in blocks of DYAD_BATCH_BLOCK on
- * the stack (about DYAD_BATCH_BLOCK * 420 bytes for double). Reentrant.
+ * the stack (DYAD_BATCH_BLOCK * 408 bytes for double). Reentrant.
  */
 #ifndef DYADFMU_BATCH_H
 #define DYADFMU_BATCH_H
