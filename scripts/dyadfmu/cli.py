@@ -136,6 +136,45 @@ def _speed_command(sub: argparse._SubParsersAction) -> None:
     speed.set_defaults(run=_speed)
 
 
+def _workers(text: str) -> int:
+    value = int(text)
+    if not 0 <= value <= 256:
+        raise argparse.ArgumentTypeError(f"must be from 0 to 256, got {value}")
+    return value
+
+
+def _sweep_command(sub: argparse._SubParsersAction) -> None:
+    sweep = sub.add_parser(
+        "sweep",
+        help="a design study over many runs on Dask (a study file: scenes/studies/README.md)",
+        description="Read a study file, draw its designs (grid, random or Latin hypercube), "
+        "run each on the mechanism FMU (and the drive FMU for a driven study) on a local Dask "
+        "cluster or an existing one, and write the table (results.csv), the best designs "
+        "(report.md) and a plot (designs.png) to OUT/<study>/. A failed run is a row with "
+        "its status.",
+    )
+    sweep.add_argument("study", type=Path, metavar="STUDY.toml", help="the study file")
+    sweep.add_argument(
+        "--workers",
+        type=_workers,
+        default=2,
+        help="local Dask worker processes (default 2; 0 runs in this process, without Dask)",
+    )
+    sweep.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        default=None,
+        help="the address of an existing Dask scheduler (tcp://host:8786) to run on instead "
+        "of a local cluster; its workers must see the FMU files at the same paths",
+    )
+    sweep.add_argument(
+        "--out", type=Path, default=Path("out/sweep"), help="output folder (default out/sweep)"
+    )
+    sweep.add_argument("--no-plots", action="store_true", help="write the table and report only")
+    _build_argument(sweep)
+    sweep.set_defaults(run=_sweep)
+
+
 def _scene_command(sub: argparse._SubParsersAction) -> None:
     scene = sub.add_parser(
         "scene",
@@ -192,6 +231,7 @@ def parser() -> argparse.ArgumentParser:
     _run_command(sub)
     _study_command(sub)
     _speed_command(sub)
+    _sweep_command(sub)
     _scene_command(sub)
     _own_commands(sub)
     return top
@@ -231,6 +271,24 @@ def _speed(args: argparse.Namespace) -> int:
         print(f"dyadfmu: {error}", file=sys.stderr)
         return 2
     print("\n".join(speed_report.markdown(*figures)))
+    return 0
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from .sweep import study
+    from .sweep.sources import SourceError
+    from .sweep.studyfile import StudyError
+
+    try:
+        result = study.run_study(
+            args.study, args.out, args.workers, args.scheduler, args.build, not args.no_plots
+        )
+    except (StudyError, SourceError, FileNotFoundError, ValueError) as error:
+        print(f"dyadfmu sweep: {error}", file=sys.stderr)
+        return 2
+    print(result.files[1].read_text(encoding="utf-8"))
+    for path in result.files:
+        print(f"wrote {path}")
     return 0
 
 

@@ -1,0 +1,138 @@
+"""Plots and the report of a design study (:mod:`dyadfmu.sweep`): the objective over
+one parameter, a heat map over two (a grid) or a scatter coloured by the objective, the
+Pareto front of the objective against the first constraint's figure, and a Markdown
+summary with the best designs.
+
+Names from the study file reach the Markdown through :func:`markdown_cell` (a study
+file is untrusted input)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.axes import Axes  # noqa: E402
+
+from ..sweep.results import Table, best_designs, feasible, pareto_front  # noqa: E402
+from ..sweep.studyfile import Study  # noqa: E402
+
+__all__ = ["plot_study", "report_text", "markdown_cell"]
+
+
+def markdown_cell(text: str) -> str:
+    """Text safe in a Markdown table cell: one line, no pipes, no markup characters."""
+    out = " ".join(str(text).split())
+    for ch in "\\|*_`<>[]#":
+        out = out.replace(ch, "\\" + ch)
+    return out
+
+
+def _is_grid(table: Table) -> bool:
+    x, y = table.values[:, 0], table.values[:, 1]
+    return len(np.unique(x)) * len(np.unique(y)) == len(table)
+
+
+def _heat_map(ax: Axes, table: Table, z: np.ndarray, label: str) -> None:
+    xs, ys = np.unique(table.values[:, 0]), np.unique(table.values[:, 1])
+    grid = np.full((len(ys), len(xs)), np.nan)
+    for k in range(len(table)):
+        grid[np.searchsorted(ys, table.values[k, 1]), np.searchsorted(xs, table.values[k, 0])] = z[
+            k
+        ]
+    mesh = ax.pcolormesh(xs, ys, grid, shading="nearest", cmap="viridis")
+    plt.colorbar(mesh, ax=ax, label=label)
+
+
+def _design_plot(ax: Axes, table: Table, study: Study, ok: np.ndarray) -> None:
+    ran = np.array([s == "ok" for s in table.status], dtype=bool)
+    z = np.where(ran, table.column(study.objective.minimize), np.nan)
+    x = table.values[:, 0]
+    if table.values.shape[1] == 1:
+        order = np.argsort(x)
+        ax.plot(x[order], z[order], "-", color="0.5")
+        ax.plot(x[ok], z[ok], "o", ms=3, color="C0", label="feasible")
+        ax.set_ylabel(study.objective.minimize)
+        ax.legend(fontsize=8)
+    else:
+        if _is_grid(table):
+            _heat_map(ax, table, z, study.objective.minimize)
+        else:
+            points = ax.scatter(x, table.values[:, 1], c=z, s=12, cmap="viridis")
+            plt.colorbar(points, ax=ax, label=study.objective.minimize)
+        out = ~ok
+        ax.plot(x[out], table.values[out, 1], "x", color="w", ms=5, label="infeasible or failed")
+        ax.legend(fontsize=8, loc="lower right")
+        ax.set_ylabel(table.parameters[1])
+    ax.set_xlabel(table.parameters[0])
+
+
+def _pareto_plot(ax: Axes, table: Table, study: Study) -> None:
+    other = study.objective.constraints[0].figure
+    a, b = table.column(study.objective.minimize), table.column(other)
+    ran = np.array([s == "ok" for s in table.status]) & np.isfinite(a) & np.isfinite(b)
+    ax.scatter(a[ran], b[ran], s=8, color="0.6", label="designs")
+    front = pareto_front(a, b, ran)
+    ax.plot(a[front], b[front], "o-", ms=4, color="C3", label="Pareto front")
+    ax.axhline(study.objective.constraints[0].maximum, color="C0", ls="--", label=f"{other} limit")
+    ax.set_xlabel(study.objective.minimize)
+    ax.set_ylabel(other)
+    ax.legend(fontsize=8)
+
+
+def plot_study(table: Table, study: Study, path: Path) -> Path:
+    """The study's plot: designs against the objective, and the Pareto front where the
+    study has a constraint."""
+    ok = feasible(table, study)
+    panels = 2 if study.objective.constraints else 1
+    fig, axes = plt.subplots(1, panels, figsize=(6.5 * panels, 5), squeeze=False)
+    _design_plot(axes[0][0], table, study, ok)
+    for k in best_designs(table, study)[:1]:
+        if table.values.shape[1] >= 2:
+            axes[0][0].plot(*table.values[k, :2], "r*", ms=14, label="best")
+    if panels == 2:
+        _pareto_plot(axes[0][1], table, study)
+    fig.suptitle(f"{study.name}: {len(table)} designs, {int(ok.sum())} feasible")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def report_text(table: Table, study: Study, seconds: float, workers: str) -> str:
+    """The study's Markdown summary: what ran, the statuses, the best designs."""
+    statuses = {s: table.status.count(s) for s in dict.fromkeys(table.status)}
+    lines = [
+        f"# Study {markdown_cell(study.name)}",
+        "",
+        markdown_cell(study.description),
+        "",
+        f"{len(table)} designs ({study.sampling.method}) run in {seconds:.1f} s on {workers} "
+        "(not counting a local cluster's start): "
+        f"{len(table) / max(seconds, 1e-9):.1f} runs/s. Statuses: "
+        + ", ".join(f"{markdown_cell(s)} {n}" for s, n in statuses.items())
+        + ".",
+        "",
+        f"Best designs by {markdown_cell(study.objective.minimize)}"
+        + (
+            " subject to "
+            + ", ".join(
+                f"{markdown_cell(c.figure)} <= {c.maximum:g}" for c in study.objective.constraints
+            )
+            if study.objective.constraints
+            else ""
+        )
+        + ":",
+        "",
+        "| design | "
+        + " | ".join(map(markdown_cell, table.parameters + table.figure_names))
+        + " |",
+        "|---:|" + "---:|" * (len(table.parameters) + len(table.figure_names)),
+    ]
+    for k in best_designs(table, study):
+        cells = [f"{v:.6g}" for v in (*table.values[k], *table.figures[k])]
+        lines.append(f"| {k} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"

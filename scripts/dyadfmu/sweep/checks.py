@@ -1,0 +1,104 @@
+"""The names of a study checked against its FMUs' model descriptions before anything
+runs: a varied or fixed parameter must be a parameter of its FMU (tunable in the scene),
+a load an input, a figure's series an output or input. A name that is not is refused as
+``StudyError("FILE:LINE: ...")`` with what the FMU has instead."""
+
+from __future__ import annotations
+
+from fmpy.model_description import ModelDescription
+
+from .studyfile import Counterweight, Driven, Study, StudyError, line_of
+
+__all__ = ["check_names", "base_values"]
+
+
+def _fail(study: Study, table: str, index: int | None, key: str, why: str) -> None:
+    line = line_of(study.text, table, index, key)
+    raise StudyError(f"{study.path}:{line}: {why}")
+
+
+def _names(md: ModelDescription, causalities: tuple) -> list:
+    return [v.name for v in md.modelVariables if v.causality in causalities]
+
+
+def _short_list(names: list) -> str:
+    shown = ", ".join(names[:12])
+    return shown + (f", ... ({len(names)} in all)" if len(names) > 12 else "") if names else "none"
+
+
+def _check_parameters(study: Study, md: ModelDescription, what: str) -> None:
+    params = _names(md, ("parameter",))
+    for k, p in enumerate(study.parameters):
+        weight = isinstance(p, Counterweight)
+        wanted = p.needs() if weight else () if p.name.startswith("drive.") else (p.name,)
+        for name in wanted:
+            if name not in params:
+                _fail(
+                    study,
+                    "parameter",
+                    k,
+                    "counterweight" if weight else "name",
+                    f"{name} is not a parameter of {what} (make it tunable in the scene); "
+                    f"its parameters: {_short_list(params)}",
+                )
+    for name, _ in study.fixed:
+        if name not in params:
+            _fail(
+                study,
+                "fixed",
+                None,
+                name,
+                f"{name} is not a parameter of {what}; its parameters: {_short_list(params)}",
+            )
+
+
+def _check_loads(study: Study, md: ModelDescription, what: str) -> None:
+    inputs = [n for n in _names(md, ("input",)) if not n.endswith((".angle", ".omega", ".epsilon"))]
+    for load in study.loads:
+        if load.name not in inputs:
+            _fail(
+                study,
+                "loads",
+                None,
+                load.name,
+                f"{load.name} is not a load input of {what}; its loads: {_short_list(inputs)}",
+            )
+
+
+def _check_figures(
+    study: Study, md: ModelDescription, drive_md: ModelDescription | None, what: str
+) -> None:
+    known = set(_names(md, ("output", "input")))
+    if drive_md is not None:
+        known |= {"drive." + n for n in _names(drive_md, ("output",))}
+    for k, f in enumerate(study.figures):
+        for name in f.of:
+            if name not in known:
+                hint = "; the drive's outputs are drive.NAME" if drive_md is not None else ""
+                _fail(
+                    study,
+                    "figure",
+                    k,
+                    "of",
+                    f"{f.name}: {name} is not an output or input of {what}{hint}",
+                )
+
+
+def check_names(
+    study: Study, md: ModelDescription, drive_md: ModelDescription | None, what: str
+) -> None:
+    """StudyError where a name of the study is not in its FMUs (``what`` names the
+    mechanism FMU in the message)."""
+    if isinstance(study.run, Driven) != (drive_md is not None):
+        raise ValueError("a driven study needs the drive's model description, only it")
+    _check_parameters(study, md, what)
+    _check_loads(study, md, what)
+    _check_figures(study, md, drive_md, what)
+
+
+def base_values(study: Study, md: ModelDescription) -> dict:
+    """The start values of the parameters the counterweights change."""
+    start = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
+    return {
+        n: start[n] for p in study.parameters if isinstance(p, Counterweight) for n in p.needs()
+    }

@@ -1,0 +1,254 @@
+"""One run of a study per design, of one of two kinds:
+
+- :class:`KinetostaticRun`: the mechanism FMU turned through one revolution at constant
+  crank speed (the loads from the study's load case at each angle);
+- :class:`DrivenRun`: the drive FMU (motor and rotor) and the mechanism FMU co-simulated
+  with the stabilised coupling of :mod:`dyadfmu.cosim.mechanism_drive`: at each
+  communication point the mechanism FMU gives its torque at zero crank acceleration
+  and, as its directional derivative, the inertia it adds at the crank; the drive solves
+  the acceleration with both.
+
+A run object holds only data (paths, settings), so that it travels to Dask workers as
+it is; each worker process loads each FMU once (:func:`slave`) and resets it between
+runs. A run that fails returns its status (``singular``, ``cannot_assemble``,
+``diverged``, ``refused``: the FMU refused a parameter value) with the FMU's message and
+NaN figures; it never raises.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from fmpy.model_description import ModelDescription
+
+from ..fmi.slave import Slave, SlaveError
+from .checks import base_values
+from .figures import figure_value, series_names
+from .studyfile import Driven, Kinetostatic, Study
+
+__all__ = ["Outcome", "KinetostaticRun", "DrivenRun", "run_of", "run_rows", "slave", "STATUS_NAMES"]
+
+#: The mechanism FMU's ``status`` output.
+STATUS_NAMES = {0: "ok", 1: "singular", 2: "invalid_input", 3: "out_of_range", 4: "cannot_assemble"}
+
+_SLAVES: dict = {}
+
+
+def slave(path: str, role: str) -> Slave:
+    """This process's instance of the FMU at ``path`` (loaded on first use)."""
+    key = (path, role)
+    if key not in _SLAVES:
+        _SLAVES[key] = Slave(path, instance_name=role, label=role)
+    return _SLAVES[key]
+
+
+def _fresh(path: str, role: str, parameters: dict) -> Slave:
+    """The process's instance, reset and initialised with ``parameters``."""
+    s = slave(path, role)
+    s.reset()
+    s.initialize(parameters)
+    return s
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """A run's figures (by the study's figure order), its status and the FMU's message."""
+
+    figures: tuple
+    status: str
+    message: str = ""
+
+
+class _Failed(Exception):
+    def __init__(self, status: str, message: str):
+        super().__init__(message)
+        self.status, self.message = status, message
+
+
+def _assignments(study_parameters: tuple, values: tuple, base: dict) -> dict:
+    out: dict = {}
+    for p, v in zip(study_parameters, values, strict=True):
+        out.update(p.assign(float(v), base))
+    return out
+
+
+@dataclass(frozen=True)
+class _Common:
+    mechanism: str  # the mechanism FMU's path
+    driver: str  # the crank's name in the mechanism FMU
+    parameters: tuple
+    base: tuple  # ((name, start value), ...) the counterweights read
+    fixed: tuple
+    loads: tuple
+    figures: tuple
+
+    def mechanism_parameters(self, values: tuple) -> dict:
+        """The mechanism FMU's parameters of a design (drive.* left out)."""
+        assigned = dict(self.fixed)
+        assigned.update(_assignments(self.parameters, values, dict(self.base)))
+        return {n: v for n, v in assigned.items() if not n.startswith("drive.")}
+
+    def inputs(self) -> tuple:
+        """The mechanism FMU's inputs a point sets: the crank's motion, then the loads."""
+        crank = tuple(f"{self.driver}.{q}" for q in ("angle", "omega", "epsilon"))
+        return crank + tuple(load.name for load in self.loads)
+
+    def guarded(self, run: Callable[[], Outcome]) -> Outcome:
+        """run(), or the Outcome of its failure (NaN figures and the status)."""
+        nothing = (math.nan,) * len(self.figures)
+        try:
+            return run()
+        except _Failed as e:
+            return Outcome(nothing, e.status, e.message)
+        except SlaveError as e:
+            return Outcome(nothing, "refused" if e.status >= 3 else "discarded", str(e))
+
+    def outcome(self, series: dict, phi: np.ndarray | None) -> Outcome:
+        """The figures over the recorded series."""
+        values = tuple(figure_value(f, series, phi) for f in self.figures)
+        if not all(map(math.isfinite, values)):
+            return Outcome(values, "diverged", "a figure is not finite")
+        return Outcome(values, "ok")
+
+
+def _failed_point(mech: Slave, where: str) -> _Failed:
+    code = mech.get_status()
+    message = mech.messages[-1] if mech.messages else f"outputs not finite {where}"
+    return _Failed(STATUS_NAMES.get(code, f"status {code}") if code else "diverged", message)
+
+
+@dataclass(frozen=True)
+class KinetostaticRun(_Common):
+    """One revolution at constant crank speed ``speed`` (rad/s), ``points`` angles."""
+
+    speed: float = 0.0
+    points: int = 360
+
+    def __call__(self, values: tuple) -> Outcome:
+        """The figures of the design ``values``."""
+        return self.guarded(lambda: self._run(values))
+
+    def _run(self, values: tuple) -> Outcome:
+        mech = _fresh(self.mechanism, "mechanism", self.mechanism_parameters(values))
+        names, inputs = series_names(self.figures), self.inputs()
+        rows = np.empty((self.points, len(names)))
+        for k in range(self.points):
+            phi = 2 * math.pi * k / self.points
+            mech.set(inputs, (phi, self.speed, 0.0) + tuple(ld.at(phi) for ld in self.loads))
+            rows[k] = mech.get(names)
+            if not np.all(np.isfinite(rows[k])):
+                raise _failed_point(mech, f"at crank angle {phi:.6g} rad")
+        return self.outcome(dict(zip(names, rows.T, strict=True)), None)
+
+
+@dataclass(frozen=True)
+class DrivenRun(_Common):
+    """The drive and the mechanism co-simulated; see the module's docstring."""
+
+    drive: str = ""  # the drive FMU's path
+    drive_fixed: tuple = ()
+    step: float = 1e-3
+    duration: float = 1.0
+    settle: float = 0.0
+    start_speed: float = 0.0
+    start_angle: float = 0.0
+
+    def __call__(self, values: tuple) -> Outcome:
+        """The figures of the design ``values``."""
+        return self.guarded(lambda: self._run(values))
+
+    def _drive_parameters(self, values: tuple) -> dict:
+        p = {f"drive.{n}": v for n, v in self.drive_fixed}
+        p.update(_assignments(self.parameters, values, dict(self.base)))
+        p = {n[6:]: v for n, v in p.items() if n.startswith("drive.")}
+        # the crank, its mass and its weight, are the mechanism FMU's
+        p.update(
+            {"crank.mass": 0.0, "start.angle": self.start_angle, "start.speed": self.start_speed}
+        )
+        return p
+
+    def _point(self, d: Slave, y: Slave, t: float, inputs: tuple) -> float:
+        phi, omega = d.get(("crank.angle", "crank.omega"))
+        loads = tuple(ld.at(phi) for ld in self.loads)
+        y.set(inputs, (phi, omega, 0.0) + loads)
+        torque0 = y.get(f"{self.driver}.torque")
+        (j,) = y.directional_derivative((f"{self.driver}.torque",), (inputs[2],), [1.0])
+        if not (math.isfinite(torque0) and math.isfinite(j)):
+            raise _failed_point(y, f"at t = {t:g} s")
+        d.set(("load.torque", "load.inertia"), (-torque0, j))
+        eps = d.get("crank.epsilon")
+        if not all(map(math.isfinite, (phi, omega, eps))):
+            raise _Failed("diverged", f"the crank's motion is not finite at t = {t:g} s")
+        y.set((inputs[2],), (eps,))
+        return phi
+
+    def _run(self, values: tuple) -> Outcome:
+        d = _fresh(self.drive, "drive", self._drive_parameters(values))
+        y = _fresh(self.mechanism, "mechanism", self.mechanism_parameters(values))
+        inputs, names = self.inputs(), series_names(self.figures)
+        own = tuple(n for n in names if not n.startswith("drive."))
+        of_drive = tuple(n[6:] for n in names if n.startswith("drive."))
+        n = int(round(self.duration / self.step))
+        first = int(math.ceil(self.settle / self.step - 1e-9))
+        phis, rows = [], []
+        for k in range(n + 1):
+            phi = self._point(d, y, k * self.step, inputs)
+            if k >= first:
+                phis.append(phi)
+                rows.append(tuple(y.get(own)) + tuple(d.get(of_drive)))
+            if k < n:
+                y.do_step(k * self.step, self.step)
+                d.do_step(k * self.step, self.step)
+        recorded = np.array(rows).reshape(len(rows), len(names))
+        order = own + tuple(f"drive.{q}" for q in of_drive)
+        series = {name: recorded[:, order.index(name)] for name in names}
+        return self.outcome(series, np.unwrap(np.array(phis)))
+
+
+def _crank_of(md: ModelDescription) -> str:
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    drivers = [n[: -len(".angle")] for n in inputs if n.endswith(".angle")]
+    for d in drivers:
+        if {f"{d}.omega", f"{d}.epsilon", f"{d}.torque"} <= {v.name for v in md.modelVariables}:
+            return d
+    raise ValueError(
+        "the study needs a mechanism FMU driven by a crank (inputs CRANK.angle, .omega, "
+        ".epsilon and output CRANK.torque); this FMU has none"
+    )
+
+
+def run_of(
+    study: Study, mechanism: str, drive: str | None, md: ModelDescription
+) -> KinetostaticRun | DrivenRun:
+    """The run of a study on the mechanism FMU at path ``mechanism`` (model description
+    ``md``) and, for a driven study, the drive FMU at ``drive``."""
+    common = dict(
+        mechanism=mechanism,
+        driver=_crank_of(md),
+        parameters=study.parameters,
+        base=tuple(base_values(study, md).items()),
+        fixed=study.fixed,
+        loads=study.loads,
+        figures=study.figures,
+    )
+    if isinstance(study.run, Kinetostatic):
+        return KinetostaticRun(**common, speed=study.run.speed, points=study.run.points)
+    r: Driven = study.run
+    return DrivenRun(
+        **common,
+        drive=str(drive),
+        drive_fixed=r.drive,
+        step=r.step,
+        duration=r.duration,
+        settle=r.settle,
+        start_speed=r.start_speed,
+        start_angle=r.start_angle,
+    )
+
+
+def run_rows(run: KinetostaticRun | DrivenRun, rows: list) -> list:
+    """[(design index, Outcome)] of the designs [(index, values)], in order."""
+    return [(index, run(tuple(values))) for index, values in rows]

@@ -1,0 +1,123 @@
+"""The FMUs a study runs. A study that names an .fmu runs it as it is. A study that
+names a scene runs that scene's mechanism FMU built with the study's parameters tunable:
+the scene is copied to the study's output folder with those parameters added to its
+``tunable`` list, under the identifier ``<identifier>_sweep_<hash of the copy>``, and
+built by scripts/build-scene into build-scene/fmus/ unless that FMU is there already. The
+drive FMU is the build's."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import subprocess
+import tomllib
+from pathlib import Path
+
+from .. import paths
+from .studyfile import Counterweight, Driven, Study
+
+__all__ = ["toml_text", "sweep_scene", "mechanism_fmu", "drive_fmu", "SourceError"]
+
+
+class SourceError(RuntimeError):
+    """An FMU the study needs could not be built or found."""
+
+
+def _value(v: object) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            raise ValueError(f"not a finite number: {v!r}")
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a TOML basic string: JSON's escapes are TOML's
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{json.dumps(k)} = {_value(x)}" for k, x in v.items()) + " }"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def _is_table_array(v: object) -> bool:
+    return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+
+def _table(lines: list, header: str, data: dict) -> None:
+    nested = {k: v for k, v in data.items() if isinstance(v, dict) or _is_table_array(v)}
+    lines.extend(f"{json.dumps(k)} = {_value(v)}" for k, v in data.items() if k not in nested)
+    for k, v in nested.items():
+        name = f"{header}.{json.dumps(k)}" if header else json.dumps(k)
+        for item in v if isinstance(v, list) else [v]:
+            lines.append("")
+            lines.append(f"[[{name}]]" if isinstance(v, list) else f"[{name}]")
+            _table(lines, name, item)
+
+
+def toml_text(data: dict) -> str:
+    """TOML text of parsed TOML data (tables, arrays of tables, strings, numbers, booleans
+    and arrays): every key quoted, every string escaped."""
+    lines: list = []
+    _table(lines, "", data)
+    return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def _varied(study: Study) -> list:
+    names = []
+    for p in study.parameters:
+        names += list(p.needs()) if isinstance(p, Counterweight) else [p.name]
+    names += [n for n, _ in study.fixed]
+    return [n for n in dict.fromkeys(names) if not n.startswith("drive.")]
+
+
+def sweep_scene(study: Study, out: Path) -> Path:
+    """The study's copy of its scene, with the varied parameters tunable (written only
+    when it changed)."""
+    data = tomllib.loads(study.scene.read_text(encoding="utf-8"))
+    scene = data.get("scene", {})
+    tunable = list(scene.get("tunable", []))
+    scene["tunable"] = tunable + [n for n in _varied(study) if n not in tunable]
+    # named by its content: two studies of one scene never share a build they differ in
+    digest = hashlib.sha256(toml_text(data).encode()).hexdigest()[:10]
+    scene["identifier"] = f"{scene.get('identifier', 'scene')}_sweep_{digest}"
+    text = "# the study's scene with its parameters tunable (dyadfmu sweep)\n" + toml_text(data)
+    path = out / f"{scene['identifier']}.toml"
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        out.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _build_scene(scene: Path, identifier: str, fmi: int) -> Path:
+    fmu = paths.ROOT / "build-scene" / "fmus" / f"{identifier}_fmi{fmi}.fmu"
+    if fmu.is_file():  # the identifier names the scene's content
+        return fmu
+    done = subprocess.run(
+        [str(paths.ROOT / "scripts" / "build-scene"), str(scene)],
+        capture_output=True,
+        text=True,
+        env=dict(os.environ),
+    )
+    if done.returncode != 0 or not fmu.is_file():
+        raise SourceError(f"scripts/build-scene {scene} failed:\n{done.stderr[-2000:]}")
+    return fmu
+
+
+def mechanism_fmu(study: Study, out: Path) -> Path:
+    """The mechanism FMU of the study (built from its scene where it names one)."""
+    if study.fmu is not None:
+        return study.fmu
+    scene = sweep_scene(study, out)
+    identifier = tomllib.loads(scene.read_text(encoding="utf-8"))["scene"]["identifier"]
+    return _build_scene(scene, identifier, study.fmi)
+
+
+def drive_fmu(study: Study, build: Path | None) -> Path | None:
+    """The drive FMU of a driven study, None for a kinetostatic one."""
+    if not isinstance(study.run, Driven):
+        return None
+    return paths.built_fmu("drive", study.fmi, build)

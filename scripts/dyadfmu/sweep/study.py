@@ -1,0 +1,82 @@
+"""A study from its file to its table, plot and report (``dyadfmu sweep``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+
+from ..report import sweep as report
+from . import execute, sources
+from .checks import check_names
+from .designs import designs
+from .results import Table, best_designs, table_of, write_csv
+from .runs import DrivenRun, KinetostaticRun, run_of
+from .studyfile import Study, read_study
+
+__all__ = ["SweepResult", "run_study", "prepare"]
+
+
+@dataclass
+class SweepResult:
+    """A finished study: its table, where it was written, how long it took."""
+
+    study: Study
+    table: Table
+    best: list
+    files: list
+    seconds: float
+
+
+def prepare(
+    path: Path, out: Path, build: Path | None = None
+) -> tuple[Study, KinetostaticRun | DrivenRun, np.ndarray]:
+    """(study, run, designs): the study read, its FMUs found or built and its names
+    checked against them, its designs drawn."""
+    study = read_study(path)
+    mechanism = sources.mechanism_fmu(study, out)
+    drive = sources.drive_fmu(study, build)
+    md = read_model_description(str(mechanism))
+    drive_md = read_model_description(str(drive)) if drive is not None else None
+    check_names(study, md, drive_md, mechanism.name)
+    run = run_of(study, str(mechanism), str(drive) if drive else None, md)
+    values = designs(
+        study.sampling, [p.low for p in study.parameters], [p.high for p in study.parameters]
+    )
+    return study, run, values
+
+
+def run_study(
+    path: Path,
+    out: Path,
+    workers: int = 2,
+    scheduler: str | None = None,
+    build: Path | None = None,
+    plots: bool = True,
+) -> SweepResult:
+    """Run a study: ``workers`` = 0 runs it in this process, else on a local Dask cluster
+    of that many processes, or on the cluster at ``scheduler``."""
+    study_out = out / Path(path).stem
+    study_out.mkdir(parents=True, exist_ok=True)
+    study, run, values = prepare(Path(path), study_out, build)
+    progress = execute.Progress(len(values))
+    if workers == 0 and scheduler is None:
+        outcomes, where = execute.run_serial(run, values, progress), "this process"
+    else:
+        outcomes = execute.run_dask(run, values, workers, scheduler, progress)
+        where = (
+            f"the cluster at {scheduler}"
+            if scheduler
+            else f"{workers} local worker" + "s" * (workers > 1)
+        )
+    seconds = progress.seconds()
+    progress.close()
+    table = table_of(study, values, outcomes)
+    files = [study_out / "results.csv", study_out / "report.md"]
+    write_csv(table, files[0])
+    files[1].write_text(report.report_text(table, study, seconds, where), encoding="utf-8")
+    if plots:
+        files.append(report.plot_study(table, study, study_out / "designs.png"))
+    return SweepResult(study, table, best_designs(table, study), files, seconds)

@@ -1,0 +1,529 @@
+"""A study file (TOML) read into typed data: what FMUs, which parameters over which
+ranges, how each design runs, the load case, the figures and the objective.
+
+Everything in a study file is untrusted input. A problem is refused as
+``StudyError("FILE:LINE: what is wrong")``, naming the key; nothing runs then. The
+format is described in scenes/studies/README.md.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import NoReturn
+
+__all__ = [
+    "StudyError",
+    "Parameter",
+    "Counterweight",
+    "LoadTable",
+    "Figure",
+    "Constraint",
+    "Objective",
+    "Sampling",
+    "Kinetostatic",
+    "Driven",
+    "Study",
+    "read_study",
+    "line_of",
+    "STATS",
+    "SAMPLING_METHODS",
+]
+
+#: What a figure makes of its series (see :mod:`dyadfmu.sweep.figures`).
+STATS = ("peak", "rms", "mean", "min", "max", "fluctuation", "work_per_revolution")
+SAMPLING_METHODS = ("grid", "random", "lhs")
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
+#: The drive FMU's parameters a study may set or vary (as ``drive.<name>``).
+DRIVE_PARAMETERS = ("motor.stall_torque", "motor.no_load_speed", "inertia")
+
+
+class StudyError(ValueError):
+    """A study file refused: the message starts with FILE:LINE."""
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A varied FMU parameter: ``name`` of the mechanism FMU, or ``drive.<name>`` of the
+    drive FMU, from ``low`` to ``high`` (its unit is the FMU's)."""
+
+    name: str
+    low: float
+    high: float
+
+    def assign(self, value: float, base: dict) -> dict:
+        """The FMU parameter values this design value sets: {fmu variable name: value}."""
+        return {self.name: value}
+
+    def needs(self) -> tuple:
+        """The FMU parameters whose start values :meth:`assign` reads."""
+        return ()
+
+
+@dataclass(frozen=True)
+class Counterweight:
+    """A point mass (kg, from ``low`` to ``high``) added to link ``link`` at ``at`` (m, in
+    the link's frame): it changes the link's mass, centre of mass and inertia about it."""
+
+    name: str
+    low: float
+    high: float
+    link: str
+    at: tuple
+
+    def needs(self) -> tuple:
+        """The link's mass, centre of mass and inertia, as the FMU starts with them."""
+        return tuple(f"{self.link}.{p}" for p in ("mass", "com.x", "com.y", "inertia"))
+
+    def assign(self, value: float, base: dict) -> dict:
+        """The link's parameters with the mass ``value`` added at ``at``."""
+        m0, cx, cy, i0 = (base[n] for n in self.needs())
+        ax, ay = self.at
+        mass = m0 + value
+        if not mass > 0:
+            return {f"{self.link}.mass": mass}
+        gx, gy = (m0 * cx + value * ax) / mass, (m0 * cy + value * ay) / mass
+        inertia = (
+            i0 + m0 * ((cx - gx) ** 2 + (cy - gy) ** 2) + value * ((ax - gx) ** 2 + (ay - gy) ** 2)
+        )
+        names = self.needs()
+        return dict(zip(names, (mass, gx, gy, inertia), strict=True))
+
+
+@dataclass(frozen=True)
+class LoadTable:
+    """An input of the mechanism FMU as a periodic function of the crank angle: linear
+    between (angle [rad], value) points over one revolution from angle[0]."""
+
+    name: str
+    angle: tuple
+    value: tuple
+
+    def at(self, phi: float) -> float:
+        """The load at crank angle ``phi`` (rad)."""
+        a0 = self.angle[0]
+        x = a0 + (phi - a0) % (2 * math.pi)
+        angles = self.angle + (a0 + 2 * math.pi,)
+        values = self.value + (self.value[0],)
+        for k in range(len(angles) - 1):
+            if x <= angles[k + 1]:
+                span = angles[k + 1] - angles[k]
+                w = (x - angles[k]) / span if span > 0 else 1.0
+                return values[k] + w * (values[k + 1] - values[k])
+        return values[-1]
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A number collected per run: ``stat`` of the series ``of`` (one output, or the
+    magnitude of two: a vector's x and y)."""
+
+    name: str
+    of: tuple
+    stat: str
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """A design is feasible where ``figure`` <= ``maximum``."""
+
+    figure: str
+    maximum: float
+
+
+@dataclass(frozen=True)
+class Objective:
+    """The figure to minimise, the constraints, and how many best designs to list."""
+
+    minimize: str
+    constraints: tuple = ()
+    best: int = 5
+
+
+@dataclass(frozen=True)
+class Sampling:
+    """How the designs are drawn: ``grid`` (``count`` values per parameter), ``random``
+    or ``lhs`` (``count`` designs, from ``seed``)."""
+
+    method: str
+    count: int
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class Kinetostatic:
+    """Each design: one revolution of the crank at constant ``speed`` (rad/s), at
+    ``points`` equally spaced angles."""
+
+    speed: float
+    points: int
+
+
+@dataclass(frozen=True)
+class Driven:
+    """Each design: the drive FMU and the mechanism FMU co-simulated (stabilised
+    coupling) from ``start_speed`` (rad/s) for ``duration`` s at communication step
+    ``step`` s; figures from ``settle`` s on. ``drive`` holds the drive's fixed
+    parameters."""
+
+    step: float
+    duration: float
+    settle: float
+    start_speed: float
+    start_angle: float = 0.0
+    drive: tuple = ()  # ((name, value), ...)
+
+
+@dataclass(frozen=True)
+class Study:
+    """A study file, read and checked."""
+
+    path: Path
+    description: str
+    scene: Path | None
+    fmu: Path | None
+    fmi: int
+    run: Kinetostatic | Driven
+    parameters: tuple
+    sampling: Sampling
+    loads: tuple
+    fixed: tuple  # ((mechanism parameter name, value), ...)
+    figures: tuple
+    objective: Objective
+    text: str = field(repr=False, default="")
+
+    @property
+    def name(self) -> str:
+        """The study's name: its file name without .toml."""
+        return self.path.stem
+
+
+# ---- locating a key ------------------------------------------------------------------------
+
+
+def line_of(text: str, table: str, index: int | None = None, key: str | None = None) -> int:
+    """The line of ``key`` in ``[table]`` (or the ``index``-th ``[[table]]``), else of
+    the table's header, else 1."""
+    header = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
+    seen, inside, header_line = -1, False, 0
+    for number, line in enumerate(text.splitlines(), start=1):
+        m = header.match(line)
+        if m:
+            name = m.group(1).replace('"', "")
+            if name == table:
+                seen += 1
+                inside = index is None or seen == index
+                header_line = number if inside else header_line
+            else:
+                inside = False
+            continue
+        if inside and key is not None:
+            k = re.match(r'^\s*"?([^"=]+?)"?\s*=', line)
+            if k and k.group(1).strip() == key:
+                return number
+    return header_line or 1
+
+
+class _Reader:
+    """Reads values out of a parsed study file, refusing a bad one with its line."""
+
+    def __init__(self, path: Path, text: str):
+        self.path, self.text = path, text
+
+    def fail(
+        self, table: str, why: str, index: int | None = None, key: str | None = None
+    ) -> NoReturn:
+        """Raise StudyError at the key's line."""
+        line = line_of(self.text, table, index, key)
+        raise StudyError(f"{self.path}:{line}: {why}")
+
+    def table(self, data: dict, name: str, required: bool = True) -> dict:
+        """A sub-table of the file."""
+        value = data.get(name)
+        if value is None and not required:
+            return {}
+        if not isinstance(value, dict):
+            self.fail(name, f"[{name}] is required and must be a table")
+        return value
+
+    def number(
+        self,
+        t: dict,
+        table: str,
+        key: str,
+        index: int | None = None,
+        default: object = None,
+        positive: bool = False,
+    ) -> float:
+        """A finite number (a positive one if ``positive``)."""
+        value = t.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            self.fail(table, f"{key} must be a number (got {value!r})", index, key)
+        value = float(value)
+        if not math.isfinite(value) or (positive and not value > 0):
+            kind = "a positive finite number" if positive else "a finite number"
+            self.fail(table, f"{key} must be {kind} (got {value!r})", index, key)
+        return value
+
+    def integer(
+        self, t: dict, table: str, key: str, low: int, high: int, default: object = None
+    ) -> int:
+        """An integer in [low, high]."""
+        value = t.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            self.fail(table, f"{key} must be an integer from {low} to {high}", None, key)
+        return value
+
+    def name(self, value: object, table: str, key: str, index: int | None = None) -> str:
+        """A variable name: dot-separated identifiers."""
+        if not isinstance(value, str) or not _NAME.match(value) or len(value) > 200:
+            self.fail(table, f"{key} must be a variable name like 'crank.mass'", index, key)
+        return value
+
+    def unknown_keys(self, t: dict, table: str, allowed: tuple, index: int | None = None) -> None:
+        """Refuse a key the format does not have (a misspelt one, say)."""
+        for key in t:
+            if key not in allowed:
+                self.fail(table, f"unknown key {key!r}; expected {', '.join(allowed)}", index, key)
+
+
+# ---- the parts -----------------------------------------------------------------------------
+
+
+def _sources(r: _Reader, study: dict) -> tuple:
+    scene, fmu = study.get("scene"), study.get("fmu")
+    if (scene is None) == (fmu is None):
+        r.fail("study", "give exactly one of scene (a scene file) or fmu (an .fmu file)")
+    key = "scene" if scene is not None else "fmu"
+    value = scene if scene is not None else fmu
+    if not isinstance(value, str) or not value or "\0" in value:
+        r.fail("study", f"{key} must be a file name", key=key)
+    path = (r.path.parent / value).resolve()
+    suffix = ".toml" if key == "scene" else ".fmu"
+    if path.suffix != suffix or not path.is_file():
+        r.fail("study", f"{key} = {value!r}: no such {suffix} file next to the study", key=key)
+    return (path, None) if key == "scene" else (None, path)
+
+
+def _run(r: _Reader, data: dict) -> Kinetostatic | Driven:
+    t = r.table(data, "run")
+    kind = t.get("kind")
+    if kind == "kinetostatic":
+        r.unknown_keys(t, "run", ("kind", "speed", "points"))
+        return Kinetostatic(
+            speed=r.number(t, "run", "speed", positive=True),
+            points=r.integer(t, "run", "points", 8, 100_000, default=360),
+        )
+    if kind == "driven":
+        r.unknown_keys(
+            t, "run", ("kind", "step", "duration", "settle", "start_speed", "start_angle")
+        )
+        step = r.number(t, "run", "step", positive=True)
+        duration = r.number(t, "run", "duration", positive=True)
+        settle = r.number(t, "run", "settle", default=0.0)
+        if not 0 <= settle < duration:
+            r.fail("run", "settle must be at least 0 and below duration", key="settle")
+        if not 2 <= duration / step <= 10_000_000:
+            r.fail("run", "duration / step must be from 2 to 1e7 steps", key="step")
+        drive = r.table(data, "drive", required=False)
+        for name in drive:
+            if name not in DRIVE_PARAMETERS:
+                r.fail(
+                    "drive",
+                    f"unknown drive parameter {name!r}; expected one of "
+                    f"{', '.join(DRIVE_PARAMETERS)}",
+                    key=name,
+                )
+        return Driven(
+            step=step,
+            duration=duration,
+            settle=settle,
+            start_speed=r.number(t, "run", "start_speed"),
+            start_angle=r.number(t, "run", "start_angle", default=0.0),
+            drive=tuple((n, r.number(drive, "drive", n, positive=True)) for n in drive),
+        )
+    r.fail("run", f"kind must be 'kinetostatic' or 'driven' (got {kind!r})", key="kind")
+
+
+def _parameter(r: _Reader, t: dict, k: int, driven: bool):
+    allowed = ("name", "low", "high", "counterweight", "at")
+    r.unknown_keys(t, "parameter", allowed, k)
+    name = r.name(t.get("name"), "parameter", "name", k)
+    low = r.number(t, "parameter", "low", k)
+    high = r.number(t, "parameter", "high", k)
+    if not low <= high:
+        r.fail("parameter", f"{name}: low must not exceed high", k, "high")
+    if name.startswith("drive.") and not driven:
+        r.fail("parameter", f"{name}: a drive parameter needs [run] kind = 'driven'", k, "name")
+    if name.startswith("drive.") and name[6:] not in DRIVE_PARAMETERS:
+        r.fail(
+            "parameter",
+            f"{name}: the drive's parameters are "
+            f"{', '.join('drive.' + p for p in DRIVE_PARAMETERS)}",
+            k,
+            "name",
+        )
+    if "counterweight" not in t:
+        if "at" in t:
+            r.fail("parameter", "at belongs to a counterweight", k, "at")
+        return Parameter(name, low, high)
+    link = r.name(t["counterweight"], "parameter", "counterweight", k)
+    at = t.get("at")
+    if (
+        not isinstance(at, list)
+        or len(at) != 2
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in at)
+        or not all(math.isfinite(v) for v in at)
+    ):
+        r.fail("parameter", "at must be [x, y] in metres, finite", k, "at")
+    if low < 0:
+        r.fail("parameter", f"{name}: a counterweight's mass cannot be negative", k, "low")
+    return Counterweight(name, low, high, link, (float(at[0]), float(at[1])))
+
+
+def _parameters(r: _Reader, data: dict, driven: bool) -> tuple:
+    items = data.get("parameter")
+    if not isinstance(items, list) or not items or not all(isinstance(t, dict) for t in items):
+        r.fail("parameter", "at least one [[parameter]] table is required")
+    if len(items) > 8:
+        r.fail("parameter", "at most 8 parameters", 8)
+    params = tuple(_parameter(r, t, k, driven) for k, t in enumerate(items))
+    names = [p.name for p in params]
+    for k, n in enumerate(names):
+        if names.index(n) != k:
+            r.fail("parameter", f"parameter {n} is given twice", k, "name")
+    return params
+
+
+def _sampling(r: _Reader, data: dict, n_params: int) -> Sampling:
+    t = r.table(data, "sampling")
+    r.unknown_keys(t, "sampling", ("method", "count", "seed"))
+    method = t.get("method")
+    if method not in SAMPLING_METHODS:
+        r.fail("sampling", f"method must be one of {', '.join(SAMPLING_METHODS)}", key="method")
+    count = r.integer(t, "sampling", "count", 1, 1_000_000)
+    if method == "grid" and count**n_params > 1_000_000:
+        r.fail("sampling", f"a grid of {count}^{n_params} designs is over a million", key="count")
+    seed = r.integer(t, "sampling", "seed", 0, 2**63 - 1, default=0)
+    return Sampling(method, count, seed)
+
+
+def _load(r: _Reader, name: str, value: object) -> LoadTable:
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        v = r.number({name: value}, "loads", name)
+        return LoadTable(name, (0.0,), (v,))
+    if not isinstance(value, dict) or set(value) != {"angle", "value"}:
+        r.fail(
+            "loads", f"{name}: a number, or a table {{ angle = [...], value = [...] }}", key=name
+        )
+    angle, val = value["angle"], value["value"]
+    ok = (
+        isinstance(angle, list)
+        and isinstance(val, list)
+        and 1 <= len(angle) == len(val) <= 10_000
+        and all(isinstance(x, int | float) and not isinstance(x, bool) for x in angle + val)
+        and all(math.isfinite(x) for x in angle + val)
+    )
+    if not ok:
+        r.fail(
+            "loads",
+            f"{name}: angle and value must be lists of finite numbers of one length",
+            key=name,
+        )
+    if (
+        any(b < a for a, b in zip(angle, angle[1:], strict=False))
+        or angle[-1] - angle[0] >= 2 * math.pi
+    ):
+        r.fail("loads", f"{name}: the angles must increase within one revolution (rad)", key=name)
+    return LoadTable(name, tuple(map(float, angle)), tuple(map(float, val)))
+
+
+def _figures(r: _Reader, data: dict) -> tuple:
+    items = data.get("figure")
+    if not isinstance(items, list) or not items or not all(isinstance(t, dict) for t in items):
+        r.fail("figure", "at least one [[figure]] table is required")
+    figures = []
+    for k, t in enumerate(items):
+        r.unknown_keys(t, "figure", ("name", "of", "stat"), k)
+        name = r.name(t.get("name"), "figure", "name", k)
+        of = t.get("of")
+        of = [of] if isinstance(of, str) else of
+        if not isinstance(of, list) or not 1 <= len(of) <= 2:
+            r.fail("figure", f"{name}: of must name one output or two (x and y)", k, "of")
+        of = tuple(r.name(o, "figure", "of", k) for o in of)
+        if t.get("stat") not in STATS:
+            r.fail("figure", f"{name}: stat must be one of {', '.join(STATS)}", k, "stat")
+        if name in {f.name for f in figures} or name in ("design", "status", "message"):
+            r.fail("figure", f"figure name {name} is taken", k, "name")
+        figures.append(Figure(name, of, t["stat"]))
+    return tuple(figures)
+
+
+def _objective(r: _Reader, data: dict, figures: tuple) -> Objective:
+    t = r.table(data, "objective")
+    r.unknown_keys(t, "objective", ("minimize", "constraints", "best"))
+    names = {f.name for f in figures}
+    if t.get("minimize") not in names:
+        r.fail(
+            "objective", f"minimize must name a figure: {', '.join(sorted(names))}", key="minimize"
+        )
+    constraints = []
+    for c in t.get("constraints", []):
+        if not isinstance(c, dict) or set(c) != {"figure", "max"} or c["figure"] not in names:
+            r.fail(
+                "objective", "a constraint is { figure = NAME, max = NUMBER }", key="constraints"
+            )
+        constraints.append(Constraint(c["figure"], r.number(c, "objective", "max")))
+    best = r.integer(t, "objective", "best", 1, 1000, default=5)
+    return Objective(t["minimize"], tuple(constraints), best)
+
+
+def read_study(path: Path | str) -> Study:
+    """Read and check a study file (StudyError naming FILE:LINE where it is wrong)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+        data = tomllib.loads(text)
+    except (OSError, UnicodeDecodeError) as e:
+        raise StudyError(f"{path}: cannot read: {e}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise StudyError(f"{path}: not valid TOML: {e}") from None
+    r = _Reader(path, text)
+    r.unknown_keys(
+        data,
+        "",
+        ("study", "run", "drive", "sampling", "parameter", "loads", "fixed", "figure", "objective"),
+    )
+    study = r.table(data, "study")
+    r.unknown_keys(study, "study", ("description", "scene", "fmu", "fmi"))
+    description = study.get("description", "")
+    if not isinstance(description, str) or len(description) > 500:
+        r.fail("study", "description must be one line of text", key="description")
+    scene, fmu = _sources(r, study)
+    fmi = r.integer(study, "study", "fmi", 2, 3, default=2)
+    run = _run(r, data)
+    params = _parameters(r, data, isinstance(run, Driven))
+    loads = tuple(
+        _load(r, r.name(n, "loads", n), v) for n, v in r.table(data, "loads", False).items()
+    )
+    fixed_t = r.table(data, "fixed", False)
+    fixed = tuple((r.name(n, "fixed", n), r.number(fixed_t, "fixed", n)) for n in fixed_t)
+    figures = _figures(r, data)
+    return Study(
+        path=path,
+        description=" ".join(description.split()),
+        scene=scene,
+        fmu=fmu,
+        fmi=fmi,
+        run=run,
+        parameters=params,
+        sampling=_sampling(r, data, len(params)),
+        loads=loads,
+        fixed=fixed,
+        figures=figures,
+        objective=_objective(r, data, figures),
+        text=text,
+    )

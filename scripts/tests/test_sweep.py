@@ -1,0 +1,334 @@
+"""Design studies (dyadfmu sweep): the study file refused with its line where it is wrong,
+the designs, the counterweight's mass properties, the figures, the Pareto front, the
+scene copy, and whole studies: on a local Dask cluster of two workers the table equals
+the same runs in a loop, a failed run is a row with its status, and the best
+counterweight is the one that balances the crank (known in closed form)."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from dyadfmu import paths
+from dyadfmu.sweep import designs, execute, figures, results, runs, sources, study
+from dyadfmu.sweep.studyfile import (
+    Counterweight,
+    Figure,
+    LoadTable,
+    Sampling,
+    StudyError,
+    read_study,
+)
+
+ROOT = Path(__file__).resolve().parents[2]
+BALANCE = paths.build_dir() / "fmus" / "balance_fmi2.fmu"
+
+#: The crank of tests/scenes/balance.toml: mass, centre of mass (m), inertia (kg m2).
+M0, C0, I0 = 2.0, (0.012, 0.003), 3.0e-3
+#: Where the study's counterweight goes, and its mass that brings the centre of mass to O.
+AT = (-0.036, -0.009)
+BALANCING = M0 * math.hypot(*C0) / math.hypot(*AT)  # = 2/3 kg: m0 c0 + m a = 0
+
+BALANCE_STUDY = f"""
+[study]
+description = "counterweight on a crank with its own unbalance"
+fmu = "{BALANCE}"
+
+[run]
+kind = "kinetostatic"
+speed = 100.0
+points = 36
+
+[sampling]
+method = "grid"
+count = 13                    # 0 to 2 kg in steps of 1/6 kg: 2/3 kg is the 5th
+
+[[parameter]]
+name = "counterweight"
+counterweight = "crank"
+at = [{AT[0]}, {AT[1]}]
+low = 0.0
+high = 2.0
+
+[[figure]]
+name = "bearing_peak"
+of = ["crank.R_O.x", "crank.R_O.y"]
+stat = "peak"
+
+[[figure]]
+name = "torque_rms"
+of = "crank.torque"
+stat = "rms"
+
+[objective]
+minimize = "bearing_peak"
+best = 3
+"""
+
+
+def _write(tmp_path: Path, text: str, name: str = "study.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _refused(tmp_path: Path, text: str) -> str:
+    with pytest.raises(StudyError) as info:
+        read_study(_write(tmp_path, text))
+    return str(info.value)
+
+
+# ---- the study file --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "old, new, marker, words",
+    [
+        ('stat = "peak"', 'stat = "highest"', "highest", "stat must be one of"),
+        ("speed = 100.0", "speed = -1.0", "speed =", "speed must be a positive"),
+        ("low = 0.0", "low = -1.0", "low =", "cannot be negative"),
+        ("at = [", "at = [1.0, ", "at =", "at must be [x, y]"),
+        ("high = 2.0", "high = nan", "high =", "high must be a finite number"),
+        ('minimize = "bearing_peak"', 'minimize = "bearing"', "minimize", "must name a figure"),
+        ("[[parameter]]", "[[parameter]]\nstep = 1", "step = 1", "unknown key 'step'"),
+        ('name = "counterweight"', 'name = "drive.inertia"', "drive.inertia", "kind = 'driven'"),
+        ('kind = "kinetostatic"', 'kind = "static"', "static", "kind must be"),
+        ('method = "grid"', 'method = "sobol"', "sobol", "method must be one of"),
+    ],
+)
+def test_a_bad_study_is_refused_at_its_line(tmp_path, old, new, marker, words):
+    text = BALANCE_STUDY.replace(old, new, 1)
+    assert text != BALANCE_STUDY
+    line = next(k for k, t in enumerate(text.splitlines(), start=1) if marker in t)
+    message = _refused(tmp_path, text)
+    assert message.startswith(f"{tmp_path / 'study.toml'}:{line}: "), message
+    assert words in message
+
+
+def test_a_grid_over_a_million_designs_is_refused(tmp_path):
+    text = BALANCE_STUDY.replace("count = 13 ", "count = 1001 ")
+    text += '\n[[parameter]]\nname = "crank.length"\nlow = 0.04\nhigh = 0.06\n'
+    assert "over a million" in _refused(tmp_path, text)
+
+
+def test_a_name_the_fmu_does_not_have_is_refused_with_its_line(tmp_path):
+    if not BALANCE.is_file():
+        pytest.skip(f"{BALANCE} is not built")
+    for old, new, words in [
+        ('of = "crank.torque"', 'of = "crank.torque_peak"', "crank.torque_peak is not an output"),
+        ('counterweight = "crank"', 'counterweight = "rod"', "rod.mass is not a parameter"),
+    ]:
+        text = BALANCE_STUDY.replace(old, new)
+        line = next(k for k, t in enumerate(text.splitlines(), start=1) if new in t)
+        with pytest.raises(StudyError) as info:
+            study.prepare(_write(tmp_path, text), tmp_path)
+        assert str(info.value).startswith(f"{tmp_path / 'study.toml'}:{line}: ")
+        assert words in str(info.value)
+
+
+def test_a_missing_source_file_is_refused(tmp_path):
+    text = BALANCE_STUDY.replace(str(BALANCE), "no_such.fmu")
+    assert "no such .fmu file" in _refused(tmp_path, text)
+
+
+# ---- designs ---------------------------------------------------------------------------------
+
+
+def test_a_grid_varies_the_first_parameter_slowest():
+    d = designs.designs(Sampling("grid", 3), [0.0, 10.0], [2.0, 30.0])
+    assert d.tolist() == [[a, b] for a in (0.0, 1.0, 2.0) for b in (10.0, 20.0, 30.0)]
+
+
+@pytest.mark.parametrize("method", ["random", "lhs"])
+def test_drawn_designs_are_within_bounds_and_repeat_by_seed(method):
+    lows, highs = [-1.0, 100.0, 0.0], [1.0, 300.0, 1e-3]
+    a = designs.designs(Sampling(method, 50, seed=7), lows, highs)
+    b = designs.designs(Sampling(method, 50, seed=7), lows, highs)
+    c = designs.designs(Sampling(method, 50, seed=8), lows, highs)
+    assert a.shape == (50, 3) and np.array_equal(a, b) and not np.array_equal(a, c)
+    assert np.all(a >= lows) and np.all(a <= highs)
+
+
+def test_a_latin_hypercube_has_one_design_in_each_stratum():
+    d = designs.designs(Sampling("lhs", 40, seed=3), [0.0, -5.0], [1.0, 5.0])
+    for j, (lo, hi) in enumerate([(0.0, 1.0), (-5.0, 5.0)]):
+        strata = np.floor((d[:, j] - lo) / (hi - lo) * 40).astype(int)
+        assert sorted(strata) == list(range(40))
+
+
+# ---- the counterweight, the loads, the figures -----------------------------------------------
+
+
+def test_a_counterweight_moves_the_centre_of_mass_and_adds_its_inertia():
+    cw = Counterweight("cw", 0.0, 1.0, "crank", (-0.05, 0.02))
+    base = {"crank.mass": 2.0, "crank.com.x": 0.01, "crank.com.y": 0.0, "crank.inertia": 4e-3}
+    out = cw.assign(0.5, base)
+    # two bodies about the origin: the mass moment and the inertia about O are sums
+    assert out["crank.mass"] == 2.5
+    assert out["crank.com.x"] * 2.5 == pytest.approx(2.0 * 0.01 + 0.5 * -0.05, rel=1e-15)
+    assert out["crank.com.y"] * 2.5 == pytest.approx(0.5 * 0.02, rel=1e-15)
+    about_o = 4e-3 + 2.0 * 0.01**2 + 0.5 * (0.05**2 + 0.02**2)
+    g2 = out["crank.com.x"] ** 2 + out["crank.com.y"] ** 2
+    assert out["crank.inertia"] + 2.5 * g2 == pytest.approx(about_o, rel=1e-14)
+    assert cw.assign(0.0, base) == pytest.approx(base)
+
+
+def test_a_load_table_is_periodic_and_linear_between_points():
+    table = LoadTable("f", (1.0, 2.0, 4.0), (10.0, 20.0, 0.0))
+    assert table.at(1.5) == pytest.approx(15.0)
+    assert table.at(3.0) == pytest.approx(10.0)
+    assert table.at(1.5 + 2 * math.pi) == pytest.approx(15.0)
+    # from 4 rad back to 1 + 2 pi: 0 -> 10
+    assert table.at(4.0 + (2 * math.pi - 3.0) / 2) == pytest.approx(5.0)
+    assert table.at(0.5) == pytest.approx(table.at(0.5 + 2 * math.pi))
+
+
+def test_the_figures_of_known_series():
+    phi = np.linspace(0.0, 4 * math.pi, 401)
+    series = {"t": 2.0 + np.sin(phi), "x": 3.0 * np.ones(401), "y": 4.0 * np.ones(401)}
+
+    def value(of, stat, phis=phi):
+        return figures.figure_value(Figure("f", of, stat), series, phis)
+
+    assert value(("x", "y"), "peak") == 5.0
+    assert value(("t",), "fluctuation") == pytest.approx(2.0 / 2.0, rel=1e-3)
+    # the work of a torque 2 + sin over two revolutions, per revolution: 2 * 2 pi
+    assert value(("t",), "work_per_revolution") == pytest.approx(4 * math.pi, rel=1e-5)
+    equal = np.linspace(0.0, 2 * math.pi, 36, endpoint=False)
+    series["t"] = 2.0 + np.sin(equal)
+    assert value(("t",), "work_per_revolution", None) == pytest.approx(4 * math.pi, rel=1e-14)
+    assert value(("t",), "rms", None) == pytest.approx(math.sqrt(4.5), rel=1e-14)
+
+
+def test_the_pareto_front_keeps_the_designs_none_beats_in_both():
+    a = np.array([1.0, 2.0, 3.0, 2.5, 0.5, 4.0])
+    b = np.array([5.0, 3.0, 1.0, 4.0, 9.0, 0.5])
+    mask = np.array([True, True, True, True, True, False])
+    assert results.pareto_front(a, b, mask) == [4, 0, 1, 2]
+
+
+# ---- the scene copy --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "data",
+    [
+        {
+            "a": 'quote " backslash \\ newline \n tab \t unicode \u00e9 \u2028',
+            "b": [1, 2.5e-8, True],
+        },
+        {
+            "scene": {"identifier": "x", "tunable": []},
+            "dyad": [{"k": {"link": "frame", "at": [0.0, 0.01]}}, {"n": 1}],
+        },
+        {"loads": {'weird "key"': {"angle": [0.0], "value": [1.0]}}},
+    ],
+)
+def test_toml_text_reads_back_as_the_same_data(data):
+    assert tomllib.loads(sources.toml_text(data)) == data
+
+
+def test_every_builtin_scene_reads_back_through_toml_text():
+    for path in sorted((ROOT / "scenes").glob("*.toml")):
+        data = tomllib.loads(path.read_text())
+        assert tomllib.loads(sources.toml_text(data)) == data, path
+
+
+def test_the_scene_copy_makes_the_study_parameters_tunable_and_passes_the_checks(tmp_path):
+    s = read_study(ROOT / "scenes" / "studies" / "engine_counterweight.toml")
+    path = sources.sweep_scene(s, tmp_path)
+    scene = tomllib.loads(path.read_text())["scene"]
+    assert scene["identifier"].startswith("engine_sweep_")
+    assert set(scene["tunable"]) >= {"crank.mass", "crank.com.x", "crank.com.y", "crank.inertia"}
+    assert sources.sweep_scene(s, tmp_path) == path  # the same study, the same copy
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "modelDescription" / "scene.py"), str(path), "--check"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+
+
+# ---- whole studies -----------------------------------------------------------------------------
+
+
+def _needs_balance():
+    if not BALANCE.is_file():
+        pytest.skip(f"{BALANCE} is not built")
+
+
+def test_the_best_counterweight_is_the_one_that_balances_the_crank(tmp_path):
+    _needs_balance()
+    result = study.run_study(_write(tmp_path, BALANCE_STUDY), tmp_path / "out", workers=0)
+    best = result.best[0]
+    assert result.table.values[best, 0] == pytest.approx(BALANCING, rel=1e-12)
+    peak = result.table.column("bearing_peak")
+    # balanced, the bearing carries nothing; otherwise (m0 + m) omega^2 |com|
+    assert peak[best] < 1e-9 * peak.max()
+    for k in (0, 12):
+        m = result.table.values[k, 0]
+        com = np.hypot(M0 * C0[0] + m * AT[0], M0 * C0[1] + m * AT[1])
+        assert peak[k] == pytest.approx(100.0**2 * com, rel=1e-12)
+    assert (tmp_path / "out" / "study" / "results.csv").is_file()
+
+
+FAILING_STUDY = BALANCE_STUDY.replace(
+    "[[figure]]",
+    '[[parameter]]\nname = "rod.length"\nlow = 0.02\nhigh = 0.2\n\n[[figure]]',
+    1,
+).replace("count = 13 ", "count = 3 ")
+
+
+def test_a_local_cluster_of_two_gives_the_loop_s_table_and_failures_are_rows(tmp_path):
+    _needs_balance()
+    path = _write(tmp_path, FAILING_STUDY)
+    s, run, values = study.prepare(path, tmp_path)
+    loop = results.table_of(s, values, [(k, run(tuple(v))) for k, v in enumerate(values)])
+    on_dask = results.table_of(s, values, execute.run_dask(run, values, workers=2))
+    assert on_dask.status == loop.status and on_dask.message == loop.message
+    assert np.array_equal(on_dask.values, loop.values)
+    assert np.array_equal(on_dask.figures, loop.figures, equal_nan=True)
+    # a rod of 2 cm cannot reach the piston's line from a crank of 5 cm
+    short = [k for k in range(len(values)) if values[k, 1] == 0.02]
+    assert short and all(loop.status[k] == "cannot_assemble" for k in short)
+    assert all("cannot assemble" in loop.message[k] for k in short)
+    assert all(np.isnan(loop.figures[k]).all() for k in short)
+    assert all(loop.status[k] == "ok" for k in range(len(values)) if k not in short)
+
+
+def test_a_driven_study_on_two_workers_equals_its_loop(tmp_path):
+    text = (ROOT / "scenes" / "studies" / "shaper_motor.toml").read_text()
+    shaper = paths.build_dir() / "fmus" / "shaper_fmi2.fmu"
+    if not shaper.is_file():
+        pytest.skip(f"{shaper} is not built")
+    text = text.replace('scene = "../shaper.toml"', f'fmu = "{shaper}"')
+    text = text.replace("count = 8", "count = 2").replace("duration = 4.0", "duration = 0.3")
+    text = text.replace("settle = 2.0", "settle = 0.1").replace(
+        'name = "drive.inertia"', 'name = "drive.motor.no_load_speed"'
+    )
+    text = text.replace("low = 2.0\nhigh = 60.0", "low = 7.0\nhigh = 8.0").replace(
+        '[drive]\n"motor.no_load_speed" = 7.5', "[drive]\ninertia = 5.0"
+    )
+    s, run, values = study.prepare(_write(tmp_path, text), tmp_path)
+    assert isinstance(run, runs.DrivenRun)
+    loop = [(k, run(tuple(v))) for k, v in enumerate(values)]
+    assert loop == execute.run_dask(run, values, workers=2)
+    assert all(o.status == "ok" for _, o in loop)
+    # a stiffer motor (higher stall torque) holds the speed closer to its mean
+    fluct = {tuple(values[k]): o.figures[1] for k, o in loop}
+    assert fluct[(500.0, 8.0)] < fluct[(100.0, 8.0)]
+
+
+def test_a_study_runs_on_an_existing_cluster_by_its_address(tmp_path):
+    _needs_balance()
+    from dask.distributed import LocalCluster
+
+    s, run, values = study.prepare(_write(tmp_path, BALANCE_STUDY), tmp_path)
+    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster:
+        remote = execute.run_dask(run, values, workers=0, scheduler=cluster.scheduler_address)
+    assert remote == [(k, run(tuple(v))) for k, v in enumerate(values)]
