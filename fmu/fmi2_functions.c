@@ -298,3 +298,18 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     return to_fmi2(
         fmu_unsupported((fmu_instance*)c, "fmi2GetStringStatus", "there is no String status"));
 }
+
+/* Not FMI: the model over many rows in one call, without an importer's instance
+ * (fmu_evaluate_rows), for dyadfmu's design studies. Returns the fmu_status. */
+FMI2_Export int dyadfmu_evaluate_rows(const char* token, const unsigned int vr_p[], size_t n_p,
+                                      const double p[], const unsigned int vr_i[], size_t n_i,
+                                      const double x[], const unsigned int vr_o[], size_t n_o,
+                                      double y[], int status[], size_t rows);
+FMI2_Export int dyadfmu_evaluate_rows(const char* token, const unsigned int vr_p[], size_t n_p,
+                                      const double p[], const unsigned int vr_i[], size_t n_i,
+                                      const double x[], const unsigned int vr_o[], size_t n_o,
+                                      double y[], int status[], size_t rows)
+{
+    return (int)fmu_evaluate_rows(&fmu_this_model, token, 0, vr_p, n_p, p, vr_i, n_i, x, vr_o, n_o,
+                                  y, status, rows);
+}

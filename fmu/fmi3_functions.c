@@ -462,3 +462,18 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     }
     return to_fmi3(status);
 }
+
+/* Not FMI: the model over many rows in one call, without an importer's instance
+ * (fmu_evaluate_rows), for dyadfmu's design studies. Returns the fmu_status. */
+FMI3_Export int dyadfmu_evaluate_rows(const char* token, const unsigned int vr_p[], size_t n_p,
+                                      const double p[], const unsigned int vr_i[], size_t n_i,
+                                      const double x[], const unsigned int vr_o[], size_t n_o,
+                                      double y[], int status[], size_t rows);
+FMI3_Export int dyadfmu_evaluate_rows(const char* token, const unsigned int vr_p[], size_t n_p,
+                                      const double p[], const unsigned int vr_i[], size_t n_i,
+                                      const double x[], const unsigned int vr_o[], size_t n_o,
+                                      double y[], int status[], size_t rows)
+{
+    return (int)fmu_evaluate_rows(&fmu_this_model, token, 1, vr_p, n_p, p, vr_i, n_i, x, vr_o, n_o,
+                                  y, status, rows);
+}

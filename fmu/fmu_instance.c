@@ -1075,3 +1075,93 @@ fmu_status fmu_unsupported(fmu_instance* instance, const char* function, const c
     fmu_log(instance, FMU_ERROR, "%s is not supported by this FMU: %s", function, why);
     return FMU_ERROR;
 }
+
+/* ---- many rows at once ---------------------------------------------------------------------- */
+
+/* 1 if every value reference names a Real of one of the causalities in `wanted`. */
+static int all_of(const fmu_model* model, const unsigned int vr[], size_t count, unsigned wanted)
+{
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v;
+        if (vr[k] >= model->vr_limit || model->index_of_vr[vr[k]] < 0) {
+            return 0;
+        }
+        v = &model->variables[model->index_of_vr[vr[k]]];
+        if (v->type != FMU_REAL || !((1u << v->causality) & wanted)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* A design's parameters set on a reset instance, and its initialisation; FMU_OK if
+ * the instance is in step mode with them. */
+static fmu_status start_design(fmu_instance* instance, int first, const unsigned int vr_p[],
+                               size_t n_p, const double p[])
+{
+    fmu_status status = first ? FMU_OK : fmu_reset(instance);
+    if (status == FMU_OK && n_p > 0) {
+        status = fmu_set_real(instance, vr_p, n_p, p, "dyadfmu_evaluate_rows");
+    }
+    if (status == FMU_OK) {
+        status = fmu_enter_initialization(instance, 0.0);
+    }
+    if (status == FMU_OK && fmu_exit_initialization(instance) == FMU_ERROR) {
+        status = FMU_ERROR;
+    }
+    return status;
+}
+
+static void fill_nan(double values[], size_t count)
+{
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        values[k] = NAN;
+    }
+}
+
+fmu_status fmu_evaluate_rows(const fmu_model* model, const char* token, int time_at_vr_0,
+                             const unsigned int vr_p[], size_t n_p, const double p[],
+                             const unsigned int vr_i[], size_t n_i, const double x[],
+                             const unsigned int vr_o[], size_t n_o, double y[], int status[],
+                             size_t rows)
+{
+    const fmu_logger quiet = {NULL, NULL, NULL, "rows"};
+    fmu_instance* instance;
+    fmu_status design = FMU_OK;
+    size_t r;
+    if ((n_p > 0 && (vr_p == NULL || p == NULL)) || (n_i > 0 && (vr_i == NULL || x == NULL)) ||
+        (n_o > 0 && (vr_o == NULL || y == NULL)) || (rows > 0 && status == NULL) ||
+        !all_of(model, vr_p, n_p, 1u << FMU_PARAMETER) ||
+        !all_of(model, vr_i, n_i, 1u << FMU_INPUT) ||
+        !all_of(model, vr_o, n_o, (1u << FMU_OUTPUT) | (1u << FMU_INPUT) | (1u << FMU_PARAMETER))) {
+        return FMU_ERROR;
+    }
+    instance = fmu_instantiate(model, "rows", token, quiet, 0, NULL, NULL, time_at_vr_0);
+    if (instance == NULL) {
+        return FMU_FATAL;
+    }
+    for (r = 0; r < rows; ++r) {
+        /* no arithmetic on an absent (NULL) array */
+        const double* row_p = n_p > 0 ? p + r * n_p : NULL;
+        double* row_y = n_o > 0 ? y + r * n_o : NULL;
+        fmu_status s;
+        if (r == 0 || (n_p > 0 && memcmp(row_p, row_p - n_p, n_p * sizeof *row_p) != 0)) {
+            design = start_design(instance, r == 0, vr_p, n_p, row_p);
+        }
+        s = design;
+        if (s == FMU_OK && n_i > 0) {
+            s = fmu_set_real(instance, vr_i, n_i, x + r * n_i, "dyadfmu_evaluate_rows");
+        }
+        if (s == FMU_OK && n_o > 0) {
+            s = fmu_get_real(instance, vr_o, n_o, row_y, "dyadfmu_evaluate_rows");
+        }
+        status[r] = (int)s;
+        if (s != FMU_OK) {
+            fill_nan(row_y, n_o);
+        }
+    }
+    fmu_free(instance);
+    return FMU_OK;
+}

@@ -171,6 +171,22 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
 fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,
                                     const unsigned int vr[], size_t count, const char* function);
 
+/* The model evaluated on `rows` rows without an importer's instance: for each row,
+ * the parameters p (rows x n_p, value references vr_p) and the inputs x (rows x n_i,
+ * vr_i) set, the Real outputs vr_o read into y (rows x n_o), and that row's worst
+ * status in status[row] (anything but FMU_OK: the row's outputs are NaN; the set or
+ * the evaluation failed, as the same calls through FMI would). The instance is reset
+ * and initialised again only where a row's parameters differ from the row before,
+ * so rows sorted by their parameters cost one evaluation each. FMU_ERROR (no row
+ * evaluated) where a value reference is unknown or of the wrong kind, or an array is
+ * missing; FMU_FATAL where no instance could be made (a wrong token, no memory). Not part of FMI:
+ * exported as dyadfmu_evaluate_rows for the design studies (scripts/dyadfmu/sweep). */
+fmu_status fmu_evaluate_rows(const fmu_model* model, const char* token, int time_at_vr_0,
+                             const unsigned int vr_p[], size_t n_p, const double p[],
+                             const unsigned int vr_i[], size_t n_i, const double x[],
+                             const unsigned int vr_o[], size_t n_o, double y[], int status[],
+                             size_t rows);
+
 /* Error with a logged "not supported" for an entry point this FMU does not offer. */
 fmu_status fmu_unsupported(fmu_instance* instance, const char* function, const char* why);
 

@@ -1696,6 +1696,51 @@ static int test_rrt_fmi2_core(void)
     return fails;
 }
 
+typedef int (*rows_entry)(const char* token, const unsigned int vr_p[], size_t n_p,
+                          const double p[], const unsigned int vr_i[], size_t n_i, const double x[],
+                          const unsigned int vr_o[], size_t n_o, double y[], int status[],
+                          size_t rows);
+
+/* dyadfmu_evaluate_rows of one binary: each row as the core solves it, a row with a NaN
+ * input refused alone (status error, NaN outputs), a bad call refused whole. */
+static int rows_match_the_core(void* library, const char* token)
+{
+    int fails = 0;
+    rows_entry evaluate;
+    const unsigned set[3] = {vr_of("link_n.angle"), vr_of("link_m.force.x"), vr_of("link_n.omega")};
+    const double x[3][3] = {{0.3, -2500, 40}, {-0.5, 700, -15}, {0.1, NAN, 3}};
+    unsigned outs[32];
+    double y[3 * 32]; /* rows of n outputs */
+    int status[3] = {-1, -1, -1};
+    const size_t n = real_outputs(outs);
+    size_t k;
+    *(void**)(&evaluate) = dlsym(library, "dyadfmu_evaluate_rows");
+    CHECK(evaluate != NULL, "dyadfmu_evaluate_rows is not exported");
+    if (evaluate == NULL) {
+        return fails;
+    }
+    CHECK(evaluate(token, NULL, 0, NULL, set, 3, &x[0][0], outs, n, y, status, 3) == 0,
+          "a valid call");
+    for (k = 0; k < 2; ++k) {
+        const dyad_result want = core_result(set, x[k], 3);
+        CHECK(status[k] == 0 && outputs_match(y + k * n, &want), "row %zu differs from the core",
+              k);
+    }
+    CHECK(status[2] == 3 && isnan(y[2 * n]) && isnan(y[3 * n - 1]), "a NaN input: status %d",
+          status[2]);
+    CHECK(evaluate(token, NULL, 0, NULL, outs, 1, &x[0][0], outs, n, y, status, 1) == 3,
+          "an output set is refused");
+    CHECK(evaluate("not the token", NULL, 0, NULL, set, 3, &x[0][0], outs, n, y, status, 1) == 4,
+          "a wrong token is refused");
+    return fails;
+}
+
+static int test_rrt_rows_match_the_core(void)
+{
+    return rows_match_the_core(api2.library, md2.token) +
+           rows_match_the_core(api3.library, md3.token);
+}
+
 static int test_rrt_fmi2_singular(void)
 {
     int fails = 0;
@@ -2100,6 +2145,7 @@ static const named_test generic_tests[] = {
 /* Tests of one model, run when the FMUs are that model. */
 static const named_test rrt_tests[] = {
     {"rrt_fmi2_core", test_rrt_fmi2_core},
+    {"rrt_rows_match_the_core", test_rrt_rows_match_the_core},
     {"rrt_bad_input_names_its_variable", test_rrt_bad_input_names_its_variable},
     {"rrt_fmi2_singular", test_rrt_fmi2_singular},
     {"rrt_fmi3_core", test_rrt_fmi3_core},

@@ -120,7 +120,11 @@ def test_a_name_the_fmu_does_not_have_is_refused_with_its_line(tmp_path):
     if not BALANCE.is_file():
         pytest.skip(f"{BALANCE} is not built")
     for old, new, words in [
-        ('of = "crank.torque"', 'of = "crank.torque_peak"', "crank.torque_peak is not an output"),
+        (
+            'of = "crank.torque"',
+            'of = "crank.torque_peak"',
+            "crank.torque_peak is not a Real output",
+        ),
         ('counterweight = "crank"', 'counterweight = "rod"', "rod.mass is not a parameter"),
     ]:
         text = BALANCE_STUDY.replace(old, new)
@@ -332,3 +336,32 @@ def test_a_study_runs_on_an_existing_cluster_by_its_address(tmp_path):
     with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=None) as cluster:
         remote = execute.run_dask(run, values, workers=0, scheduler=cluster.scheduler_address)
     assert remote == [(k, run(tuple(v))) for k, v in enumerate(values)]
+
+
+def test_the_rows_entry_gives_the_fmi_calls_figures_bit_for_bit(tmp_path):
+    _needs_balance()
+    s, run, values = study.prepare(_write(tmp_path, FAILING_STUDY), tmp_path)
+    assert isinstance(run, runs.KinetostaticRun) and run.use_rows
+    from dataclasses import replace
+
+    through_fmi = replace(run, use_rows=False)
+    rows = [(k, tuple(v)) for k, v in enumerate(values)]
+    assert run.chunk(rows) == through_fmi.chunk(rows)
+
+
+def test_the_rows_entry_refuses_a_value_reference_of_the_wrong_kind():
+    _needs_balance()
+    from dyadfmu.sweep.rows import rows_entry
+
+    entry = rows_entry(BALANCE)
+    x = np.zeros((2, 3))
+    inputs = ("crank.angle", "crank.omega", "crank.epsilon")
+    with pytest.raises(RuntimeError, match="refused"):  # an output set
+        entry.evaluate((), np.zeros((2, 0)), ("crank.torque",) * 3, x, ("crank.torque",))
+    with pytest.raises(RuntimeError, match="refused"):  # a parameter as an input
+        entry.evaluate((), np.zeros((2, 0)), ("crank.mass",) * 3, x, ("crank.torque",))
+    y, status = entry.evaluate(
+        ("crank.mass",), np.array([[2.0], [-1.0]]), inputs, x, ("crank.torque", "crank.R_O.x")
+    )
+    assert status[0] == 0 and np.all(np.isfinite(y[0]))
+    assert status[1] == 3 and np.all(np.isnan(y[1]))  # a negative mass: refused, NaN

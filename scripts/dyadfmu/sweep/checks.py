@@ -17,8 +17,12 @@ def _fail(study: Study, table: str, index: int | None, key: str, why: str) -> No
     raise StudyError(f"{study.path}:{line}: {why}")
 
 
-def _names(md: ModelDescription, causalities: tuple) -> list:
-    return [v.name for v in md.modelVariables if v.causality in causalities]
+def _names(md: ModelDescription, causalities: tuple, reals: bool = False) -> list:
+    return [
+        v.name
+        for v in md.modelVariables
+        if v.causality in causalities and (not reals or v.type in ("Real", "Float64"))
+    ]
 
 
 def _short_list(names: list) -> str:
@@ -68,9 +72,9 @@ def _check_loads(study: Study, md: ModelDescription, what: str) -> None:
 def _check_figures(
     study: Study, md: ModelDescription, drive_md: ModelDescription | None, what: str
 ) -> None:
-    known = set(_names(md, ("output", "input")))
+    known = set(_names(md, ("output", "input"), reals=True))
     if drive_md is not None:
-        known |= {"drive." + n for n in _names(drive_md, ("output",))}
+        known |= {"drive." + n for n in _names(drive_md, ("output",), reals=True)}
     for k, f in enumerate(study.figures):
         for name in f.of:
             if name not in known:
@@ -80,7 +84,7 @@ def _check_figures(
                     "figure",
                     k,
                     "of",
-                    f"{f.name}: {name} is not an output or input of {what}{hint}",
+                    f"{f.name}: {name} is not a Real output or input of {what}{hint}",
                 )
 
 

@@ -69,7 +69,7 @@ def _chunks(designs: np.ndarray, size: int) -> list:
 def run_serial(run: Callable, designs: np.ndarray, progress: Progress | None = None) -> list:
     """[(index, Outcome)] of every design, one after another in this process."""
     out = []
-    for chunk in _chunks(designs, 8):
+    for chunk in _chunks(designs, 64):
         out += run_rows(run, chunk)
         if progress is not None:
             progress.advance(len(chunk))
@@ -101,7 +101,7 @@ def run_dask(
     client, cluster = _client(scheduler, workers)
     try:
         slots = max(workers if scheduler is None else len(client.scheduler_info()["workers"]), 1)
-        size = max(1, min(64, len(designs) // (4 * slots)))
+        size = max(1, min(512, -(-len(designs) // (4 * slots))))
         client.wait_for_workers(slots)
         if progress is not None:
             progress.restart()  # the cluster's start is not the runs' time

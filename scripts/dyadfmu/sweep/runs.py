@@ -17,6 +17,7 @@ NaN figures; it never raises.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -27,6 +28,7 @@ from fmpy.model_description import ModelDescription
 from ..fmi.slave import Slave, SlaveError
 from .checks import base_values
 from .figures import figure_value, series_names
+from .rows import rows_entry
 from .studyfile import Driven, Kinetostatic, Study
 
 __all__ = ["Outcome", "KinetostaticRun", "DrivenRun", "run_of", "run_rows", "slave", "STATUS_NAMES"]
@@ -106,6 +108,10 @@ class _Common:
         except SlaveError as e:
             return Outcome(nothing, "refused" if e.status >= 3 else "discarded", str(e))
 
+    def chunk(self, rows: list) -> list:
+        """[(index, Outcome)] of the designs [(index, values)], one run after another."""
+        return [(index, self(tuple(values))) for index, values in rows]
+
     def outcome(self, series: dict, phi: np.ndarray | None) -> Outcome:
         """The figures over the recorded series."""
         values = tuple(figure_value(f, series, phi) for f in self.figures)
@@ -126,10 +132,42 @@ class KinetostaticRun(_Common):
 
     speed: float = 0.0
     points: int = 360
+    use_rows: bool = True  # evaluate a chunk in one call where the binary can
 
     def __call__(self, values: tuple) -> Outcome:
-        """The figures of the design ``values``."""
+        """The figures of the design ``values``, through FMI calls."""
         return self.guarded(lambda: self._run(values))
+
+    @functools.cached_property
+    def _point_inputs(self) -> np.ndarray:
+        """The inputs at every angle: the crank's motion and the loads (points x inputs)."""
+        rows = []
+        for k in range(self.points):
+            phi = 2 * math.pi * k / self.points
+            rows.append((phi, self.speed, 0.0) + tuple(ld.at(phi) for ld in self.loads))
+        return np.array(rows)
+
+    def chunk(self, rows: list) -> list:
+        """[(index, Outcome)] of the designs [(index, values)]: every angle of every
+        design in one call of the binary's rows entry; a design that fails there runs
+        again through FMI, whose calls name the failure."""
+        entry = rows_entry(self.mechanism) if self.use_rows else None
+        params = [self.mechanism_parameters(tuple(v)) for _, v in rows]
+        p_names = tuple(params[0]) if params else ()
+        if entry is None or any(tuple(p) != p_names for p in params):
+            return super().chunk(rows)
+        names, n = series_names(self.figures), self.points
+        p = np.repeat(np.array([[d[k] for k in p_names] for d in params]), n, axis=0)
+        x = np.tile(self._point_inputs, (len(rows), 1))
+        y, status = entry.evaluate(p_names, p, self.inputs(), x, names)
+        out = []
+        for j, (index, values) in enumerate(rows):
+            block, ok = y[j * n : (j + 1) * n], not status[j * n : (j + 1) * n].any()
+            if ok and np.all(np.isfinite(block)):
+                out.append((index, self.outcome(dict(zip(names, block.T, strict=True)), None)))
+            else:
+                out.append((index, self(tuple(values))))
+        return out
 
     def _run(self, values: tuple) -> Outcome:
         mech = _fresh(self.mechanism, "mechanism", self.mechanism_parameters(values))
@@ -251,4 +289,4 @@ def run_of(
 
 def run_rows(run: KinetostaticRun | DrivenRun, rows: list) -> list:
     """[(design index, Outcome)] of the designs [(index, values)], in order."""
-    return [(index, run(tuple(values))) for index, values in rows]
+    return run.chunk(rows)

@@ -83,13 +83,13 @@ class Counterweight:
         m0, cx, cy, i0 = (base[n] for n in self.needs())
         ax, ay = self.at
         mass = m0 + value
-        if not mass > 0:
-            return {f"{self.link}.mass": mass}
+        names = self.needs()
+        if not mass > 0:  # nothing there: the link as it was
+            return dict(zip(names, (mass, cx, cy, i0), strict=True))
         gx, gy = (m0 * cx + value * ax) / mass, (m0 * cy + value * ay) / mass
         inertia = (
             i0 + m0 * ((cx - gx) ** 2 + (cy - gy) ** 2) + value * ((ax - gx) ** 2 + (ay - gy) ** 2)
         )
-        names = self.needs()
         return dict(zip(names, (mass, gx, gy, inertia), strict=True))
 
 
