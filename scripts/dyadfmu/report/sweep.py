@@ -36,6 +36,10 @@ def _is_grid(table: Table) -> bool:
     return len(np.unique(x)) * len(np.unique(y)) == len(table)
 
 
+def _label(name: str, units: dict) -> str:
+    return f"{name} [{units[name]}]" if units.get(name, "1") != "1" else name
+
+
 def _heat_map(ax: Axes, table: Table, z: np.ndarray, label: str) -> None:
     xs, ys = np.unique(table.values[:, 0]), np.unique(table.values[:, 1])
     grid = np.full((len(ys), len(xs)), np.nan)
@@ -47,7 +51,7 @@ def _heat_map(ax: Axes, table: Table, z: np.ndarray, label: str) -> None:
     plt.colorbar(mesh, ax=ax, label=label)
 
 
-def _design_plot(ax: Axes, table: Table, study: Study, ok: np.ndarray) -> None:
+def _design_plot(ax: Axes, table: Table, study: Study, ok: np.ndarray, units: dict) -> None:
     ran = np.array([s == "ok" for s in table.status], dtype=bool)
     z = np.where(ran, table.column(study.objective.minimize), np.nan)
     x = table.values[:, 0]
@@ -55,22 +59,22 @@ def _design_plot(ax: Axes, table: Table, study: Study, ok: np.ndarray) -> None:
         order = np.argsort(x)
         ax.plot(x[order], z[order], "-", color="0.5")
         ax.plot(x[ok], z[ok], "o", ms=3, color="C0", label="feasible")
-        ax.set_ylabel(study.objective.minimize)
+        ax.set_ylabel(_label(study.objective.minimize, units))
         ax.legend(fontsize=8)
     else:
         if _is_grid(table):
-            _heat_map(ax, table, z, study.objective.minimize)
+            _heat_map(ax, table, z, _label(study.objective.minimize, units))
         else:
             points = ax.scatter(x, table.values[:, 1], c=z, s=12, cmap="viridis")
-            plt.colorbar(points, ax=ax, label=study.objective.minimize)
+            plt.colorbar(points, ax=ax, label=_label(study.objective.minimize, units))
         out = ~ok
         ax.plot(x[out], table.values[out, 1], "x", color="w", ms=5, label="infeasible or failed")
         ax.legend(fontsize=8, loc="lower right")
-        ax.set_ylabel(table.parameters[1])
-    ax.set_xlabel(table.parameters[0])
+        ax.set_ylabel(_label(table.parameters[1], units))
+    ax.set_xlabel(_label(table.parameters[0], units))
 
 
-def _pareto_plot(ax: Axes, table: Table, study: Study) -> None:
+def _pareto_plot(ax: Axes, table: Table, study: Study, units: dict) -> None:
     other = study.objective.constraints[0].figure
     a, b = table.column(study.objective.minimize), table.column(other)
     ran = np.array([s == "ok" for s in table.status]) & np.isfinite(a) & np.isfinite(b)
@@ -78,23 +82,24 @@ def _pareto_plot(ax: Axes, table: Table, study: Study) -> None:
     front = pareto_front(a, b, ran)
     ax.plot(a[front], b[front], "o-", ms=4, color="C3", label="Pareto front")
     ax.axhline(study.objective.constraints[0].maximum, color="C0", ls="--", label=f"{other} limit")
-    ax.set_xlabel(study.objective.minimize)
-    ax.set_ylabel(other)
+    ax.set_xlabel(_label(study.objective.minimize, units))
+    ax.set_ylabel(_label(other, units))
     ax.legend(fontsize=8)
 
 
-def plot_study(table: Table, study: Study, path: Path) -> Path:
+def plot_study(table: Table, study: Study, path: Path, units: dict | None = None) -> Path:
     """The study's plot: designs against the objective, and the Pareto front where the
     study has a constraint."""
+    units = units or {}
     ok = feasible(table, study)
     panels = 2 if study.objective.constraints else 1
     fig, axes = plt.subplots(1, panels, figsize=(6.5 * panels, 5), squeeze=False)
-    _design_plot(axes[0][0], table, study, ok)
+    _design_plot(axes[0][0], table, study, ok, units)
     for k in best_designs(table, study)[:1]:
         if table.values.shape[1] >= 2:
             axes[0][0].plot(*table.values[k, :2], "r*", ms=14, label="best")
     if panels == 2:
-        _pareto_plot(axes[0][1], table, study)
+        _pareto_plot(axes[0][1], table, study, units)
     fig.suptitle(f"{study.name}: {len(table)} designs, {int(ok.sum())} feasible")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -102,8 +107,11 @@ def plot_study(table: Table, study: Study, path: Path) -> Path:
     return path
 
 
-def report_text(table: Table, study: Study, seconds: float, workers: str) -> str:
+def report_text(
+    table: Table, study: Study, seconds: float, workers: str, units: dict | None = None
+) -> str:
     """The study's Markdown summary: what ran, the statuses, the best designs."""
+    units = units or {}
     statuses = {s: table.status.count(s) for s in dict.fromkeys(table.status)}
     lines = [
         f"# Study {markdown_cell(study.name)}",
@@ -128,7 +136,7 @@ def report_text(table: Table, study: Study, seconds: float, workers: str) -> str
         + ":",
         "",
         "| design | "
-        + " | ".join(map(markdown_cell, table.parameters + table.figure_names))
+        + " | ".join(markdown_cell(_label(n, units)) for n in table.parameters + table.figure_names)
         + " |",
         "|---:|" + "---:|" * (len(table.parameters) + len(table.figure_names)),
     ]

@@ -9,7 +9,7 @@ from fmpy.model_description import ModelDescription
 
 from .studyfile import Counterweight, Driven, Study, StudyError, line_of
 
-__all__ = ["check_names", "base_values"]
+__all__ = ["check_names", "base_values", "units_of"]
 
 
 def _fail(study: Study, table: str, index: int | None, key: str, why: str) -> None:
@@ -106,3 +106,32 @@ def base_values(study: Study, md: ModelDescription) -> dict:
     return {
         n: start[n] for p in study.parameters if isinstance(p, Counterweight) for n in p.needs()
     }
+
+
+def _unit(md: ModelDescription | None, name: str) -> str:
+    if md is None:
+        return "1"
+    return next((v.unit for v in md.modelVariables if v.name == name and v.unit), "1")
+
+
+def _figure_unit(of_unit: str, stat: str) -> str:
+    if stat == "fluctuation":
+        return "1"
+    if stat == "work_per_revolution":
+        return "J" if of_unit == "N.m" else f"{of_unit}.rad"
+    return of_unit
+
+
+def units_of(study: Study, md: ModelDescription, drive_md: ModelDescription | None) -> dict:
+    """The unit of every parameter and figure of the study (FMI unit names; "1" for none)."""
+
+    def unit(name: str) -> str:
+        if name.startswith("drive."):
+            return _unit(drive_md, name[6:])
+        return _unit(md, name)
+
+    units = {
+        p.name: "kg" if isinstance(p, Counterweight) else unit(p.name) for p in study.parameters
+    }
+    units.update({f.name: _figure_unit(unit(f.of[0]), f.stat) for f in study.figures})
+    return units

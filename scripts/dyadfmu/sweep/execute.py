@@ -10,6 +10,7 @@ starts from a reset FMU, so the table is the same whatever the number of workers
 
 from __future__ import annotations
 
+import logging
 import sys
 import time
 from collections.abc import Callable
@@ -82,7 +83,11 @@ def _client(scheduler: str | None, workers: int):
     if scheduler is not None:
         return Client(scheduler), None
     cluster = LocalCluster(
-        n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.ERROR,  # the progress bar says how it goes
     )
     return Client(cluster), cluster
 

@@ -10,7 +10,7 @@ from fmpy import read_model_description
 
 from ..report import sweep as report
 from . import execute, sources
-from .checks import check_names
+from .checks import check_names, units_of
 from .designs import designs
 from .results import Table, best_designs, table_of, write_csv
 from .runs import DrivenRun, KinetostaticRun, run_of
@@ -32,9 +32,9 @@ class SweepResult:
 
 def prepare(
     path: Path, out: Path, build: Path | None = None
-) -> tuple[Study, KinetostaticRun | DrivenRun, np.ndarray]:
-    """(study, run, designs): the study read, its FMUs found or built and its names
-    checked against them, its designs drawn."""
+) -> tuple[Study, KinetostaticRun | DrivenRun, np.ndarray, dict]:
+    """(study, run, designs, units): the study read, its FMUs found or built and its
+    names checked against them, its designs drawn, the units of its columns."""
     study = read_study(path)
     mechanism = sources.mechanism_fmu(study, out)
     drive = sources.drive_fmu(study, build)
@@ -45,7 +45,7 @@ def prepare(
     values = designs(
         study.sampling, [p.low for p in study.parameters], [p.high for p in study.parameters]
     )
-    return study, run, values
+    return study, run, values, units_of(study, md, drive_md)
 
 
 def run_study(
@@ -60,7 +60,7 @@ def run_study(
     of that many processes, or on the cluster at ``scheduler``."""
     study_out = out / Path(path).stem
     study_out.mkdir(parents=True, exist_ok=True)
-    study, run, values = prepare(Path(path), study_out, build)
+    study, run, values, units = prepare(Path(path), study_out, build)
     progress = execute.Progress(len(values))
     if workers == 0 and scheduler is None:
         outcomes, where = execute.run_serial(run, values, progress), "this process"
@@ -76,7 +76,7 @@ def run_study(
     table = table_of(study, values, outcomes)
     files = [study_out / "results.csv", study_out / "report.md"]
     write_csv(table, files[0])
-    files[1].write_text(report.report_text(table, study, seconds, where), encoding="utf-8")
+    files[1].write_text(report.report_text(table, study, seconds, where, units), encoding="utf-8")
     if plots:
-        files.append(report.plot_study(table, study, study_out / "designs.png"))
+        files.append(report.plot_study(table, study, study_out / "designs.png", units))
     return SweepResult(study, table, best_designs(table, study), files, seconds)
