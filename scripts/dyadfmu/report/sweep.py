@@ -100,7 +100,9 @@ def plot_study(table: Table, study: Study, path: Path, units: dict | None = None
             axes[0][0].plot(*table.values[k, :2], "r*", ms=14, label="best")
     if panels == 2:
         _pareto_plot(axes[0][1], table, study, units)
-    fig.suptitle(f"{study.name}: {len(table)} designs, {int(ok.sum())} feasible")
+    # the file's name as plain text: matplotlib would read $...$ in it as mathematics
+    title = study.name.replace("$", r"\$")
+    fig.suptitle(f"{title}: {len(table)} designs, {int(ok.sum())} feasible")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
