@@ -201,6 +201,7 @@ def test_the_figures_of_known_series():
 
     assert value(("x", "y"), "peak") == 5.0
     assert value(("t",), "fluctuation") == pytest.approx(2.0 / 2.0, rel=1e-3)
+    assert value(("t",), "drop") == pytest.approx(2.0 / 3.0, rel=1e-3)
     # the work of a torque 2 + sin over two revolutions, per revolution: 2 * 2 pi
     assert value(("t",), "work_per_revolution") == pytest.approx(4 * math.pi, rel=1e-5)
     equal = np.linspace(0.0, 2 * math.pi, 36, endpoint=False)

@@ -115,7 +115,7 @@ def _unit(md: ModelDescription | None, name: str) -> str:
 
 
 def _figure_unit(of_unit: str, stat: str) -> str:
-    if stat == "fluctuation":
+    if stat in ("fluctuation", "drop"):
         return "1"
     if stat == "work_per_revolution":
         return "J" if of_unit == "N.m" else f"{of_unit}.rad"

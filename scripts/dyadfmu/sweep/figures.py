@@ -1,5 +1,5 @@
 """The figures of a run from its series: peak, RMS, mean, min, max, the fluctuation
-(max - min) / mean, and the work per revolution (the integral of the series over the
+(max - min) / mean, the drop (max - min) / max, and the work per revolution (the integral of the series over the
 crank angle, per revolution: a torque's energy per cycle).
 
 Each series is sampled at the run's points (kinetostatic: equally spaced crank angles
@@ -29,6 +29,10 @@ def _fluctuation(v: np.ndarray, phi: np.ndarray | None) -> float:
     return float((np.max(v) - np.min(v)) / np.mean(v))
 
 
+def _drop(v: np.ndarray, phi: np.ndarray | None) -> float:
+    return float((np.max(v) - np.min(v)) / np.max(v))
+
+
 def _work_per_revolution(v: np.ndarray, phi: np.ndarray | None) -> float:
     if phi is None:  # one revolution at equally spaced angles: the periodic mean
         return float(np.mean(v)) * 2 * math.pi
@@ -46,6 +50,7 @@ _STATS = {
     "min": lambda v, phi: float(np.min(v)),
     "max": lambda v, phi: float(np.max(v)),
     "fluctuation": _fluctuation,
+    "drop": _drop,
     "work_per_revolution": _work_per_revolution,
 }
 

@@ -34,7 +34,7 @@ __all__ = [
 ]
 
 #: What a figure makes of its series (see :mod:`dyadfmu.sweep.figures`).
-STATS = ("peak", "rms", "mean", "min", "max", "fluctuation", "work_per_revolution")
+STATS = ("peak", "rms", "mean", "min", "max", "fluctuation", "drop", "work_per_revolution")
 SAMPLING_METHODS = ("grid", "random", "lhs")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
 #: The drive FMU's parameters a study may set or vary (as ``drive.<name>``).
