@@ -1,6 +1,7 @@
 """The figures of a run from its series: peak, RMS, mean, min, max, the fluctuation
-(max - min) / mean, the drop (max - min) / max, and the work per revolution (the integral of the series over the
-crank angle, per revolution: a torque's energy per cycle).
+(max - min) / mean, the drop (max - min) / max, and the work per revolution (the
+integral of the series over the crank angle, per revolution: a torque's energy per
+cycle).
 
 Each series is sampled at the run's points (kinetostatic: equally spaced crank angles
 over one revolution; driven: the communication points from ``settle`` on). RMS and mean
