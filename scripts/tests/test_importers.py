@@ -80,8 +80,13 @@ def fmutool() -> str:
     return required(importers.fmutool_executable(), "fmutool (fmu-manipulation-toolbox)")
 
 
+#: Built with the tests for the design studies' tests only (tests/scenes/balance.toml: a
+#: crank whose bearing force is known in closed form); no harness signals to compare on.
+STUDY_TEST_FMUS = {"balance_fmi2", "balance_fmi3"}
+
+
 def test_the_comparison_covers_every_fmu_the_build_makes():
-    built = {p.stem for p in (paths.build_dir() / "fmus").glob("*.fmu")}
+    built = {p.stem for p in (paths.build_dir() / "fmus").glob("*.fmu")} - STUDY_TEST_FMUS
     assert built == {f"{name}_fmi{version}" for name, version in ALL}
 
 
