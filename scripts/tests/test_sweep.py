@@ -366,3 +366,18 @@ def test_the_rows_entry_refuses_a_value_reference_of_the_wrong_kind():
     )
     assert status[0] == 0 and np.all(np.isfinite(y[0]))
     assert status[1] == 3 and np.all(np.isnan(y[1]))  # a negative mass: refused, NaN
+
+
+def test_a_scene_identifier_or_study_name_cannot_leave_the_output_folder(tmp_path):
+    scene = (ROOT / "tests" / "scenes" / "balance.toml").read_text()
+    (tmp_path / "evil.toml").write_text(
+        scene.replace('identifier = "balance"', 'identifier = "../../x"')
+    )
+    text = BALANCE_STUDY.replace(f'fmu = "{BALANCE}"', 'scene = "evil.toml"')
+    s = read_study(_write(tmp_path, text))
+    with pytest.raises(sources.SourceError, match="C identifier"):
+        sources.sweep_scene(s, tmp_path / "out")
+    assert not (tmp_path / "x_sweep").exists() and not list(tmp_path.parent.glob("x_sweep*"))
+    with pytest.raises(StudyError, match="name"):
+        study.run_study(_write(tmp_path, BALANCE_STUDY, "...toml"), tmp_path / "o", workers=0)
+    assert not (tmp_path / "results.csv").exists()

@@ -11,6 +11,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import subprocess
 import tomllib
 from pathlib import Path
@@ -35,7 +36,9 @@ def _value(v: object) -> str:
             raise ValueError(f"not a finite number: {v!r}")
         return repr(v)
     if isinstance(v, str):
-        return json.dumps(v)  # a TOML basic string: JSON's escapes are TOML's
+        # a TOML basic string: JSON's escapes are TOML's; characters beyond the BMP stay
+        # as they are (JSON would write surrogate pairs, which TOML refuses)
+        return json.dumps(v, ensure_ascii=False)
     if isinstance(v, list):
         return "[" + ", ".join(_value(x) for x in v) + "]"
     if isinstance(v, dict):
@@ -78,12 +81,17 @@ def sweep_scene(study: Study, out: Path) -> Path:
     """The study's copy of its scene, with the varied parameters tunable (written only
     when it changed)."""
     data = tomllib.loads(study.scene.read_text(encoding="utf-8"))
-    scene = data.get("scene", {})
+    scene = data.get("scene")
+    identifier = scene.get("identifier") if isinstance(scene, dict) else None
+    if not isinstance(identifier, str) or not re.fullmatch(
+        r"[A-Za-z_][A-Za-z0-9_]{0,63}", identifier
+    ):
+        raise SourceError(f"{study.scene}: [scene] identifier must be a C identifier")
     tunable = list(scene.get("tunable", []))
     scene["tunable"] = tunable + [n for n in _varied(study) if n not in tunable]
     # named by its content: two studies of one scene never share a build they differ in
     digest = hashlib.sha256(toml_text(data).encode()).hexdigest()[:10]
-    scene["identifier"] = f"{scene.get('identifier', 'scene')}_sweep_{digest}"
+    scene["identifier"] = f"{identifier}_sweep_{digest}"
     text = "# the study's scene with its parameters tunable (dyadfmu sweep)\n" + toml_text(data)
     path = out / f"{scene['identifier']}.toml"
     if not path.is_file() or path.read_text(encoding="utf-8") != text:

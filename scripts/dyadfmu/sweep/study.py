@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -14,7 +15,7 @@ from .checks import check_names, units_of
 from .designs import designs
 from .results import Table, best_designs, table_of, write_csv
 from .runs import DrivenRun, KinetostaticRun, run_of
-from .studyfile import Study, read_study
+from .studyfile import Study, StudyError, read_study
 
 __all__ = ["SweepResult", "run_study", "prepare"]
 
@@ -58,6 +59,11 @@ def run_study(
 ) -> SweepResult:
     """Run a study: ``workers`` = 0 runs it in this process, else on a local Dask cluster
     of that many processes, or on the cluster at ``scheduler``."""
+    if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}", Path(path).stem):
+        raise StudyError(
+            f"{path}: a study file's name (its output folder) must be letters, "
+            "digits, '_', '-' and '.'"
+        )
     study_out = out / Path(path).stem
     study_out.mkdir(parents=True, exist_ok=True)
     study, run, values, units = prepare(Path(path), study_out, build)
