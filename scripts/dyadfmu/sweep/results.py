@@ -14,7 +14,7 @@ import numpy as np
 
 from .studyfile import Study
 
-__all__ = ["Table", "table_of", "best_designs", "pareto_front", "write_csv", "read_csv"]
+__all__ = ["Table", "table_of", "best_designs", "pareto_front", "write_csv"]
 
 
 @dataclass
@@ -101,19 +101,3 @@ def write_csv(table: Table, path: Path) -> None:
                     table.message[k],
                 ]
             )
-
-
-def read_csv(path: Path, n_parameters: int) -> Table:
-    """A table written by :func:`write_csv`."""
-    with open(path, newline="", encoding="utf-8") as f:
-        rows = list(csv.reader(f))
-    head, body = rows[0], rows[1:]
-    p = n_parameters
-    return Table(
-        head[1 : 1 + p],
-        head[1 + p : -2],
-        np.array([[float(x) for x in r[1 : 1 + p]] for r in body]).reshape(len(body), p),
-        np.array([[float(x) for x in r[1 + p : -2]] for r in body]).reshape(len(body), -1),
-        [r[-2] for r in body],
-        [r[-1] for r in body],
-    )
