@@ -7,6 +7,7 @@ counterweight is the one that balances the crank (known in closed form)."""
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 import tomllib
@@ -125,7 +126,7 @@ def test_a_name_the_fmu_does_not_have_is_refused_with_its_line(tmp_path):
             'of = "crank.torque_peak"',
             "crank.torque_peak is not a Real output",
         ),
-        ('counterweight = "crank"', 'counterweight = "rod"', "rod.mass is not a parameter"),
+        ('counterweight = "crank"', 'counterweight = "rod"', "rod.mass is not a Real parameter"),
     ]:
         text = BALANCE_STUDY.replace(old, new)
         line = next(k for k, t in enumerate(text.splitlines(), start=1) if new in t)
@@ -381,3 +382,251 @@ def test_a_scene_identifier_or_study_name_cannot_leave_the_output_folder(tmp_pat
     with pytest.raises(StudyError, match="name"):
         study.run_study(_write(tmp_path, BALANCE_STUDY, "...toml"), tmp_path / "o", workers=0)
     assert not (tmp_path / "results.csv").exists()
+
+
+# ---- untrusted study files: refused with their line, never a traceback -----------------------
+
+HUGE = "1" + "0" * 400  # a TOML integer no float holds
+
+DRIVEN_RUN = """[run]
+kind = "driven"
+step = 0.1
+duration = 1.0
+settle = 0.0
+start_speed = 1.0
+"""
+
+
+@pytest.mark.parametrize(
+    "old, new, marker, words",
+    [
+        ("high = 2.0", f"high = {HUGE}", "high =", "high must be a finite number"),
+        ("at = [", f"at = [{HUGE}, ", "at = [", "at must be [x, y]"),
+        ("at = [", "at = [2000.0, ", "at = [", "within +-1000"),
+        ("high = 2.0", "high = 2e6", "high =", "above 1e+06 kg"),
+        (
+            "[[figure]]",
+            '[[parameter]]\nname = "crank.length"\nlow = -1.7e308\nhigh = 1.7e308\n\n[[figure]]',
+            "high = 1.7e308",
+            "high - low is not a finite",
+        ),
+        ("speed = 100.0", "speed = 1979-05-27", "speed =", "speed must be a number"),
+        ('minimize = "bearing_peak"', 'minimize = ["bearing_peak"]', "minimize", "must name"),
+        ("best = 3", 'constraints = [{ figure = ["x"], max = 1 }]', "constraints", "constraint"),
+        ("best = 3", "constraints = 5", "constraints", "constraints must be a list"),
+        (
+            "best = 3",
+            f'constraints = [{{ figure = "torque_rms", max = {HUGE} }}]',
+            "constraints",
+            "max must be a finite number",
+        ),
+        ('name = "torque_rms"', 'name = "counterweight"', 'name = "counterweight"', "is taken"),
+        ("[sampling]", "[drive]\ninertia = 1.0\n\n[sampling]", "[drive]", "kind = 'driven'"),
+        ("[study]", "[study]\nfmi = 3", "fmi = 3", "an .fmu has its own"),
+        ("[study]", "loads = 5\n\n[study]", "loads = 5", "loads must be a table"),
+        (
+            "[sampling]",
+            '[loads."crank.torque"]\nangle = [0.0]\nvalue = [1e13]\n\n[sampling]',
+            "[loads.",
+            "a load beyond",
+        ),
+        ("[sampling]", "[fixed]\ncrank.mass = 1.0\n\n[sampling]", "crank.mass", "in quotes"),
+        ("[sampling]", "[fixed.crank]\nmass = 1.0\n\n[sampling]", "[fixed.crank]", "in quotes"),
+        (
+            "[sampling]",
+            '[fixed]\n"crank.mass" = 1.0\n\n[sampling]',
+            '"crank.mass"',
+            "crank.mass is set twice: by counterweight counterweight and by [fixed]",
+        ),
+        (
+            "[[figure]]",
+            '[[parameter]]\nname = "second"\ncounterweight = "crank"\nat = [0.0, 0.0]\n'
+            "low = 0.0\nhigh = 1.0\n\n[[figure]]",
+            'counterweight = "crank"',
+            "crank.mass is set twice: by counterweight counterweight and by counterweight second",
+        ),
+        (
+            "[[figure]]",
+            '[[parameter]]\nname = "crank.com.x"\nlow = 0.0\nhigh = 1.0\n\n[[figure]]',
+            'name = "crank.com.x"',
+            "crank.com.x is set twice",
+        ),
+        (
+            'method = "grid"\ncount = 13 ',
+            'method = "random"\ncount = 1000000 ',
+            "count = 1000000",
+            "split the study",
+        ),
+    ],
+)
+def test_an_untrusted_study_is_refused_at_its_line_without_a_traceback(
+    tmp_path, old, new, marker, words
+):
+    text = BALANCE_STUDY.replace(old, new, 1)
+    if "split the study" in words:
+        text = text.replace("points = 36", "points = 100000")
+    assert text != BALANCE_STUDY
+    line = max(k for k, t in enumerate(text.splitlines(), start=1) if marker in t)
+    message = _refused(tmp_path, text)
+    assert message.startswith(f"{tmp_path / 'study.toml'}:{line}: "), message
+    assert words in message
+
+
+@pytest.mark.parametrize(
+    "run, words",
+    [
+        ("settle = 0.0", None),
+        ("settle = 0.2", "fewer than 10 communication points"),
+        ("step = 1e-7", "1e+08"),
+    ],
+)
+def test_a_driven_run_keeps_enough_points_and_bounded_work(tmp_path, run, words):
+    key = run.split(" =")[0]
+    driven = DRIVEN_RUN.replace(f"{key} = ", f"{run}\n#", 1)
+    text = BALANCE_STUDY.replace(
+        '[run]\nkind = "kinetostatic"\nspeed = 100.0\npoints = 36\n', driven
+    )
+    text = text.replace("count = 13 ", "count = 1001 ")
+    if words is None:
+        assert read_study(_write(tmp_path, text)).run.settle == 0.0
+        return
+    line = next(k for k, t in enumerate(text.splitlines(), start=1) if t.startswith(key))
+    line = (
+        line
+        if key == "settle"
+        else next(k for k, t in enumerate(text.splitlines(), start=1) if t.startswith("count"))
+    )
+    message = _refused(tmp_path, text)
+    assert message.startswith(f"{tmp_path / 'study.toml'}:{line}: "), message
+    assert words in message
+
+
+def test_line_of_finds_dotted_keys_and_sub_tables():
+    from dyadfmu.sweep.studyfile import line_of
+
+    text = (
+        "[study]\n"  # 1
+        'scene = "x"\n'  # 2
+        "[fixed]\n"  # 3
+        "rocker.mass = 1\n"  # 4
+        '"crank.mass" = 2\n'  # 5
+        "[fixed.gravity]\n"  # 6
+        "x = 1\n"  # 7
+        '[loads."slider.force.x"]\n'  # 8
+        "angle = [0.0]\n"  # 9
+        "[[figure]]\n"  # 10
+        'name = "a"\n'  # 11
+        "[[figure]]   # the second\n"  # 12
+        'name = "b"\n'  # 13
+    )
+    assert line_of(text, "fixed", key="rocker") == 4
+    assert line_of(text, "fixed", key="crank.mass") == 5
+    assert line_of(text, "fixed", key="gravity") == 6
+    assert line_of(text, "loads", key="slider.force.x") == 8
+    assert line_of(text, "loads") == 8
+    assert line_of(text, "figure", 1, "name") == 13
+    assert line_of(text, "", key="study") == 1
+    assert line_of(text, "objective") == 1
+
+
+def test_the_report_drops_control_characters_and_escapes_markup():
+    from dyadfmu.report.sweep import markdown_cell
+
+    cell = markdown_cell("a\x1b[31m\x07 $x$ |b| ~~s~~ ![i](u)\nnext\u202e")
+    assert all(ch.isprintable() for ch in cell)
+    assert re.search(r"(?<!\\)[$|~!\[\]*_`<>#]", cell) is None, cell
+    assert "\\$x\\$" in cell and "\\|b\\|" in cell and "\\~\\~s" in cell
+
+
+def test_a_report_without_a_feasible_design_says_so(tmp_path):
+    text = BALANCE_STUDY.replace("best = 3", 'constraints = [{ figure = "torque_rms", max = -1 }]')
+    s = read_study(_write(tmp_path, text))
+    table = results.Table(
+        ["counterweight"], ["bearing_peak", "torque_rms"], np.zeros((1, 1)),
+        np.ones((1, 2)), ["ok"], [""],
+    )  # fmt: skip
+    from dyadfmu.report.sweep import report_text
+
+    assert "No design ran and met every constraint" in report_text(table, s, 1.0, "x")
+
+
+def test_a_fluctuation_about_a_mean_that_is_not_positive_is_a_status_not_a_number():
+    fluct = Figure("f", ("w",), "fluctuation")
+    drop = Figure("d", ("w",), "drop")
+    peak = Figure("p", ("w",), "peak")
+    with pytest.raises(figures.UndefinedFigure, match="positive mean"):
+        figures.figure_value(fluct, {"w": np.array([-1.0, 1.0, -0.5])}, None)
+    with pytest.raises(figures.UndefinedFigure, match="maximum is positive"):
+        figures.figure_value(drop, {"w": np.array([-1.0, -2.0])}, None)
+    run = runs.KinetostaticRun("x.fmu", "crank", (), (), (), (), (fluct, peak))
+    outcome = run.outcome({"w": np.array([-1.0, 1.0, -0.5])}, None)
+    assert outcome.status == "undefined_figure" and "f: fluctuation" in outcome.message
+    assert math.isnan(outcome.figures[0]) and outcome.figures[1] == 1.0
+
+
+def test_a_broken_fmu_is_refused_naming_the_file(tmp_path):
+    import zipfile
+
+    junk = tmp_path / "junk.fmu"
+    junk.write_bytes(b"not a zip")
+    with pytest.raises(sources.SourceError, match="junk.fmu: not an FMU that can be read"):
+        sources.model_description(junk)
+    empty = tmp_path / "empty.fmu"
+    with zipfile.ZipFile(empty, "w") as z:
+        z.writestr("readme.txt", "no model description")
+    with pytest.raises(sources.SourceError, match="empty.fmu: not an FMU that can be read"):
+        sources.model_description(empty)
+    _needs_balance()
+    stripped = tmp_path / "stripped.fmu"
+    with zipfile.ZipFile(BALANCE) as src, zipfile.ZipFile(stripped, "w") as dst:
+        for item in src.infolist():
+            if not item.filename.startswith("binaries/"):
+                dst.writestr(item, src.read(item))
+    with pytest.raises(sources.SourceError, match="no binary for this platform"):
+        sources.model_description(stripped)
+    assert sources.model_description(BALANCE).coSimulation is not None
+
+
+def test_a_counterweight_on_a_link_whose_mass_is_not_a_real_start_value_is_refused(tmp_path):
+    from dyadfmu.sweep.checks import base_values
+    from fmpy.model_description import ModelDescription, ScalarVariable
+
+    md = ModelDescription()
+    for name, start in (("crank.mass", "true"), ("crank.com.x", "0"), ("crank.com.y", "0")):
+        v = ScalarVariable(name=name, valueReference=len(md.modelVariables))
+        v.causality, v.type, v.start = "parameter", "Real", start
+        md.modelVariables.append(v)
+    s = read_study(_write(tmp_path, BALANCE_STUDY))
+    with pytest.raises(StudyError, match="no finite start value"):
+        base_values(s, md)
+
+
+def test_a_malformed_scene_is_refused_with_the_scene_checker_s_line(tmp_path):
+    scene = (ROOT / "tests" / "scenes" / "balance.toml").read_text()
+    text = BALANCE_STUDY.replace(f'fmu = "{BALANCE}"', 'scene = "bad.toml"')
+    for bad, words in (
+        (scene.replace("[effects]", "when = 1979-05-27\n\n[effects]"), "bad.toml:"),
+        (scene.replace("[scene]", "scene = 5\n[scene]"), "bad.toml"),
+        (scene.replace('tunable = ["crank", "rod.length"]', 'tunable = "crank"'), "bad.toml"),
+        (scene + "\n[[[oops\n", "bad.toml"),
+    ):
+        (tmp_path / "bad.toml").write_text(bad)
+        s = read_study(_write(tmp_path, text))
+        with pytest.raises(sources.SourceError) as info:
+            sources.sweep_scene(s, tmp_path / "out")
+        assert str(info.value).startswith(str(tmp_path / "bad.toml")) and words in str(info.value)
+
+
+def test_a_chunk_the_rows_entry_refuses_runs_through_fmi(tmp_path, monkeypatch):
+    _needs_balance()
+    s, run, values, _ = study.prepare(_write(tmp_path, BALANCE_STUDY), tmp_path)
+    rows = list(enumerate(values[:3]))
+    through_rows = run.chunk(rows)
+
+    def refuse(*args, **kwargs):
+        raise RuntimeError("dyadfmu_evaluate_rows refused the call (status 3)")
+
+    from dyadfmu.sweep import rows as rows_module
+
+    monkeypatch.setattr(rows_module.RowsEntry, "evaluate", refuse)
+    assert run.chunk(rows) == through_rows

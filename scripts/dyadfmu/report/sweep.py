@@ -8,6 +8,7 @@ file is untrusted input)."""
 
 from __future__ import annotations
 
+import unicodedata
 from pathlib import Path
 
 import matplotlib
@@ -24,9 +25,12 @@ __all__ = ["plot_study", "report_text", "markdown_cell"]
 
 
 def markdown_cell(text: str) -> str:
-    """Text safe in a Markdown table cell: one line, no pipes, no markup characters."""
-    out = " ".join(str(text).split())
-    for ch in "\\|*_`<>[]#":
+    """Text safe in a Markdown table cell: one line, printable characters only (control
+    and format characters dropped), every markup character escaped (``$`` too: some
+    renderers read mathematics between two)."""
+    printable = "".join(ch if unicodedata.category(ch)[0] != "C" else " " for ch in str(text))
+    out = " ".join(printable.split())
+    for ch in "\\|*_`<>[]#$~!":
         out = out.replace(ch, "\\" + ch)
     return out
 
@@ -38,6 +42,12 @@ def _is_grid(table: Table) -> bool:
 
 def _label(name: str, units: dict) -> str:
     return f"{name} [{units[name]}]" if units.get(name, "1") != "1" else name
+
+
+def _axis_label(name: str, units: dict) -> str:
+    """A plot's label: the unit comes from an FMU, and matplotlib reads $...$ as
+    mathematics."""
+    return _label(name, units).replace("$", r"\$")
 
 
 def _heat_map(ax: Axes, table: Table, z: np.ndarray, label: str) -> None:
@@ -59,19 +69,19 @@ def _design_plot(ax: Axes, table: Table, study: Study, ok: np.ndarray, units: di
         order = np.argsort(x)
         ax.plot(x[order], z[order], "-", color="0.5")
         ax.plot(x[ok], z[ok], "o", ms=3, color="C0", label="feasible")
-        ax.set_ylabel(_label(study.objective.minimize, units))
+        ax.set_ylabel(_axis_label(study.objective.minimize, units))
         ax.legend(fontsize=8)
     else:
         if _is_grid(table):
-            _heat_map(ax, table, z, _label(study.objective.minimize, units))
+            _heat_map(ax, table, z, _axis_label(study.objective.minimize, units))
         else:
             points = ax.scatter(x, table.values[:, 1], c=z, s=12, cmap="viridis")
-            plt.colorbar(points, ax=ax, label=_label(study.objective.minimize, units))
+            plt.colorbar(points, ax=ax, label=_axis_label(study.objective.minimize, units))
         out = ~ok
         ax.plot(x[out], table.values[out, 1], "x", color="w", ms=5, label="infeasible or failed")
         ax.legend(fontsize=8, loc="lower right")
-        ax.set_ylabel(_label(table.parameters[1], units))
-    ax.set_xlabel(_label(table.parameters[0], units))
+        ax.set_ylabel(_axis_label(table.parameters[1], units))
+    ax.set_xlabel(_axis_label(table.parameters[0], units))
 
 
 def _pareto_plot(ax: Axes, table: Table, study: Study, units: dict) -> None:
@@ -82,8 +92,8 @@ def _pareto_plot(ax: Axes, table: Table, study: Study, units: dict) -> None:
     front = pareto_front(a, b, ran)
     ax.plot(a[front], b[front], "o-", ms=4, color="C3", label="Pareto front")
     ax.axhline(study.objective.constraints[0].maximum, color="C0", ls="--", label=f"{other} limit")
-    ax.set_xlabel(_label(study.objective.minimize, units))
-    ax.set_ylabel(_label(other, units))
+    ax.set_xlabel(_axis_label(study.objective.minimize, units))
+    ax.set_ylabel(_axis_label(other, units))
     ax.legend(fontsize=8)
 
 
@@ -120,7 +130,8 @@ def report_text(
         "",
         markdown_cell(study.description),
         "",
-        f"{len(table)} designs ({study.sampling.method}) run in {seconds:.1f} s on {workers} "
+        f"{len(table)} designs ({study.sampling.method}) run in {seconds:.1f} s on "
+        f"{markdown_cell(workers)} "
         "(not counting a local cluster's start): "
         f"{len(table) / max(seconds, 1e-9):.1f} runs/s. Statuses: "
         + ", ".join(f"{markdown_cell(s)} {n}" for s, n in statuses.items())
@@ -142,7 +153,10 @@ def report_text(
         + " |",
         "|---:|" + "---:|" * (len(table.parameters) + len(table.figure_names)),
     ]
-    for k in best_designs(table, study):
+    best = best_designs(table, study)
+    for k in best:
         cells = [f"{v:.6g}" for v in (*table.values[k], *table.figures[k])]
         lines.append(f"| {k} | " + " | ".join(cells) + " |")
+    if not best:
+        lines += ["", "No design ran and met every constraint: the table above is empty."]
     return "\n".join(lines) + "\n"

@@ -5,6 +5,8 @@ a load an input, a figure's series an output or input. A name that is not is ref
 
 from __future__ import annotations
 
+import math
+
 from fmpy.model_description import ModelDescription
 
 from .studyfile import Counterweight, Driven, Study, StudyError, line_of
@@ -31,7 +33,7 @@ def _short_list(names: list) -> str:
 
 
 def _check_parameters(study: Study, md: ModelDescription, what: str) -> None:
-    params = _names(md, ("parameter",))
+    params = _names(md, ("parameter",), reals=True)
     for k, p in enumerate(study.parameters):
         weight = isinstance(p, Counterweight)
         wanted = p.needs() if weight else () if p.name.startswith("drive.") else (p.name,)
@@ -42,7 +44,8 @@ def _check_parameters(study: Study, md: ModelDescription, what: str) -> None:
                     "parameter",
                     k,
                     "counterweight" if weight else "name",
-                    f"{name} is not a parameter of {what} (make it tunable in the scene); "
+                    f"{name} is not a Real parameter of {what} (make it tunable in the "
+                    "scene); "
                     f"its parameters: {_short_list(params)}",
                 )
     for name, _ in study.fixed:
@@ -52,7 +55,7 @@ def _check_parameters(study: Study, md: ModelDescription, what: str) -> None:
                 "fixed",
                 None,
                 name,
-                f"{name} is not a parameter of {what}; its parameters: {_short_list(params)}",
+                f"{name} is not a Real parameter of {what}; its parameters: {_short_list(params)}",
             )
 
 
@@ -101,11 +104,27 @@ def check_names(
 
 
 def base_values(study: Study, md: ModelDescription) -> dict:
-    """The start values of the parameters the counterweights change."""
-    start = {v.name: float(v.start) for v in md.modelVariables if v.causality == "parameter"}
-    return {
-        n: start[n] for p in study.parameters if isinstance(p, Counterweight) for n in p.needs()
-    }
+    """The start values of the parameters the counterweights change (StudyError where
+    the FMU gives one no finite start value)."""
+    start = {v.name: v.start for v in md.modelVariables if v.causality == "parameter"}
+    base = {}
+    for k, p in enumerate(study.parameters):
+        for name in p.needs() if isinstance(p, Counterweight) else ():
+            try:
+                value = float(start.get(name))
+            except (TypeError, ValueError):
+                value = math.nan
+            if not math.isfinite(value):
+                _fail(
+                    study,
+                    "parameter",
+                    k,
+                    "counterweight",
+                    f"{p.name}: the FMU gives {name} no finite start value "
+                    f"(start {start.get(name)!r})",
+                )
+            base[name] = value
+    return base
 
 
 def _unit(md: ModelDescription | None, name: str) -> str:

@@ -1,7 +1,8 @@
 """The figures of a run from its series: peak, RMS, mean, min, max, the fluctuation
 (max - min) / mean, the drop (max - min) / max, and the work per revolution (the
 integral of the series over the crank angle, per revolution: a torque's energy per
-cycle).
+cycle). The fluctuation is defined for a series with a positive mean (a speed), the
+drop for one with a positive maximum; elsewhere the run's row says so.
 
 Each series is sampled at the run's points (kinetostatic: equally spaced crank angles
 over one revolution; driven: the communication points from ``settle`` on). RMS and mean
@@ -17,7 +18,7 @@ import numpy as np
 
 from .studyfile import Figure
 
-__all__ = ["figure_value", "series_names"]
+__all__ = ["figure_value", "series_names", "UndefinedFigure"]
 
 
 def _series(figure: Figure, series: dict) -> np.ndarray:
@@ -26,12 +27,23 @@ def _series(figure: Figure, series: dict) -> np.ndarray:
     return np.hypot(series[figure.of[0]], series[figure.of[1]])
 
 
+class UndefinedFigure(ValueError):
+    """A figure that has no value over its series (a fluctuation about a mean that is
+    not positive, say)."""
+
+
 def _fluctuation(v: np.ndarray, phi: np.ndarray | None) -> float:
-    return float((np.max(v) - np.min(v)) / np.mean(v))
+    mean = float(np.mean(v))
+    if not mean > 0:
+        raise UndefinedFigure(f"fluctuation needs a series with a positive mean (mean {mean:.6g})")
+    return float((np.max(v) - np.min(v)) / mean)
 
 
 def _drop(v: np.ndarray, phi: np.ndarray | None) -> float:
-    return float((np.max(v) - np.min(v)) / np.max(v))
+    top = float(np.max(v))
+    if not top > 0:
+        raise UndefinedFigure(f"drop needs a series whose maximum is positive (max {top:.6g})")
+    return float((top - np.min(v)) / top)
 
 
 def _work_per_revolution(v: np.ndarray, phi: np.ndarray | None) -> float:
@@ -58,7 +70,8 @@ _STATS = {
 
 def figure_value(figure: Figure, series: dict, phi: np.ndarray | None) -> float:
     """The figure of one run; ``phi`` is the unwrapped crank angle (rad) at the samples,
-    None for one revolution at equally spaced angles."""
+    None for one revolution at equally spaced angles. UndefinedFigure where the figure
+    has no value over this series."""
     return _STATS[figure.stat](_series(figure, series), phi)
 
 

@@ -12,7 +12,7 @@ A run object holds only data (paths, settings), so that it travels to Dask worke
 it is; each worker process loads each FMU once (:func:`slave`) and resets it between
 runs. A run that fails returns its status (``singular``, ``cannot_assemble``,
 ``diverged``, ``refused``: the FMU refused a parameter value) with the FMU's message and
-NaN figures; it never raises.
+NaN figures, or ``undefined_figure`` with the figures that have a value; it never raises.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from fmpy.model_description import ModelDescription
 
 from ..fmi.slave import Slave, SlaveError
 from .checks import base_values
-from .figures import figure_value, series_names
+from .figures import UndefinedFigure, figure_value, series_names
 from .rows import rows_entry
 from .studyfile import Driven, Kinetostatic, Study
 
@@ -107,6 +107,8 @@ class _Common:
             return Outcome(nothing, e.status, e.message)
         except SlaveError as e:
             return Outcome(nothing, "refused" if e.status >= 3 else "discarded", str(e))
+        except ArithmeticError as e:  # a design's parameters out of a float's range
+            return Outcome(nothing, "refused", f"the design's parameters: {e}")
 
     def chunk(self, rows: list) -> list:
         """[(index, Outcome)] of the designs [(index, values)], one run after another."""
@@ -114,10 +116,18 @@ class _Common:
 
     def outcome(self, series: dict, phi: np.ndarray | None) -> Outcome:
         """The figures over the recorded series."""
-        values = tuple(figure_value(f, series, phi) for f in self.figures)
+        values, undefined = [], []
+        for f in self.figures:
+            try:
+                values.append(figure_value(f, series, phi))
+            except UndefinedFigure as e:
+                values.append(math.nan)
+                undefined.append(f"{f.name}: {e}")
+        if undefined:
+            return Outcome(tuple(values), "undefined_figure", "; ".join(undefined))
         if not all(map(math.isfinite, values)):
-            return Outcome(values, "diverged", "a figure is not finite")
-        return Outcome(values, "ok")
+            return Outcome(tuple(values), "diverged", "a figure is not finite")
+        return Outcome(tuple(values), "ok")
 
 
 def _failed_point(mech: Slave, where: str) -> _Failed:
@@ -152,14 +162,22 @@ class KinetostaticRun(_Common):
         design in one call of the binary's rows entry; a design that fails there runs
         again through FMI, whose calls name the failure."""
         entry = rows_entry(self.mechanism) if self.use_rows else None
-        params = [self.mechanism_parameters(tuple(v)) for _, v in rows]
+        if entry is None:
+            return super().chunk(rows)
+        try:
+            params = [self.mechanism_parameters(tuple(v)) for _, v in rows]
+        except ArithmeticError:  # the FMI path gives each design its own row
+            return super().chunk(rows)
         p_names = tuple(params[0]) if params else ()
-        if entry is None or any(tuple(p) != p_names for p in params):
+        if any(tuple(p) != p_names for p in params):
             return super().chunk(rows)
         names, n = series_names(self.figures), self.points
         p = np.repeat(np.array([[d[k] for k in p_names] for d in params]), n, axis=0)
         x = np.tile(self._point_inputs, (len(rows), 1))
-        y, status = entry.evaluate(p_names, p, self.inputs(), x, names)
+        try:
+            y, status = entry.evaluate(p_names, p, self.inputs(), x, names)
+        except RuntimeError:  # refused as a whole (an FMU whose GUID is not its binary's)
+            return super().chunk(rows)
         out = []
         for j, (index, values) in enumerate(rows):
             block, ok = y[j * n : (j + 1) * n], not status[j * n : (j + 1) * n].any()
@@ -213,7 +231,10 @@ class DrivenRun(_Common):
         loads = tuple(ld.at(phi) for ld in self.loads)
         y.set(inputs, (phi, omega, 0.0) + loads)
         torque0 = y.get(f"{self.driver}.torque")
-        (j,) = y.directional_derivative((f"{self.driver}.torque",), (inputs[2],), [1.0])
+        try:
+            (j,) = y.directional_derivative((f"{self.driver}.torque",), (inputs[2],), [1.0])
+        except SlaveError as e:  # the FMU's status output says why
+            raise _failed_point(y, f"at t = {t:g} s: {e}") from None
         if not (math.isfinite(torque0) and math.isfinite(j)):
             raise _failed_point(y, f"at t = {t:g} s")
         d.set(("load.torque", "load.inertia"), (-torque0, j))

@@ -13,13 +13,25 @@ import math
 import os
 import re
 import subprocess
+import sys
 import tomllib
+import zipfile
 from pathlib import Path
+
+from fmpy import read_model_description
+from fmpy.model_description import ModelDescription
 
 from .. import paths
 from .studyfile import Counterweight, Driven, Study
 
-__all__ = ["toml_text", "sweep_scene", "mechanism_fmu", "drive_fmu", "SourceError"]
+__all__ = [
+    "toml_text",
+    "sweep_scene",
+    "mechanism_fmu",
+    "drive_fmu",
+    "model_description",
+    "SourceError",
+]
 
 
 class SourceError(RuntimeError):
@@ -77,18 +89,45 @@ def _varied(study: Study) -> list:
     return [n for n in dict.fromkeys(names) if not n.startswith("drive.")]
 
 
-def sweep_scene(study: Study, out: Path) -> Path:
-    """The study's copy of its scene, with the varied parameters tunable (written only
-    when it changed)."""
-    data = tomllib.loads(study.scene.read_text(encoding="utf-8"))
+def check_scene(scene: Path) -> None:
+    """SourceError with the scene checker's messages (FILE:LINE each) where the scene
+    file is not a valid scene."""
+    done = subprocess.run(
+        [sys.executable, str(paths.ROOT / "modelDescription" / "scene.py"), str(scene), "--check"],
+        capture_output=True,
+        text=True,
+    )
+    if done.returncode != 0:
+        raise SourceError(f"{scene}: not a valid scene:\n{done.stderr.strip()[-4000:]}")
+
+
+def _copy_of(scene_file: Path, study: Study) -> dict:
+    """The scene's data with the study's parameters added to its tunable list."""
+    data = tomllib.loads(scene_file.read_text(encoding="utf-8"))
     scene = data.get("scene")
     identifier = scene.get("identifier") if isinstance(scene, dict) else None
     if not isinstance(identifier, str) or not re.fullmatch(
         r"[A-Za-z_][A-Za-z0-9_]{0,63}", identifier
     ):
-        raise SourceError(f"{study.scene}: [scene] identifier must be a C identifier")
-    tunable = list(scene.get("tunable", []))
+        raise ValueError("[scene] identifier must be a C identifier of at most 64 characters")
+    tunable = scene.get("tunable", [])
+    if not isinstance(tunable, list) or not all(isinstance(n, str) for n in tunable):
+        raise ValueError("[scene] tunable must be a list of parameter names")
     scene["tunable"] = tunable + [n for n in _varied(study) if n not in tunable]
+    toml_text(data)  # every value can be written
+    return data
+
+
+def sweep_scene(study: Study, out: Path) -> Path:
+    """The study's copy of its scene, with the varied parameters tunable (written only
+    when it changed)."""
+    try:
+        data = _copy_of(study.scene, study)
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, ValueError, TypeError) as e:
+        check_scene(study.scene)  # its messages name the line
+        raise SourceError(f"{study.scene}: {e}") from None
+    scene = data["scene"]
+    identifier = scene["identifier"]
     # named by its content: two studies of one scene never share a build they differ in
     digest = hashlib.sha256(toml_text(data).encode()).hexdigest()[:10]
     scene["identifier"] = f"{identifier}_sweep_{digest}"
@@ -100,10 +139,11 @@ def sweep_scene(study: Study, out: Path) -> Path:
     return path
 
 
-def _build_scene(scene: Path, identifier: str, fmi: int) -> Path:
+def _build_scene(original: Path, scene: Path, identifier: str, fmi: int) -> Path:
     fmu = paths.ROOT / "build-scene" / "fmus" / f"{identifier}_fmi{fmi}.fmu"
     if fmu.is_file():  # the identifier names the scene's content
         return fmu
+    check_scene(original)  # a problem of the user's file named at its own line
     done = subprocess.run(
         [str(paths.ROOT / "scripts" / "build-scene"), str(scene)],
         capture_output=True,
@@ -121,7 +161,7 @@ def mechanism_fmu(study: Study, out: Path) -> Path:
         return study.fmu
     scene = sweep_scene(study, out)
     identifier = tomllib.loads(scene.read_text(encoding="utf-8"))["scene"]["identifier"]
-    return _build_scene(scene, identifier, study.fmi)
+    return _build_scene(study.scene, scene, identifier, study.fmi)
 
 
 def drive_fmu(study: Study, build: Path | None) -> Path | None:
@@ -129,3 +169,21 @@ def drive_fmu(study: Study, build: Path | None) -> Path | None:
     if not isinstance(study.run, Driven):
         return None
     return paths.built_fmu("drive", study.fmi, build)
+
+
+def model_description(fmu: Path) -> ModelDescription:
+    """The model description of an FMU a study runs, checked: a co-simulation FMU of
+    FMI 2 or 3 with a binary for this platform (SourceError naming the file otherwise)."""
+    try:
+        md = read_model_description(str(fmu))
+        with zipfile.ZipFile(fmu) as archive:
+            members = set(archive.namelist())
+    except Exception as e:  # a broken archive or XML: zipfile, lxml and fmpy raise their own
+        raise SourceError(f"{fmu}: not an FMU that can be read ({type(e).__name__}: {e})") from None
+    version = md.fmiVersion.split(".")[0] if isinstance(md.fmiVersion, str) else ""
+    if version not in ("2", "3") or md.coSimulation is None:
+        raise SourceError(f"{fmu}: not a co-simulation FMU of FMI 2 or 3")
+    binary = f"binaries/{paths.PLATFORM[int(version)]}/{md.coSimulation.modelIdentifier}.so"
+    if binary not in members:
+        raise SourceError(f"{fmu}: no binary for this platform ({binary})")
+    return md

@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from fmpy import read_model_description
 
 from ..report import sweep as report
 from . import execute, sources
@@ -39,8 +38,8 @@ def prepare(
     study = read_study(path)
     mechanism = sources.mechanism_fmu(study, out)
     drive = sources.drive_fmu(study, build)
-    md = read_model_description(str(mechanism))
-    drive_md = read_model_description(str(drive)) if drive is not None else None
+    md = sources.model_description(mechanism)
+    drive_md = sources.model_description(drive) if drive is not None else None
     check_names(study, md, drive_md, mechanism.name)
     run = run_of(study, str(mechanism), str(drive) if drive else None, md)
     values = designs(

@@ -39,10 +39,34 @@ SAMPLING_METHODS = ("grid", "random", "lhs")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
 #: The drive FMU's parameters a study may set or vary (as ``drive.<name>``).
 DRIVE_PARAMETERS = ("motor.stall_torque", "motor.no_load_speed", "inertia")
+#: A driven run's figures are taken from at least this many communication points.
+MIN_RECORDED = 10
+#: The most work a study may ask for: crank positions (kinetostatic: designs x points)
+#: or communication steps (driven: designs x steps), a few hours on one core here. A
+#: study beyond them is split into several.
+MAX_POSITIONS = 10_000_000_000
+MAX_STEPS = 100_000_000
+#: A counterweight's bounds: its mass (kg) and its distance from the link's frame (m).
+MAX_COUNTERWEIGHT_MASS = 1e6
+MAX_COUNTERWEIGHT_AT = 1e3
+#: The largest load a load case may give (in the load input's unit: N or N m).
+MAX_LOAD = 1e12
 
 
 class StudyError(ValueError):
     """A study file refused: the message starts with FILE:LINE."""
+
+
+def finite(value: object) -> float | None:
+    """``value`` as a finite float; None for anything else (a bool, a string, an
+    integer too large for a float, inf, NaN)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:
+        return None
+    return x if math.isfinite(x) else None
 
 
 @dataclass(frozen=True)
@@ -204,26 +228,66 @@ class Study:
 # ---- locating a key ------------------------------------------------------------------------
 
 
+_KEY_PART = re.compile(r"""\s*(?:"((?:[^"\\]|\\.)*)"|'([^']*)'|([A-Za-z0-9_-]+))\s*""")
+
+
+def _key_path(line: str, pos: int) -> tuple[tuple, int] | None:
+    """The parts of the TOML dotted key at ``pos`` (``a."b.c".d`` gives a, b.c, d) and
+    where it ends, None where no key starts there."""
+    parts = []
+    while True:
+        m = _KEY_PART.match(line, pos)
+        if not m:
+            return None
+        basic, literal, bare = m.groups()
+        parts.append(basic.replace('\\"', '"') if basic is not None else literal or bare or "")
+        pos = m.end()
+        if not line.startswith(".", pos):
+            return tuple(parts), pos
+        pos += 1
+
+
+def _header(line: str) -> tuple | None:
+    """The table name of a ``[a.b]`` or ``[[a.b]]`` line as its parts, None for another."""
+    text = line.strip()
+    opening = 2 if text.startswith("[[") else 1 if text.startswith("[") else 0
+    found = _key_path(text, opening) if opening else None
+    if found is None or not text.startswith("]" * opening, found[1]):
+        return None
+    rest = text[found[1] + opening :].strip()
+    return found[0] if not rest or rest.startswith("#") else None
+
+
+def _assigned_key(line: str) -> tuple | None:
+    """The key a ``key = value`` line assigns, as its parts."""
+    found = _key_path(line, 0)
+    return found[0] if found and line.startswith("=", found[1]) else None
+
+
 def line_of(text: str, table: str, index: int | None = None, key: str | None = None) -> int:
     """The line of ``key`` in ``[table]`` (or the ``index``-th ``[[table]]``), else of
-    the table's header, else 1."""
-    header = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
-    seen, inside, header_line = -1, False, 0
+    the table's header, else 1. ``table`` "" is the file's top level. A key written as a
+    dotted key (``gravity.x = 1``) or as a sub-table (``[fixed.gravity]``) is found by its
+    first part."""
+    want = tuple(table.split(".")) if table else ()
+    seen, inside, prefix, header_line = -1, not want, (), 0
     for number, line in enumerate(text.splitlines(), start=1):
-        m = header.match(line)
-        if m:
-            name = m.group(1).replace('"', "")
-            if name == table:
+        header = _header(line)
+        if header is not None:
+            inside, prefix = False, ()
+            if header == want:
                 seen += 1
                 inside = index is None or seen == index
                 header_line = number if inside else header_line
-            else:
-                inside = False
+            elif header[: len(want)] == want and index is None:  # a sub-table of it
+                inside, prefix = True, header[len(want) :]
+                header_line = header_line or number
+                if key is not None and prefix[0] == key:
+                    return number
             continue
-        if inside and key is not None:
-            k = re.match(r'^\s*"?([^"=]+?)"?\s*=', line)
-            if k and k.group(1).strip() == key:
-                return number
+        assigned = _assigned_key(line) if inside and key is not None else None
+        if assigned is not None and (prefix + assigned)[0] == key:
+            return number
     return header_line or 1
 
 
@@ -241,12 +305,14 @@ class _Reader:
         raise StudyError(f"{self.path}:{line}: {why}")
 
     def table(self, data: dict, name: str, required: bool = True) -> dict:
-        """A sub-table of the file."""
+        """A table at the top of the file."""
         value = data.get(name)
-        if value is None and not required:
+        if value is None:
+            if required:
+                self.fail(name, f"a [{name}] table is required")
             return {}
         if not isinstance(value, dict):
-            self.fail(name, f"[{name}] is required and must be a table")
+            self.fail("", f"{name} must be a table: [{name}]", key=name)
         return value
 
     def number(
@@ -261,12 +327,12 @@ class _Reader:
         """A finite number (a positive one if ``positive``)."""
         value = t.get(key, default)
         if isinstance(value, bool) or not isinstance(value, int | float):
-            self.fail(table, f"{key} must be a number (got {value!r})", index, key)
-        value = float(value)
-        if not math.isfinite(value) or (positive and not value > 0):
+            self.fail(table, f"{key} must be a number (got {_shown(value)})", index, key)
+        x = finite(value)
+        if x is None or (positive and not x > 0):
             kind = "a positive finite number" if positive else "a finite number"
-            self.fail(table, f"{key} must be {kind} (got {value!r})", index, key)
-        return value
+            self.fail(table, f"{key} must be {kind} (got {_shown(value)})", index, key)
+        return x
 
     def integer(
         self, t: dict, table: str, key: str, low: int, high: int, default: object = None
@@ -288,6 +354,12 @@ class _Reader:
         for key in t:
             if key not in allowed:
                 self.fail(table, f"unknown key {key!r}; expected {', '.join(allowed)}", index, key)
+
+
+def _shown(value: object) -> str:
+    """A value as a message shows it: short, one line."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 # ---- the parts -----------------------------------------------------------------------------
@@ -313,6 +385,10 @@ def _run(r: _Reader, data: dict) -> Kinetostatic | Driven:
     kind = t.get("kind")
     if kind == "kinetostatic":
         r.unknown_keys(t, "run", ("kind", "speed", "points"))
+        if "drive" in data:
+            r.fail(
+                "drive", "[drive] sets the drive FMU's parameters: it needs [run] kind = 'driven'"
+            )
         return Kinetostatic(
             speed=r.number(t, "run", "speed", positive=True),
             points=r.integer(t, "run", "points", 8, 100_000, default=360),
@@ -328,13 +404,21 @@ def _run(r: _Reader, data: dict) -> Kinetostatic | Driven:
             r.fail("run", "settle must be at least 0 and below duration", key="settle")
         if not 2 <= duration / step <= 10_000_000:
             r.fail("run", "duration / step must be from 2 to 1e7 steps", key="step")
+        if (duration - settle) / step < MIN_RECORDED - 1:
+            r.fail(
+                "run",
+                f"settle leaves fewer than {MIN_RECORDED} communication points to take the "
+                f"figures from: (duration - settle) / step must be at least {MIN_RECORDED - 1}",
+                key="settle",
+            )
         drive = r.table(data, "drive", required=False)
         for name in drive:
             if name not in DRIVE_PARAMETERS:
                 r.fail(
                     "drive",
                     f"unknown drive parameter {name!r}; expected one of "
-                    f"{', '.join(DRIVE_PARAMETERS)}",
+                    f"{', '.join(DRIVE_PARAMETERS)} (a name with a dot is written in quotes: "
+                    '"motor.stall_torque" = 200)',
                     key=name,
                 )
         return Driven(
@@ -356,6 +440,8 @@ def _parameter(r: _Reader, t: dict, k: int, driven: bool):
     high = r.number(t, "parameter", "high", k)
     if not low <= high:
         r.fail("parameter", f"{name}: low must not exceed high", k, "high")
+    if not math.isfinite(high - low):
+        r.fail("parameter", f"{name}: high - low is not a finite number", k, "high")
     if name.startswith("drive.") and not driven:
         r.fail("parameter", f"{name}: a drive parameter needs [run] kind = 'driven'", k, "name")
     if name.startswith("drive.") and name[6:] not in DRIVE_PARAMETERS:
@@ -372,16 +458,24 @@ def _parameter(r: _Reader, t: dict, k: int, driven: bool):
         return Parameter(name, low, high)
     link = r.name(t["counterweight"], "parameter", "counterweight", k)
     at = t.get("at")
-    if (
-        not isinstance(at, list)
-        or len(at) != 2
-        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in at)
-        or not all(math.isfinite(v) for v in at)
-    ):
-        r.fail("parameter", "at must be [x, y] in metres, finite", k, "at")
+    xy = [finite(v) for v in at] if isinstance(at, list) and len(at) == 2 else [None]
+    if not all(v is not None and abs(v) <= MAX_COUNTERWEIGHT_AT for v in xy):
+        r.fail(
+            "parameter",
+            f"at must be [x, y] in metres, each within +-{MAX_COUNTERWEIGHT_AT:g}",
+            k,
+            "at",
+        )
     if low < 0:
         r.fail("parameter", f"{name}: a counterweight's mass cannot be negative", k, "low")
-    return Counterweight(name, low, high, link, (float(at[0]), float(at[1])))
+    if high > MAX_COUNTERWEIGHT_MASS:
+        r.fail(
+            "parameter",
+            f"{name}: a counterweight above {MAX_COUNTERWEIGHT_MASS:g} kg",
+            k,
+            "high",
+        )
+    return Counterweight(name, low, high, link, (xy[0], xy[1]))
 
 
 def _parameters(r: _Reader, data: dict, driven: bool) -> tuple:
@@ -414,34 +508,39 @@ def _sampling(r: _Reader, data: dict, n_params: int) -> Sampling:
 def _load(r: _Reader, name: str, value: object) -> LoadTable:
     if isinstance(value, int | float) and not isinstance(value, bool):
         v = r.number({name: value}, "loads", name)
+        if abs(v) > MAX_LOAD:
+            r.fail("loads", f"{name}: a load beyond +-{MAX_LOAD:g}", key=name)
         return LoadTable(name, (0.0,), (v,))
     if not isinstance(value, dict) or set(value) != {"angle", "value"}:
         r.fail(
-            "loads", f"{name}: a number, or a table {{ angle = [...], value = [...] }}", key=name
+            "loads",
+            f"{name}: a number, or a table {{ angle = [...], value = [...] }} (a name with "
+            'a dot is written in quotes: "piston.force" = ...)',
+            key=name,
         )
     angle, val = value["angle"], value["value"]
-    ok = (
-        isinstance(angle, list)
-        and isinstance(val, list)
-        and 1 <= len(angle) == len(val) <= 10_000
-        and all(isinstance(x, int | float) and not isinstance(x, bool) for x in angle + val)
-        and all(math.isfinite(x) for x in angle + val)
-    )
-    if not ok:
+    ok = isinstance(angle, list) and isinstance(val, list) and 1 <= len(angle) == len(val) <= 10_000
+    angle = [finite(x) for x in angle] if ok else []
+    val = [finite(x) for x in val] if ok else []
+    if not ok or any(x is None for x in angle + val):
         r.fail(
             "loads",
             f"{name}: angle and value must be lists of finite numbers of one length",
             key=name,
+        )
+    if any(abs(x) > MAX_LOAD for x in val) or any(abs(a) > 100 for a in angle):
+        r.fail(
+            "loads", f"{name}: a load beyond +-{MAX_LOAD:g}, or an angle beyond +-100 rad", key=name
         )
     if (
         any(b < a for a, b in zip(angle, angle[1:], strict=False))
         or angle[-1] - angle[0] >= 2 * math.pi
     ):
         r.fail("loads", f"{name}: the angles must increase within one revolution (rad)", key=name)
-    return LoadTable(name, tuple(map(float, angle)), tuple(map(float, val)))
+    return LoadTable(name, tuple(angle), tuple(val))
 
 
-def _figures(r: _Reader, data: dict) -> tuple:
+def _figures(r: _Reader, data: dict, parameters: tuple) -> tuple:
     items = data.get("figure")
     if not isinstance(items, list) or not items or not all(isinstance(t, dict) for t in items):
         r.fail("figure", "at least one [[figure]] table is required")
@@ -456,8 +555,14 @@ def _figures(r: _Reader, data: dict) -> tuple:
         of = tuple(r.name(o, "figure", "of", k) for o in of)
         if t.get("stat") not in STATS:
             r.fail("figure", f"{name}: stat must be one of {', '.join(STATS)}", k, "stat")
-        if name in {f.name for f in figures} or name in ("design", "status", "message"):
-            r.fail("figure", f"figure name {name} is taken", k, "name")
+        taken = {f.name for f in figures} | {p.name for p in parameters}
+        if name in taken or name in ("design", "status", "message"):
+            r.fail(
+                "figure",
+                f"figure name {name} is taken (by a parameter, another figure or a column)",
+                k,
+                "name",
+            )
         figures.append(Figure(name, of, t["stat"]))
     return tuple(figures)
 
@@ -466,19 +571,90 @@ def _objective(r: _Reader, data: dict, figures: tuple) -> Objective:
     t = r.table(data, "objective")
     r.unknown_keys(t, "objective", ("minimize", "constraints", "best"))
     names = {f.name for f in figures}
-    if t.get("minimize") not in names:
+    minimize = t.get("minimize")
+    if not isinstance(minimize, str) or minimize not in names:
         r.fail(
             "objective", f"minimize must name a figure: {', '.join(sorted(names))}", key="minimize"
         )
     constraints = []
-    for c in t.get("constraints", []):
-        if not isinstance(c, dict) or set(c) != {"figure", "max"} or c["figure"] not in names:
+    items = t.get("constraints", [])
+    if not isinstance(items, list) or len(items) > 100:
+        r.fail("objective", "constraints must be a list of constraints", key="constraints")
+    for c in items:
+        if (
+            not isinstance(c, dict)
+            or set(c) != {"figure", "max"}
+            or not isinstance(c["figure"], str)
+            or c["figure"] not in names
+        ):
             r.fail(
-                "objective", "a constraint is { figure = NAME, max = NUMBER }", key="constraints"
+                "objective",
+                f"a constraint is {{ figure = NAME, max = NUMBER }} with NAME one of "
+                f"{', '.join(sorted(names))}",
+                key="constraints",
             )
-        constraints.append(Constraint(c["figure"], r.number(c, "objective", "max")))
+        maximum = finite(c["max"])
+        if maximum is None:
+            r.fail(
+                "objective",
+                f"{c['figure']}: a constraint's max must be a finite number "
+                f"(got {_shown(c['max'])})",
+                key="constraints",
+            )
+        constraints.append(Constraint(c["figure"], maximum))
     best = r.integer(t, "objective", "best", 1, 1000, default=5)
     return Objective(t["minimize"], tuple(constraints), best)
+
+
+def _fixed_value(r: _Reader, fixed: dict, name: str) -> float:
+    value = fixed[name]
+    if isinstance(value, dict) and value:  # crank.mass = 1 reads as a table crank
+        first = next(iter(value))
+        r.fail(
+            "fixed",
+            f'{name}: a name with a dot is written in quotes: "{name}.{first}" = ...',
+            key=name,
+        )
+    return r.number(fixed, "fixed", name)
+
+
+def _check_assigned_once(r: _Reader, params: tuple, fixed: tuple, run: object) -> None:
+    """Refuse an FMU parameter that two entries of the study set: the later one would
+    silently override the earlier (two counterweights on one link, a counterweight and
+    the link's varied mass, a parameter both varied and fixed)."""
+    by: dict = {}
+
+    def claim(name: str, what: str, table: str, index: int | None, key: str) -> None:
+        if name in by:
+            r.fail(table, f"{name} is set twice: by {by[name]} and by {what}", index, key)
+        by[name] = what
+
+    for k, p in enumerate(params):
+        if isinstance(p, Counterweight):
+            for n in p.needs():
+                claim(n, f"counterweight {p.name}", "parameter", k, "counterweight")
+        else:
+            claim(p.name, f"parameter {p.name}", "parameter", k, "name")
+    for n, _ in fixed:
+        claim(n, "[fixed]", "fixed", None, n)
+    for n, _ in getattr(run, "drive", ()):
+        claim(f"drive.{n}", "[drive]", "drive", None, n)
+
+
+def _check_work(r: _Reader, sampling: Sampling, n_params: int, run: object) -> None:
+    designs = sampling.count**n_params if sampling.method == "grid" else sampling.count
+    if isinstance(run, Kinetostatic):
+        work, limit, what = designs * run.points, MAX_POSITIONS, "crank positions"
+    else:
+        steps = round(run.duration / run.step)
+        work, limit, what = designs * steps, MAX_STEPS, "communication steps"
+    if work > limit:
+        r.fail(
+            "sampling",
+            f"{designs} designs make {work:.3g} {what} in all, over the limit of {limit:.0e}: "
+            "split the study",
+            key="count",
+        )
 
 
 def read_study(path: Path | str) -> Study:
@@ -503,15 +679,21 @@ def read_study(path: Path | str) -> Study:
     if not isinstance(description, str) or len(description) > 500:
         r.fail("study", "description must be one line of text", key="description")
     scene, fmu = _sources(r, study)
+    if fmu is not None and "fmi" in study:
+        r.fail(
+            "study", "fmi chooses the version a scene is built for: an .fmu has its own", key="fmi"
+        )
     fmi = r.integer(study, "study", "fmi", 2, 3, default=2)
     run = _run(r, data)
     params = _parameters(r, data, isinstance(run, Driven))
-    loads = tuple(
-        _load(r, r.name(n, "loads", n), v) for n, v in r.table(data, "loads", False).items()
-    )
+    loads_t = r.table(data, "loads", False)
+    loads = tuple(_load(r, r.name(n, "loads", n), v) for n, v in loads_t.items())
     fixed_t = r.table(data, "fixed", False)
-    fixed = tuple((r.name(n, "fixed", n), r.number(fixed_t, "fixed", n)) for n in fixed_t)
-    figures = _figures(r, data)
+    fixed = tuple((r.name(n, "fixed", n), _fixed_value(r, fixed_t, n)) for n in fixed_t)
+    _check_assigned_once(r, params, fixed, run)
+    figures = _figures(r, data, params)
+    sampling = _sampling(r, data, len(params))
+    _check_work(r, sampling, len(params), run)
     return Study(
         path=path,
         description=" ".join(description.split()),
@@ -520,7 +702,7 @@ def read_study(path: Path | str) -> Study:
         fmi=fmi,
         run=run,
         parameters=params,
-        sampling=_sampling(r, data, len(params)),
+        sampling=sampling,
         loads=loads,
         fixed=fixed,
         figures=figures,
