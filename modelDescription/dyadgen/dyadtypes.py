@@ -3,6 +3,8 @@ lengths may be 0, and what conditions them."""
 
 from __future__ import annotations
 
+import math
+
 #: Pair kinds at (D_m, E, D_n) of each type.
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}
 TYPES = tuple(PAIRS)  # RRR, RRT, RTR, TRT, RTT
@@ -71,3 +73,6 @@ UNITS = {
     "kg/m": {"kg": 1, "m": -1},
 }
 BASE_UNIT_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+#: The unit a simulator shows a variable in by default, and its factor: shown = factor *
+#: value. Angles in degrees, angular speeds in revolutions per minute.
+DISPLAY_UNITS = {"rad": ("deg", 180 / math.pi), "rad/s": ("rpm", 30 / math.pi)}

@@ -149,8 +149,9 @@ def test_a_singular_position_ends_both_runs_alike(version, fmi_sim, tmp_path):
 
 
 def test_fmi_sim_refuses_the_fmi3_units_it_is_given_a_copy_without(fmi_sim, tmp_path):
-    """fmi-sim 0.7.0 rejects `unit` on an FMI 3 <Float64> (the schema allows it): it runs
-    a copy whose model description differs in exactly those attributes."""
+    """fmi-sim 0.7.0 rejects `unit` and `displayUnit` on an FMI 3 <Float64> (the schema
+    allows them): it runs a copy whose model description differs in exactly those
+    attributes."""
     original = fmu_file("dyad_rrt", 3)
     refused = importers.fmi_sim(fmi_sim, original, tmp_path / "refused.csv", 0.01, 0.005)
     assert refused.returncode != 0
@@ -163,9 +164,11 @@ def test_fmi_sim_refuses_the_fmi3_units_it_is_given_a_copy_without(fmi_sim, tmp_
                 assert a.read(item) == b.read(item), item
         before = etree.fromstring(a.read("modelDescription.xml"))
         after = etree.fromstring(b.read("modelDescription.xml"))
-    assert sum(1 for v in before.iter("Float64") if v.get("unit")) > 0
+    for attribute in ("unit", "displayUnit"):
+        assert sum(1 for v in before.iter("Float64") if v.get(attribute)) > 0, attribute
     for v in before.iter("Float64"):
         v.attrib.pop("unit", None)
+        v.attrib.pop("displayUnit", None)
     assert etree.tostring(before, method="c14n") == etree.tostring(after, method="c14n")
     assert importers.fmi_sim(fmi_sim, copy, tmp_path / "accepted.csv", 0.01, 0.005).returncode == 0
 

@@ -1555,3 +1555,29 @@ def _write_generic_tables():
 
 
 _write_generic_tables()
+
+
+def test_angles_display_in_degrees_and_speeds_in_rpm():
+    """Every built FMU, FMI 2 and 3: a variable in rad shows in deg, one in rad/s in rpm,
+    by the unit definitions' factors (shown = factor * value)."""
+    from dyadfmu import paths
+    from fmpy import read_model_description
+
+    fmus = sorted((paths.build_dir() / "fmus").glob("*.fmu"))
+    if not fmus:
+        pytest.skip("no FMU built")
+    want = {"rad": ("deg", 180 / math.pi), "rad/s": ("rpm", 60 / (2 * math.pi))}
+    for fmu in fmus:
+        md = read_model_description(str(fmu))
+        declared = {
+            u.name: [(d.name, d.factor, d.offset) for d in u.displayUnits]
+            for u in md.unitDefinitions
+        }
+        for unit, (name, factor) in want.items():
+            if unit in declared:
+                ((shown, got, offset),) = declared[unit]
+                assert shown == name and got == pytest.approx(factor, rel=1e-15), fmu.name
+                assert offset in (None, 0, 0.0), fmu.name
+        for v in md.modelVariables:
+            expected = want.get(v.unit, (None,))[0]
+            assert v.displayUnit == expected, (fmu.name, v.name)

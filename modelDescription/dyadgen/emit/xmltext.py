@@ -4,7 +4,7 @@ header comment, the root element, the unit definitions and the log categories.""
 from __future__ import annotations
 
 from dyadgen import textsafe
-from dyadgen.dyadtypes import BASE_UNIT_ORDER, UNITS
+from dyadgen.dyadtypes import BASE_UNIT_ORDER, DISPLAY_UNITS, UNITS
 from dyadgen.table import Table, Variable
 
 GENERATION_TOOL = "dyadfmu generate.py"
@@ -84,6 +84,9 @@ def unit_definitions(table: Table) -> list[str]:
         exps = UNITS[unit]
         lines.append(f'    <Unit name="{textsafe.xml_attribute(unit)}">')
         lines.append(element(3, "BaseUnit", [(b, exps[b]) for b in BASE_UNIT_ORDER if b in exps]))
+        if unit in DISPLAY_UNITS:
+            name, factor = DISPLAY_UNITS[unit]
+            lines.append(element(3, "DisplayUnit", [("name", name), ("factor", num(factor))]))
         lines.append("    </Unit>")
     lines.append("  </UnitDefinitions>")
     return lines
@@ -125,7 +128,8 @@ def variable_attributes(v: Variable) -> list[tuple[str, object]]:
 
 
 def typed_attributes(v: Variable, unit_first: bool) -> list[tuple[str, object]]:
-    """start, unit, min, max of a Real (FMI 2 order) or unit first (FMI 3 order)."""
+    """start, unit, displayUnit, min, max of a Real (FMI 2 order) or unit first (FMI 3
+    order)."""
     attrs = []
     if v.unit and unit_first:
         attrs.append(("unit", v.unit))
@@ -133,6 +137,8 @@ def typed_attributes(v: Variable, unit_first: bool) -> list[tuple[str, object]]:
         attrs.append(("start", num(v.start)))
     if v.unit and not unit_first:
         attrs.append(("unit", v.unit))
+    if v.unit in DISPLAY_UNITS:
+        attrs.append(("displayUnit", DISPLAY_UNITS[v.unit][0]))
     if v.min is not None:
         attrs.append(("min", num(v.min)))
     if v.max is not None:

@@ -146,9 +146,9 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
 # ---------------------------------------------------------------------------
 def readable_copy(fmu: Path, dest: Path) -> Path:
     """A copy of the FMU that fmi-sim 0.7.0 reads. Its FMI 3 parser (fmi-schema 0.8)
-    refuses a `unit` attribute on <Float64>, which the FMI 3 schema allows and our model
-    descriptions carry; the copy goes without those attributes (a unit changes nothing an
-    importer computes). An FMI 2 FMU is copied unchanged."""
+    refuses the `unit` and `displayUnit` attributes on <Float64>, which the FMI 3 schema
+    allows and our model descriptions carry; the copy goes without those attributes (a
+    unit changes nothing an importer computes). An FMI 2 FMU is copied unchanged."""
     dest.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(dest, "w", zipfile.ZIP_DEFLATED) as out:
         for item in src.infolist():
@@ -165,6 +165,7 @@ def _without_float64_units(xml: bytes) -> bytes:
         return xml
     for variable in root.iter("Float64"):
         variable.attrib.pop("unit", None)
+        variable.attrib.pop("displayUnit", None)
     return etree.tostring(root, xml_declaration=True, encoding="UTF-8")
 
 
