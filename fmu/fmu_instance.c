@@ -88,10 +88,7 @@ void fmu_log(const fmu_instance* instance, fmu_status status, const char* format
 
 /* Logging before an instance exists. */
 static void log_to(const fmu_logger* logger, fmu_status status, const char* format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
+    FMU_PRINTF_FORMAT(3, 4);
 static void log_to(const fmu_logger* logger, fmu_status status, const char* format, ...)
 {
     va_list args;

@@ -12,6 +12,17 @@
 
 #include "fmu_model.h"
 
+/* Format checking of the printf-style loggers. MinGW builds use its C99 stdio
+ * (__USE_MINGW_ANSI_STDIO), whose formats (%zu) are GNU's, not the Microsoft
+ * runtime's. */
+#if defined(__MINGW32__)
+#define FMU_PRINTF_FORMAT(fmt, first) __attribute__((format(gnu_printf, fmt, first)))
+#elif defined(__GNUC__)
+#define FMU_PRINTF_FORMAT(fmt, first) __attribute__((format(printf, fmt, first)))
+#else
+#define FMU_PRINTF_FORMAT(fmt, first)
+#endif
+
 /* The states of the co-simulation state machine, as bits so that each entry
  * point can name the states it may be called in with one mask. */
 typedef enum fmu_state {
@@ -133,10 +144,7 @@ fmu_status fmu_check_call(fmu_instance* instance, fmu_operation operation, const
 /* Logs printf-style through the instance's logger. Errors, discards and
  * warnings are always passed on; FMU_OK messages only with logCalls on. */
 void fmu_log(const fmu_instance* instance, fmu_status status, const char* format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
+    FMU_PRINTF_FORMAT(3, 4);
 
 fmu_status fmu_set_debug_logging(fmu_instance* instance, int logging_on, size_t count,
                                  const char* const categories[]);

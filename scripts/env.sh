@@ -7,9 +7,14 @@ DYADFMU_VENV=${DYADFMU_VENV:-$DYADFMU_ROOT/.venv}
 
 dyadfmu_log() { printf '== %s\n' "$*" >&2; }
 
-# Debian packages: command to check -> package providing it.
+# dyadfmu_ensure_system [NEED...]: the Debian packages a command needs. Always the
+# compiler, make, CMake and Python with venv; NEED `study`: GSL (the generic-solve
+# baseline of the benchmark) and valgrind (its instruction counts); `windows`: the
+# MinGW-w64 cross compiler and Wine (the FMUs' Windows binaries, tested under Wine).
+# As root the missing ones are installed; otherwise the command stops, naming them
+# and itself.
 dyadfmu_ensure_system() {
-    local missing=()
+    local missing=() need
     command -v cmake >/dev/null 2>&1 || missing+=(cmake)
     command -v cc >/dev/null 2>&1 || missing+=(gcc libc6-dev)
     command -v make >/dev/null 2>&1 || missing+=(make)
@@ -17,17 +22,30 @@ dyadfmu_ensure_system() {
     if ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
         missing+=(python3-venv)
     fi
-    # GSL for the generic-solve baseline of the study; valgrind counts its instructions.
-    [ -f /usr/include/gsl/gsl_linalg.h ] || missing+=(libgsl-dev)
-    command -v valgrind >/dev/null 2>&1 || missing+=(valgrind)
+    for need in "$@"; do
+        case $need in
+        study)
+            [ -f /usr/include/gsl/gsl_linalg.h ] || missing+=(libgsl-dev)
+            command -v valgrind >/dev/null 2>&1 || missing+=(valgrind)
+            ;;
+        windows)
+            command -v x86_64-w64-mingw32-gcc >/dev/null 2>&1 || missing+=(gcc-mingw-w64-x86-64)
+            command -v wine >/dev/null 2>&1 || missing+=(wine wine64)
+            ;;
+        *)
+            dyadfmu_log "dyadfmu_ensure_system: unknown need '$need' (study, windows)"
+            return 2
+            ;;
+        esac
+    done
     if [ ${#missing[@]} -eq 0 ]; then
         return 0
     fi
     if [ "$(id -u)" -ne 0 ]; then
-        dyadfmu_log "missing system packages: ${missing[*]} (run as root, or install them: apt-get install ${missing[*]})"
+        dyadfmu_log "$(basename "$0") needs the system packages ${missing[*]}: install them (apt-get install ${missing[*]}) or run it as root"
         return 1
     fi
-    dyadfmu_log "installing system packages: ${missing[*]}"
+    dyadfmu_log "installing system packages for $(basename "$0"): ${missing[*]}"
     apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
 }
 

@@ -3,12 +3,26 @@
 
 #include "fmu_probe.h"
 
-#include <dlfcn.h>
 #include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The binary of this platform, and how to load it: the probes run on the Linux
+ * binaries natively and, cross-compiled with MinGW-w64, on the Windows ones
+ * under Wine (tests/fmu_replay.c). */
+#if defined(_WIN32)
+#include <windows.h>
+#define PROBE_PLATFORM_FMI2 "win64"
+#define PROBE_PLATFORM_FMI3 "x86_64-windows"
+#define PROBE_BINARY_SUFFIX ".dll"
+#else
+#include <dlfcn.h>
+#define PROBE_PLATFORM_FMI2 "linux64"
+#define PROBE_PLATFORM_FMI3 "x86_64-linux"
+#define PROBE_BINARY_SUFFIX ".so"
+#endif
 
 /* ---- a minimal XML reader ------------------------------------------------------------------- */
 
@@ -322,11 +336,7 @@ static int type_of_element(int fmi_version, const char* name, probe_type* type)
     return 0;
 }
 
-static int fail(char* error, size_t error_size, const char* format, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
+static int fail(char* error, size_t error_size, const char* format, ...) PROBE_PRINTF_FORMAT(3, 4);
 static int fail(char* error, size_t error_size, const char* format, ...)
 {
     va_list args;
@@ -520,8 +530,8 @@ int probe_read_model(const char* directory, probe_model* model, char* error, siz
         probe_free_model(model);
         return fail(error, error_size, "out of memory");
     }
-    sprintf(model->binary_path, "%s/binaries/%s/%s.so", directory,
-            model->fmi_version == 2 ? "linux64" : "x86_64-linux", model->identifier);
+    sprintf(model->binary_path, "%s/binaries/%s/%s" PROBE_BINARY_SUFFIX, directory,
+            model->fmi_version == 2 ? PROBE_PLATFORM_FMI2 : PROBE_PLATFORM_FMI3, model->identifier);
     return 1;
 }
 
@@ -587,6 +597,28 @@ unsigned probe_unused_vr(const probe_model* model)
 
 /* ---- loading -------------------------------------------------------------------------------- */
 
+#if defined(_WIN32)
+static int resolve(void* library, const char* name, void* function_pointer, char* error,
+                   size_t error_size)
+{
+    FARPROC symbol = GetProcAddress((HMODULE)library, name);
+    if (symbol == NULL) {
+        return fail(error, error_size, "missing symbol %s", name);
+    }
+    memcpy(function_pointer, &symbol, sizeof symbol);
+    return 1;
+}
+
+static void* open_library(const probe_model* model, char* error, size_t error_size)
+{
+    HMODULE library = LoadLibraryA(model->binary_path);
+    if (library == NULL) {
+        fail(error, error_size, "cannot load %s: error %lu", model->binary_path,
+             (unsigned long)GetLastError());
+    }
+    return (void*)library;
+}
+#else
 static int resolve(void* library, const char* name, void* function_pointer, char* error,
                    size_t error_size)
 {
@@ -608,6 +640,7 @@ static void* open_library(const probe_model* model, char* error, size_t error_si
     }
     return library;
 }
+#endif
 
 #define PROBE_RESOLVE2(name) \
     ok = ok && resolve(api->library, "fmi2" #name, &api->name, error, error_size);
@@ -647,7 +680,11 @@ int probe_load_fmi3(const probe_model* model, probe_fmi3* api, char* error, size
 void probe_unload(void* library)
 {
     if (library != NULL) {
+#if defined(_WIN32)
+        FreeLibrary((HMODULE)library);
+#else
         dlclose(library);
+#endif
     }
 }
 

@@ -14,6 +14,16 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 
+/* Format checking of printf-style helpers; MinGW builds use its C99 stdio
+ * (__USE_MINGW_ANSI_STDIO), whose formats are GNU's. */
+#if defined(__MINGW32__)
+#define PROBE_PRINTF_FORMAT(fmt, first) __attribute__((format(gnu_printf, fmt, first)))
+#elif defined(__GNUC__)
+#define PROBE_PRINTF_FORMAT(fmt, first) __attribute__((format(printf, fmt, first)))
+#else
+#define PROBE_PRINTF_FORMAT(fmt, first)
+#endif
+
 /* ---- the model description ------------------------------------------------ */
 
 typedef enum probe_causality {
@@ -60,7 +70,7 @@ typedef struct probe_model {
     probe_variable* variables;
     size_t variable_count;
     char* directory;   /* the extracted FMU */
-    char* binary_path; /* binaries/<platform>/<identifier>.so */
+    char* binary_path; /* binaries/<platform>/<identifier>.so, or .dll on Windows */
 } probe_model;
 
 /* Reads DIR/modelDescription.xml. Returns 1, or 0 with the reason in `error`. */

@@ -1,0 +1,232 @@
+"""The Windows binaries of the FMUs against the Linux ones, over the harness's inputs.
+
+Every FMU carries a Windows binary (binaries/win64, binaries/x86_64-windows) cross-compiled
+with MinGW-w64 beside its Linux one. tests/fmu_replay.c drives an extracted FMU over given
+inputs and writes every output as its bit pattern; the build makes it for Linux
+(build/fmu/fmu_replay) and for Windows (build/fmu_replay.exe, run under Wine). Both run each
+FMU's stage directory (build/fmus/stage/<id>_fmi<v>: what the .fmu holds) over the inputs of
+:func:`dyadfmu.cosim.importers.setup_of`, and :func:`compare` sets the two side by side.
+
+``python -m dyadfmu.cosim.windows`` prints the table over every FMU of the build.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import struct
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+
+from .. import paths
+from ..fmi.simulate import CoSimSetup
+from . import importers
+
+__all__ = [
+    "Replay",
+    "Difference",
+    "wine_executable",
+    "replay_programs",
+    "write_inputs",
+    "read_outputs",
+    "run",
+    "compare",
+    "replay_all",
+]
+
+
+def wine_executable() -> str | None:
+    """Wine (Debian ``wine``), None where it is not installed."""
+    return shutil.which("wine")
+
+
+def replay_programs(build: Path | None = None) -> tuple[Path, Path]:
+    """(the Linux fmu_replay, the Windows fmu_replay.exe) of the build."""
+    build = build or paths.build_dir()
+    return build / "fmu" / "fmu_replay", build / "fmu_replay.exe"
+
+
+def _bits(x: float) -> str:
+    return f"{struct.unpack('<Q', struct.pack('<d', float(x)))[0]:016x}"
+
+
+def _double(bits: str) -> float:
+    return struct.unpack("<d", struct.pack("<Q", int(bits, 16)))[0]
+
+
+def write_inputs(setup: CoSimSetup, path: Path) -> None:
+    """The setup's inputs in fmu_replay's form: one row per communication step, each
+    value as its bit pattern (exact on every C library)."""
+    md = read_model_description(str(setup.path))
+    vr = {v.name: v.valueReference for v in md.modelVariables if v.causality == "input"}
+    names = [n for n in setup.inputs if n in vr]  # a setup may feed more than this FMU takes
+    steps = len(setup.time) - 1
+    lines = [
+        f"steps {steps} step {_bits(setup.step)} inputs {len(names)} "
+        + " ".join(str(vr[n]) for n in names)
+    ]
+    for k in range(steps):
+        lines.append(" ".join(_bits(setup.inputs[n][k]) for n in names))
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+
+
+@dataclass
+class Replay:
+    """One run's outputs: per step the doStep status, the real and the integer outputs,
+    by value reference."""
+
+    status: np.ndarray
+    reals: dict  # value reference -> values per step
+    integers: dict
+
+
+def read_outputs(path: Path) -> Replay:
+    """What fmu_replay wrote."""
+    lines = path.read_text(encoding="ascii").splitlines()
+    real_vrs = [int(x) for x in lines[0].split()[2:]]
+    integer_vrs = [int(x) for x in lines[1].split()[2:]]
+    rows = [line.split() for line in lines[2:]]
+    status = np.array([int(r[0]) for r in rows])
+    reals = {vr: np.array([_double(r[1 + j]) for r in rows]) for j, vr in enumerate(real_vrs)}
+    base = 1 + len(real_vrs)
+    integers = {vr: np.array([int(r[base + j]) for r in rows]) for j, vr in enumerate(integer_vrs)}
+    return Replay(status, reals, integers)
+
+
+def _windows_path(path: Path) -> str:
+    """The path as a Windows program under Wine sees it (drive Z: is /)."""
+    return "Z:" + str(path.resolve()).replace("/", "\\")
+
+
+def _wine_env(build: Path) -> dict:
+    env = dict(os.environ)
+    env.update(
+        WINEPREFIX=str((build / "wine-prefix").resolve()),
+        WINEDEBUG="-all",
+        WINEDLLOVERRIDES="mscoree,mshtml=",  # no Mono or Gecko installer prompts
+    )
+    env.pop("DISPLAY", None)
+    return env
+
+
+def run(jobs: list, workdir: Path, windows: bool, build: Path | None = None) -> None:
+    """Runs fmu_replay (under Wine if ``windows``) over [(stage dir, input, output)]."""
+    build = build or paths.build_dir()
+    linux, exe = replay_programs(build)
+    workdir.mkdir(parents=True, exist_ok=True)
+    name = "jobs_windows.txt" if windows else "jobs_linux.txt"
+    spell = _windows_path if windows else (lambda p: str(p.resolve()))
+    (workdir / name).write_text(
+        "".join(" ".join(spell(Path(p)) for p in job) + "\n" for job in jobs), encoding="ascii"
+    )
+    command = (
+        ["wine", str(exe), spell(workdir / name)] if windows else [str(linux), str(workdir / name)]
+    )
+    env = _wine_env(build) if windows else None
+    done = subprocess.run(command, capture_output=True, text=True, env=env, timeout=1800)
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(command)} failed:\n{done.stdout}\n{done.stderr}")
+
+
+@dataclass
+class Difference:
+    """The Windows binary's outputs against the Linux one's over one run."""
+
+    fmu: str
+    steps: int
+    outputs: int
+    identical: int  # outputs equal bit for bit at every step
+    worst: float  # largest |windows - linux| / peak |linux| over the outputs
+    worst_output: str
+    same_status: bool  # doStep statuses and integer outputs equal
+
+
+def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference:
+    """``names``: value reference -> output name."""
+    identical, worst, worst_output = 0, 0.0, ""
+    for vr, a in linux.reals.items():
+        b = windows.reals[vr]
+        same = np.array_equal(a.view(np.uint64), b.view(np.uint64))
+        identical += same
+        if same:
+            continue
+        finite = np.isfinite(a) & np.isfinite(b)
+        if not np.array_equal(np.isfinite(a), np.isfinite(b)):
+            worst, worst_output = float("inf"), names[vr]
+            continue
+        peak = float(np.max(np.abs(a[finite]))) if finite.any() else 0.0
+        diff = float(np.max(np.abs(a[finite] - b[finite]))) / (peak or 1.0)
+        if diff > worst:
+            worst, worst_output = diff, names[vr]
+    same_status = np.array_equal(linux.status, windows.status) and all(
+        np.array_equal(v, windows.integers[vr]) for vr, v in linux.integers.items()
+    )
+    return Difference(
+        fmu, len(linux.status), len(linux.reals), identical, worst, worst_output, same_status
+    )
+
+
+def replay_all(workdir: Path, build: Path | None = None, names: list | None = None) -> list:
+    """[Difference] of every FMU of the build (or those in ``names``, each as
+    ``<name>_fmi<v>``), Windows binaries under Wine against Linux ones."""
+    build = build or paths.build_dir()
+    workdir.mkdir(parents=True, exist_ok=True)
+    jobs, runs = [], []
+    for name in importers.fmu_names():
+        for version in importers.VERSIONS:
+            fmu = f"{name}_fmi{version}"
+            if names is not None and fmu not in names:
+                continue
+            setup = importers.setup_of(name, version, build)
+            stage = build / "fmus" / "stage" / fmu
+            write_inputs(setup, workdir / f"{fmu}.in")
+            jobs.append((stage, workdir / f"{fmu}.in", workdir / f"{fmu}.linux"))
+            runs.append((fmu, setup))
+    run(jobs, workdir, windows=False, build=build)
+    run([(s, i, o.with_suffix(".windows")) for s, i, o in jobs], workdir, windows=True, build=build)
+    out = []
+    for (fmu, setup), (_, _, linux) in zip(runs, jobs, strict=True):
+        md = read_model_description(str(setup.path))
+        names_of = {v.valueReference: v.name for v in md.modelVariables}
+        out.append(
+            compare(fmu, names_of, read_outputs(linux), read_outputs(linux.with_suffix(".windows")))
+        )
+    return out
+
+
+def main(argv: list | None = None) -> int:
+    """Prints, per FMU, how the Windows binary's outputs compare with the Linux one's."""
+    parser = argparse.ArgumentParser(
+        prog="python -m dyadfmu.cosim.windows",
+        description="Every FMU's Windows binary (under Wine) against its Linux binary over "
+        "the harness's inputs: outputs equal bit for bit, and the largest difference "
+        "relative to an output's peak.",
+    )
+    parser.add_argument("--build", type=Path, default=None, help="the build (default build/)")
+    parser.add_argument(
+        "--work", type=Path, default=Path("out/windows"), help="folder for the runs' files"
+    )
+    args = parser.parse_args(argv)
+    if wine_executable() is None:
+        print("python -m dyadfmu.cosim.windows: wine is not installed", file=sys.stderr)
+        return 2
+    rows = replay_all(args.work, args.build)
+    print("| FMU | steps | outputs | bit-identical | largest difference / peak | statuses |")
+    print("|---|---:|---:|---:|---:|---|")
+    for d in rows:
+        where = f" ({d.worst_output})" if d.worst_output else ""
+        print(
+            f"| {d.fmu} | {d.steps} | {d.outputs} | {d.identical} | {d.worst:.2g}{where} | "
+            f"{'equal' if d.same_status else 'DIFFER'} |"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,94 @@
+"""The FMUs' Windows binaries (cross-compiled with MinGW-w64) under Wine against their Linux
+binaries: every FMU carries both, each Windows DLL needs nothing beyond the Windows system
+DLLs, and over the harness's inputs it gives the Linux binary's outputs and statuses bit
+for bit (tests/fmu_replay.c, built for both platforms, drives them).
+
+Without Wine or the Windows build the tests skip, except under CI (CI=true), where they
+fail: scripts/run-tests installs both and configures build/ with -DDYADFMU_WINDOWS=ON.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import zipfile
+
+import numpy as np
+import pytest
+from dyadfmu import paths
+from dyadfmu.cosim import importers, windows
+
+CI = os.environ.get("CI", "").lower() == "true"
+ALL = [f"{name}_fmi{version}" for name in importers.fmu_names() for version in importers.VERSIONS]
+#: The DLLs a Windows binary may import: the system's, which every Windows has.
+SYSTEM_DLLS = {"KERNEL32.dll", "msvcrt.dll"}
+
+
+def _required(ok: bool, message: str) -> None:
+    if not ok:
+        if CI:
+            pytest.fail(message + "; under CI it must run (scripts/run-tests installs it)")
+        pytest.skip(message)
+
+
+@pytest.fixture(scope="module")
+def windows_build():
+    linux, exe = windows.replay_programs()
+    _required(exe.is_file(), f"{exe} is missing: configure the build with -DDYADFMU_WINDOWS=ON")
+    _required(linux.is_file(), f"{linux} is missing: build the tests")
+    return paths.build_dir()
+
+
+@pytest.fixture(scope="module")
+def replays(windows_build, tmp_path_factory):
+    _required(windows.wine_executable() is not None, "wine is not installed")
+    rows = windows.replay_all(tmp_path_factory.mktemp("windows"), windows_build)
+    return {d.fmu: d for d in rows}
+
+
+@pytest.mark.parametrize("fmu", ALL)
+def test_the_windows_binary_gives_the_linux_outputs_bit_for_bit(replays, fmu):
+    d = replays[fmu]
+    assert d.steps >= 100 and d.outputs > 0
+    assert d.same_status, f"{fmu}: doStep statuses or integer outputs differ"
+    assert d.identical == d.outputs, (
+        f"{fmu}: {d.outputs - d.identical} outputs differ, worst {d.worst:.3g} of its peak "
+        f"({d.worst_output})"
+    )
+
+
+@pytest.mark.parametrize("fmu", ALL)
+def test_every_fmu_carries_a_windows_binary_needing_only_system_dlls(windows_build, fmu):
+    path = windows_build / "fmus" / f"{fmu}.fmu"
+    version = int(fmu[-1])
+    identifier = fmu.rsplit("_fmi", 1)[0]
+    platform = {2: "win64", 3: "x86_64-windows"}[version]
+    with zipfile.ZipFile(path) as archive:
+        names = set(archive.namelist())
+    assert f"binaries/{platform}/{identifier}.dll" in names
+    assert f"binaries/{paths.PLATFORM[version]}/{identifier}.so" in names
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    if objdump is None:
+        pytest.skip("x86_64-w64-mingw32-objdump is not installed")
+    dll = windows_build / "fmus" / "stage" / fmu / "binaries" / platform / f"{identifier}.dll"
+    dump = subprocess.run([objdump, "-p", str(dll)], capture_output=True, text=True, check=True)
+    imported = {
+        line.split(":", 1)[1].strip() for line in dump.stdout.splitlines() if "DLL Name:" in line
+    }
+    assert imported <= SYSTEM_DLLS, imported - SYSTEM_DLLS
+
+
+def test_the_comparison_sees_one_ulp_and_a_status():
+    bits = np.array([1.0, -2.5, 3.0])
+    linux = windows.Replay(
+        np.zeros(3, int), {7: bits.copy(), 8: bits.copy()}, {9: np.zeros(3, int)}
+    )
+    same = windows.compare("x", {7: "a", 8: "b"}, linux, linux)
+    assert same.identical == 2 and same.worst == 0 and same.same_status
+    moved = bits.copy()
+    moved[1] = np.nextafter(moved[1], 0.0)
+    other = windows.Replay(np.array([0, 2, 0]), {7: bits.copy(), 8: moved}, {9: np.zeros(3, int)})
+    d = windows.compare("x", {7: "a", 8: "b"}, linux, other)
+    assert d.identical == 1 and d.worst_output == "b" and not d.same_status
+    assert d.worst == pytest.approx(np.spacing(2.5) / 3.0, rel=1e-12, abs=0)
