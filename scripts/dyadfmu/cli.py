@@ -286,6 +286,9 @@ def _sweep(args: argparse.Namespace) -> int:
     except (StudyError, SourceError, FileNotFoundError, ValueError) as error:
         print(f"dyadfmu sweep: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # --out not a folder, a scheduler not reachable
+        print(f"dyadfmu sweep: {error}", file=sys.stderr)
+        return 2
     print(result.files[1].read_text(encoding="utf-8"))
     for path in result.files:
         print(f"wrote {path}")

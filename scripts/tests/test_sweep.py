@@ -7,6 +7,7 @@ counterweight is the one that balances the crank (known in closed form)."""
 from __future__ import annotations
 
 import math
+import os
 import re
 import subprocess
 import sys
@@ -630,3 +631,132 @@ def test_a_chunk_the_rows_entry_refuses_runs_through_fmi(tmp_path, monkeypatch):
 
     monkeypatch.setattr(rows_module.RowsEntry, "evaluate", refuse)
     assert run.chunk(rows) == through_rows
+
+
+@pytest.mark.parametrize(
+    "old, new, marker, words",
+    [
+        ('name = "counterweight"', 'name = "status"', 'name = "status"', "a column of the table"),
+        ("count = 13 ", "count = 13\nseed = 4 ", "seed = 4", "seed belongs to random and lhs"),
+        (
+            '[run]\nkind = "kinetostatic"\nspeed = 100.0\npoints = 36\n',
+            'run = { kind = "kinetostatic", speed = -1.0, points = 36 }\n',
+            "run = {",
+            "speed must be a positive",
+        ),
+        (
+            '[run]\nkind = "kinetostatic"\nspeed = 100.0\npoints = 36\n',
+            'run.kind = "kinetostatic"\nrun.speed = 100.0\nrun.points = 7\n',
+            "run.points",
+            "points must be an integer",
+        ),
+        (
+            'description = "counterweight on a crank with its own unbalance"',
+            'description = """\n[run]\nspeed = 1\n"""',
+            "speed = 100.0",
+            "speed must be a positive",
+        ),
+        ("speed = 100.0", "speed = 100.0 100", "speed = 100.0 100", "not valid TOML"),
+    ],
+)
+def test_more_untrusted_studies_are_refused_at_their_line(tmp_path, old, new, marker, words):
+    text = BALANCE_STUDY.replace(old, new, 1)
+    if new.startswith("run"):  # a top-level key: before the first table
+        text = new + BALANCE_STUDY.replace(old, "", 1)
+    if '"""' in new:
+        text = text.replace("speed = 100.0", "speed = -100.0")
+    assert text != BALANCE_STUDY
+    mark = marker.replace("speed = 100.0", "speed = -100.0") if '"""' in new else marker
+    line = max(k for k, t in enumerate(text.splitlines(), start=1) if mark in t)
+    message = _refused(tmp_path, text)
+    assert message.startswith(f"{tmp_path / 'study.toml'}:{line}: "), message
+    assert words in message
+
+
+def test_a_driven_duration_must_be_whole_steps_and_a_study_file_a_regular_file(tmp_path):
+    driven = DRIVEN_RUN.replace("duration = 1.0", "duration = 1.05")
+    text = BALANCE_STUDY.replace(
+        '[run]\nkind = "kinetostatic"\nspeed = 100.0\npoints = 36\n', driven
+    )
+    assert "duration must be a whole number of steps" in _refused(tmp_path, text)
+    fifo = tmp_path / "fifo.toml"
+    os.mkfifo(fifo)
+    with pytest.raises(StudyError, match="not a study file"):
+        read_study(fifo)
+
+
+def _edited_fmu(tmp_path: Path, name: str, edit) -> Path:
+    """A copy of the balance FMU with ``edit(member name, bytes) -> bytes`` applied."""
+    import zipfile
+
+    out = tmp_path / name
+    with zipfile.ZipFile(BALANCE) as src, zipfile.ZipFile(out, "w") as dst:
+        for item in src.infolist():
+            dst.writestr(item, edit(item.filename, src.read(item)))
+    return out
+
+
+def test_a_binary_that_crashes_or_will_not_instantiate_is_refused(tmp_path):
+    _needs_balance()
+    truncated = _edited_fmu(
+        tmp_path, "trunc.fmu", lambda n, b: b[:5000] if n.endswith(".so") else b
+    )
+    with pytest.raises(sources.SourceError, match="does not load or instantiate"):
+        sources.model_description(truncated)
+    other_guid = _edited_fmu(
+        tmp_path,
+        "guid.fmu",
+        lambda n, b: (
+            re.sub(rb'guid="\{[^}]*\}"', b'guid="{00000000-0000-0000-0000-000000000000}"', b)
+            if n == "modelDescription.xml"
+            else b
+        ),
+    )
+    with pytest.raises(sources.SourceError, match="Failed to instantiate"):
+        sources.model_description(other_guid)
+
+
+def test_a_column_named_like_an_fmu_variable_or_an_alias_set_twice_is_refused(tmp_path):
+    _needs_balance()
+    text = BALANCE_STUDY.replace('name = "counterweight"', 'name = "rod.length"')
+    with pytest.raises(StudyError, match="a counterweight's name cannot be a variable"):
+        study.prepare(_write(tmp_path, text), tmp_path)
+
+    def alias(name: str, data: bytes) -> bytes:
+        if name != "modelDescription.xml":
+            return data
+        xml = data.decode()
+        m = re.search(r'<ScalarVariable name="crank.mass".*?</ScalarVariable>', xml, re.S)
+        return xml.replace(
+            m.group(0), m.group(0) + m.group(0).replace("crank.mass", "ghost.mass"), 1
+        ).encode()
+
+    aliased = _edited_fmu(tmp_path, "alias.fmu", alias)
+    text = BALANCE_STUDY.replace(str(BALANCE), str(aliased)) + '\n[fixed]\n"ghost.mass" = 50.0\n'
+    with pytest.raises(StudyError, match="ghost.mass and crank.mass are one variable"):
+        study.prepare(_write(tmp_path, text), tmp_path)
+
+
+def test_the_report_escapes_list_markers_and_entities():
+    from dyadfmu.report.sweep import markdown_cell
+
+    assert markdown_cell("- item") == "\\- item"
+    assert markdown_cell("1. first") == "1\\. first"
+    assert markdown_cell("---").startswith("\\-")
+    assert markdown_cell("&lt;img&gt;") == "&amp;lt;img&amp;gt;"
+    assert markdown_cell("a - b 1.5") == "a - b 1.5"
+
+
+def test_a_long_scene_identifier_stays_within_forty_characters_in_the_copy(tmp_path):
+    scene = (ROOT / "tests" / "scenes" / "balance.toml").read_text()
+    long_id = "balance_with_a_long_identifier_x12345678"
+    assert len(long_id) == 40
+    (tmp_path / "long.toml").write_text(
+        scene.replace('identifier = "balance"', f'identifier = "{long_id}"')
+    )
+    s = read_study(
+        _write(tmp_path, BALANCE_STUDY.replace(f'fmu = "{BALANCE}"', 'scene = "long.toml"'))
+    )
+    copy = sources.sweep_scene(s, tmp_path / "out")
+    identifier = tomllib.loads(copy.read_text())["scene"]["identifier"]
+    assert len(identifier) == 40 and identifier.startswith(long_id[:23] + "_sweep_")

@@ -8,6 +8,7 @@ file is untrusted input)."""
 
 from __future__ import annotations
 
+import re
 import unicodedata
 from pathlib import Path
 
@@ -27,12 +28,14 @@ __all__ = ["plot_study", "report_text", "markdown_cell"]
 def markdown_cell(text: str) -> str:
     """Text safe in a Markdown table cell: one line, printable characters only (control
     and format characters dropped), every markup character escaped (``$`` too: some
-    renderers read mathematics between two)."""
+    renderers read mathematics between two), ``&`` written ``&amp;`` (no entity), and a
+    list or rule marker at the start escaped."""
     printable = "".join(ch if unicodedata.category(ch)[0] != "C" else " " for ch in str(text))
-    out = " ".join(printable.split())
+    out = " ".join(printable.split()).replace("&", "&amp;")  # no entity reaches the reader
     for ch in "\\|*_`<>[]#$~!":
         out = out.replace(ch, "\\" + ch)
-    return out
+    # what starts a list, a rule or a quote at the start of a line
+    return re.sub(r"^(\d*)([-+=.)])", r"\1\\\2", out)
 
 
 def _is_grid(table: Table) -> bool:

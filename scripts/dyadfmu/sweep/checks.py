@@ -59,6 +59,50 @@ def _check_parameters(study: Study, md: ModelDescription, what: str) -> None:
             )
 
 
+def _check_columns_and_aliases(study: Study, md: ModelDescription, what: str) -> None:
+    """A counterweight's column may not take the name of an FMU parameter (the table
+    would show its mass under that name); two names the study sets may not be one
+    variable of the FMU (an alias: one would override the other)."""
+    variables = {v.name: v.valueReference for v in md.modelVariables}
+    owner: dict = {}
+    for k, p in enumerate(study.parameters):
+        weight = isinstance(p, Counterweight)
+        if weight and p.name in variables:
+            _fail(
+                study,
+                "parameter",
+                k,
+                "name",
+                f"{p.name}: a counterweight's name cannot be a variable of {what}",
+            )
+        for name in p.needs() if weight else (p.name,):
+            _claim(
+                study,
+                owner,
+                variables,
+                name,
+                ("parameter", k, "counterweight" if weight else "name"),
+            )
+    for name, _ in study.fixed:
+        _claim(study, owner, variables, name, ("fixed", None, name))
+
+
+def _claim(study: Study, owner: dict, variables: dict, name: str, where: tuple) -> None:
+    vr = variables.get(name)
+    if vr is None:
+        return
+    if vr in owner and owner[vr] != name:
+        _fail(
+            study,
+            where[0],
+            where[1],
+            where[2],
+            f"{name} and {owner[vr]} are one variable of the FMU (value reference {vr}): "
+            "set it once",
+        )
+    owner[vr] = name
+
+
 def _check_loads(study: Study, md: ModelDescription, what: str) -> None:
     inputs = [n for n in _names(md, ("input",)) if not n.endswith((".angle", ".omega", ".epsilon"))]
     for load in study.loads:
@@ -99,6 +143,7 @@ def check_names(
     if isinstance(study.run, Driven) != (drive_md is not None):
         raise ValueError("a driven study needs the drive's model description, only it")
     _check_parameters(study, md, what)
+    _check_columns_and_aliases(study, md, what)
     _check_loads(study, md, what)
     _check_figures(study, md, drive_md, what)
 

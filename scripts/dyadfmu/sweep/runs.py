@@ -29,7 +29,7 @@ from ..fmi.slave import Slave, SlaveError
 from .checks import base_values
 from .figures import UndefinedFigure, figure_value, series_names
 from .rows import rows_entry
-from .studyfile import Driven, Kinetostatic, Study
+from .studyfile import Driven, Kinetostatic, Study, recorded_from
 
 __all__ = ["Outcome", "KinetostaticRun", "DrivenRun", "run_of", "run_rows", "slave", "STATUS_NAMES"]
 
@@ -131,7 +131,7 @@ class _Common:
 
 
 def _failed_point(mech: Slave, where: str) -> _Failed:
-    code = mech.get_status()
+    code = mech.get_status() if "status" in mech.names else 0
     message = mech.messages[-1] if mech.messages else f"outputs not finite {where}"
     return _Failed(STATUS_NAMES.get(code, f"status {code}") if code else "diverged", message)
 
@@ -251,7 +251,7 @@ class DrivenRun(_Common):
         own = tuple(n for n in names if not n.startswith("drive."))
         of_drive = tuple(n[6:] for n in names if n.startswith("drive."))
         n = int(round(self.duration / self.step))
-        first = int(math.ceil(self.settle / self.step - 1e-9))
+        first = recorded_from(self.settle, self.step)
         phis, rows = [], []
         for k in range(n + 1):
             phi = self._point(d, y, k * self.step, inputs)

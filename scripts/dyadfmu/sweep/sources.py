@@ -34,6 +34,10 @@ __all__ = [
 ]
 
 
+#: The longest identifier a scene may have (MAX_NAME of the generator, scenefile/names.py).
+MAX_IDENTIFIER = 40
+
+
 class SourceError(RuntimeError):
     """An FMU the study needs could not be built or found."""
 
@@ -130,7 +134,8 @@ def sweep_scene(study: Study, out: Path) -> Path:
     identifier = scene["identifier"]
     # named by its content: two studies of one scene never share a build they differ in
     digest = hashlib.sha256(toml_text(data).encode()).hexdigest()[:10]
-    scene["identifier"] = f"{identifier}_sweep_{digest}"
+    # within the 40 characters of an identifier
+    scene["identifier"] = f"{identifier[: MAX_IDENTIFIER - 17]}_sweep_{digest}"
     text = "# the study's scene with its parameters tunable (dyadfmu sweep)\n" + toml_text(data)
     path = out / f"{scene['identifier']}.toml"
     if not path.is_file() or path.read_text(encoding="utf-8") != text:
@@ -186,4 +191,34 @@ def model_description(fmu: Path) -> ModelDescription:
     binary = f"binaries/{paths.PLATFORM[int(version)]}/{md.coSimulation.modelIdentifier}.so"
     if binary not in members:
         raise SourceError(f"{fmu}: no binary for this platform ({binary})")
+    _check_instantiates(fmu)
     return md
+
+
+#: Loads an FMU's binary, makes an instance and frees it: run in a process of its own.
+_TRIAL = (
+    "import sys\n"
+    "from dyadfmu.fmi.slave import Slave\n"
+    "Slave(sys.argv[1], instance_name='trial').close()\n"
+)
+
+
+def _check_instantiates(fmu: Path) -> None:
+    """SourceError unless the FMU's binary loads and makes an instance, tried in a
+    separate process first: a damaged binary can crash the process that loads it."""
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2]))
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", _TRIAL, str(fmu)],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=120,
+        )
+    except subprocess.TimeoutExpired:
+        raise SourceError(f"{fmu}: its binary did not load within 120 s") from None
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
+        if done.returncode < 0:
+            last = f"the process loading it died (signal {-done.returncode})"
+        raise SourceError(f"{fmu}: its binary does not load or instantiate: {last}")

@@ -14,7 +14,7 @@ from .checks import check_names, units_of
 from .designs import designs
 from .results import Table, best_designs, table_of, write_csv
 from .runs import DrivenRun, KinetostaticRun, run_of
-from .studyfile import Study, StudyError, read_study
+from .studyfile import Study, StudyError, line_of, read_study
 
 __all__ = ["SweepResult", "run_study", "prepare"]
 
@@ -41,7 +41,12 @@ def prepare(
     md = sources.model_description(mechanism)
     drive_md = sources.model_description(drive) if drive is not None else None
     check_names(study, md, drive_md, mechanism.name)
-    run = run_of(study, str(mechanism), str(drive) if drive else None, md)
+    try:
+        run = run_of(study, str(mechanism), str(drive) if drive else None, md)
+    except ValueError as e:  # no crank to drive
+        source = "scene" if study.scene is not None else "fmu"
+        line = line_of(study.text, "study", key=source)
+        raise StudyError(f"{study.path}:{line}: {mechanism.name}: {e}") from None
     values = designs(
         study.sampling, [p.low for p in study.parameters], [p.high for p in study.parameters]
     )

@@ -39,6 +39,8 @@ SAMPLING_METHODS = ("grid", "random", "lhs")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
 #: The drive FMU's parameters a study may set or vary (as ``drive.<name>``).
 DRIVE_PARAMETERS = ("motor.stall_torque", "motor.no_load_speed", "inertia")
+#: The table's own columns, which no parameter or figure may be named.
+RESERVED_COLUMNS = ("design", "status", "message")
 #: A driven run's figures are taken from at least this many communication points.
 MIN_RECORDED = 10
 #: The most work a study may ask for: crank positions (kinetostatic: designs x points)
@@ -51,6 +53,8 @@ MAX_COUNTERWEIGHT_MASS = 1e6
 MAX_COUNTERWEIGHT_AT = 1e3
 #: The largest load a load case may give (in the load input's unit: N or N m).
 MAX_LOAD = 1e12
+#: The largest study file read.
+MAX_STUDY_BYTES = 1_000_000
 
 
 class StudyError(ValueError):
@@ -271,7 +275,7 @@ def line_of(text: str, table: str, index: int | None = None, key: str | None = N
     first part."""
     want = tuple(table.split(".")) if table else ()
     seen, inside, prefix, header_line = -1, not want, (), 0
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in _outside_strings(text):
         header = _header(line)
         if header is not None:
             inside, prefix = False, ()
@@ -288,7 +292,37 @@ def line_of(text: str, table: str, index: int | None = None, key: str | None = N
         assigned = _assigned_key(line) if inside and key is not None else None
         if assigned is not None and (prefix + assigned)[0] == key:
             return number
+    if not header_line and want:  # written as a top-level key: run = { ... }, run.kind = ...
+        return _top_level_line(text, want + ((key,) if key is not None else ()))
     return header_line or 1
+
+
+def _top_level_line(text: str, path: tuple) -> int:
+    """The line of the top-level dotted key that starts with most of ``path``."""
+    best, best_length = 1, 0
+    for number, line in _outside_strings(text):
+        if _header(line) is not None:
+            break
+        assigned = _assigned_key(line) or ()
+        length = next(
+            (n for n in range(min(len(path), len(assigned)), 0, -1) if assigned[:n] == path[:n]), 0
+        )
+        if length > best_length:
+            best, best_length = number, length
+    return best
+
+
+def _outside_strings(text: str):
+    """(line number, line) of the lines that do not start inside a multi-line string."""
+    quote = None
+    for number, line in enumerate(text.splitlines(), start=1):
+        if quote is None:
+            yield number, line
+        for delimiter in re.findall(r'"""|\'\'\'', line):
+            if quote is None:
+                quote = delimiter
+            elif delimiter == quote:
+                quote = None
 
 
 class _Reader:
@@ -373,10 +407,16 @@ def _sources(r: _Reader, study: dict) -> tuple:
     value = scene if scene is not None else fmu
     if not isinstance(value, str) or not value or "\0" in value:
         r.fail("study", f"{key} must be a file name", key=key)
-    path = (r.path.parent / value).resolve()
     suffix = ".toml" if key == "scene" else ".fmu"
-    if path.suffix != suffix or not path.is_file():
-        r.fail("study", f"{key} = {value!r}: no such {suffix} file next to the study", key=key)
+    try:
+        path = (r.path.parent / value).resolve()
+        found = path.suffix == suffix and path.is_file()
+    except (OSError, RuntimeError):  # a name too long, a loop of symbolic links
+        found = False
+    if not found:
+        r.fail(
+            "study", f"{key} = {_shown(value)}: no such {suffix} file next to the study", key=key
+        )
     return (path, None) if key == "scene" else (None, path)
 
 
@@ -404,7 +444,15 @@ def _run(r: _Reader, data: dict) -> Kinetostatic | Driven:
             r.fail("run", "settle must be at least 0 and below duration", key="settle")
         if not 2 <= duration / step <= 10_000_000:
             r.fail("run", "duration / step must be from 2 to 1e7 steps", key="step")
-        if (duration - settle) / step < MIN_RECORDED - 1:
+        steps = round(duration / step)
+        if abs(duration / step - steps) > 1e-9 * steps:
+            r.fail(
+                "run",
+                "duration must be a whole number of steps "
+                f"(duration / step = {duration / step:.6g})",
+                key="duration",
+            )
+        if steps + 1 - recorded_from(settle, step) < MIN_RECORDED:
             r.fail(
                 "run",
                 f"settle leaves fewer than {MIN_RECORDED} communication points to take the "
@@ -432,10 +480,18 @@ def _run(r: _Reader, data: dict) -> Kinetostatic | Driven:
     r.fail("run", f"kind must be 'kinetostatic' or 'driven' (got {kind!r})", key="kind")
 
 
+def recorded_from(settle: float, step: float) -> int:
+    """The first communication point (its index) whose values a driven run's figures
+    take: the first at or after ``settle``."""
+    return int(math.ceil(settle / step - 1e-9))
+
+
 def _parameter(r: _Reader, t: dict, k: int, driven: bool):
     allowed = ("name", "low", "high", "counterweight", "at")
     r.unknown_keys(t, "parameter", allowed, k)
     name = r.name(t.get("name"), "parameter", "name", k)
+    if name in RESERVED_COLUMNS:
+        r.fail("parameter", f"name {name} is a column of the table already", k, "name")
     low = r.number(t, "parameter", "low", k)
     high = r.number(t, "parameter", "high", k)
     if not low <= high:
@@ -456,6 +512,10 @@ def _parameter(r: _Reader, t: dict, k: int, driven: bool):
         if "at" in t:
             r.fail("parameter", "at belongs to a counterweight", k, "at")
         return Parameter(name, low, high)
+    if name.startswith("drive."):
+        r.fail(
+            "parameter", f"{name}: a counterweight's name cannot be a drive parameter", k, "name"
+        )
     link = r.name(t["counterweight"], "parameter", "counterweight", k)
     at = t.get("at")
     xy = [finite(v) for v in at] if isinstance(at, list) and len(at) == 2 else [None]
@@ -501,6 +561,8 @@ def _sampling(r: _Reader, data: dict, n_params: int) -> Sampling:
     count = r.integer(t, "sampling", "count", 1, 1_000_000)
     if method == "grid" and count**n_params > 1_000_000:
         r.fail("sampling", f"a grid of {count}^{n_params} designs is over a million", key="count")
+    if method == "grid" and "seed" in t:
+        r.fail("sampling", "a grid is not drawn: seed belongs to random and lhs", key="seed")
     seed = r.integer(t, "sampling", "seed", 0, 2**63 - 1, default=0)
     return Sampling(method, count, seed)
 
@@ -556,7 +618,7 @@ def _figures(r: _Reader, data: dict, parameters: tuple) -> tuple:
         if t.get("stat") not in STATS:
             r.fail("figure", f"{name}: stat must be one of {', '.join(STATS)}", k, "stat")
         taken = {f.name for f in figures} | {p.name for p in parameters}
-        if name in taken or name in ("design", "status", "message"):
+        if name in taken or name in RESERVED_COLUMNS:
             r.fail(
                 "figure",
                 f"figure name {name} is taken (by a parameter, another figure or a column)",
@@ -661,12 +723,16 @@ def read_study(path: Path | str) -> Study:
     """Read and check a study file (StudyError naming FILE:LINE where it is wrong)."""
     path = Path(path)
     try:
+        if not path.is_file() or path.stat().st_size > MAX_STUDY_BYTES:
+            raise StudyError(f"{path}: not a study file (a regular file of at most 1 MB)")
         text = path.read_text(encoding="utf-8")
         data = tomllib.loads(text)
     except (OSError, UnicodeDecodeError) as e:
         raise StudyError(f"{path}: cannot read: {e}") from None
     except tomllib.TOMLDecodeError as e:
-        raise StudyError(f"{path}: not valid TOML: {e}") from None
+        at = re.search(r"\(at line (\d+), column \d+\)", str(e))
+        line = f":{at.group(1)}" if at else ""
+        raise StudyError(f"{path}{line}: not valid TOML: {e}") from None
     r = _Reader(path, text)
     r.unknown_keys(
         data,

@@ -1,0 +1,5 @@
+"""``python -m dyadfmu``: the ``dyadfmu`` command."""
+
+from .cli import main
+
+raise SystemExit(main())
