@@ -760,3 +760,15 @@ def test_a_long_scene_identifier_stays_within_forty_characters_in_the_copy(tmp_p
     copy = sources.sweep_scene(s, tmp_path / "out")
     identifier = tomllib.loads(copy.read_text())["scene"]["identifier"]
     assert len(identifier) == 40 and identifier.startswith(long_id[:23] + "_sweep_")
+
+
+def test_a_name_the_scene_has_no_parameter_of_is_refused_at_the_study_s_line(tmp_path):
+    scene = ROOT / "tests" / "scenes" / "balance.toml"
+    text = BALANCE_STUDY.replace(f'fmu = "{BALANCE}"', f'scene = "{scene}"')
+    text += '\n[fixed]\n"foo.bar" = 1.0\n'
+    line = len(text.splitlines())
+    with pytest.raises(StudyError) as info:
+        study.prepare(_write(tmp_path, text), tmp_path)
+    assert str(info.value).startswith(
+        f"{tmp_path / 'study.toml'}:{line}: foo.bar is not a parameter"
+    )

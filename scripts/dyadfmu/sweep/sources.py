@@ -22,7 +22,7 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .. import paths
-from .studyfile import Counterweight, Driven, Study
+from .studyfile import Counterweight, Driven, Study, StudyError, line_of
 
 __all__ = [
     "toml_text",
@@ -166,7 +166,31 @@ def mechanism_fmu(study: Study, out: Path) -> Path:
         return study.fmu
     scene = sweep_scene(study, out)
     identifier = tomllib.loads(scene.read_text(encoding="utf-8"))["scene"]["identifier"]
-    return _build_scene(study.scene, scene, identifier, study.fmi)
+    try:
+        return _build_scene(study.scene, scene, identifier, study.fmi)
+    except SourceError as e:
+        _refuse_unknown_name(study, str(e))
+        raise
+
+
+def _refuse_unknown_name(study: Study, message: str) -> None:
+    """StudyError at the study's line where the scene copy failed because a name the study
+    sets is not a parameter of the scene (the copy lists it as tunable)."""
+    found = re.search(
+        r"tunable '([^']+)' is no parameter of this scene \(parameters: ([^)]*)", message
+    )
+    if found is None:
+        return
+    name, known = found.groups()
+    where = ("fixed", None, name)
+    for k, p in enumerate(study.parameters):
+        if name == p.name or (isinstance(p, Counterweight) and name in p.needs()):
+            where = ("parameter", k, "counterweight" if isinstance(p, Counterweight) else "name")
+    line = line_of(study.text, *where)
+    raise StudyError(
+        f"{study.path}:{line}: {name} is not a parameter of the scene {study.scene.name}; "
+        f"its parameters: {known}"
+    )
 
 
 def drive_fmu(study: Study, build: Path | None) -> Path | None:
