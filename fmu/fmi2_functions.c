@@ -154,49 +154,58 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
         fmu_no_variables_of_type((fmu_instance*)c, FMU_OP_SET, vr, nvr, "fmi2SetString"));
 }
 
-static const char no_state[] = "canGetAndSetFMUstate is false";
-
+/* FMU state: fmu_state.c. fmi2FMUstate is the layer's fmu_saved. */
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate)
 {
-    (void)FMUstate;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetFMUstate", no_state));
+    fmu_saved* saved = FMUstate != NULL ? (fmu_saved*)*FMUstate : NULL;
+    fmu_status status =
+        fmu_get_state((fmu_instance*)c, FMUstate != NULL ? &saved : NULL, "fmi2GetFMUstate");
+    if (FMUstate != NULL) {
+        *FMUstate = saved;
+    }
+    return to_fmi2(status);
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
 {
-    (void)FMUstate;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SetFMUstate", no_state));
+    return to_fmi2(fmu_set_state((fmu_instance*)c, (const fmu_saved*)FMUstate, "fmi2SetFMUstate"));
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* FMUstate)
 {
-    (void)FMUstate;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2FreeFMUstate", no_state));
+    fmu_saved* saved = FMUstate != NULL ? (fmu_saved*)*FMUstate : NULL;
+    fmu_status status =
+        fmu_free_state((fmu_instance*)c, FMUstate != NULL ? &saved : NULL, "fmi2FreeFMUstate");
+    if (FMUstate != NULL) {
+        *FMUstate = saved;
+    }
+    return to_fmi2(status);
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t* size)
 {
-    (void)FMUstate;
-    (void)size;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SerializedFMUstateSize", no_state));
+    return to_fmi2(fmu_serialized_state_size((fmu_instance*)c, (const fmu_saved*)FMUstate, size,
+                                             "fmi2SerializedFMUstateSize"));
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serialized[],
                                  size_t size)
 {
-    (void)FMUstate;
-    (void)serialized;
-    (void)size;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SerializeFMUstate", no_state));
+    return to_fmi2(fmu_serialize_state((fmu_instance*)c, (const fmu_saved*)FMUstate,
+                                       (unsigned char*)serialized, size, "fmi2SerializeFMUstate"));
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate* FMUstate)
 {
-    (void)serializedState;
-    (void)size;
-    (void)FMUstate;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2DeSerializeFMUstate", no_state));
+    fmu_saved* saved = NULL;
+    fmu_status status =
+        fmu_deserialize_state((fmu_instance*)c, (const unsigned char*)serializedState, size,
+                              FMUstate != NULL ? &saved : NULL, "fmi2DeSerializeFMUstate");
+    if (status == FMU_OK) {
+        *FMUstate = saved;
+    }
+    return to_fmi2(status);
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[],

@@ -463,6 +463,62 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     return to_fmi3(status);
 }
 
+/* FMU state: fmu_state.c. fmi3FMUState is the layer's fmu_saved. */
+fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
+{
+    fmu_saved* saved = FMUState != NULL ? (fmu_saved*)*FMUState : NULL;
+    fmu_status status =
+        fmu_get_state((fmu_instance*)instance, FMUState != NULL ? &saved : NULL, "fmi3GetFMUState");
+    if (FMUState != NULL) {
+        *FMUState = saved;
+    }
+    return to_fmi3(status);
+}
+
+fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
+{
+    return to_fmi3(
+        fmu_set_state((fmu_instance*)instance, (const fmu_saved*)FMUState, "fmi3SetFMUState"));
+}
+
+fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
+{
+    fmu_saved* saved = FMUState != NULL ? (fmu_saved*)*FMUState : NULL;
+    fmu_status status = fmu_free_state((fmu_instance*)instance, FMUState != NULL ? &saved : NULL,
+                                       "fmi3FreeFMUState");
+    if (FMUState != NULL) {
+        *FMUState = saved;
+    }
+    return to_fmi3(status);
+}
+
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t* size)
+{
+    return to_fmi3(fmu_serialized_state_size((fmu_instance*)instance, (const fmu_saved*)FMUState,
+                                             size, "fmi3SerializedFMUStateSize"));
+}
+
+fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
+                                 fmi3Byte serializedState[], size_t size)
+{
+    return to_fmi3(fmu_serialize_state((fmu_instance*)instance, (const fmu_saved*)FMUState,
+                                       (unsigned char*)serializedState, size,
+                                       "fmi3SerializeFMUState"));
+}
+
+fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[],
+                                   size_t size, fmi3FMUState* FMUState)
+{
+    fmu_saved* saved = NULL;
+    fmu_status status =
+        fmu_deserialize_state((fmu_instance*)instance, (const unsigned char*)serializedState, size,
+                              FMUState != NULL ? &saved : NULL, "fmi3DeserializeFMUState");
+    if (status == FMU_OK) {
+        *FMUState = saved;
+    }
+    return to_fmi3(status);
+}
+
 /* Not FMI: the model over many rows in one call, without an importer's instance
  * (fmu_evaluate_rows), for dyadfmu's design studies. Returns the fmu_status. */
 FMI3_Export int dyadfmu_evaluate_rows(const char* token, const unsigned int vr_p[], size_t n_p,

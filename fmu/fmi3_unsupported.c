@@ -38,55 +38,6 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
                                    "the dependencies are declared in modelDescription.xml"));
 }
 
-fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
-{
-    (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetFMUState",
-                                   "canGetAndSetFMUState is false"));
-}
-
-fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
-{
-    (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SetFMUState",
-                                   "canGetAndSetFMUState is false"));
-}
-
-fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* FMUState)
-{
-    (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3FreeFMUState",
-                                   "canGetAndSetFMUState is false"));
-}
-
-fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t* size)
-{
-    (void)FMUState;
-    (void)size;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializedFMUStateSize",
-                                   "canGetAndSetFMUState is false"));
-}
-
-fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
-                                 fmi3Byte serializedState[], size_t size)
-{
-    (void)FMUState;
-    (void)serializedState;
-    (void)size;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3SerializeFMUState",
-                                   "canGetAndSetFMUState is false"));
-}
-
-fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[],
-                                   size_t size, fmi3FMUState* FMUState)
-{
-    (void)serializedState;
-    (void)size;
-    (void)FMUState;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3DeserializeFMUState",
-                                   "canGetAndSetFMUState is false"));
-}
-
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[],
                                     size_t nUnknowns, const fmi3ValueReference knowns[],
                                     size_t nKnowns, const fmi3Float64 seed[], size_t nSeed,

@@ -31,6 +31,7 @@ static const unsigned legal_states[FMU_OP_COUNT] = {
     [FMU_OP_STEP_STATUS] = FMU_STATE_STEP | FMU_STATE_TERMINATED,
     [FMU_OP_DEBUG_LOGGING] = ALL_STATES,
     [FMU_OP_UNSUPPORTED] = ALL_STATES,
+    [FMU_OP_STATE] = ALL_STATES,
 };
 
 /* Parameters (fixed) may change only while these hold. */
@@ -222,6 +223,11 @@ static void build_slots(fmu_instance* instance)
     instance->get_plan.count = 0;
 }
 
+void fmu_rebuild_slots(fmu_instance* instance)
+{
+    build_slots(instance);
+}
+
 static void find_angles(fmu_instance* instance)
 {
     const fmu_model* model = instance->model;
@@ -330,7 +336,9 @@ fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
     instance->model = model;
     instance->logger = logger;
     place_parts(instance, &at, instance_name);
+    instance->allocate = allocate;
     instance->release = release;
+    instance->saved = NULL;
     instance->log_categories = logging_on ? ~0u : 0u;
     instance->time_at_vr_0 = time_at_vr_0;
     find_angles(instance);
@@ -342,6 +350,7 @@ fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
 void fmu_free(fmu_instance* instance)
 {
     if (instance != NULL) {
+        fmu_free_states(instance);
         instance->release(instance);
     }
 }

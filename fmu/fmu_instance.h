@@ -45,6 +45,7 @@ typedef enum fmu_operation {
     FMU_OP_STEP_STATUS,
     FMU_OP_DEBUG_LOGGING,
     FMU_OP_UNSUPPORTED,
+    FMU_OP_STATE, /* get, set, free, serialize and deserialize an FMU state */
     FMU_OP_COUNT
 } fmu_operation;
 
@@ -98,10 +99,15 @@ typedef struct fmu_angle {
 typedef void* (*fmu_allocate)(size_t count, size_t size);
 typedef void (*fmu_release)(void* memory);
 
+/* A saved FMU state (fmu_state.c): the instance's state as serialized bytes. */
+typedef struct fmu_saved fmu_saved;
+
 typedef struct fmu_instance {
     const fmu_model* model;
     fmu_logger logger;
+    fmu_allocate allocate;
     fmu_release release;
+    fmu_saved* saved;        /* the FMU states saved from this instance, freed with it */
     unsigned log_categories; /* bit k: category k of fmu_log_category_names is on */
     fmu_state state;
     double time; /* communication point reached (s) */
@@ -197,5 +203,22 @@ fmu_status fmu_evaluate_rows(const fmu_model* model, const char* token, int time
 
 /* Error with a logged "not supported" for an entry point this FMU does not offer. */
 fmu_status fmu_unsupported(fmu_instance* instance, const char* function, const char* why);
+
+/* ---- FMU state (fmu_state.c) ----------------------------------------------------------------
+ * Get (into *state, a new one where *state is NULL), set, free (NULL is nothing), and
+ * serialize to and from bytes that name their FMU; legal in every state. A state
+ * belongs to the instance that made it and is freed with it at the latest. */
+fmu_status fmu_get_state(fmu_instance* instance, fmu_saved** state, const char* function);
+fmu_status fmu_set_state(fmu_instance* instance, const fmu_saved* state, const char* function);
+fmu_status fmu_free_state(fmu_instance* instance, fmu_saved** state, const char* function);
+void fmu_free_states(fmu_instance* instance);
+fmu_status fmu_serialized_state_size(fmu_instance* instance, const fmu_saved* state, size_t* size,
+                                     const char* function);
+fmu_status fmu_serialize_state(fmu_instance* instance, const fmu_saved* state, unsigned char* bytes,
+                               size_t size, const char* function);
+fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* bytes, size_t size,
+                                 fmu_saved** state, const char* function);
+/* The slots and plans again after the state machine's state was restored. */
+void fmu_rebuild_slots(fmu_instance* instance);
 
 #endif /* DYADFMU_FMU_INSTANCE_H */

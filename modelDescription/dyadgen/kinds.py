@@ -200,6 +200,7 @@ class DyadKind(Kind):
             "dyad_tangent.c",
             "fmu_dyad.c",
             "fmu_instance.c",
+            "fmu_state.c",
             *SHIM_FILES[version],
             f"{table.identifier}_model.c",
         ]
@@ -265,6 +266,7 @@ class DriveKind(Kind):
         return [
             "fmu_drive.c",
             "fmu_instance.c",
+            "fmu_state.c",
             *SHIM_FILES[version],
             f"{table.identifier}_model.c",
         ]
@@ -341,6 +343,7 @@ class SceneKind(Kind):
             + [
                 f"{table.identifier}_scene.c",
                 "fmu_instance.c",
+                "fmu_state.c",
                 *SHIM_FILES[version],
                 f"{table.identifier}_model.c",
             ]

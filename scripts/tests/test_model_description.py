@@ -490,6 +490,7 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
             "dyad_tangent.c",
             "fmu_dyad.c",
             "fmu_instance.c",
+            "fmu_state.c",
             *shim,
             f"{ident}_model.c",
         ]
@@ -1071,6 +1072,7 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
         assert config.sourceFileSets[0].sourceFiles == [
             "fmu_drive.c",
             "fmu_instance.c",
+            "fmu_state.c",
             *shim,
             "drive_model.c",
         ]
