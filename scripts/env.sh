@@ -8,9 +8,10 @@ DYADFMU_VENV=${DYADFMU_VENV:-$DYADFMU_ROOT/.venv}
 dyadfmu_log() { printf '== %s\n' "$*" >&2; }
 
 # dyadfmu_ensure_system [NEED...]: the Debian packages a command needs. Always the
-# compiler, make, CMake and Python with venv; NEED `study`: GSL (the generic-solve
-# baseline of the benchmark) and valgrind (its instruction counts); `windows`: the
-# MinGW-w64 cross compiler and Wine (the FMUs' Windows binaries, tested under Wine).
+# compiler, make, CMake, pkg-config (scripts/tests/test_install.py) and Python with
+# venv; NEED `study`: GSL (the generic-solve baseline of the benchmark) and valgrind
+# (its instruction counts); `windows`: the MinGW-w64 cross compiler and Wine (the
+# FMUs' Windows binaries, tested under Wine).
 # As root the missing ones are installed; otherwise the command stops, naming them
 # and itself.
 dyadfmu_ensure_system() {
@@ -18,6 +19,7 @@ dyadfmu_ensure_system() {
     command -v cmake >/dev/null 2>&1 || missing+=(cmake)
     command -v cc >/dev/null 2>&1 || missing+=(gcc libc6-dev)
     command -v make >/dev/null 2>&1 || missing+=(make)
+    command -v pkg-config >/dev/null 2>&1 || missing+=(pkg-config)
     command -v python3 >/dev/null 2>&1 || missing+=(python3)
     if ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then
         missing+=(python3-venv)
