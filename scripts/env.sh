@@ -57,10 +57,15 @@ dyadfmu_ensure_venv() {
         dyadfmu_log "creating Python venv in $DYADFMU_VENV"
         python3 -m venv "$DYADFMU_VENV"
     fi
-    if [ ! -f "$stamp" ] || [ "$DYADFMU_ROOT/scripts/pyproject.toml" -nt "$stamp" ]; then
-        dyadfmu_log "installing the pinned Python dependencies (scripts/pyproject.toml)"
+    if [ ! -f "$stamp" ] || [ "$DYADFMU_ROOT/scripts/pyproject.toml" -nt "$stamp" ] ||
+        [ "$DYADFMU_ROOT/scripts/constraints.txt" -nt "$stamp" ]; then
+        # The exact versions of scripts/constraints.txt within pyproject.toml's ranges. The
+        # package is installed editable without its CMake build (wheel.cmake=false): here the
+        # core and the FMUs come from the checkout's build directories.
+        dyadfmu_log "installing the pinned Python dependencies (scripts/constraints.txt)"
         "$DYADFMU_VENV/bin/python" -m pip install -q --upgrade pip >/dev/null
-        "$DYADFMU_VENV/bin/python" -m pip install -q -e "$DYADFMU_ROOT/scripts[test]"
+        "$DYADFMU_VENV/bin/python" -m pip install -q -c "$DYADFMU_ROOT/scripts/constraints.txt" \
+            -C wheel.cmake=false -e "$DYADFMU_ROOT/scripts[test]"
         touch "$stamp"
     fi
 }

@@ -1,8 +1,9 @@
 """Python binding of the C kinetostatic core (``libdyadfmu.so``) through ctypes.
 
 The inputs are the dicts of :mod:`dyadfmu.reference.newton_euler` (same keys, same units), so
-one configuration can be given to both. The library is looked up in
-``$DYADFMU_LIB``, else in ``build/`` beside ``scripts/``.
+one configuration can be given to both. The library is ``$DYADFMU_LIB`` when set, else the
+one an installed package bundles (``dyadfmu/_lib/libdyadfmu.so``, ``pip install ./scripts``),
+else ``build/libdyadfmu.so`` of the checkout (:func:`library_candidates`).
 
 The kinematics (``dyadfmu/kinematics.h``) take a dict shaped like ``dyad_kin_input``:
 ``{"k": {"position", "velocity", "acceleration", "guide", "omega", "epsilon"}, "p": {...},
@@ -18,7 +19,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .paths import ROOT
+from . import paths
 
 if TYPE_CHECKING:
     import numpy as np
@@ -232,12 +233,37 @@ def _fill_kin_input(dst: _KinInput, src: dict) -> None:
         dst.branch = int(src["branch"])
 
 
-def library_path() -> Path:
-    """Where the shared core is expected."""
+def library_candidates() -> list[Path]:
+    """Where the shared core is looked for, in order: $DYADFMU_LIB alone when set (the test
+    suite and scripts/run-tests set it); else the library the installed package bundles,
+    then build/ of the checkout."""
     env = os.environ.get("DYADFMU_LIB")
     if env:
-        return Path(env)
-    return ROOT / "build" / "libdyadfmu.so"
+        return [Path(env)]
+    candidates = [paths.BUNDLED_LIB]
+    if paths.in_checkout():
+        candidates.append(paths.ROOT / "build" / "libdyadfmu.so")
+    return candidates
+
+
+def library_path() -> Path:
+    """The shared core: the first of library_candidates() that exists, else the last (the
+    one to build)."""
+    candidates = library_candidates()
+    return next((path for path in candidates if path.is_file()), candidates[-1])
+
+
+def _missing_library(tried: list[Path], given: bool = False) -> str:
+    looked = ", ".join(str(path) for path in tried)
+    if given:
+        return f"C core not found at {looked}"
+    if os.environ.get("DYADFMU_LIB"):
+        return f"C core not found at $DYADFMU_LIB={looked}: point DYADFMU_LIB at libdyadfmu.so"
+    if paths.in_checkout():
+        how = "build it: cmake -S . -B build && cmake --build build (or pip install ./scripts)"
+    else:
+        how = "this installed dyadfmu lacks its bundled core: reinstall it, or set DYADFMU_LIB"
+    return f"C core (libdyadfmu.so) not found; looked for {looked}: {how}"
 
 
 class Core:
@@ -246,13 +272,11 @@ class Core:
     ``amplification`` and ``denominator``."""
 
     def __init__(self, path: os.PathLike | str | None = None):
-        path = Path(path) if path else library_path()
-        if not path.is_file():
-            raise FileNotFoundError(
-                f"C core not found at {path}; build it with "
-                "'cmake -S . -B build && cmake --build build'"
-            )
-        self._lib = ctypes.CDLL(str(path))
+        tried = [Path(path)] if path else library_candidates()
+        found = next((p for p in tried if p.is_file()), None)
+        if found is None:
+            raise FileNotFoundError(_missing_library(tried, given=bool(path)))
+        self._lib = ctypes.CDLL(str(found))
         self._lib.dyad_input_default.restype = _Input
         self._lib.dyad_solve.argtypes = [
             ctypes.c_int,
