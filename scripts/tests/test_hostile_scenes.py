@@ -416,6 +416,7 @@ def _build_fmu(table, tmp_path, name) -> Path:
         + [
             gen / f"{ident}_scene.c",
             ROOT / "fmu" / "fmu_instance.c",
+            ROOT / "fmu" / "fmu_state.c",
             ROOT / "fmu" / "fmi2_functions.c",
             gen / f"{ident}_model.c",
         ]
