@@ -15,14 +15,13 @@ they fail (scripts/env.sh installs them).
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 from dyadfmu import paths
+from tool_checks import required_tool
 
-CI = os.environ.get("CI", "").lower() == "true"
 CONSUMER = paths.ROOT / "tests" / "consumer"
 #: The consumer's executables (tests/consumer/CMakeLists.txt) and the scalar each has.
 PROGRAMS = {
@@ -32,16 +31,6 @@ PROGRAMS = {
     "consumer_float_shared": "float",
 }
 HEADERS = ["angle.h", "batch.h", "dual.h", "dyad.h", "kinematics.h", "loaded.h", "types.h"]
-
-
-def _required(tool: str) -> str:
-    path = shutil.which(tool)
-    if path is None:
-        message = f"{tool} is not installed"
-        if CI:
-            pytest.fail(message + "; under CI it must run (scripts/env.sh installs it)")
-        pytest.skip(message)
-    return path
 
 
 def _run(*command: str | Path, env: dict[str, str] | None = None) -> str:
@@ -56,7 +45,7 @@ def _run(*command: str | Path, env: dict[str, str] | None = None) -> str:
 
 
 def _cmake_build(source: Path, build: Path, *options: str) -> None:
-    _run(_required("cmake"), "-S", source, "-B", build, *options)
+    _run(required_tool("cmake"), "-S", source, "-B", build, *options)
     _run("cmake", "--build", build, "-j", str(os.cpu_count() or 2))
 
 
@@ -69,7 +58,7 @@ def _check_programs(directory: Path) -> None:
 @pytest.fixture(scope="module")
 def prefix(tmp_path_factory):
     """The core configured, built and installed alone into <tmp>/prefix."""
-    _required("cc")
+    required_tool("cc")
     tmp = tmp_path_factory.mktemp("install")
     _cmake_build(
         paths.ROOT,
@@ -124,7 +113,7 @@ def test_a_project_finds_the_installed_package_and_solves_in_double_and_float(
 
 @pytest.mark.parametrize("package, real", [("dyadfmu", "double"), ("dyadfmu_float", "float")])
 def test_a_program_builds_with_pkg_config_alone_and_solves(prefix, tmp_path, package, real):
-    pkg_config = _required("pkg-config")
+    pkg_config = required_tool("pkg-config")
     lib = next(p for p in prefix.iterdir() if p.name.startswith("lib"))
     env = {**os.environ, "PKG_CONFIG_PATH": str(lib / "pkgconfig")}
     env.pop("PKG_CONFIG_LIBDIR", None)
@@ -138,7 +127,7 @@ def test_a_program_builds_with_pkg_config_alone_and_solves(prefix, tmp_path, pac
 
 
 def test_a_project_includes_the_source_tree_with_no_option_and_gets_the_core_alone(tmp_path):
-    _required("cc")
+    required_tool("cc")
     build = tmp_path / "subdirectory"
     _cmake_build(CONSUMER, build, f"-DDYADFMU_SOURCE_DIR={paths.ROOT}")
     _check_programs(build)

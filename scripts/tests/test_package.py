@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 import zipfile
@@ -23,10 +22,10 @@ from pathlib import Path
 
 import pytest
 from dyadfmu import paths
+from tool_checks import required_tool
 
 pytestmark = pytest.mark.slow  # about 2.5 minutes: one CMake build of the whole project
 
-CI = os.environ.get("CI", "").lower() == "true"
 SCRIPTS = paths.ROOT / "scripts"
 CONSTRAINTS = SCRIPTS / "constraints.txt"
 #: The FMUs every package holds: the generic dyads and the drive, FMI 2 and 3.
@@ -95,16 +94,6 @@ print(json.dumps({
 """
 
 
-def _required(tool: str) -> str:
-    path = shutil.which(tool)
-    if path is None:
-        message = f"{tool} is not installed"
-        if CI:
-            pytest.fail(message + "; under CI it must run (scripts/env.sh installs it)")
-        pytest.skip(message)
-    return path
-
-
 def _run(*command: str | Path, cwd: Path | None = None, env: dict | None = None) -> str:
     done = subprocess.run(
         [str(c) for c in command], capture_output=True, text=True, cwd=cwd, env=env, check=False
@@ -129,8 +118,8 @@ def _clean_env() -> dict[str, str]:
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> Path:
     """The wheel of scripts/, built once (scikit-build-core in a temporary build dir)."""
-    _required("cmake")
-    _required("cc")
+    required_tool("cmake")
+    required_tool("cc")
     out = tmp_path_factory.mktemp("wheel")
     # without the FMUs' Windows binaries, to be quicker (tests/test_windows.py has them)
     windows = "--config-settings=cmake.define.DYADFMU_WINDOWS=OFF"

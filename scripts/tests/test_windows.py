@@ -9,7 +9,6 @@ fail: scripts/run-tests installs both and configures build/ with -DDYADFMU_WINDO
 
 from __future__ import annotations
 
-import os
 import shutil
 import subprocess
 import zipfile
@@ -18,31 +17,24 @@ import numpy as np
 import pytest
 from dyadfmu import paths
 from dyadfmu.cosim import importers, windows
+from tool_checks import required
 
-CI = os.environ.get("CI", "").lower() == "true"
 ALL = [f"{name}_fmi{version}" for name in importers.fmu_names() for version in importers.VERSIONS]
 #: The DLLs a Windows binary may import: the system's, which every Windows has.
 SYSTEM_DLLS = {"KERNEL32.dll", "msvcrt.dll"}
 
 
-def _required(ok: bool, message: str) -> None:
-    if not ok:
-        if CI:
-            pytest.fail(message + "; under CI it must run (scripts/run-tests installs it)")
-        pytest.skip(message)
-
-
 @pytest.fixture(scope="module")
 def windows_build():
     linux, exe = windows.replay_programs()
-    _required(exe.is_file(), f"{exe} is missing: configure the build with -DDYADFMU_WINDOWS=ON")
-    _required(linux.is_file(), f"{linux} is missing: build the tests")
+    required(exe.is_file(), f"{exe} is missing: configure the build with -DDYADFMU_WINDOWS=ON")
+    required(linux.is_file(), f"{linux} is missing: build the tests")
     return paths.build_dir()
 
 
 @pytest.fixture(scope="module")
 def replays(windows_build, tmp_path_factory):
-    _required(windows.wine_executable() is not None, "wine is not installed")
+    required(windows.wine_executable() is not None, "wine is not installed")
     rows = windows.replay_all(tmp_path_factory.mktemp("windows"), windows_build)
     return {d.fmu: d for d in rows}
 
