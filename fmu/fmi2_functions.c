@@ -5,6 +5,9 @@
 #include "fmi2Functions.h"
 #include "fmu_instance.h"
 
+/* fmi2Integer carries Integer and Enumeration variables. */
+#define INTEGER_TYPES (FMU_TYPE_BIT(FMU_INTEGER) | FMU_TYPE_BIT(FMU_ENUMERATION))
+
 static fmi2Status to_fmi2(fmu_status status)
 {
     return (fmi2Status)status;
@@ -107,7 +110,8 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Integer value[])
 {
-    return to_fmi2(fmu_get_integer((fmu_instance*)c, vr, nvr, value, "fmi2GetInteger"));
+    return to_fmi2(
+        fmu_get_integer((fmu_instance*)c, vr, nvr, value, INTEGER_TYPES, "fmi2GetInteger"));
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -135,7 +139,8 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Integer value[])
 {
-    return to_fmi2(fmu_set_integer((fmu_instance*)c, vr, nvr, value, "fmi2SetInteger"));
+    return to_fmi2(
+        fmu_set_integer((fmu_instance*)c, vr, nvr, value, INTEGER_TYPES, "fmi2SetInteger"));
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,

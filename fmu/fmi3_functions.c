@@ -1,8 +1,8 @@
 /* dyadfmu FMU layer: the FMI 3.0 co-simulation API on top of fmu_instance.
  * Each entry point translates types and names, nothing more. The FMU has
- * Float64 and Int32 variables only; every other type's getters and setters
- * reject any value reference. The entry points it does not offer at all are in
- * fmi3_unsupported.c. */
+ * Float64 and Int32 variables and Enumerations (through the Int64 getter and
+ * setter) only; every other type's getters and setters reject any value reference. The entry points
+ * it does not offer at all are in fmi3_unsupported.c. */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -226,7 +226,7 @@ fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference valueRef
         return fmi3Error;
     }
     return to_fmi3(fmu_get_integer((fmu_instance*)instance, valueReferences, nValueReferences,
-                                   values, "fmi3GetInt32"));
+                                   values, FMU_TYPE_BIT(FMU_INTEGER), "fmi3GetInt32"));
 }
 
 fmi3Status fmi3GetUInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -238,13 +238,15 @@ fmi3Status fmi3GetUInt32(fmi3Instance instance, const fmi3ValueReference valueRe
                                             nValueReferences, "fmi3GetUInt32"));
 }
 
+/* Enumerations (on_singular) are read and set as Int64. */
 fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                         size_t nValueReferences, fmi3Int64 values[], size_t nValues)
 {
-    (void)values;
-    (void)nValues;
-    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_GET, valueReferences,
-                                            nValueReferences, "fmi3GetInt64"));
+    if (!scalar_counts((fmu_instance*)instance, nValueReferences, nValues, "fmi3GetInt64")) {
+        return fmi3Error;
+    }
+    return to_fmi3(fmu_get_int64((fmu_instance*)instance, valueReferences, nValueReferences, values,
+                                 "fmi3GetInt64"));
 }
 
 fmi3Status fmi3GetUInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -355,7 +357,7 @@ fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference valueRef
         return fmi3Error;
     }
     return to_fmi3(fmu_set_integer((fmu_instance*)instance, valueReferences, nValueReferences,
-                                   values, "fmi3SetInt32"));
+                                   values, FMU_TYPE_BIT(FMU_INTEGER), "fmi3SetInt32"));
 }
 
 fmi3Status fmi3SetUInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -370,10 +372,11 @@ fmi3Status fmi3SetUInt32(fmi3Instance instance, const fmi3ValueReference valueRe
 fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                         size_t nValueReferences, const fmi3Int64 values[], size_t nValues)
 {
-    (void)values;
-    (void)nValues;
-    return to_fmi3(fmu_no_variables_of_type((fmu_instance*)instance, FMU_OP_SET, valueReferences,
-                                            nValueReferences, "fmi3SetInt64"));
+    if (!scalar_counts((fmu_instance*)instance, nValueReferences, nValues, "fmi3SetInt64")) {
+        return fmi3Error;
+    }
+    return to_fmi3(fmu_set_int64((fmu_instance*)instance, valueReferences, nValueReferences, values,
+                                 "fmi3SetInt64"));
 }
 
 fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference valueReferences[],

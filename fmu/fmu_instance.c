@@ -228,17 +228,22 @@ void fmu_rebuild_slots(fmu_instance* instance)
     build_slots(instance);
 }
 
-static void find_angles(fmu_instance* instance)
+/* The angle variables, and the settings the layer reads (kept as set). */
+static void find_places(fmu_instance* instance)
 {
     const fmu_model* model = instance->model;
     size_t k;
     instance->angle_count = 0;
+    instance->on_singular = NULL;
     for (k = 0; k < model->variable_count; ++k) {
-        if (model->variables[k].target == FMU_TARGET_INPUT_ANGLE) {
+        const fmu_variable* v = &model->variables[k];
+        if (v->target == FMU_TARGET_INPUT_ANGLE) {
             fmu_angle* a = &instance->angles[instance->angle_count++];
             a->angle = &instance->values[k];
-            a->unit = (double*)(void*)((char*)instance->input + model->variables[k].offset);
+            a->unit = (double*)(void*)((char*)instance->input + v->offset);
             a->converted = NAN;
+        } else if (v->target == FMU_TARGET_SETTING && v->offset == FMU_SETTING_ON_SINGULAR) {
+            instance->on_singular = &instance->values[k];
         }
     }
 }
@@ -341,7 +346,7 @@ fmu_instance* fmu_instantiate(const fmu_model* model, const char* instance_name,
     instance->saved = NULL;
     instance->log_categories = logging_on ? ~0u : 0u;
     instance->time_at_vr_0 = time_at_vr_0;
-    find_angles(instance);
+    find_places(instance);
     load_start_values(instance);
     fmu_log(instance, FMU_OK, "instantiated %s", model->identifier);
     return instance;
@@ -545,6 +550,13 @@ static fmu_status advance_states(fmu_instance* instance, double current_time, do
     return status;
 }
 
+/* Whether a step the model has no answer for goes on (on_singular = continue). The
+ * step's failure is then logged as a warning, once, when it is found. */
+static int continues(const fmu_instance* instance)
+{
+    return instance->on_singular != NULL && *instance->on_singular == FMU_ON_SINGULAR_CONTINUE;
+}
+
 fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
                        const char* function)
 {
@@ -559,7 +571,10 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
     if (instance->model->behaviour->advance != NULL) {
         return advance_states(instance, current_time, step_size, function);
     }
-    status = solve(instance, FMU_DISCARD, function, 1);
+    status = solve(instance, continues(instance) ? FMU_WARNING : FMU_DISCARD, function, 1);
+    if (status == FMU_WARNING) {
+        status = FMU_OK; /* on_singular = continue: the outputs NaN, the status set */
+    }
     if (status == FMU_OK) {
         instance->time = current_time + step_size;
         instance->last_successful_time = instance->time;
@@ -593,12 +608,40 @@ fmu_status fmu_reset(fmu_instance* instance)
 
 static const char* type_name(fmu_value_type type)
 {
-    return type == FMU_REAL ? "Real" : "Integer";
+    switch (type) {
+    case FMU_REAL: return "Real";
+    case FMU_INTEGER: return "Integer";
+    case FMU_ENUMERATION: return "Enumeration";
+    }
+    return "?";
 }
 
-/* The variable of a value reference of the given type, or NULL with a logged error. */
-static const fmu_variable* lookup(const fmu_instance* instance, unsigned int vr,
-                                  fmu_value_type type, const char* function)
+/* The types a call addresses, for a message. */
+static const char* types_name(unsigned types)
+{
+    if (types == (FMU_TYPE_BIT(FMU_INTEGER) | FMU_TYPE_BIT(FMU_ENUMERATION))) {
+        return "Integer or Enumeration";
+    }
+    if (types == FMU_TYPE_BIT(FMU_INTEGER)) {
+        return "Integer";
+    }
+    return types == FMU_TYPE_BIT(FMU_ENUMERATION) ? "Enumeration" : "Real";
+}
+
+/* How a get or set passes its values: the C type of the importer's array, and the
+ * variable types the call addresses (FMU_TYPE_BIT). */
+typedef enum array_type { ARRAY_DOUBLE = 0, ARRAY_INT, ARRAY_INT64 } array_type;
+typedef struct value_access {
+    array_type array;
+    unsigned types;
+} value_access;
+
+static const value_access reals = {ARRAY_DOUBLE, FMU_TYPE_BIT(FMU_REAL)};
+
+/* The variable of a value reference of one of the given types, or NULL with a
+ * logged error. */
+static const fmu_variable* lookup(const fmu_instance* instance, unsigned int vr, unsigned types,
+                                  const char* function)
 {
     const fmu_model* model = instance->model;
     const fmu_variable* v;
@@ -607,9 +650,9 @@ static const fmu_variable* lookup(const fmu_instance* instance, unsigned int vr,
         return NULL;
     }
     v = &model->variables[model->index_of_vr[vr]];
-    if (v->type != type) {
+    if (!(FMU_TYPE_BIT(v->type) & types)) {
         fmu_log(instance, FMU_ERROR, "%s: value reference %u (%s) is of type %s, not %s", function,
-                vr, v->name, type_name(v->type), type_name(type));
+                vr, v->name, type_name(v->type), types_name(types));
         return NULL;
     }
     return v;
@@ -624,6 +667,15 @@ static fmu_status check_arrays(const fmu_instance* instance, const void* vr, siz
         return FMU_ERROR;
     }
     return FMU_OK;
+}
+
+/* The items of an enumeration, for a message. */
+static const char* items_of(const fmu_variable* v)
+{
+    if (v->target == FMU_TARGET_SETTING && v->offset == FMU_SETTING_ON_SINGULAR) {
+        return "1 (discard) or 2 (continue)";
+    }
+    return "see its declared type";
 }
 
 /* Whether a value may be stored in v now; logs the reason if not. */
@@ -646,6 +698,11 @@ static fmu_status check_settable(const fmu_instance* instance, const fmu_variabl
                 value);
         return FMU_ERROR;
     }
+    if (v->type == FMU_ENUMERATION && !(value >= v->min && value <= v->max)) {
+        fmu_log(instance, FMU_ERROR, "%s: %s = %.0f is not an item of its enumeration: %s",
+                function, v->name, value, items_of(v));
+        return FMU_ERROR;
+    }
     if ((v->bounds & FMU_HAS_MIN) &&
         ((v->bounds & FMU_MIN_EXCLUSIVE) ? !(value > v->min) : !(value >= v->min))) {
         fmu_log(instance, FMU_ERROR, "%s: %s = %g %s: it must be %s %g", function, v->name, value,
@@ -661,18 +718,24 @@ static fmu_status check_settable(const fmu_instance* instance, const fmu_variabl
     return FMU_OK;
 }
 
-/* The importer's arrays are double (Real) or int (Integer); the store is double. */
-static double value_at(const void* values, fmu_value_type type, size_t k)
+/* The importer's arrays are double, int or int64_t; the store is double (which
+ * holds every value an Integer or Enumeration may take exactly). */
+static double value_at(const void* values, array_type array, size_t k)
 {
-    return type == FMU_REAL ? ((const double*)values)[k] : (double)((const int*)values)[k];
+    switch (array) {
+    case ARRAY_INT: return (double)((const int*)values)[k];
+    case ARRAY_INT64: return (double)((const int64_t*)values)[k];
+    case ARRAY_DOUBLE: break;
+    }
+    return ((const double*)values)[k];
 }
 
-static void store_at(void* values, fmu_value_type type, size_t k, double value)
+static void store_at(void* values, array_type array, size_t k, double value)
 {
-    if (type == FMU_REAL) {
-        ((double*)values)[k] = value;
-    } else {
-        ((int*)values)[k] = (int)value;
+    switch (array) {
+    case ARRAY_INT: ((int*)values)[k] = (int)value; break;
+    case ARRAY_INT64: ((int64_t*)values)[k] = (int64_t)value; break;
+    case ARRAY_DOUBLE: ((double*)values)[k] = value; break;
     }
 }
 
@@ -685,7 +748,7 @@ static const fmu_slot* slot_of(const fmu_instance* instance, unsigned int vr)
 /* Finds and logs why a set is refused, by the checks that name the variable;
  * FMU_OK if none refuses it. */
 static fmu_status explain_refusal(const fmu_instance* instance, const unsigned int vr[],
-                                  size_t count, const void* values, fmu_value_type type,
+                                  size_t count, const void* values, value_access access,
                                   const char* function)
 {
     size_t k;
@@ -697,9 +760,9 @@ static fmu_status explain_refusal(const fmu_instance* instance, const unsigned i
                     function);
             return FMU_ERROR;
         }
-        v = lookup(instance, vr[k], type, function);
+        v = lookup(instance, vr[k], access.types, function);
         if (v == NULL ||
-            check_settable(instance, v, value_at(values, type, k), function) != FMU_OK) {
+            check_settable(instance, v, value_at(values, access.array, k), function) != FMU_OK) {
             return FMU_ERROR;
         }
     }
@@ -720,15 +783,16 @@ static void after_set(fmu_instance* instance)
 /* Every value is checked before any is stored: a rejected call changes nothing.
  * The caller checked that a set is legal now. */
 static fmu_status set_values(fmu_instance* instance, const unsigned int vr[], size_t count,
-                             const void* values, fmu_value_type type, const char* function)
+                             const void* values, value_access access, const char* function)
 {
     size_t k;
     if (check_arrays(instance, vr, count, values, function) != FMU_OK ||
-        explain_refusal(instance, vr, count, values, type, function) != FMU_OK) {
+        explain_refusal(instance, vr, count, values, access, function) != FMU_OK) {
         return FMU_ERROR;
     }
     for (k = 0; k < count; ++k) {
-        store(instance, (size_t)instance->model->index_of_vr[vr[k]], value_at(values, type, k));
+        store(instance, (size_t)instance->model->index_of_vr[vr[k]],
+              value_at(values, access.array, k));
     }
     if (count > 0) {
         after_set(instance);
@@ -775,7 +839,7 @@ static double read_variable(fmu_instance* instance, const fmu_variable* v)
  * for a value reference that is not of `type`; otherwise, if `solve_counts`,
  * the status of that solve (a failed one as FMU_WARNING), else FMU_OK. */
 static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], size_t count,
-                             void* values, fmu_value_type type, int solve_counts,
+                             void* values, value_access access, int solve_counts,
                              const char* function)
 {
     fmu_status worst = FMU_OK;
@@ -787,11 +851,11 @@ static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], si
     for (k = 0; k < count; ++k) {
         const fmu_slot* slot = slot_of(instance, vr[k]);
         const fmu_variable* v;
-        if (type == FMU_REAL && slot != NULL && slot->read == &instance->time) {
-            store_at(values, type, k, instance->time);
+        if (access.array == ARRAY_DOUBLE && slot != NULL && slot->read == &instance->time) {
+            store_at(values, access.array, k, instance->time);
             continue;
         }
-        v = lookup(instance, vr[k], type, function);
+        v = lookup(instance, vr[k], access.types, function);
         if (v == NULL) {
             return FMU_ERROR;
         }
@@ -800,7 +864,7 @@ static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], si
             worst = solve_counts ? solved_status : FMU_OK;
             solved = 1;
         }
-        store_at(values, type, k, read_variable(instance, v));
+        store_at(values, access.array, k, read_variable(instance, v));
     }
     return worst;
 }
@@ -910,16 +974,27 @@ fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t 
             return FMU_OK;
         }
     }
-    return set_values(instance, vr, count, values, FMU_REAL, function);
+    return set_values(instance, vr, count, values, reals, function);
 }
 
 fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
-                           const int values[], const char* function)
+                           const int values[], unsigned types, const char* function)
 {
+    const value_access access = {ARRAY_INT, types};
     if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK) {
         return FMU_ERROR;
     }
-    return set_values(instance, vr, count, values, FMU_INTEGER, function);
+    return set_values(instance, vr, count, values, access, function);
+}
+
+fmu_status fmu_set_int64(fmu_instance* instance, const unsigned int vr[], size_t count,
+                         const int64_t values[], const char* function)
+{
+    const value_access access = {ARRAY_INT64, FMU_TYPE_BIT(FMU_ENUMERATION)};
+    if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    return set_values(instance, vr, count, values, access, function);
 }
 
 fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
@@ -930,7 +1005,7 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
         return FMU_ERROR;
     }
     if (vr == NULL || values == NULL) {
-        return get_values(instance, vr, count, values, FMU_REAL, 1, function);
+        return get_values(instance, vr, count, values, reals, 1, function);
     }
     if (!instance->dirty && instance->evaluation.status == FMU_OK &&
         plan_fits(&instance->get_plan, vr, count)) {
@@ -946,19 +1021,30 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
         make_plan(instance, &instance->get_plan, vr, count);
         return solved;
     }
-    return get_values(instance, vr, count, values, FMU_REAL, 1, function);
+    return get_values(instance, vr, count, values, reals, 1, function);
 }
 
 fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
-                           int values[], const char* function)
+                           int values[], unsigned types, const char* function)
 {
+    const value_access access = {ARRAY_INT, types};
     if (fmu_check_call(instance, FMU_OP_GET, function) != FMU_OK) {
         return FMU_ERROR;
     }
     /* The status output is how the model reports a singular configuration or
      * a rejected input (logged when it was evaluated): reading it succeeds
      * whatever it says. */
-    return get_values(instance, vr, count, values, FMU_INTEGER, 0, function);
+    return get_values(instance, vr, count, values, access, 0, function);
+}
+
+fmu_status fmu_get_int64(fmu_instance* instance, const unsigned int vr[], size_t count,
+                         int64_t values[], const char* function)
+{
+    const value_access access = {ARRAY_INT64, FMU_TYPE_BIT(FMU_ENUMERATION)};
+    if (fmu_check_call(instance, FMU_OP_GET, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    return get_values(instance, vr, count, values, access, 0, function);
 }
 
 /* The seed block from the knowns' rates: an angle's rate as the derivative of
@@ -970,7 +1056,7 @@ static fmu_status seed_knowns(fmu_instance* instance, const unsigned int knowns[
     size_t k;
     memset(instance->seed, 0, instance->model->behaviour->input_size);
     for (k = 0; k < n_knowns; ++k) {
-        const fmu_variable* v = lookup(instance, knowns[k], FMU_REAL, function);
+        const fmu_variable* v = lookup(instance, knowns[k], reals.types, function);
         double* rate;
         if (v == NULL) {
             return FMU_ERROR;
@@ -1004,7 +1090,7 @@ static fmu_status check_unknowns(fmu_instance* instance, const unsigned int unkn
 {
     size_t k;
     for (k = 0; k < n_unknowns; ++k) {
-        const fmu_variable* v = lookup(instance, unknowns[k], FMU_REAL, function);
+        const fmu_variable* v = lookup(instance, unknowns[k], reals.types, function);
         if (v == NULL) {
             return FMU_ERROR;
         }

@@ -9,6 +9,7 @@
 #define DYADFMU_FMU_INSTANCE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "fmu_model.h"
 
@@ -123,6 +124,9 @@ typedef struct fmu_instance {
     size_t angle_count;
     int angles_pending; /* an angle may have changed since the input's (cos, sin) */
     int time_at_vr_0;   /* value reference 0 reads the time (FMI 3) */
+    /* The value of on_singular as set (FMU_ON_SINGULAR_...); NULL: the model has no
+     * such setting, and doStep discards a step the model has no answer for. */
+    const double* on_singular;
     /* The model's blocks (see fmu_behaviour), in the instance's own memory:
      * input kept up to date by every set, output of the last evaluation, and
      * scratch for directional derivatives. */
@@ -162,16 +166,27 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
 fmu_status fmu_terminate(fmu_instance* instance);
 fmu_status fmu_reset(fmu_instance* instance);
 
-/* Get and set by value reference. `type` is the type the importer asked for;
- * a value reference of another type is an error. */
+/* Get and set by value reference, each function for the variable types its FMI
+ * call addresses; a value reference of another type is an error. */
 fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         double values[], const char* function);
 fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         const double values[], const char* function);
+
+/* The bit of a type in a set of types. */
+#define FMU_TYPE_BIT(type) (1u << (unsigned)(type))
+
+/* Values passed as int: `types` is what the call addresses, FMU_TYPE_BIT(FMU_INTEGER)
+ * for fmi3Int32, and Enumerations too for fmi2Integer. */
 fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
-                           int values[], const char* function);
+                           int values[], unsigned types, const char* function);
 fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
-                           const int values[], const char* function);
+                           const int values[], unsigned types, const char* function);
+/* Enumerations passed as int64_t (fmi3Int64). */
+fmu_status fmu_get_int64(fmu_instance* instance, const unsigned int vr[], size_t count,
+                         int64_t values[], const char* function);
+fmu_status fmu_set_int64(fmu_instance* instance, const unsigned int vr[], size_t count,
+                         const int64_t values[], const char* function);
 
 /* Exact directional derivative of Real outputs (unknowns) along a seed on Real
  * inputs (knowns), at the current inputs (dyad_solve_tangent_of). */

@@ -23,8 +23,9 @@ typedef enum fmu_causality {
 } fmu_causality;
 
 typedef enum fmu_value_type {
-    FMU_REAL = 0, /* fmi2Real / fmi3Float64 */
-    FMU_INTEGER   /* fmi2Integer / fmi3Int32 */
+    FMU_REAL = 0,   /* fmi2Real / fmi3Float64 */
+    FMU_INTEGER,    /* fmi2Integer / fmi3Int32 */
+    FMU_ENUMERATION /* an item's value: fmi2Integer / fmi3Int64 */
 } fmu_value_type;
 
 /* Where a variable's value lives: in the model's input block (parameters and
@@ -34,8 +35,23 @@ typedef enum fmu_target {
     FMU_TARGET_INPUT_REAL = 0, /* the double at `offset` in the input block */
     FMU_TARGET_INPUT_ANGLE,    /* the two doubles at `offset` in the input block: (cos, sin) */
     FMU_TARGET_RESULT_REAL,    /* the double at `offset` in the output block */
-    FMU_TARGET_RESULT_STATUS   /* the int (enum) at `offset` in the output block */
+    FMU_TARGET_RESULT_STATUS,  /* the int (enum) at `offset` in the output block */
+    FMU_TARGET_SETTING         /* a setting of the FMU layer itself: `offset` is its fmu_setting */
 } fmu_target;
+
+/* What the FMU layer itself reads, not the model: the variables of target
+ * FMU_TARGET_SETTING. */
+typedef enum fmu_setting {
+    /* What doStep does where the model has no answer (a singular position, a
+     * mechanism that cannot assemble, reactions that overflow): the items of the
+     * enumeration on_singular. */
+    FMU_SETTING_ON_SINGULAR = 0
+} fmu_setting;
+
+enum {
+    FMU_ON_SINGULAR_DISCARD = 1, /* doStep returns Discard (the default) */
+    FMU_ON_SINGULAR_CONTINUE = 2 /* doStep returns OK: outputs NaN, status says why */
+};
 
 /* Bits of fmu_variable.bounds. */
 enum {
@@ -52,7 +68,7 @@ typedef struct fmu_variable {
     fmu_causality causality;
     fmu_value_type type;
     fmu_target target;
-    size_t offset;   /* into dyad_input or dyad_result, see target */
+    size_t offset;   /* into dyad_input or dyad_result, or the fmu_setting; see target */
     double start;    /* start value (inputs and parameters) */
     double min, max; /* bounds, valid where `bounds` says so */
     unsigned bounds; /* FMU_HAS_MIN | FMU_HAS_MAX | ..._EXCLUSIVE */

@@ -119,9 +119,12 @@ static const char* const state_names[STATE_COUNT] = {"Instantiated", "Initializa
 
 /* Inputs all at one extreme value: a doStep that the model cannot complete
  * (the reactions or the state overflow) and must discard. Returns 1 if found. */
-static int fmi2_discard(fmi2Component c)
+static const double extremes[] = {DBL_MAX, -DBL_MAX, 1e300, -1e300};
+
+/* An input and an extreme value of it that make the step from 0 to 0.01 s one the
+ * model cannot complete, left set; 1 if found. */
+static int fmi2_find_discard(fmi2Component c, unsigned* vr, double* value)
 {
-    static const double extremes[] = {DBL_MAX, -DBL_MAX, 1e300, -1e300};
     size_t e, k;
     for (k = 0; k < md2.variable_count; ++k) {
         const probe_variable* v = &md2.variables[k];
@@ -131,6 +134,8 @@ static int fmi2_discard(fmi2Component c)
         for (e = 0; e < sizeof extremes / sizeof extremes[0]; ++e) {
             api2.SetReal(c, &v->vr, 1, &extremes[e]);
             if (api2.DoStep(c, 0, 0.01, fmi2True) == fmi2Discard) {
+                *vr = v->vr;
+                *value = extremes[e];
                 return 1;
             }
             /* back to the start values for the next try */
@@ -140,6 +145,14 @@ static int fmi2_discard(fmi2Component c)
         }
     }
     return 0;
+}
+
+/* A step the model cannot complete (fmi2_find_discard); 1 if found. */
+static int fmi2_discard(fmi2Component c)
+{
+    unsigned vr;
+    double value;
+    return fmi2_find_discard(c, &vr, &value);
 }
 
 /* An instance in `state`, or NULL if this FMU cannot get there. */
@@ -537,7 +550,7 @@ static int test_fmi2_wrong_types_and_unknown_vrs(void)
             CHECK(api2.SetInteger(c, &v->vr, 1, &integer) == fmi2Error &&
                       logged_error(&book, count),
                   "Real %s set as Integer", v->name);
-        } else if (v->type == PROBE_INTEGER) {
+        } else if (v->type == PROBE_INTEGER || v->type == PROBE_ENUMERATION) {
             CHECK(api2.GetReal(c, &v->vr, 1, &value) == fmi2Error && logged_error(&book, count) &&
                       strstr(book.last, v->name) != NULL,
                   "Integer %s read as Real: %s", v->name, book.last);
@@ -774,9 +787,8 @@ static int initialise_fmi3(fmi3Instance c)
            api3.ExitInitializationMode(c) == fmi3OK;
 }
 
-static int fmi3_discard(fmi3Instance c)
+static int fmi3_find_discard(fmi3Instance c, unsigned* vr, double* value)
 {
-    static const double extremes[] = {DBL_MAX, -DBL_MAX, 1e300, -1e300};
     size_t e, k;
     for (k = 0; k < md3.variable_count; ++k) {
         const probe_variable* v = &md3.variables[k];
@@ -786,6 +798,8 @@ static int fmi3_discard(fmi3Instance c)
         for (e = 0; e < sizeof extremes / sizeof extremes[0]; ++e) {
             api3.SetFloat64(c, &v->vr, 1, &extremes[e], 1);
             if (step3(c, 0, 0.01) == fmi3Discard) {
+                *vr = v->vr;
+                *value = extremes[e];
                 return 1;
             }
             /* back to the start values for the next try */
@@ -795,6 +809,13 @@ static int fmi3_discard(fmi3Instance c)
         }
     }
     return 0;
+}
+
+static int fmi3_discard(fmi3Instance c)
+{
+    unsigned vr;
+    double value;
+    return fmi3_find_discard(c, &vr, &value);
 }
 
 static fmi3Instance fmi3_in_state(probe_log_book* book, int state)
@@ -1188,7 +1209,9 @@ static int fmi3_wrong_type_calls(fmi3Instance c, const probe_variable* v, probe_
         case 5: status = api3.GetInt16(c, &vr, 1, (fmi3Int16*)&any, 1); break;
         case 6: status = api3.GetUInt16(c, &vr, 1, (fmi3UInt16*)&any, 1); break;
         case 7: status = api3.GetUInt32(c, &vr, 1, (fmi3UInt32*)&any, 1); break;
-        case 8: status = api3.GetInt64(c, &vr, 1, &any.i64, 1); break;
+        case 8:
+            status = v->type == PROBE_ENUMERATION ? -1 : (int)api3.GetInt64(c, &vr, 1, &any.i64, 1);
+            break;
         case 9: status = api3.GetUInt64(c, &vr, 1, &any.u64, 1); break;
         case 10: status = api3.GetBoolean(c, &vr, 1, (fmi3Boolean*)&any, 1); break;
         case 11: status = api3.GetString(c, &vr, 1, &any.s, 1); break;
@@ -1211,7 +1234,11 @@ static int fmi3_wrong_type_calls(fmi3Instance c, const probe_variable* v, probe_
         case 19: status = api3.SetInt16(c, &vr, 1, (fmi3Int16*)&any, 1); break;
         case 20: status = api3.SetUInt16(c, &vr, 1, (fmi3UInt16*)&any, 1); break;
         case 21: status = api3.SetUInt32(c, &vr, 1, (fmi3UInt32*)&any, 1); break;
-        case 22: status = api3.SetInt64(c, &vr, 1, &any.i64, 1); break;
+        case 22:
+            status = v->type == PROBE_ENUMERATION && settable
+                         ? -1
+                         : (int)api3.SetInt64(c, &vr, 1, &any.i64, 1);
+            break;
         case 23: status = api3.SetUInt64(c, &vr, 1, &any.u64, 1); break;
         case 24: status = api3.SetBoolean(c, &vr, 1, (fmi3Boolean*)&any, 1); break;
         case 25:
@@ -1525,6 +1552,161 @@ static int run_interleaved(int version, int together, uint64_t traces[2])
     return ok;
 }
 
+/* ---- on_singular: what doStep does where the model has no answer ----------------------------- */
+
+/* Whether the declaration of on_singular is the one the FMU layer reads: a fixed
+ * Enumeration parameter whose default is 1 (discard). Every model but the drive has
+ * it; the drive's failed steps cannot go on (its states stay where they were). */
+static int declares_on_singular(const probe_model* md, const probe_variable* v, int* fails_out)
+{
+    int fails = 0;
+    if (v == NULL) {
+        CHECK(strcmp(md->identifier, "drive") == 0, "%s has no on_singular", md->identifier);
+        *fails_out += fails;
+        return 0;
+    }
+    CHECK(v->type == PROBE_ENUMERATION && v->causality == PROBE_PARAMETER &&
+              v->variability == PROBE_FIXED && v->has_start && v->start == 1,
+          "on_singular is not a fixed Enumeration parameter starting at 1 (discard)");
+    *fails_out += fails;
+    return fails == 0;
+}
+
+/* After a continued step: the status says why, no output is infinite, and the
+ * reactions (some Real output at least) are NaN. */
+static int continued_outputs(const values_read* r, int status, int fmi_version)
+{
+    int fails = 0;
+    size_t k, nan = 0;
+    for (k = 0; k < r->n_reals; ++k) {
+        CHECK(!isinf(r->reals[k]), "FMI %d: continued step: output %zu is infinite", fmi_version,
+              k);
+        nan += isnan(r->reals[k]) != 0;
+    }
+    CHECK(nan > 0, "FMI %d: continued step: no output is NaN", fmi_version);
+    CHECK(status != 0, "FMI %d: continued step: status 0", fmi_version);
+    return fails;
+}
+
+static int test_fmi2_on_singular(void)
+{
+    int fails = 0;
+    probe_log_book book;
+    const probe_variable* v = probe_variable_named(&md2, "on_singular");
+    const picks p = pick(&md2);
+    const fmi2Integer refused[3] = {0, 3, -1}, go_on = 2, discard = 1;
+    fmi2Component c;
+    fmi2Integer item = 0, status = 0;
+    fmi2Boolean terminated = fmi2True;
+    unsigned vr = 0;
+    double value = 0, last = 0;
+    values_read r;
+    size_t k;
+    long count;
+    if (!declares_on_singular(&md2, v, &fails) || p.status == NULL) {
+        return fails;
+    }
+    c = new_fmi2(&book, "discard");
+    CHECK(initialise_fmi2(c) && fmi2_find_discard(c, &vr, &value), "no input discards a step");
+    api2.FreeInstance(c);
+    if (fails) {
+        return fails;
+    }
+    c = new_fmi2(&book, "continue");
+    for (k = 0; k < 3; ++k) {
+        count = book.count;
+        CHECK(api2.SetInteger(c, &v->vr, 1, &refused[k]) == fmi2Error &&
+                  logged_error(&book, count) && strstr(book.last, "1 (discard) or 2 (continue)"),
+              "on_singular = %d: %s", refused[k], book.last);
+    }
+    CHECK(api2.SetInteger(c, &v->vr, 1, &go_on) == fmi2OK, "on_singular = 2 refused");
+    CHECK(initialise_fmi2(c), "initialise");
+    CHECK(api2.GetInteger(c, &v->vr, 1, &item) == fmi2OK && item == 2, "on_singular reads %d",
+          item);
+    count = book.count;
+    CHECK(api2.SetInteger(c, &v->vr, 1, &discard) == fmi2Error && logged_error(&book, count),
+          "on_singular set after initialization");
+    CHECK(api2.SetReal(c, &vr, 1, &value) == fmi2OK, "set the failing input");
+    count = book.count;
+    CHECK(api2.DoStep(c, 0, 0.01, fmi2True) == fmi2OK, "the step did not go on");
+    CHECK(book.count > count && book.last_status == fmi2Warning, "not logged as a warning: %s",
+          book.last);
+    CHECK(api2.GetRealStatus(c, fmi2LastSuccessfulTime, &last) == fmi2OK && last == 0.01,
+          "last successful time %g", last);
+    CHECK(api2.GetBooleanStatus(c, fmi2Terminated, &terminated) == fmi2OK && !terminated,
+          "asks to terminate");
+    CHECK(fmi2_read_all(c, &r) && api2.GetInteger(c, &p.status->vr, 1, &status) == fmi2OK,
+          "read the outputs");
+    fails += continued_outputs(&r, status, 2);
+    CHECK(api2.DoStep(c, 0.01, 0.01, fmi2True) == fmi2OK, "the next step did not go on");
+    CHECK(api2.Reset(c) == fmi2OK && initialise_fmi2(c) &&
+              api2.GetInteger(c, &v->vr, 1, &item) == fmi2OK && item == 1,
+          "reset leaves on_singular = %d", item);
+    api2.FreeInstance(c);
+    return fails;
+}
+
+static int test_fmi3_on_singular(void)
+{
+    int fails = 0;
+    probe_log_book book;
+    const probe_variable* v = probe_variable_named(&md3, "on_singular");
+    const picks p = pick(&md3);
+    const fmi3Int64 refused[3] = {0, 3, INT64_MAX}, go_on = 2, discard = 1;
+    fmi3Instance c;
+    fmi3Int64 item = 0;
+    fmi3Int32 status = 0;
+    fmi3Boolean event, terminate = fmi3True, early;
+    fmi3Float64 last = 0;
+    unsigned vr = 0;
+    double value = 0;
+    values_read r;
+    size_t k;
+    long count;
+    if (!declares_on_singular(&md3, v, &fails) || p.status == NULL) {
+        return fails;
+    }
+    c = new_fmi3(&book, "discard");
+    CHECK(initialise_fmi3(c) && fmi3_find_discard(c, &vr, &value), "no input discards a step");
+    api3.FreeInstance(c);
+    if (fails) {
+        return fails;
+    }
+    c = new_fmi3(&book, "continue");
+    for (k = 0; k < 3; ++k) {
+        count = book.count;
+        CHECK(api3.SetInt64(c, &v->vr, 1, &refused[k], 1) == fmi3Error &&
+                  logged_error(&book, count) && strstr(book.last, "1 (discard) or 2 (continue)"),
+              "on_singular = %lld: %s", (long long)refused[k], book.last);
+    }
+    count = book.count;
+    CHECK(api3.SetInt32(c, &v->vr, 1, &status, 1) == fmi3Error && logged_error(&book, count),
+          "on_singular set as Int32");
+    CHECK(api3.SetInt64(c, &v->vr, 1, &go_on, 1) == fmi3OK, "on_singular = 2 refused");
+    CHECK(initialise_fmi3(c), "initialise");
+    CHECK(api3.GetInt64(c, &v->vr, 1, &item, 1) == fmi3OK && item == 2, "on_singular reads %lld",
+          (long long)item);
+    count = book.count;
+    CHECK(api3.SetInt64(c, &v->vr, 1, &discard, 1) == fmi3Error && logged_error(&book, count),
+          "on_singular set after initialization");
+    CHECK(api3.SetFloat64(c, &vr, 1, &value, 1) == fmi3OK, "set the failing input");
+    count = book.count;
+    CHECK(api3.DoStep(c, 0, 0.01, fmi3True, &event, &terminate, &early, &last) == fmi3OK &&
+              !terminate && last == 0.01,
+          "the step did not go on");
+    CHECK(book.count > count && book.last_status == fmi3Warning, "not logged as a warning: %s",
+          book.last);
+    CHECK(fmi3_read_all(c, &r) && api3.GetInt32(c, &p.status->vr, 1, &status, 1) == fmi3OK,
+          "read the outputs");
+    fails += continued_outputs(&r, status, 3);
+    CHECK(step3(c, 0.01, 0.01) == fmi3OK, "the next step did not go on");
+    CHECK(api3.Reset(c) == fmi3OK && initialise_fmi3(c) &&
+              api3.GetInt64(c, &v->vr, 1, &item, 1) == fmi3OK && item == 1,
+          "reset leaves on_singular = %lld", (long long)item);
+    api3.FreeInstance(c);
+    return fails;
+}
+
 static int test_instances_independent(void)
 {
     int fails = 0, version;
@@ -1772,8 +1954,8 @@ static int test_rrt_bad_input_names_its_variable(void)
         dyad_result out;
         fmu_evaluation evaluation;
         size_t j;
-        if (v->causality == FMU_OUTPUT) {
-            continue;
+        if (v->causality == FMU_OUTPUT || v->target == FMU_TARGET_SETTING) {
+            continue; /* a setting is the FMU layer's: the model never reads it */
         }
         for (j = 0; j < fmu_this_model.variable_count; ++j) {
             const fmu_variable* w = &fmu_this_model.variables[j];
@@ -2275,6 +2457,8 @@ static const named_test generic_tests[] = {
     {"fmi3_invalid_values", test_fmi3_invalid_values},
     {"fmi3_reset", test_fmi3_reset},
     {"fmi3_instantiate_refusals", test_fmi3_instantiate_refusals},
+    {"fmi2_on_singular", test_fmi2_on_singular},
+    {"fmi3_on_singular", test_fmi3_on_singular},
     {"instances_independent", test_instances_independent},
     {"fmu_state_round_trip", test_fmu_state_round_trip},
     {"exports_only_fmi", test_exports_only_fmi},

@@ -15,7 +15,8 @@
  *     output is finite; otherwise every output is NaN, except those the model
  *     descriptions keep defined (a dyad's conditioning and amplification; the
  *     drive's motor.torque, NaN only where it overflows itself), and doStep is
- *     not OK; the drive's crank.angle and crank.omega are its states and are
+ *     not OK unless on_singular (set too, FMI 2 as Integer, FMI 3 as Int64) is 2,
+ *     continue; the drive's crank.angle and crank.omega are its states and are
  *     finite whatever the status;
  *   - an OK doStep had finite t, h > 0 and t + h, reports t + h as the last
  *     successful time, and moved a model's state if the step should have;
@@ -78,6 +79,7 @@ typedef struct fuzz_fmu {
     size_t* settable; /* inputs and parameters */
     size_t settable_count;
     int status_index;          /* the Integer output `status`, -1 if none */
+    int on_singular;           /* the Enumeration parameter on_singular, -1 if none */
     int angle, omega, epsilon; /* a state: outputs crank.angle, .omega, .epsilon; -1 if none */
     fuzz_rule* rule;           /* per variable: what an output may be when status is not 0 */
 } fuzz_fmu;
@@ -108,7 +110,7 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
         printf("out of memory\n");
         return 0;
     }
-    f->status_index = f->angle = f->omega = f->epsilon = -1;
+    f->status_index = f->angle = f->omega = f->epsilon = f->on_singular = -1;
     for (k = 0; k < n; ++k) {
         const probe_variable* v = &f->model.variables[k];
         size_t j;
@@ -124,6 +126,9 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
         }
         if (v->causality == PROBE_INPUT || v->causality == PROBE_PARAMETER) {
             f->settable[f->settable_count++] = k;
+        }
+        if (v->type == PROBE_ENUMERATION && strcmp(v->name, "on_singular") == 0) {
+            f->on_singular = (int)k;
         }
         if (v->causality == PROBE_OUTPUT) {
             if (v->type == PROBE_INTEGER && strcmp(v->name, "status") == 0) {
@@ -182,7 +187,7 @@ typedef struct fuzz_snapshot {
 } fuzz_snapshot;
 
 typedef struct fuzz_counts {
-    long episodes, instances, steps, steps_ok, steps_discard, steps_error;
+    long episodes, instances, steps, steps_ok, steps_continued, steps_discard, steps_error;
     long sets, sets_rejected, gets, illegal_calls, replays;
 } fuzz_counts;
 
@@ -290,6 +295,11 @@ static int call_set_integer(fuzz_episode* e, const unsigned* vrs, size_t n, cons
         return (int)e->fmu->f2.SetInteger(e->instance, vrs, n, values);
     }
     return (int)e->fmu->f3.SetInt32(e->instance, vrs, n, values, n);
+}
+
+static int call_set_int64(fuzz_episode* e, const unsigned* vrs, size_t n, const int64_t* values)
+{
+    return (int)e->fmu->f3.SetInt64(e->instance, vrs, n, values, n);
 }
 
 static int call_get_real(fuzz_episode* e, const unsigned* vrs, size_t n, double* values)
@@ -619,6 +629,19 @@ static double nasty_time(probe_rng* rng, double tracked)
 
 /* ---- operations ----------------------------------------------------------------------------- */
 
+/* Whether a setter of `type` (the type it is named for) sets a variable of type
+ * `variable`: FMI 2's fmi2SetInteger sets Enumerations too, FMI 3 has fmi3SetInt64. */
+static int sets_type(const fuzz_episode* e, probe_type type, probe_type variable)
+{
+    return variable == type || (fmi2(e) && type == PROBE_INTEGER && variable == PROBE_ENUMERATION);
+}
+
+/* Whether doStep goes on where the model has no answer: on_singular is 2, continue. */
+static int continues(const fuzz_episode* e)
+{
+    return e->fmu->on_singular >= 0 && e->shadow[e->fmu->on_singular] == 2;
+}
+
 /* Why a set of this variable and value must be refused now, or NULL. */
 static const char* must_refuse(const fuzz_episode* e, const probe_variable* v, double value,
                                probe_type type)
@@ -626,8 +649,11 @@ static const char* must_refuse(const fuzz_episode* e, const probe_variable* v, d
     if (v == NULL) {
         return "unknown value reference";
     }
-    if (v->type != type) {
+    if (!sets_type(e, type, v->type)) {
         return "wrong type";
+    }
+    if (v->type == PROBE_ENUMERATION && !(value == 1 || value == 2)) {
+        return "not an item of on_singular (1 discard, 2 continue)";
     }
     if (e->state == S_TERMINATED) {
         return "set in Terminated";
@@ -748,15 +774,21 @@ static void op_set_integer(fuzz_episode* e)
     unsigned vr = random_vr(e, PROBE_INTEGER);
     const int value = specials[probe_rng_below(&e->rng, sizeof specials / sizeof specials[0])];
     const double as_double = value;
+    /* FMI 3 sets an Enumeration as Int64 (and now and then, wrongly, as Int32) */
+    const probe_variable* v = probe_variable_of_vr(&e->fmu->model, vr);
+    const int as_int64 =
+        !fmi2(e) && v != NULL && v->type == PROBE_ENUMERATION && probe_rng_below(&e->rng, 4) != 0;
+    const int64_t wide = value;
     long log_count;
     int status;
     trace(e, vr);
     trace(e, (uint64_t)(unsigned)value);
     take_before(e);
     log_count = e->book.count;
-    status = call_set_integer(e, &vr, 1, &value);
-    note(e, "setInteger vr %u = %d -> %d", vr, value, status);
-    judge_set(e, &vr, 1, &as_double, PROBE_INTEGER, status, log_count, "setInteger");
+    status = as_int64 ? call_set_int64(e, &vr, 1, &wide) : call_set_integer(e, &vr, 1, &value);
+    note(e, "set%s vr %u = %d -> %d", as_int64 ? "Int64" : "Integer", vr, value, status);
+    judge_set(e, &vr, 1, &as_double, as_int64 ? PROBE_ENUMERATION : PROBE_INTEGER, status,
+              log_count, as_int64 ? "setInt64" : "setInteger");
 }
 
 /* Every variable settable now, to plausible values, in one call: brings an
@@ -860,10 +892,13 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
     if (stopped(e)) {
         return;
     }
-    if (!e->after.valid || e->after.get_status != 0) {
+    /* on_singular = continue: an OK step without an answer, which the getter warns of */
+    if (!e->after.valid ||
+        (e->after.get_status != 0 && !(continues(e) && e->after.get_status == 1))) {
         violation(e, "doStep returned OK, the getter then %d", e->after.get_status);
         return;
     }
+    e->counts->steps_continued += e->after.get_status == 1;
     if (!fmi2(e)) {
         const unsigned time_vr = 0;
         double time = NAN;
@@ -1359,12 +1394,13 @@ int main(int argc, char** argv)
         }
     }
     clock_gettime(CLOCK_MONOTONIC, &ended);
-    printf("fuzz %s fmi%d: %ld steps (%ld ok, %ld discarded, %ld refused), %ld sets (%ld "
-           "refused), %ld reads, %ld illegal calls, %ld episodes on %ld instances, %ld replays "
-           "identical; %.1f s\n",
+    printf("fuzz %s fmi%d: %ld steps (%ld ok, of them %ld continued without an answer, %ld "
+           "discarded, %ld refused), %ld sets (%ld refused), %ld reads, %ld illegal calls, %ld "
+           "episodes on %ld instances, %ld replays identical; %.1f s\n",
            fmu.model.identifier, fmu.model.fmi_version, counts.steps, counts.steps_ok,
-           counts.steps_discard, counts.steps_error, counts.sets, counts.sets_rejected, counts.gets,
-           counts.illegal_calls, counts.episodes, counts.instances, counts.replays,
+           counts.steps_continued, counts.steps_discard, counts.steps_error, counts.sets,
+           counts.sets_rejected, counts.gets, counts.illegal_calls, counts.episodes,
+           counts.instances, counts.replays,
            (double)(ended.tv_sec - started.tv_sec) +
                1e-9 * (double)(ended.tv_nsec - started.tv_nsec));
     free(e.shadow);

@@ -311,10 +311,10 @@ static int parse_variability(const char* text, probe_variability* variability)
 /* Element names of variable types: FMI 2 (child of <ScalarVariable>), FMI 3. */
 static int type_of_element(int fmi_version, const char* name, probe_type* type)
 {
-    static const char* const fmi2_others[] = {"Boolean", "String", "Enumeration"};
-    static const char* const fmi3_others[] = {"Float32", "Int8",  "UInt8",      "Int16",   "UInt16",
-                                              "UInt32",  "Int64", "UInt64",     "Boolean", "String",
-                                              "Binary",  "Clock", "Enumeration"};
+    static const char* const fmi2_others[] = {"Boolean", "String"};
+    static const char* const fmi3_others[] = {"Float32", "Int8",   "UInt8",  "Int16",
+                                              "UInt16",  "UInt32", "Int64",  "UInt64",
+                                              "Boolean", "String", "Binary", "Clock"};
     const char* const* others = fmi_version == 2 ? fmi2_others : fmi3_others;
     const size_t count = fmi_version == 2 ? sizeof fmi2_others / sizeof fmi2_others[0]
                                           : sizeof fmi3_others / sizeof fmi3_others[0];
@@ -325,6 +325,10 @@ static int type_of_element(int fmi_version, const char* name, probe_type* type)
     }
     if (strcmp(name, fmi_version == 2 ? "Integer" : "Int32") == 0) {
         *type = PROBE_INTEGER;
+        return 1;
+    }
+    if (strcmp(name, "Enumeration") == 0) {
+        *type = PROBE_ENUMERATION;
         return 1;
     }
     for (k = 0; k < count; ++k) {

@@ -46,8 +46,9 @@ typedef enum probe_variability {
 
 /* The types the FMUs of dyadfmu use; every other type is PROBE_OTHER. */
 typedef enum probe_type {
-    PROBE_REAL = 0, /* fmi2Real, fmi3Float64 */
-    PROBE_INTEGER,  /* fmi2Integer, fmi3Int32 */
+    PROBE_REAL = 0,    /* fmi2Real, fmi3Float64 */
+    PROBE_INTEGER,     /* fmi2Integer, fmi3Int32 */
+    PROBE_ENUMERATION, /* through fmi2Integer, fmi3Int64 */
     PROBE_OTHER
 } probe_type;
 

@@ -9,6 +9,7 @@ effects, outputs and tunable parameters) or, for the crank drive, a variable tab
                  outputs need (the derived inputs and outputs)
     table        the interface table: variables, value references, dependencies,
                  validated, and the instantiation token
+    settings     what the FMU layer itself reads (on_singular), the same in every kind
     kinds        one object per kind of model (generic dyad, tailored scene, drive):
                  its structures, its table, its source files, its C and documentation
     emit/        the generated files: both model descriptions, the build description,

@@ -8,6 +8,7 @@ import tomllib
 
 from dyadgen.dyadtypes import MAY_BE_ZERO, PAIRS
 from dyadgen.locations import INTERFACE_DIR
+from dyadgen.settings import ON_SINGULAR, Setting
 
 
 class Entry:
@@ -23,6 +24,7 @@ class Entry:
         domain: dict | None = None,
         depends: tuple | None = None,
         description: str | None = None,
+        start: float | None = None,
     ) -> None:
         self.lives = lives
         self.name = name
@@ -33,6 +35,21 @@ class Entry:
         # An output's true dependencies (input names) where the generator knows them.
         self.depends = depends
         self.description = description
+        self.start = start  # where the catalogue fixes it (a setting's default item)
+
+
+def setting_entry(setting: Setting) -> Entry:
+    """The parameter of a setting of the FMU layer, an Enumeration."""
+    return Entry(
+        setting.lives,
+        setting.name,
+        "parameter",
+        None,
+        value_type="Enumeration",
+        domain=setting.domain,
+        description=setting.description,
+        start=setting.start,
+    )
 
 
 def _length_domain(dyad_type: str, g: str) -> dict:
@@ -106,6 +123,7 @@ def _dyad_parameters(dyad_type: str) -> list[Entry]:
             None,
             domain=threshold_domain,
         ),
+        setting_entry(ON_SINGULAR),
     ]
 
 
@@ -135,7 +153,7 @@ def dyad_catalogue(dyad_type: str) -> dict[str, Entry]:
     independent = interface["independent"][dyad_type]
     inputs = [entry.name for entry in entries if entry.causality == "input"]
     for entry in entries:
-        entry.description = texts[entry.lives]
+        entry.description = entry.description or texts[entry.lives]
         if entry.causality == "output":
             entry.depends = tuple(name for name in inputs if name not in independent[entry.name])
     return {entry.lives: entry for entry in entries}
@@ -206,4 +224,9 @@ def drive_catalogue() -> dict[str, Entry]:
 
 def drive_absence_reason(lives: str) -> str:
     """Why a well-formed `lives` is not a variable of the drive."""
+    if lives == ON_SINGULAR.lives:
+        return (
+            "the drive has no on_singular: it has no singular position, and a step it "
+            "cannot integrate leaves its states where they were, so it cannot go on"
+        )
     return f"the drive FMU has no variable for '{lives}'"

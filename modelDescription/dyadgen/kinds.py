@@ -27,6 +27,7 @@ from dyadgen.emit.c_table import model_c
 from dyadgen.emit.scene_c import scene_c, scene_header
 from dyadgen.model import Input, Param, Scene
 from dyadgen.scenefile.problems import SceneError
+from dyadgen.settings import ON_SINGULAR, Setting
 from dyadgen.structs import (
     DRIVE_INPUT_MEMBERS,
     DRIVE_OUTPUT_MEMBERS,
@@ -170,7 +171,7 @@ class DyadKind(Kind):
 
     def lives_syntax(self) -> str:
         """What a `lives` of a dyad looks like."""
-        return "expected 'input.<member path>[@angle]' or 'result.<member path>'"
+        return "expected 'input.<member path>[@angle]', 'result.<member path>' or 'fmu.<setting>'"
 
     def resolve_lives(self, struct: str, path: str, angle: bool) -> Lives:
         """A member path of dyad_input or dyad_result."""
@@ -438,6 +439,21 @@ def _settable_row(
     _bounds(raw, settable.domain)
 
 
+def _setting_row(rows: list, setting: Setting) -> None:
+    """The row of a setting of the FMU layer: an Enumeration parameter."""
+    raw = _row(
+        rows,
+        setting.name,
+        "parameter",
+        None,
+        type="Enumeration",
+        start=setting.start,
+        description=setting.description,
+        lives=setting.lives,
+    )
+    _bounds(raw, setting.domain)
+
+
 def _scene_rows(scene: Scene) -> list[dict]:
     """The rows of a tailored scene's table: its inputs, tunable parameters, outputs."""
     rows: list[dict] = []
@@ -446,6 +462,7 @@ def _scene_rows(scene: Scene) -> list[dict]:
     for prm in scene.parameters():
         if prm.tunable:
             _settable_row(rows, prm, "parameter", prm.value, f"input.{prm.member}")
+    _setting_row(rows, ON_SINGULAR)
     for o in scene.outputs:
         _row(
             rows,
@@ -498,7 +515,9 @@ def generic_data(scene: Scene) -> dict:
         }
         if entry.unit:
             raw["unit"] = entry.unit
-        if entry.causality == "input":
+        if entry.start is not None:
+            raw["start"] = entry.start
+        elif entry.causality == "input":
             raw["start"] = starts[entry.name]
         elif entry.causality == "parameter":
             raw["start"] = params[entry.name].value

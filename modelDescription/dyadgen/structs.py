@@ -1,5 +1,6 @@
 """The C structures a model's variables live in, and the `lives` grammar that names a
-member of them: ``input.<member path>[@angle]`` or ``result.<member path>``.
+member of them: ``input.<member path>[@angle]`` or ``result.<member path>``, or a
+setting of the FMU layer itself: ``fmu.<setting>`` (settings.py).
 
 A generic dyad lives in dyad_input and dyad_result (src/include/dyadfmu/types.h), whose
 members nest (link m's direction: input.m.dir); the drive in fmu_drive_input and
@@ -11,6 +12,8 @@ DYAD.D_m.x lives in input.DYAD_D_m_x).
 from __future__ import annotations
 
 import re
+
+from dyadgen.settings import SETTINGS, Setting
 
 # Member trees of dyad_input and dyad_result (types.h). Leaves: "real" (a
 # dyad_real), "dir" (a unit dyad_vec2 set from an angle), "status", "enum".
@@ -99,12 +102,12 @@ STATE_START = {"angle": "start.angle", "speed": "start.speed"}
 #: struct.member.path[@angle]; a scene's flat members keep the case of its variables'
 #: names (a pair point's parameter DYAD.D_m.x lives in input.DYAD_D_m_x). Matched whole.
 LIVES_RE = re.compile(
-    r"(input|result)\.([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)(@angle)?"
+    r"(input|result|fmu)\.([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)(@angle)?"
 )
 
 
 class Lives:
-    """A parsed `lives`: struct ("input" | "result"), member path, angle flag, and
+    """A parsed `lives`: struct ("input" | "result" | "fmu"), member path, angle flag, and
     the kind of model whose structs it names."""
 
     def __init__(self, struct: str, path: str, angle: bool, kind: Structs) -> None:
@@ -114,20 +117,31 @@ class Lives:
         self.kind = kind
 
     @property
+    def setting(self) -> Setting | None:
+        """The FMU layer's setting it names, or None."""
+        return SETTINGS[self.path] if self.struct == "fmu" else None
+
+    @property
     def target(self) -> str:
         """The FMU_TARGET_... of the variable (fmu/fmu_model.h)."""
+        if self.struct == "fmu":
+            return "FMU_TARGET_SETTING"
         if self.struct == "input":
             return "FMU_TARGET_INPUT_ANGLE" if self.angle else "FMU_TARGET_INPUT_REAL"
         return "FMU_TARGET_RESULT_STATUS" if self.path == "status" else "FMU_TARGET_RESULT_REAL"
 
     @property
     def offset(self) -> str:
-        """The C expression of the member's offset in its struct."""
+        """The C expression of the member's offset in its struct; a setting's fmu_setting."""
+        if self.struct == "fmu":
+            return SETTINGS[self.path].c_name
         return self.kind.lives_offset(self)
 
     @property
     def field(self) -> str:
         """The dyad_field the solver names when it rejects the value."""
+        if self.struct == "fmu":
+            return "DYAD_FIELD_NONE"
         return self.kind.lives_field(self)
 
 
@@ -162,13 +176,24 @@ class Structs:
         match = LIVES_RE.fullmatch(text)
         if not match:
             raise ValueError(self.lives_syntax())
+        if match.group(1) == "fmu":
+            return self.resolve_setting(match.group(2), bool(match.group(3)))
         return self.resolve_lives(match.group(1), match.group(2), bool(match.group(3)))
+
+    def resolve_setting(self, path: str, angle: bool) -> Lives:
+        """`fmu.<setting>`: a setting of the FMU layer, the same in every kind."""
+        if path not in SETTINGS or angle:
+            raise ValueError(
+                f"the FMU layer has no setting '{path}{'@angle' if angle else ''}' "
+                f"(settings: {', '.join(SETTINGS)})"
+            )
+        return Lives("fmu", path, False, self)
 
     def lives_syntax(self) -> str:
         """What a `lives` of this kind looks like, for a message."""
         return (
-            f"expected 'input.<member of {self.input_type}>' or "
-            f"'result.<member of {self.output_type}>'"
+            f"expected 'input.<member of {self.input_type}>', "
+            f"'result.<member of {self.output_type}>' or 'fmu.<setting>'"
         )
 
     def resolve_lives(self, struct: str, path: str, angle: bool) -> Lives:

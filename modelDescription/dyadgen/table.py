@@ -34,7 +34,7 @@ from dyadgen.dyadtypes import UNITS
 from dyadgen.structs import Lives, Structs
 
 CAUSALITIES = ("input", "parameter", "output")
-VALUE_TYPES = ("Real", "Integer")
+VALUE_TYPES = ("Real", "Integer", "Enumeration")
 VARIABLE_KEYS = {
     "name",
     "vr",
@@ -343,6 +343,8 @@ class _Check:
                 self.bad(f"start is missing (every {causality} needs one)")
             elif not _finite(raw["start"]):
                 self.bad(f"start {raw['start']!r} must be a finite number")
+            elif raw["type"] == "Enumeration" and raw["start"] != int(raw["start"]):
+                self.bad(f"start {raw['start']!r} of an Enumeration must be an item's value")
         elif causality == "output" and has_start:
             self.bad("start is present, but an output is calculated and must not have one")
         if not self.bounds(raw, causality):

@@ -723,7 +723,7 @@ def test_a_chain_of_200_dyads_is_checked_generated_and_compiles(tmp_path):
     path = long_chain.write_chain(200, tmp_path)
     done = run_tool(path, "--check")
     assert done.returncode == 0, done.stderr
-    assert "chain200 (tailored): 1803 inputs, 3 parameters, 1604 outputs" in done.stdout
+    assert "chain200 (tailored): 1803 inputs, 4 parameters, 1604 outputs" in done.stdout
     out = tmp_path / "generated"
     assert run_tool(path, "--out", out).returncode == 0
     source = out / "chain200_scene.c"

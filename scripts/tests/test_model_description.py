@@ -174,6 +174,8 @@ def random_value(name, rng):
     }
     if leaf == "singular_threshold":
         return 1.4901161193847656e-08
+    if leaf == "on_singular":
+        return 1  # the FMU layer's setting: the solve never reads it
     lo, hi = ranges[leaf]
     return float(rng.uniform(lo, hi))
 
@@ -369,7 +371,7 @@ EXPECTED_UNIT = [  # by name pattern, independent of the generator's catalogue
     (r"link_[mn]\.(length|com\.[xy])", "m"),
     (r"link_[mn]\.mass", "kg"),
     (r"link_[mn]\.inertia", "kg.m2"),
-    (r"singular_threshold|conditioning|amplification|status", None),
+    (r"singular_threshold|on_singular|conditioning|amplification|status", None),
 ]
 BASE_UNITS = {
     "rad": {"rad": 1},
@@ -418,7 +420,7 @@ def expected_names(dyad_type):
         inputs.append("guide_k.angle")
     if d_n == "T":
         inputs.append("guide_p.angle")
-    params += ["gravity.x", "gravity.y", "singular_threshold"]
+    params += ["gravity.x", "gravity.y", "singular_threshold", "on_singular"]
     outputs = [f"R_{p}.{c}" for p in ("mk", "np", "mn") for c in "xy"]
     for p, kind in (("mk", d_m), ("np", d_n), ("mn", e)):
         if kind == "T":
@@ -526,8 +528,8 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
             else:
                 assert v.initial == "calculated" and v.start is None
                 assert v.variability == ("discrete" if v.name == "status" else "continuous")
-            want_type = ("Integer", "Int32") if v.name == "status" else ("Real", "Float64")
-            assert v.type in want_type, v.name
+            want_type = {"status": ("Integer", "Int32"), "on_singular": ("Enumeration",)}
+            assert v.type in want_type.get(v.name, ("Real", "Float64")), v.name
 
     # type-specific presence
     names = set(inputs + params + outputs)
@@ -622,7 +624,7 @@ def test_c_table_matches_the_table(generated, dyad_type):
     c_text = (generated[dyad_type] / f"{identifier(dyad_type)}_model.c").read_text()
     rows = re.findall(
         r'\{(\d+)u, "([^"]*)", "([^"]*)", (FMU_\w+), (FMU_\w+), (FMU_\w+), '
-        r"(offsetof\(\w+, [\w.]+\)|0),\s+(\S+), (\S+), (\S+), ([\w |]+)\}",
+        r"(offsetof\(\w+, [\w.]+\)|0|FMU_SETTING_\w+),\s+(\S+), (\S+), (\S+), ([\w |]+)\}",
         c_text,
     )
     feeds = {
@@ -643,6 +645,8 @@ def test_c_table_matches_the_table(generated, dyad_type):
             assert index not in feeds
         if v["name"] == "status":
             assert (target, offset) == ("FMU_TARGET_RESULT_STATUS", "0")
+        if v["name"] == "on_singular":
+            assert (target, offset) == ("FMU_TARGET_SETTING", "FMU_SETTING_ON_SINGULAR")
     vr_limit = len(raw["variable"]) + 1
     assert re.search(rf"index_of_vr, {vr_limit}, &fmu_dyad_behaviour, &dyad\}};", c_text)
     assert re.search(r"index_of_vr\[\d+\] = \{\s*-1, 0, 1, 2,", c_text)
@@ -1105,8 +1109,8 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
             else:
                 assert v.initial == "calculated" and v.start is None
                 assert v.variability == ("discrete" if v.name == "status" else "continuous")
-            want_type = ("Integer", "Int32") if v.name == "status" else ("Real", "Float64")
-            assert v.type in want_type, v.name
+            want_type = {"status": ("Integer", "Int32"), "on_singular": ("Enumeration",)}
+            assert v.type in want_type.get(v.name, ("Real", "Float64")), v.name
     by_name = {v.name: v for v in variables3}
     for name in ("motor.stall_torque", "motor.no_load_speed", "inertia", "crank.mass"):
         assert float(by_name[name].min) == 0 and by_name[name].max is None, name

@@ -93,9 +93,13 @@ def test_the_example_scene_has_the_variables_the_readme_names(tmp_path):
     path.write_text(scene.group(1) + "\n")
     done = _check_scene(path)
     assert done.returncode == 0, done.stderr
-    counts = re.search(r"(\d+) inputs, (\d+) parameters, (\d+) outputs", done.stdout + done.stderr)
+    counts = re.search(
+        r"(\d+) inputs?, (\d+) parameters?, (\d+) outputs?", done.stdout + done.stderr
+    )
     said = re.search(
-        r"(\d+) inputs \(.*?\),\s+(no|\d+)\s+parameters,\s+and\s+(\d+)\s+outputs", text, re.S
+        r"(\d+) inputs \(.*?\),\s+(no|\d+)\s+parameters?\b.*?,\s+and\s+(\d+)\s+outputs",
+        text,
+        re.S,
     )
     assert counts and said
     stated = tuple(0 if g == "no" else int(g) for g in said.groups())
@@ -120,7 +124,7 @@ def test_a_command_shown_runs_a_file_that_exists(document, command):
     program = ROOT / words[0]
     if words[0].startswith(".venv/bin/"):
         name = words[0].removeprefix(".venv/bin/")
-        assert name in ("python", "pip", "dyadfmu"), f"{document}: {command}"
+        assert name in ("python", "pip", "dyadfmu", "fmpy"), f"{document}: {command}"
         if name == "python" and len(words) > 1 and not words[1].startswith("-"):
             assert (ROOT / words[1]).is_file(), f"{document}: {command}"
         return

@@ -116,7 +116,7 @@ def test_cmake_stops_on_a_malformed_scene(tmp_path):
 def test_static_press_takes_no_motion_and_computes_no_inertia_or_weight():
     v = variables("press")
     assert v["input"] == ["crank.angle", "ram.force.x", "ram.force.y", "rod.angle"]
-    assert v["parameter"] == []
+    assert v["parameter"] == ["on_singular"]  # the FMU layer's setting alone
     assert v["output"] == ["press.N_mk", "press.R_np.x", "press.R_np.y", "crank.torque", "status"]
     code = (GENERATED / "press" / "press_scene.c").read_text()
     body = code[code.index("static void evaluate") :]
@@ -129,7 +129,7 @@ def test_static_press_takes_no_motion_and_computes_no_inertia_or_weight():
 def test_horizontal_monitor_has_no_weight_and_one_reaction():
     v = variables("monitor")
     assert v["output"] == ["agitator.R_mk.x", "agitator.R_mk.y", "status"]
-    assert v["parameter"] == ["rocker.mass"]
+    assert v["parameter"] == ["rocker.mass", "on_singular"]
     assert not any("gravity" in n for n in v["input"] + v["parameter"])
     code = (GENERATED / "monitor" / "monitor_scene.c").read_text()
     body = code[code.index("static void evaluate") :]
@@ -358,7 +358,7 @@ def test_the_readme_scene_builds_as_described(tmp_path):
     scene.write_text(found.group(1) + "\n")
     done = run_tool(scene, "--check")
     assert done.returncode == 0, done.stderr
-    assert "3 inputs, 0 parameters, 3 outputs" in done.stdout
+    assert "3 inputs, 1 parameter, 3 outputs" in done.stdout
     assert "scripts/build-scene my_press.toml" in readme
 
 

@@ -59,10 +59,13 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.check:
         n = table.counts()
-        print(
-            f"{scene.identifier} ({kind.label}): {n['input']} inputs, {n['parameter']} "
-            f"parameters, {n['output']} outputs"
-        )
+        counts = ", ".join(_counted(n[c], c) for c in ("input", "parameter", "output"))
+        print(f"{scene.identifier} ({kind.label}): {counts}")
         return 0
     write_files(args.out, outputs_of(table))
     return 0
+
+
+def _counted(count: int, noun: str) -> str:
+    """'1 parameter', '4 parameters'."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"

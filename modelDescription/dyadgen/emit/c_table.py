@@ -9,7 +9,7 @@ from dyadgen.emit.xmltext import num
 from dyadgen.table import Table, Variable
 
 _CAUSALITY = {"input": "FMU_INPUT", "parameter": "FMU_PARAMETER", "output": "FMU_OUTPUT"}
-_VALUE_TYPE = {"Real": "FMU_REAL", "Integer": "FMU_INTEGER"}
+_VALUE_TYPE = {"Real": "FMU_REAL", "Integer": "FMU_INTEGER", "Enumeration": "FMU_ENUMERATION"}
 
 
 def _bounds_flags(v: Variable) -> str:

@@ -11,7 +11,7 @@ from string import Template
 
 from dyadgen import textsafe
 from dyadgen.dyadtypes import MAY_BE_ZERO, PAIRS, TYPE_NOTES
-from dyadgen.emit.xmltext import num
+from dyadgen.emit.xmltext import num, settings_of
 from dyadgen.model import Attachment, Param, Scene
 from dyadgen.table import Table, Variable
 
@@ -41,6 +41,13 @@ def _fmt_bounds(v: Variable) -> str:
     return f"{lo}{lo_v}, {hi_v}{hi}"
 
 
+def _start_text(v: Variable) -> str:
+    """The start value as the model descriptions write it; none for an output."""
+    if v.start is None:
+        return ""
+    return str(int(v.start)) if v.type == "Enumeration" else num(v.start)
+
+
 def variable_rows(table: Table) -> str:
     """The table of every variable."""
     o = [
@@ -49,7 +56,7 @@ def variable_rows(table: Table) -> str:
         "<th>start</th><th>range</th><th>description</th></tr>",
     ]
     for v in table.variables:
-        start = num(v.start) if v.start is not None else ""
+        start = _start_text(v)
         o.append(
             f'<tr><td class="num">{v.vr}</td><td><code>{h(v.name)}</code></td>'
             f"<td>{v.causality}</td><td>{v.type}</td><td>{h(v.unit or '-')}</td>"
@@ -58,6 +65,24 @@ def variable_rows(table: Table) -> str:
         )
     o.append("</table>")
     return "\n".join(o)
+
+
+def settings_section(table: Table) -> str:
+    """A section per setting of the FMU layer: its items and what each does."""
+    parts = []
+    for s in settings_of(table):
+        rows = "".join(
+            f'<tr><td class="num">{i.value}</td><td><code>{h(i.name)}</code></td>'
+            f"<td>{h(i.description)}</td></tr>"
+            for i in s.items
+        )
+        parts.append(
+            f"<h2><code>{h(s.name)}</code></h2>\n<p>{h(s.description)}. A fixed parameter of "
+            f"declared type <code>{h(s.type_name)}</code>, set through <code>fmi2SetInteger</code>"
+            f" or <code>fmi3SetInt64</code>; any other value is refused with Error.</p>\n"
+            f"<table><tr><th>value</th><th>item</th><th>doStep</th></tr>{rows}</table>"
+        )
+    return "\n".join(parts)
 
 
 def page(name: str, table: Table, **values: object) -> str:
@@ -76,6 +101,7 @@ def page(name: str, table: Table, **values: object) -> str:
         description=h(table.description),
         variables=variables,
         variable_section=section,
+        settings=settings_section(table),
         **values,
     )
 

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 from dyadgen.emit.xmltext import (
     element,
+    enumeration_attributes,
+    item_elements,
     model_description_text,
     root_attributes,
+    settings_of,
     typed_attributes,
     variable_attributes,
 )
@@ -43,10 +46,29 @@ def _variables(table: Table) -> list[str]:
         lines.append(element(2, "ScalarVariable", variable_attributes(v), close=False))
         if v.type == "Integer":
             lines.append("      <Integer/>")
+        elif v.type == "Enumeration":
+            lines.append(element(3, "Enumeration", enumeration_attributes(v)))
         else:
             lines.append(element(3, "Real", typed_attributes(v, unit_first=False)))
         lines.append("    </ScalarVariable>")
     lines.append("  </ModelVariables>")
+    return lines
+
+
+def _type_definitions(table: Table) -> list[str]:
+    """A <SimpleType> with the <Enumeration> of each setting."""
+    settings = settings_of(table)
+    if not settings:
+        return []
+    lines = ["  <TypeDefinitions>"]
+    for s in settings:
+        attrs = [("name", s.type_name), ("description", s.type_description)]
+        lines.append(element(2, "SimpleType", attrs, close=False))
+        lines.append("      <Enumeration>")
+        lines += item_elements(4, s)
+        lines.append("      </Enumeration>")
+        lines.append("    </SimpleType>")
+    lines.append("  </TypeDefinitions>")
     return lines
 
 
@@ -70,4 +92,6 @@ def model_description(table: Table) -> str:
     root = root_attributes(table, "2.0", "guid")
     root.append(("numberOfEventIndicators", "0"))
     model = _variables(table) + _structure(table)
-    return model_description_text(table, root, _cosimulation(table), model)
+    return model_description_text(
+        table, root, _cosimulation(table), _type_definitions(table), model
+    )

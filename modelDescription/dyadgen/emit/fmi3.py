@@ -4,13 +4,19 @@ from __future__ import annotations
 
 from dyadgen.emit.xmltext import (
     element,
+    enumeration_attributes,
     header,
+    item_elements,
     model_description_text,
     root_attributes,
+    settings_of,
     typed_attributes,
     variable_attributes,
 )
 from dyadgen.table import Table
+
+#: The FMI 3 element of each table type.
+_ELEMENT = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Enumeration"}
 
 
 def _cosimulation(table: Table) -> str:
@@ -48,9 +54,27 @@ def _variables(table: Table) -> list[str]:
         )
     )
     for v in table.variables:
-        attrs = variable_attributes(v) + typed_attributes(v, unit_first=True)
-        lines.append(element(2, "Int32" if v.type == "Integer" else "Float64", attrs))
+        if v.type == "Enumeration":
+            attrs = variable_attributes(v) + enumeration_attributes(v)
+        else:
+            attrs = variable_attributes(v) + typed_attributes(v, unit_first=True)
+        lines.append(element(2, _ELEMENT[v.type], attrs))
     lines.append("  </ModelVariables>")
+    return lines
+
+
+def _type_definitions(table: Table) -> list[str]:
+    """An <EnumerationType> for each setting."""
+    settings = settings_of(table)
+    if not settings:
+        return []
+    lines = ["  <TypeDefinitions>"]
+    for s in settings:
+        attrs = [("name", s.type_name), ("description", s.type_description)]
+        lines.append(element(2, "EnumerationType", attrs, close=False))
+        lines += item_elements(3, s)
+        lines.append("    </EnumerationType>")
+    lines.append("  </TypeDefinitions>")
     return lines
 
 
@@ -70,7 +94,9 @@ def model_description(table: Table) -> str:
     """fmi3/modelDescription.xml."""
     root = root_attributes(table, "3.0", "instantiationToken")
     model = _variables(table) + _structure(table)
-    return model_description_text(table, root, [_cosimulation(table)], model)
+    return model_description_text(
+        table, root, [_cosimulation(table)], _type_definitions(table), model
+    )
 
 
 def build_description(table: Table) -> str:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dyadgen import textsafe
 from dyadgen.dyadtypes import BASE_UNIT_ORDER, DISPLAY_UNITS, UNITS
+from dyadgen.settings import Setting
 from dyadgen.table import Table, Variable
 
 GENERATION_TOOL = "dyadfmu generate.py"
@@ -58,14 +59,17 @@ def model_description_text(
     table: Table,
     root: list[tuple[str, object]],
     cosimulation: list[str],
+    types: list[str],
     model: list[str],
 ) -> str:
-    """A whole modelDescription.xml: the root, the version's <CoSimulation>, what both
-    versions write alike, then the version's variables and structure (model)."""
+    """A whole modelDescription.xml: the root, the version's <CoSimulation>, the units,
+    the version's type definitions (types), what both versions write alike, then the
+    version's variables and structure (model)."""
     lines = header(table)
     lines.append(element(0, "fmiModelDescription", root, close=False, wrap=True))
     lines += cosimulation
     lines += unit_definitions(table)
+    lines += types
     lines += common_tail(table)
     lines += model
     lines.append("</fmiModelDescription>")
@@ -102,6 +106,27 @@ def common_tail(table: Table) -> list[str]:
     lines.append("  </LogCategories>")
     lines.append('  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>')
     return lines
+
+
+def settings_of(table: Table) -> list[Setting]:
+    """The FMU layer's settings among the table's variables, whose enumeration types
+    the model descriptions declare."""
+    return [v.lives.setting for v in table.variables if v.lives.setting is not None]
+
+
+def item_elements(indent: int, setting: Setting) -> list[str]:
+    """The <Item>s of a setting's enumeration."""
+    return [
+        element(
+            indent, "Item", [("name", i.name), ("value", i.value), ("description", i.description)]
+        )
+        for i in setting.items
+    ]
+
+
+def enumeration_attributes(v: Variable) -> list[tuple[str, object]]:
+    """declaredType and start of an Enumeration (its items bound it)."""
+    return [("declaredType", v.lives.setting.type_name), ("start", int(v.start))]
 
 
 def variability(v: Variable) -> str:

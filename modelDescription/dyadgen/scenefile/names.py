@@ -21,7 +21,15 @@ NAME = re.compile(r"[a-z][a-z0-9_]*")
 #: be significant, and every file name (<identifier>_fmi3.fmu) far below 255 bytes.
 MAX_NAME = 40
 #: Names with a meaning in a scene: they cannot name a crank, dyad or link.
-RESERVED = {"frame", "external", "gravity", "singular_threshold", "status", "time"}
+RESERVED = {
+    "frame",
+    "external",
+    "gravity",
+    "on_singular",
+    "singular_threshold",
+    "status",
+    "time",
+}
 #: Prefixes of the core's, the FMU layer's and the FMI standard's C names: no name may
 #: start with one (nor be the prefix without its underscore, 'dyad' or 'fmu').
 RESERVED_PREFIXES = ("dyad_", "fmu_", "fmi2", "fmi3")
