@@ -20,6 +20,7 @@ from dyadgen.catalogue import (
     drive_catalogue,
     dyad_absence_reason,
     dyad_catalogue,
+    setting_entry,
 )
 from dyadgen.dyadtypes import PAIRS
 from dyadgen.emit import documentation, fmi2, fmi3
@@ -27,7 +28,7 @@ from dyadgen.emit.c_table import model_c
 from dyadgen.emit.scene_c import scene_c, scene_header
 from dyadgen.model import Input, Param, Scene
 from dyadgen.scenefile.problems import SceneError
-from dyadgen.settings import ON_SINGULAR, Setting
+from dyadgen.settings import ON_SINGULAR
 from dyadgen.structs import (
     DRIVE_INPUT_MEMBERS,
     DRIVE_OUTPUT_MEMBERS,
@@ -439,21 +440,6 @@ def _settable_row(
     _bounds(raw, settable.domain)
 
 
-def _setting_row(rows: list, setting: Setting) -> None:
-    """The row of a setting of the FMU layer: an Enumeration parameter."""
-    raw = _row(
-        rows,
-        setting.name,
-        "parameter",
-        None,
-        type="Enumeration",
-        start=setting.start,
-        description=setting.description,
-        lives=setting.lives,
-    )
-    _bounds(raw, setting.domain)
-
-
 def _scene_rows(scene: Scene) -> list[dict]:
     """The rows of a tailored scene's table: its inputs, tunable parameters, outputs."""
     rows: list[dict] = []
@@ -462,7 +448,7 @@ def _scene_rows(scene: Scene) -> list[dict]:
     for prm in scene.parameters():
         if prm.tunable:
             _settable_row(rows, prm, "parameter", prm.value, f"input.{prm.member}")
-    _setting_row(rows, ON_SINGULAR)
+    rows.append(entry_row(setting_entry(ON_SINGULAR), len(rows) + 1, ON_SINGULAR.start))
     for o in scene.outputs:
         _row(
             rows,
@@ -500,6 +486,21 @@ def is_generic(scene: Scene) -> bool:
     )
 
 
+def entry_row(entry: Entry, vr: int, start: float | None) -> dict:
+    """The table row (as a table file holds it) of a catalogue entry."""
+    raw = {"name": entry.name, "vr": vr, "causality": entry.causality, "type": entry.value_type}
+    if entry.unit:
+        raw["unit"] = entry.unit
+    if start is not None:
+        raw["start"] = start
+    raw.update((key, value) for key, value in entry.domain.items() if value is not False)
+    raw["description"] = entry.description
+    raw["lives"] = entry.lives
+    if entry.causality == "output":
+        raw["depends"] = list(entry.depends)
+    return raw
+
+
 def generic_data(scene: Scene) -> dict:
     """The variable table (as a table file holds it) of a generic scene."""
     d = scene.dyads[0]
@@ -507,26 +508,13 @@ def generic_data(scene: Scene) -> dict:
     starts = {i.name: i.start for i in scene.inputs}
     rows = []
     for entry in dyad_catalogue(d.type).values():
-        raw = {
-            "name": entry.name,
-            "vr": len(rows) + 1,
-            "causality": entry.causality,
-            "type": entry.value_type,
-        }
-        if entry.unit:
-            raw["unit"] = entry.unit
         if entry.start is not None:
-            raw["start"] = entry.start
+            start = entry.start
         elif entry.causality == "input":
-            raw["start"] = starts[entry.name]
-        elif entry.causality == "parameter":
-            raw["start"] = params[entry.name].value
-        raw.update((key, value) for key, value in entry.domain.items() if value is not False)
-        raw["description"] = entry.description
-        raw["lives"] = entry.lives
-        if entry.causality == "output":
-            raw["depends"] = list(entry.depends)
-        rows.append(raw)
+            start = starts[entry.name]
+        else:
+            start = params[entry.name].value if entry.causality == "parameter" else None
+        rows.append(entry_row(entry, len(rows) + 1, start))
     model = {"type": d.type, "identifier": scene.identifier, "description": scene.description}
     return {"model": model, "variable": rows}
 
