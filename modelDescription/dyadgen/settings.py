@@ -40,11 +40,6 @@ class Setting:
         values = [item.value for item in self.items]
         return {"min": float(min(values)), "max": float(max(values))}
 
-    def item_list(self) -> str:
-        """The items as a message names them: '1 (discard) or 2 (continue)'."""
-        named = [f"{item.value} ({item.name})" for item in self.items]
-        return ", ".join(named[:-1]) + " or " + named[-1]
-
 
 ON_SINGULAR = Setting(
     name="on_singular",
