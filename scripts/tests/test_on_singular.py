@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from dyadfmu.fmi.slave import Slave, SlaveError
 from fmpy import read_model_description
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -137,3 +138,26 @@ def test_every_fmu_but_the_drive_declares_on_singular():
         ), path.name
         items = {i.name: int(i.value) for i in v.declaredType.items}
         assert items == {"discard": 1, "continue": 2}, path.name
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_the_python_slave_sets_and_reads_on_singular(version):
+    """dyadfmu's own wrapper takes on_singular among the parameters, by its item's value;
+    the singular step then goes on, where by default it raises."""
+    rod = "link_n.angle"
+    default = Slave(fmu("dyad_rrt", version), instance_name="default")
+    default.initialize({"link_m.mass": 2.0})
+    default.set(rod, math.pi / 2)
+    with pytest.raises(SlaveError):
+        default.do_step(0.0, STEP)
+    goes_on = Slave(fmu("dyad_rrt", version), instance_name="continue")
+    goes_on.initialize({"link_m.mass": 2.0, "on_singular": 2})
+    assert goes_on.get("on_singular") == 2 and goes_on.get("link_m.mass") == 2.0
+    goes_on.set(rod, math.pi / 2)
+    goes_on.do_step(0.0, STEP)
+    assert goes_on.get_status() == 1 and math.isnan(goes_on.get("R_np.x"))
+    goes_on.set(rod, 0.4)
+    goes_on.do_step(STEP, STEP)
+    assert goes_on.get_status() == 0 and math.isfinite(goes_on.get("R_np.x"))
+    default.close()
+    goes_on.close()

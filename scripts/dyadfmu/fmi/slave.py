@@ -101,9 +101,11 @@ class Slave:
         if self.version == 2:
             self._set, self._get = self.fmu.setReal, self.fmu.getReal
             self._get_int = self.fmu.getInteger
+            self._set_item, self._get_item = self.fmu.setInteger, self.fmu.getInteger
         else:
             self._set, self._get = self.fmu.setFloat64, self.fmu.getFloat64
             self._get_int = self.fmu.getInt32
+            self._set_item, self._get_item = self.fmu.setInt64, self.fmu.getInt64
 
     # ---- logging -----------------------------------------------------------
     def _log(self, status: int, category: object, message: object) -> None:
@@ -175,17 +177,32 @@ class Slave:
         self._call("exitInitializationMode", self.fmu.exitInitializationMode)
 
     def set(self, names: tuple | str, values: Sequence[float] | float) -> None:
-        """Set real variables: a tuple of names and their values, or one name and a value."""
+        """Set variables: a tuple of names and their values, or one name and a value. Reals,
+        and Enumerations (``on_singular``) by their items' values."""
         if isinstance(names, str):
             names, values = (names,), (values,)
-        self._call("set", self._set, self._refs(names), [float(v) for v in values])
+        if not any(self._is_item(n) for n in names):
+            self._call("set", self._set, self._refs(names), [float(v) for v in values])
+            return
+        pairs = list(zip(names, values, strict=True))
+        items = [(n, int(v)) for n, v in pairs if self._is_item(n)]
+        reals = [(n, float(v)) for n, v in pairs if not self._is_item(n)]
+        for setter, chosen in ((self._set_item, items), (self._set, reals)):
+            if chosen:
+                refs = self._refs(tuple(n for n, _ in chosen))
+                self._call("set", setter, refs, [v for _, v in chosen])
+
+    def _is_item(self, name: str) -> bool:
+        return self.types.get(name) == "Enumeration"
 
     def get(self, names: tuple | str) -> list | float | int:
         """Real variables by a tuple of names (a list), or one variable by name (a number;
-        an integer for integer variables such as ``status``)."""
+        an integer for integer variables such as ``status`` and Enumerations)."""
         if isinstance(names, str):
             if self.types.get(names) in _INTEGER_TYPES:
                 return int(self._call("get", self._get_int, self._refs((names,)))[0])
+            if self._is_item(names):
+                return int(self._call("get", self._get_item, self._refs((names,)))[0])
             return self._call("get", self._get, self._refs((names,)))[0]
         return self._call("get", self._get, self._refs(names))
 
