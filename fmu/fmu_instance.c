@@ -925,7 +925,11 @@ static int set_by_plan(fmu_instance* instance, size_t count, const double values
     if (!all_within(values, plan->low, plan->high, count)) {
         return 0;
     }
-    for (k = 0; k < count; ++k) {
+    for (k = 0; k + 2 <= count; k += 2) { /* in order: a repeated reference keeps its last */
+        *plan->write[k] = values[k];
+        *plan->write[k + 1] = values[k + 1];
+    }
+    if (k < count) {
         *plan->write[k] = values[k];
     }
     instance->angles_pending |= instance->angle_count > 0;
@@ -1012,7 +1016,11 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
         /* after a step, the same outputs again: read where the plan says */
         const double** read = instance->get_plan.read;
         size_t k;
-        for (k = 0; k < count; ++k) {
+        for (k = 0; k + 2 <= count; k += 2) {
+            values[k] = *read[k];
+            values[k + 1] = *read[k + 1];
+        }
+        if (k < count) {
             values[k] = *read[k];
         }
         return FMU_OK;
