@@ -69,7 +69,7 @@ void dyad_link_resultant(const dyad_link* link, dyad_vec2 gravity, dyad_vec2* fo
                          dyad_real* moment);
 
 /** cos(angle) and sin(angle) (-) of `angle` (rad) as the FMUs convert a link
- *  angle to its direction (dyadfmu/angle.h): within about 2.2e-16 of the true
+ *  angle to its direction (dyadfmu/angle.h): within about 1.1e-16 of the true
  *  values, in double whatever the library's scalar. */
 void dyad_angle_cos_sin(double angle, double* cos_out, double* sin_out);
 
