@@ -5,10 +5,9 @@ from __future__ import annotations
 from dyadgen.emit.xmltext import (
     element,
     enumeration_attributes,
-    item_elements,
     model_description_text,
     root_attributes,
-    settings_of,
+    type_definitions,
     typed_attributes,
     variable_attributes,
 )
@@ -55,23 +54,6 @@ def _variables(table: Table) -> list[str]:
     return lines
 
 
-def _type_definitions(table: Table) -> list[str]:
-    """A <SimpleType> with the <Enumeration> of each setting."""
-    settings = settings_of(table)
-    if not settings:
-        return []
-    lines = ["  <TypeDefinitions>"]
-    for s in settings:
-        attrs = [("name", s.type_name), ("description", s.type_description)]
-        lines.append(element(2, "SimpleType", attrs, close=False))
-        lines.append("      <Enumeration>")
-        lines += item_elements(4, s)
-        lines.append("      </Enumeration>")
-        lines.append("    </SimpleType>")
-    lines.append("  </TypeDefinitions>")
-    return lines
-
-
 def _structure(table: Table) -> list[str]:
     index = {v.name: v.index + 1 for v in table.variables}  # 1-based, FMI 2
     lines = ["  <ModelStructure>", "    <Outputs>"]
@@ -93,5 +75,9 @@ def model_description(table: Table) -> str:
     root.append(("numberOfEventIndicators", "0"))
     model = _variables(table) + _structure(table)
     return model_description_text(
-        table, root, _cosimulation(table), _type_definitions(table), model
+        table,
+        root,
+        _cosimulation(table),
+        type_definitions(table, ("SimpleType", "Enumeration")),
+        model,
     )

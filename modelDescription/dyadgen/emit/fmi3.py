@@ -6,10 +6,9 @@ from dyadgen.emit.xmltext import (
     element,
     enumeration_attributes,
     header,
-    item_elements,
     model_description_text,
     root_attributes,
-    settings_of,
+    type_definitions,
     typed_attributes,
     variable_attributes,
 )
@@ -63,21 +62,6 @@ def _variables(table: Table) -> list[str]:
     return lines
 
 
-def _type_definitions(table: Table) -> list[str]:
-    """An <EnumerationType> for each setting."""
-    settings = settings_of(table)
-    if not settings:
-        return []
-    lines = ["  <TypeDefinitions>"]
-    for s in settings:
-        attrs = [("name", s.type_name), ("description", s.type_description)]
-        lines.append(element(2, "EnumerationType", attrs, close=False))
-        lines += item_elements(3, s)
-        lines.append("    </EnumerationType>")
-    lines.append("  </TypeDefinitions>")
-    return lines
-
-
 def _structure(table: Table) -> list[str]:
     vr_of = {v.name: v.vr for v in table.variables}
     lines = ["  <ModelStructure>"]
@@ -95,7 +79,7 @@ def model_description(table: Table) -> str:
     root = root_attributes(table, "3.0", "instantiationToken")
     model = _variables(table) + _structure(table)
     return model_description_text(
-        table, root, [_cosimulation(table)], _type_definitions(table), model
+        table, root, [_cosimulation(table)], type_definitions(table, ("EnumerationType",)), model
     )
 
 

@@ -114,14 +114,29 @@ def settings_of(table: Table) -> list[Setting]:
     return [v.lives.setting for v in table.variables if v.lives.setting is not None]
 
 
-def item_elements(indent: int, setting: Setting) -> list[str]:
-    """The <Item>s of a setting's enumeration."""
-    return [
-        element(
-            indent, "Item", [("name", i.name), ("value", i.value), ("description", i.description)]
-        )
-        for i in setting.items
-    ]
+def type_definitions(table: Table, tags: tuple[str, ...]) -> list[str]:
+    """<TypeDefinitions> with each setting's enumeration: its items inside the nested
+    elements `tags`, the first named for the setting's type (FMI 2: SimpleType and
+    Enumeration; FMI 3: EnumerationType). None where the table has no setting."""
+    settings = settings_of(table)
+    if not settings:
+        return []
+    lines = ["  <TypeDefinitions>"]
+    for s in settings:
+        named = [("name", s.type_name), ("description", s.type_description)]
+        for depth, tag in enumerate(tags):
+            lines.append(element(2 + depth, tag, named if depth == 0 else [], close=False))
+        lines += [
+            element(
+                2 + len(tags),
+                "Item",
+                [("name", i.name), ("value", i.value), ("description", i.description)],
+            )
+            for i in s.items
+        ]
+        lines += [f"{'  ' * (2 + depth)}</{tag}>" for depth, tag in reversed(list(enumerate(tags)))]
+    lines.append("  </TypeDefinitions>")
+    return lines
 
 
 def enumeration_attributes(v: Variable) -> list[tuple[str, object]]:
