@@ -121,7 +121,8 @@ static void store(fmu_instance* instance, size_t index, double value)
     }
 }
 
-/* The (cos, sin) of every angle that changed since the model last read them. */
+/* The (cos, sin) of every angle that changed since the model last read them, two at
+ * a time (both again where one of the two changed: as cheap as one alone). */
 static void sync_angles(fmu_instance* instance)
 {
     fmu_angle* a = instance->angles;
@@ -129,11 +130,16 @@ static void sync_angles(fmu_instance* instance)
     if (!instance->angles_pending) {
         return;
     }
-    for (; a < end; ++a) {
-        if (*a->angle != a->converted) {
-            a->converted = *a->angle;
-            dyad_cos_sin(a->converted, &a->unit[0], &a->unit[1]);
+    for (; end - a >= 2; a += 2) {
+        if (*a[0].angle != a[0].converted || *a[1].angle != a[1].converted) {
+            a[0].converted = *a[0].angle;
+            a[1].converted = *a[1].angle;
+            dyad_cos_sin_pair(a[0].converted, a[1].converted, a[0].unit, a[1].unit);
         }
+    }
+    if (a < end && *a->angle != a->converted) {
+        a->converted = *a->angle;
+        dyad_cos_sin(a->converted, &a->unit[0], &a->unit[1]);
     }
     instance->angles_pending = 0;
 }
@@ -360,6 +366,13 @@ void fmu_free(fmu_instance* instance)
     }
 }
 
+/* Whether a call may take the common path: legal now, and not one to log. */
+static int quiet_call(const fmu_instance* instance, fmu_operation operation)
+{
+    return (legal_states[operation] & (unsigned)instance->state) &&
+           !(instance->log_categories & (1u << LOG_CALLS));
+}
+
 fmu_status fmu_check_call(fmu_instance* instance, fmu_operation operation, const char* function)
 {
     if (instance == NULL) {
@@ -423,7 +436,8 @@ fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time)
 /* ---- the solve ------------------------------------------------------------------------------ */
 
 /* Logs why the last evaluation failed. */
-static void log_failure(fmu_instance* instance, fmu_status not_solvable, const char* function)
+FMU_COLD static void log_failure(fmu_instance* instance, fmu_status not_solvable,
+                                 const char* function)
 {
     const fmu_evaluation* e = &instance->evaluation;
     if (e->status == FMU_ERROR && e->bad_variable >= 0) {
@@ -491,12 +505,19 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
     return status;
 }
 
-/* Refuses a step whose size is not positive or whose end is not a later finite
- * time: a sum that overflows would leave the instance at an infinite time, one
- * below the resolution of double at current_time would advance the states but
- * not the time. */
-static fmu_status check_step(fmu_instance* instance, double current_time, double step_size,
-                             const char* function)
+/* Whether a step may be taken: a positive size and a later finite end. A sum that
+ * overflows would leave the instance at an infinite time, one below the resolution
+ * of double at current_time would advance the states but not the time. */
+static int step_is_valid(double current_time, double step_size)
+{
+    const double end = current_time + step_size;
+    return fabs(current_time) <= DBL_MAX && step_size > 0 && step_size <= DBL_MAX &&
+           fabs(end) <= DBL_MAX && end > current_time;
+}
+
+/* Refuses, with the reason, a step that step_is_valid does not take. */
+FMU_COLD static fmu_status check_step(fmu_instance* instance, double current_time, double step_size,
+                                      const char* function)
 {
     if (!isfinite(current_time) || !isfinite(step_size) || !(step_size > 0)) {
         fmu_log(instance, FMU_ERROR,
@@ -505,7 +526,7 @@ static fmu_status check_step(fmu_instance* instance, double current_time, double
                 function, current_time, step_size);
         return FMU_ERROR;
     }
-    if (!isfinite(current_time + step_size) || !(current_time + step_size > current_time)) {
+    if (!step_is_valid(current_time, step_size)) {
         fmu_log(instance, FMU_ERROR,
                 "%s: currentCommunicationPoint = %.17g s + communicationStepSize = %.17g s "
                 "= %.17g s is not a finite time after the current one",
@@ -557,8 +578,10 @@ static int continues(const fmu_instance* instance)
     return instance->on_singular != NULL && *instance->on_singular == FMU_ON_SINGULAR_CONTINUE;
 }
 
-fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
-                       const char* function)
+/* A step the common path did not take: a checked call, a model with states, or a
+ * step without an answer. */
+FMU_COLD static fmu_status do_step_checked(fmu_instance* instance, double current_time,
+                                           double step_size, const char* function)
 {
     fmu_status status = fmu_check_call(instance, FMU_OP_DO_STEP, function);
     if (status != FMU_OK) {
@@ -584,6 +607,34 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
         instance->terminate_requested = 1;
     }
     return status;
+}
+
+fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
+                       const char* function)
+{
+    /* the common case: an algebraic model whose new inputs have an answer */
+    if (instance != NULL && quiet_call(instance, FMU_OP_DO_STEP) &&
+        instance->model->behaviour->advance == NULL && step_is_valid(current_time, step_size)) {
+        fmu_evaluation* e = &instance->evaluation;
+        if (instance->dirty) {
+            sync_angles(instance);
+            instance->model->behaviour->evaluate(instance->model, instance->input, instance->output,
+                                                 e);
+            if (e->status != FMU_OK) {
+                /* found now: do_step_checked logs it, once, and decides */
+                instance->dirty = 1;
+                return do_step_checked(instance, current_time, step_size, function);
+            }
+            instance->dirty = 0;
+        }
+        if (e->status == FMU_OK) {
+            instance->time = current_time + step_size;
+            instance->last_successful_time = instance->time;
+            instance->terminate_requested = 0;
+            return FMU_OK;
+        }
+    }
+    return do_step_checked(instance, current_time, step_size, function);
 }
 
 fmu_status fmu_terminate(fmu_instance* instance)
@@ -917,23 +968,71 @@ static int all_within(const double values[], const double low[], const double hi
     return within;
 }
 
+/* 1 if every value is finite: their products with 0 add up to 0, where an infinity
+ * or a NaN makes the sum NaN. Three instructions a pair instead of eight for
+ * all_within, for a plan whose values have no bounds but the finite doubles. */
+static int all_finite(const double values[], size_t count)
+{
+    size_t k = 0;
+    double sum = 0;
+#if defined(__SSE2__)
+    const __m128d zero = _mm_setzero_pd();
+    __m128d sums[2];
+    sums[0] = zero;
+    sums[1] = zero;
+    for (; k + 4 <= count; k += 4) {
+        sums[0] = _mm_add_pd(sums[0], _mm_mul_pd(_mm_loadu_pd(values + k), zero));
+        sums[1] = _mm_add_pd(sums[1], _mm_mul_pd(_mm_loadu_pd(values + k + 2), zero));
+    }
+    sums[0] = _mm_add_pd(sums[0], sums[1]);
+    sum = _mm_cvtsd_f64(_mm_add_sd(sums[0], _mm_unpackhi_pd(sums[0], sums[0])));
+#endif
+    for (; k + 2 <= count; k += 2) {
+        sum += values[k] * 0.0 + values[k + 1] * 0.0;
+    }
+    if (k < count) {
+        sum += values[k] * 0.0;
+    }
+    return sum == 0;
+}
+
 /* A set by the plan: every value checked, then every one stored. */
 static int set_by_plan(fmu_instance* instance, size_t count, const double values[])
 {
     const fmu_plan* plan = &instance->set_plan;
-    size_t k;
-    if (!all_within(values, plan->low, plan->high, count)) {
+    double* const* write = plan->write;
+    size_t k = 0;
+    if (!(plan->finite_only ? all_finite(values, count)
+                            : all_within(values, plan->low, plan->high, count))) {
         return 0;
     }
-    for (k = 0; k + 2 <= count; k += 2) { /* in order: a repeated reference keeps its last */
-        *plan->write[k] = values[k];
-        *plan->write[k + 1] = values[k + 1];
+    /* in order: a repeated reference keeps its last value */
+    for (; k + 4 <= count; k += 4) {
+        *write[k] = values[k];
+        *write[k + 1] = values[k + 1];
+        *write[k + 2] = values[k + 2];
+        *write[k + 3] = values[k + 3];
     }
-    if (k < count) {
-        *plan->write[k] = values[k];
+    for (; k < count; ++k) {
+        *write[k] = values[k];
     }
     instance->angles_pending |= instance->angle_count > 0;
     return 1;
+}
+
+/* A get by the plan: each value from where it is kept. */
+static void get_by_plan(const fmu_plan* plan, size_t count, double values[])
+{
+    const double* const* read = plan->read;
+    size_t k = 0;
+#if defined(__SSE2__)
+    for (; k + 2 <= count; k += 2) {
+        _mm_storeu_pd(values + k, _mm_loadh_pd(_mm_load_sd(read[k]), read[k + 1]));
+    }
+#endif
+    if (k < count) {
+        values[k] = *read[k];
+    }
 }
 
 /* A plan of a call the slots accepted (every vr below vr_limit), none for a call
@@ -941,6 +1040,7 @@ static int set_by_plan(fmu_instance* instance, size_t count, const double values
 static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsigned int vr[],
                       size_t count)
 {
+    int finite_only = 1;
     size_t k;
     plan->count = 0;
     if (count > instance->model->vr_limit) {
@@ -953,32 +1053,40 @@ static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsign
         plan->high[k] = slot->high;
         plan->write[k] = slot->write;
         plan->read[k] = slot->read;
+        finite_only &= slot->low == -DBL_MAX && slot->high == DBL_MAX;
     }
+    plan->finite_only = finite_only;
     plan->count = count;
+}
+
+/* A set of Reals the common path did not take: checked call, and a new plan or a
+ * refusal that names the value. */
+FMU_COLD static fmu_status set_reals_checked(fmu_instance* instance, const unsigned int vr[],
+                                             size_t count, const double values[],
+                                             const char* function)
+{
+    if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    if (count > 0 && vr != NULL && values != NULL &&
+        set_reals_at_once(instance, vr, count, values)) {
+        make_plan(instance, &instance->set_plan, vr, count);
+        after_set(instance);
+        return FMU_OK;
+    }
+    return set_values(instance, vr, count, values, reals, function);
 }
 
 fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t count,
                         const double values[], const char* function)
 {
-    if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK) {
-        return FMU_ERROR;
+    /* the common case: the same references as the last set, every value valid */
+    if (instance != NULL && vr != NULL && values != NULL && quiet_call(instance, FMU_OP_SET) &&
+        plan_fits(&instance->set_plan, vr, count) && set_by_plan(instance, count, values)) {
+        after_set(instance);
+        return FMU_OK;
     }
-    if (count > 0 && vr != NULL && values != NULL) {
-        int accepted;
-        if (plan_fits(&instance->set_plan, vr, count)) {
-            accepted = set_by_plan(instance, count, values);
-        } else {
-            accepted = set_reals_at_once(instance, vr, count, values);
-            if (accepted) {
-                make_plan(instance, &instance->set_plan, vr, count);
-            }
-        }
-        if (accepted) {
-            after_set(instance);
-            return FMU_OK;
-        }
-    }
-    return set_values(instance, vr, count, values, reals, function);
+    return set_reals_checked(instance, vr, count, values, function);
 }
 
 fmu_status fmu_set_integer(fmu_instance* instance, const unsigned int vr[], size_t count,
@@ -1001,35 +1109,34 @@ fmu_status fmu_set_int64(fmu_instance* instance, const unsigned int vr[], size_t
     return set_values(instance, vr, count, values, access, function);
 }
 
-fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
-                        double values[], const char* function)
+/* A get of Reals the common path did not take: checked call, a solve where an output
+ * needs one, and a new plan or the reason a value reference is refused. */
+FMU_COLD static fmu_status get_reals_checked(fmu_instance* instance, const unsigned int vr[],
+                                             size_t count, double values[], const char* function)
 {
     fmu_status solved = FMU_OK;
     if (fmu_check_call(instance, FMU_OP_GET, function) != FMU_OK) {
         return FMU_ERROR;
     }
-    if (vr == NULL || values == NULL) {
-        return get_values(instance, vr, count, values, reals, 1, function);
-    }
-    if (!instance->dirty && instance->evaluation.status == FMU_OK &&
-        plan_fits(&instance->get_plan, vr, count)) {
-        /* after a step, the same outputs again: read where the plan says */
-        const double** read = instance->get_plan.read;
-        size_t k;
-        for (k = 0; k + 2 <= count; k += 2) {
-            values[k] = *read[k];
-            values[k + 1] = *read[k + 1];
-        }
-        if (k < count) {
-            values[k] = *read[k];
-        }
-        return FMU_OK;
-    }
-    if (get_reals_at_once(instance, vr, count, values, &solved, function)) {
+    if (vr != NULL && values != NULL &&
+        get_reals_at_once(instance, vr, count, values, &solved, function)) {
         make_plan(instance, &instance->get_plan, vr, count);
         return solved;
     }
     return get_values(instance, vr, count, values, reals, 1, function);
+}
+
+fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t count,
+                        double values[], const char* function)
+{
+    /* the common case: after a step, the same references as the last get */
+    if (instance != NULL && vr != NULL && values != NULL && quiet_call(instance, FMU_OP_GET) &&
+        !instance->dirty && instance->evaluation.status == FMU_OK &&
+        plan_fits(&instance->get_plan, vr, count)) {
+        get_by_plan(&instance->get_plan, count, values);
+        return FMU_OK;
+    }
+    return get_reals_checked(instance, vr, count, values, function);
 }
 
 fmu_status fmu_get_integer(fmu_instance* instance, const unsigned int vr[], size_t count,

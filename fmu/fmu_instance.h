@@ -83,6 +83,7 @@ typedef struct fmu_slot {
  * its calls every step) is one vector check of the values and a copy. */
 typedef struct fmu_plan {
     size_t count;        /* of the call; 0: none */
+    int finite_only;     /* set: every interval is all the finite doubles */
     unsigned int* vr;    /* its value references */
     double* low;         /* set: each value's accepted interval */
     double* high;        /* (contiguous for a vector check) */

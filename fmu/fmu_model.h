@@ -7,6 +7,14 @@
 
 #include <stddef.h>
 
+/* A path that is rarely taken (a refusal, a log message) kept out of the function that
+ * calls it, so that the common path saves and restores fewer registers. */
+#if defined(__GNUC__)
+#define FMU_COLD __attribute__((noinline, cold))
+#else
+#define FMU_COLD
+#endif
+
 /* Same numbering as fmi2Status and fmi3Status. */
 typedef enum fmu_status {
     FMU_OK = 0,

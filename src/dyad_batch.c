@@ -91,6 +91,35 @@ static inline void gather_column(const dyad_input_array* column, size_t offset, 
     }
 }
 
+/* The copies of the common layouts, each its own function: inlined, their unrolled
+ * moves would crowd the general copies out of unrolling. */
+#if defined(__GNUC__)
+#define BATCH_OUT_OF_LINE __attribute__((noinline))
+#else
+#define BATCH_OUT_OF_LINE
+#endif
+
+/* A whole block of a column of its own (stride 1: a NumPy array of one field), as
+ * plain moves. */
+BATCH_OUT_OF_LINE static void gather_contiguous(const dyad_real* source, size_t offset,
+                                                dyad_input block[])
+{
+    size_t r;
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        *(dyad_real*)(void*)((char*)&block[r] + offset) = source[r];
+    }
+}
+
+/* A whole block of x and y of an (N, 2) array (stride 2), as plain moves. */
+BATCH_OUT_OF_LINE static void gather_pairs(const dyad_real* source, size_t offset,
+                                           dyad_input block[])
+{
+    size_t r;
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        *(dyad_real*)(void*)((char*)&block[r] + offset) = source[2 * r];
+    }
+}
+
 /* Rows first .. first + rows - 1 of the columns that vary by row. */
 static void gather(const dyad_batch_input* input, size_t first, size_t rows, dyad_input block[])
 {
@@ -98,7 +127,11 @@ static void gather(const dyad_batch_input* input, size_t first, size_t rows, dya
     for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
         const dyad_input_array* column = &input->column[c];
         if (column->data != NULL && column->stride != 0) {
-            if (rows == DYAD_BATCH_BLOCK) {
+            if (rows == DYAD_BATCH_BLOCK && column->stride == 1) {
+                gather_contiguous(column->data + first, input_offset[c], block);
+            } else if (rows == DYAD_BATCH_BLOCK && column->stride == 2) {
+                gather_pairs(column->data + 2 * first, input_offset[c], block);
+            } else if (rows == DYAD_BATCH_BLOCK) {
                 gather_column(column, input_offset[c], first, DYAD_BATCH_BLOCK, block);
             } else {
                 gather_column(column, input_offset[c], first, rows, block);
@@ -119,6 +152,26 @@ static inline void scatter_column(const dyad_output_array* column, size_t offset
     }
 }
 
+/* A whole block into a column of its own (stride 1), as plain moves. */
+BATCH_OUT_OF_LINE static void scatter_contiguous(dyad_real* target, size_t offset,
+                                                 const dyad_result results[])
+{
+    size_t r;
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        target[r] = *(const dyad_real*)(const void*)((const char*)&results[r] + offset);
+    }
+}
+
+/* A whole block into x or y of an (N, 2) array (stride 2), as plain moves. */
+BATCH_OUT_OF_LINE static void scatter_pairs(dyad_real* target, size_t offset,
+                                            const dyad_result results[])
+{
+    size_t r;
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        target[2 * r] = *(const dyad_real*)(const void*)((const char*)&results[r] + offset);
+    }
+}
+
 static void scatter(const dyad_batch_output* output, size_t first, size_t rows,
                     const dyad_result results[])
 {
@@ -127,7 +180,11 @@ static void scatter(const dyad_batch_output* output, size_t first, size_t rows,
     for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
         const dyad_output_array* column = &output->column[c];
         if (column->data != NULL) {
-            if (rows == DYAD_BATCH_BLOCK) {
+            if (rows == DYAD_BATCH_BLOCK && column->stride == 1) {
+                scatter_contiguous(column->data + first, output_offset[c], results);
+            } else if (rows == DYAD_BATCH_BLOCK && column->stride == 2) {
+                scatter_pairs(column->data + 2 * first, output_offset[c], results);
+            } else if (rows == DYAD_BATCH_BLOCK) {
                 scatter_column(column, output_offset[c], first, DYAD_BATCH_BLOCK, results);
             } else {
                 scatter_column(column, output_offset[c], first, rows, results);

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "dyadfmu/angle.h"
 #include "dyadfmu/batch.h"
 #include "dyadfmu/dyad.h"
 #include "dyadfmu/kinematics.h"
@@ -2465,6 +2466,45 @@ static int test_angle_cos_sin_near_libm(void)
     return fails;
 }
 
+/* dyad_cos_sin_pair gives what dyad_cos_sin gives for each angle, bit for bit, in
+ * either lane and with the other lane anywhere: in range, beyond it, infinite, NaN. */
+static int test_angle_pair_matches_single(void)
+{
+    static const double odd[] = {
+        3e9,         -1.5e6, 1e6,  -1e6,  1.0000000001e6, (double)INFINITY, -(double)INFINITY,
+        (double)NAN, 0.0,    -0.0, 1e-300};
+    int fails = 0;
+    long mismatches = 0;
+    long k;
+    size_t a, b;
+    for (k = -200000; k <= 200000; ++k) {
+        const double angle0 = k * 7.3e-5 - 0.01;
+        const double angle1 = (double)k * 31.7 + 0.5;
+        double one0[2], one1[2], pair0[2], pair1[2];
+        dyad_cos_sin(angle0, &one0[0], &one0[1]);
+        dyad_cos_sin(angle1, &one1[0], &one1[1]);
+        dyad_cos_sin_pair(angle0, angle1, pair0, pair1);
+        mismatches +=
+            memcmp(one0, pair0, sizeof one0) != 0 || memcmp(one1, pair1, sizeof one1) != 0;
+    }
+    CHECK(mismatches == 0, "%ld pairs of angles differ from one at a time", mismatches);
+    for (a = 0; a < sizeof odd / sizeof odd[0]; ++a) {
+        for (b = 0; b < sizeof odd / sizeof odd[0]; ++b) {
+            double one0[2], one1[2], pair0[2], pair1[2];
+            dyad_cos_sin(odd[a], &one0[0], &one0[1]);
+            dyad_cos_sin(odd[b], &one1[0], &one1[1]);
+            dyad_cos_sin_pair(odd[a], odd[b], pair0, pair1);
+            CHECK(same_real(one0[0], pair0[0]) && same_real(one0[1], pair0[1]) &&
+                      same_real(one1[0], pair1[0]) && same_real(one1[1], pair1[1]),
+                  "angles %g and %g: (%.17g, %.17g) (%.17g, %.17g) in a pair, (%.17g, %.17g) "
+                  "(%.17g, %.17g) one at a time",
+                  odd[a], odd[b], pair0[0], pair0[1], pair1[0], pair1[1], one0[0], one0[1], one1[0],
+                  one1[1]);
+        }
+    }
+    return fails;
+}
+
 static const named_test tests[] = {
     {"equilibrium_random", test_equilibrium_random},
     {"rrr_symmetric_truss", test_rrr_symmetric_truss},
@@ -2483,6 +2523,7 @@ static const named_test tests[] = {
     {"batch_matches_solve", test_batch_matches_solve},
     {"batch_refusals", test_batch_refusals},
     {"angle_cos_sin_near_libm", test_angle_cos_sin_near_libm},
+    {"angle_pair_matches_single", test_angle_pair_matches_single},
     {"tangent_of_each_type", test_tangent_of_each_type},
     {"react_tangent_finite_differences", test_react_tangent_finite_differences},
     {"kin_reproduces_built", test_kin_reproduces_built},

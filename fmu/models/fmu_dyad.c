@@ -18,8 +18,9 @@ static int variable_of_field(const fmu_model* model, dyad_field field)
     return -1;
 }
 
-static void report(const fmu_model* model, const dyad_input* input, const dyad_result* result,
-                   fmu_evaluation* evaluation)
+/* Why a solve failed, for the log. */
+FMU_COLD static void report_failure(const fmu_model* model, const dyad_input* input,
+                                    const dyad_result* result, fmu_evaluation* evaluation)
 {
     evaluation->bad_variable = -1;
     evaluation->reason[0] = '\0';
@@ -49,6 +50,18 @@ static void report(const fmu_model* model, const dyad_input* input, const dyad_r
                  dyad_status_name(result->status));
         break;
     }
+}
+
+static void report(const fmu_model* model, const dyad_input* input, const dyad_result* result,
+                   fmu_evaluation* evaluation)
+{
+    if (result->status == DYAD_STATUS_OK) {
+        evaluation->status = FMU_OK;
+        evaluation->bad_variable = -1;
+        evaluation->reason[0] = '\0';
+        return;
+    }
+    report_failure(model, input, result, evaluation);
 }
 
 static void initialise(const fmu_model* model, void* input)

@@ -19,11 +19,20 @@
  * branch beyond the range check. Beyond |angle| = 1e6 rad, and for a non-finite
  * angle, libm does it. The constants are computed with mpmath by
  * scripts/dyadfmu/angle_table.py, which a test runs against this file.
+ *
+ * dyad_cos_sin_pair turns two angles with the same operations in the two lanes of
+ * SSE2 registers: the same bits as two calls of dyad_cos_sin (a test compares
+ * them), for about the instructions of one. A dyad has two link angles, and the
+ * FMUs convert theirs in pairs.
  */
 #ifndef DYADFMU_ANGLE_H
 #define DYADFMU_ANGLE_H
 
 #include <math.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /** Largest |angle| (rad) reduced here; libm reduces a larger one. */
 #define DYAD_ANGLE_FAST_LIMIT 1e6
@@ -103,10 +112,38 @@
 /* END generated */
 /* clang-format on */
 
+/* The table of cos and sin at j pi / 32 (hi, lo, hi, lo), one per translation unit. */
+static inline const double (*dyad_angle_table(void))[4]
+{
+    static const double table[64][4] = {DYAD_ANGLE_TABLE};
+    return table;
+}
+
+/* The Taylor coefficients of sin r (r^3 .. r^9) and cos r (r^2 .. r^8). */
+#define DYAD_ANGLE_S3 (-0.16666666666666666)
+#define DYAD_ANGLE_S5 0.008333333333333333
+#define DYAD_ANGLE_S7 (-0.0001984126984126984)
+#define DYAD_ANGLE_S9 2.7557319223985893e-06
+#define DYAD_ANGLE_C2 (-0.5)
+#define DYAD_ANGLE_C4 0.041666666666666664
+#define DYAD_ANGLE_C6 (-0.001388888888888889)
+#define DYAD_ANGLE_C8 2.48015873015873e-05
+
+/* The series in z = r^2: sin r = r + r z DYAD_SIN_SERIES(z), cos r - 1 = z
+ * DYAD_COS_SERIES(z). Macros, so that the scalar and the paired code evaluate the same
+ * operations in the same order: `add` and `mul` are their sum and product, `c(NAME)`
+ * their constant DYAD_ANGLE_NAME. */
+#define DYAD_SIN_SERIES(z, add, mul, c) \
+    add(c(S3), mul(z, add(c(S5), mul(z, add(c(S7), mul(z, c(S9)))))))
+#define DYAD_COS_SERIES(z, add, mul, c) \
+    add(c(C2), mul(z, add(c(C4), mul(z, add(c(C6), mul(z, c(C8)))))))
+#define DYAD_SCALAR_ADD(a, b)      ((a) + (b))
+#define DYAD_SCALAR_MUL(a, b)      ((a) * (b))
+#define DYAD_SCALAR_CONSTANT(name) DYAD_ANGLE_##name
+
 /** cos(angle) and sin(angle) (-) of `angle` (rad), to about 1.1e-16. */
 static inline void dyad_cos_sin(double angle, double* cos_out, double* sin_out)
 {
-    static const double table[64][4] = {DYAD_ANGLE_TABLE}; /* cos hi, lo, sin hi, lo */
     const double* t;
     double k, r, z, sin_r, cos_m1;
     long j;
@@ -119,15 +156,134 @@ static inline void dyad_cos_sin(double angle, double* cos_out, double* sin_out)
     k = (double)j;
     r = ((angle - k * DYAD_ANGLE_P1) - k * DYAD_ANGLE_P2) - k * DYAD_ANGLE_P3;
     z = r * r;
-    sin_r = r + r * z *
-                    (-0.16666666666666666 +
-                     z * (0.008333333333333333 +
-                          z * (-0.0001984126984126984 + z * 2.7557319223985893e-06)));
-    cos_m1 = z * (-0.5 + z * (0.041666666666666664 +
-                              z * (-0.001388888888888889 + z * 2.48015873015873e-05)));
-    t = table[(unsigned long)j & 63u];
+    sin_r = r + r * z * DYAD_SIN_SERIES(z, DYAD_SCALAR_ADD, DYAD_SCALAR_MUL, DYAD_SCALAR_CONSTANT);
+    cos_m1 = z * DYAD_COS_SERIES(z, DYAD_SCALAR_ADD, DYAD_SCALAR_MUL, DYAD_SCALAR_CONSTANT);
+    t = dyad_angle_table()[(unsigned long)j & 63u];
     *cos_out = t[0] + ((t[0] * cos_m1 - t[2] * sin_r) + t[1]);
     *sin_out = t[2] + ((t[2] * cos_m1 + t[0] * sin_r) + t[3]);
+}
+
+#if defined(__SSE2__)
+/* The constants of dyad_cos_sin, each twice: one per lane. */
+enum {
+    DYAD_PAIR_S3 = 0,
+    DYAD_PAIR_S5,
+    DYAD_PAIR_S7,
+    DYAD_PAIR_S9,
+    DYAD_PAIR_C2,
+    DYAD_PAIR_C4,
+    DYAD_PAIR_C6,
+    DYAD_PAIR_C8,
+    DYAD_PAIR_STEPS_PER_RAD,
+    DYAD_PAIR_P1,
+    DYAD_PAIR_P2,
+    DYAD_PAIR_P3,
+    DYAD_PAIR_FAST_LIMIT,
+    DYAD_PAIR_HALF,
+    DYAD_PAIR_SIGN,
+    DYAD_PAIR_COUNT
+};
+#define DYAD_PAIR_OF(name)                       \
+    {                                            \
+        {                                        \
+            DYAD_ANGLE_##name, DYAD_ANGLE_##name \
+        }                                        \
+    }
+
+typedef union dyad_angle_pair {
+    double lane[2];
+    __m128d both;
+} dyad_angle_pair;
+
+static inline const dyad_angle_pair* dyad_angle_pairs(void)
+{
+    static const dyad_angle_pair pairs[DYAD_PAIR_COUNT] = {
+        DYAD_PAIR_OF(S3),         DYAD_PAIR_OF(S5), DYAD_PAIR_OF(S7),
+        DYAD_PAIR_OF(S9),         DYAD_PAIR_OF(C2), DYAD_PAIR_OF(C4),
+        DYAD_PAIR_OF(C6),         DYAD_PAIR_OF(C8), DYAD_PAIR_OF(STEPS_PER_RAD),
+        DYAD_PAIR_OF(P1),         DYAD_PAIR_OF(P2), DYAD_PAIR_OF(P3),
+        DYAD_PAIR_OF(FAST_LIMIT), {{0.5, 0.5}},     {{-0.0, -0.0}}};
+    const dyad_angle_pair* p = pairs;
+#if defined(__GNUC__)
+    /* Hidden from the optimiser, which would otherwise rebuild each pair from one
+     * double (two instructions) instead of loading it (none: an operand). */
+    __asm__("" : "+r"(p));
+#endif
+    return p;
+}
+#define DYAD_PAIR_CONSTANT(name) (pairs[DYAD_PAIR_##name].both)
+#endif
+
+#if defined(__GNUC__)
+#define DYAD_ANGLE_RARE static __attribute__((noinline, cold, unused))
+#else
+#define DYAD_ANGLE_RARE static inline
+#endif
+
+/* The lanes of dyad_cos_sin_pair that libm turns (bit k of `fast` clear: angle k),
+ * out of line so that the common path calls nothing and saves no registers. */
+DYAD_ANGLE_RARE void dyad_cos_sin_by_libm(int fast, double angle0, double angle1, double unit0[2],
+                                          double unit1[2])
+{
+    if (!(fast & 1)) {
+        unit0[0] = cos(angle0);
+        unit0[1] = sin(angle0);
+    }
+    if (!(fast & 2)) {
+        unit1[0] = cos(angle1);
+        unit1[1] = sin(angle1);
+    }
+}
+
+/** The unit vectors unit0 = (cos, sin)(angle0) and unit1 = (cos, sin)(angle1) (-) of two
+ *  angles (rad): bit for bit dyad_cos_sin of each, in about the instructions of one
+ *  where SSE2 computes both at once. */
+static inline void dyad_cos_sin_pair(double angle0, double angle1, double unit0[2], double unit1[2])
+{
+#if defined(__SSE2__)
+    const dyad_angle_pair* pairs = dyad_angle_pairs();
+    const double (*table)[4] = dyad_angle_table();
+    const __m128d sign = DYAD_PAIR_CONSTANT(SIGN);
+    __m128d x = _mm_set_pd(angle1, angle0);
+    __m128d k, r, z, sin_r, cos_m1, c_hi, c_lo, s_hi, s_lo, c, s, in_range;
+    __m128i j;
+    int fast;
+    /* an angle that libm turns (beyond the fast range, or not finite) is 0 here */
+    in_range = _mm_cmple_pd(_mm_andnot_pd(sign, x), DYAD_PAIR_CONSTANT(FAST_LIMIT));
+    fast = _mm_movemask_pd(in_range);
+    x = _mm_and_pd(x, in_range);
+    j = _mm_cvttpd_epi32(_mm_add_pd(_mm_mul_pd(x, DYAD_PAIR_CONSTANT(STEPS_PER_RAD)),
+                                    _mm_or_pd(_mm_and_pd(sign, x), DYAD_PAIR_CONSTANT(HALF))));
+    k = _mm_cvtepi32_pd(j);
+    r = _mm_sub_pd(_mm_sub_pd(_mm_sub_pd(x, _mm_mul_pd(k, DYAD_PAIR_CONSTANT(P1))),
+                              _mm_mul_pd(k, DYAD_PAIR_CONSTANT(P2))),
+                   _mm_mul_pd(k, DYAD_PAIR_CONSTANT(P3)));
+    z = _mm_mul_pd(r, r);
+    sin_r = _mm_add_pd(r, _mm_mul_pd(_mm_mul_pd(r, z), DYAD_SIN_SERIES(z, _mm_add_pd, _mm_mul_pd,
+                                                                       DYAD_PAIR_CONSTANT)));
+    cos_m1 = _mm_mul_pd(z, DYAD_COS_SERIES(z, _mm_add_pd, _mm_mul_pd, DYAD_PAIR_CONSTANT));
+    j = _mm_and_si128(j, _mm_set1_epi32(63));
+    c_hi = _mm_loadh_pd(_mm_load_sd(&table[_mm_cvtsi128_si32(j)][0]),
+                        &table[_mm_cvtsi128_si32(_mm_shuffle_epi32(j, 1))][0]);
+    c_lo = _mm_loadh_pd(_mm_load_sd(&table[_mm_cvtsi128_si32(j)][1]),
+                        &table[_mm_cvtsi128_si32(_mm_shuffle_epi32(j, 1))][1]);
+    s_hi = _mm_loadh_pd(_mm_load_sd(&table[_mm_cvtsi128_si32(j)][2]),
+                        &table[_mm_cvtsi128_si32(_mm_shuffle_epi32(j, 1))][2]);
+    s_lo = _mm_loadh_pd(_mm_load_sd(&table[_mm_cvtsi128_si32(j)][3]),
+                        &table[_mm_cvtsi128_si32(_mm_shuffle_epi32(j, 1))][3]);
+    c = _mm_add_pd(c_hi,
+                   _mm_add_pd(_mm_sub_pd(_mm_mul_pd(c_hi, cos_m1), _mm_mul_pd(s_hi, sin_r)), c_lo));
+    s = _mm_add_pd(s_hi,
+                   _mm_add_pd(_mm_add_pd(_mm_mul_pd(s_hi, cos_m1), _mm_mul_pd(c_hi, sin_r)), s_lo));
+    _mm_storeu_pd(unit0, _mm_unpacklo_pd(c, s));
+    _mm_storeu_pd(unit1, _mm_unpackhi_pd(c, s));
+    if (fast != 3) {
+        dyad_cos_sin_by_libm(fast, angle0, angle1, unit0, unit1);
+    }
+#else
+    dyad_cos_sin(angle0, &unit0[0], &unit0[1]);
+    dyad_cos_sin(angle1, &unit1[0], &unit1[1]);
+#endif
 }
 
 #endif
