@@ -4,12 +4,16 @@
  * column by column (a column given once for every row is written into the block
  * once, before the first row), solved row by row, and its results are written out
  * column by column. The gather and scatter loops run over one column's rows, so
- * each is a short strided copy. */
+ * each is a short strided copy. How each column of a whole block is copied is
+ * decided once per call, with loops of their own for the layouts NumPy gives
+ * dyadfmu.solve: a field's rows contiguous, or x and y of an (N, 2) array, which
+ * fill adjacent members and so move together. */
 #include "dyadfmu/batch.h"
 
 #include "dyadfmu/dyad.h"
 
 #include <stddef.h>
+#include <string.h>
 
 #define LINK_OFFSETS(g)                                                                           \
     offsetof(dyad_input, g.dir.x), offsetof(dyad_input, g.dir.y), offsetof(dyad_input, g.length), \
@@ -120,22 +124,80 @@ BATCH_OUT_OF_LINE static void gather_pairs(const dyad_real* source, size_t offse
     }
 }
 
-/* Rows first .. first + rows - 1 of the columns that vary by row. */
-static void gather(const dyad_batch_input* input, size_t first, size_t rows, dyad_input block[])
+/* A whole block of x and y of an (N, 2) array at once: both members of a vector of
+ * dyad_input, adjacent there too. */
+BATCH_OUT_OF_LINE static void gather_vectors(const dyad_real* source, size_t offset,
+                                             dyad_input block[])
+{
+    size_t r;
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        memcpy((char*)&block[r] + offset, source + 2 * r, 2 * sizeof *source);
+    }
+}
+
+/* Whether columns c and c + 1 are x and y of one (N, 2) array that fill adjacent
+ * members: then one copy moves both. */
+static int adjacent_pair(const dyad_real* x, ptrdiff_t x_stride, const dyad_real* y,
+                         ptrdiff_t y_stride, size_t x_offset, size_t y_offset)
+{
+    return x != NULL && x_stride == 2 && y == x + 1 && y_stride == 2 &&
+           y_offset == x_offset + sizeof *x;
+}
+
+/* How a whole block copies each input column, decided once per call. */
+typedef enum copy_kind {
+    COPY_NONE = 0,   /* the block holds its value already (preset), or column c - 1 copies it */
+    COPY_VECTOR,     /* this column and the next, x and y of an (N, 2) array */
+    COPY_CONTIGUOUS, /* stride 1 */
+    COPY_PAIRS,      /* stride 2 alone */
+    COPY_GENERAL     /* any other stride */
+} copy_kind;
+
+static void plan_gather(const dyad_batch_input* input, unsigned char kinds[])
 {
     int c;
     for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
         const dyad_input_array* column = &input->column[c];
-        if (column->data != NULL && column->stride != 0) {
-            if (rows == DYAD_BATCH_BLOCK && column->stride == 1) {
-                gather_contiguous(column->data + first, input_offset[c], block);
-            } else if (rows == DYAD_BATCH_BLOCK && column->stride == 2) {
-                gather_pairs(column->data + 2 * first, input_offset[c], block);
-            } else if (rows == DYAD_BATCH_BLOCK) {
-                gather_column(column, input_offset[c], first, DYAD_BATCH_BLOCK, block);
-            } else {
+        kinds[c] = COPY_NONE;
+        if (column->data == NULL || column->stride == 0) {
+            continue;
+        }
+        if (c + 1 < DYAD_INPUT_COLUMN_COUNT &&
+            adjacent_pair(column->data, column->stride, input->column[c + 1].data,
+                          input->column[c + 1].stride, input_offset[c], input_offset[c + 1])) {
+            kinds[c] = COPY_VECTOR;
+            kinds[++c] = COPY_NONE;
+        } else {
+            kinds[c] = column->stride == 1   ? COPY_CONTIGUOUS
+                       : column->stride == 2 ? COPY_PAIRS
+                                             : COPY_GENERAL;
+        }
+    }
+}
+
+/* Rows first .. first + rows - 1 of the columns that vary by row. */
+static void gather(const dyad_batch_input* input, const unsigned char kinds[], size_t first,
+                   size_t rows, dyad_input block[])
+{
+    int c;
+    for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
+        const dyad_input_array* column = &input->column[c];
+        if (rows < DYAD_BATCH_BLOCK) {
+            if (column->data != NULL && column->stride != 0) {
                 gather_column(column, input_offset[c], first, rows, block);
             }
+            continue;
+        }
+        switch ((copy_kind)kinds[c]) {
+        case COPY_NONE: break;
+        case COPY_VECTOR: gather_vectors(column->data + 2 * first, input_offset[c], block); break;
+        case COPY_CONTIGUOUS:
+            gather_contiguous(column->data + first, input_offset[c], block);
+            break;
+        case COPY_PAIRS: gather_pairs(column->data + 2 * first, input_offset[c], block); break;
+        case COPY_GENERAL:
+            gather_column(column, input_offset[c], first, DYAD_BATCH_BLOCK, block);
+            break;
         }
     }
 }
@@ -172,6 +234,16 @@ BATCH_OUT_OF_LINE static void scatter_pairs(dyad_real* target, size_t offset,
     }
 }
 
+/* A whole block into x and y of an (N, 2) array at once, from adjacent members. */
+BATCH_OUT_OF_LINE static void scatter_vectors(dyad_real* target, size_t offset,
+                                              const dyad_result results[])
+{
+    size_t r;
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        memcpy(target + 2 * r, (const char*)&results[r] + offset, 2 * sizeof *target);
+    }
+}
+
 static void scatter(const dyad_batch_output* output, size_t first, size_t rows,
                     const dyad_result results[])
 {
@@ -180,7 +252,13 @@ static void scatter(const dyad_batch_output* output, size_t first, size_t rows,
     for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
         const dyad_output_array* column = &output->column[c];
         if (column->data != NULL) {
-            if (rows == DYAD_BATCH_BLOCK && column->stride == 1) {
+            if (rows == DYAD_BATCH_BLOCK && c + 1 < DYAD_OUTPUT_COLUMN_COUNT &&
+                adjacent_pair(column->data, column->stride, output->column[c + 1].data,
+                              output->column[c + 1].stride, output_offset[c],
+                              output_offset[c + 1])) {
+                scatter_vectors(column->data + 2 * first, output_offset[c], results);
+                ++c;
+            } else if (rows == DYAD_BATCH_BLOCK && column->stride == 1) {
                 scatter_contiguous(column->data + first, output_offset[c], results);
             } else if (rows == DYAD_BATCH_BLOCK && column->stride == 2) {
                 scatter_pairs(column->data + 2 * first, output_offset[c], results);
@@ -220,6 +298,7 @@ size_t dyad_solve_batch(dyad_type type, size_t count, const dyad_batch_input* in
     const dyad_solver solve = solver_of(type);
     dyad_input block[DYAD_BATCH_BLOCK];
     dyad_result results[DYAD_BATCH_BLOCK];
+    unsigned char kinds[DYAD_INPUT_COLUMN_COUNT];
     size_t first, r, solved = 0;
     if (output == NULL) {
         return 0;
@@ -229,9 +308,10 @@ size_t dyad_solve_batch(dyad_type type, size_t count, const dyad_batch_input* in
         return 0;
     }
     preset(input, block);
+    plan_gather(input, kinds);
     for (first = 0; first < count; first += DYAD_BATCH_BLOCK) {
         const size_t rows = count - first < DYAD_BATCH_BLOCK ? count - first : DYAD_BATCH_BLOCK;
-        gather(input, first, rows, block);
+        gather(input, kinds, first, rows, block);
         for (r = 0; r < rows; ++r) {
             solved += solve(&block[r], &results[r]) == DYAD_STATUS_OK;
         }

@@ -2399,6 +2399,51 @@ static int test_batch_matches_solve(void)
     return fails;
 }
 
+/* Columns in pairs of one interleaved array, as NumPy's (N, 2) arrays come: columns
+ * 2k and 2k + 1 read x and y of one array, and fill adjacent members of dyad_input, so
+ * a whole block copies both at once; the outputs likewise. Bit for bit dyad_solve. */
+static int test_batch_interleaved_pairs(void)
+{
+    static dyad_input rows[BATCH_ROWS];
+    static dyad_real pairs[DYAD_INPUT_COLUMN_COUNT / 2 + 1][2 * BATCH_ROWS];
+    static dyad_real written[DYAD_OUTPUT_COLUMN_COUNT / 2 + 1][2 * BATCH_ROWS];
+    static dyad_real out[DYAD_OUTPUT_COLUMN_COUNT * BATCH_ROWS];
+    static unsigned char status[BATCH_ROWS], field[BATCH_ROWS];
+    int fails = 0, t, c;
+    size_t r;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = (dyad_type)t;
+        rng g = {0x1A7E0000u + (uint64_t)t};
+        dyad_batch_input in;
+        dyad_batch_output res;
+        size_t ok;
+        for (r = 0; r < BATCH_ROWS; ++r) {
+            rows[r] = random_input(&g, type);
+        }
+        for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
+            for (r = 0; r < BATCH_ROWS; ++r) {
+                pairs[c / 2][2 * r + (size_t)(c % 2)] = input_scalar(&rows[r], c);
+            }
+            in.column[c].data = &pairs[c / 2][c % 2];
+            in.column[c].stride = 2;
+        }
+        for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+            res.column[c].data = &written[c / 2][c % 2];
+            res.column[c].stride = 2;
+        }
+        res.status = status;
+        res.field = field;
+        ok = dyad_solve_batch(type, BATCH_ROWS, &in, &res);
+        for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+            for (r = 0; r < BATCH_ROWS; ++r) {
+                out[c * BATCH_ROWS + r] = written[c / 2][2 * r + (size_t)(c % 2)];
+            }
+        }
+        fails += batch_rows_match(type, rows, out, status, field, ok);
+    }
+    return fails;
+}
+
 /* An unknown type or no input: every row invalid and named so, outputs NaN. */
 static int test_batch_refusals(void)
 {
@@ -2521,6 +2566,7 @@ static const named_test tests[] = {
     {"invalid_before_singular", test_invalid_before_singular},
     {"react_loaded", test_react_loaded},
     {"batch_matches_solve", test_batch_matches_solve},
+    {"batch_interleaved_pairs", test_batch_interleaved_pairs},
     {"batch_refusals", test_batch_refusals},
     {"angle_cos_sin_near_libm", test_angle_cos_sin_near_libm},
     {"angle_pair_matches_single", test_angle_pair_matches_single},

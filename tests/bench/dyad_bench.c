@@ -3,7 +3,8 @@
  *   gsl_lu   the same dyad as a dense 6x6 system, LU with GSL (dense_gsl.c),
  *   gsl_svd  the same with an SVD,
  *   fmu      an FMU binary stepped from C (FMI 2 or 3), one row per doStep,
- *   batch    dyad_solve_batch over the rows in place (columns of stride 35).
+ *   batch    dyad_solve_batch over the rows laid out as dyadfmu.solve passes NumPy
+ *            arrays (a scalar's rows contiguous, a vector's x and y interleaved).
  *
  * Built twice from this file: dyad_bench against the double core (all methods),
  * dyad_bench_float against the float core (method core only; inputs are rounded
@@ -102,7 +103,8 @@ static void usage(FILE* out)
             "  core     dyad_solve of the C core (%s)\n"
             "  gsl_lu   the dyad's 6x6 Newton-Euler system, GSL LU (double binary only)\n"
             "  gsl_svd  the same, GSL SVD (double binary only)\n"
-            "  batch    dyad_solve_batch, one call over all rows read in place as columns\n"
+            "  batch    dyad_solve_batch, one call over all rows laid out as dyadfmu.solve\n"
+            "           passes NumPy arrays (scalars stride 1, vectors' x and y stride 2)\n"
             "           (double binary only)\n"
             "  fmu      the FMU binary stepped from C, one doStep (h = 1e-3 s) per row\n"
             "           (double binary only)\n"
@@ -478,27 +480,68 @@ void bench_loop_batch(dyad_type type, const dyad_batch_input* in, const dyad_bat
     dyad_solve_batch(type, count, in, out);
 }
 
-/* Runs batch on the inputs file: the rows are the columns, read in place. */
+/* Whether a column is the x of a vector field: dyadfmu.solve passes each vector as an
+ * (N, 2) array, x and y interleaved, and each scalar as an array of its own. */
+static int starts_vector(int column, int output)
+{
+    static const int input_x[] = {DYAD_IN_M_DIR_X,   DYAD_IN_M_ACCEL_D_X, DYAD_IN_M_COM_X,
+                                  DYAD_IN_M_FORCE_X, DYAD_IN_N_DIR_X,     DYAD_IN_N_ACCEL_D_X,
+                                  DYAD_IN_N_COM_X,   DYAD_IN_N_FORCE_X,   DYAD_IN_GUIDE_K_X,
+                                  DYAD_IN_GUIDE_P_X, DYAD_IN_GRAVITY_X};
+    static const int output_x[] = {DYAD_OUT_R_MK_X, DYAD_OUT_R_NP_X, DYAD_OUT_R_MN_X};
+    const int* x = output ? output_x : input_x;
+    const size_t n = output ? sizeof output_x / sizeof *x : sizeof input_x / sizeof *x;
+    size_t k;
+    for (k = 0; k < n; ++k) {
+        if (x[k] == column) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Runs batch on the inputs file, its rows laid out first as dyadfmu.solve passes NumPy
+ * arrays: a scalar field's rows contiguous (stride 1), a vector's x and y interleaved
+ * (stride 2); the outputs likewise. */
 static void run_batch(const options* opt)
 {
-    size_t rows, count, c;
+    size_t rows, count, c, r;
     long rep;
     double* raw = read_rows(opt->inputs, IN_COLS, &rows);
     double* per_config = xmalloc((size_t)opt->repeat, sizeof *per_config);
-    double* results;
+    double *columns, *results;
     unsigned char* status;
     dyad_batch_input in;
     dyad_batch_output out;
     count = rows_to_use(opt, rows, opt->inputs);
+    columns = xmalloc(count * DYAD_INPUT_COLUMN_COUNT, sizeof *columns);
     results = xmalloc(count * DYAD_OUTPUT_COLUMN_COUNT, sizeof *results);
     status = xmalloc(2 * count, 1);
     for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
-        in.column[c].data = raw + c;
-        in.column[c].stride = IN_COLS;
+        const int vector = starts_vector((int)c, 0);
+        in.column[c].data = columns + c * count;
+        in.column[c].stride = vector ? 2 : 1;
+        for (r = 0; r < count; ++r) {
+            columns[c * count + (vector ? 2 * r : r)] = raw[r * IN_COLS + c];
+            if (vector) {
+                columns[c * count + 2 * r + 1] = raw[r * IN_COLS + c + 1];
+            }
+        }
+        if (vector) {
+            ++c;
+            in.column[c].data = columns + (c - 1) * count + 1;
+            in.column[c].stride = 2;
+        }
     }
     for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+        const int vector = starts_vector((int)c, 1);
         out.column[c].data = results + c * count;
-        out.column[c].stride = 1;
+        out.column[c].stride = vector ? 2 : 1;
+        if (vector) {
+            ++c;
+            out.column[c].data = results + (c - 1) * count + 1;
+            out.column[c].stride = 2;
+        }
     }
     out.status = status;
     out.field = status + count;
@@ -509,6 +552,7 @@ static void run_batch(const options* opt)
     }
     print_json(opt, count, per_config);
     free(raw);
+    free(columns);
     free(results);
     free(status);
     free(per_config);

@@ -196,8 +196,8 @@ def batch_keywords(rows: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def batch_instructions(build: Path, dyad: str, rows: np.ndarray, work: Path) -> float:
-    """Instructions per row of one dyad_solve_batch call over `rows`, read in place as
-    columns (the benchmark's method batch)."""
+    """Instructions per row of one dyad_solve_batch call over `rows`, laid out as
+    :func:`dyadfmu.solve` passes NumPy arrays (the benchmark's method batch)."""
     inputs = work / "speed_batch.bin"
     rows.astype("<f8").tofile(inputs)
     program = [str(bench.bench_binary(build, "double"))]
