@@ -21,9 +21,13 @@
  * scripts/dyadfmu/angle_table.py, which a test runs against this file.
  *
  * dyad_cos_sin_pair turns two angles with the same operations in the two lanes of
- * SSE2 registers: the same bits as two calls of dyad_cos_sin (a test compares
- * them), for about the instructions of one. A dyad has two link angles, and the
- * FMUs convert theirs in pairs.
+ * SSE2 registers, for about the instructions of one. A dyad has two link angles,
+ * and the FMUs convert theirs in pairs. It gives the same bits as two calls of
+ * dyad_cos_sin (a test compares them) where the compiler rounds every product and
+ * sum in double, as the project builds it (ISO C, -std=c99): a compiler that fuses
+ * a * b + c into one operation (GCC's GNU modes on a target with FMA) or keeps
+ * x87 extended precision (32-bit x86) changes the scalar code alone, and the two
+ * may then differ in the last place.
  */
 #ifndef DYADFMU_ANGLE_H
 #define DYADFMU_ANGLE_H
@@ -236,7 +240,8 @@ DYAD_ANGLE_RARE void dyad_cos_sin_by_libm(int fast, double angle0, double angle1
 }
 
 /** The unit vectors unit0 = (cos, sin)(angle0) and unit1 = (cos, sin)(angle1) (-) of two
- *  angles (rad): bit for bit dyad_cos_sin of each, in about the instructions of one
+ *  angles (rad): dyad_cos_sin of each (bit for bit where products and sums are each
+ *  rounded to double, see the top of this file), in about the instructions of one
  *  where SSE2 computes both at once. */
 static inline void dyad_cos_sin_pair(double angle0, double angle1, double unit0[2], double unit1[2])
 {
