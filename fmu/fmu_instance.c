@@ -536,6 +536,14 @@ FMU_COLD static fmu_status check_step(fmu_instance* instance, double current_tim
     return FMU_OK;
 }
 
+/* A step that reached `end`: the time there, and nothing to end the simulation for. */
+static void step_completed(fmu_instance* instance, double end)
+{
+    instance->time = end;
+    instance->last_successful_time = end;
+    instance->terminate_requested = 0;
+}
+
 /* A step of a model with states: the outputs at its start, the states
  * advanced, the outputs at its end. */
 static fmu_status advance_states(fmu_instance* instance, double current_time, double step_size,
@@ -561,8 +569,7 @@ static fmu_status advance_states(fmu_instance* instance, double current_time, do
         instance->time = current_time + step_size;
         status = solve(instance, FMU_DISCARD, function, 1);
         if (status == FMU_OK) {
-            instance->last_successful_time = instance->time;
-            instance->terminate_requested = 0;
+            step_completed(instance, instance->time);
             return FMU_OK;
         }
     }
@@ -599,9 +606,7 @@ FMU_COLD static fmu_status do_step_checked(fmu_instance* instance, double curren
         status = FMU_OK; /* on_singular = continue: the outputs NaN, the status set */
     }
     if (status == FMU_OK) {
-        instance->time = current_time + step_size;
-        instance->last_successful_time = instance->time;
-        instance->terminate_requested = 0;
+        step_completed(instance, current_time + step_size);
     } else if (status == FMU_DISCARD) {
         instance->last_successful_time = current_time;
         instance->terminate_requested = 1;
@@ -628,9 +633,7 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
             instance->dirty = 0;
         }
         if (e->status == FMU_OK) {
-            instance->time = current_time + step_size;
-            instance->last_successful_time = instance->time;
-            instance->terminate_requested = 0;
+            step_completed(instance, current_time + step_size);
             return FMU_OK;
         }
     }
