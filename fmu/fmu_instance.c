@@ -257,14 +257,17 @@ static void find_places(fmu_instance* instance)
 /* A plan's arrays for up to `capacity` values, aligned. */
 static size_t plan_size(size_t capacity)
 {
-    return round_up(capacity * sizeof(unsigned int)) + 2 * round_up(capacity * sizeof(double)) +
+    return 2 * round_up(capacity * sizeof(unsigned int)) + 2 * round_up(capacity * sizeof(double)) +
            2 * round_up(capacity * sizeof(double*));
 }
 
 static void place_plan(fmu_plan* plan, char* at, size_t capacity)
 {
     plan->count = 0;
+    plan->bounded_count = 0;
     plan->vr = (unsigned int*)(void*)at;
+    at += round_up(capacity * sizeof(unsigned int));
+    plan->position = (unsigned int*)(void*)at;
     at += round_up(capacity * sizeof(unsigned int));
     plan->low = (double*)(void*)at;
     at += round_up(capacity * sizeof(double));
@@ -945,95 +948,135 @@ static int get_reals_at_once(fmu_instance* instance, const unsigned int vr[], si
     return 1;
 }
 
-/* 1 if the call names the same value references as the plan's. */
-static int plan_fits(const fmu_plan* plan, const unsigned int vr[], size_t count)
+/* 1 if vr[k] == planned[k] for every k < count (count > 0): four at a time, the
+ * last four overlapping those before where count is not a multiple of four, so
+ * that no loop handles a tail. */
+FMU_INLINE int same_references(const unsigned int planned[], const unsigned int vr[], size_t count)
 {
-    return count == plan->count && count > 0 && memcmp(vr, plan->vr, count * sizeof *vr) == 0;
-}
-
-/* 1 if low[k] <= values[k] <= high[k] for every k (never for a NaN). */
-static int all_within(const double values[], const double low[], const double high[], size_t count)
-{
-    size_t k = 0;
-    int within = 1;
+    unsigned int differ;
 #if defined(__SSE2__)
-    __m128d ok = _mm_castsi128_pd(_mm_set1_epi32(-1));
-    for (; k + 2 <= count; k += 2) {
-        const __m128d v = _mm_loadu_pd(values + k);
-        ok = _mm_and_pd(ok, _mm_and_pd(_mm_cmpge_pd(v, _mm_loadu_pd(low + k)),
-                                       _mm_cmple_pd(v, _mm_loadu_pd(high + k))));
+    if (count >= 4) {
+        const __m128i* const mine = (const __m128i*)(const void*)planned;
+        const __m128i* const theirs = (const __m128i*)(const void*)vr;
+        const __m128i* const mine_last = (const __m128i*)(const void*)(planned + count - 4);
+        const __m128i* const theirs_last = (const __m128i*)(const void*)(vr + count - 4);
+        __m128i d = _mm_xor_si128(_mm_loadu_si128(mine_last), _mm_loadu_si128(theirs_last));
+        size_t k = 0;
+        for (; 4 * k + 8 < count; k += 2) {
+            d = _mm_or_si128(d,
+                             _mm_xor_si128(_mm_loadu_si128(mine + k), _mm_loadu_si128(theirs + k)));
+            d = _mm_or_si128(
+                d, _mm_xor_si128(_mm_loadu_si128(mine + k + 1), _mm_loadu_si128(theirs + k + 1)));
+        }
+        if (4 * k + 4 < count) {
+            d = _mm_or_si128(d,
+                             _mm_xor_si128(_mm_loadu_si128(mine + k), _mm_loadu_si128(theirs + k)));
+        }
+        return _mm_movemask_epi8(_mm_cmpeq_epi32(d, _mm_setzero_si128())) == 0xFFFF;
     }
-    within = _mm_movemask_pd(ok) == 3;
 #endif
-    for (; k < count; ++k) {
-        within &= values[k] >= low[k] && values[k] <= high[k];
+    differ = vr[0] ^ planned[0];
+    if (count >= 2) {
+        size_t k;
+        for (k = 1; k < count; ++k) {
+            differ |= vr[k] ^ planned[k];
+        }
     }
-    return within;
+    return differ == 0;
 }
 
-/* 1 if every value is finite: their products with 0 add up to 0, where an infinity
- * or a NaN makes the sum NaN. Three instructions a pair instead of eight for
- * all_within, for a plan whose values have no bounds but the finite doubles. */
+/* 1 if every value is finite (count > 0): their products with 0 add up to 0,
+ * where an infinity or a NaN makes the sum NaN. Four at a time as in
+ * same_references. */
 static int all_finite(const double values[], size_t count)
 {
-    size_t k = 0;
-    double sum = 0;
+    double sum;
 #if defined(__SSE2__)
-    const __m128d zero = _mm_setzero_pd();
-    __m128d sums[2];
-    sums[0] = zero;
-    sums[1] = zero;
-    for (; k + 4 <= count; k += 4) {
-        sums[0] = _mm_add_pd(sums[0], _mm_mul_pd(_mm_loadu_pd(values + k), zero));
-        sums[1] = _mm_add_pd(sums[1], _mm_mul_pd(_mm_loadu_pd(values + k + 2), zero));
+    if (count >= 4) {
+        const __m128d zero = _mm_setzero_pd();
+        __m128d low = _mm_mul_pd(_mm_loadu_pd(values + count - 4), zero);
+        __m128d high = _mm_mul_pd(_mm_loadu_pd(values + count - 2), zero);
+        size_t k;
+        for (k = 0; k + 4 < count; k += 4) {
+            low = _mm_add_pd(low, _mm_mul_pd(_mm_loadu_pd(values + k), zero));
+            high = _mm_add_pd(high, _mm_mul_pd(_mm_loadu_pd(values + k + 2), zero));
+        }
+        low = _mm_add_pd(low, high);
+        sum = _mm_cvtsd_f64(_mm_add_sd(low, _mm_unpackhi_pd(low, low)));
+        return sum == 0;
     }
-    sums[0] = _mm_add_pd(sums[0], sums[1]);
-    sum = _mm_cvtsd_f64(_mm_add_sd(sums[0], _mm_unpackhi_pd(sums[0], sums[0])));
 #endif
-    for (; k + 2 <= count; k += 2) {
-        sum += values[k] * 0.0 + values[k + 1] * 0.0;
-    }
-    if (k < count) {
-        sum += values[k] * 0.0;
+    sum = values[0] * 0.0;
+    if (count >= 2) {
+        size_t k;
+        for (k = 1; k < count; ++k) {
+            sum += values[k] * 0.0;
+        }
     }
     return sum == 0;
 }
 
-/* A set by the plan: every value checked, then every one stored. */
+/* 1 if each value with bounds tighter than finite is within them (never a NaN). */
+static int bounded_within(const fmu_plan* plan, const double values[])
+{
+    int within = 1;
+    size_t j;
+    for (j = 0; j < plan->bounded_count; ++j) {
+        const double value = values[plan->position[j]];
+        within &= value >= plan->low[j] && value <= plan->high[j];
+    }
+    return within;
+}
+
+/* A set by the plan (count > 0): every value checked, then every one stored, in
+ * order (a repeated reference keeps its last value; the overlapping last four
+ * store again what they stored, in the same order, so that still holds). */
 static int set_by_plan(fmu_instance* instance, size_t count, const double values[])
 {
     const fmu_plan* plan = &instance->set_plan;
     double* const* write = plan->write;
-    size_t k = 0;
-    if (!(plan->finite_only ? all_finite(values, count)
-                            : all_within(values, plan->low, plan->high, count))) {
+    size_t k;
+    if (!all_finite(values, count) || !bounded_within(plan, values)) {
         return 0;
     }
-    /* in order: a repeated reference keeps its last value */
-    for (; k + 4 <= count; k += 4) {
+    if (count >= 4) {
+        for (k = 0; k + 4 < count; k += 4) {
+            *write[k] = values[k];
+            *write[k + 1] = values[k + 1];
+            *write[k + 2] = values[k + 2];
+            *write[k + 3] = values[k + 3];
+        }
+        k = count - 4;
         *write[k] = values[k];
         *write[k + 1] = values[k + 1];
         *write[k + 2] = values[k + 2];
         *write[k + 3] = values[k + 3];
-    }
-    for (; k < count; ++k) {
-        *write[k] = values[k];
+    } else {
+        for (k = 0; k < count; ++k) {
+            *write[k] = values[k];
+        }
     }
     instance->angles_pending |= instance->angle_count > 0;
     return 1;
 }
 
-/* A get by the plan: each value from where it is kept. */
+/* A get by the plan (count > 0): each value from where it is kept, two at a time,
+ * the last two overlapping where count is odd. */
 static void get_by_plan(const fmu_plan* plan, size_t count, double values[])
 {
     const double* const* read = plan->read;
-    size_t k = 0;
+    size_t k;
 #if defined(__SSE2__)
-    for (; k + 2 <= count; k += 2) {
+    if (count >= 2) {
+        for (k = 0; k + 2 < count; k += 2) {
+            _mm_storeu_pd(values + k, _mm_loadh_pd(_mm_load_sd(read[k]), read[k + 1]));
+        }
+        k = count - 2;
         _mm_storeu_pd(values + k, _mm_loadh_pd(_mm_load_sd(read[k]), read[k + 1]));
+        return;
     }
 #endif
-    if (k < count) {
+    for (k = 0; k < count; ++k) {
         values[k] = *read[k];
     }
 }
@@ -1043,8 +1086,7 @@ static void get_by_plan(const fmu_plan* plan, size_t count, double values[])
 static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsigned int vr[],
                       size_t count)
 {
-    int finite_only = 1;
-    size_t k;
+    size_t k, bounded = 0;
     plan->count = 0;
     if (count > instance->model->vr_limit) {
         return;
@@ -1052,13 +1094,16 @@ static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsign
     for (k = 0; k < count; ++k) {
         const fmu_slot* slot = &instance->slots[vr[k]];
         plan->vr[k] = vr[k];
-        plan->low[k] = slot->low;
-        plan->high[k] = slot->high;
         plan->write[k] = slot->write;
         plan->read[k] = slot->read;
-        finite_only &= slot->low == -DBL_MAX && slot->high == DBL_MAX;
+        if (slot->low != -DBL_MAX || slot->high != DBL_MAX) {
+            plan->position[bounded] = (unsigned int)k;
+            plan->low[bounded] = slot->low;
+            plan->high[bounded] = slot->high;
+            ++bounded;
+        }
     }
-    plan->finite_only = finite_only;
+    plan->bounded_count = bounded;
     plan->count = count;
 }
 
@@ -1084,8 +1129,9 @@ fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t 
                         const double values[], const char* function)
 {
     /* the common case: the same references as the last set, every value valid */
-    if (instance != NULL && vr != NULL && values != NULL && quiet_call(instance, FMU_OP_SET) &&
-        plan_fits(&instance->set_plan, vr, count) && set_by_plan(instance, count, values)) {
+    if (instance != NULL && vr != NULL && values != NULL && count == instance->set_plan.count &&
+        count > 0 && quiet_call(instance, FMU_OP_SET) &&
+        same_references(instance->set_plan.vr, vr, count) && set_by_plan(instance, count, values)) {
         after_set(instance);
         return FMU_OK;
     }
@@ -1133,9 +1179,10 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
                         double values[], const char* function)
 {
     /* the common case: after a step, the same references as the last get */
-    if (instance != NULL && vr != NULL && values != NULL && quiet_call(instance, FMU_OP_GET) &&
-        !instance->dirty && instance->evaluation.status == FMU_OK &&
-        plan_fits(&instance->get_plan, vr, count)) {
+    if (instance != NULL && vr != NULL && values != NULL && count == instance->get_plan.count &&
+        count > 0 && quiet_call(instance, FMU_OP_GET) && !instance->dirty &&
+        instance->evaluation.status == FMU_OK &&
+        same_references(instance->get_plan.vr, vr, count)) {
         get_by_plan(&instance->get_plan, count, values);
         return FMU_OK;
     }

@@ -82,11 +82,12 @@ typedef struct fmu_slot {
  * so that the same call again (the same value references: an importer repeats
  * its calls every step) is one vector check of the values and a copy. */
 typedef struct fmu_plan {
-    size_t count;        /* of the call; 0: none */
-    int finite_only;     /* set: every interval is all the finite doubles */
-    unsigned int* vr;    /* its value references */
-    double* low;         /* set: each value's accepted interval */
-    double* high;        /* (contiguous for a vector check) */
+    size_t count;           /* of the call; 0: none */
+    unsigned int* vr;       /* its value references */
+    size_t bounded_count;   /* set: the values with bounds tighter than finite, */
+    unsigned int* position; /* their positions in the call, */
+    double* low;            /* and their accepted intervals */
+    double* high;
     double** write;      /* where a set stores each value */
     const double** read; /* where a get reads each value */
 } fmu_plan;

@@ -15,6 +15,14 @@
 #define FMU_COLD
 #endif
 
+/* A step of the common path, inlined into each of its callers even where the
+ * compiler's size heuristics would call it: the call would cost more than it does. */
+#if defined(__GNUC__)
+#define FMU_INLINE static inline __attribute__((always_inline))
+#else
+#define FMU_INLINE static inline
+#endif
+
 /* Same numbering as fmi2Status and fmi3Status. */
 typedef enum fmu_status {
     FMU_OK = 0,

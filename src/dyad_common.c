@@ -218,6 +218,14 @@ dyad_field dyad_first_bad_field(dyad_type type, const dyad_input* in)
     return DYAD_FIELD_NONE;
 }
 
+dyad_field dyad_check_input(dyad_type type, const dyad_input* input)
+{
+    if ((unsigned)type >= DYAD_TYPE_COUNT) {
+        return DYAD_FIELD_TYPE;
+    }
+    return input == NULL ? DYAD_FIELD_INPUT : dyad_first_bad_field(type, input);
+}
+
 dyad_status dyad_reject(dyad_result* result, dyad_status status, dyad_field field)
 {
     dyad_fill_outputs(result, (dyad_real)NAN);

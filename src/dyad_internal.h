@@ -15,9 +15,10 @@
 typedef dyad_loaded_link dyad_body;
 typedef dyad_loaded dyad_prepared;
 
-/* A solver's closed forms, inlined into both dyad_solve_<type> and
- * dyad_react_<type> even where the compiler's size heuristics would not: the
- * validating path is the hot one and a call would cost it a tenth. */
+/* A solver's steps (its input prepared, its closed forms), inlined into each
+ * entry (dyad_solve_<type>, dyad_solve_valid_<type>, dyad_react_<type>) even
+ * where the compiler's size heuristics would not: a call would cost the solve a
+ * tenth. */
 #if defined(__GNUC__) || defined(__clang__)
 #define DYAD_CLOSED_FORM static inline __attribute__((always_inline))
 #else
@@ -183,6 +184,25 @@ static inline void dyad_fill_outputs(dyad_result* result, dyad_real value)
     result->m_mn = value;
 }
 
+/* The frames and resultants of an input known to be valid, and the outputs
+ * cleared for the closed forms. */
+DYAD_CLOSED_FORM void dyad_prepare_valid(dyad_type type, const dyad_input* input,
+                                         dyad_prepared* prepared, dyad_result* result)
+{
+    dyad_prepare_body(&input->m, input->gravity, &prepared->m);
+    dyad_prepare_body(&input->n, input->gravity, &prepared->n);
+    prepared->i_k =
+        dyad_guide_used(type, DYAD_PAIR_DM) ? dyad_unit_of(input->guide_k) : dyad_vec2_make(0, 0);
+    prepared->j_k = dyad_perp(prepared->i_k);
+    prepared->i_p =
+        dyad_guide_used(type, DYAD_PAIR_DN) ? dyad_unit_of(input->guide_p) : dyad_vec2_make(0, 0);
+    prepared->j_p = dyad_perp(prepared->i_p);
+    prepared->singular_threshold = input->singular_threshold;
+    dyad_fill_outputs(result, 0);
+    result->status = DYAD_STATUS_OK;
+    result->field = DYAD_FIELD_NONE;
+}
+
 static inline dyad_status dyad_prepare(dyad_type type, const dyad_input* input,
                                        dyad_prepared* prepared, dyad_result* result)
 {
@@ -199,18 +219,7 @@ static inline dyad_status dyad_prepare(dyad_type type, const dyad_input* input,
         result->denominator = result->conditioning = result->amplification = (dyad_real)NAN;
         return dyad_reject(result, DYAD_STATUS_INVALID_INPUT, bad);
     }
-    dyad_prepare_body(&input->m, input->gravity, &prepared->m);
-    dyad_prepare_body(&input->n, input->gravity, &prepared->n);
-    prepared->i_k =
-        dyad_guide_used(type, DYAD_PAIR_DM) ? dyad_unit_of(input->guide_k) : dyad_vec2_make(0, 0);
-    prepared->j_k = dyad_perp(prepared->i_k);
-    prepared->i_p =
-        dyad_guide_used(type, DYAD_PAIR_DN) ? dyad_unit_of(input->guide_p) : dyad_vec2_make(0, 0);
-    prepared->j_p = dyad_perp(prepared->i_p);
-    prepared->singular_threshold = input->singular_threshold;
-    dyad_fill_outputs(result, 0);
-    result->status = DYAD_STATUS_OK;
-    result->field = DYAD_FIELD_NONE;
+    dyad_prepare_valid(type, input, prepared, result);
     return DYAD_STATUS_OK;
 }
 

@@ -71,6 +71,13 @@ dyad_status dyad_react_rrr(const dyad_loaded* dyad, dyad_result* result)
     return status == DYAD_STATUS_OK ? rrr_reactions(dyad, result) : status;
 }
 
+dyad_status dyad_solve_valid_rrr(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    dyad_prepare_valid(DYAD_RRR, input, &p, result);
+    return rrr_reactions(&p, result);
+}
+
 dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
 {
     dyad_prepared p;

@@ -72,6 +72,13 @@ dyad_status dyad_react_rrt(const dyad_loaded* dyad, dyad_result* result)
     return status == DYAD_STATUS_OK ? rrt_reactions(dyad, result) : status;
 }
 
+dyad_status dyad_solve_valid_rrt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    dyad_prepare_valid(DYAD_RRT, input, &p, result);
+    return rrt_reactions(&p, result);
+}
+
 dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
 {
     dyad_prepared p;

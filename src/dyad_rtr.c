@@ -96,6 +96,13 @@ dyad_status dyad_react_rtr(const dyad_loaded* dyad, dyad_result* result)
     return status == DYAD_STATUS_OK ? rtr_reactions(dyad, result) : status;
 }
 
+dyad_status dyad_solve_valid_rtr(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    dyad_prepare_valid(DYAD_RTR, input, &p, result);
+    return rtr_reactions(&p, result);
+}
+
 dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result)
 {
     dyad_prepared p;

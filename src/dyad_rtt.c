@@ -83,6 +83,13 @@ dyad_status dyad_react_rtt(const dyad_loaded* dyad, dyad_result* result)
     return status == DYAD_STATUS_OK ? rtt_reactions(dyad, result) : status;
 }
 
+dyad_status dyad_solve_valid_rtt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    dyad_prepare_valid(DYAD_RTT, input, &p, result);
+    return rtt_reactions(&p, result);
+}
+
 dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
 {
     dyad_prepared p;

@@ -65,6 +65,13 @@ dyad_status dyad_react_trt(const dyad_loaded* dyad, dyad_result* result)
     return status == DYAD_STATUS_OK ? trt_reactions(dyad, result) : status;
 }
 
+dyad_status dyad_solve_valid_trt(const dyad_input* input, dyad_result* result)
+{
+    dyad_prepared p;
+    dyad_prepare_valid(DYAD_TRT, input, &p, result);
+    return trt_reactions(&p, result);
+}
+
 dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
 {
     dyad_prepared p;

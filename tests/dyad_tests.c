@@ -950,6 +950,52 @@ static double result_distance(const dyad_result* a, const dyad_result* b)
     return worst / (scale > 0 ? scale : 1);
 }
 
+/* dyad_solve_valid_<type> against dyad_solve_<type>, bit for bit, on valid inputs:
+ * random ones, and near-singular and exactly singular ones (statuses included);
+ * and dyad_check_input naming what dyad_solve refuses. */
+static int test_solve_valid_matches_solve(void)
+{
+    static const dyad_solver valid[DYAD_TYPE_COUNT] = {dyad_solve_valid_rrr, dyad_solve_valid_rrt,
+                                                       dyad_solve_valid_rtr, dyad_solve_valid_trt,
+                                                       dyad_solve_valid_rtt};
+    int fails = 0;
+    int t, k;
+    rng r = {20261126u};
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        const dyad_type type = all_types[t];
+        int singular = 0;
+        for (k = 0; k < 2014; ++k) {
+            /* the last 14: exactly singular, then approaching it */
+            const dyad_input in = k < 2000
+                                      ? random_input(&r, type)
+                                      : near_singular(type, k == 2000 ? 0 : pow(10, 2000 - k), 0);
+            dyad_result want, got;
+            const dyad_status status = dyad_solve(type, &in, &want);
+            CHECK(dyad_check_input(type, &in) == DYAD_FIELD_NONE, "%s case %d: refused (%s)",
+                  dyad_type_name(type), k, dyad_field_name(dyad_check_input(type, &in)));
+            CHECK(valid[t](&in, &got) == status && memcmp(&got, &want, sizeof got) == 0,
+                  "%s case %d: valid solve %s, solve %s (R_mn.x %.17g, %.17g)",
+                  dyad_type_name(type), k, dyad_status_name(got.status), dyad_status_name(status),
+                  (double)got.r_mn.x, (double)want.r_mn.x);
+            singular += status == DYAD_STATUS_SINGULAR;
+        }
+        CHECK(singular > 0, "%s: no singular case compared", dyad_type_name(type));
+    }
+    {
+        dyad_input in = valid_input(DYAD_RRR);
+        CHECK(dyad_check_input(DYAD_TYPE_COUNT, &in) == DYAD_FIELD_TYPE, "unknown type not named");
+        CHECK(dyad_check_input(DYAD_RRR, NULL) == DYAD_FIELD_INPUT, "NULL input not named");
+        in.n.mass = -1;
+        CHECK(dyad_check_input(DYAD_RRR, &in) == DYAD_FIELD_N_MASS, "negative mass: %s",
+              dyad_field_name(dyad_check_input(DYAD_RRR, &in)));
+        in = valid_input(DYAD_RRR), in.m.length = 0;
+        CHECK(dyad_check_input(DYAD_RRR, &in) == DYAD_FIELD_M_LENGTH &&
+                  dyad_check_input(DYAD_RRT, &in) == DYAD_FIELD_NONE,
+              "RRR refuses l_m = 0, RRT allows it");
+    }
+    return fails;
+}
+
 static int test_react_loaded(void)
 {
     static dyad_status (*const react[DYAD_TYPE_COUNT])(const dyad_loaded*, dyad_result*) = {
@@ -2565,6 +2611,7 @@ static const named_test tests[] = {
     {"singular", test_singular},
     {"invalid_before_singular", test_invalid_before_singular},
     {"react_loaded", test_react_loaded},
+    {"solve_valid_matches_solve", test_solve_valid_matches_solve},
     {"batch_matches_solve", test_batch_matches_solve},
     {"batch_interleaved_pairs", test_batch_interleaved_pairs},
     {"batch_refusals", test_batch_refusals},

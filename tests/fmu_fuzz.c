@@ -206,6 +206,8 @@ typedef struct fuzz_episode {
     int verbose;
     int failed; /* an invariant broke */
     fuzz_counts* counts;
+    unsigned last_vrs[6]; /* of the last setReal of op_set_real, */
+    size_t last_n;        /* which a third of them call again */
     char failure[1200];
 } fuzz_episode;
 
@@ -744,19 +746,29 @@ static void op_set_real(fuzz_episode* e)
     unsigned vrs[6];
     double values[6];
     const uint64_t pick = probe_rng_below(&e->rng, 100);
-    const size_t n = pick < 4 ? 0 : pick < 65 ? 1 : 2 + (size_t)probe_rng_below(&e->rng, 5);
+    /* a third of them the same value references as the last: an importer's every
+     * step, which the FMU serves by its plan of that call */
+    const int again = e->last_n > 0 && probe_rng_below(&e->rng, 3) == 0;
+    const size_t n = again       ? e->last_n
+                     : pick < 4  ? 0
+                     : pick < 65 ? 1
+                                 : 2 + (size_t)probe_rng_below(&e->rng, 5);
     long log_count;
     size_t k;
     int status;
     for (k = 0; k < n; ++k) {
         const probe_variable* v;
         /* now and then the same variable twice: the last value counts */
-        vrs[k] = k > 0 && probe_rng_below(&e->rng, 10) == 0 ? vrs[k - 1] : random_vr(e, PROBE_REAL);
+        vrs[k] = again                                        ? e->last_vrs[k]
+                 : k > 0 && probe_rng_below(&e->rng, 10) == 0 ? vrs[k - 1]
+                                                              : random_vr(e, PROBE_REAL);
+        e->last_vrs[k] = vrs[k];
         v = probe_variable_of_vr(&e->fmu->model, vrs[k]);
         values[k] = v != NULL ? nasty_value(&e->rng, v) : special_value(&e->rng);
         trace(e, vrs[k]);
         trace_double(e, values[k]);
     }
+    e->last_n = n;
     take_before(e);
     log_count = e->book.count;
     status = call_set_real(e, vrs, n, values);
@@ -1255,6 +1267,7 @@ static uint64_t run_episode(fuzz_episode* e, uint64_t seed)
     probe_log_book_clear(&e->book);
     e->trace = PROBE_HASH_START;
     e->failed = 0;
+    e->last_n = 0;
     e->call = 0;
     e->step_quota = 1 + (long)probe_rng_below(&e->rng, 200);
     e->time = 0;

@@ -70,11 +70,18 @@ static void initialise(const fmu_model* model, void* input)
     *(dyad_input*)input = dyad_input_default();
 }
 
+/* The layer checks every value against its variable's bounds where it is set,
+ * and a dyad's bounds are its fields' domains (an angle gives a unit direction),
+ * so the common solve skips the core's check of its input. Where that solve has
+ * no answer, the checking solve runs again to say whether an input is to blame:
+ * the first line of defence should a value reach the block another way. */
 static void evaluate(const fmu_model* model, const void* input, void* output,
                      fmu_evaluation* evaluation)
 {
     const fmu_dyad_data* dyad = (const fmu_dyad_data*)model->data;
-    dyad->solve((const dyad_input*)input, (dyad_result*)output);
+    if (dyad->solve_valid((const dyad_input*)input, (dyad_result*)output) != DYAD_STATUS_OK) {
+        dyad->solve((const dyad_input*)input, (dyad_result*)output);
+    }
     report(model, (const dyad_input*)input, (const dyad_result*)output, evaluation);
 }
 

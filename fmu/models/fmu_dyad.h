@@ -14,6 +14,7 @@ typedef struct fmu_dyad_feed {
 
 typedef struct fmu_dyad_data {
     dyad_solver solve;                /* this type's solver: the FMU links no other */
+    dyad_solver solve_valid;          /* the same without the check of its input */
     const dyad_tangent_type* tangent; /* its directional derivative (&dyad_tangent_rrt, ...) */
     /* Which variable feeds which field, in the order of the variables: an
      * invalid input is blamed on the first variable that feeds its field. */

@@ -226,8 +226,8 @@ class DyadKind(Kind):
             *feeds,
             "};",
             "",
-            f"static const fmu_dyad_data dyad = {{dyad_solve_{t}, &dyad_tangent_{t}, "
-            f"feeds, {len(feeds)}}};",
+            f"static const fmu_dyad_data dyad = {{dyad_solve_{t}, dyad_solve_valid_{t}, "
+            f"&dyad_tangent_{t}, feeds, {len(feeds)}}};",
             "",
         ], "&dyad"
 

@@ -1563,6 +1563,49 @@ def _write_generic_tables():
 _write_generic_tables()
 
 
+@pytest.mark.parametrize("dyad_type", TYPES)
+def test_bounds_are_the_core_domains(dyad_type):
+    """A dyad FMU checks each value against its variable's bounds where it is set and
+    then solves without the core's check of its input (dyad_solve_valid_<type>). That
+    holds only if the bounds are the domains the core checks: a length may be 0 exactly
+    where the C core's dyad_length_may_be_zero says so, a mass and an inertia not
+    below 0, the singular threshold strictly between 0 and 1, every other field any
+    finite number, and a direction set only as an angle (a unit vector)."""
+    import ctypes
+
+    from dyadfmu.core import library_path
+
+    lib = ctypes.CDLL(str(library_path()))
+    lib.dyad_length_may_be_zero.argtypes = [ctypes.c_int, ctypes.c_int]
+    checked = 0
+    for v in load_raw(dyad_type)["variable"]:
+        lives = v.get("lives", "")
+        if v["causality"] == "output" or not lives.startswith("input."):
+            continue
+        field = lives.removeprefix("input.")
+        bounds = (
+            v.get("min"),
+            v.get("max"),
+            v.get("min_exclusive", False),
+            v.get("max_exclusive", False),
+        )
+        leaf = field.split(".")[-1].split("@")[0]
+        if leaf == "length":
+            may_be_zero = lib.dyad_length_may_be_zero(TYPES.index(dyad_type), "mn".index(field[0]))
+            expected = (0.0, None, not may_be_zero, False)
+        elif leaf in ("mass", "inertia"):
+            expected = (0.0, None, False, False)
+        elif field == "singular_threshold":
+            expected = (0.0, 1.0, True, True)
+        else:
+            expected = (None, None, False, False)
+        if leaf in ("dir", "guide_k", "guide_p"):
+            assert field.endswith("@angle"), f"{v['name']}: a direction is set as an angle"
+        assert bounds == expected, f"{dyad_type} {v['name']}: bounds {bounds}, core {expected}"
+        checked += 1
+    assert checked >= 25
+
+
 def test_angles_display_in_degrees_and_speeds_in_rpm():
     """Every built FMU, FMI 2 and 3: a variable in rad shows in deg, one in rad/s in rpm,
     by the unit definitions' factors (shown = factor * value)."""

@@ -35,6 +35,25 @@ dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result);
 dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result);
 dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result);
 
+/** The first field of `input` that is out of its domain for the type (the one
+ *  dyad_solve would refuse with DYAD_STATUS_INVALID_INPUT), DYAD_FIELD_TYPE for
+ *  an unknown type, DYAD_FIELD_INPUT for NULL; DYAD_FIELD_NONE if it is valid. */
+dyad_field dyad_check_input(dyad_type type, const dyad_input* input);
+
+/** The per-type solvers for an input the caller knows to be valid, as a caller
+ *  does that checks each value where it is set (the FMUs check every value
+ *  against the bounds of its variable, which are the fields' domains): they
+ *  skip the check on the way in. The input must be one for which
+ *  dyad_check_input returns DYAD_FIELD_NONE; for any other the results mean
+ *  nothing. The status is DYAD_STATUS_OK, DYAD_STATUS_SINGULAR or
+ *  DYAD_STATUS_OUT_OF_RANGE, never DYAD_STATUS_INVALID_INPUT; for a valid input
+ *  every output equals dyad_solve_<type>'s, bit for bit. */
+dyad_status dyad_solve_valid_rrr(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_valid_rrt(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_valid_rtr(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_valid_trt(const dyad_input* input, dyad_result* result);
+dyad_status dyad_solve_valid_rtt(const dyad_input* input, dyad_result* result);
+
 /** The reactions and their directional derivative along `seed`, exactly (one
  *  more solve of the closed forms, no finite differences). `seed` has the layout
  *  of the input and holds the rate of each field; a direction's rate is the
