@@ -456,10 +456,13 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
         fmu_log(fmu, FMU_ERROR, "fmi3DoStep: an output argument is NULL");
         return fmi3Error;
     }
-    status = fmu_do_step(fmu, currentCommunicationPoint, communicationStepSize, "fmi3DoStep");
-    if (fmu != NULL && eventHandlingNeeded != NULL) {
+    if (fmu != NULL) {
+        /* before the step: fewer pointers kept across the call */
         *eventHandlingNeeded = fmi3False;
         *earlyReturn = fmi3False;
+    }
+    status = fmu_do_step(fmu, currentCommunicationPoint, communicationStepSize, "fmi3DoStep");
+    if (fmu != NULL) {
         *terminateSimulation = fmu->terminate_requested ? fmi3True : fmi3False;
         *lastSuccessfulTime = fmu->last_successful_time;
     }

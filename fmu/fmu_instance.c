@@ -123,7 +123,7 @@ static void store(fmu_instance* instance, size_t index, double value)
 
 /* The (cos, sin) of every angle that changed since the model last read them, two at
  * a time (both again where one of the two changed: as cheap as one alone). */
-static void sync_angles(fmu_instance* instance)
+FMU_INLINE void sync_angles(fmu_instance* instance)
 {
     fmu_angle* a = instance->angles;
     fmu_angle* const end = a + instance->angle_count;
@@ -265,6 +265,8 @@ static void place_plan(fmu_plan* plan, char* at, size_t capacity)
 {
     plan->count = 0;
     plan->bounded_count = 0;
+    plan->store = NULL;
+    plan->load = NULL;
     plan->vr = (unsigned int*)(void*)at;
     at += round_up(capacity * sizeof(unsigned int));
     plan->position = (unsigned int*)(void*)at;
@@ -513,9 +515,10 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
  * of double at current_time would advance the states but not the time. */
 static int step_is_valid(double current_time, double step_size)
 {
+    /* x - x is 0 for a finite x: both ends finite, and the end later (so the size is
+     * positive, finite, and above the resolution of double at current_time) */
     const double end = current_time + step_size;
-    return fabs(current_time) <= DBL_MAX && step_size > 0 && step_size <= DBL_MAX &&
-           fabs(end) <= DBL_MAX && end > current_time;
+    return (end - end) + (current_time - current_time) == 0 && end > current_time;
 }
 
 /* Refuses, with the reason, a step that step_is_valid does not take. */
@@ -830,8 +833,8 @@ static fmu_status explain_refusal(const fmu_instance* instance, const unsigned i
 static void after_set(fmu_instance* instance)
 {
     instance->dirty = 1;
-    if (instance->model->behaviour->start != NULL &&
-        ((unsigned)instance->state & PARAMETER_STATES)) {
+    if (((unsigned)instance->state & PARAMETER_STATES) &&
+        instance->model->behaviour->start != NULL) {
         sync_angles(instance);
         instance->model->behaviour->start(instance->model, instance->input);
     }
@@ -1016,6 +1019,35 @@ static int all_finite(const double values[], size_t count)
     return sum == 0;
 }
 
+/* same_references and all_finite in one pass: a set's common case. */
+FMU_INLINE int same_and_finite(const unsigned int planned[], const unsigned int vr[],
+                               const double values[], size_t count)
+{
+#if defined(__SSE2__)
+    if (count >= 4) {
+        const __m128i* const mine = (const __m128i*)(const void*)planned;
+        const __m128i* const theirs = (const __m128i*)(const void*)vr;
+        const size_t last = count - 4;
+        const __m128d zero = _mm_setzero_pd();
+        __m128i d = _mm_xor_si128(_mm_loadu_si128((const __m128i*)(const void*)(planned + last)),
+                                  _mm_loadu_si128((const __m128i*)(const void*)(vr + last)));
+        __m128d low = _mm_mul_pd(_mm_loadu_pd(values + last), zero);
+        __m128d high = _mm_mul_pd(_mm_loadu_pd(values + last + 2), zero);
+        size_t k;
+        for (k = 0; 4 * k < last; ++k) {
+            d = _mm_or_si128(d,
+                             _mm_xor_si128(_mm_loadu_si128(mine + k), _mm_loadu_si128(theirs + k)));
+            low = _mm_add_pd(low, _mm_mul_pd(_mm_loadu_pd(values + 4 * k), zero));
+            high = _mm_add_pd(high, _mm_mul_pd(_mm_loadu_pd(values + 4 * k + 2), zero));
+        }
+        low = _mm_add_pd(low, high);
+        return _mm_movemask_epi8(_mm_cmpeq_epi32(d, _mm_setzero_si128())) == 0xFFFF &&
+               _mm_cvtsd_f64(_mm_add_sd(low, _mm_unpackhi_pd(low, low))) == 0;
+    }
+#endif
+    return same_references(planned, vr, count) && all_finite(values, count);
+}
+
 /* 1 if each value with bounds tighter than finite is within them (never a NaN). */
 static int bounded_within(const fmu_plan* plan, const double values[])
 {
@@ -1028,18 +1060,21 @@ static int bounded_within(const fmu_plan* plan, const double values[])
     return within;
 }
 
-/* A set by the plan (count > 0): every value checked, then every one stored, in
- * order (a repeated reference keeps its last value; the overlapping last four
- * store again what they stored, in the same order, so that still holds). */
+/* A set by the plan (count > 0) of finite values: every bound checked, then every
+ * value stored, in order (a repeated reference keeps its last value; the
+ * overlapping last four store again what they stored, in the same order, so that
+ * still holds). */
 static int set_by_plan(fmu_instance* instance, size_t count, const double values[])
 {
     const fmu_plan* plan = &instance->set_plan;
     double* const* write = plan->write;
     size_t k;
-    if (!all_finite(values, count) || !bounded_within(plan, values)) {
+    if (!bounded_within(plan, values)) {
         return 0;
     }
-    if (count >= 4) {
+    if (plan->store != NULL) {
+        plan->store(instance->input, instance->values, values);
+    } else if (count >= 4) {
         for (k = 0; k + 4 < count; k += 4) {
             *write[k] = values[k];
             *write[k + 1] = values[k + 1];
@@ -1062,10 +1097,14 @@ static int set_by_plan(fmu_instance* instance, size_t count, const double values
 
 /* A get by the plan (count > 0): each value from where it is kept, two at a time,
  * the last two overlapping where count is odd. */
-static void get_by_plan(const fmu_plan* plan, size_t count, double values[])
+static void get_by_plan(const fmu_plan* plan, const void* output, size_t count, double values[])
 {
     const double* const* read = plan->read;
     size_t k;
+    if (plan->load != NULL) {
+        plan->load(output, values);
+        return;
+    }
 #if defined(__SSE2__)
     if (count >= 2) {
         for (k = 0; k + 2 < count; k += 2) {
@@ -1086,6 +1125,7 @@ static void get_by_plan(const fmu_plan* plan, size_t count, double values[])
 static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsigned int vr[],
                       size_t count)
 {
+    const fmu_copies* copies = instance->model->copies;
     size_t k, bounded = 0;
     plan->count = 0;
     if (count > instance->model->vr_limit) {
@@ -1104,6 +1144,16 @@ static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsign
         }
     }
     plan->bounded_count = bounded;
+    plan->store = NULL;
+    plan->load = NULL;
+    if (copies != NULL && count == copies->input_count && count > 0 &&
+        same_references(copies->input_vrs, vr, count)) {
+        plan->store = copies->store_inputs;
+    }
+    if (copies != NULL && count == copies->output_count && count > 0 &&
+        same_references(copies->output_vrs, vr, count)) {
+        plan->load = copies->load_outputs;
+    }
     plan->count = count;
 }
 
@@ -1131,7 +1181,8 @@ fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t 
     /* the common case: the same references as the last set, every value valid */
     if (instance != NULL && vr != NULL && values != NULL && count == instance->set_plan.count &&
         count > 0 && quiet_call(instance, FMU_OP_SET) &&
-        same_references(instance->set_plan.vr, vr, count) && set_by_plan(instance, count, values)) {
+        same_and_finite(instance->set_plan.vr, vr, values, count) &&
+        set_by_plan(instance, count, values)) {
         after_set(instance);
         return FMU_OK;
     }
@@ -1183,7 +1234,7 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
         count > 0 && quiet_call(instance, FMU_OP_GET) && !instance->dirty &&
         instance->evaluation.status == FMU_OK &&
         same_references(instance->get_plan.vr, vr, count)) {
-        get_by_plan(&instance->get_plan, count, values);
+        get_by_plan(&instance->get_plan, instance->output, count, values);
         return FMU_OK;
     }
     return get_reals_checked(instance, vr, count, values, function);

@@ -90,6 +90,10 @@ typedef struct fmu_plan {
     double* high;
     double** write;      /* where a set stores each value */
     const double** read; /* where a get reads each value */
+    /* The model's straight copy where the call is its every step's (fmu_copies);
+     * NULL: by `write` or `read`. */
+    void (*store)(void* input, double* values, const double* from);
+    void (*load)(const void* output, double* to);
 } fmu_plan;
 
 /* An angle variable: kept as set, read by the model as its unit vector. */

@@ -124,6 +124,21 @@ typedef struct fmu_behaviour {
                        void* output, void* rate, fmu_evaluation* evaluation);
 } fmu_behaviour;
 
+/* The calls an importer makes every step, set every Real input and get every Real
+ * output, each with its value references in ascending order: generated with the
+ * table as straight copies between the caller's array and where the values are
+ * kept, every place a constant. The layer uses them for a call that names exactly
+ * these references; any other goes by the slots. */
+typedef struct fmu_copies {
+    const unsigned int* input_vrs; /* NULL: the model has no Real input */
+    size_t input_count;
+    /* the inputs into the input block, an angle into `values` (per variable, as set) */
+    void (*store_inputs)(void* input, double* values, const double* from);
+    const unsigned int* output_vrs; /* NULL: no Real output */
+    size_t output_count;
+    void (*load_outputs)(const void* output, double* to);
+} fmu_copies;
+
 typedef struct fmu_model {
     const char* identifier; /* modelIdentifier, e.g. "dyad_rrt" */
     const char* token;      /* instantiation token (FMI 3) / GUID (FMI 2) */
@@ -133,6 +148,7 @@ typedef struct fmu_model {
     unsigned int vr_limit;
     const fmu_behaviour* behaviour;
     const void* data; /* the behaviour's model data (a dyad: fmu_dyad_data) */
+    const fmu_copies* copies;
 } fmu_model;
 
 /* The model compiled into this FMU, defined by the generated <model>_model.c. */

@@ -836,6 +836,89 @@ static void op_set_plausible(fuzz_episode* e)
     free(values);
 }
 
+/* Every Real input in one call, in ascending value references: the call an importer
+ * makes every step, which the FMU serves by its model's straight copy. Now and then
+ * one value nasty, which must refuse the whole call. */
+static void op_set_inputs(fuzz_episode* e)
+{
+    const fuzz_fmu* f = e->fmu;
+    unsigned* vrs = (unsigned*)malloc((f->settable_count + 1) * sizeof *vrs);
+    double* values = (double*)malloc((f->settable_count + 1) * sizeof *values);
+    size_t k, n = 0;
+    long log_count;
+    int status;
+    if (vrs == NULL || values == NULL) {
+        free(vrs);
+        free(values);
+        return;
+    }
+    for (k = 0; k < f->settable_count; ++k) {
+        const probe_variable* v = &f->model.variables[f->settable[k]];
+        if (v->type == PROBE_REAL && v->causality == PROBE_INPUT) {
+            vrs[n] = v->vr;
+            values[n] = plausible_value(&e->rng, v);
+            ++n;
+        }
+    }
+    if (n > 0 && probe_rng_below(&e->rng, 4) == 0) {
+        const size_t at = (size_t)probe_rng_below(&e->rng, n);
+        const probe_variable* v = probe_variable_of_vr(&e->fmu->model, vrs[at]);
+        values[at] = v != NULL ? nasty_value(&e->rng, v) : special_value(&e->rng);
+    }
+    for (k = 0; k < n; ++k) {
+        trace_double(e, values[k]);
+    }
+    take_before(e);
+    log_count = e->book.count;
+    status = call_set_real(e, vrs, n, values);
+    note(e, "setReal every input (%zu) -> %d", n, status);
+    judge_set(e, vrs, n, values, PROBE_REAL, status, log_count, "setReal (every input)");
+    free(vrs);
+    free(values);
+}
+
+/* Every Real output in one call, in ascending value references (the FMU's straight
+ * copy), against the snapshot's get of every Real: the same values, bit for bit,
+ * and the same status. */
+static void op_get_outputs(fuzz_episode* e)
+{
+    const fuzz_fmu* f = e->fmu;
+    unsigned* vrs = (unsigned*)malloc((f->real_count + 1) * sizeof *vrs);
+    double* values = (double*)malloc((f->real_count + 1) * sizeof *values);
+    size_t* at = (size_t*)malloc((f->real_count + 1) * sizeof *at);
+    size_t k, n = 0;
+    int status;
+    take_before(e);
+    if (vrs == NULL || values == NULL || at == NULL || !e->before.valid) {
+        free(vrs);
+        free(values);
+        free(at);
+        return;
+    }
+    for (k = 0; k < f->real_count; ++k) {
+        if (f->model.variables[f->reals[k]].causality == PROBE_OUTPUT) {
+            vrs[n] = f->real_vrs[k];
+            at[n++] = k;
+        }
+    }
+    status = call_get_real(e, vrs, n, values);
+    note(e, "getReal every output (%zu) -> %d", n, status);
+    if (status != e->before.get_status) {
+        violation(e, "getReal of every output: status %d, of every Real %d", status,
+                  e->before.get_status);
+    }
+    for (k = 0; k < n && status == 0; ++k) {
+        if (memcmp(&values[k], &e->before.reals[at[k]], sizeof values[k]) != 0) {
+            violation(e, "getReal of every output: vr %u = %.17g, of every Real %.17g", vrs[k],
+                      values[k], e->before.reals[at[k]]);
+            break;
+        }
+    }
+    free(vrs);
+    free(values);
+    free(at);
+}
+
 /* FMI 2: the last successful time and the terminate flag, from the status getters. */
 static void fmi2_step_status(fuzz_episode* e, double* last, int* terminate)
 {
@@ -1222,12 +1305,16 @@ static void one_call(fuzz_episode* e)
         }
         break;
     case S_STEP:
-        if (pick < 35) {
+        if (pick < 30) {
             op_set_real(e);
-        } else if (pick < 38) {
+        } else if (pick < 33) {
             op_set_integer(e);
-        } else if (pick < 44) {
+        } else if (pick < 39) {
             op_set_plausible(e);
+        } else if (pick < 46) {
+            op_set_inputs(e);
+        } else if (pick < 50) {
+            op_get_outputs(e);
         } else if (pick < 84) {
             op_do_step(e);
         } else if (pick < 90) {

@@ -648,8 +648,29 @@ def test_c_table_matches_the_table(generated, dyad_type):
         if v["name"] == "on_singular":
             assert (target, offset) == ("FMU_TARGET_SETTING", "FMU_SETTING_ON_SINGULAR")
     vr_limit = len(raw["variable"]) + 1
-    assert re.search(rf"index_of_vr, {vr_limit}, &fmu_dyad_behaviour, &dyad\}};", c_text)
+    assert re.search(rf"index_of_vr, {vr_limit}, &fmu_dyad_behaviour, &dyad, &copies\}};", c_text)
     assert re.search(r"index_of_vr\[\d+\] = \{\s*-1, 0, 1, 2,", c_text)
+    # the straight copies of every step: each input from its place in the call to where
+    # the layer keeps it (an angle as set, per variable), each output from its result
+    inputs = [(i, v) for i, v in enumerate(raw["variable"]) if v["causality"] == "input"]
+    outputs = [v for v in raw["variable"] if v["causality"] == "output" and v["type"] == "Real"]
+    stores = re.findall(r"^    (.*) = from\[(\d+)\];", c_text, re.MULTILINE)
+    loads = re.findall(
+        r"^    to\[(\d+)\] = \*\(const double\*\)\(const void\*\)\(out \+ (.*)\);",
+        c_text,
+        re.MULTILINE,
+    )
+    assert [int(k) for _, k in stores] == list(range(len(inputs)))
+    for (place, _), (index, v) in zip(stores, inputs, strict=True):
+        field = v["lives"].removeprefix("input.")
+        if field.endswith("@angle"):
+            assert place == f"values[{index}]", v["name"]
+        else:
+            assert place == f"*(double*)(void*)(in + offsetof(dyad_input, {field}))", v["name"]
+    assert [int(k) for k, _ in loads] == list(range(len(outputs)))
+    for (_, offset), v in zip(loads, outputs, strict=True):
+        assert offset == f"offsetof(dyad_result, {v['lives'].removeprefix('result.')})", v["name"]
+    assert f"input_vrs, {len(inputs)}, store_inputs, output_vrs, {len(outputs)}" in c_text
 
 
 def start_values(raw):
@@ -1213,7 +1234,7 @@ def test_drive_c_table_matches_the_table(generated_drive):
     assert (
         f'const fmu_model fmu_this_model = {{"drive", "{token}",\n'
         f"                                  variables, {len(raw['variable'])}, "
-        f"index_of_vr, {vr_limit}, &fmu_drive_behaviour, NULL}};"
+        f"index_of_vr, {vr_limit}, &fmu_drive_behaviour, NULL, &copies}};"
     ) in c_text
 
 

@@ -55,6 +55,73 @@ def _index_of_vr(table: Table) -> tuple[list[str], int]:
     return lines, vr_limit
 
 
+def _double_at(block: str, offset: str, const: str = "") -> str:
+    return f"*({const}double*)({const}void*)({block} + {offset})"
+
+
+def _store_inputs(inputs: list[Variable]) -> list[str]:
+    lines = [
+        "static void store_inputs(void* restrict input, double* restrict values,",
+        "                         const double* restrict from)",
+        "{",
+        "    char* const in = (char*)input;",
+    ]
+    if not any(v.lives.target == "FMU_TARGET_INPUT_ANGLE" for v in inputs):
+        lines.append("    (void)values; /* no angle */")
+    for k, v in enumerate(inputs):
+        if v.lives.target == "FMU_TARGET_INPUT_ANGLE":
+            lines.append(f"    values[{v.index}] = from[{k}]; /* an angle, as set */")
+        else:
+            lines.append(f"    {_double_at('in', v.lives.offset)} = from[{k}];")
+    return lines + ["}", ""]
+
+
+def _load_outputs(outputs: list[Variable]) -> list[str]:
+    lines = [
+        "static void load_outputs(const void* restrict output, double* restrict to)",
+        "{",
+        "    const char* const out = (const char*)output;",
+    ]
+    for k, v in enumerate(outputs):
+        lines.append(f"    to[{k}] = {_double_at('out', v.lives.offset, 'const ')};")
+    return lines + ["}", ""]
+
+
+def _vr_list(name: str, variables: list[Variable]) -> list[str]:
+    lines = [f"static const unsigned int {name}[] = {{"]
+    vrs = [f"{v.vr}u" for v in variables]
+    for start in range(0, len(vrs), 12):
+        lines.append("    " + ", ".join(vrs[start : start + 12]) + ",")
+    return lines + ["};"]
+
+
+def _copies(table: Table) -> list[str]:
+    """fmu_copies: the set of every Real input and the get of every Real output, each in
+    ascending value references, as straight copies (see fmu/fmu_model.h)."""
+    by_vr = sorted(table.variables, key=lambda v: v.vr)
+    inputs = [v for v in by_vr if v.causality == "input" and v.type == "Real"]
+    outputs = [
+        v for v in by_vr if v.causality == "output" and v.lives.target == "FMU_TARGET_RESULT_REAL"
+    ]
+    lines = [
+        "/* The importer's every step: every Real input set and every Real output read,",
+        " * in ascending value references, with every place a constant. */",
+    ]
+    cells = []
+    if inputs:
+        lines += _vr_list("input_vrs", inputs) + [""] + _store_inputs(inputs)
+        cells += ["input_vrs", str(len(inputs)), "store_inputs"]
+    else:
+        cells += ["NULL", "0", "NULL"]
+    if outputs:
+        lines += _vr_list("output_vrs", outputs) + [""] + _load_outputs(outputs)
+        cells += ["output_vrs", str(len(outputs)), "load_outputs"]
+    else:
+        cells += ["NULL", "0", "NULL"]
+    lines.append(f"static const fmu_copies copies = {{{', '.join(cells)}}};")
+    return lines + [""]
+
+
 def model_c(table: Table) -> str:
     """<identifier>_model.c."""
     kind = table.kind
@@ -78,12 +145,13 @@ def model_c(table: Table) -> str:
     lines += index_lines + [""]
     data_lines, data = kind.model_data(table)
     lines += data_lines
+    lines += _copies(table)
     lines.append(
         f"const fmu_model fmu_this_model = {{{textsafe.c_string(table.identifier)}, "
         f"{textsafe.c_string(table.token)},"
     )
     lines.append(
         f"                                  variables, {len(table.variables)}, "
-        f"index_of_vr, {vr_limit}, &{kind.behaviour}, {data}}};"
+        f"index_of_vr, {vr_limit}, &{kind.behaviour}, {data}, &copies}};"
     )
     return "\n".join(lines) + "\n"

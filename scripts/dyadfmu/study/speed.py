@@ -14,7 +14,7 @@ import shutil
 import subprocess
 import time as clock
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -39,22 +39,26 @@ NUMPY_ROWS = 10_000
 @dataclass
 class Step:
     """Instructions of one FMU step from C (set every input, doStep, get every Real
-    output) and, inside it, of the model's evaluation and of its angles' directions."""
+    output), inside it of the model's evaluation and of its angles' directions, and of
+    the bare core call the step is held against: for a dyad the core's public solve
+    (dyad_solve, which checks its input: the FMU checks each value where it is set and
+    so evaluates without that check), for a scene its evaluation."""
 
     step: float
     evaluate: float
     directions: float
+    bare: float
 
     @property
     def ratio(self) -> float:
-        """Step over the bare core call (the model's evaluation)."""
-        return self.step / self.evaluate
+        """Step over the bare core call."""
+        return self.step / self.bare
 
     @property
     def ratio_with_directions(self) -> float:
         """Step over the core call from the FMU's own inputs: the angles' directions and
-        the evaluation."""
-        return self.step / (self.evaluate + self.directions)
+        the bare call."""
+        return self.step / (self.bare + self.directions)
 
 
 @dataclass
@@ -167,22 +171,32 @@ def step_rows(md: ModelDescription, count: int, seed: int) -> tuple[list, list, 
     return inputs, outputs, rows
 
 
-def step_counts(build: Path, identifier: str, version: int, count: int, work: Path) -> Step:
-    """Instructions per step of an FMU's binary from C, and of its evaluation and its
-    angles' directions inside the step."""
-    md = read_model_description(str(paths.built_fmu(identifier, version, build)))
-    inputs, outputs, rows = step_rows(md, count, seed=version)
+def _step_instructions(
+    build: Path, identifier: str, version: int, md: ModelDescription, rows: np.ndarray, work: Path
+) -> tuple[float, float]:
+    """(instructions per step, of the evaluation inside it) over `rows`."""
+    inputs, outputs, _ = step_rows(md, 1, seed=version)
     data = work / "speed_fmu.bin"
     rows.astype("<f8").tofile(data)
     binary = paths.stage_binary(build, identifier, version)
     program = [str(bench.bench_binary(build, "double"))]
     program += bench.fmu_step_arguments(binary, version, md.guid, data, inputs, outputs)
     out = _callgrind(program + ["--repeat", "1"], work, "bench_loop_*", per_instruction=False)
-    return Step(
-        step=_collected(out) / count,
-        evaluate=inclusive(out, "evaluate") / count,
-        directions=inclusive(out, "sync_angles") / count,
-    )
+    return _collected(out) / len(rows), inclusive(out, "evaluate") / len(rows)
+
+
+def step_counts(build: Path, identifier: str, version: int, count: int, work: Path) -> Step:
+    """Instructions per step of an FMU's binary from C, of its evaluation inside the step,
+    and of its angles' directions: what the step costs more where every angle changes
+    than where the angles are held (the layer converts an angle only when it changed)."""
+    md = read_model_description(str(paths.built_fmu(identifier, version, build)))
+    inputs, _, rows = step_rows(md, count, seed=version)
+    step, evaluate = _step_instructions(build, identifier, version, md, rows, work)
+    held = rows.copy()
+    angles = [k for k, v in enumerate(inputs) if v.unit == "rad"]
+    held[:, angles] = rows[0, angles]
+    step_held, _ = _step_instructions(build, identifier, version, md, held, work)
+    return Step(step=step, evaluate=evaluate, directions=step - step_held, bare=evaluate)
 
 
 def batch_keywords(rows: np.ndarray) -> dict[str, np.ndarray]:
@@ -252,9 +266,8 @@ def measure(
         solve_flops, solve_instructions = core_counts(build, dyad, rows[:2000], work)
         figures = TypeSpeed(dyad, closed_form_flops(dyad), solve_flops, solve_instructions)
         for version in (2, 3):
-            figures.steps[version] = step_counts(
-                build, f"dyad_{dyad.lower()}", version, steps, work
-            )
+            step = step_counts(build, f"dyad_{dyad.lower()}", version, steps, work)
+            figures.steps[version] = replace(step, bare=solve_instructions)
         figures.batch_instructions = batch_instructions(build, dyad, rows[:batch_rows], work)
         types.append(figures)
     log("speed: dyadfmu.solve timed")
