@@ -829,14 +829,21 @@ static fmu_status explain_refusal(const fmu_instance* instance, const unsigned i
     return FMU_OK;
 }
 
-/* Until initialization ends, the states follow their start parameters. */
-static void after_set(fmu_instance* instance)
+/* The states from their start parameters, after a set before initialization ends. */
+static void restart_states(fmu_instance* instance)
 {
-    instance->dirty = 1;
-    if (((unsigned)instance->state & PARAMETER_STATES) &&
-        instance->model->behaviour->start != NULL) {
+    if (instance->model->behaviour->start != NULL) {
         sync_angles(instance);
         instance->model->behaviour->start(instance->model, instance->input);
+    }
+}
+
+/* Until initialization ends, the states follow their start parameters. */
+FMU_INLINE void after_set(fmu_instance* instance)
+{
+    instance->dirty = 1;
+    if ((unsigned)instance->state & PARAMETER_STATES) {
+        restart_states(instance);
     }
 }
 
