@@ -803,9 +803,11 @@ static void op_set_integer(fuzz_episode* e)
               log_count, as_int64 ? "setInt64" : "setInteger");
 }
 
-/* Every variable settable now, to plausible values, in one call: brings an
- * instance that nasty values put out of its domain back to solvable inputs. */
-static void op_set_plausible(fuzz_episode* e)
+/* Sets in one call every Real settable now (inputs_only: every Real input, which in
+ * ascending value references is the call an importer makes every step and the FMU
+ * serves by its model's straight copy), to plausible values; with `maybe_nasty`, a
+ * quarter of the time one of them nasty, which must refuse the whole call. */
+static void set_all(fuzz_episode* e, int inputs_only, int maybe_nasty, const char* call)
 {
     const fuzz_fmu* f = e->fmu;
     unsigned* vrs = (unsigned*)malloc((f->settable_count + 1) * sizeof *vrs);
@@ -820,50 +822,16 @@ static void op_set_plausible(fuzz_episode* e)
     }
     for (k = 0; k < f->settable_count; ++k) {
         const probe_variable* v = &f->model.variables[f->settable[k]];
-        if (v->type == PROBE_REAL && must_refuse(e, v, 0.0, PROBE_REAL) == NULL) {
-            vrs[n] = v->vr;
-            values[n] = plausible_value(&e->rng, v);
-            trace_double(e, values[n]);
-            ++n;
-        }
-    }
-    take_before(e);
-    log_count = e->book.count;
-    status = call_set_real(e, vrs, n, values);
-    note(e, "setReal %zu plausible values -> %d", n, status);
-    judge_set(e, vrs, n, values, PROBE_REAL, status, log_count, "setReal (plausible)");
-    free(vrs);
-    free(values);
-}
-
-/* Every Real input in one call, in ascending value references: the call an importer
- * makes every step, which the FMU serves by its model's straight copy. Now and then
- * one value nasty, which must refuse the whole call. */
-static void op_set_inputs(fuzz_episode* e)
-{
-    const fuzz_fmu* f = e->fmu;
-    unsigned* vrs = (unsigned*)malloc((f->settable_count + 1) * sizeof *vrs);
-    double* values = (double*)malloc((f->settable_count + 1) * sizeof *values);
-    size_t k, n = 0;
-    long log_count;
-    int status;
-    if (vrs == NULL || values == NULL) {
-        free(vrs);
-        free(values);
-        return;
-    }
-    for (k = 0; k < f->settable_count; ++k) {
-        const probe_variable* v = &f->model.variables[f->settable[k]];
-        if (v->type == PROBE_REAL && v->causality == PROBE_INPUT) {
+        if (v->type == PROBE_REAL && (inputs_only ? v->causality == PROBE_INPUT
+                                                  : must_refuse(e, v, 0.0, PROBE_REAL) == NULL)) {
             vrs[n] = v->vr;
             values[n] = plausible_value(&e->rng, v);
             ++n;
         }
     }
-    if (n > 0 && probe_rng_below(&e->rng, 4) == 0) {
+    if (maybe_nasty && n > 0 && probe_rng_below(&e->rng, 4) == 0) {
         const size_t at = (size_t)probe_rng_below(&e->rng, n);
-        const probe_variable* v = probe_variable_of_vr(&e->fmu->model, vrs[at]);
-        values[at] = v != NULL ? nasty_value(&e->rng, v) : special_value(&e->rng);
+        values[at] = nasty_value(&e->rng, probe_variable_of_vr(&f->model, vrs[at]));
     }
     for (k = 0; k < n; ++k) {
         trace_double(e, values[k]);
@@ -871,10 +839,22 @@ static void op_set_inputs(fuzz_episode* e)
     take_before(e);
     log_count = e->book.count;
     status = call_set_real(e, vrs, n, values);
-    note(e, "setReal every input (%zu) -> %d", n, status);
-    judge_set(e, vrs, n, values, PROBE_REAL, status, log_count, "setReal (every input)");
+    note(e, "%s: %zu values -> %d", call, n, status);
+    judge_set(e, vrs, n, values, PROBE_REAL, status, log_count, call);
     free(vrs);
     free(values);
+}
+
+/* Every variable settable now, to plausible values, in one call: brings an instance
+ * that nasty values put out of its domain back to solvable inputs. */
+static void op_set_plausible(fuzz_episode* e)
+{
+    set_all(e, 0, 0, "setReal (plausible)");
+}
+
+static void op_set_inputs(fuzz_episode* e)
+{
+    set_all(e, 1, 1, "setReal (every input)");
 }
 
 /* Every Real output in one call, in ascending value references (the FMU's straight
