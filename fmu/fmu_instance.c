@@ -234,6 +234,22 @@ void fmu_rebuild_slots(fmu_instance* instance)
     build_slots(instance);
 }
 
+int fmu_value_allowed(const fmu_variable* v, double value)
+{
+    fmu_slot range;
+    accepted_range(v, &range);
+    return value >= range.low && value <= range.high;
+}
+
+void fmu_angles_stale(fmu_instance* instance)
+{
+    size_t k;
+    for (k = 0; k < instance->angle_count; ++k) {
+        instance->angles[k].converted = NAN;
+    }
+    instance->angles_pending = instance->angle_count > 0;
+}
+
 /* The angle variables, and the settings the layer reads (kept as set). */
 static void find_places(fmu_instance* instance)
 {

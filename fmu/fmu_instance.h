@@ -242,4 +242,12 @@ fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* by
 /* The slots and plans again after the state machine's state was restored. */
 void fmu_rebuild_slots(fmu_instance* instance);
 
+/* 1 if `value` may be set to `v` (a Real parameter or input): finite and within its
+ * bounds, whatever the state. */
+int fmu_value_allowed(const fmu_variable* v, double value);
+
+/* After a state was restored: every angle's unit vector computed again from the
+ * angle, before the model next reads it. */
+void fmu_angles_stale(fmu_instance* instance);
+
 #endif /* DYADFMU_FMU_INSTANCE_H */

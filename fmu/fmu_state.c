@@ -14,7 +14,8 @@
  * the blocks, so that a state from another FMU, or from another build of this
  * one, is refused; the checksum (FNV-1a over the payload) refuses a damaged one.
  * What the layer would use as an index (the state machine's state, the variable
- * an evaluation blames) is checked before it is restored. The saved states of an
+ * an evaluation blames) is checked before it is restored, and so is every parameter
+ * and input (as a set checks it: the models solve them without checking again). The saved states of an
  * instance are kept in a list and freed with it. */
 #include <stdint.h>
 #include <string.h>
@@ -163,6 +164,42 @@ static int indices_valid(fmu_instance* instance, const unsigned char* bytes)
            memchr(e.reason, '\0', sizeof e.reason) != NULL;
 }
 
+/* The first parameter or input whose value in the state's bytes could not have been
+ * set (not finite, or outside its bounds), or NULL: a state is serialized from values
+ * that were checked when they were set, and the model solves them without checking
+ * again. */
+static const fmu_variable* value_refused(fmu_instance* instance, const unsigned char* bytes,
+                                         double* value)
+{
+    state_part part[PART_COUNT];
+    const fmu_model* m = instance->model;
+    const unsigned char *values, *input;
+    size_t at = HEADER_SIZE, k;
+    parts_of(instance, part);
+    for (k = 0; k < 7; ++k) {
+        at += part[k].size;
+    }
+    values = bytes + at; /* part 7, then the input block */
+    input = values + part[7].size;
+    for (k = 0; k < m->variable_count; ++k) {
+        const fmu_variable* v = &m->variables[k];
+        if (v->type != FMU_REAL || v->causality == FMU_OUTPUT) {
+            continue;
+        }
+        if (v->target == FMU_TARGET_INPUT_REAL) {
+            memcpy(value, input + v->offset, sizeof *value);
+        } else if (v->target == FMU_TARGET_INPUT_ANGLE) {
+            memcpy(value, values + k * sizeof(double), sizeof *value);
+        } else {
+            continue;
+        }
+        if (!fmu_value_allowed(v, *value)) {
+            return v;
+        }
+    }
+    return NULL;
+}
+
 static fmu_saved* new_saved(fmu_instance* instance, size_t size)
 {
     fmu_saved* saved = (fmu_saved*)instance->allocate(1, sizeof(fmu_saved) + size);
@@ -226,6 +263,7 @@ fmu_status fmu_set_state(fmu_instance* instance, const fmu_saved* state, const c
     }
     read_state(instance, state->bytes);
     fmu_rebuild_slots(instance);
+    fmu_angles_stale(instance); /* the directions from the angles, not from the bytes */
     return FMU_OK;
 }
 
@@ -293,6 +331,8 @@ fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* by
                                  fmu_saved** state, const char* function)
 {
     const char* problem;
+    const fmu_variable* refused;
+    double value = 0;
     fmu_saved* saved = NULL;
     fmu_status status = fmu_check_call(instance, FMU_OP_STATE, function);
     if (status != FMU_OK) {
@@ -302,6 +342,11 @@ fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* by
         bytes == NULL || state == NULL ? "NULL arguments" : state_problem(instance, bytes, size);
     if (problem == NULL && !indices_valid(instance, bytes)) {
         problem = "a state out of range";
+    }
+    if (problem == NULL && (refused = value_refused(instance, bytes, &value)) != NULL) {
+        fmu_log(instance, FMU_ERROR, "%s: refused: %s = %g could not have been set", function,
+                refused->name, value);
+        return FMU_ERROR;
     }
     if (problem == NULL && (saved = new_saved(instance, size)) == NULL) {
         problem = "out of memory";

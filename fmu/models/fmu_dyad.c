@@ -70,11 +70,12 @@ static void initialise(const fmu_model* model, void* input)
     *(dyad_input*)input = dyad_input_default();
 }
 
-/* The layer checks every value against its variable's bounds where it is set,
- * and a dyad's bounds are its fields' domains (an angle gives a unit direction),
- * so the common solve skips the core's check of its input. Where that solve has
- * no answer, the checking solve runs again to say whether an input is to blame:
- * the first line of defence should a value reach the block another way. */
+/* The layer checks every value against its variable's bounds where it is set (and
+ * a deserialized FMU state's values likewise), and a dyad's bounds are its fields'
+ * domains (an angle gives a unit direction, computed again after a state is
+ * restored), so the common solve skips the core's check of its input. Where that
+ * solve has no answer, the checking solve runs again to say whether an input is to
+ * blame. */
 static void evaluate(const fmu_model* model, const void* input, void* output,
                      fmu_evaluation* evaluation)
 {
