@@ -14,9 +14,9 @@
  * the blocks, so that a state from another FMU, or from another build of this
  * one, is refused; the checksum (FNV-1a over the payload) refuses a damaged one.
  * What the layer would use as an index (the state machine's state, the variable
- * an evaluation blames) is checked before it is restored, and so is every parameter
- * and input (as a set checks it: the models solve them without checking again). The saved states of an
- * instance are kept in a list and freed with it. */
+ * an evaluation blames) is checked before it is restored, and so is every
+ * parameter and input, as a set checks it: the models solve them without checking
+ * again. The saved states of an instance are kept in a list and freed with it. */
 #include <stdint.h>
 #include <string.h>
 
