@@ -1012,32 +1012,14 @@ FMU_INLINE int same_references(const unsigned int planned[], const unsigned int 
 }
 
 /* 1 if every value is finite (count > 0): their products with 0 add up to 0,
- * where an infinity or a NaN makes the sum NaN. Four at a time as in
- * same_references. */
+ * where an infinity or a NaN makes the sum NaN. What same_and_finite does four at
+ * a time, for fewer than four values or without SSE2. */
 static int all_finite(const double values[], size_t count)
 {
-    double sum;
-#if defined(__SSE2__)
-    if (count >= 4) {
-        const __m128d zero = _mm_setzero_pd();
-        __m128d low = _mm_mul_pd(_mm_loadu_pd(values + count - 4), zero);
-        __m128d high = _mm_mul_pd(_mm_loadu_pd(values + count - 2), zero);
-        size_t k;
-        for (k = 0; k + 4 < count; k += 4) {
-            low = _mm_add_pd(low, _mm_mul_pd(_mm_loadu_pd(values + k), zero));
-            high = _mm_add_pd(high, _mm_mul_pd(_mm_loadu_pd(values + k + 2), zero));
-        }
-        low = _mm_add_pd(low, high);
-        sum = _mm_cvtsd_f64(_mm_add_sd(low, _mm_unpackhi_pd(low, low)));
-        return sum == 0;
-    }
-#endif
-    sum = values[0] * 0.0;
-    if (count >= 2) {
-        size_t k;
-        for (k = 1; k < count; ++k) {
-            sum += values[k] * 0.0;
-        }
+    double sum = 0;
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        sum += values[k] * 0.0;
     }
     return sum == 0;
 }
