@@ -43,6 +43,35 @@ const size_t fmu_log_category_count =
     sizeof fmu_log_category_names / sizeof fmu_log_category_names[0];
 enum { LOG_ERROR = 0, LOG_WARNING, LOG_DISCARD, LOG_CALLS };
 
+/* Which operations may take their common path, worked out whenever the state or the
+ * logged categories change so that each call tests one bit: legal now, and not a call
+ * to log; a set only once the parameters are closed (before, it restarts the states);
+ * a step only of a model without states. */
+static void find_common_paths(fmu_instance* instance)
+{
+    const unsigned state = (unsigned)instance->state;
+    unsigned paths = 0;
+    if (!(instance->log_categories & (1u << LOG_CALLS))) {
+        if (legal_states[FMU_OP_GET] & state) {
+            paths |= 1u << FMU_OP_GET;
+        }
+        if ((legal_states[FMU_OP_SET] & state) && !(state & PARAMETER_STATES)) {
+            paths |= 1u << FMU_OP_SET;
+        }
+        if ((legal_states[FMU_OP_DO_STEP] & state) && instance->model->behaviour->advance == NULL) {
+            paths |= 1u << FMU_OP_DO_STEP;
+        }
+    }
+    instance->common_paths = paths;
+}
+
+/* Moves the state machine to `state`. */
+static void enter_state(fmu_instance* instance, fmu_state state)
+{
+    instance->state = state;
+    find_common_paths(instance);
+}
+
 static const char* state_name(fmu_state state)
 {
     switch (state) {
@@ -116,20 +145,16 @@ static double* kept_value(fmu_instance* instance, size_t index)
 static void store(fmu_instance* instance, size_t index, double value)
 {
     *kept_value(instance, index) = value;
-    if (instance->model->variables[index].target == FMU_TARGET_INPUT_ANGLE) {
-        instance->angles_pending = 1;
-    }
 }
 
 /* The (cos, sin) of every angle that changed since the model last read them, two at
- * a time (both again where one of the two changed: as cheap as one alone). */
+ * a time (both again where one of the two changed: as cheap as one alone). It runs
+ * only before an evaluation, so comparing each angle costs less than a flag kept up
+ * to date by every set. */
 FMU_INLINE void sync_angles(fmu_instance* instance)
 {
     fmu_angle* a = instance->angles;
     fmu_angle* const end = a + instance->angle_count;
-    if (!instance->angles_pending) {
-        return;
-    }
     for (; end - a >= 2; a += 2) {
         if (*a[0].angle != a[0].converted || *a[1].angle != a[1].converted) {
             a[0].converted = *a[0].angle;
@@ -141,7 +166,6 @@ FMU_INLINE void sync_angles(fmu_instance* instance)
         a->converted = *a->angle;
         dyad_cos_sin(a->converted, &a->unit[0], &a->unit[1]);
     }
-    instance->angles_pending = 0;
 }
 
 /* Sizes rounded up so that every block is aligned for any scalar. */
@@ -167,7 +191,7 @@ static void load_start_values(fmu_instance* instance)
     if (instance->model->behaviour->start != NULL) {
         instance->model->behaviour->start(instance->model, instance->input);
     }
-    instance->state = FMU_STATE_INSTANTIATED;
+    enter_state(instance, FMU_STATE_INSTANTIATED);
     build_slots(instance);
     instance->time = 0;
     instance->last_successful_time = 0;
@@ -225,13 +249,14 @@ static void build_slots(fmu_instance* instance)
     for (vr = 0; vr < model->vr_limit; ++vr) {
         build_slot(instance, vr, &instance->slots[vr]);
     }
-    instance->set_plan.count = 0; /* the accepted intervals changed */
-    instance->get_plan.count = 0;
+    instance->set_plan.count = FMU_NO_PLAN; /* the accepted intervals changed */
+    instance->get_plan.count = FMU_NO_PLAN;
 }
 
 void fmu_rebuild_slots(fmu_instance* instance)
 {
     build_slots(instance);
+    find_common_paths(instance);
 }
 
 int fmu_value_allowed(const fmu_variable* v, double value)
@@ -247,7 +272,6 @@ void fmu_angles_stale(fmu_instance* instance)
     for (k = 0; k < instance->angle_count; ++k) {
         instance->angles[k].converted = NAN;
     }
-    instance->angles_pending = instance->angle_count > 0;
 }
 
 /* The angle variables, and the settings the layer reads (kept as set). */
@@ -279,7 +303,7 @@ static size_t plan_size(size_t capacity)
 
 static void place_plan(fmu_plan* plan, char* at, size_t capacity)
 {
-    plan->count = 0;
+    plan->count = FMU_NO_PLAN;
     plan->bounded_count = 0;
     plan->store = NULL;
     plan->load = NULL;
@@ -387,11 +411,10 @@ void fmu_free(fmu_instance* instance)
     }
 }
 
-/* Whether a call may take the common path: legal now, and not one to log. */
+/* Whether a call may take its common path (find_common_paths). */
 static int quiet_call(const fmu_instance* instance, fmu_operation operation)
 {
-    return (legal_states[operation] & (unsigned)instance->state) &&
-           !(instance->log_categories & (1u << LOG_CALLS));
+    return (instance->common_paths >> operation) & 1u;
 }
 
 fmu_status fmu_check_call(fmu_instance* instance, fmu_operation operation, const char* function)
@@ -441,6 +464,7 @@ fmu_status fmu_set_debug_logging(fmu_instance* instance, int logging_on, size_t 
     }
     instance->log_categories =
         logging_on ? (instance->log_categories | bits) : (instance->log_categories & ~bits);
+    find_common_paths(instance);
     return FMU_OK;
 }
 
@@ -504,7 +528,7 @@ fmu_status fmu_enter_initialization(fmu_instance* instance, double start_time)
     fmu_status status =
         fmu_check_call(instance, FMU_OP_ENTER_INITIALIZATION, "enterInitializationMode");
     if (status == FMU_OK) {
-        instance->state = FMU_STATE_INITIALIZATION;
+        enter_state(instance, FMU_STATE_INITIALIZATION);
         instance->time = start_time;
         instance->last_successful_time = start_time;
     }
@@ -520,7 +544,7 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
     }
     status = solve(instance, FMU_WARNING, "exitInitializationMode", 1);
     if (status != FMU_ERROR) {
-        instance->state = FMU_STATE_STEP;
+        enter_state(instance, FMU_STATE_STEP);
         build_slots(instance); /* the parameters close */
     }
     return status;
@@ -641,7 +665,7 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
 {
     /* the common case: an algebraic model whose new inputs have an answer */
     if (instance != NULL && quiet_call(instance, FMU_OP_DO_STEP) &&
-        instance->model->behaviour->advance == NULL && step_is_valid(current_time, step_size)) {
+        step_is_valid(current_time, step_size)) {
         fmu_evaluation* e = &instance->evaluation;
         if (instance->dirty) {
             sync_angles(instance);
@@ -666,7 +690,7 @@ fmu_status fmu_terminate(fmu_instance* instance)
 {
     fmu_status status = fmu_check_call(instance, FMU_OP_TERMINATE, "terminate");
     if (status == FMU_OK) {
-        instance->state = FMU_STATE_TERMINATED;
+        enter_state(instance, FMU_STATE_TERMINATED);
     }
     return status;
 }
@@ -900,7 +924,6 @@ static int set_reals_at_once(fmu_instance* instance, const unsigned int vr[], si
     for (k = 0; k < count; ++k) {
         *slots[vr[k]].write = values[k];
     }
-    instance->angles_pending |= instance->angle_count > 0;
     return 1;
 }
 
@@ -1096,7 +1119,6 @@ static int set_by_plan(fmu_instance* instance, size_t count, const double values
             *write[k] = values[k];
         }
     }
-    instance->angles_pending |= instance->angle_count > 0;
     return 1;
 }
 
@@ -1125,15 +1147,15 @@ static void get_by_plan(const fmu_plan* plan, const void* output, size_t count, 
     }
 }
 
-/* A plan of a call the slots accepted (every vr below vr_limit), none for a call
- * longer than the table (a repeated reference: rare, and not planned). */
+/* A plan of a call the slots accepted (every vr below vr_limit), none for an empty
+ * call or one longer than the table (a repeated reference: rare, and not planned). */
 static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsigned int vr[],
                       size_t count)
 {
     const fmu_copies* copies = instance->model->copies;
     size_t k, bounded = 0;
-    plan->count = 0;
-    if (count > instance->model->vr_limit) {
+    plan->count = FMU_NO_PLAN;
+    if (count == 0 || count > instance->model->vr_limit) {
         return;
     }
     for (k = 0; k < count; ++k) {
@@ -1184,11 +1206,11 @@ fmu_status fmu_set_real(fmu_instance* instance, const unsigned int vr[], size_t 
                         const double values[], const char* function)
 {
     /* the common case: the same references as the last set, every value valid */
-    if (instance != NULL && vr != NULL && values != NULL && count == instance->set_plan.count &&
-        count > 0 && quiet_call(instance, FMU_OP_SET) &&
+    if (instance != NULL && count == instance->set_plan.count && vr != NULL && values != NULL &&
+        quiet_call(instance, FMU_OP_SET) &&
         same_and_finite(instance->set_plan.vr, vr, values, count) &&
         set_by_plan(instance, count, values)) {
-        after_set(instance);
+        instance->dirty = 1; /* the parameters are closed: no states to restart */
         return FMU_OK;
     }
     return set_reals_checked(instance, vr, count, values, function);
@@ -1235,8 +1257,8 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
                         double values[], const char* function)
 {
     /* the common case: after a step, the same references as the last get */
-    if (instance != NULL && vr != NULL && values != NULL && count == instance->get_plan.count &&
-        count > 0 && quiet_call(instance, FMU_OP_GET) && !instance->dirty &&
+    if (instance != NULL && count == instance->get_plan.count && vr != NULL && values != NULL &&
+        quiet_call(instance, FMU_OP_GET) && !instance->dirty &&
         instance->evaluation.status == FMU_OK &&
         same_references(instance->get_plan.vr, vr, count)) {
         get_by_plan(&instance->get_plan, instance->output, count, values);

@@ -81,8 +81,11 @@ typedef struct fmu_slot {
 /* The places of the last Real set or get that the slots accepted, by position,
  * so that the same call again (the same value references: an importer repeats
  * its calls every step) is one vector check of the values and a copy. */
+/* The count of a plan that matches no call. */
+#define FMU_NO_PLAN ((size_t)-1)
+
 typedef struct fmu_plan {
-    size_t count;           /* of the call; 0: none */
+    size_t count;           /* of the call (never 0); FMU_NO_PLAN: none */
     unsigned int* vr;       /* its value references */
     size_t bounded_count;   /* set: the values with bounds tighter than finite, */
     unsigned int* position; /* their positions in the call, */
@@ -117,6 +120,8 @@ typedef struct fmu_instance {
     fmu_saved* saved;        /* the FMU states saved from this instance, freed with it */
     unsigned log_categories; /* bit k: category k of fmu_log_category_names is on */
     fmu_state state;
+    /* bit k: operation k may take its common path now (find_common_paths) */
+    unsigned common_paths;
     double time; /* communication point reached (s) */
     double last_successful_time;
     int terminate_requested;   /* set when a step cannot be completed */
@@ -128,8 +133,7 @@ typedef struct fmu_instance {
     fmu_plan get_plan;
     fmu_angle* angles; /* the angle variables, angle_count of them */
     size_t angle_count;
-    int angles_pending; /* an angle may have changed since the input's (cos, sin) */
-    int time_at_vr_0;   /* value reference 0 reads the time (FMI 3) */
+    int time_at_vr_0; /* value reference 0 reads the time (FMI 3) */
     /* The value of on_singular as set (FMU_ON_SINGULAR_...); NULL: the model has no
      * such setting, and doStep discards a step the model has no answer for. */
     const double* on_singular;
@@ -239,7 +243,8 @@ fmu_status fmu_serialize_state(fmu_instance* instance, const fmu_saved* state, u
                                size_t size, const char* function);
 fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* bytes, size_t size,
                                  fmu_saved** state, const char* function);
-/* The slots and plans again after the state machine's state was restored. */
+/* The slots, plans and common paths again after the state machine's state was
+ * restored. */
 void fmu_rebuild_slots(fmu_instance* instance);
 
 /* 1 if `value` may be set to `v` (a Real parameter or input): finite and within its

@@ -56,7 +56,9 @@ typedef struct state_part {
     size_t size;
 } state_part;
 
-enum { PART_COUNT = 10 };
+/* The parts of a state's payload, in order: the parts before the values are fixed
+ * in size. */
+enum { PART_VALUES = 6, PART_INPUT, PART_OUTPUT, PART_COUNT };
 
 static void parts_of(fmu_instance* instance, state_part part[PART_COUNT])
 {
@@ -67,10 +69,9 @@ static void parts_of(fmu_instance* instance, state_part part[PART_COUNT])
     part[3] = (state_part){&instance->terminate_requested, sizeof instance->terminate_requested};
     part[4] = (state_part){&instance->dirty, sizeof instance->dirty};
     part[5] = (state_part){&instance->evaluation, sizeof instance->evaluation};
-    part[6] = (state_part){&instance->angles_pending, sizeof instance->angles_pending};
-    part[7] = (state_part){instance->values, m->variable_count * sizeof(double)};
-    part[8] = (state_part){instance->input, m->behaviour->input_size};
-    part[9] = (state_part){instance->output, m->behaviour->output_size};
+    part[PART_VALUES] = (state_part){instance->values, m->variable_count * sizeof(double)};
+    part[PART_INPUT] = (state_part){instance->input, m->behaviour->input_size};
+    part[PART_OUTPUT] = (state_part){instance->output, m->behaviour->output_size};
 }
 
 static size_t state_size(fmu_instance* instance)
@@ -176,11 +177,11 @@ static const fmu_variable* value_refused(fmu_instance* instance, const unsigned 
     const unsigned char *values, *input;
     size_t at = HEADER_SIZE, k;
     parts_of(instance, part);
-    for (k = 0; k < 7; ++k) {
+    for (k = 0; k < PART_VALUES; ++k) {
         at += part[k].size;
     }
-    values = bytes + at; /* part 7, then the input block */
-    input = values + part[7].size;
+    values = bytes + at; /* the values as set, then the input block */
+    input = values + part[PART_VALUES].size;
     for (k = 0; k < m->variable_count; ++k) {
         const fmu_variable* v = &m->variables[k];
         if (v->type != FMU_REAL || v->causality == FMU_OUTPUT) {

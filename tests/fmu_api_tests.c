@@ -714,6 +714,117 @@ static int test_fmi2_repeated_calls_keep_their_checks(void)
     return fails;
 }
 
+/* The Real inputs (their values as read after initialization) and Real outputs of an
+ * instance, for an importer's every step. */
+typedef struct step_calls {
+    fmi2ValueReference inputs[64], outputs[64];
+    double values[64], got[64];
+    size_t n_inputs, n_outputs;
+} step_calls;
+
+static int find_step_calls(fmi2Component c, step_calls* calls)
+{
+    size_t k;
+    calls->n_inputs = calls->n_outputs = 0;
+    for (k = 0; k < md2.variable_count; ++k) {
+        const probe_variable* v = &md2.variables[k];
+        if (v->type == PROBE_REAL && v->causality == PROBE_INPUT && calls->n_inputs < 64) {
+            calls->inputs[calls->n_inputs++] = v->vr;
+        } else if (v->type == PROBE_REAL && v->causality == PROBE_OUTPUT && calls->n_outputs < 64) {
+            calls->outputs[calls->n_outputs++] = v->vr;
+        }
+    }
+    return api2.GetReal(c, calls->inputs, calls->n_inputs, calls->values) == fmi2OK;
+}
+
+/* Sets, steps and gets `rounds` times (an importer's every step); 1 if each call says
+ * OK, so that the repeated calls take their common path. */
+static int step_rounds(fmi2Component c, step_calls* calls, int rounds, double* t)
+{
+    int ok = 1, k;
+    for (k = 0; k < rounds; ++k, *t += 1e-3) {
+        ok &= api2.SetReal(c, calls->inputs, calls->n_inputs, calls->values) == fmi2OK;
+        ok &= api2.DoStep(c, *t, 1e-3, fmi2True) == fmi2OK;
+        ok &= api2.GetReal(c, calls->outputs, calls->n_outputs, calls->got) == fmi2OK;
+    }
+    return ok;
+}
+
+/* A parameter set twice in initialization (the second time by the same call, as an
+ * importer repeats it) leaves every value as one set of its last value does: the
+ * states restart from it too. */
+static int check_parameter_set_twice(const probe_variable* p)
+{
+    int fails = 0, exit_twice, exit_once;
+    probe_log_book book;
+    values_read twice, once;
+    const double first = p->has_start ? p->start : 0.0, last = other_value(p);
+    fmi2Component a = new_fmi2(&book, "twice"), b = new_fmi2(&book, "once");
+    CHECK(api2.SetupExperiment(a, fmi2False, 0, 0, fmi2False, 0) == fmi2OK &&
+              api2.EnterInitializationMode(a) == fmi2OK &&
+              api2.SetReal(a, &p->vr, 1, &first) == fmi2OK &&
+              api2.SetReal(a, &p->vr, 1, &last) == fmi2OK,
+          "%s set twice in initialization", p->name);
+    CHECK(api2.SetupExperiment(b, fmi2False, 0, 0, fmi2False, 0) == fmi2OK &&
+              api2.EnterInitializationMode(b) == fmi2OK &&
+              api2.SetReal(b, &p->vr, 1, &last) == fmi2OK,
+          "%s set once in initialization", p->name);
+    exit_twice = (int)api2.ExitInitializationMode(a);
+    exit_once = (int)api2.ExitInitializationMode(b);
+    CHECK(exit_twice == exit_once, "%s: exit %d after two sets, %d after one", p->name, exit_twice,
+          exit_once);
+    if (exit_twice <= fmi2Warning && exit_once <= fmi2Warning) {
+        CHECK(fmi2_read_all(a, &twice) && fmi2_read_all(b, &once) && same_values(&twice, &once),
+              "%s = %g set after %g: not the values of %g set once", p->name, last, first, last);
+    }
+    api2.FreeInstance(a);
+    api2.FreeInstance(b);
+    return fails;
+}
+
+/* What lets a set, get or doStep take its common path follows every change of the
+ * instance: logCalls switched on logs each repeated call (and off, none); a state
+ * restored from before initialization refuses a step and a get again; a parameter set
+ * twice in initialization restarts the states as often. */
+static int test_fmi2_common_paths_follow_the_instance(void)
+{
+    int fails = 0;
+    probe_log_book book;
+    const char* const calls_category[] = {"logCalls"};
+    fmi2Component c = new_fmi2(&book, "paths");
+    fmi2FMUstate before_initialization = NULL;
+    step_calls calls;
+    double t = 0;
+    long count;
+    size_t k;
+    CHECK(api2.GetFMUstate(c, &before_initialization) == fmi2OK, "state before initialization");
+    CHECK(initialise_fmi2(c) && find_step_calls(c, &calls), "initialise");
+    CHECK(step_rounds(c, &calls, 3, &t), "steps");
+    CHECK(api2.SetDebugLogging(c, fmi2True, 1, calls_category) == fmi2OK, "logCalls on");
+    count = book.count;
+    CHECK(step_rounds(c, &calls, 2, &t) && book.count >= count + 6,
+          "logCalls on: %ld messages for 6 calls", book.count - count);
+    CHECK(api2.SetDebugLogging(c, fmi2False, 1, calls_category) == fmi2OK, "logCalls off");
+    count = book.count;
+    CHECK(step_rounds(c, &calls, 2, &t) && book.count == count,
+          "logCalls off: %ld messages for 6 calls", book.count - count);
+    CHECK(api2.SetFMUstate(c, before_initialization) == fmi2OK, "state restored");
+    CHECK(api2.DoStep(c, t, 1e-3, fmi2True) == fmi2Error,
+          "a step accepted in the restored Instantiated state");
+    CHECK(api2.GetReal(c, calls.outputs, calls.n_outputs, calls.got) == fmi2Error,
+          "a get accepted in the restored Instantiated state");
+    api2.FreeFMUstate(c, &before_initialization);
+    api2.FreeInstance(c);
+    for (k = 0; k < md2.variable_count; ++k) {
+        const probe_variable* v = &md2.variables[k];
+        if (v->type == PROBE_REAL && v->causality == PROBE_PARAMETER &&
+            v->variability == PROBE_FIXED) {
+            fails += check_parameter_set_twice(v);
+        }
+    }
+    return fails;
+}
+
 /* Reset brings back every start value and the Instantiated state. */
 static int test_fmi2_reset(void)
 {
@@ -2519,6 +2630,7 @@ static const named_test generic_tests[] = {
     {"fmi2_wrong_types_and_unknown_vrs", test_fmi2_wrong_types_and_unknown_vrs},
     {"fmi2_invalid_values", test_fmi2_invalid_values},
     {"fmi2_repeated_calls_keep_their_checks", test_fmi2_repeated_calls_keep_their_checks},
+    {"fmi2_common_paths_follow_the_instance", test_fmi2_common_paths_follow_the_instance},
     {"fmi2_reset", test_fmi2_reset},
     {"fmi2_instantiate_refusals", test_fmi2_instantiate_refusals},
     {"fmi3_state_machine", test_fmi3_state_machine},
