@@ -3,6 +3,8 @@ per row, broadcasting, and errors that name the bad field."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import dyadfmu
 import numpy as np
 import pytest
@@ -166,3 +168,30 @@ def test_out_sharing_memory_with_an_input_is_refused():
     np.testing.assert_array_equal(first.n_mk, before)  # nothing was written
     # a copy of it is fine
     dyadfmu.solve("RRR", out=first, **dict(fields, m_moment=first.n_mk.copy()))
+
+
+def test_partial_overlaps_are_refused_and_neighbours_are_not():
+    rows = random_set("RRR", 30, seed=9)
+    fields = keywords(rows)
+    first = dyadfmu.solve("RRR", **fields)
+    # an input that starts inside an output (its y components)
+    with pytest.raises(ValueError, match=r"out\.r_mk shares memory with an input"):
+        dyadfmu.solve("RRR", out=first, **dict(fields, m_moment=first.r_mk[:, 1]))
+    # an output that starts inside an input
+    shared = np.ascontiguousarray(np.concatenate([fields["m_inertia"], fields["m_inertia"]]))
+    inside = dataclasses.replace(first, n_np=shared[10:40])
+    with pytest.raises(ValueError, match=r"out\.n_np shares memory with an input"):
+        dyadfmu.solve("RRR", out=inside, **dict(fields, m_inertia=shared[:30]))
+    # an output right after an input in the same buffer: no byte shared
+    after = dataclasses.replace(first, n_np=shared[30:60])
+    done = dyadfmu.solve("RRR", out=after, **dict(fields, m_inertia=shared[:30]))
+    np.testing.assert_array_equal(done.n_np, first.n_np)
+
+
+def test_contiguous_fields_read_in_place_match_strided_ones():
+    rows = random_set("RTT", 200, seed=10)
+    strided = keywords(rows)
+    contiguous = {name: np.ascontiguousarray(a) for name, a in strided.items()}
+    a, b = dyadfmu.solve("RTT", **strided), dyadfmu.solve("RTT", **contiguous)
+    for name in (f.name for f in dataclasses.fields(a)):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
