@@ -1976,6 +1976,46 @@ static int check_crafted_state(int version, void* c, const unsigned char* bytes,
     return fails;
 }
 
+/* A state whose checksum is good but which holds NaN for an input: refused, naming it
+ * (as a set refuses it: the FMU solves its inputs without checking them again). The
+ * input is set to a value of its own first, so that the state holds that value once
+ * (the angle last converted is the one before). */
+static int check_crafted_nan(int version)
+{
+    const probe_model* md = version == 2 ? &md2 : &md3;
+    const double mark = 0.6180339887498949;
+    const probe_variable* v = NULL;
+    probe_log_book book;
+    void* c = version == 2 ? (void*)new_fmi2(&book, "nan") : (void*)new_fmi3(&book, "nan");
+    void *state = NULL, *bad = NULL;
+    unsigned char* bytes = NULL;
+    size_t size = 0, k;
+    int fails = 0, set;
+    for (k = 0; k < md->variable_count && v == NULL; ++k) {
+        if (md->variables[k].type == PROBE_REAL && md->variables[k].causality == PROBE_INPUT) {
+            v = &md->variables[k];
+        }
+    }
+    if (v != NULL && (version == 2 ? initialise_fmi2(c) : initialise_fmi3(c))) {
+        set = version == 2 ? (int)api2.SetReal(c, &v->vr, 1, &mark)
+                           : (int)api3.SetFloat64(c, &v->vr, 1, &mark, 1);
+        CHECK(set == 0 && get_state(version, c, &state) == 0 &&
+                  serialize(version, c, state, &bytes, &size) == 0 &&
+                  craft_state(bytes, size, mark, NAN),
+              "FMI %d: no state holding %s = %.17g once", version, v->name, mark);
+        CHECK(bytes == NULL || deserialize(version, c, bytes, size, &bad) == 3,
+              "FMI %d: a state with %s = NaN accepted", version, v->name);
+        CHECK(bad == NULL && strstr(book.last, v->name) != NULL &&
+                  strstr(book.last, "could not have been set") != NULL,
+              "FMI %d: the NaN in %s not named: %s", version, v->name, book.last);
+    } else {
+        CHECK(v == NULL, "FMI %d: initialise", version);
+    }
+    free(bytes);
+    free_either(version, c);
+    return fails;
+}
+
 /* Bytes that are not this FMU's state: damaged, cut short, or another instance's; and a
  * crafted one (check_crafted_state). */
 static int check_refused_states(int version, void* c, void* other, unsigned char* bytes,
@@ -1993,6 +2033,7 @@ static int check_refused_states(int version, void* c, void* other, unsigned char
           "FMI %d: its own state refused", version);
     CHECK(set_state(version, other, state) == 3, "FMI %d: another instance's state set", version);
     fails += check_crafted_state(version, c, bytes, size, book);
+    fails += check_crafted_nan(version);
     return fails;
 }
 
