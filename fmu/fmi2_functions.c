@@ -74,17 +74,15 @@ void fmi2FreeInstance(fmi2Component c)
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime)
 {
+    const fmu_experiment experiment = {startTime, stopTimeDefined != fmi2False, stopTime};
     (void)toleranceDefined;
     (void)tolerance;
-    (void)stopTimeDefined;
-    (void)stopTime;
-    return to_fmi2(fmu_setup_experiment((fmu_instance*)c, startTime));
+    return to_fmi2(fmu_setup_experiment((fmu_instance*)c, &experiment));
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
-    fmu_instance* instance = (fmu_instance*)c;
-    return to_fmi2(fmu_enter_initialization(instance, instance != NULL ? instance->time : 0));
+    return to_fmi2(fmu_enter_initialization((fmu_instance*)c, NULL));
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c)

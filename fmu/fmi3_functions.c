@@ -141,11 +141,10 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
                                        fmi3Float64 tolerance, fmi3Float64 startTime,
                                        fmi3Boolean stopTimeDefined, fmi3Float64 stopTime)
 {
+    const fmu_experiment experiment = {startTime, stopTimeDefined != fmi3False, stopTime};
     (void)toleranceDefined;
     (void)tolerance;
-    (void)stopTimeDefined;
-    (void)stopTime;
-    return to_fmi3(fmu_enter_initialization((fmu_instance*)instance, startTime));
+    return to_fmi3(fmu_enter_initialization((fmu_instance*)instance, &experiment));
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)

@@ -195,6 +195,7 @@ static void load_start_values(fmu_instance* instance)
     build_slots(instance);
     instance->time = 0;
     instance->last_successful_time = 0;
+    instance->stop_limit = (double)INFINITY;
     instance->terminate_requested = 0;
     instance->dirty = 1;
 }
@@ -468,12 +469,44 @@ fmu_status fmu_set_debug_logging(fmu_instance* instance, int logging_on, size_t 
     return FMU_OK;
 }
 
-fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time)
+/* Refuses, naming it, a start or stop time that no step could follow: not finite,
+ * or a stop before the start. */
+static fmu_status check_experiment(fmu_instance* instance, const fmu_experiment* x,
+                                   const char* function)
+{
+    if (!isfinite(x->start_time) || (x->stop_defined && !isfinite(x->stop_time))) {
+        fmu_log(instance, FMU_ERROR, "%s: startTime = %g s, stopTime = %g s: both must be finite",
+                function, x->start_time, x->stop_defined ? x->stop_time : (double)INFINITY);
+        return FMU_ERROR;
+    }
+    if (x->stop_defined && x->stop_time < x->start_time) {
+        fmu_log(instance, FMU_ERROR, "%s: stopTime = %.17g s is before startTime = %.17g s",
+                function, x->stop_time, x->start_time);
+        return FMU_ERROR;
+    }
+    return FMU_OK;
+}
+
+/* The experiment's start as the time reached, and its stop as the limit of a step's
+ * end: the stop time, with room for the rounding of a sum of steps that reaches it
+ * (an importer's last step ends within 1e-9 of it, relatively, as fmpy's does). */
+static void start_experiment(fmu_instance* instance, const fmu_experiment* x)
+{
+    instance->time = x->start_time;
+    instance->last_successful_time = x->start_time;
+    instance->stop_limit = x->stop_defined
+                               ? x->stop_time + 1e-9 * fmax(fabs(x->start_time), fabs(x->stop_time))
+                               : (double)INFINITY;
+}
+
+fmu_status fmu_setup_experiment(fmu_instance* instance, const fmu_experiment* experiment)
 {
     fmu_status status = fmu_check_call(instance, FMU_OP_SETUP_EXPERIMENT, "setupExperiment");
     if (status == FMU_OK) {
-        instance->time = start_time;
-        instance->last_successful_time = start_time;
+        status = check_experiment(instance, experiment, "setupExperiment");
+    }
+    if (status == FMU_OK) {
+        start_experiment(instance, experiment);
     }
     return status;
 }
@@ -523,14 +556,18 @@ static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const c
 
 /* ---- the state machine ---------------------------------------------------------------------- */
 
-fmu_status fmu_enter_initialization(fmu_instance* instance, double start_time)
+fmu_status fmu_enter_initialization(fmu_instance* instance, const fmu_experiment* experiment)
 {
     fmu_status status =
         fmu_check_call(instance, FMU_OP_ENTER_INITIALIZATION, "enterInitializationMode");
+    if (status == FMU_OK && experiment != NULL) {
+        status = check_experiment(instance, experiment, "enterInitializationMode");
+    }
     if (status == FMU_OK) {
         enter_state(instance, FMU_STATE_INITIALIZATION);
-        instance->time = start_time;
-        instance->last_successful_time = start_time;
+        if (experiment != NULL) {
+            start_experiment(instance, experiment);
+        }
     }
     return status;
 }
@@ -550,15 +587,17 @@ fmu_status fmu_exit_initialization(fmu_instance* instance)
     return status;
 }
 
-/* Whether a step may be taken: a positive size and a later finite end. A sum that
- * overflows would leave the instance at an infinite time, one below the resolution
- * of double at current_time would advance the states but not the time. */
-static int step_is_valid(double current_time, double step_size)
+/* Whether a step may be taken: a positive size and a later finite end, not past the
+ * stop. A sum that overflows would leave the instance at an infinite time, one below
+ * the resolution of double at current_time would advance the states but not the
+ * time. */
+static int step_is_valid(const fmu_instance* instance, double current_time, double step_size)
 {
     /* x - x is 0 for a finite x: both ends finite, and the end later (so the size is
      * positive, finite, and above the resolution of double at current_time) */
     const double end = current_time + step_size;
-    return (end - end) + (current_time - current_time) == 0 && end > current_time;
+    return (end - end) + (current_time - current_time) == 0 && end > current_time &&
+           end <= instance->stop_limit;
 }
 
 /* Refuses, with the reason, a step that step_is_valid does not take. */
@@ -572,11 +611,35 @@ FMU_COLD static fmu_status check_step(fmu_instance* instance, double current_tim
                 function, current_time, step_size);
         return FMU_ERROR;
     }
-    if (!step_is_valid(current_time, step_size)) {
+    if (!(current_time + step_size > current_time) || !isfinite(current_time + step_size)) {
         fmu_log(instance, FMU_ERROR,
                 "%s: currentCommunicationPoint = %.17g s + communicationStepSize = %.17g s "
                 "= %.17g s is not a finite time after the current one",
                 function, current_time, step_size, current_time + step_size);
+        return FMU_ERROR;
+    }
+    if (!step_is_valid(instance, current_time, step_size)) {
+        fmu_log(instance, FMU_ERROR,
+                "%s: currentCommunicationPoint = %.17g s + communicationStepSize = %.17g s "
+                "= %.17g s ends past the experiment's stopTime (%.17g s at the latest)",
+                function, current_time, step_size, current_time + step_size, instance->stop_limit);
+        return FMU_ERROR;
+    }
+    return FMU_OK;
+}
+
+/* Refuses a step of a model with states that starts elsewhere than where its states
+ * are (within the rounding of a sum of steps): they would be carried to another
+ * time. An algebraic model's outputs do not depend on the time; it steps from any
+ * communication point. */
+static fmu_status check_continues(fmu_instance* instance, double current_time, const char* function)
+{
+    if (fabs(current_time - instance->time) >
+        1e-9 * fmax(fabs(current_time), fabs(instance->time))) {
+        fmu_log(instance, FMU_ERROR,
+                "%s: currentCommunicationPoint = %.17g s, but the states are at t = %.17g s: a "
+                "step starts where the last one ended (or at a restored FMU state's time)",
+                function, current_time, instance->time);
         return FMU_ERROR;
     }
     return FMU_OK;
@@ -643,6 +706,10 @@ FMU_COLD static fmu_status do_step_checked(fmu_instance* instance, double curren
     if (check_step(instance, current_time, step_size, function) != FMU_OK) {
         return FMU_ERROR;
     }
+    if (instance->model->behaviour->advance != NULL &&
+        check_continues(instance, current_time, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
     instance->time = current_time;
     if (instance->model->behaviour->advance != NULL) {
         return advance_states(instance, current_time, step_size, function);
@@ -665,7 +732,7 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
 {
     /* the common case: an algebraic model whose new inputs have an answer */
     if (instance != NULL && quiet_call(instance, FMU_OP_DO_STEP) &&
-        step_is_valid(current_time, step_size)) {
+        step_is_valid(instance, current_time, step_size)) {
         fmu_evaluation* e = &instance->evaluation;
         if (instance->dirty) {
             sync_angles(instance);
@@ -1435,12 +1502,13 @@ static int all_of(const fmu_model* model, const unsigned int vr[], size_t count,
 static fmu_status start_design(fmu_instance* instance, int first, const unsigned int vr_p[],
                                size_t n_p, const double p[])
 {
+    static const fmu_experiment from_zero = {0.0, 0, 0.0};
     fmu_status status = first ? FMU_OK : fmu_reset(instance);
     if (status == FMU_OK && n_p > 0) {
         status = fmu_set_real(instance, vr_p, n_p, p, "dyadfmu_evaluate_rows");
     }
     if (status == FMU_OK) {
-        status = fmu_enter_initialization(instance, 0.0);
+        status = fmu_enter_initialization(instance, &from_zero);
     }
     if (status == FMU_OK && fmu_exit_initialization(instance) == FMU_ERROR) {
         status = FMU_ERROR;

@@ -124,6 +124,9 @@ typedef struct fmu_instance {
     unsigned common_paths;
     double time; /* communication point reached (s) */
     double last_successful_time;
+    /* the latest end of a step (s): the importer's stopTime, less the rounding of a
+     * sum of steps that reaches it; +inf where none is defined */
+    double stop_limit;
     int terminate_requested;   /* set when a step cannot be completed */
     int dirty;                 /* inputs changed since the last evaluation */
     fmu_evaluation evaluation; /* of the last evaluation */
@@ -168,8 +171,16 @@ void fmu_log(const fmu_instance* instance, fmu_status status, const char* format
 
 fmu_status fmu_set_debug_logging(fmu_instance* instance, int logging_on, size_t count,
                                  const char* const categories[]);
-fmu_status fmu_setup_experiment(fmu_instance* instance, double start_time);
-fmu_status fmu_enter_initialization(fmu_instance* instance, double start_time);
+/* The simulated interval an importer announces (s). */
+typedef struct fmu_experiment {
+    double start_time;
+    int stop_defined; /* stop_time holds the end: a step past it is refused */
+    double stop_time;
+} fmu_experiment;
+
+fmu_status fmu_setup_experiment(fmu_instance* instance, const fmu_experiment* experiment);
+/* `experiment`: FMI 3's; NULL for FMI 2, which announced it by setupExperiment. */
+fmu_status fmu_enter_initialization(fmu_instance* instance, const fmu_experiment* experiment);
 fmu_status fmu_exit_initialization(fmu_instance* instance);
 fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_size,
                        const char* function);

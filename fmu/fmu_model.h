@@ -122,6 +122,11 @@ typedef struct fmu_behaviour {
      * rates; an angle's rate as the derivative of its (cos, sin)). NULL: none. */
     void (*derivative)(const struct fmu_model* model, const void* input, const void* seed,
                        void* output, void* rate, fmu_evaluation* evaluation);
+    /* A model with states: the name of a state that no step could have left in the
+     * input block `input` (bytes of a deserialized FMU state, perhaps unaligned),
+     * with its value, or NULL. NULL: no state to check. */
+    const char* (*state_refused)(const struct fmu_model* model, const unsigned char* input,
+                                 double* value);
 } fmu_behaviour;
 
 /* The calls an importer makes every step, set every Real input and get every Real

@@ -15,8 +15,8 @@
  * one, is refused; the checksum (FNV-1a over the payload) refuses a damaged one.
  * What the layer would use as an index (the state machine's state, the variable
  * an evaluation blames) is checked before it is restored, and so is every
- * parameter and input, as a set checks it: the models solve them without checking
- * again. The saved states of an instance are kept in a list and freed with it. */
+ * parameter and input, as a set checks it (the models solve them without checking
+ * again), and a model's states, as a step leaves them (fmu_behaviour.state_refused). The saved states of an instance are kept in a list and freed with it. */
 #include <stdint.h>
 #include <string.h>
 
@@ -165,12 +165,11 @@ static int indices_valid(fmu_instance* instance, const unsigned char* bytes)
            memchr(e.reason, '\0', sizeof e.reason) != NULL;
 }
 
-/* The first parameter or input whose value in the state's bytes could not have been
- * set (not finite, or outside its bounds), or NULL: a state is serialized from values
- * that were checked when they were set, and the model solves them without checking
- * again. */
-static const fmu_variable* value_refused(fmu_instance* instance, const unsigned char* bytes,
-                                         double* value)
+/* The name of the first parameter or input whose value in the state's bytes could
+ * not have been set (not finite, or outside its bounds), or of a state that no step
+ * could have reached, or NULL: a state is serialized from values that were checked
+ * when they were set, and the model solves them without checking again. */
+static const char* value_refused(fmu_instance* instance, const unsigned char* bytes, double* value)
 {
     state_part part[PART_COUNT];
     const fmu_model* m = instance->model;
@@ -195,10 +194,11 @@ static const fmu_variable* value_refused(fmu_instance* instance, const unsigned 
             continue;
         }
         if (!fmu_value_allowed(v, *value)) {
-            return v;
+            return v->name;
         }
     }
-    return NULL;
+    return m->behaviour->state_refused != NULL ? m->behaviour->state_refused(m, input, value)
+                                               : NULL;
 }
 
 static fmu_saved* new_saved(fmu_instance* instance, size_t size)
@@ -332,7 +332,7 @@ fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* by
                                  fmu_saved** state, const char* function)
 {
     const char* problem;
-    const fmu_variable* refused;
+    const char* refused;
     double value = 0;
     fmu_saved* saved = NULL;
     fmu_status status = fmu_check_call(instance, FMU_OP_STATE, function);
@@ -345,8 +345,8 @@ fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* by
         problem = "a state out of range";
     }
     if (problem == NULL && (refused = value_refused(instance, bytes, &value)) != NULL) {
-        fmu_log(instance, FMU_ERROR, "%s: refused: %s = %g could not have been set", function,
-                refused->name, value);
+        fmu_log(instance, FMU_ERROR, "%s: refused: %s = %g could not have been set or reached",
+                function, refused, value);
         return FMU_ERROR;
     }
     if (problem == NULL && (saved = new_saved(instance, size)) == NULL) {

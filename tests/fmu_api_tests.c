@@ -1906,27 +1906,43 @@ static int deserialize(int version, void* c, const unsigned char* bytes, size_t 
                         : (int)api3.DeserializeFMUState(c, bytes, size, state);
 }
 
-/* The state's bytes with its value `from` of a parameter or input (found once in the
- * payload) replaced by `to`, and the checksum made good again: a crafted state. */
-static int craft_state(unsigned char* bytes, size_t size, double from, double to)
+/* How many times the state's payload holds the value `from`. */
+static size_t occurrences(const unsigned char* bytes, size_t size, double from)
+{
+    const size_t header = 32;
+    size_t k, found = 0;
+    for (k = header; k + sizeof from <= size; ++k) {
+        found += memcmp(bytes + k, &from, sizeof from) == 0;
+    }
+    return found;
+}
+
+/* The state's bytes with every value `from` replaced by `to`, and the checksum made
+ * good again. */
+static void replace_and_seal(unsigned char* bytes, size_t size, double from, double to)
 {
     const size_t header = 32;
     uint64_t h = 0xcbf29ce484222325ULL;
-    size_t k, found = 0, at = 0;
+    size_t k;
     for (k = header; k + sizeof from <= size; ++k) {
         if (memcmp(bytes + k, &from, sizeof from) == 0) {
-            ++found;
-            at = k;
+            memcpy(bytes + k, &to, sizeof to);
         }
     }
-    if (found != 1) {
-        return 0;
-    }
-    memcpy(bytes + at, &to, sizeof to);
     for (k = header; k < size; ++k) {
         h = (h ^ bytes[k]) * 0x100000001b3ULL; /* FNV-1a, as fmu_state.c */
     }
     memcpy(bytes + 24, &h, sizeof h);
+}
+
+/* The state's bytes with its value `from` of a parameter or input (found once in the
+ * payload) replaced by `to`, and the checksum made good again: a crafted state. */
+static int craft_state(unsigned char* bytes, size_t size, double from, double to)
+{
+    if (occurrences(bytes, size, from) != 1) {
+        return 0;
+    }
+    replace_and_seal(bytes, size, from, to);
     return 1;
 }
 
@@ -2450,6 +2466,92 @@ static int test_bad_steps(void)
     return fails;
 }
 
+/* An experiment announced from `start` to `stop` (stop_defined): FMI 2's
+ * setupExperiment, FMI 3's enterInitializationMode; its status. */
+static int announce(int version, void* c, double start, int stop_defined, double stop)
+{
+    if (version == 2) {
+        return (int)api2.SetupExperiment(c, fmi2False, 0, start, stop_defined, stop);
+    }
+    return (int)api3.EnterInitializationMode(c, fmi3False, 0, start, stop_defined, stop);
+}
+
+static int step_either(int version, void* c, double t, double h)
+{
+    return version == 2 ? (int)api2.DoStep(c, t, h, fmi2True) : (int)step3(c, t, h);
+}
+
+static int initialise_from(int version, void* c, double start, double stop)
+{
+    if (announce(version, c, start, 1, stop) != 0) {
+        return 0;
+    }
+    return version == 2 ? api2.EnterInitializationMode(c) == fmi2OK &&
+                              api2.ExitInitializationMode(c) == fmi2OK
+                        : api3.ExitInitializationMode(c) == fmi3OK;
+}
+
+/* An experiment whose stop is before its start, or whose times are not finite, is
+ * refused with a message. */
+static int check_bad_experiments(int version)
+{
+    static const double experiments[][2] = {{1, 0.5},      {0, -1e-300}, {NAN, 1},
+                                            {INFINITY, 1}, {0, NAN},     {0, INFINITY}};
+    int fails = 0;
+    size_t k;
+    for (k = 0; k < sizeof experiments / sizeof experiments[0]; ++k) {
+        probe_log_book book;
+        void* c = version == 2 ? new_fmi2(&book, "experiment") : new_fmi3(&book, "experiment");
+        const int status = announce(version, c, experiments[k][0], 1, experiments[k][1]);
+        CHECK(status == 3 && logged_error(&book, 0),
+              "FMI %d: startTime %g, stopTime %g: status %d, expected Error and a message (%s)",
+              version, experiments[k][0], experiments[k][1], status, book.last);
+        free_either(version, c);
+    }
+    return fails;
+}
+
+/* Ten steps of 0.1 s from 0 reach a stop of 1 s (their sum rounds below it), and a step
+ * of the whole interval does too; a step past the stop is refused with a message and
+ * changes nothing. */
+static int check_steps_to_the_stop(int version)
+{
+    int fails = 0, ok = 1, k, status;
+    double t = 0;
+    probe_log_book book;
+    values_read before, after;
+    void* c = version == 2 ? new_fmi2(&book, "stop") : new_fmi3(&book, "stop");
+    CHECK(initialise_from(version, c, 0, 1), "FMI %d: initialised with a stop", version);
+    for (k = 0; k < 10; ++k, t += 0.1) {
+        ok &= step_either(version, c, t, 0.1) == 0;
+    }
+    CHECK(ok, "FMI %d: ten steps of 0.1 s to the stop at 1 s (%s)", version, book.last);
+    ok = version == 2 ? fmi2_read_all(c, &before) : fmi3_read_all(c, &before);
+    status = step_either(version, c, t, 1e-3);
+    ok &= version == 2 ? fmi2_read_all(c, &after) : fmi3_read_all(c, &after);
+    CHECK(ok && status == 3 && strstr(book.last, "stopTime") != NULL &&
+              same_values(&before, &after),
+          "FMI %d: doStep(%.17g, 1e-3) past the stop: status %d, expected Error naming stopTime "
+          "and no change (%s)",
+          version, t, status, book.last);
+    free_either(version, c);
+    c = version == 2 ? new_fmi2(&book, "stop") : new_fmi3(&book, "stop");
+    CHECK(initialise_from(version, c, -3, 7) && step_either(version, c, -3, 10) == 0,
+          "FMI %d: one step over the whole experiment (%s)", version, book.last);
+    free_either(version, c);
+    return fails;
+}
+
+static int test_experiment_stop(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        fails += check_bad_experiments(version);
+        fails += check_steps_to_the_stop(version);
+    }
+    return fails;
+}
+
 /* ---- the drive ------------------------------------------------------------------------------ */
 
 /* Inputs the drive refuses only when it evaluates them (inertia + load.inertia
@@ -2655,11 +2757,88 @@ static int test_drive_discard_keeps_state(void)
     return fails;
 }
 
+/* The drive steps on from where its states are, within rounding, or from a restored
+ * FMU state's time; a step from elsewhere is refused with a message and moves
+ * nothing. */
+static int test_drive_steps_on_from_its_time(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        probe_log_book book;
+        void* c = version == 2 ? new_fmi2(&book, "time") : new_fmi3(&book, "time");
+        void* saved = NULL;
+        double angle, omega;
+        int status, restored;
+        CHECK((version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)) &&
+                  step_either(version, c, 0, 0.01) == 0,
+              "FMI %d: initialised, one step (%s)", version, book.last);
+        angle = get_named(version, c, "crank.angle");
+        omega = get_named(version, c, "crank.omega");
+        status = step_either(version, c, 0.5, 0.01);
+        CHECK(status == 3 && strstr(book.last, "currentCommunicationPoint") != NULL &&
+                  probe_bits(get_named(version, c, "crank.angle")) == probe_bits(angle) &&
+                  probe_bits(get_named(version, c, "crank.omega")) == probe_bits(omega),
+              "FMI %d: doStep(0.5, 0.01) with the states at 0.01 s: status %d, expected Error "
+              "and the state kept (%s)",
+              version, status, book.last);
+        free_either(version, c);
+        c = version == 2 ? new_fmi2(&book, "time") : new_fmi3(&book, "time");
+        restored = (version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)) &&
+                   step_either(version, c, 0, 0.01) == 0 &&
+                   (version == 2 ? api2.GetFMUstate(c, &saved) == fmi2OK
+                                 : api3.GetFMUState(c, &saved) == fmi3OK) &&
+                   step_either(version, c, 0.01 * (1 + 1e-12), 0.01) == 0 &&
+                   (version == 2 ? api2.SetFMUstate(c, saved) == fmi2OK
+                                 : api3.SetFMUState(c, saved) == fmi3OK) &&
+                   step_either(version, c, 0.01, 0.02) == 0;
+        CHECK(restored,
+              "FMI %d: a step from within rounding of the states' time, and one from "
+              "a restored state's time (%s)",
+              version, book.last);
+        free_either(version, c);
+    }
+    return fails;
+}
+
+/* A state whose checksum is good but whose crank speed no step could have reached
+ * (NaN, in the states and in the outputs that show them): refused, naming it. */
+static int test_drive_crafted_state(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        probe_log_book book;
+        void* c = version == 2 ? new_fmi2(&book, "craft") : new_fmi3(&book, "craft");
+        void *state = NULL, *bad = NULL;
+        unsigned char* bytes = NULL;
+        size_t size = 0;
+        double omega = NAN;
+        CHECK((version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)) &&
+                  step_either(version, c, 0, 0.01) == 0 &&
+                  (omega = get_named(version, c, "crank.omega")) != 0 &&
+                  get_state(version, c, &state) == 0 &&
+                  serialize(version, c, state, &bytes, &size) == 0,
+              "FMI %d: a state after one step (%s)", version, book.last);
+        CHECK(bytes != NULL && occurrences(bytes, size, omega) >= 1,
+              "FMI %d: the state does not hold crank.omega = %.17g", version, omega);
+        if (bytes != NULL) {
+            replace_and_seal(bytes, size, omega, NAN);
+            CHECK(deserialize(version, c, bytes, size, &bad) == 3 && bad == NULL &&
+                      strstr(book.last, "crank.omega") != NULL,
+                  "FMI %d: a state with crank.omega = NaN accepted: %s", version, book.last);
+        }
+        free(bytes);
+        free_either(version, c);
+    }
+    return fails;
+}
+
 static const named_test drive_tests[] = {
     {"drive_errors_logged_every_time", test_drive_errors_logged_every_time},
     {"drive_step_beyond_cap", test_drive_step_beyond_cap},
     {"drive_outputs_never_infinite", test_drive_outputs_never_infinite},
     {"drive_discard_keeps_state", test_drive_discard_keeps_state},
+    {"drive_steps_on_from_its_time", test_drive_steps_on_from_its_time},
+    {"drive_crafted_state", test_drive_crafted_state},
 };
 
 /* ---- runner --------------------------------------------------------------------------------- */
@@ -2688,6 +2867,7 @@ static const named_test generic_tests[] = {
     {"fmu_state_round_trip", test_fmu_state_round_trip},
     {"exports_only_fmi", test_exports_only_fmi},
     {"bad_steps", test_bad_steps},
+    {"experiment_stop", test_experiment_stop},
 };
 
 /* Tests of one model, run when the FMUs are that model. */

@@ -33,6 +33,7 @@
 #include "fmu_drive.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -206,5 +207,24 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
     in->speed = speed;
 }
 
-const fmu_behaviour fmu_drive_behaviour = {
-    sizeof(fmu_drive_input), sizeof(fmu_drive_output), initialise, evaluate, start, advance, NULL};
+/* A step leaves the states finite (advance refuses one that would not), and so does
+ * start, from finite parameters. */
+static const char* state_refused(const fmu_model* model, const unsigned char* input, double* value)
+{
+    (void)model;
+    memcpy(value, input + offsetof(fmu_drive_input, angle), sizeof *value);
+    if (!isfinite(*value)) {
+        return "crank.angle";
+    }
+    memcpy(value, input + offsetof(fmu_drive_input, speed), sizeof *value);
+    return isfinite(*value) ? NULL : "crank.omega";
+}
+
+const fmu_behaviour fmu_drive_behaviour = {sizeof(fmu_drive_input),
+                                           sizeof(fmu_drive_output),
+                                           initialise,
+                                           evaluate,
+                                           start,
+                                           advance,
+                                           NULL,
+                                           state_refused};

@@ -96,4 +96,4 @@ static void derivative(const fmu_model* model, const void* input, const void* se
 }
 
 const fmu_behaviour fmu_dyad_behaviour = {
-    sizeof(dyad_input), sizeof(dyad_result), initialise, evaluate, NULL, NULL, derivative};
+    sizeof(dyad_input), sizeof(dyad_result), initialise, evaluate, NULL, NULL, derivative, NULL};
