@@ -7,11 +7,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from dyadgen.emit import fmi2, fmi3
-from dyadgen.locations import GOLDEN_DIR, INTERFACE_DIR, SCENES_DIR
+from dyadgen.locations import GOLDEN_DIR, HAND_TABLES, INTERFACE_DIR, SCENES_DIR
 from dyadgen.pipeline import build_table, load_scene, load_table
 
 #: The variable tables written by hand; the dyad FMUs' tables come from their scenes.
-TABLES = ("drive.toml",)
+TABLES = HAND_TABLES
 #: The scenes of the generic per-type dyad FMUs, whose model descriptions are golden.
 GOLDEN_SCENES = (
     "dyad_rrr.toml",

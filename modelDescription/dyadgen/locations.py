@@ -13,6 +13,10 @@ ROOT = MODEL_DESCRIPTION.parent
 INTERFACE_DIR = MODEL_DESCRIPTION / "interface"
 GOLDEN_DIR = INTERFACE_DIR / "golden"
 SCENES_DIR = ROOT / "scenes"
+#: The scenes the build adds with its tests (fmu/CMakeLists.txt: tests/scenes/*.toml).
+TEST_SCENES_DIR = ROOT / "tests" / "scenes"
+#: The variable tables written by hand (interface/), each an FMU of the build.
+HAND_TABLES = ("drive.toml",)
 #: A scene with every feature of the generated code (see the file and scenefile.c_names).
 C_NAMES_PROBE = INTERFACE_DIR / "c_names_probe.toml"
 #: every probe: external kinematics, internal with a crank, internal with a ram

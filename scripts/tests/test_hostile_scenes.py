@@ -63,8 +63,15 @@ def run_tool(*args):
     )
 
 
+#: The identifier of a copy of the six-bar: a built-in scene's own identifier is refused
+#: in any other file.
+COPY_ID = "my_sixbar"
+
+
 def sixbar_with(tmp_path, name="sixbar.toml", **scene_keys) -> Path:
-    """The six-bar scene with keys of its [scene] table replaced, written to tmp_path."""
+    """The six-bar scene with keys of its [scene] table replaced (its identifier
+    COPY_ID unless given), written to tmp_path."""
+    scene_keys.setdefault("identifier", f'"{COPY_ID}"')
     text = SIXBAR.read_text(encoding="utf-8")
     for key, value in scene_keys.items():
         line = f"{key} = {value}"
@@ -317,7 +324,7 @@ def test_an_awkward_description_stays_in_comments_and_strings(description, tmp_p
     assert textsafe.description_problem(description) is None
     out = _generate(tmp_path, description)
     _no_scene_text_in_code(out, "leakmark")
-    assert textsafe.c_comment(description) in (out / "sixbar_scene.c").read_text()
+    assert textsafe.c_comment(description) in (out / f"{COPY_ID}_scene.c").read_text()
     _compiles(out, tmp_path)
     _valid_model_descriptions(out, tmp_path, description)
     page = (out / "documentation" / "index.html").read_text()
@@ -665,6 +672,8 @@ def test_mutated_scenes_give_messages_never_tracebacks(tmp_path):
     names that clash, tables where strings belong: the generator accepts the scene and
     generates it, or refuses it with file:line messages; nothing else escapes."""
     sources = [(p, tomllib.loads(p.read_text())) for p in sorted(SCENES_DIR.glob("*.toml"))]
+    for _, data in sources:  # a copy may not keep a built-in scene's identifier
+        data["scene"]["identifier"] = "my_" + data["scene"]["identifier"]
     rng = random.Random(2024)
     outcomes = collections.Counter()
     for trial in range(600):
@@ -756,3 +765,114 @@ def test_cmake_stops_on_a_planted_description(tmp_path):
     assert (
         "hostile_description_comment_end.toml:5: [scene]: description must not contain" in message
     ), done.stderr
+
+
+# ---------------------------------------------------------------------------
+# identifiers that would break the build: the core's prefixes, a built-in FMU's name
+# ---------------------------------------------------------------------------
+def _identifier_refusal(tmp_path, identifier: str) -> tuple[int, list[str]]:
+    """(line of the identifier, the problems) of the six-bar copied under `identifier`."""
+    path = sixbar_with(tmp_path, "named.toml", identifier=toml_string(identifier))
+    line = path.read_text().splitlines().index(f"identifier = {toml_string(identifier)}") + 1
+    try:
+        pipeline.load_scene(path)
+    except SceneError as error:
+        return line, error.args[0]
+    return line, []
+
+
+@pytest.mark.parametrize(
+    "identifier, prefix",
+    [
+        ("dyad_check", "dyad_"),  # its dyad_check_input is the core's function
+        ("fmu_x", "fmu_"),
+        ("fmi2Foo", "fmi2"),
+        ("fmi3_x", "fmi3"),
+        ("dyadfmu_x", "dyadfmu_"),
+        ("Dyad_Check", "dyad_"),
+        ("fmu", "fmu_"),
+    ],
+)
+def test_an_identifier_with_a_reserved_prefix_is_refused_at_its_line(tmp_path, identifier, prefix):
+    line, problems = _identifier_refusal(tmp_path, identifier)
+    assert (
+        f"named.toml:{line}: [scene]: identifier '{identifier}' starts with '{prefix}', which "
+        "is reserved for the C names of the core, the FMU layer and FMI"
+    ) in "\n".join(problems), problems
+
+
+def _builtin_files() -> list[tuple[Path, str]]:
+    """(file, identifier) of every FMU the build always makes, read as CMake finds them."""
+    files = sorted(SCENES_DIR.glob("*.toml")) + sorted((ROOT / "tests" / "scenes").glob("*.toml"))
+    found = [(p, tomllib.loads(p.read_text())["scene"]["identifier"]) for p in files]
+    drive = MD_DIR / "interface" / "drive.toml"
+    return found + [(drive, tomllib.loads(drive.read_text())["model"]["identifier"])]
+
+
+@pytest.mark.parametrize("path, identifier", _builtin_files(), ids=lambda v: str(v)[-20:])
+def test_a_built_in_fmu_s_identifier_is_refused_in_another_file(tmp_path, path, identifier):
+    """A second scene named like a built-in FMU makes CMake define its targets twice."""
+    line, problems = _identifier_refusal(tmp_path, identifier)
+    where = path.relative_to(ROOT)
+    assert any(
+        p.startswith(f"named.toml:{line}: [scene]: identifier '{identifier}' names a built-in FMU")
+        and f"(from {where})" in p
+        for p in problems
+    ), problems
+
+
+def test_each_built_in_scene_keeps_its_own_identifier():
+    for path, _ in _builtin_files()[:-1]:
+        pipeline.load_scene(path)  # no SceneError, dyad_rrr's 'dyad_' prefix included
+
+
+# ---------------------------------------------------------------------------
+# untrusted TOML: size, nesting, byte order mark
+# ---------------------------------------------------------------------------
+def test_a_deeply_nested_value_is_refused_at_its_line_without_a_traceback(tmp_path):
+    path = tmp_path / "deep.toml"
+    path.write_text(SIXBAR.read_text() + "\n[start]\ncom = " + "[" * 5000 + "]" * 5000 + "\n")
+    line = len(path.read_text().splitlines())
+    done = run_tool(path, "--check")
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    assert f"error: deep.toml:{line}: arrays or tables nested more than 32 deep" in done.stderr
+
+
+def test_a_file_without_end_is_not_read_to_its_end():
+    done = subprocess.run(
+        [sys.executable, str(SCENE_TOOL), "/dev/zero", "--check"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    assert "error: zero: larger than 1000000 bytes: not read" in done.stderr
+
+
+def test_a_byte_order_mark_is_accepted(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + sixbar_with(tmp_path).read_bytes())
+    assert pipeline.load_scene(path).identifier == COPY_ID
+
+
+# ---------------------------------------------------------------------------
+# a refused value is told once, not again by the checks that depend on it
+# ---------------------------------------------------------------------------
+def _engine_problems(tmp_path, old: str, new: str) -> list[str]:
+    text = (SCENES_DIR / "engine.toml").read_text()
+    text = text.replace('identifier = "engine"', 'identifier = "my_engine"')
+    assert old in text
+    return _refusal(tmp_path, text.replace(old, new, 1))
+
+
+def test_a_refused_link_name_is_told_once(tmp_path):
+    """The probe's case: a [[link]] refused for its name left the dyad without links, and
+    the load on the other link, 'piston', was told as a load on an unknown link."""
+    problems = _engine_problems(tmp_path, 'name = "rod"', 'name = "ro\\"d"')
+    assert any("link #2: name 'ro\"d' must be a lower-case identifier" in p for p in problems)
+    assert not any("[loads]" in p for p in problems), problems
+
+
+def test_a_refused_gravity_is_not_told_again_as_an_unknown_tunable(tmp_path):
+    problems = _engine_problems(tmp_path, "y = -9.81", "y = nan")
+    assert len(problems) == 1 and "[gravity]: 'y' must be a finite number" in problems[0]

@@ -772,3 +772,49 @@ def test_a_name_the_scene_has_no_parameter_of_is_refused_at_the_study_s_line(tmp
     assert str(info.value).startswith(
         f"{tmp_path / 'study.toml'}:{line}: foo.bar is not a parameter"
     )
+
+
+# ---- untrusted study files: nesting, byte order mark; names before the build ------------------
+
+
+def test_a_deeply_nested_study_is_refused_at_its_line_not_with_a_recursion_error(tmp_path):
+    text = BALANCE_STUDY + '\n[fixed]\n"crank.mass" = ' + "[" * 5000 + "]" * 5000 + "\n"
+    line = len(text.splitlines())
+    message = _refused(tmp_path, text)
+    assert message == f"{tmp_path / 'study.toml'}:{line}: arrays or tables nested more than 32 deep"
+
+
+def test_the_sweep_command_refuses_a_deeply_nested_study_without_a_traceback(tmp_path):
+    path = _write(tmp_path, "[study]\nx = " + "[" * 5000 + "]" * 5000 + "\n")
+    done = subprocess.run(
+        [sys.executable, "-m", "dyadfmu", "sweep", str(path), "--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        cwd=ROOT / "scripts",
+    )
+    assert done.returncode != 0 and "Traceback" not in done.stderr, done.stderr
+    assert f"{path}:2: arrays or tables nested more than 32 deep" in done.stderr
+
+
+def test_a_study_with_a_byte_order_mark_is_read(tmp_path):
+    path = tmp_path / "study.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + BALANCE_STUDY.encode())
+    assert read_study(path).description == "counterweight on a crank with its own unbalance"
+
+
+def test_a_misspelt_name_is_refused_before_the_scene_s_fmu_is_built(tmp_path, monkeypatch):
+    """scenes/studies/README.md: every problem is refused before anything runs; the
+    mechanism FMU's build (tens of seconds) is not started for a misspelt figure."""
+
+    def no_build(*args, **kwargs):
+        raise AssertionError("the mechanism FMU was built before the names were checked")
+
+    monkeypatch.setattr(sources, "mechanism_fmu", no_build)
+    scene = ROOT / "tests" / "scenes" / "balance.toml"
+    text = BALANCE_STUDY.replace(f'fmu = "{BALANCE}"', f'scene = "{scene}"')
+    text = text.replace('of = "crank.torque"', 'of = "crank.torqe"')
+    line = next(k for k, t in enumerate(text.splitlines(), start=1) if "crank.torqe" in t)
+    with pytest.raises(StudyError) as info:
+        study.prepare(_write(tmp_path, text), tmp_path)
+    assert str(info.value).startswith(f"{tmp_path / 'study.toml'}:{line}: torque_rms: ")
+    assert "crank.torqe is not a Real output or input of balance_sweep_" in str(info.value)

@@ -15,8 +15,12 @@ TWO_BRANCHES = ("RRR", "RRT", "RTR")
 ATTACHMENT_KEYS = ("link", "at", "guide")
 
 
-def link_tables(p: Problems, data: dict, crank: Crank | None) -> dict[str, tuple[dict, int]]:
-    """The [[link]] tables by name (tables first, so that dyads can refer to them)."""
+def link_tables(
+    p: Problems, data: dict, crank: Crank | None, refused: dict[str, int]
+) -> dict[str, tuple[dict, int]]:
+    """The [[link]] tables by name (tables first, so that dyads can refer to them); the
+    index of each table whose name is refused goes to `refused`, by that name, so that
+    what refers to it is not refused again."""
     tables: dict[str, tuple[dict, int]] = {}
     rows = data.get("link", [])
     if not isinstance(rows, list):
@@ -31,6 +35,8 @@ def link_tables(p: Problems, data: dict, crank: Crank | None) -> dict[str, tuple
         problem = name_problem(name)
         if problem:
             p.add(f"link #{i + 1}: name {problem}", "link", i, "name")
+            if isinstance(name, str):
+                refused.setdefault(name, i)
         elif name in tables:
             also = p.loc.line("link", tables[name][1])
             p.add(f"link '{name}' is described twice (also line {also})", "link", i, "name")
@@ -236,11 +242,19 @@ class Mechanism:
     """The [[dyad]] tables parsed in order: the dyads, their links, and which dyad owns
     each link name."""
 
-    def __init__(self, p: Problems, crank: Crank | None, tables: dict, internal: bool) -> None:
+    def __init__(
+        self,
+        p: Problems,
+        crank: Crank | None,
+        tables: dict,
+        internal: bool,
+        refused: dict[str, int] | None = None,
+    ) -> None:
         self.p = p
         self.crank = crank
         self.internal = internal
         self.tables = tables
+        self.refused = refused or {}  # link name -> its table, whose name was refused
         self.dyads: list[Dyad] = []
         self.links: dict[str, Link] = {}
         self.owner: dict[str, str] = {}  # link name -> "dyad 'x' as m"
@@ -342,6 +356,22 @@ class Mechanism:
             f"Assembly branch of {dyad.name or 'the dyad'}: +1 or -1 (only the sign counts)",
         )
 
+    def tables_of_names(self, rows: object) -> dict[str, tuple[str, int]]:
+        """Every name a link or dyad table was given (valid or refused) -> (section,
+        index) of its table: where a later check looks for a problem already told."""
+        found = {name: ("link", i) for name, i in self.refused.items()}
+        found.update({name: ("link", i) for name, (_, i) in self.tables.items()})
+        for i, row in enumerate(rows if isinstance(rows, list) else []):
+            name = row.get("name") if isinstance(row, dict) else None
+            if isinstance(name, str):
+                found.setdefault(name, ("dyad", i))
+        return found
+
+    def known(self) -> set[str]:
+        """The link names the scene describes or connects, valid or refused: a later
+        check refers to one of those without telling a problem of its own."""
+        return set(self.tables) | set(self.owner) | set(self.refused)
+
     def link_numbers(self, inertia: bool, needs_mass: bool) -> None:
         """Every described link's numbers; a link of no dyad is a problem."""
         for lname, (row, i) in self.tables.items():
@@ -369,6 +399,8 @@ class Mechanism:
             p.add(
                 f"{label}: link '{lname}' is the crank, which no dyad may contain", "dyad", i, side
             )
+            return False
+        if lname in self.refused:  # its table's name was refused there
             return False
         if lname not in self.tables:
             p.add(

@@ -9,6 +9,7 @@ import re
 from dataclasses import dataclass
 
 from dyadgen import cnames
+from dyadgen.locations import relative_to_checkout
 from dyadgen.scenefile.problems import Problems, shown
 
 #: The scene's identifier (it names the FMU, its files and C types) and the names of the
@@ -83,6 +84,33 @@ def identifier_problem(identifier: object) -> str | None:
         )
     if identifier in cnames.C_KEYWORDS:
         return f"'{identifier}' is a C keyword"
+    return None
+
+
+#: Prefixes an identifier may not start with (in any case): the C names it leads to
+#: (<identifier>_input, ...) would be the core's, the FMU layer's or FMI's ('dyad_check'
+#: gives dyad_check_input, a function of the core), and dyadfmu_ is the project's own.
+IDENTIFIER_PREFIXES = RESERVED_PREFIXES + ("dyadfmu_",)
+
+
+def reserved_identifier_problem(identifier: str, builtins: dict) -> str | None:
+    """Why a valid C identifier cannot name the FMU of a scene that is not built in: the
+    identifier of an FMU the build always makes (`builtins`, identifier -> its file), or
+    a reserved prefix; None where it can."""
+    if identifier in builtins:
+        where = relative_to_checkout(builtins[identifier])
+        return (
+            f"'{identifier}' names a built-in FMU (from {where}): a "
+            f"build with both would make the targets {identifier}_fmi2 and "
+            f"{identifier}_fmi3 twice; choose another identifier"
+        )
+    for prefix in IDENTIFIER_PREFIXES:
+        if (identifier.lower() + "_").startswith(prefix.lower()):
+            return (
+                f"'{identifier}' starts with '{prefix}', which is reserved for the C names "
+                f"of the core, the FMU layer and FMI (no identifier starts with "
+                f"{', '.join(IDENTIFIER_PREFIXES)} or is one of them without its '_')"
+            )
     return None
 
 

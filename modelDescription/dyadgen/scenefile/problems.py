@@ -21,6 +21,9 @@ class Problems:
         self.path = path
         self.loc = locator
         self.items: list[str] = []
+        #: (section, index) of every table with a problem: a later check skips what
+        #: only follows from a value refused there (a tunable value that was refused)
+        self.troubled: set[tuple[str, int]] = set()
 
     def where(self, section: str = "", index: int = 0, key: str | None = None) -> str:
         """file:line of a table or key; a table written as a plain key (scene = 1) is
@@ -34,6 +37,7 @@ class Problems:
     def add(self, message: str, section: str = "", index: int = 0, key: str | None = None) -> None:
         """Record a problem of a table (the index-th of an array) or of one of its keys."""
         self.items.append(f"{self.where(section, index, key)}: {textsafe.plain(message)}")
+        self.troubled.add((section, index))
 
 
 def real(value: object) -> float | None:

@@ -91,13 +91,15 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     crank = sections.crank(p, data, inertia, needs_mass, internal) or sections.ram(
         p, data, needs_mass, internal
     )
-    found = mechanism.Mechanism(p, crank, mechanism.link_tables(p, data, crank), internal)
+    refused: dict[str, int] = {}
+    tables = mechanism.link_tables(p, data, crank, refused)
+    found = mechanism.Mechanism(p, crank, tables, internal, refused)
     found.parse(data)
     found.link_numbers(inertia, needs_mass)
     if c_names is not None:
         objects = _named_objects(identifier, found, crank)
         c_name_clashes(p, objects, c_names())
-    sections.loads(p, data, found.links)
+    sections.loads(p, data, found.links, found.known())
     scene = Scene(
         path=path,
         identifier=identifier,
@@ -111,7 +113,7 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
         threshold=threshold,
         kinematics=kinematics,
     )
-    sections.tunable(p, scene_t, scene)
+    sections.tunable(p, scene_t, scene, found.tables_of_names(data.get("dyad", [])))
     if not p.items:
         _derive(p, scene, scene_t, data)
     if p.items:

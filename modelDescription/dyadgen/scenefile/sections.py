@@ -4,13 +4,16 @@ links and dyads. Each parser records every problem it finds and returns what is 
 
 from __future__ import annotations
 
-import re
-import tomllib
 from pathlib import Path
 
 from dyadgen import textsafe
 from dyadgen.model import Crank, Param, Scene, member
-from dyadgen.scenefile.names import identifier_problem, name_problem
+from dyadgen.scenefile.builtins import builtin_identifiers, is_builtin
+from dyadgen.scenefile.names import (
+    identifier_problem,
+    name_problem,
+    reserved_identifier_problem,
+)
 from dyadgen.scenefile.problems import (
     Problems,
     SceneError,
@@ -20,6 +23,7 @@ from dyadgen.scenefile.problems import (
     shown,
     unknown_keys,
 )
+from dyadgen.tomltext import TomlTextError, read_toml
 
 SCENE_KEYS = {
     "identifier",
@@ -40,23 +44,15 @@ DEFAULT_THRESHOLD = 1.4901161193847656e-8
 
 
 def read_text(path: Path) -> tuple[str, dict]:
-    """The text of a scene file and its TOML; raises SceneError where it is no TOML text."""
-    shown_name = textsafe.plain(path.name)
+    """The text of a scene file and its TOML; raises SceneError where it is no TOML text
+    (or too large, or nested too deeply: tomltext)."""
     try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise SceneError([f"{shown_name}: cannot read: {exc.strerror}"]) from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise SceneError([f"{shown_name}:{line}: not UTF-8 text (byte {exc.start + 1})"]) from None
-    try:
-        return text, tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        line = re.search(r"at line (\d+)", str(exc))
-        where = f"{shown_name}:{line.group(1)}" if line else shown_name
-        raise SceneError([f"{where}: invalid TOML: {textsafe.plain(exc)}"]) from None
+        return read_toml(path)
+    except TomlTextError as exc:
+        line = "" if exc.line is None else f":{exc.line}"
+        raise SceneError(
+            [f"{textsafe.plain(path.name)}{line}: {textsafe.plain(exc.message)}"]
+        ) from None
 
 
 def scene_section(p: Problems, data: dict) -> tuple[dict, str, str]:
@@ -72,6 +68,8 @@ def scene_section(p: Problems, data: dict) -> tuple[dict, str, str]:
     unknown_keys(p, scene_t, SCENE_KEYS, "[scene]", "scene", 0)
     identifier = scene_t.get("identifier")
     problem = identifier_problem(identifier)
+    if problem is None and not is_builtin(p.path, identifier):
+        problem = reserved_identifier_problem(identifier, builtin_identifiers())
     if problem:
         p.add(f"[scene]: identifier {problem}", "scene", 0, "identifier")
         identifier = "scene"
@@ -304,8 +302,10 @@ def ram(p: Problems, data: dict, needs_mass: bool, internal: bool) -> Crank | No
     return found
 
 
-def loads(p: Problems, data: dict, links: dict) -> None:
-    """[loads]: the links an active force or moment acts on (an input each)."""
+def loads(p: Problems, data: dict, links: dict, known: set) -> None:
+    """[loads]: the links an active force or moment acts on (an input each). A link of
+    `known` that is not in `links` (its table or its dyad was refused) is not told
+    again."""
     loads_t = data.get("loads", {})
     if not isinstance(loads_t, dict):
         p.add("[loads] must be a table", "loads", 0)
@@ -317,6 +317,8 @@ def loads(p: Problems, data: dict, links: dict) -> None:
             p.add(f"[loads]: '{key}' must be a list of link names", "loads", 0, key)
             continue
         for lname in value:
+            if lname not in links and lname in known:
+                continue
             if lname not in links:
                 p.add(
                     f"[loads]: {key} on unknown link '{lname}' (links: "
@@ -331,8 +333,19 @@ def loads(p: Problems, data: dict, links: dict) -> None:
                 setattr(links[lname], key, True)
 
 
-def tunable(p: Problems, scene_t: dict, scene: Scene) -> None:
-    """[scene] tunable: the parameters that stay FMU parameters (all others are baked)."""
+def _told(p: Problems, entry: str, tables_of: dict, scene: Scene) -> bool:
+    """Whether a tunable entry that names no parameter names one of an object whose table
+    had a problem (a value refused there: [gravity] y = nan, a link refused)."""
+    head = entry.split(".")[0]
+    tables = dict(tables_of, gravity=("gravity", 0))
+    if scene.crank is not None:
+        tables[scene.crank.name] = (scene.crank.kind, 0)
+    return head in tables and tables[head] in p.troubled
+
+
+def tunable(p: Problems, scene_t: dict, scene: Scene, tables_of: dict) -> None:
+    """[scene] tunable: the parameters that stay FMU parameters (all others are baked).
+    `tables_of`: the link and dyad names -> (section, index) of their tables."""
     entries = scene_t.get("tunable", [])
     params = {prm.name: prm for prm in scene.parameters()}
     if not isinstance(entries, list) or not all(isinstance(t, str) for t in entries):
@@ -343,7 +356,7 @@ def tunable(p: Problems, scene_t: dict, scene: Scene) -> None:
             chosen = list(params)
         else:
             chosen = [n for n in params if n == entry or n.startswith(entry + ".")]
-        if not chosen:
+        if not chosen and not _told(p, entry, tables_of, scene):
             p.add(
                 f"[scene]: tunable '{entry}' is no parameter of this scene (parameters: "
                 f"{', '.join(params)})",

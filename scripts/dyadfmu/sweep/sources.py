@@ -14,6 +14,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 import tomllib
 import zipfile
 from pathlib import Path
@@ -30,6 +31,7 @@ __all__ = [
     "mechanism_fmu",
     "drive_fmu",
     "model_description",
+    "planned_model_description",
     "SourceError",
 ]
 
@@ -158,6 +160,36 @@ def _build_scene(original: Path, scene: Path, identifier: str, fmi: int) -> Path
     if done.returncode != 0 or not fmu.is_file():
         raise SourceError(f"scripts/build-scene {scene} failed:\n{done.stderr[-2000:]}")
     return fmu
+
+
+def _generator_refusal(study: Study, stderr: str) -> SourceError:
+    """The error of a study copy the generator refused: the user's scene's own line where
+    it is the scene's fault, the study's line where a name it sets is no parameter."""
+    check_scene(study.scene)
+    _refuse_unknown_name(study, stderr)
+    return SourceError(f"{study.scene}: the study's copy of it was refused:\n{stderr[-2000:]}")
+
+
+def planned_model_description(study: Study, out: Path) -> tuple[ModelDescription, str] | None:
+    """(model description, FMU file name) of the mechanism FMU a scene study will build,
+    generated from the study's copy of its scene without building it (scene.py --out, in
+    well under a second), so that the study's names are checked before the build; None
+    for a study of an .fmu."""
+    if study.fmu is not None:
+        return None
+    scene = sweep_scene(study, out)
+    identifier = tomllib.loads(scene.read_text(encoding="utf-8"))["scene"]["identifier"]
+    with tempfile.TemporaryDirectory(prefix="dyadfmu-sweep-") as generated:
+        done = subprocess.run(
+            [sys.executable, str(paths.GENERATOR), str(scene), "--out", generated],
+            capture_output=True,
+            text=True,
+        )
+        if done.returncode != 0:
+            raise _generator_refusal(study, done.stderr)
+        xml = Path(generated) / f"fmi{study.fmi}" / "modelDescription.xml"
+        md = read_model_description(str(xml))
+    return md, f"{identifier}_fmi{study.fmi}.fmu"
 
 
 def mechanism_fmu(study: Study, out: Path) -> Path:

@@ -34,12 +34,17 @@ def prepare(
     path: Path, out: Path, build: Path | None = None
 ) -> tuple[Study, KinetostaticRun | DrivenRun, np.ndarray, dict]:
     """(study, run, designs, units): the study read, its FMUs found or built and its
-    names checked against them, its designs drawn, the units of its columns."""
+    names checked against them, its designs drawn, the units of its columns. A scene
+    study's names are checked against the model description generated from its scene
+    first: a misspelt name is refused before the mechanism FMU is built."""
     study = read_study(path)
-    mechanism = sources.mechanism_fmu(study, out)
     drive = sources.drive_fmu(study, build)
-    md = sources.model_description(mechanism)
     drive_md = sources.model_description(drive) if drive is not None else None
+    planned = sources.planned_model_description(study, out)
+    if planned is not None:
+        check_names(study, planned[0], drive_md, planned[1])
+    mechanism = sources.mechanism_fmu(study, out)
+    md = sources.model_description(mechanism)
     check_names(study, md, drive_md, mechanism.name)
     try:
         run = run_of(study, str(mechanism), str(drive) if drive else None, md)

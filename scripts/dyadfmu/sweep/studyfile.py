@@ -53,8 +53,13 @@ MAX_COUNTERWEIGHT_MASS = 1e6
 MAX_COUNTERWEIGHT_AT = 1e3
 #: The largest load a load case may give (in the load input's unit: N or N m).
 MAX_LOAD = 1e12
-#: The largest study file read.
+#: The largest study file read, and the deepest nesting of its arrays and tables (the
+#: scene generator's limits for a scene file: modelDescription/dyadgen/tomltext.py).
 MAX_STUDY_BYTES = 1_000_000
+MAX_NESTING = 32
+_STRINGS_AND_COMMENTS = re.compile(
+    r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*|\Z'
+)
 
 
 class StudyError(ValueError):
@@ -719,20 +724,48 @@ def _check_work(r: _Reader, sampling: Sampling, n_params: int, run: object) -> N
         )
 
 
-def read_study(path: Path | str) -> Study:
-    """Read and check a study file (StudyError naming FILE:LINE where it is wrong)."""
-    path = Path(path)
+def too_deep_line(text: str, limit: int = MAX_NESTING) -> int | None:
+    """The line where arrays and inline tables first nest deeper than ``limit``, strings
+    and comments skipped (the pattern's last branch, the end, scans the rest); None where
+    they never do. (The generator's dyadgen/tomltext.py keeps the same check for scenes.)"""
+    depth, line, pos = 0, 1, 0
+    for found in _STRINGS_AND_COMMENTS.finditer(text):
+        for ch in text[pos : found.start()]:
+            line += ch == "\n"
+            depth += (ch in "[{") - (ch in "]}")
+            if depth > limit:
+                return line
+        line += found.group().count("\n")
+        pos = found.end()
+    return None
+
+
+def _read_toml(path: Path) -> tuple[str, dict]:
+    """The text of a study file (UTF-8, a byte order mark dropped) and its TOML, within
+    MAX_STUDY_BYTES and MAX_NESTING; StudyError naming the file (and line) otherwise."""
     try:
         if not path.is_file() or path.stat().st_size > MAX_STUDY_BYTES:
             raise StudyError(f"{path}: not a study file (a regular file of at most 1 MB)")
-        text = path.read_text(encoding="utf-8")
-        data = tomllib.loads(text)
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as e:
         raise StudyError(f"{path}: cannot read: {e}") from None
+    deep = too_deep_line(text)
+    if deep is not None:
+        raise StudyError(f"{path}:{deep}: arrays or tables nested more than {MAX_NESTING} deep")
+    try:
+        return text, tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         at = re.search(r"\(at line (\d+), column \d+\)", str(e))
         line = f":{at.group(1)}" if at else ""
         raise StudyError(f"{path}{line}: not valid TOML: {e}") from None
+    except RecursionError:  # not reached within MAX_NESTING; the last guard
+        raise StudyError(f"{path}: arrays or tables nested too deeply") from None
+
+
+def read_study(path: Path | str) -> Study:
+    """Read and check a study file (StudyError naming FILE:LINE where it is wrong)."""
+    path = Path(path)
+    text, data = _read_toml(path)
     r = _Reader(path, text)
     r.unknown_keys(
         data,
