@@ -7,6 +7,22 @@ DYADFMU_VENV=${DYADFMU_VENV:-$DYADFMU_ROOT/.venv}
 
 dyadfmu_log() { printf '== %s\n' "$*" >&2; }
 
+# dyadfmu_wants_help ARGS...: true if -h or --help is among the arguments.
+dyadfmu_wants_help() {
+    local arg
+    for arg in "$@"; do
+        case $arg in -h | --help) return 0 ;; esac
+    done
+    return 1
+}
+
+# dyadfmu_check_args COMMAND ARGS...: the arguments of 'dyadfmu COMMAND' checked by its own
+# parser with nothing run (dyadfmu --parse-only; needs the venv), so that a wrapper stops on
+# a mistyped option before it builds: exits with the parser's message and status (2).
+dyadfmu_check_args() {
+    "$DYADFMU_VENV/bin/dyadfmu" --parse-only "$@" || exit $?
+}
+
 # dyadfmu_ensure_system [NEED...]: the Debian packages a command needs. Always the
 # compiler, make, CMake, pkg-config (scripts/tests/test_install.py) and Python with
 # venv; NEED `study`: GSL (the generic-solve baseline of the benchmark) and valgrind

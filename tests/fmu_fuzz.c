@@ -31,6 +31,8 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
+#include <ctype.h>
+#include <errno.h>
 #include <float.h>
 #include <inttypes.h>
 #include <limits.h>
@@ -1410,29 +1412,59 @@ static int episode_and_replay(fuzz_episode* e, uint64_t seed, const char* direct
     return 0;
 }
 
+/* A whole number of option `name` from `text`: decimal digits (with `hex`, also 0x and
+ * hex digits) and nothing else, from `low` to `high`; else 0 after a message naming the
+ * option and the text. */
+static int parse_count(const char* name, const char* text, int hex, unsigned long long low,
+                       unsigned long long high, unsigned long long* value)
+{
+    char* end = NULL;
+    int digits = hex && (text[0] == '0') && (text[1] == 'x' || text[1] == 'X');
+    errno = 0;
+    if (isdigit((unsigned char)text[0])) {
+        *value = strtoull(text, &end, digits ? 16 : 10);
+    }
+    if (end == NULL || *end != '\0' || errno == ERANGE || *value < low || *value > high) {
+        fprintf(stderr, "fmu_fuzz: %s must be a whole number from %llu to %llu%s, not '%s'\n", name,
+                low, high, hex ? " (decimal or 0x hex)" : "", text);
+        return 0;
+    }
+    return 1;
+}
+
+/* The options; 0 after a message if one is bad or the FMU directory is missing. */
 static int parse_options(int argc, char** argv, fuzz_options* o)
 {
-    int a;
+    int a, ok = 1;
+    unsigned long long steps = 20000, seed = 1, replay_seed = 0;
     memset(o, 0, sizeof *o);
-    o->steps = 20000;
-    o->seed = 1;
-    for (a = 1; a < argc; ++a) {
-        if (strcmp(argv[a], "--steps") == 0 && a + 1 < argc) {
-            o->steps = strtol(argv[++a], NULL, 10);
-        } else if (strcmp(argv[a], "--seed") == 0 && a + 1 < argc) {
-            o->seed = strtoull(argv[++a], NULL, 0);
-        } else if (strcmp(argv[a], "--replay") == 0 && a + 1 < argc) {
+    for (a = 1; a < argc && ok; ++a) {
+        const char* value = a + 1 < argc ? argv[a + 1] : NULL;
+        int takes = strcmp(argv[a], "--steps") == 0 || strcmp(argv[a], "--seed") == 0 ||
+                    strcmp(argv[a], "--replay") == 0;
+        if (takes && value == NULL) {
+            fprintf(stderr, "fmu_fuzz: %s needs a value\n", argv[a]);
+            ok = 0;
+        } else if (strcmp(argv[a], "--steps") == 0) {
+            ok = parse_count("--steps", argv[++a], 0, 1, LONG_MAX, &steps);
+        } else if (strcmp(argv[a], "--seed") == 0) {
+            ok = parse_count("--seed", argv[++a], 1, 0, UINT64_MAX, &seed);
+        } else if (strcmp(argv[a], "--replay") == 0) {
             o->replay = 1;
-            o->replay_seed = strtoull(argv[++a], NULL, 0);
+            ok = parse_count("--replay", argv[++a], 1, 0, UINT64_MAX, &replay_seed);
         } else if (strcmp(argv[a], "--verbose") == 0) {
             o->verbose = 1;
         } else if (argv[a][0] != '-' && o->directory == NULL) {
             o->directory = argv[a];
         } else {
-            return 0;
+            fprintf(stderr, "fmu_fuzz: unknown argument '%s'\n", argv[a]);
+            ok = 0;
         }
     }
-    return o->directory != NULL && o->steps >= 0;
+    o->steps = (long)steps;
+    o->seed = (uint64_t)seed;
+    o->replay_seed = (uint64_t)replay_seed;
+    return ok && o->directory != NULL;
 }
 
 int main(int argc, char** argv)

@@ -101,11 +101,36 @@ def default_core() -> Core:
     return Core()
 
 
-def _as_field(name: str, width: int, value: object) -> np.ndarray:
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _shown(value: object) -> str:
+    """A value for an error message, cut short."""
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:45]}... ({len(text)} characters)"
+
+
+def _converted(name: str, value: object) -> np.ndarray:
+    """A field's value as float64, refusing complex numbers and values beyond a double's
+    range by name (the slow path: a float64 array is taken as it is)."""
     try:
-        array = np.asarray(value, dtype=np.float64)
+        array = np.asarray(value)
+        if array.dtype.kind == "c":
+            raise TypeError(f"not complex ({array.dtype}): {_shown(value)}")
+        return np.asarray(array, dtype=np.float64)
     except (TypeError, ValueError) as error:
         raise ValueError(f"{name} must be real numbers: {error}") from None
+    except OverflowError:
+        raise ValueError(
+            f"{name} must be real numbers within a double's range, not {_shown(value)}"
+        ) from None
+
+
+def _as_field(name: str, width: int, value: object) -> np.ndarray:
+    if type(value) is np.ndarray and value.dtype is _FLOAT64:
+        array = value
+    else:
+        array = _converted(name, value)
     if width == 2 and (array.ndim == 0 or array.shape[-1] != 2):
         raise ValueError(f"{name} is a vector: its last axis must have length 2, not {array.shape}")
     return array
@@ -214,6 +239,11 @@ def _new_outputs(shape: tuple) -> tuple[dict[str, np.ndarray], dict[str, int]]:
 
 def _given_outputs(out: Reactions, shape: tuple) -> dict[str, np.ndarray]:
     """The arrays of `out` to write into, each checked for its type, shape and layout."""
+    if not isinstance(out, Reactions):
+        raise TypeError(
+            f"out must be the Reactions of an earlier dyadfmu.solve, not {type(out).__name__} "
+            f"{_shown(out)}"
+        )
     arrays = {}
     kinds = [(name, width, np.float64) for name, width in OUTPUTS]
     for name, width, dtype in kinds + [("status", 1, np.uint8), ("field", 1, np.uint8)]:
@@ -226,7 +256,13 @@ def _given_outputs(out: Reactions, shape: tuple) -> dict[str, np.ndarray]:
             and array.flags.c_contiguous
             and array.flags.writeable
         ):
-            got = f"{array.dtype} {array.shape}" if isinstance(array, np.ndarray) else type(array)
+            got = (
+                f"{'a read-only ' if not array.flags.writeable else ''}"
+                f"{'' if array.flags.c_contiguous else 'non-contiguous '}{array.dtype} array "
+                f"of shape {array.shape}"
+                if isinstance(array, np.ndarray)
+                else f"{type(array).__name__} {_shown(array)}"
+            )
             raise ValueError(
                 f"out.{name} must be a writable C-contiguous {np.dtype(dtype).name} array "
                 f"of shape {want}, not {got}"
@@ -247,25 +283,30 @@ def _span(array: np.ndarray, address: int) -> tuple[int, int]:
 
 
 def _refuse_overlap(written: dict[str, tuple[int, int]], read: list[tuple[int, int]]) -> None:
-    """A batch's outputs (spans by name) must not share memory with its inputs (spans):
-    the rows are solved in blocks, and an earlier block's results would become a later
-    one's inputs. In order of their first byte, a span overlaps one of the other kind
-    exactly when it starts before the furthest end of that kind's spans so far."""
+    """A batch's outputs (spans by name) must not share memory with its inputs (spans) nor
+    with each other: the rows are solved in blocks, and an earlier block's results would
+    become a later one's inputs, or be overwritten by another output's. In order of their
+    first byte, a span overlaps an earlier one of a kind exactly when it starts before the
+    furthest end of that kind's spans so far (the output reaching it is `widest`)."""
     spans = [(first, last, name) for name, (first, last) in written.items() if first < last]
     spans += [(first, last, "") for first, last in read if first < last]
     spans.sort()
     output_end = input_end = 0
+    widest = ""
     for first, last, name in spans:
         if not name:  # an input
             if first < output_end:
                 name = next(n for n, (f, e) in written.items() if f < last and first < e)
                 raise ValueError(f"out.{name} shares memory with an input field: pass a copy")
-            if last > input_end:
-                input_end = last
+            input_end = max(input_end, last)
         elif first < input_end:
             raise ValueError(f"out.{name} shares memory with an input field: pass a copy")
-        elif last > output_end:
-            output_end = last
+        elif first < output_end:
+            raise ValueError(
+                f"out.{widest} and out.{name} share memory: each output needs its own array"
+            )
+        else:
+            output_end, widest = last, name
 
 
 def _output_columns(shape: tuple, out: Reactions | None) -> tuple[BatchOutput, dict, dict]:
@@ -298,7 +339,7 @@ def solve(dyad_type: str, *, out: Reactions | None = None, **arrays: object) -> 
     shape = _batch_shape(fields)
     columns, alive, read = _input_columns(fields, shape)
     results, written, spans = _output_columns(shape, out)
-    if out is not None and read:
+    if out is not None:
         _refuse_overlap(spans, read)
     count = math.prod(shape)
     default_core().solve_batch(kind, count, columns, results)

@@ -4,10 +4,14 @@ fmpy, compare every output with the NumPy reference, write tables and plots."""
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 
+from .argtypes import real, whole
 from .cosim import harness, scenes
 from .mechanisms import builtin
 from .report import tables
@@ -15,18 +19,10 @@ from .report import tables
 DEFAULT_MECHANISM = "slider-crank"
 
 
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 4:
-        raise argparse.ArgumentTypeError(f"must be at least 4, got {value}")
-    return value
-
-
-def _positive_float(text: str) -> float:
-    value = float(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be positive, got {value}")
-    return value
+#: Bounds of a co-simulation's length: revolutions, steps per revolution, steps in all.
+MAX_REVOLUTIONS = 1000.0
+MAX_STEPS_PER_REVOLUTION = 100_000
+MIN_STEPS, MAX_STEPS = 4, 1_000_000
 
 
 def _cosimulation_options(command: argparse.ArgumentParser, out: Path, revolutions_help: str):
@@ -37,12 +33,18 @@ def _cosimulation_options(command: argparse.ArgumentParser, out: Path, revolutio
         default="both",
         help="FMI version of the FMU to run (default both)",
     )
-    command.add_argument("--revolutions", type=_positive_float, default=2.0, help=revolutions_help)
+    command.add_argument(
+        "--revolutions",
+        type=real(0.0, MAX_REVOLUTIONS, above=True),
+        default=2.0,
+        help=revolutions_help,
+    )
     command.add_argument(
         "--steps",
-        type=_positive_int,
+        type=whole(MIN_STEPS, MAX_STEPS_PER_REVOLUTION),
         default=360,
-        help="communication steps per revolution (default 360)",
+        help=f"communication steps per revolution (default 360; {MIN_STEPS} to "
+        f"{MAX_STEPS_PER_REVOLUTION}, {MIN_STEPS} to {MAX_STEPS} in all)",
     )
     command.add_argument(
         "--motion",
@@ -83,7 +85,7 @@ def _run_command(sub: argparse._SubParsersAction) -> None:
     )
     run.add_argument(
         "--angle",
-        type=float,
+        type=real(-36000.0, 36000.0),
         default=60.0,
         help="crank angle in degrees at which the mechanism is drawn (default 60)",
     )
@@ -136,13 +138,6 @@ def _speed_command(sub: argparse._SubParsersAction) -> None:
     speed.set_defaults(run=_speed)
 
 
-def _workers(text: str) -> int:
-    value = int(text)
-    if not 0 <= value <= 256:
-        raise argparse.ArgumentTypeError(f"must be from 0 to 256, got {value}")
-    return value
-
-
 def _sweep_command(sub: argparse._SubParsersAction) -> None:
     sweep = sub.add_parser(
         "sweep",
@@ -156,7 +151,7 @@ def _sweep_command(sub: argparse._SubParsersAction) -> None:
     sweep.add_argument("study", type=Path, metavar="STUDY.toml", help="the study file")
     sweep.add_argument(
         "--workers",
-        type=_workers,
+        type=whole(0, 256),
         default=2,
         help="local Dask worker processes (default 2; 0 runs in this process, without Dask)",
     )
@@ -226,7 +221,11 @@ def parser() -> argparse.ArgumentParser:
         "joint reaction against an independent Newton-Euler solve in NumPy.",
     )
     sub = top.add_subparsers(dest="command", required=True)
-    listing = sub.add_parser("list", help="list the mechanisms and their dyads")
+    listing = sub.add_parser(
+        "list",
+        help="list the mechanisms and their dyads",
+        description="List the built-in mechanisms: name, dyad type and description.",
+    )
     listing.set_defaults(run=_list)
     _run_command(sub)
     _study_command(sub)
@@ -418,23 +417,72 @@ def _scene(args: argparse.Namespace) -> int:
     return _run_each(args, names, scenes.run, _scene_outputs)
 
 
+def _out_problem(out: Path) -> str | None:
+    """Why the output folder `out` cannot be made or written, or None: checked before the
+    work, without making it."""
+    existing = out
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        return f"--out {out}: {existing} is not a folder"
+    if not os.access(existing, os.W_OK | os.X_OK):
+        return f"--out {out}: {existing} is not writable"
+    return None
+
+
+def _problem(args: argparse.Namespace) -> str | None:
+    """What is wrong with the arguments of a run or scene command beyond each option's own
+    type, or None: the names, the length of the run, the output folder."""
+    if args.command == "run":
+        names, what, known = args.mechanisms, "mechanism", builtin.NAMES
+    else:
+        names, what, known = args.scenes, "scene", scenes.NAMES
+    unknown = [n for n in names if n not in known] if names != ["all"] else []
+    if unknown:
+        return f"unknown {what} {', '.join(unknown)}; the {what}s are: {', '.join(known)}"
+    total = int(round(args.steps * args.revolutions))
+    if not MIN_STEPS <= total <= MAX_STEPS:
+        return (
+            f"--revolutions {args.revolutions:g} at --steps {args.steps} makes {total} "
+            f"communication steps; a run needs {MIN_STEPS} to {MAX_STEPS}"
+        )
+    return _out_problem(args.out)
+
+
+#: The commands that parse their own options: command -> module, each with main(argv)
+#: and parser().
+OWN_PARSERS = {
+    "scenes": ".report.scenes",
+    "cosim": ".report.cosim",
+    "scene-bench": ".study.long_chain",
+}
+
+
+def _own_command(command: str) -> ModuleType | None:
+    """The module of a command that parses its own options, or None."""
+    name = OWN_PARSERS.get(command)
+    return importlib.import_module(name, __package__) if name else None
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the dyadfmu command with `argv` (default: the process's arguments)."""
+    """Run the dyadfmu command with `argv` (default: the process's arguments); with
+    --parse-only first, only check the arguments (exit 2 and a message if one is bad): the
+    scripts/run-* wrappers do so before they build."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    if argv[:1] == ["scenes"]:
-        from .report import scenes as scene_report  # its own options: --quick, --out, ...
-
-        return scene_report.main(argv[1:])
-    if argv[:1] == ["cosim"]:
-        from .report import cosim as cosim_report  # its own options: --quick, --out, ...
-
-        return cosim_report.main(argv[1:])
-    if argv[:1] == ["scene-bench"]:
-        from .study import long_chain  # its own options: --sizes, --generator, --write
-
-        return long_chain.main(argv[1:])
-    args = parser().parse_args(argv)
-    return args.run(args)
+    parse_only = argv[:1] == ["--parse-only"]
+    argv = argv[1:] if parse_only else argv
+    own = _own_command(argv[0]) if argv else None
+    if own is not None:
+        if parse_only:
+            own.parser().parse_args(argv[1:])
+            return 0
+        return own.main(argv[1:])
+    top = parser()
+    args = top.parse_args(argv)
+    problem = _problem(args) if args.command in ("run", "scene") else None
+    if problem:
+        top.exit(2, f"dyadfmu {args.command}: error: {problem}\n")
+    return 0 if parse_only else args.run(args)
 
 
 if __name__ == "__main__":

@@ -233,6 +233,35 @@ def _fill_kin_input(dst: _KinInput, src: dict) -> None:
         dst.branch = int(src["branch"])
 
 
+def _real(what: str, value: object) -> float:
+    """A real number of a solve's input, or an error naming it and the value given."""
+    try:
+        if isinstance(value, complex) or getattr(getattr(value, "dtype", None), "kind", "") == "c":
+            raise TypeError("complex")
+        return float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{what} must be a real number, not {value!r}") from None
+
+
+def _vec2(what: str, value: object) -> _Vec2:
+    """A vector (x, y) of a solve's input, or an error naming it and the value given."""
+    try:
+        size = len(value)
+    except TypeError:
+        size = None
+    if size != 2:
+        raise ValueError(f"{what} must be a vector (x, y) of two numbers, not {value!r}")
+    return _Vec2(_real(f"{what}[0]", value[0]), _real(f"{what}[1]", value[1]))
+
+
+def type_index(dyad_type: object) -> int:
+    """The index of a dyad type, in either case ("RRT", "rrt"), as dyadfmu.solve takes it."""
+    kind = dyad_type.upper() if isinstance(dyad_type, str) else dyad_type
+    if kind not in TYPES:
+        raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {', '.join(TYPES)}")
+    return TYPES.index(kind)
+
+
 def library_candidates() -> list[Path]:
     """Where the shared core is looked for, in order: $DYADFMU_LIB alone when set (the test
     suite and scripts/run-tests set it); else the library the installed package bundles,
@@ -331,13 +360,21 @@ class Core:
             getattr(lib, name).restype = ctypes.c_char_p
 
     @staticmethod
-    def _fill_link(dst: _Link, src: dict) -> None:
+    def _fill_link(dst: _Link, src: dict, name: str) -> None:
+        unknown = sorted(set(src) - set(LINK_KEYS), key=str)
+        missing = [key for key in LINK_KEYS if key not in src]
+        if unknown or missing:
+            wrong = [f"unknown keys {unknown}"] if unknown else []
+            wrong += [f"missing keys {missing}"] if missing else []
+            raise ValueError(
+                f"link {name}: {' and '.join(wrong)} (a link has exactly {', '.join(LINK_KEYS)})"
+            )
         for key in LINK_KEYS:
             value = src[key]
             if key in ("dir", "accel_d", "com", "force"):
-                setattr(dst, key, _Vec2(float(value[0]), float(value[1])))
+                setattr(dst, key, _vec2(f"{name}[{key!r}]", value))
             else:
-                setattr(dst, key, float(value))
+                setattr(dst, key, _real(f"{name}[{key!r}]", value))
 
     def _input(
         self,
@@ -349,15 +386,15 @@ class Core:
         singular_threshold: float = None,
     ) -> _Input:
         inp = self._lib.dyad_input_default()
-        self._fill_link(inp.m, m)
-        self._fill_link(inp.n, n)
+        self._fill_link(inp.m, m, "m")
+        self._fill_link(inp.n, n, "n")
         if guide_k is not None:
-            inp.guide_k = _Vec2(float(guide_k[0]), float(guide_k[1]))
+            inp.guide_k = _vec2("guide_k", guide_k)
         if guide_p is not None:
-            inp.guide_p = _Vec2(float(guide_p[0]), float(guide_p[1]))
-        inp.gravity = _Vec2(float(gravity[0]), float(gravity[1]))
+            inp.guide_p = _vec2("guide_p", guide_p)
+        inp.gravity = _vec2("gravity", gravity)
         if singular_threshold is not None:
-            inp.singular_threshold = float(singular_threshold)
+            inp.singular_threshold = _real("singular_threshold", singular_threshold)
         return inp
 
     def _output(self, res: _Result) -> dict:
@@ -382,11 +419,10 @@ class Core:
     ) -> dict:
         """One configuration solved by the C core: the reactions with status, field,
         conditioning, amplification and denominator."""
-        if dyad_type not in TYPES:
-            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        index = type_index(dyad_type)
         inp = self._input(m, n, guide_k, guide_p, gravity, singular_threshold)
         res = _Result()
-        self._lib.dyad_solve(TYPES.index(dyad_type), ctypes.byref(inp), ctypes.byref(res))
+        self._lib.dyad_solve(index, ctypes.byref(inp), ctypes.byref(res))
         return self._output(res)
 
     def solve_batch(
@@ -395,10 +431,9 @@ class Core:
         """dyad_solve_batch on columns the caller holds alive: `count` rows solved in one
         call; returns how many have status ok. ``dyadfmu.solve`` builds the columns from
         NumPy arrays."""
-        if dyad_type not in TYPES:
-            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        index = type_index(dyad_type)
         return self._lib.dyad_solve_batch(
-            TYPES.index(dyad_type), count, ctypes.byref(columns), ctypes.byref(results)
+            index, count, ctypes.byref(columns), ctypes.byref(results)
         )
 
     def direction(self, angle: float) -> tuple[float, float]:
@@ -417,8 +452,7 @@ class Core:
         """The reactions and their directional derivative. `inputs` and `seeds` are
         (m, n, guide_k, guide_p, gravity) tuples of the same form as solve's
         arguments; a seed direction is the derivative of the unit vector."""
-        if dyad_type not in TYPES:
-            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        index = type_index(dyad_type)
         zero = (0.0, 0.0)
         inp = self._input(*inputs, singular_threshold=singular_threshold)
         sm, sn, sk, sp, sg = seeds
@@ -427,7 +461,7 @@ class Core:
         )
         value, derivative = _Result(), _Result()
         self._lib.dyad_solve_tangent(
-            TYPES.index(dyad_type),
+            index,
             ctypes.byref(inp),
             ctypes.byref(seed),
             ctypes.byref(value),
@@ -474,24 +508,22 @@ class Core:
         links m and n (dir, angle, omega, epsilon, length with its rates, D_g and centre of
         mass with position, velocity, acceleration), E, the slides, conditioning and
         amplification. Units as in kinematics.h (m, s, rad)."""
-        if dyad_type not in TYPES:
-            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        index = type_index(dyad_type)
         inp = self.kin_input(inputs)
         res = _KinResult()
-        self._lib.dyad_kinematics(TYPES.index(dyad_type), ctypes.byref(inp), ctypes.byref(res))
+        self._lib.dyad_kinematics(index, ctypes.byref(inp), ctypes.byref(res))
         return self._kin_output(res)
 
     def kinematics_tangent(self, dyad_type: str, inputs: dict, seed: dict) -> tuple[dict, dict]:
         """The kinematics and their exact directional derivative along `seed`, a dict of the
         same shape as `inputs` holding each field's rate (missing keys: 0; a unit vector's
         rate counts by its part normal to it). Returns (value, derivative)."""
-        if dyad_type not in TYPES:
-            raise ValueError(f"unknown dyad type {dyad_type!r}; expected one of {TYPES}")
+        index = type_index(dyad_type)
         inp = self.kin_input(inputs)
         rate = self.kin_input(seed, base=_KinInput())
         value, derivative = _KinResult(), _KinResult()
         self._lib.dyad_kinematics_tangent(
-            TYPES.index(dyad_type),
+            index,
             ctypes.byref(inp),
             ctypes.byref(rate),
             ctypes.byref(value),

@@ -195,3 +195,84 @@ def test_contiguous_fields_read_in_place_match_strided_ones():
     a, b = dyadfmu.solve("RTT", **strided), dyadfmu.solve("RTT", **contiguous)
     for name in (f.name for f in dataclasses.fields(a)):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_values_beyond_a_double_or_complex_are_refused_by_name():
+    with pytest.raises(ValueError, match=r"m_mass must be real numbers within a double's range"):
+        dyadfmu.solve("RRR", m_mass=10**400)
+    with pytest.raises(ValueError, match=r"n_inertia must be real numbers within a double's"):
+        dyadfmu.solve("RRR", n_inertia=[1.0, -(10**400)])
+    for value in (np.array([1 + 2j]), np.complex128(2j), [np.array([1j, 0])]):
+        with pytest.raises(ValueError, match=r"m_moment must be real numbers: not complex"):
+            dyadfmu.solve("RRR", m_moment=value)
+    # real numbers of any kind are taken as before
+    a = dyadfmu.solve("RRR", m_mass=np.array([2], np.int32), n_mass=np.float32(1.5))
+    b = dyadfmu.solve("RRR", m_mass=np.array([2.0]), n_mass=1.5)
+    np.testing.assert_array_equal(a.r_mn, b.r_mn)
+
+
+def test_out_of_another_kind_is_refused_saying_what_was_given():
+    first = dyadfmu.solve("RRR", m_mass=np.ones(3))
+    with pytest.raises(TypeError, match=r"out must be the Reactions .* not dict \{'r_mk': 1\}"):
+        dyadfmu.solve("RRR", out={"r_mk": 1}, m_mass=np.ones(3))
+    wrong = dataclasses.replace(first, r_mk=1)
+    with pytest.raises(ValueError, match=r"out\.r_mk must be .* shape \(3, 2\), not int 1$"):
+        dyadfmu.solve("RRR", out=wrong, m_mass=np.ones(3))
+
+
+def test_outputs_sharing_memory_are_refused_naming_both():
+    rows = random_set("RRR", 30, seed=13)
+    fields = keywords(rows)
+    first = dyadfmu.solve("RRR", **fields)
+    same = np.zeros((30, 2))
+    with pytest.raises(ValueError, match=r"out\.r_mk and out\.r_np share memory"):
+        dyadfmu.solve("RRR", out=dataclasses.replace(first, r_mk=same, r_np=same), **fields)
+    # one output starting inside another (the one input elsewhere)
+    shared = np.zeros(50)
+    inside = dataclasses.replace(first, n_mk=shared[:30], n_np=shared[20:])
+    with pytest.raises(ValueError, match=r"out\.n_mk and out\.n_np share memory"):
+        dyadfmu.solve("RRR", out=inside, m_mass=np.ones(30))
+    # neighbours in one buffer share no byte: each gets its own results
+    shared = np.zeros(60)
+    apart = dataclasses.replace(first, n_mk=shared[:30], n_np=shared[30:])
+    done = dyadfmu.solve("RRR", out=apart, **fields)
+    fresh = dyadfmu.solve("RRR", **fields)
+    np.testing.assert_array_equal(done.n_mk, fresh.n_mk)
+    np.testing.assert_array_equal(done.n_np, fresh.n_np)
+
+
+def _link(**changes) -> dict:
+    link = dict(
+        dir=(1.0, 0.0), length=1.0, omega=0.5, epsilon=0.1, accel_d=(0.0, 0.0), com=(0.5, 0.0)
+    )
+    link.update(mass=2.0, inertia=0.2, force=(1.0, 0.0), moment=0.3)
+    link.update(changes)
+    return link
+
+
+def test_the_scalar_solve_refuses_bad_links_by_name(core):
+    n = _link(dir=(0.0, 1.0))
+    with pytest.raises(ValueError, match=r"link m: unknown keys \['masss'\]"):
+        core.solve("RRR", _link(masss=1.0), n)
+    with pytest.raises(ValueError, match=r"m\['dir'\] must be a vector \(x, y\) .* \(1, 0, 5\)"):
+        core.solve("RRR", _link(dir=(1, 0, 5)), n)
+    without_mass = _link()
+    del without_mass["mass"]
+    with pytest.raises(ValueError, match=r"link n: missing keys \['mass'\]"):
+        core.solve("RRR", _link(), without_mass)
+    with pytest.raises(ValueError, match=r"n\['moment'\] must be a real number, not 1j"):
+        core.solve("RRR", _link(), _link(dir=(0.0, 1.0), moment=1j))
+    with pytest.raises(ValueError, match=r"gravity must be a vector"):
+        core.solve("RRR", _link(), n, gravity=9.81)
+
+
+def test_the_scalar_solve_takes_the_types_dyadfmu_solve_takes(core):
+    m, n = _link(), _link(dir=(0.0, 1.0))
+    lower, upper = core.solve("rrr", m, n), core.solve("RRR", m, n)
+    assert upper["status"] == "ok" and lower == upper
+    batch = dyadfmu.solve(
+        "rrr", **{f"m_{k}": v for k, v in m.items()}, **{f"n_{k}": v for k, v in n.items()}
+    )
+    assert tuple(batch.r_mk) == upper["r_mk"]
+    with pytest.raises(ValueError, match="unknown dyad type 'rrx'"):
+        core.solve("rrx", m, n)

@@ -117,8 +117,9 @@ def accuracy_rows(runs: list) -> list:
     return rows
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+def parser() -> argparse.ArgumentParser:
+    """The options of 'dyadfmu scenes'."""
+    found = argparse.ArgumentParser(
         prog="dyadfmu scenes",
         description="Co-simulate every example scene's tailored FMU against its reference, "
         "draw the chains with their reactions, and measure each tailored FMU "
@@ -127,20 +128,20 @@ def _parser() -> argparse.ArgumentParser:
         "driver's motion alone (inputs before and after, worst errors, instructions with "
         "and without the kinematics); writes report.md.",
     )
-    parser.add_argument(
+    found.add_argument(
         "--out",
         type=Path,
         default=Path("out/scenes"),
         help="directory for the report, tables and drawings (default ./out/scenes)",
     )
-    parser.add_argument(
+    found.add_argument(
         "--build",
         type=Path,
         default=None,
         help="CMake build directory with fmus/ and tests/bench (default build/)",
     )
-    parser.add_argument("--quick", action="store_true", help="fewer steps and rows (for CI)")
-    return parser
+    found.add_argument("--quick", action="store_true", help="fewer steps and rows (for CI)")
+    return found
 
 
 def _log(text: str) -> None:
@@ -219,7 +220,7 @@ def _report_text(acc: list, foot: list, quick: bool, moving: list) -> list[str]:
 
 def main(argv: list[str] | None = None) -> int:
     """Run 'dyadfmu scenes' with `argv`: every scene, drawings, footprints, report.md."""
-    args = _parser().parse_args(argv)
+    args = parser().parse_args(argv)
     build = args.build or paths.build_dir()
     out = args.out
     out.mkdir(parents=True, exist_ok=True)

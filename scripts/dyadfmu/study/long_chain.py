@@ -24,6 +24,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from ..argtypes import whole
 from ..paths import GENERATOR
 
 SIZES = (25, 50, 100, 200)
@@ -130,30 +131,42 @@ def measure(
     return rows
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run 'dyadfmu scene-bench' with `argv`: print the generator's times."""
-    parser = argparse.ArgumentParser(
+#: The largest chain 'dyadfmu scene-bench' generates (dyads).
+MAX_CHAIN_DYADS = 10_000
+
+
+def parser() -> argparse.ArgumentParser:
+    """The options of 'dyadfmu scene-bench'."""
+    found = argparse.ArgumentParser(
         prog="dyadfmu scene-bench",
         description="Time the scene generator (modelDescription/scene.py --check and --out) "
         "on chains of 25, 50, 100 and 200 RRR dyads; print a Markdown table.",
     )
-    parser.add_argument(
+    found.add_argument(
         "--sizes",
-        type=int,
+        type=whole(1, MAX_CHAIN_DYADS),
         nargs="+",
         default=list(SIZES),
-        help="numbers of dyads (default 25 50 100 200)",
+        help=f"numbers of dyads (default 25 50 100 200; 1 to {MAX_CHAIN_DYADS})",
     )
-    parser.add_argument(
+    found.add_argument(
         "--generator",
         type=Path,
         default=GENERATOR,
         help="the scene.py to time (default: this checkout's)",
     )
-    parser.add_argument(
-        "--write", type=int, metavar="N", help="only write the chain of N dyads to stdout"
+    found.add_argument(
+        "--write",
+        type=whole(1, MAX_CHAIN_DYADS),
+        metavar="N",
+        help="only write the chain of N dyads to stdout",
     )
-    args = parser.parse_args(argv)
+    return found
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run 'dyadfmu scene-bench' with `argv`: print the generator's times."""
+    args = parser().parse_args(argv)
     if args.write is not None:
         sys.stdout.write(chain_scene(args.write))
         return 0

@@ -1,0 +1,254 @@
+"""Bad arguments stop early and by name: the dyadfmu command's options (before any
+co-simulation), the scripts/run-* wrappers (before they build), scripts/run-fuzz and the
+fuzz driver (before they fuzz)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+from dyadfmu import cli, paths
+from dyadfmu.cosim import harness
+
+SCRIPTS = paths.ROOT / "scripts"
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """A co-simulation started by mistake fails the test instead of running."""
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the co-simulation started despite a bad argument")
+
+    monkeypatch.setattr(harness, "run_mechanism", refuse)
+
+
+def _refused(argv: list[str], capsys) -> str:
+    """dyadfmu's message for `argv`, which it must refuse with status 2."""
+    with pytest.raises(SystemExit) as done:
+        cli.main(argv)
+    assert done.value.code == 2
+    return capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "argv,said",
+    [
+        (["--revolutions", "0.01", "--steps", "8"], "--revolutions 0.01 at --steps 8 makes 0"),
+        (["--revolutions", "1e300"], "argument --revolutions: must be a number above 0"),
+        (["--revolutions", "nan"], "argument --revolutions: must be a number above 0"),
+        (["--revolutions", "-1"], "argument --revolutions: must be a number above 0"),
+        (["--steps", "1e3"], "argument --steps: not a whole number: '1e3'"),
+        (["--steps", "3"], "argument --steps: must be from 4 to 100000, got 3"),
+        (["--angle", "nan"], "argument --angle: must be a number from -36000 to 36000, got nan"),
+        (["--angle", "inf"], "argument --angle: must be a number from -36000 to 36000, got inf"),
+        (["four-bra"], "unknown mechanism four-bra"),
+    ],
+)
+def test_run_refuses_a_bad_option_before_simulating(argv, said, capsys, no_work):
+    assert said in _refused(["run", *argv], capsys)
+
+
+def test_run_refuses_an_output_folder_it_cannot_make_before_simulating(tmp_path, capsys, no_work):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    said = _refused(["run", "--out", str(blocker / "x")], capsys)
+    assert f"--out {blocker / 'x'}: {blocker} is not a folder" in said
+    assert _refused(["scene", "--out", str(blocker)], capsys).endswith("is not a folder\n")
+
+
+def test_parse_only_checks_and_runs_nothing(tmp_path, capsys, no_work):
+    assert cli.main(["--parse-only", "run", "four-bar", "--steps", "36"]) == 0
+    assert "--quik" in _refused(["--parse-only", "study", "--quik"], capsys)
+    assert "--quik" in _refused(["--parse-only", "scenes", "--quik"], capsys)
+    assert "--fmi-version" in _refused(["--parse-only", "cosim", "--fmi-version", "4"], capsys)
+    assert cli.main(["--parse-only", "cosim", "--quick"]) == 0
+
+
+@pytest.mark.parametrize("option", ["--sizes", "--write"])
+@pytest.mark.parametrize("value", ["0", "-3", "x"])
+def test_scene_bench_refuses_a_bad_size_by_name(option, value, capsys):
+    said = _refused(["scene-bench", option, value], capsys)
+    assert f"argument {option}: " in said and value in said
+
+
+def test_sweep_refuses_a_bad_worker_count(capsys):
+    assert "argument --workers: must be from 0 to 256, got -1" in _refused(
+        ["sweep", "x.toml", "--workers", "-1"], capsys
+    )
+
+
+def test_every_command_has_a_description(capsys):
+    for command in ("list", "run", "study", "speed", "sweep", "scene"):
+        with pytest.raises(SystemExit):
+            cli.main([command, "--help"])
+        usage, _, rest = capsys.readouterr().out.partition("\n\n")
+        assert not rest.startswith("positional arguments") and not rest.startswith("options")
+
+
+# ---- the wrappers: arguments checked before the build ---------------------------------
+
+
+def _fake_machine(tmp_path: Path) -> tuple[dict, Path]:
+    """An environment in which every build tool is a stub that logs its call and fails, `id`
+    says the user is not root (nothing is installed), and the venv is one whose dyadfmu is
+    this checkout's: a wrapper that reaches its build leaves a line in the log."""
+    stubs, log = tmp_path / "bin", tmp_path / "calls.log"
+    stubs.mkdir(parents=True)
+    for tool in ("cmake", "cc", "make", "pkg-config", "valgrind", "ctest", "id"):
+        body = "echo 1000" if tool == "id" else f'echo "{tool} $*" >> "{log}"; exit 97'
+        (stubs / tool).write_text(f"#!/bin/sh\n{body}\n")
+        (stubs / tool).chmod(0o755)
+    venv = tmp_path / "venv"
+    (venv / "bin").mkdir(parents=True)
+    (venv / "bin" / "python").symlink_to(sys.executable)
+    dyadfmu = venv / "bin" / "dyadfmu"
+    dyadfmu.write_text(f'#!/bin/sh\nexec "{sys.executable}" -m dyadfmu "$@"\n')
+    dyadfmu.chmod(0o755)
+    (venv / ".dyadfmu-installed").touch()  # newer than pyproject.toml: no pip
+    env = dict(
+        os.environ,
+        PATH=f"{stubs}:{os.environ['PATH']}",
+        DYADFMU_VENV=str(venv),
+        PYTHONPATH=os.pathsep.join(filter(None, [str(SCRIPTS), os.environ.get("PYTHONPATH")])),
+    )
+    return env, log
+
+
+def _wrapper(tmp_path: Path, script: str, *args: str) -> tuple[subprocess.CompletedProcess, str]:
+    env, log = _fake_machine(tmp_path)
+    done = subprocess.run(
+        [str(SCRIPTS / script), *args], capture_output=True, text=True, env=env, timeout=120
+    )
+    return done, log.read_text() if log.exists() else ""
+
+
+@pytest.mark.parametrize(
+    "script,args,said",
+    [
+        ("run-study", ["--quik"], "unrecognized arguments: --quik"),
+        ("run-main", ["four-bar", "--steps", "x"], "argument --steps: not a whole number"),
+        ("run-main", ["four-bra"], "unknown mechanism four-bra"),
+        ("run-cosim", ["--fmi-version", "4"], "argument --fmi-version"),
+        ("run-scenes", ["--quik"], "unrecognized arguments: --quik"),
+        ("run-sweep", ["x.toml", "--workers", "-1"], "argument --workers"),
+    ],
+)
+def test_a_wrapper_refuses_a_bad_argument_before_it_builds(tmp_path, script, args, said):
+    done, calls = _wrapper(tmp_path, script, *args)
+    assert done.returncode == 2, done.stderr
+    assert said in done.stderr
+    assert "cmake" not in calls and "building" not in done.stderr
+
+
+WRAPPERS = ["run-main", "run-study", "run-cosim", "run-scenes", "run-sweep"]
+
+
+@pytest.mark.parametrize("script", WRAPPERS)
+def test_a_wrapper_answers_help_anywhere_without_building(tmp_path, script):
+    done, calls = _wrapper(tmp_path, script, "x.toml", "--quick", "-h")
+    assert done.returncode == 0 and done.stdout.startswith(f"usage: scripts/{script}")
+    assert calls == ""
+
+
+def test_a_wrapper_with_good_arguments_goes_on_to_build(tmp_path):
+    done, calls = _wrapper(tmp_path, "run-main", "four-bar", "--steps", "36")
+    assert done.returncode == 97 and calls.startswith("cmake -S"), (done.stderr, calls)
+
+
+@pytest.mark.parametrize("args", [["--quick"], ["extra"], ["--help-me"]])
+def test_run_tests_refuses_every_argument_but_help(tmp_path, args):
+    done, calls = _wrapper(tmp_path, "run-tests", *args)
+    assert done.returncode == 2 and f"unknown argument '{args[0]}'" in done.stderr
+    assert done.stderr.splitlines()[-1] == "usage: scripts/run-tests" and calls == ""
+    assert _wrapper(tmp_path / "h", "run-tests", "-h")[0].stdout.startswith("usage:")
+
+
+# ---- the fuzz run and its driver ------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "args,said",
+    [
+        (["--steps", "abc"], "--steps must be a whole number of at least 1"),
+        (["--steps", "1e3"], "--steps must be a whole number of at least 1"),
+        (["--steps", "-5"], "not '-5'"),
+        (["--steps", "0"], "--steps must be a whole number of at least 1"),
+        (["--steps"], "--steps needs a value"),
+        (["--seed", "xyz"], "--seed must be a whole number from 0 to 18446744073709551615"),
+        (["--seed", "18446744073709551616"], "--seed must be a whole number"),
+        (["--jobs", "0"], "--jobs must be a whole number of at least 1, "),
+        (["--fmu"], "--fmu needs a value"),
+    ],
+)
+def test_run_fuzz_refuses_a_bad_count_by_name(tmp_path, args, said):
+    done, calls = _wrapper(tmp_path, "run-fuzz", "--build", str(tmp_path), *args)
+    assert done.returncode == 2 and said.split(", ")[0] in done.stderr, done.stderr
+    assert calls == ""
+
+
+def test_run_fuzz_passes_good_counts_to_the_driver(tmp_path):
+    build = tmp_path / "build"
+    (build / "fmu").mkdir(parents=True)
+    (build / "fmus").mkdir()
+    with zipfile.ZipFile(build / "fmus" / "toy_fmi2.fmu", "w") as fmu:
+        fmu.writestr("modelDescription.xml", "<fmiModelDescription/>")
+    driver = build / "fmu" / "fmu_fuzz"
+    driver.write_text('#!/bin/sh\necho "$*" > "$0.args"\necho "fuzz toy fmi2: 5 steps"\n')
+    driver.chmod(0o755)
+    env = dict(os.environ, PATH=os.environ["PATH"])
+    done = subprocess.run(
+        [str(SCRIPTS / "run-fuzz"), "--steps", "05", "--seed", "42", "--build", str(build)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    args = (build / "fmu" / "fmu_fuzz.args").read_text().split()
+    assert args[:4] == ["--steps", "5", "--seed", "42"]
+
+
+def _fuzz_driver() -> Path:
+    path = paths.build_dir() / "fmu" / "fmu_fuzz"
+    if not path.is_file():
+        pytest.fail(f"{path} is missing: build the fuzz driver first (scripts/run-tests does)")
+    return path
+
+
+@pytest.mark.parametrize(
+    "args,said",
+    [
+        (["--steps", "abc"], "--steps must be a whole number from 1 to"),
+        (["--steps", "1e3"], "not '1e3'"),
+        (["--steps", "-5"], "not '-5'"),
+        (["--steps", "0"], "--steps must be a whole number from 1 to"),
+        (["--steps", "99999999999999999999"], "--steps must be a whole number"),
+        (["--seed", "xyz"], "--seed must be a whole number from 0 to 18446744073709551615"),
+        (["--seed", "-1"], "not '-1'"),
+        (["--seed", "18446744073709551616"], "--seed must be a whole number"),
+        (["--replay", "0x"], "--replay must be a whole number"),
+        (["--steps"], "--steps needs a value"),
+        (["--sleps", "5"], "unknown argument '--sleps'"),
+    ],
+)
+def test_the_fuzz_driver_refuses_a_bad_count_by_name(args, said):
+    done = subprocess.run(
+        [str(_fuzz_driver()), "no-such-fmu", *args], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 2 and said in done.stderr, (done.stdout, done.stderr)
+
+
+def test_the_fuzz_driver_takes_a_good_count():
+    """A good set of options gets past the parsing to the FMU (missing here): status 1."""
+    done = subprocess.run(
+        [str(_fuzz_driver()), "--steps", "10", "--seed", "0x1F", "no-such-fmu"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 1 and "no-such-fmu" in done.stdout + done.stderr
