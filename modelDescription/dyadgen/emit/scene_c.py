@@ -625,15 +625,28 @@ def _kinematics_code(plan: Plan) -> str:
     )
 
 
-def scene_c(scene: Scene) -> str:
-    """<identifier>_scene.c: the computation of the scene (of its current outputs)."""
+def _evaluation(scene: Scene) -> tuple[Plan, list[str], list[str], list[str]]:
+    """(plan, dyad declarations, crank declarations, body) of the scene's evaluate."""
     plan = Plan(scene)
     code = _Code()
     for write in PASSES:
         write(plan, code)
     dyad_decls, crank_decls = _declarations(plan)
+    return plan, dyad_decls, crank_decls, drop_unused_constants(code.lines)
+
+
+def inputs_read(scene: Scene) -> set[str]:
+    """The members of the input block that the scene's evaluation (its kinematics
+    included) reads; its tangent reads no other."""
+    plan, dyad_decls, crank_decls, body = _evaluation(scene)
+    text = "\n".join(dyad_decls + crank_decls + body) + _kinematics_code(plan)
+    return set(re.findall(r"\bin->([A-Za-z0-9_]+)", text))
+
+
+def scene_c(scene: Scene) -> str:
+    """<identifier>_scene.c: the computation of the scene (of its current outputs)."""
+    plan, dyad_decls, crank_decls, body = _evaluation(scene)
     reals = [o.member for o in scene.outputs if not o.integer]
-    body = drop_unused_constants(code.lines)
     tangent = tangent_c.scene_tangent(scene, plan.kinematic, dyad_decls + crank_decls + body)
     return _template().substitute(
         ident=scene.identifier,

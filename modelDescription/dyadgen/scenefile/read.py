@@ -10,11 +10,10 @@ follow from the inputs that are left."""
 from __future__ import annotations
 
 import copy
-import re
 from collections.abc import Callable
 from pathlib import Path
 
-from dyadgen.emit.scene_c import scene_c
+from dyadgen.emit.scene_c import inputs_read
 from dyadgen.model import Crank, Scene
 from dyadgen.needs import derive_inputs, derive_outputs
 from dyadgen.scenefile import mechanism, sections
@@ -52,7 +51,7 @@ def _named_objects(identifier: str, found: mechanism.Mechanism, crank: Crank | N
 def prune_inputs(scene: Scene) -> None:
     """Drop the candidate inputs the generated code never reads: a link's angular velocity
     where nothing of it lies off its pair D (its centripetal terms vanish), and the like."""
-    used = set(re.findall(r"\bin->([A-Za-z0-9_]+)", scene_c(scene)))
+    used = inputs_read(scene)
     scene.inputs = [i for i in scene.inputs if i.member in used]
 
 
