@@ -89,3 +89,18 @@ def test_speed_command_names_a_missing_benchmark(tmp_path: Path):
         assert done.returncode == 2 and "valgrind" in done.stderr
         return
     assert done.returncode == 2 and "dyad_bench is missing" in done.stderr, done.stderr
+
+
+def test_generic_fmu_rows_come_from_the_build_given(tmp_path: Path, monkeypatch):
+    """The scenes report's generic FMUs are those of its --build, not of $DYADFMU_BUILD or
+    build/: an empty build is named in the error, and the build that has the FMU gives its
+    inputs."""
+    from dyadfmu import paths
+    from dyadfmu.study import bench
+
+    built = paths.built_fmu("dyad_rrt", 2).parents[1]
+    monkeypatch.setenv("DYADFMU_BUILD", str(tmp_path / "elsewhere"))
+    with pytest.raises(FileNotFoundError, match=re.escape(str(tmp_path / "empty"))):
+        bench.fmu_rows("RRT", 4, seed=1, build=tmp_path / "empty")
+    md, inputs, outputs, rows = bench.fmu_rows("RRT", 4, seed=1, build=built)
+    assert md.modelName and rows.shape == (4, len(inputs)) and outputs

@@ -19,9 +19,9 @@ from .. import paths
 from ..fmi.slave import Slave
 
 
-def fmu_path(dyad: str, version: int) -> Path:
-    """The generic FMU of a dyad type in the build."""
-    return paths.built_fmu(f"dyad_{dyad.lower()}", version)
+def fmu_path(dyad: str, version: int, build: Path | None = None) -> Path:
+    """The generic FMU of a dyad type in `build` (default: paths.built_fmu's)."""
+    return paths.built_fmu(f"dyad_{dyad.lower()}", version, build)
 
 
 def bench_binary(build: Path, real: str) -> Path:
@@ -102,9 +102,9 @@ def instructions(build: Path, method: str, dyad: str, rows: np.ndarray, work: Pa
     return int(match.group(1)) / len(rows) if match else math.nan
 
 
-def fmu_rows(dyad: str, count: int, seed: int) -> tuple:
-    """Inputs for stepping an FMU: its start values with smooth variations."""
-    path = fmu_path(dyad, 2)
+def fmu_rows(dyad: str, count: int, seed: int, build: Path | None = None) -> tuple:
+    """Inputs for stepping an FMU (of `build`): its start values with smooth variations."""
+    path = fmu_path(dyad, 2, build)
     md = read_model_description(str(path))
     inputs = [v for v in md.modelVariables if v.causality == "input"]
     outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
@@ -147,7 +147,7 @@ def fmu_step_arguments(
 
 def fmu_from_c(build: Path, dyad: str, version: int, count: int, work: Path) -> float:
     """Seconds per doStep of the dyad FMU's binary stepped from C by the benchmark."""
-    md, inputs, outputs, rows = fmu_rows(dyad, count, seed=version)
+    md, inputs, outputs, rows = fmu_rows(dyad, count, seed=version, build=build)
     binary = paths.stage_binary(build, f"dyad_{dyad.lower()}", version)
     rows.astype("<f8").tofile(work / "fmu_inputs.bin")
     args = fmu_step_arguments(binary, version, md.guid, work / "fmu_inputs.bin", inputs, outputs)

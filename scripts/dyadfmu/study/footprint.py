@@ -129,7 +129,7 @@ def generic(
 ) -> Footprint:
     """The footprint of the generic FMU of a dyad type."""
     identifier = f"dyad_{dyad.lower()}"
-    md, _, _, rows = bench.fmu_rows(dyad, rows_count, seed=version)
+    md, _, _, rows = bench.fmu_rows(dyad, rows_count, seed=version, build=build)
     if version != 2:
         md = read_model_description(str(scenes.fmu_path(identifier, version, build)))
     instructions, seconds = _step(build, identifier, version, md, rows, work, repeat)
