@@ -16,7 +16,8 @@
  * What the layer would use as an index (the state machine's state, the variable
  * an evaluation blames) is checked before it is restored, and so is every
  * parameter and input, as a set checks it (the models solve them without checking
- * again), and a model's states, as a step leaves them (fmu_behaviour.state_refused). The saved states of an instance are kept in a list and freed with it. */
+ * again), and a model's states, as a step leaves them (fmu_behaviour.state_refused).
+ * The saved states of an instance are kept in a list and freed with it. */
 #include <stdint.h>
 #include <string.h>
 
