@@ -50,6 +50,7 @@
 #undef kv_scale
 #undef kv_perp
 #undef kv_dot
+#undef kv_norm1
 #undef kv_cross
 #undef kv_cmul
 #undef kv_in
@@ -91,6 +92,7 @@
 #define kv_scale            dyad_kdv_scale
 #define kv_perp             dyad_kdv_perp
 #define kv_dot              dyad_kdv_dot
+#define kv_norm1            dyad_kdv_norm1
 #define kv_cross            dyad_kdv_cross
 #define kv_cmul             dyad_kdv_cmul
 #define kv_in(v, s)         dyad_kdv_in((v), (s))
@@ -124,6 +126,7 @@
 #define kv_scale            dyad_scale
 #define kv_perp             dyad_perp
 #define kv_dot              dyad_dot
+#define kv_norm1            dyad_norm1
 #define kv_cross            dyad_cross
 #define kv_cmul             dyad_cmul
 #define kv_in(v, s)         (v)
@@ -165,6 +168,7 @@ typedef struct kin_in {
     dyad_kv turn_m, turn_n, com_m, com_n;
     dyad_real branch;    /* +1 or -1 */
     dyad_real threshold; /* singular threshold, not differentiated */
+    dyad_ks mount_amp;   /* the amplification the mounts' motion carries in */
 } kin_in;
 
 /* What a type's formulas find: the assembly, then the rates. */
@@ -172,6 +176,9 @@ typedef struct kin_state {
     dyad_kin_failure failure;
     dyad_ks gap;          /* by how much the failed figure failed (m) */
     dyad_ks conditioning; /* the header's figure */
+    dyad_ks closure;      /* the closure's own conditioning: distance over size */
+    dyad_ks size;         /* the size of the terms the closure's distance is made of (m) */
+    dyad_ks amplification;
     dyad_kv i_m, i_n;
     dyad_ks w_m, e_m, w_n, e_n;   /* omega, epsilon of the links */
     kin_coord l_m, l_n, s_k, s_p; /* lengths and slides with their rates */
@@ -266,6 +273,28 @@ static inline void DYAD_KIN(dyad_kin_rates)(const kin_in* in, kin_state* st, kin
     DYAD_KIN(dyad_kin_solve2)(a, b, kv_sub(from_n.acc, from_m.acc), dx, dy);
 }
 
+/* A closure whose position is a root: its argument's distance from zero, over the
+ * size of the terms that distance is the difference of. */
+static inline void DYAD_KIN(dyad_kin_closure)(kin_state* st, dyad_ks distance, dyad_ks size)
+{
+    st->closure = ks_val(size) > 0 ? ks_div(distance, size) : ks_c(0); /* 0: degenerate */
+    st->size = size;
+}
+
+/* The bound of the motion's round-off (kinematics.h): the closure's own and the
+ * velocity equations', and the mounts' carried in, where their positions' round-off
+ * (relative to their distance from the origin) is taken relative to the closure's
+ * size. Norms of 1, whose rates are defined everywhere. */
+static inline dyad_ks DYAD_KIN(dyad_kin_amplification)(const kin_in* in, const kin_state* st)
+{
+    const dyad_ks own = ks_add(ks_add(ks_c(1), ks_div(ks_c(1), st->closure)),
+                               ks_div(ks_c(1), st->conditioning));
+    const dyad_ks far = ks_add(kv_norm1(in->k.point.pos), kv_norm1(in->p.point.pos));
+    const dyad_ks ratio = ks_val(far) > 0 ? ks_div(far, st->size) : ks_c(0);
+    const dyad_ks carried = ks_mul(in->mount_amp, ks_add(ks_c(1), ratio));
+    return ks_mul(own, ks_add(ks_c(1), carried));
+}
+
 static inline dyad_kin_failure DYAD_KIN(dyad_kin_fail)(kin_state* st, dyad_kin_failure failure,
                                                        dyad_ks gap)
 {
@@ -308,6 +337,7 @@ static inline void DYAD_KIN(dyad_kin_load)(dyad_type type, const dyad_kin_input*
     in->branch =
         type == DYAD_RRR || type == DYAD_RRT || type == DYAD_RTR ? (dyad_real)v->branch : 1;
     in->threshold = v->singular_threshold;
+    in->mount_amp = ks_in(v->mount_amplification, s->mount_amplification);
 }
 
 /* The state before a type's formulas: constant lengths, no slide, the pair
@@ -316,7 +346,9 @@ static inline void DYAD_KIN(dyad_kin_start)(const kin_in* in, kin_state* st)
 {
     const dyad_ks zero = ks_c(0);
     st->failure = DYAD_KIN_CLOSES;
-    st->gap = st->conditioning = zero;
+    st->gap = st->conditioning = st->amplification = zero;
+    st->closure = ks_c(1); /* a closure without a root; a type with one sets it */
+    st->size = zero;
     st->i_m = st->i_n = kv_c(dyad_vec2_make(0, 0));
     st->w_m = st->e_m = st->w_n = st->e_n = zero;
     st->l_m = DYAD_KIN(dyad_kin_coord_of)(in->l_m, zero, zero);
@@ -360,6 +392,16 @@ static inline void DYAD_KIN(dyad_kin_put_link)(dyad_kv dir, dyad_ks omega, dyad_
     DYAD_KIN(dyad_kin_put_motion)(&s, &to->com, &rate->com);
 }
 
+/* The conditioning, the closure and the amplification. */
+static inline void DYAD_KIN(dyad_kin_put_figures)(const kin_state* st, dyad_kin_result* value,
+                                                  dyad_kin_result* rate)
+{
+    (void)rate; /* the plain pass writes the values only */
+    ks_put(st->conditioning, &value->conditioning, &rate->conditioning);
+    ks_put(st->closure, &value->closure, &rate->closure);
+    ks_put(st->amplification, &value->amplification, &rate->amplification);
+}
+
 /* Every output of a closed, conditioned dyad: value gets the values, rate
  * their derivatives (on the plain pass rate is value and never written). */
 static inline void DYAD_KIN(dyad_kin_store)(const kin_in* in, const kin_state* st,
@@ -378,8 +420,7 @@ static inline void DYAD_KIN(dyad_kin_store)(const kin_in* in, const kin_state* s
     DYAD_KIN(dyad_kin_put_coord)(&st->s_p, &value->slide_p.s, &value->slide_p.rate,
                                  &value->slide_p.accel, &rate->slide_p.s, &rate->slide_p.rate,
                                  &rate->slide_p.accel);
-    ks_put(st->conditioning, &value->conditioning, &rate->conditioning);
-    ks_put(ks_div(ks_c(1), st->conditioning), &value->amplification, &rate->amplification);
+    DYAD_KIN(dyad_kin_put_figures)(st, value, rate);
 }
 
 /* A dyad that does not close: NaN outputs, the failure and its gap. */
@@ -397,8 +438,7 @@ static inline dyad_status DYAD_KIN(dyad_kin_singular)(const kin_state* st, dyad_
                                                       dyad_kin_result* rate)
 {
     dyad_kin_reject(value, rate, DYAD_STATUS_SINGULAR, DYAD_KIN_FIELD_NONE);
-    ks_put(st->conditioning, &value->conditioning, &rate->conditioning);
-    ks_put(ks_div(ks_c(1), st->conditioning), &value->amplification, &rate->amplification);
+    DYAD_KIN(dyad_kin_put_figures)(st, value, rate);
     return DYAD_STATUS_SINGULAR;
 }
 
@@ -431,7 +471,8 @@ DYAD_CLOSED_FORM dyad_status DYAD_KIN(dyad_kin_run)(dyad_type type, kin_position
     if (position(&in, &st) != DYAD_KIN_CLOSES) {
         return DYAD_KIN(dyad_kin_failed)(&st, value, rate);
     }
-    if (!(ks_val(st.conditioning) >= in.threshold)) {
+    st.amplification = DYAD_KIN(dyad_kin_amplification)(&in, &st);
+    if (!(ks_val(st.amplification) * in.threshold <= 1)) {
         return DYAD_KIN(dyad_kin_singular)(&st, value, rate);
     }
     motion(&in, &st);

@@ -34,6 +34,20 @@
  * (the circles coincide) leaves E anywhere with the links folded on each
  * other: conditioning 0, singular.
  *
+ * Round-off. A and B are differences of the inputs and of L = |d|, each
+ * rounded to about eps (l_m + l_n + L); near full extension (A -> 0) or
+ * folding (B -> 0) that is a large part of them. h^2 is their product, so h,
+ * and with it E and both directions, is known to eps / closure of itself with
+ *      closure = min(A, B) / (l_m + l_n + L)
+ * (kinematics.h), while the conditioning h L / (l_m l_n) falls only like
+ * sqrt(closure). The velocity equations divide by a x b, proportional to h:
+ * the rates carry h's relative error, eps / closure, and the determinant's
+ * own rounding, eps / conditioning. The accelerations divide by it again, with
+ * omega^2 on their right-hand side: the same order. So every motion output is
+ * within about eps (1 + 1 / closure + 1 / conditioning) of the largest of its unit
+ * (the amplification), which scripts/tests/test_kinematics_vs_mpmath.py holds
+ * against mpmath on the way to either toggle.
+ *
  * This file is compiled once per scalar (dyad_kin_generic.h): the public
  * functions first, the formulas below, included twice.
  */
@@ -81,6 +95,7 @@ static dyad_kin_failure DYAD_KIN(rrr_position)(const kin_in* in, kin_state* st)
     }
     if (ks_val(len) == 0) {
         st->conditioning = ks_c(0); /* coincident circles: folded links */
+        DYAD_KIN(dyad_kin_closure)(st, near, reach);
         return DYAD_KIN_CLOSES;
     }
     twice = ks_add(len, len);
@@ -94,6 +109,7 @@ static dyad_kin_failure DYAD_KIN(rrr_position)(const kin_in* in, kin_state* st)
     st->i_m = kv_scale(ks_div(ks_c(1), in->l_m), DYAD_KIN(dyad_kin_combine)(a, u, h, v));
     st->i_n = kv_scale(ks_div(ks_c(1), in->l_n), DYAD_KIN(dyad_kin_combine)(b, u, h, v));
     st->conditioning = ks_abs(ks_div(ks_mul(h, len), ks_mul(in->l_m, in->l_n)));
+    DYAD_KIN(dyad_kin_closure)(st, ks_val(far) < ks_val(near) ? far : near, ks_add(reach, len));
     return DYAD_KIN_CLOSES;
 }
 

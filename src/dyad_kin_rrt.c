@@ -29,6 +29,16 @@
  * |i_n . i_k|, the kinetostatic solver's figure; from the position it is
  * |r| / l_n, exact as E - D_n turns normal to the guide (r -> 0).
  *
+ * Round-off. c carries the rounding of G_k + l_m i_m - D_n, about
+ * eps (|G_k| + l_m + |D_n|), and l_n - |c . j_k| that of l_n and |c . j_k|:
+ * as the rod turns normal to the guide (r -> 0) the root's argument is known
+ * to eps / closure of itself, with
+ *      closure = (l_n - |c . j_k|) / (l_n + |c . j_k| + |G_k|_1 + l_m + |D_n|_1)
+ * (|v|_1 = |v.x| + |v.y|, kinematics.h), and r, s_k and i_n to half of it; the
+ * conditioning |r| / l_n falls like sqrt(closure). The rates divide by
+ * a x b = -r: as for RRR, they carry eps / closure and the determinant's own
+ * rounding eps / conditioning, the accelerations the same order again.
+ *
  * Compiled once per scalar (dyad_kin_generic.h), as dyad_kin_rrr.c.
  */
 #ifndef DYAD_KIN_FORMULAS
@@ -74,6 +84,10 @@ static dyad_kin_failure DYAD_KIN(rrt_position)(const kin_in* in, kin_state* st)
     st->w_m = in->k.omega;
     st->e_m = in->k.epsilon;
     st->conditioning = ks_abs(ks_div(r, in->l_n));
+    DYAD_KIN(dyad_kin_closure)(
+        st, ks_sub(in->l_n, off),
+        ks_add(ks_add(ks_add(in->l_n, off), ks_add(kv_norm1(in->k.point.pos), in->l_m)),
+               kv_norm1(in->p.point.pos)));
     return DYAD_KIN_CLOSES;
 }
 

@@ -32,6 +32,15 @@
  * (which vanishes as D_m and D_n meet). Since d . i_m = w.x = branch r,
  * |i_beta . i_m| = r / |d|, exact as the slot stands normal to D_m D_n.
  *
+ * Round-off. |d| is rounded to about eps |d| and the slot's reach
+ * l_n |sin delta| to eps of itself, so as the slot stands normal to D_m D_n
+ * (r -> 0) the root's argument |d| - l_n |sin delta| is known to eps / closure
+ * of itself, with
+ *      closure = (|d| - l_n |sin delta|) / (|d| + l_n |sin delta|)
+ * (kinematics.h), and r, l_m and i_m to half of it; |i_beta . i_m| = r / |d|
+ * falls like sqrt(closure). The rates divide by d . i_m = branch r: they carry
+ * eps / closure and eps / conditioning, the accelerations the same order again.
+ *
  * Compiled once per scalar (dyad_kin_generic.h), as dyad_kin_rrr.c.
  */
 #ifndef DYAD_KIN_FORMULAS
@@ -92,6 +101,7 @@ static dyad_kin_failure DYAD_KIN(rtr_position)(const kin_in* in, kin_state* st)
     slant = ks_div(r, dist);
     spread = ks_div(dist, ks_add(l_m, in->l_n));
     st->conditioning = ks_val(slant) < ks_val(spread) ? slant : spread;
+    DYAD_KIN(dyad_kin_closure)(st, ks_sub(dist, reach), ks_add(dist, reach));
     return DYAD_KIN_CLOSES;
 }
 

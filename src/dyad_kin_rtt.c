@@ -25,6 +25,11 @@
  * solver's |j_k . i_m| (= |sin delta_m|): it vanishes with the slot parallel
  * to the guide, where the position too is undefined.
  *
+ * Round-off. No root: s_k and l_m are a 2 x 2 solve whose determinant is the
+ * conditioning, so the positions carry eps / conditioning of the size of their
+ * terms, |G_k|_1 + |D_n|_1 + l_n (|v|_1 = |v.x| + |v.y|), and the rates, solved
+ * with the same columns, the same order; the closure is 1 (kinematics.h).
+ *
  * Compiled once per scalar (dyad_kin_generic.h), as dyad_kin_rrr.c.
  */
 #ifndef DYAD_KIN_FORMULAS
@@ -62,6 +67,7 @@ static dyad_kin_failure DYAD_KIN(rtt_position)(const kin_in* in, kin_state* st)
     st->w_m = st->w_n = in->k.omega;
     st->e_m = st->e_n = in->k.epsilon;
     st->conditioning = ks_abs(kv_cross(i_k, i_m));
+    st->size = ks_add(ks_add(kv_norm1(in->k.point.pos), kv_norm1(in->p.point.pos)), in->l_n);
     DYAD_KIN(dyad_kin_solve2)(i_k, i_m, kv_sub(e, in->k.point.pos), &st->s_k.q, &st->l_m.q);
     return DYAD_KIN_CLOSES;
 }

@@ -25,6 +25,12 @@
  * solver's |j_k . i_p|, which vanishes as the guides turn parallel (and with
  * it the position: a singular TRT is reported before it is placed).
  *
+ * Round-off. No root: the slides are a 2 x 2 solve whose determinant is the
+ * conditioning, so the positions carry eps / conditioning of the size of their
+ * terms, |G_k|_1 + |G_p|_1 + l_m + l_n (|v|_1 = |v.x| + |v.y|), and the rates,
+ * solved with the same columns, the same order; the closure is 1
+ * (kinematics.h).
+ *
  * Compiled once per scalar (dyad_kin_generic.h), as dyad_kin_rrr.c.
  */
 #ifndef DYAD_KIN_FORMULAS
@@ -66,6 +72,8 @@ static dyad_kin_failure DYAD_KIN(trt_position)(const kin_in* in, kin_state* st)
     st->w_n = in->p.omega;
     st->e_n = in->p.epsilon;
     st->conditioning = ks_abs(kv_cross(i_k, i_p));
+    st->size = ks_add(ks_add(kv_norm1(in->k.point.pos), kv_norm1(in->p.point.pos)),
+                      ks_add(in->l_m, in->l_n));
     DYAD_KIN(dyad_kin_solve2)(i_k, kv_neg(i_p), r, &st->s_k.q, &st->s_p.q);
     return DYAD_KIN_CLOSES;
 }

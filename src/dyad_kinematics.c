@@ -31,6 +31,7 @@ static const char* const kin_field_names[DYAD_KIN_FIELD_COUNT] = {
     [DYAD_KIN_FIELD_COM_N] = "com_n",
     [DYAD_KIN_FIELD_BRANCH] = "branch",
     [DYAD_KIN_FIELD_SINGULAR_THRESHOLD] = "singular_threshold",
+    [DYAD_KIN_FIELD_MOUNT_AMPLIFICATION] = "mount_amplification",
 };
 
 static const char* const kin_failure_names[DYAD_KIN_FAILURE_COUNT] = {
@@ -159,6 +160,9 @@ static dyad_kin_field bad_dyad_field(dyad_type type, const dyad_kin_input* in)
         !(in->singular_threshold < 1)) {
         return DYAD_KIN_FIELD_SINGULAR_THRESHOLD;
     }
+    if (!dyad_is_valid_real(in->mount_amplification) || !(in->mount_amplification >= 0)) {
+        return DYAD_KIN_FIELD_MOUNT_AMPLIFICATION;
+    }
     return DYAD_KIN_FIELD_NONE;
 }
 
@@ -202,7 +206,7 @@ void dyad_kin_fill_nan(dyad_kin_result* result, dyad_status status, dyad_kin_fie
     fill_motion(&result->e, nan);
     result->slide_k.s = result->slide_k.rate = result->slide_k.accel = nan;
     result->slide_p.s = result->slide_p.rate = result->slide_p.accel = nan;
-    result->conditioning = result->amplification = nan;
+    result->conditioning = result->closure = result->amplification = nan;
 }
 
 dyad_status dyad_kin_reject(dyad_kin_result* value, dyad_kin_result* derivative, dyad_status status,

@@ -1282,6 +1282,13 @@ static int test_react_tangent_finite_differences(void)
 #define KIN_FD_LIMIT     1e-7
 #endif
 #define KIN_SAMPLES 2000
+/* The least conditioning of the random samples (their closure at least its square):
+ * float's amplification reaches 1 / threshold (2.9e3) at a closure near 7e-4. */
+#ifdef DYAD_REAL_FLOAT
+#define KIN_LEAST 0.1
+#else
+#define KIN_LEAST 0.05
+#endif
 
 /* A scalar and a planar (complex) quantity with their first two time derivatives. */
 typedef struct sjet {
@@ -1536,8 +1543,48 @@ static double built_conditioning(dyad_type type, const kin_built* b)
     }
 }
 
+/* The sum of the absolute values of a vector's components. */
+static double norm1(double complex v)
+{
+    return fabs(creal(v)) + fabs(cimag(v));
+}
+
+/* The header's closure, from the built dyad: the distance from the toggle or
+ * branch point over the size of the terms it is formed from. */
+static double built_closure(dyad_type type, const kin_built* b)
+{
+    const double l_m = b->l_m.v, l_n = b->l_n;
+    double distance, size;
+    switch (type) {
+    case DYAD_RRR: {
+        const double reach = cabs(b->d_n.v - b->d_m.v);
+        const double far = l_m + l_n - reach, near = reach - fabs(l_m - l_n);
+        distance = far < near ? far : near;
+        size = l_m + l_n + reach;
+        break;
+    }
+    case DYAD_RRT: {
+        /* D_n from the line E runs on: through G_k + l_m i_m along i_k */
+        const double off =
+            fabs(cimag((b->d_n.v - b->g_k.v - l_m * b->i_m.v) * conj(b->i_k.v)));
+        distance = l_n - off;
+        size = l_n + off + norm1(b->g_k.v) + l_m + norm1(b->d_n.v);
+        break;
+    }
+    case DYAD_RTR: {
+        const double dist = cabs(b->d_n.v - b->d_m.v);
+        const double reach = l_n * fabs(cimag(b->i_n.v * conj(b->i_m.v)));
+        distance = dist - reach;
+        size = dist + reach;
+        break;
+    }
+    default: return 1; /* TRT, RTT: no root */
+    }
+    return distance / size;
+}
+
 /* Every output of a result, raw, in a fixed order (KIN_RAW numbers). */
-#define KIN_RAW 52
+#define KIN_RAW 53
 
 static int put_motion(double* v, int k, const dyad_point_motion* p)
 {
@@ -1560,7 +1607,7 @@ static void kin_raw(const dyad_kin_result* r, double v[KIN_RAW])
     k = put_motion(v, k, &r->e);
     v[k] = r->slide_k.s, v[k + 1] = r->slide_k.rate, v[k + 2] = r->slide_k.accel;
     v[k + 3] = r->slide_p.s, v[k + 4] = r->slide_p.rate, v[k + 5] = r->slide_p.accel;
-    v[k + 6] = r->conditioning, v[k + 7] = r->amplification;
+    v[k + 6] = r->conditioning, v[k + 7] = r->closure, v[k + 8] = r->amplification;
 }
 
 /* 1 if two results hold the same outputs, bit for bit (NaN as NaN). */
@@ -1601,7 +1648,8 @@ static void jet_link(dyad_kin_link* g, vjet dir, sjet angle, sjet length, vjet d
 static void expected_raw(const kin_case* c, const kin_built* b, double v[KIN_RAW])
 {
     dyad_kin_result r;
-    double cond = built_conditioning(c->type, b);
+    const double cond = built_conditioning(c->type, b), closure = built_closure(c->type, b);
+    const double amplification = 1 + 1 / closure + 1 / cond; /* mounts known exactly */
     jet_link(&r.m, b->i_m, b->th_m, b->l_m, b->d_m, c->com_m);
     jet_link(&r.n, b->i_n, b->th_n, sconst(b->l_n), b->d_n, c->com_n);
     jet_motion(&r.e, b->e);
@@ -1610,11 +1658,13 @@ static void expected_raw(const kin_case* c, const kin_built* b, double v[KIN_RAW
     r.slide_p.s = (dyad_real)b->s_p.v, r.slide_p.rate = (dyad_real)b->s_p.d;
     r.slide_p.accel = (dyad_real)b->s_p.dd;
     r.conditioning = (dyad_real)cond;
-    r.amplification = (dyad_real)(1 / cond);
+    r.closure = (dyad_real)closure;
+    r.amplification = (dyad_real)amplification;
     kin_raw(&r, v);
     /* the narrowing above is undone where double matters */
-    v[KIN_RAW - 2] = cond;
-    v[KIN_RAW - 1] = 1 / cond;
+    v[KIN_RAW - 3] = cond;
+    v[KIN_RAW - 2] = closure;
+    v[KIN_RAW - 1] = amplification;
 }
 
 /* Worst of |got - want| / (1 + |want|) over n numbers. */
@@ -1636,7 +1686,8 @@ static kin_case conditioned_case(rng* r, dyad_type type, double least, dyad_kin_
     for (;;) {
         const kin_case c = random_kin_case(r, type);
         *in = kin_input_at(&c, 0, b);
-        if (built_conditioning(type, b) >= least) {
+        /* the closure falls like the conditioning squared */
+        if (built_conditioning(type, b) >= least && built_closure(type, b) >= least * least) {
             return c;
         }
     }
@@ -1657,7 +1708,7 @@ static int test_kin_reproduces_built(void)
             kin_built b;
             dyad_kin_result out;
             double got[KIN_RAW], want[KIN_RAW];
-            const kin_case c = conditioned_case(&r, type, 0.05, &in, &b);
+            const kin_case c = conditioned_case(&r, type, KIN_LEAST, &in, &b);
             const dyad_status s = dyad_kinematics(type, &in, &out);
             if (s != DYAD_STATUS_OK) {
                 CHECK(0, "%s sample %d: status %s", dyad_type_name(type), k, dyad_status_name(s));
@@ -1769,7 +1820,7 @@ static int test_kin_rates_finite_differences(void)
             kin_built b;
             dyad_kin_result out;
             double f[5][KIN_RAW], d1[KIN_RAW], d2[KIN_RAW], v[KIN_POS], a[KIN_POS];
-            const kin_case c = conditioned_case(&r, type, 0.05, &in, &b);
+            const kin_case c = conditioned_case(&r, type, KIN_LEAST, &in, &b);
             int ok = dyad_kinematics(type, &in, &out) == DYAD_STATUS_OK;
             kin_positions(&out, 1, v);
             kin_positions(&out, 2, a);
@@ -1878,7 +1929,7 @@ static int test_kin_tangent_finite_differences(void)
             dyad_kin_result value, rate, plain;
             double f[5][KIN_RAW], d1[KIN_RAW], d2[KIN_RAW], got[KIN_RAW];
             int ok;
-            (void)conditioned_case(&r, type, 0.05, &in, &b);
+            (void)conditioned_case(&r, type, KIN_LEAST, &in, &b);
             {
                 const dyad_kin_input seed = random_seed(&r, &in);
                 ok = dyad_kinematics_tangent(type, &in, &seed, &value, &rate) == DYAD_STATUS_OK;
@@ -1964,7 +2015,7 @@ static int test_kin_tangent_along_motion(void)
             kin_built b;
             dyad_kin_result value, rate;
             double p1[KIN_POS], v0[KIN_POS], v1[KIN_VEL], a0[KIN_VEL], e1, e2;
-            (void)conditioned_case(&r, type, 0.05, &in, &b);
+            (void)conditioned_case(&r, type, KIN_LEAST, &in, &b);
             seed = motion_seed(&in);
             CHECK(dyad_kinematics_tangent(type, &in, &seed, &value, &rate) == DYAD_STATUS_OK,
                   "%s sample %d: not solved", dyad_type_name(type), k);
@@ -1984,12 +2035,13 @@ static int test_kin_tangent_along_motion(void)
 }
 
 /* 1 if every motion output is NaN (and, with conditioning, also those two). */
-static int kin_all_nan(const dyad_kin_result* r, int with_conditioning)
+static int kin_all_nan(const dyad_kin_result* r, int with_figures)
 {
     double v[KIN_RAW];
     int k;
     kin_raw(r, v);
-    for (k = 0; k < KIN_RAW - (with_conditioning ? 0 : 2); ++k) {
+    /* the figures (conditioning, closure, amplification) come last */
+    for (k = 0; k < KIN_RAW - (with_figures ? 0 : 3); ++k) {
         if (!isnan(v[k])) {
             return 0;
         }
@@ -2092,9 +2144,11 @@ static int test_kin_singular(void)
         CHECK(s == DYAD_STATUS_SINGULAR && out.status == s, "%s case %zu: status %s",
               dyad_type_name(type), k, dyad_status_name(s));
         CHECK(out.conditioning >= 0 && out.conditioning < cases[k].in.singular_threshold &&
-                  out.amplification == 1 / out.conditioning,
-              "%s case %zu: conditioning %g, amplification %g", dyad_type_name(type), k,
-              (double)out.conditioning, (double)out.amplification);
+                  out.closure >= 0 && out.closure <= 1 &&
+                  out.amplification == 1 + 1 / out.closure + 1 / out.conditioning &&
+                  1 / out.amplification < cases[k].in.singular_threshold,
+              "%s case %zu: conditioning %g, closure %g, amplification %g", dyad_type_name(type),
+              k, (double)out.conditioning, (double)out.closure, (double)out.amplification);
         CHECK(kin_all_nan(&out, 0) && out.failure == DYAD_KIN_CLOSES && out.gap == 0,
               "%s case %zu: outputs not NaN", dyad_type_name(type), k);
         CHECK(dyad_kinematics_tangent(type, &cases[k].in, &zero, &value, &rate) == s &&
@@ -2177,7 +2231,7 @@ static int test_kin_invalid_nonfinite(void)
         dyad_kin_input base;
         kin_built b;
         dyad_kin_result good;
-        (void)conditioned_case(&r, type, 0.05, &base, &b);
+        (void)conditioned_case(&r, type, KIN_LEAST, &base, &b);
         CHECK(dyad_kinematics(type, &base, &good) == DYAD_STATUS_OK, "%s: base not solved",
               dyad_type_name(type));
         for (f = 0; f < sizeof kin_real_fields / sizeof kin_real_fields[0]; ++f) {
@@ -2215,7 +2269,7 @@ static int test_kin_invalid_domain(void)
         dyad_kin_input base, in;
         kin_built b;
         dyad_kin_result out;
-        (void)conditioned_case(&r, type, 0.05, &base, &b);
+        (void)conditioned_case(&r, type, KIN_LEAST, &base, &b);
         if (bit & KIN_DM_T) {
             in = base, in.k.guide = dyad_scale((dyad_real)1.01, in.k.guide);
             fails += expect_kin_invalid(type, &in, DYAD_KIN_FIELD_K_GUIDE, "long guide k");

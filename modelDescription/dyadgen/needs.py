@@ -29,6 +29,23 @@ AMPLIFICATION_TEXT = (
     "Data factor / conditioning: eps x amplification bounds the error of each "
     "reaction relative to the largest reaction of its unit (N or N.m)"
 )
+#: The same in a mechanism FMU, whose dyads' motion is its own round-off too.
+KINEMATIC_AMPLIFICATION_TEXT = (
+    "eps x amplification bounds the error of each reaction of the dyad relative to its "
+    "largest reaction of the unit (N or N.m), the round-off of the dyad's motion included"
+)
+#: A mechanism FMU's own amplification output.
+MECHANISM_AMPLIFICATION_TEXT = (
+    "eps x amplification bounds the error of every output with status 0 relative to the "
+    "peak of its unit over the motion: the kinematics' round-off (which grows like "
+    "1 / conditioning^2 at a dead centre) and the reactions' together"
+)
+CONDITIONING_TEXT = "Conditioning of {} in [0, 1]; below singular_threshold the dyad is singular"
+#: In a mechanism FMU the motion's amplification decides (kinematics.h).
+KINEMATIC_CONDITIONING_TEXT = (
+    "Conditioning of {} in [0, 1] (|sin| of the angle its velocity equations divide by); "
+    "the dyad is singular where its motion's amplification exceeds 1 / singular_threshold"
+)
 
 
 # ---------------------------------------------------------------------------
@@ -318,7 +335,9 @@ def reaction_text(d: Dyad, pair: str) -> str:
     return f"Force on {link} from {source} ({other}) at {pair_label(pair)}"
 
 
-def _dyad_outputs(offer: _Offer, d: Dyad, deps: list, own_geometry: list) -> None:
+def _dyad_outputs(
+    offer: _Offer, d: Dyad, deps: list, own_geometry: list, internal: bool = False
+) -> None:
     pre = d.prefix()
     source = str(d.index)
     named = d.name or "the dyad"
@@ -358,20 +377,22 @@ def _dyad_outputs(offer: _Offer, d: Dyad, deps: list, own_geometry: list) -> Non
     cond = Output(
         f"{pre}conditioning",
         None,
-        f"Conditioning of {named} in [0, 1]; below singular_threshold the dyad is singular",
+        (KINEMATIC_CONDITIONING_TEXT if internal else CONDITIONING_TEXT).format(named),
         f"{member(pre)}conditioning",
         depends=own_geometry,
         source=source,
     )
+    offer.add(cond.name, [cond])
+    if internal and not pre:
+        return  # the mechanism's own amplification, which bounds this dyad's too
     amp = Output(
         f"{pre}amplification",
         None,
-        AMPLIFICATION_TEXT,
+        KINEMATIC_AMPLIFICATION_TEXT if internal else AMPLIFICATION_TEXT,
         f"{member(pre)}amplification",
         depends=deps,
         source=source,
     )
-    offer.add(cond.name, [cond])
     offer.add(amp.name, [amp])
 
 
@@ -546,7 +567,7 @@ def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
         if scene.internal():
             _kinematic_outputs(offer, scene, d)
         deps, own_geometry = _dependencies(scene, d, index)
-        _dyad_outputs(offer, d, deps, own_geometry)
+        _dyad_outputs(offer, d, deps, own_geometry, scene.internal())
     if scene.crank and scene.crank.is_ram():
         _ram_outputs(offer, scene)
     elif scene.crank:
@@ -554,6 +575,18 @@ def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
     if scene.internal() and scene.inertia:
         _driver_inertia_outputs(offer, scene)
     chosen, problems = _choose(offer, scene, wanted)
+    if scene.internal():
+        # a mechanism FMU always says how far its outputs can be trusted
+        chosen.append(
+            Output(
+                "amplification",
+                None,
+                MECHANISM_AMPLIFICATION_TEXT,
+                "amplification",
+                depends=[i.name for i in scene.inputs],
+                source="mechanism",
+            )
+        )
     status_text = "0 ok, 1 a dyad is singular, 3 a reaction overflows"
     if scene.internal():
         status_text += ", 4 a dyad cannot assemble"

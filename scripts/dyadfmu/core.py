@@ -8,7 +8,7 @@ else ``build/libdyadfmu.so`` of the checkout (:func:`library_candidates`).
 The kinematics (``dyadfmu/kinematics.h``) take a dict shaped like ``dyad_kin_input``:
 ``{"k": {"position", "velocity", "acceleration", "guide", "omega", "epsilon"}, "p": {...},
 "length_m", "length_n", "turn_m", "turn_n", "com_m", "com_n", "branch",
-"singular_threshold"}``; a missing key keeps the value of ``dyad_kin_input_default()``.
+"singular_threshold", "mount_amplification"}``; a missing key keeps the value of ``dyad_kin_input_default()``.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ MOUNT_POINT_KEYS = ("position", "velocity", "acceleration")
 MOUNT_KEYS = (*MOUNT_POINT_KEYS, "guide", "omega", "epsilon")
 #: Vector and scalar keys of a kinematics input besides the mounts.
 KIN_VECTORS = ("turn_m", "turn_n", "com_m", "com_n")
-KIN_SCALARS = ("length_m", "length_n", "singular_threshold")
+KIN_SCALARS = ("length_m", "length_n", "singular_threshold", "mount_amplification")
 LINK_KEYS = (
     "dir",
     "length",
@@ -158,6 +158,7 @@ class _KinInput(ctypes.Structure):
         ("com_n", _Vec2),
         ("branch", ctypes.c_int),
         ("singular_threshold", ctypes.c_double),
+        ("mount_amplification", ctypes.c_double),
     ]
 
 
@@ -190,6 +191,7 @@ class _KinResult(ctypes.Structure):
         ("slide_k", _Slide),
         ("slide_p", _Slide),
         ("conditioning", ctypes.c_double),
+        ("closure", ctypes.c_double),
         ("amplification", ctypes.c_double),
     ]
 
@@ -493,6 +495,7 @@ class Core:
             "slide_k": {key: getattr(res.slide_k, key) for key in ("s", "rate", "accel")},
             "slide_p": {key: getattr(res.slide_p, key) for key in ("s", "rate", "accel")},
             "conditioning": res.conditioning,
+            "closure": res.closure,
             "amplification": res.amplification,
         }
 

@@ -83,6 +83,20 @@ class _Mounts:
             out.append(f"k.{slot}.epsilon = {epsilon};")
         return out
 
+    def carried_amplification(self, d: Dyad) -> str | None:
+        """The C sum of the amplifications of the earlier dyads whose links carry this
+        dyad's mounts (their round-off is its inputs'), or None where the frame and the
+        driver carry both: known to the last bit."""
+        owners = []
+        for att in (d.k, d.p):
+            if att.kind == "link" and att.link in self.owner:
+                owner = self.owner[att.link][0]
+                if owner not in owners:
+                    owners.append(owner)
+        if not owners:
+            return None
+        return " + ".join(f"kin->{kin_name(o)}.amplification" for o in owners)
+
     def offset(self, att: Attachment) -> str:
         """The pair's point (a guide's point) in its carrier's frame."""
         if att.at is not None:
@@ -141,6 +155,9 @@ def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad) -> list[str]:
             else f"k.branch = {int(branch.value)};"
         )
     out.append(f"k.singular_threshold = {scene.threshold.c()};")
+    carried = mounts.carried_amplification(d)
+    if carried is not None:
+        out.append(f"k.mount_amplification = {carried};")
     result = f"&kin->{kin_name(d)}"
     out.append(f"if (dyad_kinematics_{d.type.lower()}(&k, {result}) != DYAD_STATUS_OK) {{")
     out.append(f"    *failed = {d.index};")

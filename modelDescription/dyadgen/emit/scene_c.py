@@ -29,6 +29,8 @@ from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, loaders, member
 from dyadgen.table import Table
 
 TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c.in"
+#: the output member of a mechanism FMU's own amplification
+MECHANISM_AMPLIFICATION = "amplification"
 KINEMATICS_TEMPLATE = TEMPLATE.with_name("scene_kinematics.c.in")
 
 
@@ -94,6 +96,10 @@ class Plan:
         )
         self.accel: dict[str, str | None] = {}  # link -> C name of a_D or None for zero
         self.accel_size: dict[str, str] = {}  # link -> C expression of the size of a_D's terms
+
+    def direct_loaders(self, d: Dyad) -> list:
+        """The dyads whose outer pairs sit on this dyad's links."""
+        return [x for x in self.scene.dyads if any(a.link in (d.m, d.n) for a in (x.k, x.p))]
 
     def inp(self, name: str) -> str:
         """The input block's member of an input, or the C expression that computes it
@@ -396,6 +402,44 @@ def _feedback(plan: Plan, code: _Code, d: Dyad, side: str, att: Attachment) -> N
         code(f"      {carrier}_m += moment; }}")
 
 
+def _bound(plan: Plan, code: _Code, d: Dyad) -> None:
+    """The bound of a dyad's reactions, once they are solved: the core's amplification
+    (its own round-off, and that of the reactions of the dyads loading it, which reach
+    it through its loads' sizes) and, where the kinematics are internal, its motion's
+    round-off, and what its loaders' motion added to theirs. A relative error e of the
+    motion moves the loads by e of their sizes and the conditioning by e of itself:
+    e (1 + data factor) of the largest reaction, the data factor being amplification x
+    conditioning (dyad_amplification.h); so does an extra error e of a loader's
+    reactions, relative to its largest."""
+    dn = member(d.name or "dyad")
+    extra = []
+    if d in plan.kinematic:
+        extra.append(f"2.0 * kin.{kinematics_c.kin_name(d)}.amplification")
+    solved = {x.index for x in plan.solved}
+    for loader in plan.direct_loaders(d):
+        if loader.index in solved:
+            ln = member(loader.name or "dyad")
+            extra.append(f"({ln}_bound - {ln}.amplification)")
+    if not extra:
+        code(f"const double {dn}_bound = {dn}.amplification;")
+        return
+    code(
+        f"const double {dn}_bound = {dn}.amplification + {dn}.amplification * "
+        f"{dn}.conditioning * ({' + '.join(extra)});"
+    )
+
+
+def mechanism_amplification(plan: Plan) -> str:
+    """The C expression of a mechanism FMU's amplification: the bound of every output it
+    reports, its dyads' reactions (their motion's round-off carried in) and the motion
+    itself, three times over for the accelerations and the effective inertia."""
+    terms = ["1.0"] + [f"{member(d.name or 'dyad')}_bound" for d in plan.solved]
+    kin = [f"kin.{kinematics_c.kin_name(d)}.amplification" for d in plan.kinematic]
+    if kin:
+        terms.append(f"3.0 * ({' + '.join(kin)})")
+    return " + ".join(terms)
+
+
 def _chain(plan: Plan, code: _Code) -> None:
     threshold = plan.scene.threshold.c()
     code()
@@ -416,6 +460,7 @@ def _chain(plan: Plan, code: _Code) -> None:
         _feedback(plan, code, d, "k", d.k)
         _feedback(plan, code, d, "p", d.p)
         code("}")
+        _bound(plan, code, d)
 
 
 def _crank_outputs(plan: Plan) -> tuple[bool, bool]:
@@ -532,8 +577,8 @@ def _output_exprs(scene: Scene) -> dict[str, str]:
                 exprs[f"{pre}r_{pair}_{c}"] = f"{dn}.r_{pair}.{c}"
             for kind in "nm":
                 exprs[f"{pre}{kind}_{pair}"] = f"{dn}.{kind}_{pair}"
-        for rest in ("conditioning", "amplification"):
-            exprs[f"{pre}{rest}"] = f"{dn}.{rest}"
+        exprs[f"{pre}conditioning"] = f"{dn}.conditioning"
+        exprs[f"{pre}amplification"] = f"{dn}_bound"
     if scene.internal():
         exprs.update(_kinematic_exprs(scene))
     return exprs
@@ -543,6 +588,8 @@ def _outputs(plan: Plan, code: _Code) -> None:
     code()
     code("/* Outputs */")
     exprs = _output_exprs(plan.scene)
+    if plan.scene.internal():
+        exprs[MECHANISM_AMPLIFICATION] = mechanism_amplification(plan)
     for o in plan.scene.outputs:
         if not o.integer:
             code(f"out->{o.member} = {exprs[o.member]};")

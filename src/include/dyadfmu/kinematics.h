@@ -20,6 +20,17 @@
  * output. (x) is the complex product: (a (x) b) = (a.x b.x - a.y b.y,
  * a.x b.y + a.y b.x).
  *
+ * Round-off. Where a dyad closes in two ways (RRR, RRT, RTR) its position
+ * is the root of a quadratic, whose argument is a small difference near a
+ * toggle or branch point: the positions lose digits like eps / closure and,
+ * since the rates divide by the conditioning (which the root gives), the
+ * velocities and accelerations do too. `amplification` bounds all of it and
+ * what the mounts' motion brings in: every motion output is within
+ * c eps amplification of the largest output of its unit (c about 1; each
+ * type's file derives its figures). The status is singular where
+ * 1 / amplification falls below singular_threshold: with the default
+ * threshold, before the outputs lose half their digits.
+ *
  * The functions allocate nothing, keep no state and do no I/O. Each returns
  * the status it also stores in result->status; unless it is
  * DYAD_STATUS_OK every motion output is NaN.
@@ -76,9 +87,15 @@ typedef struct dyad_kin_input {
     /** Assembly branch, +1 or -1, where the dyad closes in two ways (RRR,
      *  RRT, RTR); see each function. TRT and RTT close in one way. */
     int branch;
-    /** Conditioning below which the result is DYAD_STATUS_SINGULAR (-), in
-     *  (0, 1). Default DYAD_DEFAULT_SINGULAR_THRESHOLD. */
+    /** The result is DYAD_STATUS_SINGULAR where 1 / amplification is below it
+     *  (-), in (0, 1). Default DYAD_DEFAULT_SINGULAR_THRESHOLD. */
     dyad_real singular_threshold;
+    /** The amplification the mounts' motion carries in (-), >= 0: their
+     *  round-off relative to the largest value of its unit, in eps, as the
+     *  result's `amplification` of the dyads that move them gives it (the sum
+     *  where two do). 0 (the default) for mounts known to the last bit: the
+     *  frame, a driver's given motion. */
+    dyad_real mount_amplification;
 } dyad_kin_input;
 
 /** Input fields, to name the one that made a call invalid. */
@@ -106,6 +123,7 @@ typedef enum dyad_kin_field {
     DYAD_KIN_FIELD_COM_N,
     DYAD_KIN_FIELD_BRANCH,
     DYAD_KIN_FIELD_SINGULAR_THRESHOLD,
+    DYAD_KIN_FIELD_MOUNT_AMPLIFICATION,
     DYAD_KIN_FIELD_COUNT
 } dyad_kin_field;
 
@@ -170,15 +188,30 @@ typedef struct dyad_kin_result {
     /** The velocity equations' normalised determinant (-), the same figure as
      *  the kinetostatic solvers' conditioning: RRR |i_m . j_n|, RRT |i_n . i_k|,
      *  RTR min(|i_beta . i_m|, |D_m D_n| / (l_m + l_n)), TRT |j_k . i_p|, RTT
-     *  |j_k . i_m|. Compared with the threshold; filled whenever the dyad closes. */
+     *  |j_k . i_m|. Filled whenever the dyad closes. */
     dyad_real conditioning;
-    /** 1 / conditioning (-): the growth of velocities, accelerations and their
-     *  round-off against the inputs' motion. */
+    /** The closure's own conditioning (-), in [0, 1]: where the position is a
+     *  root, the root's argument (the distance from the toggle or branch
+     *  point) over the size of the terms it is the difference of: RRR
+     *  min(l_m + l_n - |D_m D_n|, |D_m D_n| - |l_m - l_n|) / (l_m + l_n +
+     *  |D_m D_n|), RRT and RTR alike (their files). It falls like
+     *  conditioning^2. 1 where the dyad closes in one way (TRT, RTT). Filled
+     *  whenever the dyad closes. */
+    dyad_real closure;
+    /** The bound of the motion's round-off (-), >= 1: every motion output is
+     *  within c eps amplification of the largest output of its unit, the
+     *  mounts' own round-off (mount_amplification) included:
+     *      amplification = (1 + 1 / closure + 1 / conditioning)
+     *                      (1 + mount_amplification (1 + |mounts| / size)),
+     *  with |mounts| the distance of the mounts' points from the origin and
+     *  size the closure's (each type's file). The status is singular where
+     *  1 / amplification < singular_threshold. Filled whenever the dyad closes. */
     dyad_real amplification;
 } dyad_kin_result;
 
 /** Inputs with every field zero except guides, turns = (1, 0), lengths 1 m,
- *  branch +1 and the singular threshold DYAD_DEFAULT_SINGULAR_THRESHOLD. */
+ *  branch +1 and the singular threshold DYAD_DEFAULT_SINGULAR_THRESHOLD;
+ *  mount_amplification 0. */
 dyad_kin_input dyad_kin_input_default(void);
 
 /** Kinematics of the dyad of the given type. */
@@ -187,7 +220,7 @@ dyad_status dyad_kinematics(dyad_type type, const dyad_kin_input* input, dyad_ki
 /** RRR: E at distance l_m from D_m and l_n from D_n; branch +1 puts E to the
  *  left of the line from D_m to D_n (k0 . (D_n - D_m) x (E - D_m) > 0).
  *  D_m = D_n with l_m = l_n (E anywhere, the links folded) is singular with
- *  conditioning 0. */
+ *  conditioning 0; so is a dyad exactly at full extension or folding (closure 0). */
 dyad_status dyad_kinematics_rrr(const dyad_kin_input* input, dyad_kin_result* result);
 /** RRT: D_m slides on guide k; branch +1 takes the larger slide s_k. */
 dyad_status dyad_kinematics_rrt(const dyad_kin_input* input, dyad_kin_result* result);
