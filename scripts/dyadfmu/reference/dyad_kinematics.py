@@ -6,17 +6,20 @@ closure of the dyad is written as two scalar equations in two unknowns q,
     Phi(q, t) = D_m(q, t) + l_m(q) i_m(q, t) - D_n(q, t) - l_n i_n(q, t) = 0,
 
 q(0) is found by a coarse multi-start Newton search in floats, polished by
-``mpmath.findroot`` and chosen by the branch rule.  Within a relative 1e-6 of an assembly
-limit of RRR, RRT or RTR (two roots about to merge, where a float search cannot tell them
-apart or finds roots that are none), the two roots are instead started from the figure's
-intersection (circle with circle, line with circle) solved at the working precision, and
-polished the same way; a negative discriminant there means no real root, a zero one a
-double root (a dead point).  Likewise TRT and RTT within a sine of 1e-3 of parallel
-guides (or slot and guide), whose root runs far away: their linear closure is solved
-directly; the time derivatives come from the
+``mpmath.findroot`` and chosen by the branch rule; the time derivatives come from the
 implicit differentiation of Phi (q' = -J^-1 Phi_t, then q'' from the second total
 derivative), every partial derivative taken with ``mpmath.diff``.  A second, independent
 route (``method="findroot"``) solves the closure at the step points of ``mpmath.diff``.
+
+Near an assembly limit of RRR, RRT or RTR (the squared distance between the two roots
+below 1e-6 of the figure's, where a float search cannot tell them apart and mistakes near
+misses for roots) the roots are started instead from the figure's intersection (circle
+with circle, line with circle) at the working precision, then polished the same way (a
+start only: the roots are still the closure's): a negative discriminant means no real
+root, a zero one a double root (a dead point).  TRT
+and RTT within a sine of 1e-3 of parallel guides (or slot and guide), whose root runs
+beyond the float search's steps, start from their closure solved as the linear system it
+is.  Elsewhere the float search's roots are kept.
 
 Conventions (SI units: m, s, rad)
 ---------------------------------
