@@ -166,7 +166,7 @@ def test_lift_at_its_assembly_limit_50_and_80_digits_agree():
     assert r50.status == r80.status == scene_mp.OK
     assert set(r50.outputs) == set(r80.outputs)
     out = r80.outputs
-    assert out["lever.conditioning"] < 1e-6  # near the limit indeed: I(c) ~ 1/c
+    assert out["lever.conditioning"] < 1e-6  # near the limit indeed
     assert abs(out["arm.omega"]) > 1e3
     with mpmath.workdps(90):
         d_m, e, d_n = (
@@ -317,14 +317,14 @@ def _near_cases():
 NEAR_CASES = _near_cases()
 
 
-@pytest.mark.parametrize("kind", sorted(NEAR_CASES))
-@pytest.mark.parametrize("branch", (1, -1))
+@pytest.mark.parametrize(
+    ("kind", "branch"),
+    [(k, b) for k in sorted(NEAR_CASES) for b in ((1, -1) if k in ("RRR", "RRT", "RTR") else (1,))],
+)
 def test_near_limit_start_finds_the_float_search_roots(kind, branch, monkeypatch):
     """Near an assembly limit (RRR, RRT, RTR) or parallel guides (TRT, RTT), where both
     routes apply, the start from the figure and the float search give every output alike
     to 30 digits."""
-    if kind in ("TRT", "RTT") and branch < 0:
-        pytest.skip(f"a {kind} dyad closes in one way")
     inputs = dataclasses.replace(NEAR_CASES[kind], branch=branch)
     with mpmath.workdps(50):
         m = dk._model(inputs)
