@@ -11,6 +11,16 @@ implicit differentiation of Phi (q' = -J^-1 Phi_t, then q'' from the second tota
 derivative), every partial derivative taken with ``mpmath.diff``.  A second, independent
 route (``method="findroot"``) solves the closure at the step points of ``mpmath.diff``.
 
+Near an assembly limit of RRR, RRT or RTR (the squared distance between the two roots
+below 1e-6 of the figure's, where a float search cannot tell them apart and mistakes near
+misses for roots) the roots are started instead from the figure's intersection (circle
+with circle, line with circle) at the working precision, then polished the same way (a
+start only: the roots are still the closure's): a negative discriminant means no real
+root, a zero one a double root (a dead point).  TRT
+and RTT within a sine of 1e-3 of parallel guides (or slot and guide), whose root runs
+beyond the float search's steps, start from their closure solved as the linear system it
+is.  Elsewhere the float search's roots are kept.
+
 Conventions (SI units: m, s, rad)
 ---------------------------------
 * Angles counter-clockwise from +x; perp(v) = (-v.y, v.x); cross(a, b) = a.x b.y - a.y b.x.
@@ -474,16 +484,153 @@ def _branch_key(model: _Model, q: Sequence, t: Real) -> Real:
     return mpf(0) if index is None else q[index]
 
 
+def _is_root(model: _Model, q: Sequence, t: Real) -> bool:
+    """Whether q closes the figure to the tolerance of :func:`_polish`, on the scale of the
+    figure or of q's lengths where these are larger (a root run far away)."""
+    lengths = [abs(q[i]) for i in (0, 1) if i not in _angle_slots(model)]
+    tol = mpf(2) ** (-mpmath.mp.prec + 24) * max([mpf(_scale(model, t))] + lengths)
+    return max(abs(r) for r in _phi(model, q, t)) <= tol
+
+
 def _roots(model: _Model, t: Real) -> list:
     """Every distinct real root of the closure at time t, at the working precision."""
     angles = _angle_slots(model)
     tol = mpf(2) ** (-mpmath.mp.prec // 2) * _scale(model, t)
+    starts = _near_limit_starts(model, t)
+    near = starts is not None
     roots = []
-    for start in _coarse_roots(model, t):
+    for start in starts if near else _coarse_roots(model, t):
         q = _polish(model, start, t)
+        if q is None and near and _is_root(model, start, t):
+            q = list(start)  # a double root, where Newton's step is undefined
         if q is not None and not any(_same(q, r, tol, angles) for r in roots):
             roots.append(q)
     return roots
+
+
+# ---------------------------------------------------------------------------
+# near an assembly limit: the roots from the figure's intersection
+# ---------------------------------------------------------------------------
+#: Below this squared separation of its two roots (relative to the figure) a dyad is
+#: near its assembly limit: its roots are started from the figure's intersection.
+_NEAR_LIMIT = 1e-6
+
+
+def _sub(a: Vec, b: Vec) -> tuple:
+    return (a[0] - b[0], a[1] - b[1])
+
+
+def _dot(a: Vec, b: Vec) -> mpf:
+    return a[0] * b[0] + a[1] * b[1]
+
+
+def _cross(a: Vec, b: Vec) -> mpf:
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def _atan2(v: Vec) -> mpf:
+    return mpmath.atan2(v[1], v[0])
+
+
+def _unit(angle: Real) -> tuple:
+    return (mpmath.cos(angle), mpmath.sin(angle))
+
+
+def _split(discriminant: mpf, size: mpf) -> list | None:
+    """The two signed square roots of a discriminant (one where it is 0, none where it is
+    negative), or None where it is at least _NEAR_LIMIT times ``size``: away from the limit."""
+    if size <= 0 or discriminant >= _NEAR_LIMIT * size:
+        return None
+    if discriminant < 0:
+        return []
+    root = mpmath.sqrt(discriminant)
+    return [root] if root == 0 else [root, -root]
+
+
+def _rrr_starts(model: _Model, d_m: Vec, d_n: Vec) -> list | None:
+    """E on the circles about D_m (radius l_m) and D_n (l_n): E = D_m + (a d + h perp(d)) /
+    |d|^2 with d = D_n - D_m, a = (|d|^2 + l_m^2 - l_n^2) / 2 and h^2 = l_m^2 |d|^2 - a^2."""
+    lm, ln = model.length_m, model.length_n
+    with mpmath.extraprec(mpmath.mp.prec + 64):  # exact on the inputs' digits: 0 is 0
+        d = _sub(d_n, d_m)
+        dd = _dot(d, d)
+        a = (dd + lm * lm - ln * ln) / 2
+        disc = lm * lm * dd - a * a
+    roots = _split(disc, lm * lm * dd)
+    out = []
+    for h in roots or []:
+        e = tuple(d_m[c] + (a * d[c] + h * (-d[1], d[0])[c]) / dd for c in (0, 1))
+        out.append([_atan2(_sub(e, d_m)), _atan2(_sub(e, d_n))])
+    return None if roots is None else out
+
+
+def _rrt_starts(model: _Model, g_k: Vec, ang_k: Real, d_n: Vec) -> list | None:
+    """D_m = G_k + s i_k with E = D_m + l_m i_m on the circle about D_n (radius l_n): with
+    w = D_n - G_k - l_m i_m, s = w . i_k +- sqrt(l_n^2 - (i_k x w)^2)."""
+    i_k, i_m = _unit(ang_k), _unit(ang_k + model.turn_m)
+    base = tuple(g_k[c] + model.length_m * i_m[c] for c in (0, 1))
+    ln = model.length_n
+    with mpmath.extraprec(mpmath.mp.prec + 64):
+        w = _sub(d_n, base)
+        disc = ln * ln - _cross(i_k, w) ** 2
+    roots = _split(disc, ln * ln)
+    out = []
+    for h in roots or []:
+        s = _dot(w, i_k) + h
+        e = tuple(base[c] + s * i_k[c] for c in (0, 1))
+        out.append([s, _atan2(_sub(e, d_n))])
+    return None if roots is None else out
+
+
+def _rtr_starts(model: _Model, d_m: Vec, d_n: Vec, size: mpf) -> list | None:
+    """D_n - D_m = l_m i_m - l_n i_n with i_n = i_m turned by turn_n: |D_n - D_m|^2 =
+    (l_m - l_n cos turn_n)^2 + (l_n sin turn_n)^2 gives l_m, the direction of D_n - D_m
+    then angle_m."""
+    ln, turn = model.length_n, model.turn_n
+    c, s = ln * mpmath.cos(turn), ln * mpmath.sin(turn)
+    with mpmath.extraprec(mpmath.mp.prec + 64):
+        d = _sub(d_n, d_m)
+        disc = _dot(d, d) - s * s
+    roots = _split(disc, size * size)
+    out = []
+    for h in roots or []:
+        lm = c + h
+        out.append([_atan2(d) - mpmath.atan2(-s, lm - c), lm])
+    return None if roots is None else out
+
+
+def _linear_start(model: _Model, pk: Vec, ak: Real, pp: Vec, ap: Real) -> list | None:
+    """TRT and RTT, whose closure is linear in q (the angles are fixed): u q[0] + v q[1] = b
+    solved by Cramer where the sine between u and v is below sqrt(_NEAR_LIMIT) (the root
+    runs far away, beyond the float search's steps); none where u and v are parallel."""
+    i_k, i_m = _unit(ak), _unit(ak + model.turn_m)
+    if model.type == "TRT":  # s_k i_k - s_p i_p = G_p + l_n i_n - G_k - l_m i_m
+        i_p = _unit(ap)
+        i_n = _unit(ap + model.turn_n)
+        u, v = i_k, (-i_p[0], -i_p[1])
+        b = tuple(pp[c] + model.length_n * i_n[c] - pk[c] - model.length_m * i_m[c] for c in (0, 1))
+    else:  # RTT: s_k i_k + l_m i_m = D_n + l_n i_n - G_k
+        i_n = _unit(ak + model.turn_m + model.turn_n)
+        u, v = i_k, i_m
+        b = tuple(pp[c] + model.length_n * i_n[c] - pk[c] for c in (0, 1))
+    det = _cross(u, v)
+    if det * det >= _NEAR_LIMIT:
+        return None
+    return [] if det == 0 else [[_cross(b, v) / det, _cross(u, b) / det]]
+
+
+def _near_limit_starts(model: _Model, t: Real) -> list | None:
+    """The roots' starts of a dyad within a relative _NEAR_LIMIT of its assembly limit
+    (RRR, RRT, RTR) or of parallel guides or slot (TRT, RTT); none where it cannot
+    assemble; None elsewhere, where the float search finds them."""
+    (pk, ak), (pp, ap) = _mount_at(model.k, t), _mount_at(model.p, t)
+    if model.type == "RRR":
+        return _rrr_starts(model, pk, pp)
+    if model.type == "RRT":
+        return _rrt_starts(model, pk, ak, pp)
+    if model.type == "RTR":
+        return _rtr_starts(model, pk, pp, mpf(_scale(model, t)))
+    return _linear_start(model, pk, ak, pp, ap)
 
 
 def _root(model: _Model, t: Real) -> tuple[list | None, str]:

@@ -1,0 +1,859 @@
+"""Independent high-precision reference of a whole mechanism FMU (mpmath).
+
+From a scene file with internal kinematics (``scenes/*.toml`` with a ``[crank]`` or a
+``[ram]``; schema in scenes/README.md) and the FMU's input values, :func:`evaluate` gives
+every Real output of the scene's mechanism FMU as an mpf at a chosen precision, and the
+status. It is built from the two independent references of this package, not from the C
+code or the generated code:
+
+* kinematics, from the driver outwards: each dyad by :func:`.dyad_kinematics.solve`
+  (the closure solved by findroot, rates by implicit differentiation), its mounts being
+  points and guides of the driver or of the links of earlier dyads, moved as rigid
+  bodies (v = v_D + w perp(r), a = a_D + e perp(r) - w^2 r) from that dyad's mpf
+  results, never rounded to float;
+* kinetostatics, from the last dyad back: each dyad's Newton-Euler equations (the system
+  of :func:`.newton_euler.equilibrium_system`, solved by ``mpmath.lu_solve``), every later
+  dyad's reactions loading the earlier link or driver it hangs on, at its pair point (a
+  sliding pair's reactive moment too);
+* the driver's balance: a crank's torque about O and the frame's force R_O on it; a ram's
+  actuator force along its guide i_r, the guide's normal force N along j_r and reactive
+  moment M about R;
+* with inertia, the effective inertia J = sum m V.V + I W^2 over every moving body (the
+  driver included) and dJ/dq = 2 sum (m V.V' + I W W'), V, W the centre of mass's
+  velocity and the angular velocity per unit driver rate, V', W' their derivatives in the
+  driver's coordinate q: the kinematics evaluated again at unit driver rate and zero
+  driver acceleration; torque0 = torque - J q'' (a ram's force0 likewise).
+
+Every input is taken as the exact binary value of its float; every number of the scene
+(and each parameter given with the inputs) likewise; trigonometric functions of them are
+evaluated exactly. The arithmetic runs at ``dps + 20`` digits and the outputs are rounded
+to ``dps``.
+
+Units: m, s, rad, kg, N, N m. Driver coordinate q: the crank's angle (rad) or the ram's
+position (m); J in kg m2 (crank) or kg (ram); dJdq in kg m2/rad or kg/m.
+
+Status (:class:`Result`): ``"ok"``; ``"cannot assemble"`` (the first dyad, from the
+driver, whose closure has no real solution on its branch); ``"singular"`` (a dyad at a
+dead point: its closure's Jacobian vanishes to the working precision, which for the
+float inputs of an FMU means conditioning exactly 0, or TRT / RTT guides exactly
+parallel). The outputs are empty unless the status is ok.
+
+Not reproduced: ``amplification`` (a bound on the FMU's round-off, not a property of the
+mechanism) and ``status``; ``singular_threshold`` and ``on_singular`` are accepted and
+ignored.
+
+Example::
+
+    scene = read_scene("scenes/lift.toml")
+    r = evaluate(scene, {"ram.position": 0.25, "ram.velocity": 0.3,
+                         "ram.acceleration": -1.2, "platform.force.y": -900.0})
+    r.status, r.outputs["ram.force"], r.outputs["lever.R_mk.x"]
+"""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import mpmath
+from mpmath import mpf
+
+from . import dyad_kinematics as dk
+from .newton_euler import PAIRS, equilibrium_system, reactions_of_unknowns
+
+__all__ = [
+    "CANNOT_ASSEMBLE",
+    "OK",
+    "SINGULAR",
+    "Attachment",
+    "DyadSpec",
+    "MechanismScene",
+    "Result",
+    "SceneError",
+    "assembly_status",
+    "evaluate",
+    "read_scene",
+]
+
+#: The statuses of :class:`Result`.
+OK = "ok"
+CANNOT_ASSEMBLE = dk.CANNOT_ASSEMBLE
+SINGULAR = dk.SINGULAR
+
+_GUARD = 20  # decimal digits carried beyond the requested dps
+#: Whether D_m and D_n slide on a guide of k and p, by dyad type.
+_SLIDES = {t: (PAIRS[t][0] == "T", PAIRS[t][2] == "T") for t in PAIRS}
+_TWO_BRANCHES = ("RRR", "RRT", "RTR")
+_CRANK_MOTION = ("angle", "omega", "epsilon")
+_RAM_MOTION = ("position", "velocity", "acceleration")
+_IGNORED = ("singular_threshold", "on_singular")
+
+Vec = tuple
+
+
+class SceneError(ValueError):
+    """A scene or an input this reference refuses; the message names the file and field."""
+
+
+# ---------------------------------------------------------------------------
+# the scene
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Attachment:
+    """An outer pair's external link: the frame (``body`` None), the driver or a link.
+
+    ``guide``: the pair slides, on a guide of that body whose angle is the parameter
+    ``<guide>`` (rad; from x on the frame, from the body's i otherwise). ``at``: the
+    parameter prefix of the pair's point or of a point of its guide (``<at>.x``,
+    ``<at>.y``, m; global on the frame, in the body's frame otherwise), or None for the
+    crank's pin (length, 0) or the ram's point R.
+    """
+
+    body: str | None
+    guide: str | None
+    at: str | None
+
+
+@dataclass(frozen=True)
+class DyadSpec:
+    """A [[dyad]]: name ("" when the scene's only dyad is unnamed), type, links, mounts."""
+
+    name: str
+    type: str
+    m: str
+    n: str
+    k: Attachment
+    p: Attachment
+
+    @property
+    def prefix(self) -> str:
+        """The prefix of the dyad's FMU variables: ``"<name>."`` or ``""``."""
+        return f"{self.name}." if self.name else ""
+
+
+@dataclass(frozen=True)
+class MechanismScene:
+    """A scene read for :func:`evaluate`.
+
+    ``driver`` is ``"crank"`` or ``"ram"``, ``driver_name`` its name in the FMU's
+    variables; ``inputs`` the FMU's inputs with their start values (the driver's motion:
+    rad, rad/s, rad/s2 or m, m/s, m/s2; the loads: N, N m); ``parameters`` every
+    parameter of the scene under the FMU's names (tunable or baked) with its value;
+    ``translating``: the links that slide on a frame guide (no angle output).
+    """
+
+    label: str
+    driver: str
+    driver_name: str
+    inertia: bool
+    gravity: bool
+    dyads: tuple[DyadSpec, ...]
+    translating: frozenset[str]
+    forces: tuple[str, ...]
+    moments: tuple[str, ...]
+    inputs: dict[str, float]
+    parameters: dict[str, float]
+
+    @property
+    def motion_inputs(self) -> tuple[str, ...]:
+        """The driver's coordinate, rate and acceleration inputs (the rates with inertia)."""
+        names = _RAM_MOTION if self.driver == "ram" else _CRANK_MOTION
+        return tuple(f"{self.driver_name}.{k}" for k in names[: 3 if self.inertia else 1])
+
+    def split(self, values: Mapping[str, float]) -> tuple[dict, dict]:
+        """(inputs, parameters): the start values and scene values with ``values`` over
+        them; a name that is neither an input nor a parameter is refused."""
+        inputs, params = dict(self.inputs), dict(self.parameters)
+        for name, value in values.items():
+            if name in inputs:
+                inputs[name] = _finite(value, name, self.label)
+            elif name in params:
+                params[name] = _finite(value, name, self.label)
+            elif name not in _IGNORED:
+                raise SceneError(
+                    f"{self.label}: {name!r} is no input or parameter of this mechanism FMU "
+                    f"(inputs: {', '.join(self.inputs)})"
+                )
+        return inputs, params
+
+
+def _finite(value: object, name: str, label: str) -> float:
+    """A finite number (bool refused), as float."""
+    if isinstance(value, bool) or not isinstance(value, int | float | mpf):
+        raise SceneError(f"{label}: {name} must be a number, not {value!r}")
+    number = float(value)
+    if number != number or number in (float("inf"), float("-inf")):
+        raise SceneError(f"{label}: {name} must be finite, not {value!r}")
+    return number
+
+
+class _Reader:
+    """Reads a parsed scene into a :class:`MechanismScene`, naming the field of each fault."""
+
+    def __init__(self, data: Mapping, label: str) -> None:
+        self.data, self.label = data, label
+        self.params: dict[str, float] = {}
+        self.inputs: dict[str, float] = {}
+
+    def fail(self, where: str, message: str) -> None:
+        raise SceneError(f"{self.label}: {where}: {message}")
+
+    def table(self, key: str, required: bool = False) -> dict:
+        value = self.data.get(key)
+        if value is None and not required:
+            return {}
+        if not isinstance(value, Mapping):
+            self.fail(f"[{key}]", "missing or not a table")
+        return dict(value)
+
+    def number(self, table: Mapping, key: str, where: str, default: float | None = None) -> float:
+        if key not in table:
+            if default is None:
+                self.fail(where, f"missing '{key}'")
+            return default
+        return _finite(table[key], f"{where}.{key}", self.label)
+
+    def pair(self, table: Mapping, key: str, where: str, default: tuple | None = None) -> tuple:
+        value = table.get(key, default)
+        if not isinstance(value, list | tuple) or len(value) != 2:
+            self.fail(where, f"'{key}' must be [x, y] (m)")
+        return tuple(_finite(v, f"{where}.{key}", self.label) for v in value)
+
+    def param(self, name: str, value: float) -> None:
+        self.params[name] = value
+
+    def param_pair(self, name: str, value: tuple) -> None:
+        self.params[f"{name}.x"], self.params[f"{name}.y"] = value
+
+    # ---- sections ---------------------------------------------------------------------
+    def effects(self) -> tuple[bool, bool]:
+        head = self.table("scene", required=True)
+        kinematics = head.get("kinematics", "internal")
+        if kinematics != "internal":
+            self.fail("[scene].kinematics", "only a mechanism FMU (kinematics = 'internal')")
+        eff = self.table("effects")
+        inertia, gravity = bool(eff.get("inertia", False)), bool(eff.get("gravity", False))
+        if gravity:
+            g = self.table("gravity", required=True)
+            self.param("gravity.x", self.number(g, "x", "[gravity]"))
+            self.param("gravity.y", self.number(g, "y", "[gravity]"))
+        return inertia, gravity
+
+    def driver(self, needs_mass: bool, inertia: bool) -> tuple[str, str]:
+        if ("crank" in self.data) == ("ram" in self.data):
+            self.fail("[crank]/[ram]", "a mechanism FMU has exactly one driver")
+        kind = "crank" if "crank" in self.data else "ram"
+        t = self.table(kind, required=True)
+        name = str(t.get("name", kind))
+        where = f"[{kind}]"
+        self.param_pair(f"{name}.at", self.pair(t, "at", where, (0.0, 0.0)))
+        if kind == "crank":
+            self.param(f"{name}.length", self.number(t, "length", where))
+            self.param(f"{name}.inertia", self.number(t, "inertia", where) if inertia else 0.0)
+        else:
+            self.param(f"{name}.guide", self.number(t, "guide", where))
+        com = self.pair(t, "com", where) if needs_mass else (0.0, 0.0)
+        self.param_pair(f"{name}.com", com)
+        self.param(f"{name}.mass", self.number(t, "mass", where) if needs_mass else 0.0)
+        motion = _RAM_MOTION if kind == "ram" else _CRANK_MOTION
+        for key in motion[: 3 if inertia else 1]:
+            self.inputs[f"{name}.{key}"] = 0.0
+        return kind, name
+
+    def links(self, needs_mass: bool, inertia: bool) -> dict[str, dict]:
+        rows = self.data.get("link", [])
+        if not isinstance(rows, list):
+            self.fail("[[link]]", "must be an array of tables")
+        links = {}
+        for row in rows:
+            name = row.get("name") if isinstance(row, Mapping) else None
+            if not isinstance(name, str) or name in links:
+                self.fail("[[link]]", f"bad or repeated link name {name!r}")
+            where = f"link '{name}'"
+            self.param_pair(f"{name}.com", self.pair(row, "com", where))
+            self.param(f"{name}.mass", self.number(row, "mass", where) if needs_mass else 0.0)
+            self.param(f"{name}.inertia", self.number(row, "inertia", where) if inertia else 0.0)
+            links[name] = dict(row)
+        return links
+
+
+def _attachment(rd: _Reader, spec: object, side: str, dyad: str, ctx: dict) -> Attachment:
+    """The external link of pair D_m (side k) or D_n (side p) of a dyad, its parameters
+    recorded under the FMU's names."""
+    where = f"dyad '{dyad}'.{side}"
+    pre = f"{dyad}." if dyad else ""
+    slides = _SLIDES[ctx["type"]][side == "p"]
+    spec = {"link": spec} if isinstance(spec, str) else spec
+    if not isinstance(spec, Mapping) or not isinstance(spec.get("link"), str):
+        rd.fail(where, "expected 'frame', the driver's name or { link = ..., at = [x, y] }")
+    body = spec["link"]
+    if body == "crank" and ctx["driver"] == "crank":
+        body = ctx["driver_name"]
+    if body != "frame" and body != ctx["driver_name"] and body not in ctx["done"]:
+        rd.fail(where, f"{body!r} is not the frame, the driver nor a link of an earlier dyad")
+    pair = "D_m" if side == "k" else "D_n"
+    if slides:
+        if "guide" not in spec:
+            rd.fail(where, f"{pair} slides: it needs guide = <angle in rad>")
+        rd.param(f"{pre}guide_{side}.angle", rd.number(spec, "guide", where))
+        rd.param_pair(f"{pre}guide_{side}.at", rd.pair(spec, "at", where, (0.0, 0.0)))
+        return Attachment(
+            None if body == "frame" else body, f"{pre}guide_{side}.angle", f"{pre}guide_{side}.at"
+        )
+    if "guide" in spec:
+        rd.fail(where, f"{pair} is a revolute pair and has no guide")
+    if "at" not in spec:
+        if body == "frame" or body in ctx["done"]:
+            rd.fail(where, f"{pair} needs at = [x, y] (m)")
+        return Attachment(body, None, None)  # the crank's pin, or the ram's R
+    rd.param_pair(f"{pre}{pair}", rd.pair(spec, "at", where))
+    return Attachment(None if body == "frame" else body, None, f"{pre}{pair}")
+
+
+def _link_geometry(rd: _Reader, d: DyadSpec, links: dict, translating: set) -> None:
+    """Lengths, and the angle (a link on a frame guide) or turn (a link locked to a moving
+    guide or to link m) of a dyad's links, as parameters."""
+    for side, g in (("m", d.m), ("n", d.n)):
+        row, where = links[g], f"link '{g}'"
+        att = d.k if side == "m" else d.p
+        if not (side == "m" and d.type in ("RTR", "RTT")):
+            rd.param(f"{g}.length", rd.number(row, "length", where))
+        if att.guide is not None and att.body is None:  # translates on a frame guide
+            translating.add(g)
+            if "angle" in row:
+                rd.param(f"{g}.angle", rd.number(row, "angle", where))
+            else:
+                guide = rd.params[att.guide]
+                rd.param(f"{g}.angle", guide + rd.number(row, "turn", where, 0.0))
+        else:
+            rd.param(f"{g}.turn", rd.number(row, "turn", where, 0.0))
+
+
+def _dyads(rd: _Reader, links: dict, kind: str, name: str) -> tuple[list, set]:
+    rows = rd.data.get("dyad", [])
+    if not isinstance(rows, list) or not rows:
+        rd.fail("[[dyad]]", "a scene has at least one dyad")
+    ctx = {"driver": kind, "driver_name": name, "done": set(), "type": ""}
+    dyads, translating = [], set()
+    for row in rows:
+        dname = str(row.get("name", "")) if isinstance(row, Mapping) else ""
+        dtype = row.get("type") if isinstance(row, Mapping) else None
+        if dtype not in PAIRS:
+            rd.fail(f"dyad '{dname}'.type", f"expected one of {', '.join(PAIRS)}")
+        m, n = row.get("m"), row.get("n")
+        for g in (m, n):
+            if g not in links or g in ctx["done"]:
+                rd.fail(f"dyad '{dname}'", f"link {g!r} is unknown or already connected")
+        ctx["type"] = dtype
+        k = _attachment(rd, row.get("k"), "k", dname, ctx)
+        p = _attachment(rd, row.get("p"), "p", dname, ctx)
+        d = DyadSpec(dname, dtype, m, n, k, p)
+        if dtype in _TWO_BRANCHES:
+            default = 1.0 if dtype == "RTR" else None
+            rd.param(f"{d.prefix}branch", rd.number(row, "branch", f"dyad '{dname}'", default))
+        _link_geometry(rd, d, links, translating)
+        ctx["done"].update((m, n))
+        dyads.append(d)
+    return dyads, translating
+
+
+def _loads(rd: _Reader, links: dict) -> tuple[tuple, tuple]:
+    loads = rd.table("loads")
+    out = []
+    for key in ("force", "moment"):
+        names = loads.get(key, [])
+        if not isinstance(names, list) or any(g not in links for g in names):
+            rd.fail(f"[loads].{key}", "must be a list of link names")
+        for g in names:
+            components = (".x", ".y") if key == "force" else ("",)
+            for c in components:
+                rd.inputs[f"{g}.{key}{c}"] = 0.0
+        out.append(tuple(names))
+    return out[0], out[1]
+
+
+def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
+    """A scene file (path) or its parsed table read for :func:`evaluate`."""
+    if isinstance(scene, Mapping):
+        data, label = scene, "scene"
+    else:
+        label = Path(scene).name
+        try:
+            with open(scene, "rb") as f:
+                data = tomllib.load(f)
+        except (OSError, tomllib.TOMLDecodeError) as exc:
+            raise SceneError(f"{label}: cannot read the scene: {exc}") from None
+    rd = _Reader(data, label)
+    inertia, gravity = rd.effects()
+    kind, name = rd.driver(inertia or gravity, inertia)
+    links = rd.links(inertia or gravity, inertia)
+    dyads, translating = _dyads(rd, links, kind, name)
+    forces, moments = _loads(rd, links)
+    start = rd.table("start")
+    for key, value in start.items():
+        if key in rd.inputs:
+            rd.inputs[key] = _finite(value, f"[start].{key}", label)
+    return MechanismScene(
+        label=label,
+        driver=kind,
+        driver_name=name,
+        inertia=inertia,
+        gravity=gravity,
+        dyads=tuple(dyads),
+        translating=frozenset(translating),
+        forces=forces,
+        moments=moments,
+        inputs=dict(rd.inputs),
+        parameters=dict(rd.params),
+    )
+
+
+# ---------------------------------------------------------------------------
+# rigid bodies (mpf)
+# ---------------------------------------------------------------------------
+def _perp(v: Vec) -> tuple:
+    return (-v[1], v[0])
+
+
+def _cross(a: Vec, b: Vec) -> mpf:
+    return a[0] * b[1] - a[1] * b[0]
+
+
+def _dot(a: Vec, b: Vec) -> mpf:
+    return a[0] * b[0] + a[1] * b[1]
+
+
+def _add(*vs: Vec) -> tuple:
+    return (sum(v[0] for v in vs), sum(v[1] for v in vs))
+
+
+def _scale(s: mpf, v: Vec) -> tuple:
+    return (s * v[0], s * v[1])
+
+
+def _unit(angle: mpf) -> tuple:
+    return (mpmath.cos(angle), mpmath.sin(angle))
+
+
+@dataclass(frozen=True)
+class _Body:
+    """A moving body at one instant: its frame's origin D (position, velocity,
+    acceleration), its direction i, angular velocity and acceleration."""
+
+    position: Vec
+    velocity: Vec
+    acceleration: Vec
+    i: Vec
+    omega: mpf
+    epsilon: mpf
+
+    def arm(self, local: Vec) -> tuple:
+        """The vector from D to the point ``local`` of the body's frame (m)."""
+        return _add(_scale(local[0], self.i), _scale(local[1], _perp(self.i)))
+
+    def point(self, local: Vec) -> tuple:
+        """(position, velocity, acceleration) of the body's point ``local``."""
+        r = self.arm(local)
+        w, e = self.omega, self.epsilon
+        return (
+            _add(self.position, r),
+            _add(self.velocity, _scale(w, _perp(r))),
+            _add(self.acceleration, _scale(e, _perp(r)), _scale(-w * w, r)),
+        )
+
+
+# ---------------------------------------------------------------------------
+# the evaluation
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Result:
+    """What :func:`evaluate` gives: ``status`` (:data:`OK`, :data:`CANNOT_ASSEMBLE` or
+    :data:`SINGULAR`), ``dyad`` (the name of the dyad that failed, "" for a scene's only,
+    unnamed dyad; None when ok), ``reason`` (why, "" when ok) and ``outputs`` (FMU output
+    name -> mpf in the FMU's unit; empty unless ok)."""
+
+    status: str
+    dyad: str | None
+    reason: str
+    outputs: dict[str, mpf]
+
+
+@dataclass(frozen=True)
+class _Chain:
+    """The solved chain: its bodies by name, each dyad's dyad_kinematics result and the
+    unit directions of the guides of its sliding outer pairs (k, p; None where revolute)."""
+
+    bodies: dict
+    results: dict
+    guides: dict
+
+
+class _Failure(Exception):
+    """A dyad that does not close: status, dyad name, reason."""
+
+
+class _Evaluation:
+    """One evaluation of a scene at the working precision (set by the caller)."""
+
+    def __init__(self, scene: MechanismScene, inputs: dict, params: dict, work: int) -> None:
+        self.s, self.work = scene, work
+        self.inp = {k: mpf(v) for k, v in inputs.items()}
+        self.par = {k: mpf(v) for k, v in params.items()}
+        self.gravity = (
+            (self.par["gravity.x"], self.par["gravity.y"]) if scene.gravity else (mpf(0), mpf(0))
+        )
+
+    def vec(self, name: str) -> tuple:
+        return (self.par[f"{name}.x"], self.par[f"{name}.y"])
+
+    # ---- kinematics ---------------------------------------------------------------------
+    def driver_body(self, q: mpf, rate: mpf, accel: mpf) -> _Body:
+        """The driver at coordinate q moving at ``rate`` with ``accel``."""
+        c = self.s.driver_name
+        at = self.vec(f"{c}.at")
+        zero = mpf(0)
+        if self.s.driver == "crank":
+            i = (mpmath.cos(q), mpmath.sin(q))
+            return _Body(at, (zero, zero), (zero, zero), i, rate, accel)
+        i = (mpmath.cos(self.par[f"{c}.guide"]), mpmath.sin(self.par[f"{c}.guide"]))
+        return _Body(_add(at, _scale(q, i)), _scale(rate, i), _scale(accel, i), i, zero, zero)
+
+    def mount(self, att: Attachment, bodies: dict) -> dk.Mount:
+        """The motion of an outer pair's external link where the dyad meets it."""
+        if att.body is None:  # the frame: a fixed pivot, or a point of a fixed guide
+            angle = self.par[att.guide] if att.guide else mpf(0)
+            return dk.Mount(self.vec(att.at), direction=angle)
+        body = bodies[att.body]
+        if att.at is not None:
+            local = self.vec(att.at)
+        elif att.body == self.s.driver_name and self.s.driver == "crank":
+            local = (self.par[f"{att.body}.length"], mpf(0))  # the crank's pin A
+        else:
+            local = (mpf(0), mpf(0))  # the ram's R
+        pos, vel, acc = body.point(local)
+        if att.guide is None:
+            return dk.Mount(pos, vel, acc)
+        angle = mpmath.atan2(body.i[1], body.i[0]) + self.par[att.guide]
+        return dk.Mount(pos, vel, acc, angle, body.omega, body.epsilon)
+
+    def turn(self, d: DyadSpec, g: str, att: Attachment) -> mpf:
+        """The turn of link g from its guide (or link m's) as dyad_kinematics reads it."""
+        if g in self.s.translating:
+            return self.par[f"{g}.angle"] - self.par[att.guide]
+        return self.par[f"{g}.turn"]
+
+    def dyad_inputs(self, d: DyadSpec, bodies: dict) -> dk.DyadInputs:
+        branch = 1
+        if d.type in _TWO_BRANCHES:
+            branch = -1 if self.par[f"{d.prefix}branch"] < 0 else 1
+        sliding_m = d.type in ("RTR", "RTT")
+        return dk.DyadInputs(
+            d.type,
+            self.mount(d.k, bodies),
+            self.mount(d.p, bodies),
+            length_m=mpf(0) if sliding_m else self.par[f"{d.m}.length"],
+            length_n=self.par[f"{d.n}.length"],
+            turn_m=self.turn(d, d.m, d.k),
+            turn_n=self.turn(d, d.n, d.p),
+            com_m=self.vec(f"{d.m}.com"),
+            com_n=self.vec(f"{d.n}.com"),
+            branch=branch,
+        )
+
+    def kinematics(self, q: mpf, rate: mpf, accel: mpf) -> _Chain:
+        """The chain's motion, from the driver outwards; _Failure where a dyad does not
+        close."""
+        chain = _Chain({self.s.driver_name: self.driver_body(q, rate, accel)}, {}, {})
+        for d in self.s.dyads:
+            inputs = self.dyad_inputs(d, chain.bodies)
+            if _parallel(inputs):
+                raise _Failure(SINGULAR, d.name, "its guides (or slot and guide) are parallel")
+            r = dk.solve(inputs, dps=self.work)
+            if r["status"] != "ok":
+                raise _Failure(r["status"], d.name, r["reason"])
+            chain.results[d.name] = r
+            chain.guides[d.name] = tuple(
+                _unit(mount.direction) if slides else None
+                for mount, slides in zip((inputs.k, inputs.p), _SLIDES[d.type], strict=True)
+            )
+            for g, tag in ((d.m, "m"), (d.n, "n")):
+                origin = f"{tag}.d"
+                chain.bodies[g] = _Body(
+                    r[f"{origin}.position"],
+                    r[f"{origin}.velocity"],
+                    r[f"{origin}.acceleration"],
+                    r[f"i_{tag}"],
+                    r[f"omega_{tag}"],
+                    r[f"epsilon_{tag}"],
+                )
+        return chain
+
+    def motion(self) -> tuple[mpf, mpf, mpf]:
+        """The driver's coordinate, rate and acceleration inputs (rates 0 without inertia)."""
+        names = self.s.motion_inputs
+        values = [self.inp[n] for n in names] + [mpf(0)] * (3 - len(names))
+        return values[0], values[1], values[2]
+
+    def effective_inertia(self, unit: _Chain) -> tuple[mpf, mpf]:
+        """(J, dJ/dq) from the chain moved at unit driver rate and zero driver acceleration,
+        where a centre of mass's velocity and acceleration are V and V' and a body's omega
+        and epsilon W and W'."""
+        c = self.s.driver_name
+        _, v, a = unit.bodies[c].point(self.vec(f"{c}.com"))
+        inertia = self.par.get(f"{c}.inertia", mpf(0))
+        w = unit.bodies[c].omega
+        terms = [(self.par[f"{c}.mass"], inertia, v, a, w, unit.bodies[c].epsilon)]
+        for d in self.s.dyads:
+            r = unit.results[d.name]
+            for g, tag in ((d.m, "m"), (d.n, "n")):
+                v, a = r[f"{tag}.s.velocity"], r[f"{tag}.s.acceleration"]
+                w, e = r[f"omega_{tag}"], r[f"epsilon_{tag}"]
+                terms.append((self.par[f"{g}.mass"], self.par[f"{g}.inertia"], v, a, w, e))
+        j = sum((m * _dot(v, v) + i * w * w for m, i, v, _, w, _ in terms), mpf(0))
+        dj = 2 * sum((m * _dot(v, a) + i * w * e for m, i, v, a, w, e in terms), mpf(0))
+        return j, dj
+
+    def outputs(self) -> dict[str, mpf]:
+        """Every output, in the FMU's order; _Failure where a dyad does not close."""
+        q, rate, accel = self.motion()
+        chain = self.kinematics(q, rate, accel)
+        reactions = _Kinetostatics(self, chain).run()
+        out = {}
+        for d in self.s.dyads:
+            out.update(_motion_outputs(self.s, d, chain.results[d.name]))
+            out.update(reactions[d.name])
+            out[f"{d.prefix}conditioning"] = _conditioning(d, chain.results[d.name], chain)
+        c = self.s.driver_name
+        out.update(reactions[None])
+        if self.s.inertia:
+            j, dj = self.effective_inertia(self.kinematics(q, mpf(1), mpf(0)))
+            effort = "torque" if self.s.driver == "crank" else "force"
+            out[f"{c}.J"], out[f"{c}.dJdq"] = j, dj
+            out[f"{c}.{effort}0"] = out[f"{c}.{effort}"] - j * accel
+        return out
+
+
+def _parallel(inputs: dk.DyadInputs) -> bool:
+    """Whether a TRT's guides or an RTT's slot and guide are exactly parallel (c = 0)."""
+    if inputs.type == "TRT":
+        angle = mpf(inputs.p.direction) - mpf(inputs.k.direction)
+    elif inputs.type == "RTT":
+        angle = mpf(inputs.turn_m)
+    else:
+        return False
+    return mpmath.sin(angle) == 0
+
+
+class _Loads:
+    """The forces (at points) and couples later dyads put on earlier bodies."""
+
+    def __init__(self) -> None:
+        self.forces: dict[str, list] = {}
+        self.couples: dict[str, list] = {}
+
+    def add(self, body: str | None, point: Vec, force: Vec, couple: mpf) -> None:
+        if body is not None:
+            self.forces.setdefault(body, []).append((point, force))
+            self.couples.setdefault(body, []).append(couple)
+
+    def about(self, body: str, centre: Vec) -> tuple[tuple, mpf]:
+        """Their resultant force (N) and moment about ``centre`` (N m) on ``body``."""
+        force, moment = (mpf(0), mpf(0)), mpf(0)
+        for point, f in self.forces.get(body, []):
+            force = _add(force, f)
+            moment += _cross((point[0] - centre[0], point[1] - centre[1]), f)
+        return force, moment + sum(self.couples.get(body, []), mpf(0))
+
+
+class _Kinetostatics:
+    """The reactions of every dyad, from the last back, and the driver's balance."""
+
+    def __init__(self, ev: _Evaluation, chain: _Chain) -> None:
+        self.ev, self.bodies, self.results = ev, chain.bodies, chain.results
+        self.guides = chain.guides
+        self.loads = _Loads()
+        self.out: dict[str | None, dict[str, mpf]] = {}  # by dyad name; None: the driver
+
+    def active(self, g: str) -> tuple[tuple, mpf]:
+        """The active force (N, at the centre of mass) and moment (N m) inputs on link g."""
+        s, inp = self.ev.s, self.ev.inp
+        force = (inp[f"{g}.force.x"], inp[f"{g}.force.y"]) if g in s.forces else (0, 0)
+        return tuple(mpf(c) for c in force), (inp[f"{g}.moment"] if g in s.moments else mpf(0))
+
+    def link(self, g: str, tag: str, r: dict) -> dict:
+        """Link g (``m`` or ``n`` of its dyad's result r) as newton_euler reads a link."""
+        ev, inertia = self.ev, self.ev.s.inertia
+        zero = mpf(0)
+        com = ev.vec(f"{g}.com")
+        force, moment = self.active(g)
+        extra, extra_moment = self.loads.about(g, r[f"{tag}.s.position"])
+        return {
+            "dir": r[f"i_{tag}"],
+            "length": r[f"l_{tag}"],
+            "omega": r[f"omega_{tag}"] if inertia else zero,
+            "epsilon": r[f"epsilon_{tag}"] if inertia else zero,
+            "accel_d": r[f"{tag}.d.acceleration"] if inertia else (zero, zero),
+            "com": com,
+            "mass": ev.par[f"{g}.mass"],
+            "inertia": ev.par[f"{g}.inertia"],
+            "force": _add(force, extra),
+            "moment": moment + extra_moment,
+        }
+
+    def dyad(self, d: DyadSpec) -> None:
+        """One dyad's reactions (outputs), and their opposites on the bodies it hangs on."""
+        r = self.results[d.name]
+        kinds = PAIRS[d.type]
+        gk, gp = self.guides[d.name]
+        a, b = equilibrium_system(
+            kinds,
+            self.link(d.m, "m", r),
+            self.link(d.n, "n", r),
+            gk,
+            gp,
+            self.ev.gravity,
+        )
+        a = mpmath.matrix([[mpf(x) for x in row] for row in a])
+        try:
+            u = mpmath.lu_solve(a, mpmath.matrix([mpf(x) for x in b]))
+        except ZeroDivisionError:
+            raise _Failure(SINGULAR, d.name, "its Newton-Euler system is singular") from None
+        zero = mpf(0)
+        rx = reactions_of_unknowns(kinds, [u[i] for i in range(6)], gk, gp, r["i_m"], None, zero)
+        pre, out = d.prefix, self.out.setdefault(d.name, {})
+        for pair, kind in (("mk", kinds[0]), ("np", kinds[2]), ("mn", kinds[1])):
+            out[f"{pre}R_{pair}.x"], out[f"{pre}R_{pair}.y"] = rx[f"r_{pair}"]
+            if kind == "T":
+                out[f"{pre}N_{pair}"], out[f"{pre}M_{pair}"] = rx[f"n_{pair}"], rx[f"m_{pair}"]
+        minus = lambda v: (-v[0], -v[1])  # noqa: E731
+        self.loads.add(d.k.body, r["m.d.position"], minus(rx["r_mk"]), -rx["m_mk"])
+        self.loads.add(d.p.body, r["n.d.position"], minus(rx["r_np"]), -rx["m_np"])
+
+    def driver(self) -> None:
+        """The driver's balance: a crank's torque and R_O, a ram's force, N and M."""
+        ev = self.ev
+        c, body = ev.s.driver_name, self.bodies[ev.s.driver_name]
+        mass = ev.par[f"{c}.mass"]
+        arm = body.arm(ev.vec(f"{c}.com"))
+        _, _, a_s = body.point(ev.vec(f"{c}.com"))
+        if not ev.s.inertia:
+            a_s = (mpf(0), mpf(0))
+        known = _add(_scale(mass, ev.gravity), _scale(-mass, a_s))  # weight + inertia, at S
+        force, moment = self.loads.about(c, body.position)
+        force = _add(force, known)
+        moment += _cross(arm, known)
+        out = self.out.setdefault(None, {})
+        if ev.s.driver == "crank":
+            if ev.s.inertia:
+                moment -= ev.par[f"{c}.inertia"] * body.epsilon
+            out[f"{c}.torque"] = -moment
+            out[f"{c}.R_O.x"], out[f"{c}.R_O.y"] = -force[0], -force[1]
+            return
+        out[f"{c}.force"] = -_dot(force, body.i)  # the forces on the ram sum to 0
+        out[f"{c}.N"] = -_dot(force, _perp(body.i))
+        out[f"{c}.M"] = -moment
+
+    def run(self) -> dict:
+        """The outputs: by dyad name, the driver's under None."""
+        for d in reversed(self.ev.s.dyads):
+            self.dyad(d)
+        self.driver()
+        return self.out
+
+
+def _motion_outputs(s: MechanismScene, d: DyadSpec, r: dict) -> dict[str, mpf]:
+    """A dyad's link angles (rad) and rates (rad/s, rad/s2), a sliding length, its pair
+    points (m) and slides (m)."""
+    out = {}
+    for g, tag in ((d.m, "m"), (d.n, "n")):
+        if g not in s.translating:
+            out[f"{g}.angle"] = r[f"angle_{tag}"]
+            if s.inertia:
+                out[f"{g}.omega"], out[f"{g}.epsilon"] = r[f"omega_{tag}"], r[f"epsilon_{tag}"]
+        if tag == "m" and d.type in ("RTR", "RTT"):
+            out[f"{g}.length"] = r["l_m"]
+    for pair, point in (("D_m", "m.d"), ("E", "e"), ("D_n", "n.d")):
+        x, y = r[f"{point}.position"]
+        out[f"{d.prefix}{pair}.position.x"], out[f"{d.prefix}{pair}.position.y"] = x, y
+    for side, slides in zip("kp", _SLIDES[d.type], strict=True):
+        if slides:
+            out[f"{d.prefix}slide_{side}"] = r[f"s_{side}"]
+    return out
+
+
+def _conditioning(d: DyadSpec, r: dict, chain: _Chain) -> mpf:
+    """The dyad's conditioning in [0, 1], as scenes/README.md and README.md define it:
+    RRR |i_m . j_n|, RRT |i_n . i_k|, RTR the smaller of |i_beta . i_m| and |D_m D_n| /
+    (l_m + l_n), TRT |j_k . i_p|, RTT |j_k . i_m|."""
+    i_m, i_n = r["i_m"], r["i_n"]
+    i_k, i_p = chain.guides[d.name]
+    if d.type == "RRR":
+        return abs(_dot(i_m, _perp(i_n)))
+    if d.type == "RRT":
+        return abs(_dot(i_n, i_k))
+    if d.type == "TRT":
+        return abs(_dot(_perp(i_k), i_p))
+    if d.type == "RTT":
+        return abs(_dot(_perp(i_k), i_m))
+    dm_dn = _add(_scale(r["l_m"], i_m), _scale(-r["l_n"], i_n))  # D_n - D_m
+    dist = mpmath.sqrt(_dot(dm_dn, dm_dn))
+    slant = abs(_dot(dm_dn, i_m)) / dist if dist > 0 else mpf(0)
+    return min(slant, dist / (r["l_m"] + r["l_n"]))
+
+
+def _rounded(outputs: dict, dps: int) -> dict:
+    with mpmath.workdps(dps):
+        return {k: +v for k, v in outputs.items()}
+
+
+def _run(
+    scene: Mapping | str | os.PathLike | MechanismScene, values: Mapping, dps: int, what: str
+) -> Result:
+    """evaluate (``what`` = "outputs") or assembly_status ("status")."""
+    if isinstance(dps, bool) or not isinstance(dps, int) or dps < 5:
+        raise ValueError(f"dps must be an integer >= 5, not {dps!r}")
+    ms = scene if isinstance(scene, MechanismScene) else read_scene(scene)
+    inputs, params = ms.split(values)
+    work = dps + _GUARD
+    with mpmath.workdps(work):
+        ev = _Evaluation(ms, inputs, params, work)
+        try:
+            if what == "status":
+                ev.kinematics(ev.motion()[0], mpf(0), mpf(0))
+                outputs = {}
+            else:
+                outputs = ev.outputs()
+        except _Failure as failure:
+            status, dyad, reason = failure.args
+            return Result(status, dyad, reason, {})
+    return Result(OK, None, "", _rounded(outputs, dps))
+
+
+def evaluate(
+    scene: Mapping | str | os.PathLike | MechanismScene,
+    values: Mapping[str, float],
+    dps: int = 50,
+) -> Result:
+    """Every Real output of the scene's mechanism FMU at the inputs ``values`` (mpf, dps digits).
+
+    ``scene``: a scene file's path, its parsed table or :func:`read_scene`'s result (faster
+    when called often). ``values``: FMU variable name -> float, the inputs (the driver's
+    motion in rad, rad/s, rad/s2 or m, m/s, m/s2; the loads in N and N m; an input left out
+    keeps its start value) and, optionally, any parameter of the scene under its FMU name
+    (``gravity.y`` m/s2, ``engine.branch``, ``rocker.mass`` kg, ...; tunable or baked).
+    Returns a :class:`Result`; its ``outputs`` (when ok) are named and scaled as the FMU's.
+    """
+    return _run(scene, values, dps, "outputs")
+
+
+def assembly_status(
+    scene: Mapping | str | os.PathLike | MechanismScene,
+    values: Mapping[str, float],
+    dps: int = 50,
+) -> Result:
+    """The status :func:`evaluate` would give, without its outputs: the chain's kinematics
+    at zero driver rate, no reactions (about half the time of :func:`evaluate`)."""
+    return _run(scene, values, dps, "status")
