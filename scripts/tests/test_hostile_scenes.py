@@ -801,6 +801,34 @@ def test_an_identifier_with_a_reserved_prefix_is_refused_at_its_line(tmp_path, i
     ) in "\n".join(problems), problems
 
 
+#: Every name Windows reserves for a device, in the cases a scene might write it.
+_DEVICES = ["con", "prn", "aux", "nul"] + [f"{p}{n}" for p in ("com", "lpt") for n in range(10)]
+
+
+@pytest.mark.parametrize(
+    "identifier", [f(d) for d in _DEVICES for f in (str.lower, str.upper, str.capitalize)]
+)
+def test_a_windows_device_name_is_refused_as_identifier_at_its_line(tmp_path, identifier):
+    """nul.dll, com1.dll and the like are devices on Windows: no FMU binary can be so named."""
+    line, problems = _identifier_refusal(tmp_path, identifier)
+    assert problems == [
+        f"named.toml:{line}: [scene]: identifier '{identifier}' is a reserved device name on "
+        "Windows (in any case: CON, PRN, AUX, NUL, COM0 to COM9, LPT0 to LPT9): its library "
+        f"{identifier}.dll could not be created or loaded there; choose another identifier"
+    ], problems
+
+
+@pytest.mark.parametrize("identifier", ["con1", "nul_x", "com10", "lpt", "auxiliary", "Com_1"])
+def test_a_name_that_only_starts_like_a_device_is_accepted(tmp_path, identifier):
+    assert _identifier_refusal(tmp_path, identifier)[1] == []
+
+
+def test_a_superscript_port_number_is_no_identifier(tmp_path):
+    """Windows also reserves COM¹ to COM³; they are no C identifiers, refused as such."""
+    line, problems = _identifier_refusal(tmp_path, "COM\u00b9")
+    assert len(problems) == 1 and "must be a C identifier" in problems[0], problems
+
+
 def _builtin_files() -> list[tuple[Path, str]]:
     """(file, identifier) of every FMU the build always makes, read as CMake finds them."""
     files = sorted(SCENES_DIR.glob("*.toml")) + sorted((ROOT / "tests" / "scenes").glob("*.toml"))
