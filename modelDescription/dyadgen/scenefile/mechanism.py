@@ -16,9 +16,9 @@ ATTACHMENT_KEYS = ("link", "at", "guide")
 #: The most dyads in one chain: a dyad and every dyad it hangs on, directly or through
 #: others. Each output of a dyad depends on the inputs of every dyad that hangs on it,
 #: and the model descriptions list those dependencies one by one (FMI has no shorter
-#: form for them), so they grow as dyads x chain length: a chain of 2,000 dyads would
-#: write model descriptions of 728 MB each. Within the limit, checking and generating a
-#: scene grow linearly with its dyads.
+#: form for them), so they grow as dyads x chain length: a chain of 1,000 dyads wrote
+#: model descriptions of 162 MB each. Within the limit, checking and generating a scene
+#: grow linearly with its dyads.
 MAX_CHAIN = 200
 
 
@@ -339,7 +339,7 @@ class Mechanism:
         chain = {dyad.index}
         for attached in (dyad.k, dyad.p):
             if attached is not None and attached.kind == "link" and attached.link in self.links:
-                chain |= self.chains[self.links[attached.link].dyad.index]
+                chain |= self.chains.get(self.links[attached.link].dyad.index, frozenset())
         if len(chain) > MAX_CHAIN:
             self.p.add(
                 f"{label} hangs, directly or through other dyads, on {len(chain) - 1} dyads: "
