@@ -1837,6 +1837,101 @@ static int test_instances_independent(void)
 
 static void free_either(int version, void* c);
 
+/* ---- both: a directional derivative along a huge seed -------------------------------------- */
+
+static int derivative_either(int version, void* c, const unsigned outputs[], size_t n_outputs,
+                             const unsigned knowns[], const double seed[], size_t n_knowns,
+                             double rates[])
+{
+    return version == 2
+               ? (int)api2.GetDirectionalDerivative(c, outputs, n_outputs, knowns, n_knowns, seed,
+                                                    rates)
+               : (int)api3.GetDirectionalDerivative(c, outputs, n_outputs, knowns, n_knowns, seed,
+                                                    n_knowns, rates, n_outputs);
+}
+
+/* One derivative of every Real output along `seed` for the knowns (an input named once
+ * or twice): OK with every rate finite, or Discard with every rate NaN and the reason
+ * logged. *discarded counts the Discards. */
+static int check_huge_seed(int version, void* c, probe_log_book* book, const unsigned outputs[],
+                           size_t n_outputs, const unsigned knowns[], const double seed[],
+                           size_t n_knowns, const char* input, int* discarded)
+{
+    double* rates = (double*)malloc((n_outputs + 1) * sizeof *rates);
+    const long logged = book->count;
+    size_t k, finite = 0, nan = 0;
+    int fails = 0, status;
+    if (rates == NULL) {
+        return 1;
+    }
+    for (k = 0; k < n_outputs; ++k) {
+        rates[k] = 12345.0;
+    }
+    status = derivative_either(version, c, outputs, n_outputs, knowns, seed, n_knowns, rates);
+    for (k = 0; k < n_outputs; ++k) {
+        finite += isfinite(rates[k]) ? 1u : 0u;
+        nan += isnan(rates[k]) ? 1u : 0u;
+    }
+    *discarded += status == 2;
+    CHECK((status == 0 && finite == n_outputs) ||
+              (status == 2 && nan == n_outputs && book->count > logged && book->last_status == 2 &&
+               book->last[0] != '\0'),
+          "FMI %d: derivative along %s x %zu (seed %g): status %d, %zu of %zu rates finite, "
+          "%zu NaN, log '%s'",
+          version, input, n_knowns, seed[0], status, finite, n_outputs, nan,
+          book->count > logged ? book->last : "");
+    free(rates);
+    return fails;
+}
+
+/* A seed of DBL_MAX, or 1e308 given twice for one known (inf once added up), overflows
+ * the derivative: Discard with a reason and NaN rates, never OK with NaN. Every Real
+ * input in turn; at least one of them must overflow. */
+static int test_huge_seed_discards(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        const probe_model* md = version == 2 ? &md2 : &md3;
+        unsigned* outputs = (unsigned*)malloc((md->variable_count + 1) * sizeof *outputs);
+        size_t n_outputs = 0, k;
+        int discarded = 0, inputs = 0;
+        probe_log_book book;
+        void* c;
+        if (!md->provides_directional_derivatives || outputs == NULL) {
+            free(outputs);
+            continue;
+        }
+        c = version == 2 ? new_fmi2(&book, "seed") : new_fmi3(&book, "seed");
+        CHECK(c != NULL && (version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)),
+              "FMI %d: initialise", version);
+        for (k = 0; k < md->variable_count; ++k) {
+            if (md->variables[k].type == PROBE_REAL && md->variables[k].causality == PROBE_OUTPUT) {
+                outputs[n_outputs++] = md->variables[k].vr;
+            }
+        }
+        for (k = 0; c != NULL && k < md->variable_count; ++k) {
+            const probe_variable* v = &md->variables[k];
+            const unsigned twice[2] = {v->vr, v->vr};
+            const double max[1] = {DBL_MAX}, halves[2] = {1e308, 1e308};
+            if (v->type != PROBE_REAL || v->causality != PROBE_INPUT) {
+                continue;
+            }
+            ++inputs;
+            fails += check_huge_seed(version, c, &book, outputs, n_outputs, twice, max, 1, v->name,
+                                     &discarded);
+            fails += check_huge_seed(version, c, &book, outputs, n_outputs, twice, halves, 2,
+                                     v->name, &discarded);
+        }
+        CHECK(inputs == 0 || discarded > 0, "FMI %d: no huge seed of %d inputs overflowed", version,
+              inputs);
+        if (c != NULL) {
+            free_either(version, c);
+        }
+        free(outputs);
+    }
+    return fails;
+}
+
 /* Sets every Real input to its start plus a ramp and steps from step * 0.01 s. */
 static int step_with_inputs(int version, void* c, int step)
 {
@@ -2868,6 +2963,7 @@ static const named_test generic_tests[] = {
     {"exports_only_fmi", test_exports_only_fmi},
     {"bad_steps", test_bad_steps},
     {"experiment_stop", test_experiment_stop},
+    {"huge_seed_discards", test_huge_seed_discards},
 };
 
 /* Tests of one model, run when the FMUs are that model. */

@@ -1,6 +1,7 @@
 /* dyadfmu FMU layer: a dyad as an FMU model (see fmu_dyad.h). */
 #include "fmu_dyad.h"
 
+#include <math.h>
 #include <stdio.h>
 
 /* The variables' offsets address doubles: the FMUs use the double core. */
@@ -86,6 +87,33 @@ static void evaluate(const fmu_model* model, const void* input, void* output,
     report(model, (const dyad_input*)input, (const dyad_result*)output, evaluation);
 }
 
+/* The first Real output whose rate is not finite, or -1. */
+static int nonfinite_rate(const fmu_model* model, const void* rate)
+{
+    size_t k;
+    for (k = 0; k < model->variable_count; ++k) {
+        const fmu_variable* v = &model->variables[k];
+        if (v->causality == FMU_OUTPUT && v->target == FMU_TARGET_RESULT_REAL &&
+            !isfinite(*(const double*)(const void*)((const char*)rate + v->offset))) {
+            return (int)k;
+        }
+    }
+    return -1;
+}
+
+/* A finite but huge seed (DBL_MAX, or two seeds of 1e308 for one known, which the
+ * layer adds up to inf) overflows the tangent while the outputs themselves are fine:
+ * the derivative has no value in double, so it is refused as the scene FMUs refuse it
+ * rather than returned as NaN with OK. */
+FMU_COLD static void refuse_rate(const fmu_model* model, int bad, fmu_evaluation* evaluation)
+{
+    evaluation->status = FMU_DISCARD;
+    evaluation->bad_variable = -1; /* no input to blame */
+    snprintf(evaluation->reason, sizeof evaluation->reason,
+             "the directional derivative is not finite at these inputs (the rate of %s)",
+             model->variables[bad].name);
+}
+
 static void derivative(const fmu_model* model, const void* input, const void* seed, void* output,
                        void* rate, fmu_evaluation* evaluation)
 {
@@ -93,6 +121,13 @@ static void derivative(const fmu_model* model, const void* input, const void* se
     dyad_solve_tangent_of(dyad->tangent, (const dyad_input*)input, (const dyad_input*)seed,
                           (dyad_result*)output, (dyad_result*)rate);
     report(model, (const dyad_input*)input, (const dyad_result*)output, evaluation);
+    if (evaluation->status == FMU_OK) {
+        /* a solve of the tangent's loads that fails leaves its rates NaN */
+        const int bad = nonfinite_rate(model, rate);
+        if (bad >= 0) {
+            refuse_rate(model, bad, evaluation);
+        }
+    }
 }
 
 const fmu_behaviour fmu_dyad_behaviour = {

@@ -69,11 +69,16 @@ def test_parse_only_checks_and_runs_nothing(tmp_path, capsys, no_work):
     assert cli.main(["--parse-only", "cosim", "--quick"]) == 0
 
 
-@pytest.mark.parametrize("option", ["--sizes", "--write"])
+@pytest.mark.parametrize("option", ["--sizes", "--write", "--chain"])
 @pytest.mark.parametrize("value", ["0", "-3", "x"])
 def test_scene_bench_refuses_a_bad_size_by_name(option, value, capsys):
     said = _refused(["scene-bench", option, value], capsys)
     assert f"argument {option}: " in said and value in said
+
+
+def test_scene_bench_refuses_a_chain_the_generator_would_refuse(capsys):
+    said = _refused(["scene-bench", "--chain", "201"], capsys)
+    assert "argument --chain: must be from 1 to 200, got 201" in said
 
 
 def test_sweep_refuses_a_bad_worker_count(capsys):

@@ -41,8 +41,10 @@ MD_DIR = ROOT / "modelDescription"
 from dyadfmu.cosim import scenes  # noqa: E402
 from dyadfmu.study import long_chain  # noqa: E402
 from dyadgen import cnames, pipeline, textsafe  # noqa: E402
+from dyadgen.emit import fmi2, fmi3  # noqa: E402
 from dyadgen.emit import scene_c as scene_emit  # noqa: E402
 from dyadgen.kinds import SceneTable  # noqa: E402
+from dyadgen.scenefile import mechanism  # noqa: E402
 from dyadgen.scenefile import names as scene_names  # noqa: E402
 from dyadgen.scenefile.c_names import c_names  # noqa: E402
 from dyadgen.scenefile.problems import SceneError  # noqa: E402
@@ -727,6 +729,90 @@ def test_checking_a_chain_grows_linearly_with_its_dyads(tmp_path):
     assert large < 2.3 * small
 
 
+def _dyad_lines(path: Path) -> list[int]:
+    return [n for n, line in enumerate(path.read_text().splitlines(), 1) if line == "[[dyad]]"]
+
+
+def _problems(path: Path) -> list[str]:
+    try:
+        pipeline.load_scene(path)
+    except SceneError as error:
+        return error.args[0]
+    return []
+
+
+_CHAIN_RULE = (
+    "a chain has at most 200 (the model descriptions list every output's dependency on "
+    "every input of the dyads hanging on it, which grows as dyads x chain length)"
+)
+
+
+@pytest.mark.parametrize("dyads", [201, 260])
+def test_a_chain_past_its_limit_is_refused_once_at_its_first_dyad_past_it(dyads, tmp_path):
+    assert long_chain.MAX_CHAIN == mechanism.MAX_CHAIN == 200
+    path = long_chain.write_chain(dyads, tmp_path, chain=dyads)
+    line = _dyad_lines(path)[200]
+    assert _problems(path) == [
+        f"{path.name}:{line}: dyad 'd201' hangs, directly or through other dyads, on 200 "
+        f"dyads: a chain of 201, and {_CHAIN_RULE}"
+    ]
+
+
+def _two_chains_joined(tmp_path, p: str) -> Path:
+    """Two chains of 100 dyads on the crank, and a 201st dyad whose k hangs on the first
+    chain's last rocker and whose p is `p`."""
+    text = long_chain.chain_scene(200, "joined", chain=100)
+    text += f"""
+[[dyad]]
+name = "d201"
+type = "RRR"
+m = "coupler201"
+n = "rocker201"
+k = {{ link = "rocker100", at = [0.12, 0.02] }}
+p = {p}
+
+[[link]]
+name = "coupler201"
+length = 0.2
+com = [0.07, 0.01]
+mass = 1.0
+inertia = 3.0e-3
+
+[[link]]
+name = "rocker201"
+length = 0.15
+com = [0.07, 0.01]
+mass = 1.0
+inertia = 3.0e-3
+"""
+    path = tmp_path / "joined.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_a_dyad_on_two_chains_has_both_in_its_chain(tmp_path):
+    joined = _two_chains_joined(tmp_path, '{ link = "rocker200", at = [0.12, 0.02] }')
+    line = _dyad_lines(joined)[200]
+    assert _problems(joined) == [
+        f"joined.toml:{line}: dyad 'd201' hangs, directly or through other dyads, on 200 "
+        f"dyads: a chain of 201, and {_CHAIN_RULE}"
+    ]
+    assert _problems(_two_chains_joined(tmp_path, '"frame"')) == []
+
+
+def test_model_descriptions_grow_linearly_with_dyads_in_chains_of_a_given_length(tmp_path):
+    """The dependency lists grow as dyads x chain length: at a fixed chain length, twice
+    the dyads give about twice the model description (a little more: the value
+    references have more digits), not four times as one chain twice as long would."""
+    sizes = {}
+    for dyads in (100, 200):
+        table = pipeline.build_table(
+            pipeline.load_scene(long_chain.write_chain(dyads, tmp_path, chain=50))
+        )
+        sizes[dyads] = len(fmi2.model_description(table)) + len(fmi3.model_description(table))
+    assert 1.9 < sizes[200] / sizes[100] < 2.3, sizes
+
+
 @needs_gcc
 def test_a_chain_of_200_dyads_is_checked_generated_and_compiles(tmp_path):
     path = long_chain.write_chain(200, tmp_path)
@@ -799,6 +885,34 @@ def test_an_identifier_with_a_reserved_prefix_is_refused_at_its_line(tmp_path, i
         f"named.toml:{line}: [scene]: identifier '{identifier}' starts with '{prefix}', which "
         "is reserved for the C names of the core, the FMU layer and FMI"
     ) in "\n".join(problems), problems
+
+
+#: Every name Windows reserves for a device, in the cases a scene might write it.
+_DEVICES = ["con", "prn", "aux", "nul"] + [f"{p}{n}" for p in ("com", "lpt") for n in range(10)]
+
+
+@pytest.mark.parametrize(
+    "identifier", [f(d) for d in _DEVICES for f in (str.lower, str.upper, str.capitalize)]
+)
+def test_a_windows_device_name_is_refused_as_identifier_at_its_line(tmp_path, identifier):
+    """nul.dll, com1.dll and the like are devices on Windows: no FMU binary can be so named."""
+    line, problems = _identifier_refusal(tmp_path, identifier)
+    assert problems == [
+        f"named.toml:{line}: [scene]: identifier '{identifier}' is a reserved device name on "
+        "Windows (in any case: CON, PRN, AUX, NUL, COM0 to COM9, LPT0 to LPT9): its library "
+        f"{identifier}.dll could not be created or loaded there; choose another identifier"
+    ], problems
+
+
+@pytest.mark.parametrize("identifier", ["con1", "nul_x", "com10", "lpt", "auxiliary", "Com_1"])
+def test_a_name_that_only_starts_like_a_device_is_accepted(tmp_path, identifier):
+    assert _identifier_refusal(tmp_path, identifier)[1] == []
+
+
+def test_a_superscript_port_number_is_no_identifier(tmp_path):
+    """Windows also reserves COM¹ to COM³; they are no C identifiers, refused as such."""
+    line, problems = _identifier_refusal(tmp_path, "COM\u00b9")
+    assert len(problems) == 1 and "must be a C identifier" in problems[0], problems
 
 
 def _builtin_files() -> list[tuple[Path, str]]:

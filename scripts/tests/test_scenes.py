@@ -67,6 +67,44 @@ def test_every_example_scene_is_accepted(path, tmp_path):
             assert (again / file.relative_to(out)).read_bytes() == file.read_bytes()
 
 
+#: A driver's motion, the only inputs of a mechanism FMU besides its loads.
+DRIVER_MOTION = {
+    "crank": ("angle", "omega", "epsilon"),
+    "ram": ("position", "velocity", "acceleration"),
+}
+
+
+#: The scenes whose FMU gets a scene's page: all but the generic dyads (a dyad's page).
+SCENE_PAGES = [p for p in sorted(SCENES_DIR.glob("*.toml")) if not p.stem.startswith("dyad_")]
+
+
+@pytest.mark.parametrize("path", SCENE_PAGES, ids=lambda p: p.stem)
+def test_the_documentation_says_what_the_fmu_takes(path):
+    """A mechanism FMU (kinematics inside) takes its driver's motion and the loads, not the
+    links' kinematics: its page names the motion inputs and counts the loads, which are
+    every other input; a scene with external kinematics takes every link's motion."""
+    from dyadgen import pipeline
+
+    table = pipeline.build_table(pipeline.load_scene(path))
+    page = pipeline.outputs_of(table)["documentation/index.html"]
+    said = re.search(r"At every communication point it takes (.*?) and returns", page, re.S)
+    inputs = [v.name for v in table.of("input")]
+    scene = table.scene
+    if scene.kinematics == "external":
+        assert said.group(1) == "the links' current kinematics and active loads"
+        return
+    assert "current kinematics" not in page
+    driver = scene.crank
+    motion = [f"{driver.name}.{q}" for q in DRIVER_MOTION[driver.kind]]
+    loads = [n for n in inputs if n not in motion]
+    assert set(motion) <= set(inputs)
+    assert all(re.fullmatch(r"\w+\.(force\.[xy]|moment)", n) for n in loads), loads
+    named = ", ".join(f"<code>{n}</code>" for n in motion)
+    count = "(1 input)" if len(loads) == 1 else f"({len(loads)} inputs)"
+    assert said.group(1).startswith(f"only the {driver.kind}'s motion ({named}) and the active")
+    assert count in said.group(1) and "no link's motion is an input" in said.group(1)
+
+
 def test_malformed_examples_exist():
     kinds = {p.stem for p in MALFORMED}
     assert {"unknown_type", "link_twice", "output_no_pair_provides", "missing_parameter"} <= kinds

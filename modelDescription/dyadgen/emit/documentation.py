@@ -208,6 +208,26 @@ def _scene_sections(scene: Scene) -> dict[str, str]:
     }
 
 
+def _takes(table: Table) -> str:
+    """What the FMU takes at every communication point: a mechanism FMU (internal
+    kinematics) its driver's motion and its loads alone, solving the links' motion itself;
+    another every link's current kinematics and the loads."""
+    scene = table.scene
+    if not scene.internal():
+        return "the links' current kinematics and active loads"
+    motion = [v.name for v in table.of("input") if v.name.startswith(f"{scene.crank.name}.")]
+    loads = len(table.of("input")) - len(motion)
+    driver = "ram" if scene.crank.is_ram() else "crank"
+    named = ", ".join(f"<code>{h(name)}</code>" for name in motion)
+    rest = {0: "no load", 1: "the active load (1 input)"}.get(
+        loads, f"the active loads ({loads} inputs)"
+    )
+    return (
+        f"only the {driver}'s motion ({named}) and {rest}, solves the links' motion from the "
+        f"{driver}'s itself (the kinematics are inside: no link's motion is an input),"
+    )
+
+
 def scene_page(table: Table) -> str:
     """The page of a tailored scene's FMU."""
     scene = table.scene
@@ -215,6 +235,7 @@ def scene_page(table: Table) -> str:
     return page(
         "scene.html",
         table,
+        takes=_takes(table),
         scene_file=h(scene.path.name),
         inputs=n["input"],
         parameters=n["parameter"],

@@ -13,6 +13,13 @@ LINK_KEYS = {"name", "length", "angle", "turn", "com", "mass", "inertia"}
 #: the types that close in two ways, so that the scene says which
 TWO_BRANCHES = ("RRR", "RRT", "RTR")
 ATTACHMENT_KEYS = ("link", "at", "guide")
+#: The most dyads in one chain: a dyad and every dyad it hangs on, directly or through
+#: others. Each output of a dyad depends on the inputs of every dyad that hangs on it,
+#: and the model descriptions list those dependencies one by one (FMI has no shorter
+#: form for them), so they grow as dyads x chain length: a chain of 1,000 dyads wrote
+#: model descriptions of 162 MB each. Within the limit, checking and generating a scene
+#: grow linearly with its dyads.
+MAX_CHAIN = 200
 
 
 def link_tables(
@@ -259,6 +266,9 @@ class Mechanism:
         self.links: dict[str, Link] = {}
         self.owner: dict[str, str] = {}  # link name -> "dyad 'x' as m"
         self.names_seen: set = set()
+        #: each dyad's chain (the indices of the dyad and of every dyad it hangs on); None
+        #: once a chain is refused, so that no later dyad is told again
+        self.chains: dict[int, frozenset] | None = {}
 
     def parse(self, data: dict) -> None:
         """Every [[dyad]] table."""
@@ -320,6 +330,28 @@ class Mechanism:
             line = self.p.loc.line("link", self.tables[lname][1])
             self.links[lname] = Link(lname, dyad, side, line, sliding, translating)
         self.dyads.append(dyad)
+        self.chain(dyad, label)
+
+    def chain(self, dyad: Dyad, label: str) -> None:
+        """Records the dyad's chain, refused past MAX_CHAIN dyads (the first such dyad only)."""
+        if self.chains is None:
+            return
+        chain = {dyad.index}
+        for attached in (dyad.k, dyad.p):
+            if attached is not None and attached.kind == "link" and attached.link in self.links:
+                chain |= self.chains.get(self.links[attached.link].dyad.index, frozenset())
+        if len(chain) > MAX_CHAIN:
+            self.p.add(
+                f"{label} hangs, directly or through other dyads, on {len(chain) - 1} dyads: "
+                f"a chain of {len(chain)}, and a chain has at most {MAX_CHAIN} (the model "
+                "descriptions list every output's dependency on every input of the dyads "
+                "hanging on it, which grows as dyads x chain length)",
+                "dyad",
+                dyad.index,
+            )
+            self.chains = None
+            return
+        self.chains[dyad.index] = frozenset(chain)
 
     def branch(self, dyad: Dyad, row: dict, label: str) -> Param | None:
         """The assembly branch of a dyad that closes in two ways (internal kinematics)."""

@@ -68,6 +68,16 @@ def name_problem(name: object) -> str | None:
     return None
 
 
+#: Names Windows keeps for devices, in any case and whatever extension follows: a file
+#: 'nul.dll' is the device NUL, so an FMU so named has no Windows binary. The
+#: superscript forms (COM¹) are no identifiers (IDENT is ASCII), and COM0 and LPT0
+#: are reserved on current versions of Windows.
+WINDOWS_DEVICE_RULE = ("CON", "PRN", "AUX", "NUL", "COM0 to COM9", "LPT0 to LPT9")
+WINDOWS_DEVICES = frozenset(
+    ["con", "prn", "aux", "nul"] + [f"{port}{n}" for port in ("com", "lpt") for n in range(10)]
+)
+
+
 def identifier_problem(identifier: object) -> str | None:
     """Why `identifier` cannot name the FMU, or None."""
     if not isinstance(identifier, str):
@@ -84,6 +94,12 @@ def identifier_problem(identifier: object) -> str | None:
         )
     if identifier in cnames.C_KEYWORDS:
         return f"'{identifier}' is a C keyword"
+    if identifier.lower() in WINDOWS_DEVICES:
+        return (
+            f"'{identifier}' is a reserved device name on Windows (in any case: "
+            f"{', '.join(WINDOWS_DEVICE_RULE)}): its library {identifier}.dll could not "
+            "be created or loaded there; choose another identifier"
+        )
     return None
 
 

@@ -2,10 +2,13 @@
 
 A long chain is a crank followed by N RRR dyads: dyad 1 hangs on the crank's pin, and
 each later dyad's link m on a point of the previous dyad's rocker, each rocker pivoted on
-the frame. Every dyad but the last is loaded by the next one, so the chain exercises
-what grows with the number of dyads: the dyads that load a dyad, the inputs each output
-depends on, the generated code. Geometry is arbitrary (the generator does not solve the
-kinematics), so the scenes serve the generator, not co-simulation.
+the frame. The generator takes chains of at most MAX_CHAIN dyads (its dependency lists
+grow as dyads x chain length): more dyads than that come as several chains, each
+starting on the crank's pin. Every dyad but the last of its chain is loaded by the next
+one, so the chain exercises what grows with the number of dyads: the dyads that load a
+dyad, the inputs each output depends on, the generated code. Geometry is arbitrary (the
+generator does not solve the kinematics), so the scenes serve the generator, not
+co-simulation.
 
 ``dyadfmu scene-bench`` prints the time of ``scene.py --check`` and of ``scene.py --out``
 (the FMU's generated files) for 25, 50, 100 and 200 dyads: the elapsed time and the CPU
@@ -17,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -28,18 +32,23 @@ from ..argtypes import whole
 from ..paths import GENERATOR
 
 SIZES = (25, 50, 100, 200)
+#: The most dyads in one chain the generator takes (MAX_CHAIN of
+#: modelDescription/dyadgen/scenefile/mechanism.py).
+MAX_CHAIN = 200
 
 
-def chain_scene(dyads: int, identifier: str | None = None) -> str:
-    """The TOML text of a crank and `dyads` RRR dyads in a chain, inertia, gravity, a
-    force and a moment on every rocker, every output, a few tunable parameters."""
-    if dyads < 1:
-        raise ValueError(f"a chain has at least one dyad, not {dyads}")
+def chain_scene(dyads: int, identifier: str | None = None, chain: int = MAX_CHAIN) -> str:
+    """The TOML text of a crank and `dyads` RRR dyads in chains of `chain` dyads (the
+    last one shorter), inertia, gravity, a force and a moment on every rocker, every
+    output, a few tunable parameters."""
+    if dyads < 1 or chain < 1:
+        raise ValueError(f"a chain has at least one dyad, not {min(dyads, chain)}")
     ident = identifier or f"chain{dyads}"
+    chains = "a chain" if dyads <= chain else f"chains of {chain}"
     lines = [
         "[scene]",
         f'identifier = "{ident}"',
-        f'description = "A crank and a chain of {dyads} RRR dyads"',
+        f'description = "A crank and {chains} of {dyads} RRR dyads"',
         'kinematics = "external"',
         'outputs = ["all"]',
         'tunable = ["gravity", "rocker1.mass"]',
@@ -60,7 +69,8 @@ def chain_scene(dyads: int, identifier: str | None = None) -> str:
         "",
     ]
     for k in range(1, dyads + 1):
-        carrier = '"crank"' if k == 1 else f'{{ link = "rocker{k - 1}", at = [0.12, 0.02] }}'
+        first = (k - 1) % chain == 0
+        carrier = '"crank"' if first else f'{{ link = "rocker{k - 1}", at = [0.12, 0.02] }}'
         lines += [
             "[[dyad]]",
             f'name = "d{k}"',
@@ -87,10 +97,10 @@ def chain_scene(dyads: int, identifier: str | None = None) -> str:
     return "\n".join(lines)
 
 
-def write_chain(dyads: int, folder: Path) -> Path:
-    """The chain of `dyads` RRR dyads written to <folder>/chain<dyads>.toml."""
+def write_chain(dyads: int, folder: Path, chain: int = MAX_CHAIN) -> Path:
+    """`dyads` RRR dyads in chains of `chain` written to <folder>/chain<dyads>.toml."""
     path = Path(folder) / f"chain{dyads}.toml"
-    path.write_text(chain_scene(dyads), encoding="utf-8")
+    path.write_text(chain_scene(dyads, chain=chain), encoding="utf-8")
     return path
 
 
@@ -114,25 +124,30 @@ def measure(
     generator: Path = GENERATOR,
     python: str = sys.executable,
     log: Callable | None = None,
+    chain: int = MAX_CHAIN,
 ) -> list[tuple]:
-    """(dyads, (elapsed, CPU) of --check, (elapsed, CPU) of --out) for each size, in s."""
+    """(dyads, (elapsed, CPU) of --check, (elapsed, CPU) of --out, bytes of the FMI 2
+    model description) for each size, in s, the dyads in chains of `chain`."""
     rows = []
     with tempfile.TemporaryDirectory(prefix="dyadfmu-chain-") as tmp:
         for n in sizes:
-            scene = write_chain(n, Path(tmp))
+            scene = write_chain(n, Path(tmp), chain)
             check = _timed([python, str(generator), str(scene), "--check"])
             out = _timed([python, str(generator), str(scene), "--out", str(Path(tmp) / f"g{n}")])
-            rows.append((n, check, out))
+            size = (Path(tmp) / f"g{n}" / "fmi2" / "modelDescription.xml").stat().st_size
+            shutil.rmtree(Path(tmp) / f"g{n}")
+            rows.append((n, check, out, size))
             if log:
                 log(
                     f"{n} dyads: --check {check[0]:.2f} s ({check[1]:.2f} s CPU), "
-                    f"--out {out[0]:.2f} s ({out[1]:.2f} s CPU)"
+                    f"--out {out[0]:.2f} s ({out[1]:.2f} s CPU), {size / 1e6:.1f} MB"
                 )
     return rows
 
 
-#: The largest chain 'dyadfmu scene-bench' generates (dyads).
-MAX_CHAIN_DYADS = 10_000
+#: The most dyads 'dyadfmu scene-bench' generates: a scene of 2,900 such dyads is just
+#: under the 1,000,000 bytes the generator reads (modelDescription/dyadgen/tomltext.py).
+MAX_CHAIN_DYADS = 2_900
 
 
 def parser() -> argparse.ArgumentParser:
@@ -141,6 +156,13 @@ def parser() -> argparse.ArgumentParser:
         prog="dyadfmu scene-bench",
         description="Time the scene generator (modelDescription/scene.py --check and --out) "
         "on chains of 25, 50, 100 and 200 RRR dyads; print a Markdown table.",
+    )
+    found.add_argument(
+        "--chain",
+        type=whole(1, MAX_CHAIN),
+        default=MAX_CHAIN,
+        help=f"dyads per chain: more dyads come as several chains on the crank "
+        f"(default and most: {MAX_CHAIN}, the generator's limit)",
     )
     found.add_argument(
         "--sizes",
@@ -168,15 +190,21 @@ def main(argv: list[str] | None = None) -> int:
     """Run 'dyadfmu scene-bench' with `argv`: print the generator's times."""
     args = parser().parse_args(argv)
     if args.write is not None:
-        sys.stdout.write(chain_scene(args.write))
+        sys.stdout.write(chain_scene(args.write, chain=args.chain))
         return 0
-    rows = measure(args.sizes, args.generator, log=lambda t: print(t, file=sys.stderr))
-    print(
-        "| dyads | --check: elapsed (s) | --check: CPU (s) | --out: elapsed (s) | --out: CPU (s) |"
+    rows = measure(
+        args.sizes, args.generator, log=lambda t: print(t, file=sys.stderr), chain=args.chain
     )
-    print("|---|---|---|---|---|")
-    for n, check, out in rows:
-        print(f"| {n} | {check[0]:.2f} | {check[1]:.2f} | {out[0]:.2f} | {out[1]:.2f} |")
+    print(
+        "| dyads | --check: elapsed (s) | --check: CPU (s) | --out: elapsed (s) | --out: CPU (s) "
+        "| FMI 2 model description (MB) |"
+    )
+    print("|---|---|---|---|---|---|")
+    for n, check, out, size in rows:
+        print(
+            f"| {n} | {check[0]:.2f} | {check[1]:.2f} | {out[0]:.2f} | {out[1]:.2f} "
+            f"| {size / 1e6:.1f} |"
+        )
     return 0
 
 
