@@ -1,0 +1,220 @@
+"""Status 0 means right to the digits the FMU claims: every mechanism FMU against mpmath
+truth (dyadfmu.reference.scene_mp, 50 digits), over its motion and on the way to its
+assembly limits.
+
+- Over the motion (the crank around its circle, the ram over its stroke): every output
+  with status 0 within 10 eps x amplification (the FMU's own output) of the peak of its
+  unit over the motion.
+- Bisected to each assembly limit (the lift's ram where its arm and strut stretch out;
+  tests/scenes/toggles.toml's crank where its RRT rod and its RTR slot stop reaching):
+  going in, the status goes 0, then 1 (singular), and only past the last position that
+  closes 4 (cannot assemble), never back; every output with status 0 within
+  10 eps x amplification of the peak of its unit; at the last status 0 every output
+  keeps half its digits (error below sqrt(eps) of the peak of its unit).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+
+import numpy as np
+import pytest
+from dyadfmu import paths
+from dyadfmu.fmi.slave import Slave
+from dyadfmu.reference import scene_mp
+
+EPS = float(np.finfo(float).eps)
+TESTS_SCENES = paths.ROOT / "tests" / "scenes"
+#: every mechanism FMU, and the driver positions its motion is sampled at
+MOTION = {
+    name: np.linspace(-math.pi, math.pi, 13)[:-1] + 0.05
+    for name in (
+        "slider_crank",
+        "four_bar",
+        "quick_return",
+        "scotch_yoke",
+        "engine",
+        "monitor",
+        "shaper",
+        "sixbar",
+        "rocker_slider",
+    )
+}
+MOTION["trt_slot"] = np.linspace(0.1, 3.0, 8)  # the slot's cross slide only in (0, pi)
+MOTION["lift"] = np.linspace(0.1, 0.7, 8)  # m, the ram's stroke up to its limit
+MOTION["toggles"] = np.linspace(-0.9, 0.85, 8)  # rad, between its two limits
+#: the driver's rates and the loads: arbitrary, nonzero
+RATES = {"omega": 9.5, "epsilon": -23.0, "velocity": 0.35, "acceleration": -1.7}
+LOADS = {"force.x": -850.0, "force.y": 420.0, "moment": -3.5}
+#: (scene, a driver position that closes, one beyond the limit)
+LIMITS = {
+    "lift": ("lift", 0.70, 0.72),
+    "toggles rtr": ("toggles", 0.80, 0.90),
+    "toggles rrt": ("toggles", -0.90, -0.95),
+}
+
+
+def scene_file(name: str):
+    """The scene file of a mechanism FMU."""
+    shipped = paths.SCENES_DIR / f"{name}.toml"
+    return shipped if shipped.is_file() else TESTS_SCENES / f"{name}.toml"
+
+
+class Mechanism:
+    """A mechanism FMU (FMI 2) and its mpmath reference, evaluated at driver positions."""
+
+    def __init__(self, name: str) -> None:
+        self.scene = scene_mp.read_scene(scene_file(name))
+        path = paths.built_fmu(name, 2, None, how="scripts/run-tests")
+        self.fmu = Slave(path, instance_name=name)
+        self.fmu.initialize({"on_singular": 2})  # a step without an answer goes on
+        reals = [v for v in self.fmu.md.modelVariables if v.causality == "output"]
+        self.units = {v.name: v.unit or "-" for v in reals if v.type == "Real"}
+        self.compared = [n for n in self.units if not n.endswith("amplification")]
+        self.t = 0.0
+
+    def inputs(self, q: float) -> dict:
+        """The FMU's inputs with the driver at q."""
+        values = {}
+        for name in self.scene.inputs:
+            head, _, tail = name.partition(".")
+            if name == self.scene.motion_inputs[0]:
+                values[name] = q
+            elif head == self.scene.driver_name:
+                values[name] = RATES[tail]
+            else:
+                values[name] = LOADS[tail]
+        return values
+
+    def step(self, q: float) -> tuple[int, dict, dict]:
+        """(status, outputs, inputs) of one step with the driver at q."""
+        values = self.inputs(q)
+        self.fmu.set(tuple(values), list(values.values()))
+        self.fmu.do_step(self.t, 1e-3)
+        self.t += 1e-3
+        got = dict(zip(self.units, self.fmu.get(tuple(self.units)), strict=True))
+        return self.fmu.get_status(), got, values
+
+    def truth(self, values: dict) -> dict:
+        """Every output at 50 digits, as floats (the status checked ok)."""
+        r = scene_mp.evaluate(self.scene, values, dps=50)
+        assert r.status == scene_mp.OK, (values, r.reason)
+        return {k: float(v) for k, v in r.outputs.items()}
+
+    def close(self) -> None:
+        """Free the FMU."""
+        self.fmu.close()
+
+
+def _error(name: str, unit: str, got: dict, truth: dict) -> float:
+    diff = got[name] - truth[name]
+    return abs(math.remainder(diff, 2 * math.pi) if unit == "rad" else diff)
+
+
+def peaks(m: Mechanism, samples: list) -> dict:
+    """The largest |truth| of each unit over the samples (status 0 ones)."""
+    largest: dict = defaultdict(float)
+    for _, _, truth in samples:
+        for name in m.compared:
+            largest[m.units[name]] = max(largest[m.units[name]], abs(truth[name]))
+    return largest
+
+
+def worst_against_bound(m: Mechanism, samples: list) -> tuple[float, str]:
+    """The largest error / (eps x amplification x peak of its unit) over the samples,
+    with the output and driver position where it is; and of each dyad's reactions
+    against the dyad's own amplification and its largest reaction of the unit there."""
+    largest = peaks(m, samples)
+    worst = (0.0, "")
+    for q, got, truth in samples:
+        for name in m.compared:
+            scale = EPS * got["amplification"] * (largest[m.units[name]] or 1.0)
+            ratio = _error(name, m.units[name], got, truth) / scale
+            worst = max(worst, (ratio, f"{name} at {q!r}"))
+        for dyad, names in dyad_reactions(m).items():
+            own: dict = defaultdict(float)
+            for name in names:
+                own[m.units[name]] = max(own[m.units[name]], abs(truth[name]))
+            for name in names:
+                scale = EPS * got[f"{dyad}.amplification"] * (own[m.units[name]] or 1.0)
+                ratio = _error(name, m.units[name], got, truth) / scale
+                worst = max(worst, (ratio, f"{name} against {dyad}.amplification at {q!r}"))
+    return worst
+
+
+def dyad_reactions(m: Mechanism) -> dict:
+    """The reaction outputs (R_, N_, M_) of each dyad that has an amplification output."""
+    out: dict = defaultdict(list)
+    for name in m.compared:
+        dyad, _, rest = name.partition(".")
+        if f"{dyad}.amplification" in m.units and rest[:2] in ("R_", "N_", "M_"):
+            out[dyad].append(name)
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(MOTION))
+def test_over_the_motion_every_output_is_within_its_amplification(name):
+    """Every output with status 0 within 10 eps x amplification of the peak of its unit
+    over the motion; the amplification at least 1 and finite."""
+    m = Mechanism(name)
+    try:
+        samples = []
+        for q in MOTION[name]:
+            status, got, values = m.step(float(q))
+            assert status == 0, (name, q, m.fmu.messages[-1:])
+            assert 1 <= got["amplification"] < 1 / EPS, (name, q)
+            samples.append((float(q), got, m.truth(values)))
+    finally:
+        m.close()
+    worst = worst_against_bound(m, samples)
+    assert worst[0] <= 10, (name, worst)
+
+
+def find_limit(m: Mechanism, inside: float, beyond: float) -> float:
+    """The last driver position (a double) at which the FMU's chain closes: status 0 or
+    1 there, 4 at the next double beyond."""
+    assert m.step(inside)[0] != 4 and m.step(beyond)[0] == 4
+    while True:
+        mid = 0.5 * (inside + beyond)
+        if mid in (inside, beyond):
+            return inside
+        if m.step(mid)[0] == 4:
+            beyond = mid
+        else:
+            inside = mid
+
+
+@pytest.mark.parametrize("limit", sorted(LIMITS))
+def test_singular_before_the_limit_and_right_until_then(limit):
+    """Going in towards the limit in gaps of 10^-k (k = 1 .. 15 in quarter steps), then
+    at the limit itself: the status never goes back from 1 to 0, is 1 at the last
+    position that closes, and only 4 beyond it; every status-0 output within
+    10 eps x amplification of its unit's peak, and within sqrt(eps) of it at the last."""
+    name, inside, beyond = LIMITS[limit]
+    m = Mechanism(name)
+    try:
+        edge = find_limit(m, inside, beyond)
+        toward = math.copysign(1.0, beyond - inside)
+        statuses, samples = [], []
+        for k in np.arange(1.0, 15.25, 0.25):
+            q = edge - toward * 10.0**-k
+            status, got, values = m.step(q)
+            statuses.append(status)
+            if status == 0:
+                samples.append((q, got, m.truth(values)))
+        statuses.append(m.step(edge)[0])
+        after = m.step(math.nextafter(edge, toward * math.inf))[0]
+    finally:
+        m.close()
+    assert statuses[-1] == 1 and after == 4, (limit, statuses[-1], after)
+    first_singular = statuses.index(1)
+    assert set(statuses[first_singular:]) == {1}, (limit, statuses)
+    assert first_singular >= 4 and len(samples) == first_singular, (limit, statuses)
+    worst = worst_against_bound(m, samples)
+    assert worst[0] <= 10, (limit, worst)
+    q, got, truth = samples[-1]
+    largest = peaks(m, samples[-1:])
+    for name_ in m.compared:
+        error = _error(name_, m.units[name_], got, truth)
+        assert error <= math.sqrt(EPS) * (largest[m.units[name_]] or 1.0), (limit, q, name_)
