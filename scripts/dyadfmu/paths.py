@@ -1,5 +1,8 @@
 """Where the project's files are: the checkout, its scenes, the build and the FMUs in it, or,
-in an installed package (``pip install ./scripts``), the core and FMUs bundled with it."""
+in an installed package (``pip install ./scripts``), the core, the FMUs and the project's
+sources bundled with it. An installed package never looks outside itself: the folders
+around its install location (``<prefix>/lib/python3.X/...``) belong to whoever can write
+there, so nothing is run or loaded from a path derived from it."""
 
 from __future__ import annotations
 
@@ -8,31 +11,51 @@ import os
 import tempfile
 from pathlib import Path
 
-#: The checkout (the directory holding scripts/, scenes/, modelDescription/).
+#: The checkout (the directory holding scripts/, scenes/, modelDescription/) where this
+#: package runs from one (in_checkout()); in an installed package, a folder outside it that
+#: nothing reads.
 ROOT = Path(__file__).resolve().parents[2]
-#: The scene files, scenes/*.toml.
-SCENES_DIR = ROOT / "scenes"
-#: The scene generator, modelDescription/scene.py.
-GENERATOR = ROOT / "modelDescription" / "scene.py"
 
 #: What the package's build (scikit-build-core, CMakeLists.txt DYADFMU_PYTHON_PACKAGE)
-#: bundles: the shared core, dyadfmu/_lib/libdyadfmu.so, and the FMUs, dyadfmu/fmus/*.fmu.
+#: bundles: the shared core, dyadfmu/_lib/libdyadfmu.so, the FMUs, dyadfmu/fmus/*.fmu, and
+#: the sources a scene's FMU is built from, dyadfmu/_project (the CMake project's core,
+#: FMU layer, scene generator and example scenes).
 PACKAGE_DIR = Path(__file__).resolve().parent
 BUNDLED_LIB = PACKAGE_DIR / "_lib" / "libdyadfmu.so"
 BUNDLED_FMUS = PACKAGE_DIR / "fmus"
+BUNDLED_PROJECT = PACKAGE_DIR / "_project"
 
 #: The platform folder of the FMU binaries, by FMI version.
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 
 
 def in_checkout() -> bool:
-    """Whether this package runs from a checkout (scripts/dyadfmu), not an installed copy."""
+    """Whether this package runs from a checkout (scripts/dyadfmu), not an installed copy:
+    decided by the package's own folder first (an installed copy sits in site-packages and
+    bundles its core), so that files planted around an install location cannot make it
+    one."""
+    if PACKAGE_DIR.parent.name != "scripts" or BUNDLED_LIB.exists():
+        return False
     return (ROOT / "scripts" / "pyproject.toml").is_file() and (ROOT / "CMakeLists.txt").is_file()
 
 
+def project_dir() -> Path:
+    """The project's sources (CMakeLists.txt, src/, fmu/, modelDescription/, scenes/): the
+    checkout's, else those the installed package bundles."""
+    return ROOT if in_checkout() else BUNDLED_PROJECT
+
+
+#: The scene files, scenes/*.toml.
+SCENES_DIR = project_dir() / "scenes"
+#: The scene generator, modelDescription/scene.py.
+GENERATOR = project_dir() / "modelDescription" / "scene.py"
+
+
 def build_dir() -> Path:
-    """The CMake build directory: $DYADFMU_BUILD, else build/ of the checkout."""
-    return Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
+    """The CMake build directory: $DYADFMU_BUILD, else build/ of the checkout, else (an
+    installed package, which has no build of its own) ./build, where the user ran it."""
+    default = ROOT / "build" if in_checkout() else Path("build")
+    return Path(os.environ.get("DYADFMU_BUILD", default))
 
 
 def built_fmu(

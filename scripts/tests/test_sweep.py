@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tomllib
@@ -818,3 +819,67 @@ def test_a_misspelt_name_is_refused_before_the_scene_s_fmu_is_built(tmp_path, mo
         study.prepare(_write(tmp_path, text), tmp_path)
     assert str(info.value).startswith(f"{tmp_path / 'study.toml'}:{line}: torque_rms: ")
     assert "crank.torqe is not a Real output or input of balance_sweep_" in str(info.value)
+
+
+# ---- an installed package runs nothing from beside its install location ---------------------
+
+
+def test_an_installed_copy_never_takes_the_folders_around_it_for_a_checkout(tmp_path):
+    """The package copied as pip installs it (site-packages/dyadfmu with its bundled core
+    and sources), with a checkout's markers, a generator, a core and a build planted at the
+    paths derived from that place (<prefix>/lib/python3.X/...): every place the package
+    would run or load lies inside it."""
+    prefix = tmp_path / "lib" / "python3.11"
+    package = prefix / "site-packages" / "dyadfmu"
+    shutil.copytree(
+        ROOT / "scripts" / "dyadfmu", package, ignore=shutil.ignore_patterns("__pycache__")
+    )
+    (package / "_lib").mkdir()
+    (package / "_lib" / "libdyadfmu.so").write_bytes(b"")
+    (package / "_project" / "modelDescription").mkdir(parents=True)
+    (prefix / "scripts").mkdir()
+    (prefix / "scripts" / "pyproject.toml").write_text("")
+    (prefix / "CMakeLists.txt").write_text("")
+    (prefix / "modelDescription").mkdir()
+    (prefix / "modelDescription" / "scene.py").write_text("raise SystemExit(3)\n")
+    (prefix / "build").mkdir()
+    (prefix / "build" / "libdyadfmu.so").write_bytes(b"")
+    probe = (
+        "import dyadfmu.paths as p, dyadfmu.core as c\n"
+        f"assert p.__file__.startswith({str(package)!r})\n"
+        "from dyadfmu.sweep import scenebuild as b\n"
+        "print(p.in_checkout())\n"
+        "print(*[p.GENERATOR, p.SCENES_DIR, p.project_dir(), b.generator(), "
+        "b.build_folder(p.Path('out')).resolve(), p.build_dir().resolve(), "
+        "*c.library_candidates()], sep='\\n')\n"
+    )
+    import sysconfig
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith("DYADFMU_")}
+    # -S: no site hooks, so not the checkout's editable install; the copy first, then the
+    # venv's packages (NumPy, fmpy)
+    env["PYTHONPATH"] = os.pathsep.join([str(package.parent), sysconfig.get_paths()["purelib"]])
+    done = subprocess.run(
+        [sys.executable, "-S", "-c", probe], capture_output=True, text=True, cwd=tmp_path, env=env
+    )
+    assert done.returncode == 0, done.stderr
+    installed, *places = done.stdout.split("\n")[:-1]
+    assert installed == "False"
+    beside = [p for p in places if prefix in Path(p).parents and package not in Path(p).parents]
+    assert beside == [], places
+    assert Path(places[3]) == package / "_project" / "modelDescription" / "scene.py"
+
+
+def test_a_scene_study_without_cmake_or_a_compiler_is_refused_in_one_line(monkeypatch, tmp_path):
+    from dyadfmu.sweep import scenebuild
+
+    monkeypatch.setattr(scenebuild.shutil, "which", lambda name: None)
+    problem = scenebuild.tools_problem()
+    assert problem.startswith(
+        "building the study's mechanism FMU from its scene needs CMake (cmake), a C compiler "
+        "(cc), not found here: install them"
+    )
+    assert "\n" not in problem and 'fmu = "....fmu"' in problem
+    with pytest.raises(scenebuild.BuildError) as info:
+        scenebuild.scene_fmu(tmp_path / "x.toml", "x_sweep_0123456789", 2, tmp_path)
+    assert str(info.value) == problem
