@@ -291,7 +291,7 @@ def test_installed_package_runs_a_scene_study_from_its_own_sources_only(venv, tm
                    env=_clean_env())  # fmt: skip
         assert not marker.exists(), marker.read_text()
         rows = (work / "out" / "study" / "results.csv").read_text().splitlines()
-        assert rows[0] == "design,counterweight,bearing_peak,status,message"
+        assert rows[0] == "design,counterweight,bearing_peak,digits,status,message"
         assert all(row.endswith(",ok,") for row in rows[1:]) and len(rows) == 14
         # the best counterweight balances the crank: 2 kg at (12, 3) mm against m at (-36, -9) mm
         best = rows[5].split(",")

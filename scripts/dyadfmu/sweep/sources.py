@@ -122,8 +122,23 @@ def _copy_of(scene_file: Path, study: Study) -> dict:
     if not isinstance(tunable, list) or not all(isinstance(n, str) for n in tunable):
         raise ValueError("[scene] tunable must be a list of parameter names")
     scene["tunable"] = tunable + [n for n in _varied(study) if n not in tunable]
+    outputs = scene.get("outputs")
+    if isinstance(outputs, list) and "all" not in outputs:
+        # every dyad's amplification: the round-off bound a study checks at each sample
+        scene["outputs"] = outputs + [n for n in _amplifications(data) if n not in outputs]
     toml_text(data)  # every value can be written
     return data
+
+
+def _amplifications(data: dict) -> list:
+    """The amplification outputs of a scene's dyads (``DYAD.amplification``; a lone dyad
+    without a name has ``amplification``)."""
+    dyads = data.get("dyad")
+    dyads = [d for d in dyads if isinstance(d, dict)] if isinstance(dyads, list) else []
+    names = [d.get("name") for d in dyads]
+    if len(names) == 1 and names[0] is None:
+        return ["amplification"]
+    return [f"{n}.amplification" for n in names if isinstance(n, str)]
 
 
 def sweep_scene(study: Study, out: Path) -> Path:
