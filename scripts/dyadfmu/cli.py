@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 
+from . import paths
 from .argtypes import real, whole
 from .cosim import harness, scenes
 from .mechanisms import builtin
@@ -417,19 +417,6 @@ def _scene(args: argparse.Namespace) -> int:
     return _run_each(args, names, scenes.run, _scene_outputs)
 
 
-def _out_problem(out: Path) -> str | None:
-    """Why the output folder `out` cannot be made or written, or None: checked before the
-    work, without making it."""
-    existing = out
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
-    if existing.exists() and not existing.is_dir():
-        return f"--out {out}: {existing} is not a folder"
-    if not os.access(existing, os.W_OK | os.X_OK):
-        return f"--out {out}: {existing} is not writable"
-    return None
-
-
 def _problem(args: argparse.Namespace) -> str | None:
     """What is wrong with the arguments of a run or scene command beyond each option's own
     type, or None: the names, the length of the run, the output folder."""
@@ -446,7 +433,19 @@ def _problem(args: argparse.Namespace) -> str | None:
             f"--revolutions {args.revolutions:g} at --steps {args.steps} makes {total} "
             f"communication steps; a run needs {MIN_STEPS} to {MAX_STEPS}"
         )
-    return _out_problem(args.out)
+    return None
+
+
+#: The path arguments of each command parsed here: (name as shown, attribute, kind), checked
+#: after the parse, before any work (those of the other commands: their modules' PATHS).
+_BUILD = ("--build", "build", paths.FOLDER)
+PATHS = {
+    "run": (("--out", "out", paths.OUT), _BUILD),
+    "scene": (("--out", "out", paths.OUT), _BUILD),
+    "study": (("--out", "out", paths.OUT), _BUILD),
+    "speed": (_BUILD,),
+    "sweep": (("STUDY.toml", "study", paths.FILE), ("--out", "out", paths.OUT), _BUILD),
+}
 
 
 #: The commands that parse their own options: command -> module, each with main(argv)
@@ -474,15 +473,35 @@ def main(argv: list[str] | None = None) -> int:
     own = _own_command(argv[0]) if argv else None
     if own is not None:
         if parse_only:
-            own.parser().parse_args(argv[1:])
+            paths.parse_checked(own.parser(), argv[1:], own.PATHS)
             return 0
-        return own.main(argv[1:])
+        return _guarded(argv[0], own.main, argv[1:])
     top = parser()
     args = top.parse_args(argv)
     problem = _problem(args) if args.command in ("run", "scene") else None
     if problem:
         top.exit(2, f"dyadfmu {args.command}: error: {problem}\n")
-    return 0 if parse_only else args.run(args)
+    paths.refuse_bad_paths(_subparser(top, args.command), args, PATHS.get(args.command, ()))
+    return 0 if parse_only else _guarded(args.command, args.run, args)
+
+
+def _subparser(top: argparse.ArgumentParser, command: str) -> argparse.ArgumentParser:
+    """The parser of a subcommand (its prog names the command in messages)."""
+    sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices[command]
+
+
+def _guarded(command: str, run: Callable, *args: object) -> int:
+    """run(*args), with a file or folder that fails after the checks (removed meanwhile, a
+    full disk, a name the file system refuses) reported as one line, status 2."""
+    try:
+        return run(*args)
+    except paths.PathProblem as error:
+        print(f"dyadfmu {command}: error: {error}", file=sys.stderr)
+    except OSError as error:
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"dyadfmu {command}: error: {where}{error.strerror or error}", file=sys.stderr)
+    return 2
 
 
 if __name__ == "__main__":

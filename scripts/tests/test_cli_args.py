@@ -53,12 +53,162 @@ def test_run_refuses_a_bad_option_before_simulating(argv, said, capsys, no_work)
     assert said in _refused(["run", *argv], capsys)
 
 
-def test_run_refuses_an_output_folder_it_cannot_make_before_simulating(tmp_path, capsys, no_work):
-    blocker = tmp_path / "a-file"
-    blocker.write_text("")
-    said = _refused(["run", "--out", str(blocker / "x")], capsys)
-    assert f"--out {blocker / 'x'}: {blocker} is not a folder" in said
-    assert _refused(["scene", "--out", str(blocker)], capsys).endswith("is not a folder\n")
+# ---- path arguments: every command, every path option, one line before any work --------
+
+#: Every path argument of every command: (the command's words, the option ("" for the
+#: positional), its kind, the other arguments it needs).
+PATH_ARGUMENTS = [
+    ("run", "--out", "out"),
+    ("run", "--build", "folder"),
+    ("scene", "--out", "out"),
+    ("scene", "--build", "folder"),
+    ("study", "--out", "out"),
+    ("study", "--build", "folder"),
+    ("speed", "--build", "folder"),
+    ("sweep", "STUDY.toml", "file"),
+    ("sweep", "--out", "out"),
+    ("sweep", "--build", "folder"),
+    ("scenes", "--out", "out"),
+    ("scenes", "--build", "folder"),
+    ("cosim", "--out", "out"),
+    ("scene-bench", "--generator", "file"),
+]
+
+
+@pytest.fixture
+def nothing_runs(monkeypatch):
+    """The work of every command fails the test: a bad path must stop it before."""
+    from dyadfmu.report import cosim as cosim_report
+    from dyadfmu.report import scenes as scenes_report
+    from dyadfmu.study import long_chain
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the command started its work despite a bad path")
+
+    for name in ("_run", "_scene", "_study", "_speed", "_sweep"):
+        monkeypatch.setattr(cli, name, refuse)
+    monkeypatch.setattr(scenes_report, "_runs", refuse)
+    monkeypatch.setattr(cosim_report, "run_study", refuse)
+    monkeypatch.setattr(long_chain, "measure", refuse)
+
+
+def _bad_paths(tmp_path: Path, kind: str) -> list[tuple[str, str]]:
+    """(path, what the message says) for a path argument of `kind` that cannot be used:
+    in /proc (where even root makes nothing), under a regular file, the file itself, a
+    folder nobody can write (/proc: chmod does not stop root), a file that is not there."""
+    plain = tmp_path / "a-file"
+    plain.write_text("")
+    if kind == "out":
+        return [
+            ("/proc/x", "cannot be created in /proc ("),
+            ("/proc/x/y", "cannot be created in /proc ("),
+            (f"{plain}/x", f"cannot be created: {plain} is a file, not a folder"),
+            (str(plain), "is a file, not a folder"),
+            ("/proc", "is not writable ("),
+        ]
+    if kind == "folder":
+        return [
+            ("/proc/x", "does not exist"),
+            (f"{plain}/x", f"does not exist ({plain} is not a folder)"),
+            (str(plain), "is a file, not a folder"),
+            (str(tmp_path / "missing"), "does not exist"),
+        ]
+    return [
+        (str(tmp_path / "missing.toml"), "does not exist"),
+        (str(tmp_path), "is a folder, not a file"),
+        (f"{plain}/x.toml", f"does not exist ({plain} is not a folder)"),
+        ("/proc/x", "does not exist"),
+    ]
+
+
+def _argv(command: str, option: str, value: str, study: Path) -> list[str]:
+    if option == "STUDY.toml":
+        return [command, value]
+    return [command, *([str(study)] if command == "sweep" else []), option, value]
+
+
+@pytest.mark.parametrize("command, option, kind", PATH_ARGUMENTS)
+@pytest.mark.parametrize("parse_only", [False, True], ids=["run", "parse-only"])
+def test_every_path_argument_is_refused_in_one_line_before_any_work(
+    tmp_path, capsys, nothing_runs, command, option, kind, parse_only
+):
+    study = tmp_path / "study.toml"
+    study.write_text("")
+    for value, said in _bad_paths(tmp_path, kind):
+        argv = _argv(command, option, value, study)
+        with pytest.raises(SystemExit) as done:
+            cli.main(["--parse-only", *argv] if parse_only else argv)
+        err = capsys.readouterr().err
+        assert done.value.code == 2, (argv, err)
+        assert err == f"dyadfmu {command}: error: {option} {value}: {said}" + err.split(said)[1]
+        assert err.count("\n") == 1 and said in err, (argv, err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file", "study.toml"]
+
+
+@pytest.mark.parametrize("command, option, kind", PATH_ARGUMENTS)
+def test_a_usable_path_passes_and_checking_it_makes_nothing(
+    tmp_path, capsys, command, option, kind
+):
+    study = tmp_path / "study.toml"
+    study.write_text("")
+    value = {"out": tmp_path / "new" / "deep", "folder": tmp_path, "file": study}[kind]
+    assert cli.main(["--parse-only", *_argv(command, option, str(value), study)]) == 0
+    assert not (tmp_path / "new").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["study.toml"]
+
+
+def test_a_path_that_fails_during_the_work_is_one_line_too(tmp_path, capsys, monkeypatch):
+    """A folder removed, or a disk filled, after the check: one line, status 2."""
+
+    def vanished(args):
+        raise FileNotFoundError(2, "No such file or directory", str(args.out / "x.csv"))
+
+    monkeypatch.setattr(cli, "_study", vanished)
+    assert cli.main(["study", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"dyadfmu study: error: {tmp_path / 'x.csv'}: No such file or directory\n"
+
+
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (["--out", "/proc/x"], "scene.py: error: --out /proc/x: cannot be created in /proc ("),
+        (["--out", "{file}/x"], "scene.py: error: --out {file}/x: cannot be created: {file} is"),
+        (["--out", "{file}"], "scene.py: error: --out {file}: is a file, not a folder"),
+        (["--out", "/proc"], "scene.py: error: --out /proc: is not writable ("),
+    ],
+)
+def test_the_scene_generator_refuses_an_output_folder_in_one_line(tmp_path, args, said):
+    plain = tmp_path / "a-file"
+    plain.write_text("")
+    args = [a.replace("{file}", str(plain)) for a in args]
+    scene = paths.ROOT / "tests" / "scenes" / "balance.toml"
+    done = subprocess.run(
+        [sys.executable, str(paths.ROOT / "modelDescription" / "scene.py"), str(scene), *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith(said.replace("{file}", str(plain))), done.stderr
+
+
+@pytest.mark.parametrize(
+    "scene, said", [("{tmp}/none.toml", "does not exist"), ("{tmp}", "is a folder")]
+)
+def test_the_scene_generator_refuses_a_scene_file_it_cannot_read_in_one_line(tmp_path, scene, said):
+    scene = scene.replace("{tmp}", str(tmp_path))
+    done = subprocess.run(
+        [sys.executable, str(paths.ROOT / "modelDescription" / "scene.py"), scene, "--check"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert (
+        done.returncode == 2
+        and done.stderr == f"scene.py: error: {scene}: {said}" + (done.stderr.split(said)[1])
+    )
+    assert done.stderr.count("\n") == 1
 
 
 def test_parse_only_checks_and_runs_nothing(tmp_path, capsys, no_work):
@@ -158,6 +308,40 @@ def test_a_wrapper_answers_help_anywhere_without_building(tmp_path, script):
     done, calls = _wrapper(tmp_path, script, "x.toml", "--quick", "-h")
     assert done.returncode == 0 and done.stdout.startswith(f"usage: scripts/{script}")
     assert calls == ""
+
+
+@pytest.mark.parametrize(
+    "script, args, said",
+    [
+        ("run-main", ["--out", "/proc/x"], "dyadfmu run: error: --out /proc/x: cannot be created"),
+        ("run-study", ["--out", "/proc/x"], "dyadfmu study: error: --out /proc/x: cannot be"),
+        ("run-cosim", ["--out", "{file}/x"], "dyadfmu cosim: error: --out {file}/x: cannot be"),
+        ("run-scenes", ["--build", "{file}"], "dyadfmu scenes: error: --build {file}: is a file"),
+        (
+            "run-sweep",
+            ["{tmp}/none.toml"],
+            "dyadfmu sweep: error: STUDY.toml {tmp}/none.toml: does",
+        ),
+        ("run-sweep", ["{tmp}"], "dyadfmu sweep: error: STUDY.toml {tmp}: is a folder, not a file"),
+        ("run-fuzz", ["--build", "/proc/x"], "run-fuzz: error: --build /proc/x: cannot be created"),
+        (
+            "run-fuzz",
+            ["--build", "{file}/x"],
+            "run-fuzz: error: --build {file}/x: cannot be created",
+        ),
+    ],
+)
+def test_a_wrapper_refuses_a_bad_path_in_one_line_before_it_builds(tmp_path, script, args, said):
+    plain = tmp_path / "a-file"
+    plain.write_text("")
+
+    def filled(text: str) -> str:
+        return text.replace("{file}", str(plain)).replace("{tmp}", str(tmp_path))
+
+    done, calls = _wrapper(tmp_path / "machine", script, *map(filled, args))
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(filled(said)) and done.stderr.count("\n") == 1, done.stderr
+    assert calls == "" and "Traceback" not in done.stderr
 
 
 def test_a_wrapper_with_good_arguments_goes_on_to_build(tmp_path):

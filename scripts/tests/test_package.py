@@ -1,9 +1,12 @@
 """The Python package as a user installs it: `pip wheel ./scripts` (scikit-build-core runs the
-project's CMake and bundles the shared core, dyadfmu/_lib/libdyadfmu.so, and the built-in
-FMUs, dyadfmu/fmus/*.fmu), the wheel installed into a fresh venv with the dependencies at
-the versions of scripts/constraints.txt, then, from a directory outside the checkout and
-with no DYADFMU_* variable set, one dyad solved through Core() (against its closed form) and
-one bundled FMU read and simulated with fmpy.
+project's CMake and bundles the shared core, dyadfmu/_lib/libdyadfmu.so, the built-in
+FMUs, dyadfmu/fmus/*.fmu, and the sources a scene's FMU is built from, dyadfmu/_project),
+the wheel installed into a fresh venv with the dependencies at the versions of
+scripts/constraints.txt, then, from a directory outside the checkout and with no DYADFMU_*
+variable set, one dyad solved through Core() (against its closed form), one bundled FMU
+read and simulated with fmpy, and a design study of a scene (its FMU built from the
+bundled sources) while traps at every path derived from the install location record any
+use of them.
 
 One wheel build (without the FMUs' Windows binaries) and one venv per session (module
 fixtures): about two and a half minutes on two cores, 90 s of it the CMake build and 55 s
@@ -15,6 +18,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -147,8 +151,24 @@ def test_wheel_holds_core_and_fmus(wheel):
     assert all(name.endswith(".fmu") for name in fmus)
     assert "dyadfmu/mechanisms/builtin.py" in names
     assert any(n.startswith("dyadfmu/mechanisms/") and n.endswith(".toml") for n in names)
-    # the C install of `cmake --install` (headers, static libraries, CMake package) stays out
-    assert not [n for n in names if n.endswith((".h", ".a", ".cmake", ".pc"))]
+    # the C install of `cmake --install` (headers, static libraries, CMake package) stays out;
+    # the sources of a scene's FMU are there, under dyadfmu/_project only
+    project = [n for n in names if n.startswith("dyadfmu/_project/")]
+    assert not [n for n in names if n.endswith((".a", ".cmake", ".pc"))]
+    assert not [n for n in names if n.endswith(".h") and n not in project]
+    for needed in (
+        "CMakeLists.txt",
+        "fmu/CMakeLists.txt",
+        "fmu/fmu_instance.c",
+        "src/dyad_rrt.c",
+        "src/include/dyadfmu/dyad.h",
+        "modelDescription/scene.py",
+        "modelDescription/dyadgen/pipeline.py",
+        "modelDescription/interface/dyad_interface.toml",
+        "scenes/engine.toml",
+    ):
+        assert f"dyadfmu/_project/{needed}" in project, needed
+    assert any("/dyadgen/emit/templates/" in n for n in project)
     assert not [n for n in names if "__pycache__" in n]
     (info,) = [n for n in names if n.endswith(".dist-info/METADATA")]
     metadata = zipfile.ZipFile(wheel).read(info).decode()
@@ -173,3 +193,138 @@ def test_installed_package_solves_and_simulates(venv, tmp_path):
     assert got["solve"]["status"] == "ok"
     for key, value in CLOSED_FORM.items():
         assert got["solve"][key] == pytest.approx(value, rel=1e-12, abs=1e-12), key
+
+
+#: A design study of tests/scenes/balance.toml (copied beside it): the counterweight that
+#: balances the crank, known in closed form (scripts/tests/test_sweep.py).
+SCENE_STUDY = """
+[study]
+scene = "balance.toml"
+
+[run]
+kind = "kinetostatic"
+speed = 100.0
+points = 36
+
+[sampling]
+method = "grid"
+count = 13
+
+[[parameter]]
+name = "counterweight"
+counterweight = "crank"
+at = [-0.036, -0.009]
+low = 0.0
+high = 2.0
+
+[[figure]]
+name = "bearing_peak"
+of = ["crank.R_O.x", "crank.R_O.y"]
+stat = "peak"
+
+[objective]
+minimize = "bearing_peak"
+best = 1
+"""
+
+#: A shared library whose loading writes MARKER: planted where the old checkout tests
+#: looked (build/libdyadfmu.so beside the install location).
+TRAP_LIBRARY = """
+#include <stdio.h>
+__attribute__((constructor)) static void trap(void)
+{
+    FILE* f = fopen(MARKER, "a");
+    if (f) { fputs("build/libdyadfmu.so\\n", f); fclose(f); }
+}
+"""
+
+
+def _plant_traps(python: Path, marker: Path, work: Path) -> tuple[Path, Path]:
+    """Files at every path derived from the installed package's location that the package
+    must never run: the scene generator, scripts/build-scene, the checkout's markers (so
+    that a package taking itself for a checkout would go on to run them) and the core in
+    build/. Each one that runs appends its name to `marker`. Returns (that location, the
+    installed package's folder)."""
+    derived = Path(_run(python, "-c", "import dyadfmu.paths as p; print(p.ROOT)", cwd=work).strip())
+    site = Path(_run(python, "-c", "import dyadfmu; print(dyadfmu.__file__)", cwd=work).strip())
+    # <venv>/lib/python3.X, outside the package: a folder of this test's own venv
+    assert derived == site.parents[2] and python.parents[1] in derived.parents, derived
+    script = f"open({str(marker)!r}, 'a').write(__file__ + '\\n')\nraise SystemExit(3)\n"
+    for name in ("modelDescription/scene.py", "modelDescription/generate.py"):
+        (derived / name).parent.mkdir(parents=True, exist_ok=True)
+        (derived / name).write_text(script)
+    shell = derived / "scripts" / "build-scene"
+    shell.parent.mkdir(parents=True, exist_ok=True)
+    shell.write_text(f'#!/bin/sh\necho "$0" >> "{marker}"\nexit 3\n')
+    shell.chmod(0o755)
+    (derived / "scripts" / "pyproject.toml").write_text("")
+    (derived / "CMakeLists.txt").write_text(f'file(APPEND "{marker}" "CMakeLists.txt\\n")\n')
+    (derived / "build").mkdir(exist_ok=True)
+    source = work / "trap.c"
+    source.write_text(f'#define MARKER "{marker}"\n' + TRAP_LIBRARY)
+    _run("cc", "-shared", "-fPIC", "-o", derived / "build" / "libdyadfmu.so", source)
+    return derived, site.parent
+
+
+def test_installed_package_runs_a_scene_study_from_its_own_sources_only(venv, tmp_path):
+    marker = tmp_path / "ran-outside-the-package.txt"
+    work = tmp_path / "work"
+    work.mkdir()
+    derived, package = _plant_traps(venv, marker, work)
+    try:
+        (work / "balance.toml").write_text(
+            (paths.ROOT / "tests" / "scenes" / "balance.toml").read_text()
+        )
+        (work / "study.toml").write_text(SCENE_STUDY)
+        # with the checkout's markers planted beside it, the package still knows it is
+        # installed, and none of its places lies there
+        places = _run(
+            venv, "-c", "import dyadfmu.paths as p, dyadfmu.core as c; print(p.in_checkout()); "
+            "print(*[p.build_dir().resolve(), p.GENERATOR, p.SCENES_DIR, p.project_dir(), "
+            "*c.library_candidates()], sep='\\n')", cwd=work, env=_clean_env(),
+        ).split()  # fmt: skip
+        assert places[0] == "False"
+        beside = [p for p in places[1:] if derived in Path(p).parents]
+        assert places[1:] and not [p for p in beside if package not in Path(p).parents], places
+        dyadfmu = venv.parent / "dyadfmu"
+        out = _run(dyadfmu, "sweep", "study.toml", "--workers", "0", "--out", "out", cwd=work,
+                   env=_clean_env())  # fmt: skip
+        assert not marker.exists(), marker.read_text()
+        rows = (work / "out" / "study" / "results.csv").read_text().splitlines()
+        assert rows[0] == "design,counterweight,bearing_peak,digits,status,message"
+        assert all(row.endswith(",ok,") for row in rows[1:]) and len(rows) == 14
+        # the best counterweight balances the crank: 2 kg at (12, 3) mm against m at (-36, -9) mm
+        best = rows[5].split(",")
+        assert float(best[1]) == pytest.approx(2.0 / 3.0, rel=1e-12)
+        assert float(best[2]) < 1e-9 and "| 4 | 0.666667 |" in out
+        built = list((work / "out" / "study" / "build-scene" / "fmus").glob("balance_sweep_*.fmu"))
+        assert len(built) == 1  # in the study's own folder, from the bundled sources
+    finally:
+        for name in ("modelDescription", "scripts", "build", "CMakeLists.txt"):
+            target = derived / name
+            if target.is_dir():
+                shutil.rmtree(target)
+            elif target.exists():
+                target.unlink()
+
+
+def test_installed_package_without_cmake_refuses_a_scene_study_in_one_line(venv, tmp_path):
+    (tmp_path / "balance.toml").write_text(
+        (paths.ROOT / "tests" / "scenes" / "balance.toml").read_text()
+    )
+    (tmp_path / "study.toml").write_text(SCENE_STUDY)
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    env = dict(_clean_env(), PATH=str(empty))  # no cmake, no cc
+    done = subprocess.run(
+        [str(venv.parent / "dyadfmu"), "sweep", "study.toml", "--workers", "0"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env=env,
+    )
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith(
+        "dyadfmu sweep: building the study's mechanism FMU from its scene needs CMake (cmake), "
+        "a C compiler (cc), not found here: install them (Debian: apt-get install cmake gcc"
+    ), done.stderr

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tomllib
@@ -818,3 +819,346 @@ def test_a_misspelt_name_is_refused_before_the_scene_s_fmu_is_built(tmp_path, mo
         study.prepare(_write(tmp_path, text), tmp_path)
     assert str(info.value).startswith(f"{tmp_path / 'study.toml'}:{line}: torque_rms: ")
     assert "crank.torqe is not a Real output or input of balance_sweep_" in str(info.value)
+
+
+# ---- designs that are not ok: a failed sample, too few digits; min constraints; log axes ------
+
+#: A study whose figure reads an input only: the crank's angle, which every sample has
+#: whether or not the mechanism closes there. A rod of 2 cm cannot reach the piston's line
+#: from a crank of 5 cm at most crank angles (status 4, cannot assemble).
+INPUT_ONLY_STUDY = (
+    BALANCE_STUDY.replace(
+        '[[parameter]]\nname = "counterweight"\ncounterweight = "crank"\n'
+        f"at = [{AT[0]}, {AT[1]}]\nlow = 0.0\nhigh = 2.0\n",
+        '[[parameter]]\nname = "rod.length"\nlow = 0.02\nhigh = 0.2\n',
+    )
+    .replace("count = 13 ", "count = 3 ")
+    .split("[[figure]]")[0]
+    + '[[figure]]\nname = "angle_max"\nof = "crank.angle"\nstat = "max"\n\n'
+    + '[objective]\nminimize = "angle_max"\n'
+)
+
+
+@pytest.mark.parametrize("use_rows", [True, False], ids=["rows", "fmi"])
+def test_a_design_with_a_failed_sample_is_not_ok_even_where_its_figures_read_inputs(
+    tmp_path, use_rows
+):
+    _needs_balance()
+    from dataclasses import replace
+
+    s, run, values, _ = study.prepare(_write(tmp_path, INPUT_ONLY_STUDY), tmp_path)
+    assert values[:, 0].tolist() == pytest.approx([0.02, 0.11, 0.2])
+    run = replace(run, use_rows=use_rows)
+    table = results.table_of(s, values, run.chunk(list(enumerate(values))))
+    assert table.status == ["cannot_assemble", "ok", "ok"], table.message
+    assert "cannot assemble" in table.message[0]
+    assert results.feasible(table, s).tolist() == [False, True, True]
+    assert results.best_designs(table, s) in ([1, 2], [2, 1])
+
+
+def test_a_sample_whose_status_is_not_0_fails_its_design_whatever_its_outputs(
+    tmp_path, monkeypatch
+):
+    """The FMU may report a sample singular (status 1) with finite outputs, as it does near
+    a toggle position: the design is not ok, and the message says where."""
+    _needs_balance()
+    from dataclasses import replace
+
+    from dyadfmu.fmi.slave import Slave
+
+    reported = Slave.get_status
+
+    def singular_at_a_quarter_turn(self):
+        angle = self.get("crank.angle") if "crank.angle" in self.names else 0.0
+        return 1 if abs(angle - math.pi / 2) < 1e-12 else reported(self)
+
+    s, run, values, _ = study.prepare(_write(tmp_path, BALANCE_STUDY), tmp_path)
+    run = replace(run, use_rows=False)
+    assert run(tuple(values[4])).status == "ok"
+    monkeypatch.setattr(Slave, "get_status", singular_at_a_quarter_turn)
+    outcome = run(tuple(values[4]))
+    assert outcome.status == "singular" and all(map(math.isfinite, outcome.figures[:0]))
+    assert "status 1 at crank angle 1.5708 rad" in outcome.message
+    table = results.table_of(s, values, [(k, run(tuple(v))) for k, v in enumerate(values)])
+    assert set(table.status) == {"singular"} and results.best_designs(table, s) == []
+
+
+def test_the_digits_of_a_design_come_from_its_worst_amplification():
+    from dyadfmu.sweep.runs import EPS, digits_of
+
+    assert digits_of(1.0) == pytest.approx(-math.log10(EPS))  # 15.65: a double's digits
+    assert digits_of(1e8) == pytest.approx(-math.log10(EPS) - 8)
+    assert math.isnan(digits_of(math.nan)) and digits_of(math.inf) == -math.inf
+    run = runs.KinetostaticRun(
+        "x.fmu", "crank", (), (), (), (), (Figure("p", ("w",), "peak"),),
+        amplifications=("a.amplification", "b.amplification"), min_digits=8.0,
+    )  # fmt: skip
+    calm = {
+        "w": np.ones(3),
+        "a.amplification": np.array([1.0, 2.0, 3.0]),
+        "b.amplification": np.ones(3),
+    }
+    assert run.outcome(calm, None) == runs.Outcome((1.0,), "ok", "", digits_of(3.0))
+    steep = dict(calm, **{"b.amplification": np.array([1.0, 1e9, 4.0])})
+    outcome = run.outcome(steep, None)
+    assert outcome.status == "inaccurate" and outcome.figures == (1.0,)
+    assert outcome.digits == pytest.approx(digits_of(1e9))
+    assert outcome.message.startswith("b.amplification 1e+09 at sample 1: eps x amplification")
+    assert "6.7 digits, fewer than min_digits 8" in outcome.message
+    unbounded = dict(calm, **{"a.amplification": np.array([1.0, np.nan, 1.0])})
+    assert run.outcome(unbounded, None).status == "inaccurate"
+    from dyadfmu.sweep.runs import amplification_outputs
+    from fmpy.model_description import ModelDescription, ScalarVariable
+
+    md = ModelDescription()
+    for name in ("a.amplification", "b.amplification", "amplification", "a.conditioning"):
+        v = ScalarVariable(name=name, valueReference=len(md.modelVariables))
+        v.causality, v.type = "output", "Real"
+        md.modelVariables.append(v)
+    assert amplification_outputs(md) == ("amplification",)  # the mechanism's, where it has one
+    md.modelVariables = md.modelVariables[:2] + md.modelVariables[3:]
+    assert amplification_outputs(md) == ("a.amplification", "b.amplification")
+
+
+#: The balance scene's rod nearly upright at three quarters of a turn (the crank's pin 5 cm
+#: below O, the guide 1 cm above it: a rod of 6 cm stands normal to the guide there, the
+#: RRT's singular position, and a shorter one cannot reach), given mass so that the dyad
+#: carries loads, against a rod of 18 cm.
+NEAR_SINGULAR_STUDY = f"""
+[study]
+scene = "{ROOT / "tests" / "scenes" / "balance.toml"}"
+min_digits = 12
+
+[run]
+kind = "kinetostatic"
+speed = 100.0
+points = 36
+
+[sampling]
+method = "grid"
+count = 2
+
+[[parameter]]
+name = "rod.length"
+low = 0.060000000006
+high = 0.18
+
+[fixed]
+"rod.mass" = 0.5
+"rod.com.x" = 0.02
+"rod.inertia" = 1e-4
+
+[[figure]]
+name = "torque_peak"
+of = "crank.torque"
+stat = "peak"
+
+[[figure]]
+name = "amplification_max"
+of = "engine.amplification"
+stat = "max"
+
+[objective]
+minimize = "torque_peak"
+"""
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="building a study's scene needs CMake")
+def test_a_design_whose_amplification_leaves_too_few_digits_is_flagged(tmp_path):
+    result = study.run_study(_write(tmp_path, NEAR_SINGULAR_STUDY), tmp_path / "out", workers=0)
+    table, s = result.table, result.study
+    assert s.min_digits == 12
+    near, far = 0, 1
+    amplification = table.column("amplification_max")
+    assert table.digits.tolist() == [runs.digits_of(a) for a in amplification]
+    # the worst sample is at three quarters of a turn, the rod nearly upright: its
+    # conditioning is the cosine of the rod's angle to the guide, and amplification = data
+    # factor / conditioning with the data factor at least 1
+    length = table.values[near, 0]
+    conditioning = math.sqrt(length**2 - 0.06**2) / length
+    assert conditioning < 1e-4
+    assert amplification[near] >= 0.999 / conditioning
+    assert table.digits[near] < 12 <= table.digits[far]
+    assert table.status == ["inaccurate", "ok"], table.message
+    assert "fewer than min_digits 12" in table.message[near]
+    assert math.isfinite(table.figures[near][0])  # its figures kept, shown as such
+    assert result.best == [far]
+    csv = (tmp_path / "out" / "study" / "results.csv").read_text().splitlines()
+    assert csv[0].endswith(",digits,status,message") and ",inaccurate," in csv[1]
+    report = (tmp_path / "out" / "study" / "report.md").read_text()
+    assert "1 design with fewer than `min_digits` 12 is `inaccurate`, not ok." in report
+
+
+def _constraint_study(constraint: str) -> str:
+    return BALANCE_STUDY.replace("best = 3", f"constraints = [{constraint}]\nbest = 13")
+
+
+def test_a_min_constraint_excludes_the_designs_below_it(tmp_path):
+    _needs_balance()
+    text = _constraint_study('{ figure = "bearing_peak", min = 20.0 }')
+    result = study.run_study(_write(tmp_path, text), tmp_path / "out", workers=0, plots=False)
+    table, s = result.table, result.study
+    peak = table.column("bearing_peak")
+    assert set(table.status) == {"ok"} and peak.min() < 20.0 < peak.max()
+    assert results.feasible(table, s).tolist() == (peak >= 20.0).tolist()
+    assert result.best and all(peak[k] >= 20.0 for k in result.best)
+    assert peak[result.best[0]] == min(peak[peak >= 20.0])
+    report = (tmp_path / "out" / "study" / "report.md").read_text()
+    assert "subject to bearing\\_peak >= 20:" in report
+    both = _constraint_study('{ figure = "bearing_peak", min = 20.0, max = 60.0 }')
+    s = read_study(_write(tmp_path, both))
+    assert results.feasible(table, s).tolist() == ((peak >= 20) & (peak <= 60)).tolist()
+    from dyadfmu.report.sweep import report_text
+
+    assert "subject to 20 <= bearing\\_peak <= 60:" in report_text(table, s, 1.0, "x")
+
+
+@pytest.mark.parametrize(
+    "constraint, words",
+    [
+        ('{ figure = "torque_rms", min = nan }', "torque_rms: a constraint's min must be a finite"),
+        ('{ figure = "torque_rms", min = 2.0, max = 1.0 }', "min 2 is above its max 1"),
+        ('{ figure = "torque_rms" }', "a constraint is { figure = NAME, max = NUMBER }, {"),
+        ('{ figure = "torque_rms", mn = 1.0 }', "or both bounds, with NAME one of"),
+        ('{ figure = "torque", min = 1.0 }', "with NAME one of bearing_peak, torque_rms"),
+    ],
+)
+def test_a_bad_min_constraint_is_refused_at_its_line(tmp_path, constraint, words):
+    text = _constraint_study(constraint)
+    line = next(k for k, t in enumerate(text.splitlines(), start=1) if "constraints" in t)
+    message = _refused(tmp_path, text)
+    assert message.startswith(f"{tmp_path / 'study.toml'}:{line}: ") and words in message
+
+
+@pytest.mark.parametrize(
+    "value, words", [("16", "min_digits must be from 0 to 15.65"), ("-1", "from 0")]
+)
+def test_a_bad_min_digits_is_refused_at_its_line(tmp_path, value, words):
+    text = BALANCE_STUDY.replace("[study]", f"[study]\nmin_digits = {value}")
+    assert words in _refused(tmp_path, text)
+    assert read_study(_write(tmp_path, BALANCE_STUDY)).min_digits == 8.0
+
+
+def _figure_of(monkeypatch, table, s) -> object:
+    """The matplotlib figure plot_study draws (caught as it is saved)."""
+    from dyadfmu.report import sweep as report
+    from matplotlib.figure import Figure as MplFigure
+
+    drawn = []
+    monkeypatch.setattr(MplFigure, "savefig", lambda fig, *a, **k: drawn.append(fig))
+    report.plot_study(table, s, Path("unused.png"))
+    (fig,) = drawn
+    return fig
+
+
+def _table(values: np.ndarray, *figures: np.ndarray) -> results.Table:
+    """Designs that all ran: one parameter (cw) or two (cw, rod.length), and the figures
+    bearing_peak and torque_rms."""
+    names = ["cw", "rod.length"][: values.shape[1]]
+    n = len(values)
+    return results.Table(names, ["bearing_peak", "torque_rms"], values,
+                         np.column_stack(figures), ["ok"] * n, [""] * n)  # fmt: skip
+
+
+def test_a_plotted_quantity_over_many_decades_gets_a_log_axis(tmp_path, monkeypatch):
+    from matplotlib.colors import LogNorm, SymLogNorm
+
+    s = read_study(_write(tmp_path, _constraint_study('{ figure = "torque_rms", max = 600.0 }')))
+    x = np.linspace(0.0, 2.0, 10)[:, None]
+    wide = np.logspace(-3, 6, 10)  # the objective over 1e-3 .. 1e6
+    narrow = np.linspace(1.0, 500.0, 10)
+    designs, pareto = _figure_of(monkeypatch, _table(x, wide, narrow), s).axes[:2]
+    assert designs.get_yscale() == "log" and designs.get_xscale() == "linear"
+    assert pareto.get_xscale() == "log" and pareto.get_yscale() == "linear"
+    # signs mixed: symmetric log; a narrow range stays linear
+    mixed = wide * np.where(np.arange(10) % 2, -1, 1)
+    assert _figure_of(monkeypatch, _table(x, mixed, narrow), s).axes[0].get_yscale() == "symlog"
+    assert _figure_of(monkeypatch, _table(x, narrow, narrow), s).axes[0].get_yscale() == "linear"
+    # two parameters: the parameters' own axes, the objective's colour scale
+    two = BALANCE_STUDY.replace(
+        "[[figure]]",
+        '[[parameter]]\nname = "rod.length"\nlow = 0.001\nhigh = 10.0\n\n[[figure]]',
+        1,
+    )
+    s2 = read_study(_write(tmp_path, two, "two.toml"))
+    grid = np.array([[a, b] for a in (0.0, 1.0, 2.0) for b in (0.001, 0.1, 10.0)])
+    z = np.logspace(-3, 6, 9)
+    heat = _figure_of(monkeypatch, _table(grid, z, z), s2).axes[0]
+    assert heat.get_yscale() == "log" and heat.get_xscale() == "linear"
+    (mesh,) = heat.collections
+    assert isinstance(mesh.norm, LogNorm)
+    scattered = grid + np.array([[0.01 * k, 0.0] for k in range(9)])  # not a grid: a scatter
+    points = _figure_of(monkeypatch, _table(scattered, -z, z), s2).axes[0].collections[0]
+    assert isinstance(points.norm, SymLogNorm)
+
+
+def test_the_pareto_front_of_a_figure_bounded_from_below_keeps_the_highest():
+    a = np.array([1.0, 2.0, 3.0, 2.5])
+    b = np.array([5.0, 3.0, 9.0, 4.0])  # a transmission angle, say: the larger the better
+    mask = np.ones(4, dtype=bool)
+    assert results.pareto_front(a, b, mask) == [0, 1]
+    assert results.pareto_front(a, b, mask, b_higher_is_better=True) == [0, 2]
+
+
+# ---- an installed package runs nothing from beside its install location ---------------------
+
+
+def test_an_installed_copy_never_takes_the_folders_around_it_for_a_checkout(tmp_path):
+    """The package copied as pip installs it (site-packages/dyadfmu with its bundled core
+    and sources), with a checkout's markers, a generator, a core and a build planted at the
+    paths derived from that place (<prefix>/lib/python3.X/...): every place the package
+    would run or load lies inside it."""
+    prefix = tmp_path / "lib" / "python3.11"
+    package = prefix / "site-packages" / "dyadfmu"
+    shutil.copytree(
+        ROOT / "scripts" / "dyadfmu", package, ignore=shutil.ignore_patterns("__pycache__")
+    )
+    (package / "_lib").mkdir()
+    (package / "_lib" / "libdyadfmu.so").write_bytes(b"")
+    (package / "_project" / "modelDescription").mkdir(parents=True)
+    (prefix / "scripts").mkdir()
+    (prefix / "scripts" / "pyproject.toml").write_text("")
+    (prefix / "CMakeLists.txt").write_text("")
+    (prefix / "modelDescription").mkdir()
+    (prefix / "modelDescription" / "scene.py").write_text("raise SystemExit(3)\n")
+    (prefix / "build").mkdir()
+    (prefix / "build" / "libdyadfmu.so").write_bytes(b"")
+    probe = (
+        "import dyadfmu.paths as p, dyadfmu.core as c\n"
+        f"assert p.__file__.startswith({str(package)!r})\n"
+        "from dyadfmu.sweep import scenebuild as b\n"
+        "print(p.in_checkout())\n"
+        "print(*[p.GENERATOR, p.SCENES_DIR, p.project_dir(), b.generator(), "
+        "b.build_folder(p.Path('out')).resolve(), p.build_dir().resolve(), "
+        "*c.library_candidates()], sep='\\n')\n"
+    )
+    import sysconfig
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith("DYADFMU_")}
+    # -S: no site hooks, so not the checkout's editable install; the copy first, then the
+    # venv's packages (NumPy, fmpy)
+    env["PYTHONPATH"] = os.pathsep.join([str(package.parent), sysconfig.get_paths()["purelib"]])
+    done = subprocess.run(
+        [sys.executable, "-S", "-c", probe], capture_output=True, text=True, cwd=tmp_path, env=env
+    )
+    assert done.returncode == 0, done.stderr
+    installed, *places = done.stdout.split("\n")[:-1]
+    assert installed == "False"
+    beside = [p for p in places if prefix in Path(p).parents and package not in Path(p).parents]
+    assert beside == [], places
+    assert Path(places[3]) == package / "_project" / "modelDescription" / "scene.py"
+
+
+def test_a_scene_study_without_cmake_or_a_compiler_is_refused_in_one_line(monkeypatch, tmp_path):
+    from dyadfmu.sweep import scenebuild
+
+    monkeypatch.setattr(scenebuild.shutil, "which", lambda name: None)
+    problem = scenebuild.tools_problem()
+    assert problem.startswith(
+        "building the study's mechanism FMU from its scene needs CMake (cmake), a C compiler "
+        "(cc), not found here: install them"
+    )
+    assert "\n" not in problem and 'fmu = "....fmu"' in problem
+    with pytest.raises(scenebuild.BuildError) as info:
+        scenebuild.scene_fmu(tmp_path / "x.toml", "x_sweep_0123456789", 2, tmp_path)
+    assert str(info.value) == problem

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import tempfile
 from pathlib import Path
 
 from dyadgen.pipeline import build_table, load_scene, outputs_of, write_files
@@ -38,9 +40,50 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _scene_problem(scene: Path) -> str | None:
+    """Why the scene file cannot be read, or None."""
+    if scene.is_dir():
+        return "is a folder, not a file"
+    if not scene.exists():
+        return "does not exist"
+    return None
+
+
+def _out_problem(out: Path) -> str | None:
+    """Why `out` cannot be the folder the files go to (made where missing), or None: a
+    folder is made and removed in it, or in its nearest existing ancestor, which also
+    holds for root (whom permissions do not stop) and for /proc."""
+    there = out
+    while not os.path.lexists(there) and there.parent != there:
+        there = there.parent
+    try:
+        if not there.is_dir():
+            if there == out:
+                return "is a file, not a folder"
+            return f"cannot be created: {there} is not a folder"
+        os.rmdir(tempfile.mkdtemp(prefix=".scene-probe-", dir=there))
+    except OSError as error:
+        where = "is not writable" if there == out else f"cannot be created in {there}"
+        return f"{where} ({error.strerror or error})"
+    return None
+
+
+def _path_problem(args: argparse.Namespace) -> str | None:
+    """'NAME PATH: problem' for the scene file or the --out folder, or None."""
+    problem = _scene_problem(args.scene)
+    if problem:
+        return f"{args.scene}: {problem}"
+    problem = _out_problem(args.out) if args.out is not None else None
+    return f"--out {args.out}: {problem}" if problem else None
+
+
 def main(argv: list[str] | None = None) -> int:
     """scene.py SCENE --out DIR | --check | --external-inputs | --cmake-info."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    problem = _path_problem(args)
+    if problem:  # one line, before the scene is read
+        parser.exit(2, f"{parser.prog}: error: {problem}\n")
     try:
         scene = load_scene(args.scene)
         table = build_table(scene)
@@ -62,7 +105,11 @@ def main(argv: list[str] | None = None) -> int:
         counts = ", ".join(_counted(n[c], c) for c in ("input", "parameter", "output"))
         print(f"{scene.identifier} ({kind.label}): {counts}")
         return 0
-    write_files(args.out, outputs_of(table))
+    try:
+        write_files(args.out, outputs_of(table))
+    except OSError as error:  # the folder went bad after the check (a full disk, say)
+        print(f"{parser.prog}: error: {error.filename}: {error.strerror or error}", file=sys.stderr)
+        return 2
     return 0
 
 

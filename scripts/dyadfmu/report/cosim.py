@@ -18,6 +18,7 @@ import time as clock
 from collections.abc import Callable
 from pathlib import Path
 
+from .. import paths
 from ..cosim import master as cosim
 from ..cosim import mechanism_drive
 
@@ -625,9 +626,13 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
+#: The path arguments, checked before any work (dyadfmu.paths.parse_checked).
+PATHS = (("--out", "out", paths.OUT),)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run 'dyadfmu cosim' with `argv`: the study, its report and a summary."""
-    args = parser().parse_args(argv)
+    args = paths.parse_checked(parser(), argv, PATHS)
     try:
         result = run_study(
             args.out, quick=args.quick, fmi_version=args.fmi_version, verbose=args.verbose

@@ -28,7 +28,7 @@ from .. import paths
 from ..cosim import mechanism_fmus as mf
 from ..study import bench
 
-GENERATOR = paths.ROOT / "modelDescription" / "scene.py"
+GENERATOR = paths.GENERATOR
 
 
 def inputs_before(name: str) -> list[str]:

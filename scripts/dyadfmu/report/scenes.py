@@ -218,9 +218,13 @@ def _report_text(acc: list, foot: list, quick: bool, moving: list) -> list[str]:
     ]
 
 
+#: The path arguments, checked before any work (dyadfmu.paths.parse_checked).
+PATHS = (("--out", "out", paths.OUT), ("--build", "build", paths.FOLDER))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run 'dyadfmu scenes' with `argv`: every scene, drawings, footprints, report.md."""
-    args = parser().parse_args(argv)
+    args = paths.parse_checked(parser(), argv, PATHS)
     build = args.build or paths.build_dir()
     out = args.out
     out.mkdir(parents=True, exist_ok=True)

@@ -28,6 +28,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from .. import paths
 from ..argtypes import whole
 from ..paths import GENERATOR
 
@@ -186,9 +187,13 @@ def parser() -> argparse.ArgumentParser:
     return found
 
 
+#: The path arguments, checked before any work (dyadfmu.paths.parse_checked).
+PATHS = (("--generator", "generator", paths.FILE),)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run 'dyadfmu scene-bench' with `argv`: print the generator's times."""
-    args = parser().parse_args(argv)
+    args = paths.parse_checked(parser(), argv, PATHS)
     if args.write is not None:
         sys.stdout.write(chain_scene(args.write, chain=args.chain))
         return 0

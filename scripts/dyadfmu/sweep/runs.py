@@ -13,6 +13,15 @@ it is; each worker process loads each FMU once (:func:`slave`) and resets it bet
 runs. A run that fails returns its status (``singular``, ``cannot_assemble``,
 ``diverged``, ``refused``: the FMU refused a parameter value) with the FMU's message and
 NaN figures, or ``undefined_figure`` with the figures that have a value; it never raises.
+Every sample counts: one whose mechanism FMU ``status`` is not 0 fails the run with that
+status, whatever its outputs.
+
+Where the mechanism FMU has amplification outputs (the mechanism's ``amplification``,
+else each dyad's ``DYAD.amplification``), a run also reads them at every sample: the
+worst eps x amplification over the run bounds the relative round-off of its reactions
+(README: "Status, conditioning, singular positions"), given as the digits it leaves,
+-log10(eps x amplification). A run with fewer than the study's ``min_digits`` is
+``inaccurate``: its figures are kept, it is not ok.
 """
 
 from __future__ import annotations
@@ -29,9 +38,19 @@ from ..fmi.slave import Slave, SlaveError
 from .checks import base_values
 from .figures import UndefinedFigure, figure_value, series_names
 from .rows import rows_entry
-from .studyfile import Driven, Kinetostatic, Study, recorded_from
+from .studyfile import MIN_DIGITS, Driven, Kinetostatic, Study, recorded_from
 
-__all__ = ["Outcome", "KinetostaticRun", "DrivenRun", "run_of", "run_rows", "slave", "STATUS_NAMES"]
+__all__ = [
+    "Outcome",
+    "KinetostaticRun",
+    "DrivenRun",
+    "run_of",
+    "run_rows",
+    "slave",
+    "STATUS_NAMES",
+    "amplification_outputs",
+    "digits_of",
+]
 
 #: The mechanism FMU's ``status`` output.
 STATUS_NAMES = {0: "ok", 1: "singular", 2: "invalid_input", 3: "out_of_range", 4: "cannot_assemble"}
@@ -51,17 +70,46 @@ def _fresh(path: str, role: str, parameters: dict) -> Slave:
     """The process's instance, reset and initialised with ``parameters``."""
     s = slave(path, role)
     s.reset()
+    s.messages.clear()  # a failure's message is this run's, not an earlier one's
     s.initialize(parameters)
     return s
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """A run's figures (by the study's figure order), its status and the FMU's message."""
+    """A run's figures (by the study's figure order), its status, the FMU's message and
+    the digits its reactions keep (None where the FMU has no amplification output or the
+    run failed)."""
 
     figures: tuple
     status: str
     message: str = ""
+    digits: float | None = None
+
+
+#: The unit round-off of a double, the FMUs' scalar.
+EPS = float(np.finfo(float).eps)
+
+
+def digits_of(amplification: float) -> float:
+    """The decimal digits a result with this amplification keeps: -log10(eps x a); NaN for
+    a NaN amplification (no bound), -inf for an infinite one."""
+    if math.isnan(amplification) or amplification <= 0:
+        return math.nan if math.isnan(amplification) else -math.log10(EPS)
+    return -math.log10(EPS * amplification) if math.isfinite(amplification) else -math.inf
+
+
+def amplification_outputs(md: ModelDescription) -> tuple:
+    """The mechanism FMU's amplification outputs: the mechanism's ``amplification`` where
+    it has one, else every dyad's ``DYAD.amplification``; () where it has none."""
+    reals = [
+        v.name
+        for v in md.modelVariables
+        if v.causality == "output" and v.type in ("Real", "Float64")
+    ]
+    if "amplification" in reals:
+        return ("amplification",)
+    return tuple(n for n in reals if n.endswith(".amplification"))
 
 
 class _Failed(Exception):
@@ -86,6 +134,17 @@ class _Common:
     fixed: tuple
     loads: tuple
     figures: tuple
+    amplifications: tuple = ()  # the FMU's amplification outputs (amplification_outputs)
+    min_digits: float = MIN_DIGITS
+
+    def read(self) -> tuple:
+        """The mechanism FMU's variables a sample reads: the figures' series, then the
+        amplifications and the crank's torque (an output: reading it solves the sample,
+        so that its status is that of the whole mechanism even where the figures read
+        inputs only)."""
+        series = series_names(self.figures)
+        more = (*self.amplifications, f"{self.driver}.torque")
+        return series + tuple(n for n in dict.fromkeys(more) if n not in series)
 
     def mechanism_parameters(self, values: tuple) -> dict:
         """The mechanism FMU's parameters of a design (drive.* left out)."""
@@ -114,8 +173,25 @@ class _Common:
         """[(index, Outcome)] of the designs [(index, values)], one run after another."""
         return [(index, self(tuple(values))) for index, values in rows]
 
+    def accuracy(self, series: dict) -> tuple[float | None, str]:
+        """(digits, message) of the worst sample of a run's series: the message says why
+        the run is inaccurate, "" where it keeps ``min_digits`` (or the FMU has no
+        amplification output: digits None)."""
+        if not self.amplifications:
+            return None, ""
+        worst = np.max([np.max(series[n]) for n in self.amplifications])
+        digits = digits_of(float(worst))
+        if digits >= self.min_digits:  # not for NaN: a sample without a bound is no pass
+            return digits, ""
+        which = max(self.amplifications, key=lambda n: float(np.max(series[n])))
+        k = int(np.argmax(series[which]))
+        return digits, (
+            f"{which} {worst:.3g} at sample {k}: eps x amplification = {EPS * worst:.2g}, "
+            f"{digits:.1f} digits, fewer than min_digits {self.min_digits:g}"
+        )
+
     def outcome(self, series: dict, phi: np.ndarray | None) -> Outcome:
-        """The figures over the recorded series."""
+        """The figures over the recorded series, and the digits they keep."""
         values, undefined = [], []
         for f in self.figures:
             try:
@@ -123,17 +199,31 @@ class _Common:
             except UndefinedFigure as e:
                 values.append(math.nan)
                 undefined.append(f"{f.name}: {e}")
+        digits, inaccurate = self.accuracy(series)
+        if inaccurate:
+            return Outcome(tuple(values), "inaccurate", inaccurate, digits)
         if undefined:
-            return Outcome(tuple(values), "undefined_figure", "; ".join(undefined))
+            return Outcome(tuple(values), "undefined_figure", "; ".join(undefined), digits)
         if not all(map(math.isfinite, values)):
-            return Outcome(tuple(values), "diverged", "a figure is not finite")
-        return Outcome(tuple(values), "ok")
+            return Outcome(tuple(values), "diverged", "a figure is not finite", digits)
+        return Outcome(tuple(values), "ok", "", digits)
 
 
 def _failed_point(mech: Slave, where: str) -> _Failed:
     code = mech.get_status() if "status" in mech.names else 0
     message = mech.messages[-1] if mech.messages else f"outputs not finite {where}"
     return _Failed(STATUS_NAMES.get(code, f"status {code}") if code else "diverged", message)
+
+
+def _check_point(mech: Slave, values: list, where: str) -> None:
+    """_Failed where a sample's values are not finite or the FMU's status is not 0 (a
+    sample it reports singular counts as failed even where its outputs are numbers)."""
+    if not np.all(np.isfinite(values)):
+        raise _failed_point(mech, where)
+    code = mech.get_status() if "status" in mech.names else 0
+    if code != 0:
+        said = f"{mech.messages[-1]} " if mech.messages else ""
+        raise _Failed(STATUS_NAMES.get(code, f"status {code}"), f"{said}(status {code} {where})")
 
 
 @dataclass(frozen=True)
@@ -171,7 +261,7 @@ class KinetostaticRun(_Common):
         p_names = tuple(params[0]) if params else ()
         if any(tuple(p) != p_names for p in params):
             return super().chunk(rows)
-        names, n = series_names(self.figures), self.points
+        names, n = self.read(), self.points
         p = np.repeat(np.array([[d[k] for k in p_names] for d in params]), n, axis=0)
         x = np.tile(self._point_inputs, (len(rows), 1))
         try:
@@ -189,14 +279,13 @@ class KinetostaticRun(_Common):
 
     def _run(self, values: tuple) -> Outcome:
         mech = _fresh(self.mechanism, "mechanism", self.mechanism_parameters(values))
-        names, inputs = series_names(self.figures), self.inputs()
+        names, inputs = self.read(), self.inputs()
         rows = np.empty((self.points, len(names)))
         for k in range(self.points):
             phi = 2 * math.pi * k / self.points
             mech.set(inputs, (phi, self.speed, 0.0) + tuple(ld.at(phi) for ld in self.loads))
             rows[k] = mech.get(names)
-            if not np.all(np.isfinite(rows[k])):
-                raise _failed_point(mech, f"at crank angle {phi:.6g} rad")
+            _check_point(mech, rows[k], f"at crank angle {phi:.6g} rad")
         return self.outcome(dict(zip(names, rows.T, strict=True)), None)
 
 
@@ -231,11 +320,12 @@ class DrivenRun(_Common):
         loads = tuple(ld.at(phi) for ld in self.loads)
         y.set(inputs, (phi, omega, 0.0) + loads)
         torque0 = y.get(f"{self.driver}.torque")
+        _check_point(y, [torque0], f"at t = {t:g} s")
         try:
             (j,) = y.directional_derivative((f"{self.driver}.torque",), (inputs[2],), [1.0])
         except SlaveError as e:  # the FMU's status output says why
             raise _failed_point(y, f"at t = {t:g} s: {e}") from None
-        if not (math.isfinite(torque0) and math.isfinite(j)):
+        if not math.isfinite(j):
             raise _failed_point(y, f"at t = {t:g} s")
         d.set(("load.torque", "load.inertia"), (-torque0, j))
         eps = d.get("crank.epsilon")
@@ -247,7 +337,7 @@ class DrivenRun(_Common):
     def _run(self, values: tuple) -> Outcome:
         d = _fresh(self.drive, "drive", self._drive_parameters(values))
         y = _fresh(self.mechanism, "mechanism", self.mechanism_parameters(values))
-        inputs, names = self.inputs(), series_names(self.figures)
+        inputs, names = self.inputs(), self.read()
         own = tuple(n for n in names if not n.startswith("drive."))
         of_drive = tuple(n[6:] for n in names if n.startswith("drive."))
         n = int(round(self.duration / self.step))
@@ -257,13 +347,15 @@ class DrivenRun(_Common):
             phi = self._point(d, y, k * self.step, inputs)
             if k >= first:
                 phis.append(phi)
-                rows.append(tuple(y.get(own)) + tuple(d.get(of_drive)))
+                recorded = y.get(own)  # at the crank's acceleration: solved again
+                _check_point(y, recorded, f"at t = {k * self.step:g} s")
+                rows.append(tuple(recorded) + tuple(d.get(of_drive)))
             if k < n:
                 y.do_step(k * self.step, self.step)
                 d.do_step(k * self.step, self.step)
-        recorded = np.array(rows).reshape(len(rows), len(names))
+        table = np.array(rows).reshape(len(rows), len(names))
         order = own + tuple(f"drive.{q}" for q in of_drive)
-        series = {name: recorded[:, order.index(name)] for name in names}
+        series = {name: table[:, order.index(name)] for name in names}
         return self.outcome(series, np.unwrap(np.array(phis)))
 
 
@@ -292,6 +384,8 @@ def run_of(
         fixed=study.fixed,
         loads=study.loads,
         figures=study.figures,
+        amplifications=amplification_outputs(md),
+        min_digits=study.min_digits,
     )
     if isinstance(study.run, Kinetostatic):
         return KinetostaticRun(**common, speed=study.run.speed, points=study.run.points)

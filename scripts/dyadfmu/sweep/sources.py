@@ -2,8 +2,9 @@
 names a scene runs that scene's mechanism FMU built with the study's parameters tunable:
 the scene is copied to the study's output folder with those parameters added to its
 ``tunable`` list, under the identifier ``<identifier>_sweep_<hash of the copy>``, and
-built by scripts/build-scene into build-scene/fmus/ unless that FMU is there already. The
-drive FMU is the build's."""
+built by the project's CMake (:mod:`dyadfmu.sweep.scenebuild`: the checkout's
+build-scene/fmus/, or the study's output folder for an installed package) unless that
+FMU is there already. The drive FMU is the build's."""
 
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .. import paths
+from .scenebuild import BuildError, generator, scene_fmu
 from .studyfile import Counterweight, Driven, Study, StudyError, line_of
 
 __all__ = [
@@ -99,7 +101,7 @@ def check_scene(scene: Path) -> None:
     """SourceError with the scene checker's messages (FILE:LINE each) where the scene
     file is not a valid scene."""
     done = subprocess.run(
-        [sys.executable, str(paths.ROOT / "modelDescription" / "scene.py"), str(scene), "--check"],
+        [sys.executable, str(generator()), str(scene), "--check"],
         capture_output=True,
         text=True,
     )
@@ -120,8 +122,23 @@ def _copy_of(scene_file: Path, study: Study) -> dict:
     if not isinstance(tunable, list) or not all(isinstance(n, str) for n in tunable):
         raise ValueError("[scene] tunable must be a list of parameter names")
     scene["tunable"] = tunable + [n for n in _varied(study) if n not in tunable]
+    outputs = scene.get("outputs")
+    if isinstance(outputs, list) and "all" not in outputs:
+        # every dyad's amplification: the round-off bound a study checks at each sample
+        scene["outputs"] = outputs + [n for n in _amplifications(data) if n not in outputs]
     toml_text(data)  # every value can be written
     return data
+
+
+def _amplifications(data: dict) -> list:
+    """The amplification outputs of a scene's dyads (``DYAD.amplification``; a lone dyad
+    without a name has ``amplification``)."""
+    dyads = data.get("dyad")
+    dyads = [d for d in dyads if isinstance(d, dict)] if isinstance(dyads, list) else []
+    names = [d.get("name") for d in dyads]
+    if len(names) == 1 and names[0] is None:
+        return ["amplification"]
+    return [f"{n}.amplification" for n in names if isinstance(n, str)]
 
 
 def sweep_scene(study: Study, out: Path) -> Path:
@@ -146,20 +163,12 @@ def sweep_scene(study: Study, out: Path) -> Path:
     return path
 
 
-def _build_scene(original: Path, scene: Path, identifier: str, fmi: int) -> Path:
-    fmu = paths.ROOT / "build-scene" / "fmus" / f"{identifier}_fmi{fmi}.fmu"
-    if fmu.is_file():  # the identifier names the scene's content
-        return fmu
-    check_scene(original)  # a problem of the user's file named at its own line
-    done = subprocess.run(
-        [str(paths.ROOT / "scripts" / "build-scene"), str(scene)],
-        capture_output=True,
-        text=True,
-        env=dict(os.environ),
-    )
-    if done.returncode != 0 or not fmu.is_file():
-        raise SourceError(f"scripts/build-scene {scene} failed:\n{done.stderr[-2000:]}")
-    return fmu
+def _build_scene(scene: Path, identifier: str, fmi: int, out: Path) -> Path:
+    """The copy's FMU (its scene was generated already: planned_model_description)."""
+    try:
+        return scene_fmu(scene, identifier, fmi, out)
+    except BuildError as e:
+        raise SourceError(str(e)) from None
 
 
 def _generator_refusal(study: Study, stderr: str) -> SourceError:
@@ -181,7 +190,7 @@ def planned_model_description(study: Study, out: Path) -> tuple[ModelDescription
     identifier = tomllib.loads(scene.read_text(encoding="utf-8"))["scene"]["identifier"]
     with tempfile.TemporaryDirectory(prefix="dyadfmu-sweep-") as generated:
         done = subprocess.run(
-            [sys.executable, str(paths.GENERATOR), str(scene), "--out", generated],
+            [sys.executable, str(generator()), str(scene), "--out", generated],
             capture_output=True,
             text=True,
         )
@@ -199,7 +208,7 @@ def mechanism_fmu(study: Study, out: Path) -> Path:
     scene = sweep_scene(study, out)
     identifier = tomllib.loads(scene.read_text(encoding="utf-8"))["scene"]["identifier"]
     try:
-        return _build_scene(study.scene, scene, identifier, study.fmi)
+        return _build_scene(scene, identifier, study.fmi, out)
     except SourceError as e:
         _refuse_unknown_name(study, str(e))
         raise

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NoReturn
 
+import numpy as np
+
 __all__ = [
     "StudyError",
     "Parameter",
@@ -40,7 +42,12 @@ _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
 #: The drive FMU's parameters a study may set or vary (as ``drive.<name>``).
 DRIVE_PARAMETERS = ("motor.stall_torque", "motor.no_load_speed", "inertia")
 #: The table's own columns, which no parameter or figure may be named.
-RESERVED_COLUMNS = ("design", "status", "message")
+RESERVED_COLUMNS = ("design", "digits", "status", "message")
+#: The digits a design's outputs must keep by default ([study] min_digits): half of a
+#: double's, the core's singular threshold sqrt(eps) on a load that does not cancel.
+MIN_DIGITS = 8.0
+#: The most digits a double gives: -log10(eps), eps = 2^-52.
+DOUBLE_DIGITS = 52 * math.log10(2)
 #: A driven run's figures are taken from at least this many communication points.
 MIN_RECORDED = 10
 #: The most work a study may ask for: crank positions (kinetostatic: designs x points)
@@ -161,10 +168,28 @@ class Figure:
 
 @dataclass(frozen=True)
 class Constraint:
-    """A design is feasible where ``figure`` <= ``maximum``."""
+    """A design is feasible where ``minimum`` <= ``figure`` <= ``maximum`` (a bound that
+    is None does not apply; at least one is given)."""
 
     figure: str
-    maximum: float
+    maximum: float | None = None
+    minimum: float | None = None
+
+    def met(self, values: np.ndarray) -> np.ndarray:
+        """Which of the figure's ``values`` meet the constraint (NaN meets none)."""
+        values = np.asarray(values, dtype=float)
+        ok = np.isfinite(values)
+        if self.minimum is not None:
+            ok &= values >= self.minimum
+        if self.maximum is not None:
+            ok &= values <= self.maximum
+        return ok
+
+    @property
+    def higher_is_better(self) -> bool:
+        """A lower bound alone: the larger the figure, the further inside (a transmission
+        angle, a conditioning)."""
+        return self.maximum is None
 
 
 @dataclass(frozen=True)
@@ -227,6 +252,7 @@ class Study:
     figures: tuple
     objective: Objective
     text: str = field(repr=False, default="")
+    min_digits: float = MIN_DIGITS
 
     @property
     def name(self) -> str:
@@ -643,34 +669,49 @@ def _objective(r: _Reader, data: dict, figures: tuple) -> Objective:
         r.fail(
             "objective", f"minimize must name a figure: {', '.join(sorted(names))}", key="minimize"
         )
-    constraints = []
     items = t.get("constraints", [])
     if not isinstance(items, list) or len(items) > 100:
         r.fail("objective", "constraints must be a list of constraints", key="constraints")
-    for c in items:
-        if (
-            not isinstance(c, dict)
-            or set(c) != {"figure", "max"}
-            or not isinstance(c["figure"], str)
-            or c["figure"] not in names
-        ):
-            r.fail(
-                "objective",
-                f"a constraint is {{ figure = NAME, max = NUMBER }} with NAME one of "
-                f"{', '.join(sorted(names))}",
-                key="constraints",
-            )
-        maximum = finite(c["max"])
-        if maximum is None:
-            r.fail(
-                "objective",
-                f"{c['figure']}: a constraint's max must be a finite number "
-                f"(got {_shown(c['max'])})",
-                key="constraints",
-            )
-        constraints.append(Constraint(c["figure"], maximum))
+    constraints = [_constraint(r, c, names) for c in items]
     best = r.integer(t, "objective", "best", 1, 1000, default=5)
     return Objective(t["minimize"], tuple(constraints), best)
+
+
+def _constraint(r: _Reader, c: object, names: set) -> Constraint:
+    """One constraint: { figure = NAME, max = NUMBER }, { figure = NAME, min = NUMBER } or
+    both bounds."""
+    if (
+        not isinstance(c, dict)
+        or not set(c) <= {"figure", "min", "max"}
+        or not {"min", "max"} & set(c)
+        or not isinstance(c.get("figure"), str)
+        or c["figure"] not in names
+    ):
+        r.fail(
+            "objective",
+            "a constraint is { figure = NAME, max = NUMBER }, { figure = NAME, min = NUMBER } "
+            f"or both bounds, with NAME one of {', '.join(sorted(names))}",
+            key="constraints",
+        )
+    bounds = {}
+    for key in ("min", "max"):
+        if key in c:
+            bounds[key] = finite(c[key])
+            if bounds[key] is None:
+                r.fail(
+                    "objective",
+                    f"{c['figure']}: a constraint's {key} must be a finite number "
+                    f"(got {_shown(c[key])})",
+                    key="constraints",
+                )
+    if "min" in bounds and "max" in bounds and not bounds["min"] <= bounds["max"]:
+        r.fail(
+            "objective",
+            f"{c['figure']}: a constraint's min {bounds['min']:g} is above its max "
+            f"{bounds['max']:g}: no design could meet it",
+            key="constraints",
+        )
+    return Constraint(c["figure"], maximum=bounds.get("max"), minimum=bounds.get("min"))
 
 
 def _fixed_value(r: _Reader, fixed: dict, name: str) -> float:
@@ -773,7 +814,7 @@ def read_study(path: Path | str) -> Study:
         ("study", "run", "drive", "sampling", "parameter", "loads", "fixed", "figure", "objective"),
     )
     study = r.table(data, "study")
-    r.unknown_keys(study, "study", ("description", "scene", "fmu", "fmi"))
+    r.unknown_keys(study, "study", ("description", "scene", "fmu", "fmi", "min_digits"))
     description = study.get("description", "")
     if not isinstance(description, str) or len(description) > 500:
         r.fail("study", "description must be one line of text", key="description")
@@ -783,6 +824,14 @@ def read_study(path: Path | str) -> Study:
             "study", "fmi chooses the version a scene is built for: an .fmu has its own", key="fmi"
         )
     fmi = r.integer(study, "study", "fmi", 2, 3, default=2)
+    min_digits = r.number(study, "study", "min_digits", default=MIN_DIGITS)
+    if not 0 <= min_digits <= DOUBLE_DIGITS:
+        r.fail(
+            "study",
+            f"min_digits must be from 0 to {DOUBLE_DIGITS:.2f} (a double's digits), "
+            f"got {min_digits:g}",
+            key="min_digits",
+        )
     run = _run(r, data)
     params = _parameters(r, data, isinstance(run, Driven))
     loads_t = r.table(data, "loads", False)
@@ -807,4 +856,5 @@ def read_study(path: Path | str) -> Study:
         figures=figures,
         objective=_objective(r, data, figures),
         text=text,
+        min_digits=min_digits,
     )
