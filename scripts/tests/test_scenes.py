@@ -166,7 +166,7 @@ def test_static_press_takes_no_motion_and_computes_no_inertia_or_weight():
 
 def test_horizontal_monitor_has_no_weight_and_one_reaction():
     v = variables("monitor")
-    assert v["output"] == ["agitator.R_mk.x", "agitator.R_mk.y", "status"]
+    assert v["output"] == ["agitator.R_mk.x", "agitator.R_mk.y", "amplification", "status"]
     assert v["parameter"] == ["rocker.mass", "on_singular"]
     assert not any("gravity" in n for n in v["input"] + v["parameter"])
     code = (GENERATED / "monitor" / "monitor_scene.c").read_text()
@@ -194,6 +194,33 @@ def test_outputs_of_one_dyad_solve_only_what_loads_it(tmp_path):
     md = (out / "fmi2" / "modelDescription.xml").read_text()
     inputs = re.findall(r'name="([^"]+)"[^>]*causality="input"', md)
     assert inputs == ["crank.angle", "crank.omega", "crank.epsilon", "output.moment"]
+
+
+def test_a_mechanism_fmu_always_bounds_what_it_reports(tmp_path):
+    """A mechanism FMU's own amplification is always an output: with reactions asked,
+    the bound of each dyad solved; with the motion alone, three times the motion's
+    amplification of each dyad whose kinematics run, every one carried to the next."""
+    text = (SCENES_DIR / "sixbar.toml").read_text()
+    for wanted, terms in (
+        ('["second.R_np"]', ["second_bound", "3.0 * kin.first.amplification"]),
+        ('["rocker.omega"]', ["3.0 * kin.first.amplification"]),
+        ('["output.epsilon"]', ["3.0 * kin.first.amplification", "3.0 * kin.second.amplification"]),
+    ):
+        scene = tmp_path / "sixbar_some.toml"
+        scene.write_text(
+            text.replace('outputs = ["all"]', f"outputs = {wanted}").replace(
+                'identifier = "sixbar"', 'identifier = "sixbar_some"'
+            )
+        )
+        out = tmp_path / "gen"
+        assert run_tool(scene, "--out", out).returncode == 0
+        code = (out / "sixbar_some_scene.c").read_text()
+        line = re.search(r"out->amplification = ([^N].*);", code).group(1)
+        assert line == " + ".join(["1.0", *terms]), (wanted, line)
+        carried = "k.mount_amplification = kin->first.amplification;" in code
+        assert carried == any("second" in t for t in terms), wanted  # where second moves
+        md = (out / "fmi2" / "modelDescription.xml").read_text()
+        assert 'name="amplification"' in md
 
 
 def test_the_generic_scenes_are_the_per_type_fmus():

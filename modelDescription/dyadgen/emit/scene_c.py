@@ -431,12 +431,16 @@ def _bound(plan: Plan, code: _Code, d: Dyad) -> None:
 
 def mechanism_amplification(plan: Plan) -> str:
     """The C expression of a mechanism FMU's amplification: the bound of every output it
-    reports, its dyads' reactions (their motion's round-off carried in) and the motion
-    itself, three times over for the accelerations and the effective inertia."""
+    reports. A dyad whose reactions are solved contributes its bound, which holds its
+    motion's amplification twice over; one whose motion alone is reported, three times
+    its motion's (the accelerations and the effective inertia square the rates)."""
+    solved = {d.index for d in plan.solved}
     terms = ["1.0"] + [f"{member(d.name or 'dyad')}_bound" for d in plan.solved]
-    kin = [f"kin.{kinematics_c.kin_name(d)}.amplification" for d in plan.kinematic]
-    if kin:
-        terms.append(f"3.0 * ({' + '.join(kin)})")
+    terms += [
+        f"3.0 * kin.{kinematics_c.kin_name(d)}.amplification"
+        for d in plan.kinematic
+        if d.index not in solved
+    ]
     return " + ".join(terms)
 
 
