@@ -30,8 +30,7 @@ enum { HEADER = 32, MAX_VALUES = 512, MISMATCHES_SHOWN = 8 };
 
 /* The states of the co-simulation state machine, as the test tells them apart. */
 typedef enum machine { M_INSTANTIATED = 0, M_INITIALIZATION, M_STEP, M_TERMINATED } machine;
-static const char* const machine_names[] = {"Instantiated", "Initialization", "Step",
-                                            "Terminated"};
+static const char* const machine_names[] = {"Instantiated", "Initialization", "Step", "Terminated"};
 
 /* The drive's states and the start parameters a fresh instance takes them from. */
 static const char* const model_states[][2] = {{"crank.angle", "start.angle"},
@@ -82,9 +81,9 @@ static int new_instance(const fmu* f, instance* in, const char* name)
         in->c = f->f2.Instantiate(name, fmi2CoSimulation, f->md.token, "", &callbacks, fmi2False,
                                   fmi2False);
     } else {
-        in->c = f->f3.InstantiateCoSimulation(name, f->md.token, NULL, fmi3False, fmi3False,
-                                              fmi3False, fmi3False, NULL, 0, &in->book,
-                                              probe_fmi3_logger, NULL);
+        in->c =
+            f->f3.InstantiateCoSimulation(name, f->md.token, NULL, fmi3False, fmi3False, fmi3False,
+                                          fmi3False, NULL, 0, &in->book, probe_fmi3_logger, NULL);
     }
     return in->c != NULL;
 }
@@ -186,8 +185,7 @@ static int do_step(instance* in, double t, double h, double* last, int* flag)
         *flag = terminated != fmi2False;
     } else {
         fmi3Boolean event = fmi3False, terminated = fmi3False, early = fmi3False;
-        status =
-            (int)in->f->f3.DoStep(in->c, t, h, fmi3True, &event, &terminated, &early, last);
+        status = (int)in->f->f3.DoStep(in->c, t, h, fmi3True, &event, &terminated, &early, last);
         *flag = terminated != fmi3False;
     }
     return status;
@@ -405,10 +403,10 @@ static unsigned char* base_state(const fmu* f, int steps, size_t* size)
 
 typedef struct restored {
     machine m;
-    int was_instantiated; /* restored in Instantiated, then entered initialization */
-    reading before;       /* the outputs as restored (the first state they can be read in) */
-    int exit_status;      /* from Initialization: exitInitializationMode's status */
-    reading after_exit;   /* and the outputs after it */
+    int was_instantiated;      /* restored in Instantiated, then entered initialization */
+    reading before;            /* the outputs as restored (the first state they can be read in) */
+    int exit_status;           /* from Initialization: exitInitializationMode's status */
+    reading after_exit;        /* and the outputs after it */
     double values[MAX_VALUES]; /* parameters, inputs, then settings as read back */
     int64_t settings[MAX_VALUES];
     double states[MODEL_STATE_COUNT];
@@ -505,7 +503,8 @@ static int fresh_like(const fmu* f, instance* ref, const restored* r, reading* b
         return 0;
     }
     for (k = 0; k < f->n_parameters + f->n_inputs; ++k) {
-        const size_t index = k < f->n_parameters ? f->parameters[k] : f->inputs[k - f->n_parameters];
+        const size_t index =
+            k < f->n_parameters ? f->parameters[k] : f->inputs[k - f->n_parameters];
         double value = r->values[k];
         /* after initialization the states are their own; before, they follow their
          * start values, which the fresh instance is given as they are */
@@ -561,8 +560,10 @@ static int same_step(instance* in, instance* ref, const restored* r, char* why, 
     }
     if ((status_in == 0 || status_in == 2) &&
         (probe_bits(last_in) != probe_bits(last_ref) || flag_in != flag_ref)) {
-        snprintf(why, why_size, "after doStep: last successful time %.17g, terminate %d; a fresh "
-                 "instance %.17g, %d", last_in, flag_in, last_ref, flag_ref);
+        snprintf(why, why_size,
+                 "after doStep: last successful time %.17g, terminate %d; a fresh "
+                 "instance %.17g, %d",
+                 last_in, flag_in, last_ref, flag_ref);
         return 0;
     }
     read_outputs(in, &a);
@@ -593,12 +594,11 @@ static int agrees(instance* in, tally* t, char* why, size_t why_size)
     ref.c = NULL;
     ok = fresh_like(in->f, &ref, &r, &before, &after_exit, why, why_size);
     if (ok && (bad = differs(in->f, &r.before, &before)) != -1) {
-        snprintf(why, why_size, "in %s, %s differs from a fresh instance's",
-                 machine_names[r.m], bad >= 0 ? var(in->f, (size_t)bad)->name : "a getter's status");
+        snprintf(why, why_size, "in %s, %s differs from a fresh instance's", machine_names[r.m],
+                 bad >= 0 ? var(in->f, (size_t)bad)->name : "a getter's status");
         ok = 0;
     }
-    if (ok && r.m == M_INITIALIZATION &&
-        (bad = differs(in->f, &r.after_exit, &after_exit)) != -1) {
+    if (ok && r.m == M_INITIALIZATION && (bad = differs(in->f, &r.after_exit, &after_exit)) != -1) {
         snprintf(why, why_size, "after exitInitializationMode, %s differs",
                  bad >= 0 ? var(in->f, (size_t)bad)->name : "a getter's status");
         ok = 0;
@@ -650,8 +650,9 @@ static void try_state(instance* target, const unsigned char* bytes, size_t size,
 /* The values an 8-byte field is given: doubles, then integers. */
 static size_t field_values(const unsigned char* field, uint64_t out[], size_t capacity)
 {
-    double was, doubles[] = {NAN, INFINITY, -INFINITY, 7, -1, 1e300, -1e300, 0, -0.0, 1, 2, 3,
-                             0.5, DBL_MAX, DBL_MIN, 4.9e-324, 0, 0, 0, 0};
+    double was,
+        doubles[] = {NAN, INFINITY, -INFINITY, 7,       -1,      1e300,    -1e300, 0, -0.0, 1,
+                     2,   3,        0.5,       DBL_MAX, DBL_MIN, 4.9e-324, 0,      0, 0,    0};
     const int64_t integers[] = {0, 1, 2, 3, 4, 5, 7, 8, 16, -1, INT64_MAX, INT64_MIN};
     const size_t n_doubles = sizeof doubles / sizeof doubles[0];
     size_t k, n = 0;
@@ -731,7 +732,8 @@ static void fuzz_random(instance* target, const unsigned char* base, size_t size
         at = HEADER + 8 * (size_t)probe_rng_below(&rng, fields);
         value = probe_rng_next(&rng);
         if (k % 2 == 1) { /* a double of any magnitude and sign */
-            const double x = ldexp(probe_rng_uniform(&rng) - 0.5, (int)probe_rng_below(&rng, 80) - 40);
+            const double x =
+                ldexp(probe_rng_uniform(&rng) - 0.5, (int)probe_rng_below(&rng, 80) - 40);
             memcpy(&value, &x, 8);
         }
         memcpy(bytes, base, size);
@@ -804,11 +806,11 @@ static int load(const char* directory, int version, fmu* f)
     char error[512];
     memset(f, 0, sizeof *f);
     f->version = version;
-    if (!probe_read_model(directory, &f->md, error, sizeof error) ||
-        f->md.fmi_version != version ||
+    if (!probe_read_model(directory, &f->md, error, sizeof error) || f->md.fmi_version != version ||
         !(version == 2 ? probe_load_fmi2(&f->md, &f->f2, error, sizeof error)
                        : probe_load_fmi3(&f->md, &f->f3, error, sizeof error))) {
-        printf("%s: %s\n", directory, f->md.fmi_version != version ? "not this FMI version" : error);
+        printf("%s: %s\n", directory,
+               f->md.fmi_version != version ? "not this FMI version" : error);
         return 0;
     }
     sort_variables(f);
