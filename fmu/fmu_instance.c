@@ -4,6 +4,7 @@
 #include "dyadfmu/angle.h"
 
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -147,6 +148,11 @@ static void store(fmu_instance* instance, size_t index, double value)
     *kept_value(instance, index) = value;
 }
 
+double* fmu_kept_value(fmu_instance* instance, size_t index)
+{
+    return kept_value(instance, index);
+}
+
 /* The (cos, sin) of every angle that changed since the model last read them, two at
  * a time (both again where one of the two changed: as cheap as one alone). It runs
  * only before an evaluation, so comparing each angle costs less than a flag kept up
@@ -254,25 +260,18 @@ static void build_slots(fmu_instance* instance)
     instance->get_plan.count = FMU_NO_PLAN;
 }
 
-void fmu_rebuild_slots(fmu_instance* instance)
-{
-    build_slots(instance);
-    find_common_paths(instance);
-}
-
-int fmu_value_allowed(const fmu_variable* v, double value)
-{
-    fmu_slot range;
-    accepted_range(v, &range);
-    return value >= range.low && value <= range.high;
-}
-
-void fmu_angles_stale(fmu_instance* instance)
+void fmu_restored(fmu_instance* instance, fmu_state state)
 {
     size_t k;
     for (k = 0; k < instance->angle_count; ++k) {
         instance->angles[k].converted = NAN;
     }
+    instance->evaluation.status = FMU_OK;
+    instance->evaluation.bad_variable = -1;
+    instance->evaluation.reason[0] = '\0';
+    instance->dirty = 1;
+    enter_state(instance, state);
+    build_slots(instance);
 }
 
 /* The angle variables, and the settings the layer reads (kept as set). */
@@ -682,8 +681,10 @@ static fmu_status advance_states(fmu_instance* instance, double current_time, do
             return FMU_OK;
         }
     }
-    instance->last_successful_time = current_time;
-    instance->terminate_requested = status == FMU_DISCARD;
+    if (status == FMU_DISCARD) {
+        instance->last_successful_time = current_time;
+        instance->terminate_requested = 1;
+    }
     return status;
 }
 
@@ -694,11 +695,30 @@ static int continues(const fmu_instance* instance)
     return instance->on_singular != NULL && *instance->on_singular == FMU_ON_SINGULAR_CONTINUE;
 }
 
+/* A step of an algebraic model: its outputs for the inputs, or none. */
+static fmu_status step_algebraic(fmu_instance* instance, double current_time, double step_size,
+                                 const char* function)
+{
+    fmu_status status =
+        solve(instance, continues(instance) ? FMU_WARNING : FMU_DISCARD, function, 1);
+    if (status == FMU_WARNING) {
+        status = FMU_OK; /* on_singular = continue: the outputs NaN, the status set */
+    }
+    if (status == FMU_OK) {
+        step_completed(instance, current_time + step_size);
+    } else if (status == FMU_DISCARD) {
+        instance->last_successful_time = current_time;
+        instance->terminate_requested = 1;
+    }
+    return status;
+}
+
 /* A step the common path did not take: a checked call, a model with states, or a
  * step without an answer. */
 FMU_COLD static fmu_status do_step_checked(fmu_instance* instance, double current_time,
                                            double step_size, const char* function)
 {
+    double time;
     fmu_status status = fmu_check_call(instance, FMU_OP_DO_STEP, function);
     if (status != FMU_OK) {
         return status;
@@ -710,19 +730,15 @@ FMU_COLD static fmu_status do_step_checked(fmu_instance* instance, double curren
         check_continues(instance, current_time, function) != FMU_OK) {
         return FMU_ERROR;
     }
-    instance->time = current_time;
-    if (instance->model->behaviour->advance != NULL) {
-        return advance_states(instance, current_time, step_size, function);
-    }
-    status = solve(instance, continues(instance) ? FMU_WARNING : FMU_DISCARD, function, 1);
-    if (status == FMU_WARNING) {
-        status = FMU_OK; /* on_singular = continue: the outputs NaN, the status set */
-    }
-    if (status == FMU_OK) {
-        step_completed(instance, current_time + step_size);
-    } else if (status == FMU_DISCARD) {
-        instance->last_successful_time = current_time;
-        instance->terminate_requested = 1;
+    time = instance->time;
+    instance->time = current_time; /* where a failure found now is logged */
+    status = instance->model->behaviour->advance != NULL
+                 ? advance_states(instance, current_time, step_size, function)
+                 : step_algebraic(instance, current_time, step_size, function);
+    if (status == FMU_ERROR) {
+        /* a step refused reached no time: the time, the last successful time and the
+         * terminate flag stay, so that the last successful time is never after the time */
+        instance->time = time;
     }
     return status;
 }
@@ -845,10 +861,58 @@ static const char* items_of(const fmu_variable* v)
     return "see its declared type";
 }
 
+/* Why a value of an Enumeration is not one of its items (NaN, a fraction, another
+ * number); 0 if it is. */
+static int item_refused(const fmu_variable* v, double value, char* why, size_t size)
+{
+    if (value >= v->min && value <= v->max && value == floor(value)) {
+        return 0;
+    }
+    snprintf(why, size, "%s = %.17g is not an item of its enumeration: %s", v->name, value,
+             items_of(v));
+    return 1;
+}
+
+/* Why a value outside v's bounds is; 0 if it is within them. */
+static int bound_refused(const fmu_variable* v, double value, char* why, size_t size)
+{
+    if ((v->bounds & FMU_HAS_MIN) &&
+        ((v->bounds & FMU_MIN_EXCLUSIVE) ? !(value > v->min) : !(value >= v->min))) {
+        snprintf(why, size, "%s = %g %s: it must be %s %g", v->name, value, v->unit,
+                 (v->bounds & FMU_MIN_EXCLUSIVE) ? ">" : ">=", v->min);
+        return 1;
+    }
+    if ((v->bounds & FMU_HAS_MAX) &&
+        ((v->bounds & FMU_MAX_EXCLUSIVE) ? !(value < v->max) : !(value <= v->max))) {
+        snprintf(why, size, "%s = %g %s: it must be %s %g", v->name, value, v->unit,
+                 (v->bounds & FMU_MAX_EXCLUSIVE) ? "<" : "<=", v->max);
+        return 1;
+    }
+    return 0;
+}
+
+int fmu_value_refused(const fmu_variable* v, double value, char* why, size_t size)
+{
+    if (v->type == FMU_ENUMERATION) {
+        return item_refused(v, value, why, size);
+    }
+    if (!isfinite(value)) {
+        snprintf(why, size, "%s = %g is not a finite number", v->name, value);
+        return 1;
+    }
+    if (v->type == FMU_INTEGER &&
+        !(value == floor(value) && value >= (double)INT_MIN && value <= (double)INT_MAX)) {
+        snprintf(why, size, "%s = %.17g is not an Integer", v->name, value);
+        return 1;
+    }
+    return bound_refused(v, value, why, size);
+}
+
 /* Whether a value may be stored in v now; logs the reason if not. */
 static fmu_status check_settable(const fmu_instance* instance, const fmu_variable* v, double value,
                                  const char* function)
 {
+    char why[300];
     if (v->causality == FMU_OUTPUT) {
         fmu_log(instance, FMU_ERROR, "%s: %s is an output and cannot be set", function, v->name);
         return FMU_ERROR;
@@ -860,26 +924,8 @@ static fmu_status check_settable(const fmu_instance* instance, const fmu_variabl
                 function, v->name, state_name(instance->state));
         return FMU_ERROR;
     }
-    if (!isfinite(value)) {
-        fmu_log(instance, FMU_ERROR, "%s: %s = %g is not a finite number", function, v->name,
-                value);
-        return FMU_ERROR;
-    }
-    if (v->type == FMU_ENUMERATION && !(value >= v->min && value <= v->max)) {
-        fmu_log(instance, FMU_ERROR, "%s: %s = %.0f is not an item of its enumeration: %s",
-                function, v->name, value, items_of(v));
-        return FMU_ERROR;
-    }
-    if ((v->bounds & FMU_HAS_MIN) &&
-        ((v->bounds & FMU_MIN_EXCLUSIVE) ? !(value > v->min) : !(value >= v->min))) {
-        fmu_log(instance, FMU_ERROR, "%s: %s = %g %s: it must be %s %g", function, v->name, value,
-                v->unit, (v->bounds & FMU_MIN_EXCLUSIVE) ? ">" : ">=", v->min);
-        return FMU_ERROR;
-    }
-    if ((v->bounds & FMU_HAS_MAX) &&
-        ((v->bounds & FMU_MAX_EXCLUSIVE) ? !(value < v->max) : !(value <= v->max))) {
-        fmu_log(instance, FMU_ERROR, "%s: %s = %g %s: it must be %s %g", function, v->name, value,
-                v->unit, (v->bounds & FMU_MAX_EXCLUSIVE) ? "<" : "<=", v->max);
+    if (fmu_value_refused(v, value, why, sizeof why)) {
+        fmu_log(instance, FMU_ERROR, "%s: %s", function, why);
         return FMU_ERROR;
     }
     return FMU_OK;
@@ -897,11 +943,31 @@ static double value_at(const void* values, array_type array, size_t k)
     return ((const double*)values)[k];
 }
 
+/* A kept value as the importer's integer type. Every value kept is one the type holds
+ * (the setters and a restored FMU state check it); were one not, it saturates, and a
+ * NaN reads as the type's minimum, rather than convert with undefined behaviour. */
+static int to_int(double value)
+{
+    if (value >= (double)INT_MAX) {
+        return INT_MAX;
+    }
+    return value > (double)INT_MIN ? (int)value : INT_MIN;
+}
+
+static int64_t to_int64(double value)
+{
+    const double limit = 9223372036854775808.0; /* 2^63: INT64_MAX + 1 */
+    if (value >= limit) {
+        return INT64_MAX;
+    }
+    return value >= -limit ? (int64_t)value : INT64_MIN;
+}
+
 static void store_at(void* values, array_type array, size_t k, double value)
 {
     switch (array) {
-    case ARRAY_INT: ((int*)values)[k] = (int)value; break;
-    case ARRAY_INT64: ((int64_t*)values)[k] = (int64_t)value; break;
+    case ARRAY_INT: ((int*)values)[k] = to_int(value); break;
+    case ARRAY_INT64: ((int64_t*)values)[k] = to_int64(value); break;
     case ARRAY_DOUBLE: ((double*)values)[k] = value; break;
     }
 }

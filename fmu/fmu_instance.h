@@ -254,16 +254,20 @@ fmu_status fmu_serialize_state(fmu_instance* instance, const fmu_saved* state, u
                                size_t size, const char* function);
 fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* bytes, size_t size,
                                  fmu_saved** state, const char* function);
-/* The slots, plans and common paths again after the state machine's state was
- * restored. */
-void fmu_rebuild_slots(fmu_instance* instance);
 
-/* 1 if `value` may be set to `v` (a Real parameter or input): finite and within its
- * bounds, whatever the state. */
-int fmu_value_allowed(const fmu_variable* v, double value);
+/* Where the value of a parameter, input or setting (variable `index`) is kept as set:
+ * where the model reads it, or for an angle or a setting in `values`. */
+double* fmu_kept_value(fmu_instance* instance, size_t index);
 
-/* After a state was restored: every angle's unit vector computed again from the
- * angle, before the model next reads it. */
-void fmu_angles_stale(fmu_instance* instance);
+/* 0 if `value` may be stored in the parameter, input or setting v, whatever the
+ * state: a Real finite and within its bounds, an Integer a whole number of its type
+ * within its bounds, an Enumeration one of its items. Else 1, with why not (naming
+ * v, "on_singular = nan is not an item of its enumeration: ...") in `why`. */
+int fmu_value_refused(const fmu_variable* v, double value, char* why, size_t size);
+
+/* After a state's values were stored (fmu_kept_value) and its model states written
+ * into the input block: the state machine in `state`, and the outputs to be evaluated
+ * again before they are read (every angle's unit vector converted again). */
+void fmu_restored(fmu_instance* instance, fmu_state state);
 
 #endif /* DYADFMU_FMU_INSTANCE_H */

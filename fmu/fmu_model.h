@@ -101,6 +101,24 @@ typedef struct fmu_evaluation {
     char reason[200];
 } fmu_evaluation;
 
+/* One state of a model with states: a double of its input block that its start sets
+ * and its steps advance (the drive: the crank's angle and speed). An FMU state keeps
+ * it, since nothing else does. */
+typedef struct fmu_model_state {
+    const char* name; /* as its output shows it, e.g. "crank.angle" */
+    const char* unit; /* SI unit, "" if dimensionless */
+    size_t offset;    /* of the double in the input block */
+} fmu_model_state;
+
+/* The states of a model with states. */
+typedef struct fmu_states {
+    const fmu_model_state* states;
+    size_t count;
+    /* The index of the first state that no start or step could have left in the input
+     * block `input` (its parameters and inputs set, their angles converted), or -1. */
+    int (*refused)(const struct fmu_model* model, const void* input);
+} fmu_states;
+
 /* What a kind of model computes, on its own input and output blocks. */
 typedef struct fmu_behaviour {
     size_t input_size;  /* bytes of the input block */
@@ -122,11 +140,9 @@ typedef struct fmu_behaviour {
      * rates; an angle's rate as the derivative of its (cos, sin)). NULL: none. */
     void (*derivative)(const struct fmu_model* model, const void* input, const void* seed,
                        void* output, void* rate, fmu_evaluation* evaluation);
-    /* A model with states: the name of a state that no step could have left in the
-     * input block `input` (bytes of a deserialized FMU state, perhaps unaligned),
-     * with its value, or NULL. NULL: no state to check. */
-    const char* (*state_refused)(const struct fmu_model* model, const unsigned char* input,
-                                 double* value);
+    /* A model with states: what they are, for an FMU state (fmu_state.c). NULL for an
+     * algebraic model. */
+    const fmu_states* states;
 } fmu_behaviour;
 
 /* The calls an importer makes every step, set every Real input and get every Real

@@ -1,26 +1,37 @@
 /* dyadfmu FMU layer: FMU state (canGetAndSetFMUState, canSerializeFMUState), the
  * same for FMI 2 and FMI 3.
  *
- * What an instance is, beyond its model and its importer's settings: the state
- * machine's state, the time reached, the values as set (parameters, inputs,
- * angles), the model's input block (for the drive, its states too) and output
- * block with the last evaluation, and the angles' converted values. A saved state
- * holds exactly that, in the serialized form itself, so that get, set, serialize
- * and deserialize are one format and two copies:
+ * A state holds what the FMU cannot compute again and nothing it can: the state
+ * machine's state, the time and the last successful time, the terminate flag, the
+ * value of every parameter, input and setting as set, and the model's own states (the
+ * drive's crank angle and speed: fmu_behaviour.states). The outputs, the evaluation
+ * and the angles' unit vectors are not kept: a restored instance evaluates again
+ * before its outputs are read, so that no byte of a state can make an output disagree
+ * with its inputs. A saved state is the serialized form itself, so that get, set,
+ * serialize and deserialize are one format and two copies:
  *
  *   magic "dyadfmu\0" | fingerprint | size | checksum | payload
  *
- * The fingerprint is of the model (its instantiation token) and of the sizes of
- * the blocks, so that a state from another FMU, or from another build of this
- * one, is refused; the checksum (FNV-1a over the payload) refuses a damaged one.
- * What the layer would use as an index (the state machine's state, the variable
- * an evaluation blames) is checked before it is restored, and so is every
- * parameter and input, as a set checks it (the models solve them without checking
- * again), and a model's states, as a step leaves them (fmu_behaviour.state_refused).
- * The saved states of an instance are kept in a list and freed with it. */
+ * and the payload is 8-byte fields: the state machine's state (int64), the time and
+ * the last successful time (double, s), the terminate flag (int64), one double per
+ * parameter, input and setting in the order of the variable table, one per model
+ * state. The fingerprint is of the model (its instantiation token), of this format's
+ * version and of the counts of the fields, so that a state of another FMU, of another
+ * build or of an older format is refused; the checksum (FNV-1a over the payload)
+ * refuses a damaged one: it guards against accidents, not against a crafted state.
+ * That is what the checks of every field are for, each as a setter or a step would
+ * check it, so that a state holds only what calls could have left: a value a setter
+ * would accept, times that are finite and ordered as steps leave them, one of the four
+ * states of the machine, model states a start or step could leave. A refused state
+ * names its field. The saved states of an instance are kept in a list and freed with
+ * it. */
+#include <inttypes.h>
+#include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
+#include "dyadfmu/angle.h"
 #include "fmu_instance.h"
 
 struct fmu_saved {
@@ -29,7 +40,14 @@ struct fmu_saved {
     unsigned char bytes[];
 };
 
-enum { HEADER_SIZE = 32 };
+enum { HEADER_SIZE = 32, FIELD_SIZE = 8 };
+/* The fields of the payload before the values, in order. */
+enum { AT_MACHINE = 0, AT_TIME, AT_LAST_TIME, AT_TERMINATE, AT_VALUES };
+/* The format of the payload; a state of another format is refused by its fingerprint. */
+enum { FORMAT_VERSION = 2 };
+/* The machine's states before initialization ends: the model's states follow their
+ * start values, and no step was taken. */
+enum { BEFORE_STEPS = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION };
 static const char magic[8] = "dyadfmu";
 
 static uint64_t fnv1a(uint64_t h, const void* data, size_t size)
@@ -42,76 +60,95 @@ static uint64_t fnv1a(uint64_t h, const void* data, size_t size)
     return h;
 }
 
-static uint64_t fingerprint(const fmu_instance* instance)
+/* The number of parameters, inputs and settings: the variables that are not outputs. */
+static size_t kept_count(const fmu_model* m)
 {
-    const fmu_model* m = instance->model;
-    const uint64_t sizes[4] = {m->variable_count, m->behaviour->input_size,
-                               m->behaviour->output_size, instance->angle_count};
-    uint64_t h = fnv1a(0xcbf29ce484222325ULL, m->token, strlen(m->token));
-    return fnv1a(h, sizes, sizeof sizes);
-}
-
-/* The copies that make up the payload, in order: (where in the instance, size). */
-typedef struct state_part {
-    void* at;
-    size_t size;
-} state_part;
-
-/* The parts of a state's payload, in order: the parts before the values are fixed
- * in size. */
-enum { PART_VALUES = 6, PART_INPUT, PART_OUTPUT, PART_COUNT };
-
-static void parts_of(fmu_instance* instance, state_part part[PART_COUNT])
-{
-    const fmu_model* m = instance->model;
-    part[0] = (state_part){&instance->state, sizeof instance->state};
-    part[1] = (state_part){&instance->time, sizeof instance->time};
-    part[2] = (state_part){&instance->last_successful_time, sizeof instance->last_successful_time};
-    part[3] = (state_part){&instance->terminate_requested, sizeof instance->terminate_requested};
-    part[4] = (state_part){&instance->dirty, sizeof instance->dirty};
-    part[5] = (state_part){&instance->evaluation, sizeof instance->evaluation};
-    part[PART_VALUES] = (state_part){instance->values, m->variable_count * sizeof(double)};
-    part[PART_INPUT] = (state_part){instance->input, m->behaviour->input_size};
-    part[PART_OUTPUT] = (state_part){instance->output, m->behaviour->output_size};
-}
-
-static size_t state_size(fmu_instance* instance)
-{
-    state_part part[PART_COUNT];
-    size_t size = HEADER_SIZE + instance->angle_count * sizeof(double);
-    size_t k;
-    parts_of(instance, part);
-    for (k = 0; k < PART_COUNT; ++k) {
-        size += part[k].size;
+    size_t k, count = 0;
+    for (k = 0; k < m->variable_count; ++k) {
+        count += m->variables[k].causality != FMU_OUTPUT;
     }
-    return size;
+    return count;
+}
+
+static size_t model_state_count(const fmu_model* m)
+{
+    return m->behaviour->states != NULL ? m->behaviour->states->count : 0;
+}
+
+static uint64_t fingerprint(const fmu_model* m)
+{
+    const uint64_t counts[4] = {FORMAT_VERSION, m->variable_count, kept_count(m),
+                                model_state_count(m)};
+    uint64_t h = fnv1a(0xcbf29ce484222325ULL, m->token, strlen(m->token));
+    return fnv1a(h, counts, sizeof counts);
+}
+
+static size_t state_size(const fmu_model* m)
+{
+    return HEADER_SIZE + FIELD_SIZE * (AT_VALUES + kept_count(m) + model_state_count(m));
+}
+
+/* The fields of a payload, which need not be aligned. */
+static double real_at(const unsigned char* payload, size_t field)
+{
+    double x;
+    memcpy(&x, payload + FIELD_SIZE * field, sizeof x);
+    return x;
+}
+
+static int64_t integer_at(const unsigned char* payload, size_t field)
+{
+    int64_t x;
+    memcpy(&x, payload + FIELD_SIZE * field, sizeof x);
+    return x;
+}
+
+static void put_real(unsigned char* payload, size_t field, double x)
+{
+    memcpy(payload + FIELD_SIZE * field, &x, sizeof x);
+}
+
+static void put_integer(unsigned char* payload, size_t field, int64_t x)
+{
+    memcpy(payload + FIELD_SIZE * field, &x, sizeof x);
+}
+
+/* The double at `offset` of a block. */
+static double* block_real(void* block, size_t offset)
+{
+    return (double*)(void*)((char*)block + offset);
 }
 
 /* The instance's state into bytes (of state_size). */
 static void write_state(fmu_instance* instance, unsigned char* bytes)
 {
-    state_part part[PART_COUNT];
-    unsigned char* at = bytes + HEADER_SIZE;
-    const uint64_t print = fingerprint(instance), size = state_size(instance);
+    const fmu_model* m = instance->model;
+    const fmu_states* states = m->behaviour->states;
+    unsigned char* payload = bytes + HEADER_SIZE;
+    const uint64_t print = fingerprint(m), size = state_size(m);
+    size_t k, field = AT_VALUES;
     uint64_t check;
-    size_t k;
-    parts_of(instance, part);
-    for (k = 0; k < PART_COUNT; ++k) {
-        memcpy(at, part[k].at, part[k].size);
-        at += part[k].size;
+    put_integer(payload, AT_MACHINE, (int64_t)instance->state);
+    put_real(payload, AT_TIME, instance->time);
+    put_real(payload, AT_LAST_TIME, instance->last_successful_time);
+    put_integer(payload, AT_TERMINATE, instance->terminate_requested);
+    for (k = 0; k < m->variable_count; ++k) {
+        if (m->variables[k].causality != FMU_OUTPUT) {
+            put_real(payload, field++, *fmu_kept_value(instance, k));
+        }
     }
-    for (k = 0; k < instance->angle_count; ++k, at += sizeof(double)) {
-        memcpy(at, &instance->angles[k].converted, sizeof(double));
+    for (k = 0; k < model_state_count(m); ++k) {
+        put_real(payload, field++, *block_real(instance->input, states->states[k].offset));
     }
-    check = fnv1a(0xcbf29ce484222325ULL, bytes + HEADER_SIZE, (size_t)size - HEADER_SIZE);
+    check = fnv1a(0xcbf29ce484222325ULL, payload, (size_t)size - HEADER_SIZE);
     memcpy(bytes, magic, 8);
     memcpy(bytes + 8, &print, 8);
     memcpy(bytes + 16, &size, 8);
     memcpy(bytes + 24, &check, 8);
 }
 
-/* Why `bytes` is not a state of this instance's FMU, or NULL. */
-static const char* state_problem(fmu_instance* instance, const unsigned char* bytes, size_t size)
+/* Why `bytes` is not a state of this FMU as a whole, or NULL. */
+static const char* header_problem(const fmu_model* m, const unsigned char* bytes, size_t size)
 {
     uint64_t print, stored_size, check;
     if (size < HEADER_SIZE || memcmp(bytes, magic, 8) != 0) {
@@ -120,9 +157,8 @@ static const char* state_problem(fmu_instance* instance, const unsigned char* by
     memcpy(&print, bytes + 8, 8);
     memcpy(&stored_size, bytes + 16, 8);
     memcpy(&check, bytes + 24, 8);
-    if (print != fingerprint(instance) || stored_size != state_size(instance) ||
-        size != stored_size) {
-        return "a state of another FMU, or of another build of this one";
+    if (print != fingerprint(m) || stored_size != state_size(m) || size != stored_size) {
+        return "a state of another FMU, or of another build or format of this one";
     }
     if (check != fnv1a(0xcbf29ce484222325ULL, bytes + HEADER_SIZE, size - HEADER_SIZE)) {
         return "a damaged state (its checksum does not match)";
@@ -130,76 +166,166 @@ static const char* state_problem(fmu_instance* instance, const unsigned char* by
     return NULL;
 }
 
-/* The state's bytes into the instance (a state checked by state_problem). */
-static void read_state(fmu_instance* instance, const unsigned char* bytes)
+/* Why the state machine's state is none of its four; 0 if it is one. */
+static int machine_refused(int64_t machine, char* why, size_t size)
 {
-    state_part part[PART_COUNT];
-    const unsigned char* at = bytes + HEADER_SIZE;
-    size_t k;
-    parts_of(instance, part);
-    for (k = 0; k < PART_COUNT; ++k) {
-        memcpy(part[k].at, at, part[k].size);
-        at += part[k].size;
+    if (machine == FMU_STATE_INSTANTIATED || machine == FMU_STATE_INITIALIZATION ||
+        machine == FMU_STATE_STEP || machine == FMU_STATE_TERMINATED) {
+        return 0;
     }
-    for (k = 0; k < instance->angle_count; ++k, at += sizeof(double)) {
-        memcpy(&instance->angles[k].converted, at, sizeof(double));
-    }
+    snprintf(why, size,
+             "the state machine's state = %" PRId64 " is none of 1 (Instantiated), 2 "
+             "(Initialization Mode), 4 (Step Mode), 8 (Terminated)",
+             machine);
+    return 1;
 }
 
-/* 1 if what the layer uses as an index is in range in the state's bytes: the
- * state machine's state, and the variable its evaluation blames. */
-static int indices_valid(fmu_instance* instance, const unsigned char* bytes)
+/* Why the times and the terminate flag are not as calls leave them, 0 if they are: both
+ * times finite; where the last step was not discarded (the flag 0, as before any step)
+ * the last successful time is the time, else no later. */
+static int times_refused(const unsigned char* payload, char* why, size_t size)
 {
-    state_part part[PART_COUNT];
-    fmu_state state;
-    fmu_evaluation e;
-    size_t at = HEADER_SIZE, k;
-    parts_of(instance, part);
-    memcpy(&state, bytes + at, sizeof state);
-    for (k = 0; k < 5; ++k) {
-        at += part[k].size;
+    const double time = real_at(payload, AT_TIME), last = real_at(payload, AT_LAST_TIME);
+    const int64_t machine = integer_at(payload, AT_MACHINE);
+    const int64_t terminate = integer_at(payload, AT_TERMINATE);
+    if (!isfinite(time) || !isfinite(last)) {
+        snprintf(why, size, "%s = %g s is not a finite time",
+                 isfinite(time) ? "last successful time" : "time", isfinite(time) ? last : time);
+        return 1;
     }
-    memcpy(&e, bytes + at, sizeof e); /* part 5 */
-    return (state == FMU_STATE_INSTANTIATED || state == FMU_STATE_INITIALIZATION ||
-            state == FMU_STATE_STEP || state == FMU_STATE_TERMINATED) &&
-           e.bad_variable >= -1 && e.bad_variable < (int)instance->model->variable_count &&
-           memchr(e.reason, '\0', sizeof e.reason) != NULL;
+    if (terminate != 0 && (terminate != 1 || (machine & BEFORE_STEPS))) {
+        snprintf(why, size, "the terminate flag = %" PRId64 " is not %s", terminate,
+                 (machine & BEFORE_STEPS) ? "0 before any step" : "0 or 1");
+        return 1;
+    }
+    if (terminate == 0 && last != time) {
+        snprintf(why, size,
+                 "last successful time = %.17g s differs from time = %.17g s, but the "
+                 "terminate flag = 0 says no step was discarded",
+                 last, time);
+        return 1;
+    }
+    if (!(last <= time)) {
+        snprintf(why, size, "last successful time = %.17g s is after time = %.17g s", last, time);
+        return 1;
+    }
+    return 0;
 }
 
-/* The name of the first parameter or input whose value in the state's bytes could
- * not have been set (not finite, or outside its bounds), or of a state that no step
- * could have reached, or NULL: a state is serialized from values that were checked
- * when they were set, and the model solves them without checking again. */
-static const char* value_refused(fmu_instance* instance, const unsigned char* bytes, double* value)
+/* Why a parameter, input or setting holds a value no setter would accept, naming it;
+ * 0 if each holds one. */
+static int values_refused(const fmu_model* m, const unsigned char* payload, char* why, size_t size)
 {
-    state_part part[PART_COUNT];
-    const fmu_model* m = instance->model;
-    const unsigned char *values, *input;
-    size_t at = HEADER_SIZE, k;
-    parts_of(instance, part);
-    for (k = 0; k < PART_VALUES; ++k) {
-        at += part[k].size;
-    }
-    values = bytes + at; /* the values as set, then the input block */
-    input = values + part[PART_VALUES].size;
+    size_t k, field = AT_VALUES;
     for (k = 0; k < m->variable_count; ++k) {
         const fmu_variable* v = &m->variables[k];
-        if (v->type != FMU_REAL || v->causality == FMU_OUTPUT) {
+        if (v->causality != FMU_OUTPUT &&
+            fmu_value_refused(v, real_at(payload, field++), why, size)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* The input block of the state's values (checked) in `block`: initialised, each value
+ * where the model reads it, an angle as its unit vector. */
+static void build_block(const fmu_model* m, const unsigned char* payload, void* block)
+{
+    size_t k, field = AT_VALUES;
+    m->behaviour->initialise(m, block);
+    for (k = 0; k < m->variable_count; ++k) {
+        const fmu_variable* v = &m->variables[k];
+        if (v->causality == FMU_OUTPUT) {
             continue;
         }
         if (v->target == FMU_TARGET_INPUT_REAL) {
-            memcpy(value, input + v->offset, sizeof *value);
+            *block_real(block, v->offset) = real_at(payload, field);
         } else if (v->target == FMU_TARGET_INPUT_ANGLE) {
-            memcpy(value, values + k * sizeof(double), sizeof *value);
-        } else {
-            continue;
+            double* unit = block_real(block, v->offset);
+            dyad_cos_sin(real_at(payload, field), &unit[0], &unit[1]);
         }
-        if (!fmu_value_allowed(v, *value)) {
-            return v->name;
+        ++field;
+    }
+}
+
+/* Why a model state is not one the model's start (before initialization ends) or a
+ * step could leave, naming it; 0 if none. `block`: scratch of the input block's size. */
+static int model_states_refused(const fmu_model* m, const unsigned char* payload, void* block,
+                                char* why, size_t size)
+{
+    const fmu_states* states = m->behaviour->states;
+    const size_t first = AT_VALUES + kept_count(m);
+    size_t k;
+    int bad = -1;
+    if (states == NULL) {
+        return 0;
+    }
+    build_block(m, payload, block);
+    if ((integer_at(payload, AT_MACHINE) & BEFORE_STEPS) && m->behaviour->start != NULL) {
+        m->behaviour->start(m, block);
+        for (k = 0; k < states->count && bad < 0; ++k) {
+            const double kept = real_at(payload, first + k);
+            bad = memcmp(&kept, block_real(block, states->states[k].offset), sizeof kept) != 0
+                      ? (int)k
+                      : -1;
+        }
+    } else {
+        for (k = 0; k < states->count; ++k) {
+            *block_real(block, states->states[k].offset) = real_at(payload, first + k);
+        }
+        bad = states->refused != NULL ? states->refused(m, block) : -1;
+    }
+    if (bad >= 0) {
+        const fmu_model_state* s = &states->states[bad];
+        snprintf(why, size, "%s = %g %s is not a state %s could leave", s->name,
+                 real_at(payload, first + (size_t)bad), s->unit,
+                 (integer_at(payload, AT_MACHINE) & BEFORE_STEPS)
+                     ? "its start values before initialization ends"
+                     : "a step");
+    }
+    return bad >= 0;
+}
+
+/* Why `bytes` is not a state this instance's FMU could be in, naming the field, into
+ * `why`; 0 if it is one. */
+static int state_refused(fmu_instance* instance, const unsigned char* bytes, size_t size, char* why,
+                         size_t why_size)
+{
+    const fmu_model* m = instance->model;
+    const unsigned char* payload = bytes + HEADER_SIZE;
+    const char* problem = header_problem(m, bytes, size);
+    if (problem != NULL) {
+        snprintf(why, why_size, "%s", problem);
+        return 1;
+    }
+    /* the scratch of directional derivatives, which set it before each use */
+    return machine_refused(integer_at(payload, AT_MACHINE), why, why_size) ||
+           times_refused(payload, why, why_size) || values_refused(m, payload, why, why_size) ||
+           model_states_refused(m, payload, instance->seed, why, why_size);
+}
+
+/* The state's bytes (checked by state_refused) into the instance: the input block
+ * initialised, every value stored as a set stores it, the model's states, and every
+ * output to be evaluated again. */
+static void read_state(fmu_instance* instance, const unsigned char* bytes)
+{
+    const fmu_model* m = instance->model;
+    const fmu_states* states = m->behaviour->states;
+    const unsigned char* payload = bytes + HEADER_SIZE;
+    size_t k, field = AT_VALUES;
+    m->behaviour->initialise(m, instance->input);
+    for (k = 0; k < m->variable_count; ++k) {
+        if (m->variables[k].causality != FMU_OUTPUT) {
+            *fmu_kept_value(instance, k) = real_at(payload, field++);
         }
     }
-    return m->behaviour->state_refused != NULL ? m->behaviour->state_refused(m, input, value)
-                                               : NULL;
+    for (k = 0; k < model_state_count(m); ++k) {
+        *block_real(instance->input, states->states[k].offset) = real_at(payload, field++);
+    }
+    instance->time = real_at(payload, AT_TIME);
+    instance->last_successful_time = real_at(payload, AT_LAST_TIME);
+    instance->terminate_requested = (int)integer_at(payload, AT_TERMINATE);
+    fmu_restored(instance, (fmu_state)integer_at(payload, AT_MACHINE));
 }
 
 static fmu_saved* new_saved(fmu_instance* instance, size_t size)
@@ -234,7 +360,7 @@ static fmu_status unknown_state(fmu_instance* instance, const char* function)
 
 fmu_status fmu_get_state(fmu_instance* instance, fmu_saved** state, const char* function)
 {
-    const size_t size = instance != NULL ? state_size(instance) : 0;
+    const size_t size = instance != NULL ? state_size(instance->model) : 0;
     fmu_status status = fmu_check_call(instance, FMU_OP_STATE, function);
     if (status != FMU_OK) {
         return status;
@@ -256,6 +382,7 @@ fmu_status fmu_get_state(fmu_instance* instance, fmu_saved** state, const char* 
 
 fmu_status fmu_set_state(fmu_instance* instance, const fmu_saved* state, const char* function)
 {
+    char why[300];
     fmu_status status = fmu_check_call(instance, FMU_OP_STATE, function);
     if (status != FMU_OK) {
         return status;
@@ -263,9 +390,12 @@ fmu_status fmu_set_state(fmu_instance* instance, const fmu_saved* state, const c
     if (state == NULL || !owns(instance, state)) {
         return unknown_state(instance, function);
     }
+    /* checked when it was deserialized; again, since nothing a state holds is trusted */
+    if (state_refused(instance, state->bytes, state->size, why, sizeof why)) {
+        fmu_log(instance, FMU_ERROR, "%s: refused: %s", function, why);
+        return FMU_ERROR;
+    }
     read_state(instance, state->bytes);
-    fmu_rebuild_slots(instance);
-    fmu_angles_stale(instance); /* the directions from the angles, not from the bytes */
     return FMU_OK;
 }
 
@@ -332,29 +462,20 @@ fmu_status fmu_serialize_state(fmu_instance* instance, const fmu_saved* state, u
 fmu_status fmu_deserialize_state(fmu_instance* instance, const unsigned char* bytes, size_t size,
                                  fmu_saved** state, const char* function)
 {
-    const char* problem;
-    const char* refused;
-    double value = 0;
+    char why[300];
     fmu_saved* saved = NULL;
     fmu_status status = fmu_check_call(instance, FMU_OP_STATE, function);
     if (status != FMU_OK) {
         return status;
     }
-    problem =
-        bytes == NULL || state == NULL ? "NULL arguments" : state_problem(instance, bytes, size);
-    if (problem == NULL && !indices_valid(instance, bytes)) {
-        problem = "a state out of range";
+    if (bytes == NULL || state == NULL) {
+        snprintf(why, sizeof why, "NULL arguments");
+    } else if (!state_refused(instance, bytes, size, why, sizeof why) &&
+               (saved = new_saved(instance, size)) == NULL) {
+        snprintf(why, sizeof why, "out of memory");
     }
-    if (problem == NULL && (refused = value_refused(instance, bytes, &value)) != NULL) {
-        fmu_log(instance, FMU_ERROR, "%s: refused: %s = %g could not have been set or reached",
-                function, refused, value);
-        return FMU_ERROR;
-    }
-    if (problem == NULL && (saved = new_saved(instance, size)) == NULL) {
-        problem = "out of memory";
-    }
-    if (problem != NULL) {
-        fmu_log(instance, FMU_ERROR, "%s: refused: %s", function, problem);
+    if (saved == NULL) {
+        fmu_log(instance, FMU_ERROR, "%s: refused: %s", function, why);
         return FMU_ERROR;
     }
     memcpy(saved->bytes, bytes, size);

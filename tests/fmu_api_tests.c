@@ -2012,22 +2012,30 @@ static size_t occurrences(const unsigned char* bytes, size_t size, double from)
     return found;
 }
 
+/* The state's checksum made good again for its payload, as one who crafts it would. */
+static void seal(unsigned char* bytes, size_t size)
+{
+    const size_t header = 32;
+    uint64_t h = 0xcbf29ce484222325ULL;
+    size_t k;
+    for (k = header; k < size; ++k) {
+        h = (h ^ bytes[k]) * 0x100000001b3ULL; /* FNV-1a, as fmu_state.c */
+    }
+    memcpy(bytes + 24, &h, sizeof h);
+}
+
 /* The state's bytes with every value `from` replaced by `to`, and the checksum made
  * good again. */
 static void replace_and_seal(unsigned char* bytes, size_t size, double from, double to)
 {
     const size_t header = 32;
-    uint64_t h = 0xcbf29ce484222325ULL;
     size_t k;
     for (k = header; k + sizeof from <= size; ++k) {
         if (memcmp(bytes + k, &from, sizeof from) == 0) {
             memcpy(bytes + k, &to, sizeof to);
         }
     }
-    for (k = header; k < size; ++k) {
-        h = (h ^ bytes[k]) * 0x100000001b3ULL; /* FNV-1a, as fmu_state.c */
-    }
-    memcpy(bytes + 24, &h, sizeof h);
+    seal(bytes, size);
 }
 
 /* The state's bytes with its value `from` of a parameter or input (found once in the
@@ -2069,8 +2077,7 @@ static int check_crafted_state(int version, void* c, const unsigned char* bytes,
             continue;
         }
         CHECK(deserialize(version, c, crafted, size, &bad) == 3 && bad == NULL &&
-                  strstr(book->last, v->name) != NULL &&
-                  strstr(book->last, "could not have been set") != NULL,
+                  strstr(book->last, "refused: ") != NULL && strstr(book->last, v->name) != NULL,
               "FMI %d: a state with %s = %g accepted: %s", version, v->name, v->min - 1,
               book->last);
         tried = -1;
@@ -2089,8 +2096,7 @@ static int check_crafted_state(int version, void* c, const unsigned char* bytes,
 
 /* A state whose checksum is good but which holds NaN for an input: refused, naming it
  * (as a set refuses it: the FMU solves its inputs without checking them again). The
- * input is set to a value of its own first, so that the state holds that value once
- * (the angle last converted is the one before). */
+ * input is set to a value of its own first, so that the state holds that value once. */
 static int check_crafted_nan(int version)
 {
     const probe_model* md = version == 2 ? &md2 : &md3;
@@ -2116,8 +2122,8 @@ static int check_crafted_nan(int version)
               "FMI %d: no state holding %s = %.17g once", version, v->name, mark);
         CHECK(bytes == NULL || deserialize(version, c, bytes, size, &bad) == 3,
               "FMI %d: a state with %s = NaN accepted", version, v->name);
-        CHECK(bad == NULL && strstr(book.last, v->name) != NULL &&
-                  strstr(book.last, "could not have been set") != NULL,
+        CHECK(bad == NULL && strstr(book.last, "refused: ") != NULL &&
+                  strstr(book.last, v->name) != NULL,
               "FMI %d: the NaN in %s not named: %s", version, v->name, book.last);
     } else {
         CHECK(v == NULL, "FMI %d: initialise", version);
@@ -2927,7 +2933,54 @@ static int test_drive_crafted_state(void)
     return fails;
 }
 
+/* The time reached (FMI 3: the variable time; FMI 2: the last successful time). */
+static double time_reached(int version, void* c)
+{
+    const unsigned vr = 0;
+    double t = NAN;
+    (void)(version == 2 ? (int)api2.GetRealStatus(c, fmi2LastSuccessfulTime, &t)
+                        : (int)api3.GetFloat64(c, &vr, 1, &t, 1));
+    return t;
+}
+
+/* A step the model refuses with Error (inertia + load.inertia not positive), asked from
+ * one ulp after the time reached (within the rounding a step from there allows): the
+ * time, the last successful time and the terminate flag stay where they were, so that
+ * the state taken then is one a restore accepts (the last successful time never after
+ * the time). */
+static int test_drive_refused_step_keeps_time(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        probe_log_book book;
+        void* c = version == 2 ? new_fmi2(&book, "refused") : new_fmi3(&book, "refused");
+        void *state = NULL, *restored = NULL;
+        unsigned char* bytes = NULL;
+        size_t size = 0;
+        const double t = 0.01;
+        CHECK((version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)) &&
+                  step_either(version, c, 0, t) == 0 && set_named(version, c, "load.inertia", -1),
+              "FMI %d: set up (%s)", version, book.last);
+        CHECK(step_either(version, c, nextafter(t, 1), 0.01) == 3 &&
+                  strstr(book.last, "inertia") != NULL,
+              "FMI %d: the step with inertia + load.inertia < 0 not refused: %s", version,
+              book.last);
+        CHECK(probe_bits(time_reached(version, c)) == probe_bits(t),
+              "FMI %d: after a refused step, the time reads %.17g, not %.17g", version,
+              time_reached(version, c), t);
+        CHECK(get_state(version, c, &state) == 0 &&
+                  serialize(version, c, state, &bytes, &size) == 0 &&
+                  deserialize(version, c, bytes, size, &restored) == 0 &&
+                  set_state(version, c, restored) == 0,
+              "FMI %d: the state after a refused step is not restored: %s", version, book.last);
+        free(bytes);
+        free_either(version, c);
+    }
+    return fails;
+}
+
 static const named_test drive_tests[] = {
+    {"drive_refused_step_keeps_time", test_drive_refused_step_keeps_time},
     {"drive_errors_logged_every_time", test_drive_errors_logged_every_time},
     {"drive_step_beyond_cap", test_drive_step_beyond_cap},
     {"drive_outputs_never_infinite", test_drive_outputs_never_infinite},
@@ -2935,6 +2988,450 @@ static const named_test drive_tests[] = {
     {"drive_steps_on_from_its_time", test_drive_steps_on_from_its_time},
     {"drive_crafted_state", test_drive_crafted_state},
 };
+
+/* ---- both: a restored FMU state is evaluated again ------------------------------------------ */
+
+/* The instance's state as serialized bytes (the state itself goes with the instance),
+ * or NULL. */
+static unsigned char* state_bytes(int version, void* c, size_t* size)
+{
+    void* state = NULL;
+    unsigned char* bytes = NULL;
+    if (get_state(version, c, &state) != 0 || serialize(version, c, state, &bytes, size) != 0) {
+        free(bytes);
+        return NULL;
+    }
+    return bytes;
+}
+
+static int read_all(int version, void* c, values_read* r)
+{
+    return version == 2 ? fmi2_read_all(c, r) : fmi3_read_all(c, r);
+}
+
+/* An instance after a step with `v` = `value` (its outputs read, so evaluated); NULL
+ * if it cannot get there. */
+static void* stepped_with(int version, probe_log_book* book, const probe_variable* v, double value)
+{
+    void* c = version == 2 ? (void*)new_fmi2(book, "crafted") : (void*)new_fmi3(book, "crafted");
+    values_read r;
+    if (c != NULL && (version == 2 ? initialise_fmi2(c) : initialise_fmi3(c)) &&
+        (v == NULL || set_named(version, c, v->name, value)) &&
+        step_either(version, c, 0, 0.01) != 3 && read_all(version, c, &r)) {
+        return c;
+    }
+    free_either(version, c);
+    return NULL;
+}
+
+/* 1 if the outputs in `a` and `b` (read by read_all) are the same bit for bit. */
+static int same_outputs(const probe_model* md, const values_read* a, const values_read* b)
+{
+    size_t k, at = 0;
+    for (k = 0; k < md->variable_count; ++k) {
+        const probe_variable* v = &md->variables[k];
+        if (v->type == PROBE_REAL && v->causality == PROBE_OUTPUT &&
+            probe_bits(a->reals[at]) != probe_bits(b->reals[at])) {
+            return 0;
+        }
+        at += v->type == PROBE_REAL;
+    }
+    return a->n_integers == b->n_integers &&
+           memcmp(a->integers, b->integers, a->n_integers * sizeof a->integers[0]) == 0;
+}
+
+/* The instance `ref` (stepped with v = from) with v = to: its values read into
+ * `expected`; 1 if its outputs changed (v changes the outputs). */
+static int input_changes_outputs(int version, void* ref, const probe_variable* v, double to,
+                                 values_read* expected)
+{
+    values_read before;
+    return read_all(version, ref, &before) && set_named(version, ref, v->name, to) &&
+           read_all(version, ref, expected) &&
+           !same_outputs(version == 2 ? &md2 : &md3, &before, expected);
+}
+
+/* A state whose input changed in its bytes, from 0.3 to 1.0 (0.3 one ulp up, so that no
+ * other value of the state is it), restores the outputs of 1.0, before and after a step:
+ * a restored state keeps no output, it evaluates again. The input is the first (an
+ * angle first) whose change changes the outputs. */
+static int check_input_changed(int version, const probe_variable* v, int* found)
+{
+    const double from = nextafter(0.3, 1), to = 1.0;
+    probe_log_book book, ref_book;
+    void *c, *ref, *state = NULL;
+    values_read restored, expected;
+    unsigned char* bytes = NULL;
+    size_t size = 0;
+    int fails = 0;
+    if ((v->has_min && v->min > from) || (v->has_max && v->max < to)) {
+        return 0;
+    }
+    c = stepped_with(version, &book, v, from);
+    ref = stepped_with(version, &ref_book, v, from);
+    if (c != NULL && ref != NULL && input_changes_outputs(version, ref, v, to, &expected)) {
+        *found = 1;
+        CHECK((bytes = state_bytes(version, c, &size)) != NULL &&
+                  occurrences(bytes, size, from) >= 1,
+              "FMI %d: no state holding %s = %.17g", version, v->name, from);
+    }
+    if (bytes != NULL) {
+        replace_and_seal(bytes, size, from, to);
+        CHECK(deserialize(version, c, bytes, size, &state) == 0 &&
+                  set_state(version, c, state) == 0,
+              "FMI %d: a state with %s = %g refused: %s", version, v->name, to, book.last);
+        CHECK(read_all(version, c, &restored) && same_values(&restored, &expected),
+              "FMI %d: a state with %s changed to %g restores the outputs of %.17g", version,
+              v->name, to, from);
+        CHECK(step_either(version, c, 0.01, 0.01) == step_either(version, ref, 0.01, 0.01) &&
+                  read_all(version, c, &restored) == read_all(version, ref, &expected) &&
+                  same_values(&restored, &expected),
+              "FMI %d: a step from a state with %s changed to %g is not that of %g", version,
+              v->name, to, to);
+    }
+    free(bytes);
+    free_either(version, ref);
+    free_either(version, c);
+    return fails;
+}
+
+/* check_input_changed on the first input (an angle first) that changes the outputs. */
+static int check_an_input_changed(int version)
+{
+    const probe_model* md = version == 2 ? &md2 : &md3;
+    int fails = 0, found = 0, angles;
+    size_t k;
+    for (angles = 1; angles >= 0 && !found; --angles) {
+        for (k = 0; k < md->variable_count && !found; ++k) {
+            const probe_variable* v = &md->variables[k];
+            if (v->type == PROBE_REAL && v->causality == PROBE_INPUT &&
+                (strstr(v->name, "angle") != NULL) == angles) {
+                fails += check_input_changed(version, v, &found);
+            }
+        }
+    }
+    CHECK(found, "FMI %d: no input from 0.3 to 1 changes an output", version);
+    return fails;
+}
+
+/* 1 if `x` is the value of a parameter or input in `r` (read by read_all). */
+static int is_a_set_value(const probe_model* md, const values_read* r, double x)
+{
+    size_t k, at = 0;
+    for (k = 0; k < md->variable_count; ++k) {
+        const probe_variable* v = &md->variables[k];
+        if (v->type != PROBE_REAL) {
+            continue;
+        }
+        if (v->causality != PROBE_OUTPUT && probe_bits(r->reals[at]) == probe_bits(x)) {
+            return 1;
+        }
+        ++at;
+    }
+    return 0;
+}
+
+/* A state whose bytes hold NaN where they hold an output's value (one output at a time,
+ * one whose value no parameter or input has): refused, or restored with every output
+ * as it was. A state does not keep what the FMU computes; where it did, the NaN was
+ * read back with status 0. */
+static int check_outputs_not_kept(int version, void* c, probe_log_book* book)
+{
+    const probe_model* md = version == 2 ? &md2 : &md3;
+    values_read before, after;
+    unsigned char *bytes, *crafted;
+    size_t size = 0, k, at = 0;
+    int fails = 0;
+    CHECK(read_all(version, c, &before) && (bytes = state_bytes(version, c, &size)) != NULL,
+          "FMI %d: a state after a step", version);
+    crafted = bytes != NULL ? (unsigned char*)malloc(size) : NULL;
+    for (k = 0; k < md->variable_count && crafted != NULL; ++k) {
+        const probe_variable* v = &md->variables[k];
+        const double x = v->type == PROBE_REAL ? before.reals[at++] : 0;
+        void* state = NULL;
+        if (v->type != PROBE_REAL || v->causality != PROBE_OUTPUT || x == 0 || !isfinite(x) ||
+            is_a_set_value(md, &before, x) || occurrences(bytes, size, x) == 0) {
+            continue;
+        }
+        memcpy(crafted, bytes, size);
+        replace_and_seal(crafted, size, x, NAN);
+        if (deserialize(version, c, crafted, size, &state) == 3) {
+            CHECK(strstr(book->last, "refused: ") != NULL, "FMI %d: %s", version, book->last);
+            continue;
+        }
+        CHECK(set_state(version, c, state) == 0 && read_all(version, c, &after) &&
+                  same_values(&before, &after),
+              "FMI %d: a state with %s = NaN in its bytes restores other outputs (%s = %g)",
+              version, v->name, v->name, after.reals[at - 1]);
+    }
+    free(crafted);
+    free(bytes);
+    return fails;
+}
+
+/* A state with the int 7 at each 4-byte offset of its payload in turn: where it is
+ * accepted, the status output reads what the model says, never 7 (no model has such a
+ * status): the status is evaluated again, not restored. */
+static int check_status_recomputed(int version, void* c, probe_log_book* book)
+{
+    const int seven = 7;
+    unsigned char *bytes, *crafted;
+    size_t size = 0, at;
+    int fails = 0, accepted = 0;
+    CHECK((bytes = state_bytes(version, c, &size)) != NULL, "FMI %d: a state", version);
+    crafted = bytes != NULL ? (unsigned char*)malloc(size) : NULL;
+    for (at = 32; crafted != NULL && at + sizeof seven <= size; at += sizeof seven) {
+        void* state = NULL;
+        memcpy(crafted, bytes, size);
+        memcpy(crafted + at, &seven, sizeof seven);
+        if (memcmp(crafted, bytes, size) == 0) {
+            continue;
+        }
+        seal(crafted, size);
+        if (deserialize(version, c, crafted, size, &state) != 0) {
+            continue;
+        }
+        ++accepted;
+        CHECK(set_state(version, c, state) == 0 && get_status_output(version, c) != 7,
+              "FMI %d: status reads 7 after a state with 7 at payload byte %zu (%s)", version,
+              at - 32, book->last);
+    }
+    CHECK(bytes == NULL || accepted > 0, "FMI %d: no state with a 7 accepted", version);
+    free(crafted);
+    free(bytes);
+    return fails;
+}
+
+static int test_fmu_state_evaluated_again(void)
+{
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        probe_log_book book;
+        void* c;
+        fails += check_an_input_changed(version);
+        c = stepped_with(version, &book, NULL, 0);
+        CHECK(c != NULL, "FMI %d: a step", version);
+        if (c != NULL) {
+            fails += check_outputs_not_kept(version, c, &book);
+            fails += check_status_recomputed(version, c, &book);
+        }
+        free_either(version, c);
+    }
+    return fails;
+}
+
+/* Sets on_singular (FMI 2 as Integer, FMI 3 as Int64); 1 if accepted. */
+static int set_on_singular(int version, void* c, const probe_variable* v, int value)
+{
+    const int64_t wide = value;
+    return version == 2 ? api2.SetInteger(c, &v->vr, 1, &value) == fmi2OK
+                        : api3.SetInt64(c, &v->vr, 1, &wide, 1) == fmi3OK;
+}
+
+/* The state of an initialised instance with on_singular = `value`, or NULL. */
+static unsigned char* state_with_on_singular(int version, const probe_variable* v, int value,
+                                             probe_log_book* book, void** c, size_t* size)
+{
+    *c = version == 2 ? (void*)new_fmi2(book, "setting") : (void*)new_fmi3(book, "setting");
+    if (*c == NULL || !set_on_singular(version, *c, v, value) ||
+        !(version == 2 ? initialise_fmi2(*c) : initialise_fmi3(*c))) {
+        return NULL;
+    }
+    return state_bytes(version, *c, size);
+}
+
+/* Where the two states (of one size) hold `a` and `b` as an 8-byte double, or as an
+ * int, at one offset of their payloads; 0 if nowhere. */
+static size_t offset_of(const unsigned char* sa, const unsigned char* sb, size_t size, double a,
+                        double b, int as_int)
+{
+    const int ia = (int)a, ib = (int)b;
+    size_t k;
+    for (k = 32; sa != NULL && sb != NULL && k + 8 <= size; ++k) {
+        if (as_int ? memcmp(sa + k, &ia, sizeof ia) == 0 && memcmp(sb + k, &ib, sizeof ib) == 0
+                   : memcmp(sa + k, &a, 8) == 0 && memcmp(sb + k, &b, 8) == 0) {
+            return k;
+        }
+    }
+    return 0;
+}
+
+/* A state whose on_singular (found as the one 8-byte value that is 1.0 in a state with
+ * on_singular = 1 and 2.0 in one with 2) is NaN, infinite, a fraction or no item:
+ * refused, naming it, as a set of a value that is not one of its items is. Where it was
+ * not, reading it back converted NaN to an int. */
+static int test_fmu_state_setting_refused(void)
+{
+    static const double bad[] = {NAN, INFINITY, 1.5, 1 + DBL_EPSILON, 0, 3, -1, 1e300};
+    int fails = 0, version;
+    for (version = 2; version <= 3; ++version) {
+        const probe_variable* v = probe_variable_named(version == 2 ? &md2 : &md3, "on_singular");
+        probe_log_book book_1, book_2;
+        void *c1 = NULL, *c2 = NULL, *state = NULL;
+        unsigned char *a = NULL, *b = NULL;
+        size_t size_1 = 0, size_2 = 0, at, k;
+        int64_t read = 0;
+        if (v != NULL) {
+            a = state_with_on_singular(version, v, 1, &book_1, &c1, &size_1);
+            b = state_with_on_singular(version, v, 2, &book_2, &c2, &size_2);
+        }
+        at = size_1 == size_2 ? offset_of(a, b, size_1, 1, 2, 0) : 0;
+        CHECK(v == NULL || at > 0, "FMI %d: on_singular not found in the state", version);
+        for (k = 0; at > 0 && k < sizeof bad / sizeof bad[0]; ++k) {
+            char expected[100];
+            snprintf(expected, sizeof expected,
+                     "refused: on_singular = %.17g is not an item of its enumeration", bad[k]);
+            memcpy(b + at, &bad[k], 8);
+            seal(b, size_2);
+            state = NULL;
+            CHECK(deserialize(version, c2, b, size_2, &state) == 3 && state == NULL &&
+                      strstr(book_2.last, expected) != NULL,
+                  "FMI %d: a state with on_singular = %g: %s", version, bad[k], book_2.last);
+            if (state != NULL && set_state(version, c2, state) == 0) {
+                (void)(version == 2 ? (int)api2.GetInteger(c2, &v->vr, 1, &(int){0})
+                                    : (int)api3.GetInt64(c2, &v->vr, 1, &read, 1));
+            }
+        }
+        free(a);
+        free(b);
+        free_either(version, c1);
+        free_either(version, c2);
+    }
+    return fails;
+}
+
+/* A state whose state machine's state (found as the int that is 4, Step, in a state
+ * taken in step mode and 8, Terminated, in one taken after terminate) is none of the
+ * four: refused, naming it. */
+static int check_machine_refused(int version)
+{
+    static const int bad[] = {0, 3, 5, 6, 16, -1, 4 | 8};
+    probe_log_book book;
+    void* c = version == 2 ? (void*)new_fmi2(&book, "machine") : (void*)new_fmi3(&book, "machine");
+    unsigned char *step = NULL, *terminated = NULL;
+    size_t size = 0, other = 0, at, k;
+    int fails = 0;
+    if (c != NULL && (version == 2 ? initialise_fmi2(c) : initialise_fmi3(c))) {
+        step = state_bytes(version, c, &size);
+        if ((version == 2 ? (int)api2.Terminate(c) : (int)api3.Terminate(c)) == 0) {
+            terminated = state_bytes(version, c, &other);
+        }
+    }
+    at = size == other ? offset_of(step, terminated, size, 4, 8, 1) : 0;
+    CHECK(at > 0, "FMI %d: the state machine's state not found in the state", version);
+    for (k = 0; at > 0 && k < sizeof bad / sizeof bad[0]; ++k) {
+        void* state = NULL;
+        memcpy(step + at, &bad[k], sizeof bad[k]);
+        seal(step, size);
+        CHECK(deserialize(version, c, step, size, &state) == 3 &&
+                  strstr(book.last, "refused: the state machine's state") != NULL,
+              "FMI %d: a state with the state machine in %d: %s", version, bad[k], book.last);
+    }
+    free(step);
+    free(terminated);
+    free_either(version, c);
+    return fails;
+}
+
+/* A step from `t` that the model cannot complete, with a Real input at an extreme value
+ * (a step that completes on the way moves `t` on); 1 if found. */
+static int discard_from(int version, void* c, double* t)
+{
+    const probe_model* md = version == 2 ? &md2 : &md3;
+    size_t e, k;
+    for (k = 0; k < md->variable_count; ++k) {
+        const probe_variable* v = &md->variables[k];
+        for (e = 0; is_real_setting(v) && v->causality == PROBE_INPUT && e < 4; ++e) {
+            const int status =
+                set_named(version, c, v->name, extremes[e]) ? step_either(version, c, *t, 0.01) : 3;
+            if (status == 2) {
+                return 1;
+            }
+            *t += status == 0 ? 0.01 : 0;
+        }
+    }
+    return 0;
+}
+
+/* One place of the state that holds the time `t` given `value`: a time that is not
+ * finite, or a last successful time after the time, is refused, naming it; after a
+ * discarded step (the terminate flag set) a later time is one a step can leave (the
+ * drive's, when its states moved), and the time then reads `value`. Returns 1 if the
+ * state was accepted. */
+static int check_time_place(int version, void* c, probe_log_book* book, unsigned char* crafted,
+                            size_t size, double t, double value, int* fails_out)
+{
+    void* state = NULL;
+    int fails = 0, accepted;
+    seal(crafted, size);
+    accepted = deserialize(version, c, crafted, size, &state) == 0;
+    if (accepted) {
+        CHECK(isfinite(value) && value > t && set_state(version, c, state) == 0 &&
+                  probe_bits(time_reached(version, c)) == probe_bits(version == 2 ? t : value),
+              "FMI %d: a state with %.17g for the time %.17g accepted (time reached %.17g)",
+              version, value, t, time_reached(version, c));
+    } else {
+        CHECK(strstr(book->last, "refused: ") != NULL && strstr(book->last, "time = ") != NULL,
+              "FMI %d: a state with %.17g for the time %.17g: %s", version, value, t, book->last);
+    }
+    *fails_out += fails;
+    return accepted;
+}
+
+/* A state after steps from 12.5 s, and one after a discarded step, whose time or last
+ * successful time (each place that holds the time, in turn) is NaN, infinite, or one
+ * second later: refused, naming it, but for a later time after a discarded step (one
+ * place accepted). Where such states were not refused, the time read NaN, or the last
+ * successful time was after it. */
+static int check_times_refused(int version, int discarded)
+{
+    static const double bad[] = {NAN, INFINITY, -INFINITY, 1};
+    probe_log_book book;
+    void* c = version == 2 ? (void*)new_fmi2(&book, "times") : (void*)new_fmi3(&book, "times");
+    unsigned char *bytes = NULL, *crafted = NULL;
+    size_t size = 0, at, k, places = 0, accepted = 0;
+    double t = 12.5;
+    int fails = 0, step;
+    CHECK(c != NULL && initialise_from(version, c, t, 100), "FMI %d: initialise", version);
+    for (step = 0; c != NULL && step < 3; ++step, t += 0.01) {
+        CHECK(step_either(version, c, t, 0.01) != 3, "FMI %d: step", version);
+    }
+    if (c != NULL && discarded && !discard_from(version, c, &t)) {
+        printf("    FMI %d: no input makes a step discard\n", version);
+        free_either(version, c);
+        return fails;
+    }
+    bytes = c != NULL ? state_bytes(version, c, &size) : NULL;
+    crafted = bytes != NULL ? (unsigned char*)malloc(size) : NULL;
+    for (at = 32; crafted != NULL && at + 8 <= size; ++at) {
+        if (memcmp(bytes + at, &t, 8) != 0) {
+            continue;
+        }
+        ++places;
+        for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+            const double value = k == 3 ? t + bad[k] : bad[k];
+            memcpy(crafted, bytes, size);
+            memcpy(crafted + at, &value, 8);
+            accepted += check_time_place(version, c, &book, crafted, size, t, value, &fails);
+        }
+    }
+    CHECK(places >= 1 && accepted == (discarded ? 1u : 0u),
+          "FMI %d: the state holds its time %.17g in %zu places, %zu of them accepted later",
+          version, t, places, accepted);
+    free(crafted);
+    free(bytes);
+    free_either(version, c);
+    return fails;
+}
+
+static int test_fmu_state_machine_and_times_refused(void)
+{
+    int fails = check_machine_refused(2) + check_machine_refused(3), discarded;
+    for (discarded = 0; discarded <= 1; ++discarded) {
+        fails += check_times_refused(2, discarded) + check_times_refused(3, discarded);
+    }
+    return fails;
+}
 
 /* ---- runner --------------------------------------------------------------------------------- */
 
@@ -2960,6 +3457,9 @@ static const named_test generic_tests[] = {
     {"fmi3_on_singular", test_fmi3_on_singular},
     {"instances_independent", test_instances_independent},
     {"fmu_state_round_trip", test_fmu_state_round_trip},
+    {"fmu_state_evaluated_again", test_fmu_state_evaluated_again},
+    {"fmu_state_setting_refused", test_fmu_state_setting_refused},
+    {"fmu_state_machine_and_times_refused", test_fmu_state_machine_and_times_refused},
     {"exports_only_fmi", test_exports_only_fmi},
     {"bad_steps", test_bad_steps},
     {"experiment_stop", test_experiment_stop},

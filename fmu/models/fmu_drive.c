@@ -207,24 +207,28 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
     in->speed = speed;
 }
 
+/* The crank's angle and speed: what an FMU state keeps of the drive beyond its
+ * parameters and inputs. */
+static const fmu_model_state drive_states[] = {
+    {"crank.angle", "rad", offsetof(fmu_drive_input, angle)},
+    {"crank.omega", "rad/s", offsetof(fmu_drive_input, speed)},
+};
+
 /* A step leaves the states finite (advance refuses one that would not), and so does
- * start, from finite parameters. */
-static const char* state_refused(const fmu_model* model, const unsigned char* input, double* value)
+ * start, from finite parameters; any finite pair is a start. */
+static int state_refused(const fmu_model* model, const void* input)
 {
+    const fmu_drive_input* in = (const fmu_drive_input*)input;
     (void)model;
-    memcpy(value, input + offsetof(fmu_drive_input, angle), sizeof *value);
-    if (!isfinite(*value)) {
-        return "crank.angle";
+    if (!isfinite(in->angle)) {
+        return 0;
     }
-    memcpy(value, input + offsetof(fmu_drive_input, speed), sizeof *value);
-    return isfinite(*value) ? NULL : "crank.omega";
+    return isfinite(in->speed) ? -1 : 1;
 }
 
-const fmu_behaviour fmu_drive_behaviour = {sizeof(fmu_drive_input),
-                                           sizeof(fmu_drive_output),
-                                           initialise,
-                                           evaluate,
-                                           start,
-                                           advance,
-                                           NULL,
-                                           state_refused};
+static const fmu_states drive_state_table = {
+    drive_states, sizeof drive_states / sizeof drive_states[0], state_refused};
+
+const fmu_behaviour fmu_drive_behaviour = {
+    sizeof(fmu_drive_input), sizeof(fmu_drive_output), initialise, evaluate, start, advance, NULL,
+    &drive_state_table};

@@ -1,9 +1,11 @@
 """FMU state through fmpy, over the harness's inputs, on every FMU the build makes (FMI 2
 and 3): a state saved after some steps and restored continues bit for bit as the first
 run did (for the drive: its motion rolled back and run again), the same after the state
-went through serialized bytes, and bytes that are not a state of the FMU are refused.
-The C misuse matrix (tests/fmu_api_tests.c, fmu_state_round_trip) calls the same entry
-points directly."""
+went through serialized bytes, and bytes that are not a state of the FMU are refused, so
+is a state with any one of its 8-byte fields NaN and its checksum made good again (every
+field is checked as a setter checks it), with a message naming the field. The C misuse
+matrix (tests/fmu_api_tests.c) and the state fuzz (tests/fmu_state_fuzz.c) call the same
+entry points directly."""
 
 from __future__ import annotations
 
@@ -79,5 +81,38 @@ def test_a_restored_state_continues_bit_for_bit(name, version):
         with pytest.raises(Exception, match="status 3|Error|error"):
             deserialize(bytes(damaged))
         assert any("checksum" in m for m in s.messages), s.messages[-3:]
+    finally:
+        s.close()
+
+
+def _seal(data: bytearray) -> bytes:
+    """The state's checksum made good again (FNV-1a over the payload, as fmu_state.c)."""
+    h = 0xCBF29CE484222325
+    for byte in data[32:]:
+        h = ((h ^ byte) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+    data[24:32] = h.to_bytes(8, "little")
+    return bytes(data)
+
+
+@pytest.mark.parametrize("name,version", ALL, ids=IDS)
+def test_a_crafted_state_is_refused_naming_its_field(name, version):
+    setup = importers.setup_of(name, version)
+    s = Slave(setup.path, instance_name="crafted")
+    try:
+        s.initialize()
+        get, set_, free, serialize, deserialize = _calls(s)
+        data = serialize(get())
+        fields = (len(data) - 32) // 8
+        assert fields >= 5
+        for k in range(fields):
+            crafted = bytearray(data)
+            crafted[32 + 8 * k : 40 + 8 * k] = np.array([np.nan]).tobytes()
+            with pytest.raises(Exception, match="status 3|Error|error"):
+                deserialize(_seal(crafted))
+            assert "refused: " in s.messages[-1] and "checksum" not in s.messages[-1], (
+                k,
+                s.messages[-1],
+            )
+        set_(deserialize(data))
     finally:
         s.close()
