@@ -82,7 +82,9 @@ def fmutool() -> str:
 
 #: Built with the tests for the design studies' tests only (tests/scenes/balance.toml: a
 #: crank whose bearing force is known in closed form); no harness signals to compare on.
-STUDY_TEST_FMUS = {"balance_fmi2", "balance_fmi3"}
+#: FMUs of tests/scenes/ that other tests run: the study's balance, the toggles of the
+#: mechanism FMUs' status at their assembly limits (test_toggles.py)
+STUDY_TEST_FMUS = {"balance_fmi2", "balance_fmi3", "toggles_fmi2", "toggles_fmi3"}
 
 
 def test_the_comparison_covers_every_fmu_the_build_makes():

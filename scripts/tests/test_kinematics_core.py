@@ -53,7 +53,13 @@ def test_slider_crank_matches_its_closed_form(core):
     dx, dy = x(theta) - r * math.cos(theta), -r * math.sin(theta)
     assert out["n"]["angle"] == pytest.approx(math.atan2(dy, dx), rel=1e-13)
     assert out["conditioning"] == pytest.approx(abs(dx) / rod, rel=1e-13)
-    assert out["amplification"] == pytest.approx(1 / out["conditioning"], rel=1e-15)
+    # the rod's end E = D_m runs on the guide line, which passes r sin(theta) from the pin:
+    # the closure is (rod - |dy|) over the size of the terms it is formed from
+    closure = (rod - abs(dy)) / (rod + abs(dy) + abs(r * math.cos(theta)) + abs(r * math.sin(theta)))
+    assert out["closure"] == pytest.approx(closure, rel=1e-13)
+    assert out["amplification"] == pytest.approx(
+        1 + 1 / out["closure"] + 1 / out["conditioning"], rel=1e-15
+    )
 
 
 def test_failure_reports_its_figure_and_gap(core):

@@ -423,7 +423,7 @@ def test_the_readme_scene_builds_as_described(tmp_path):
     scene.write_text(found.group(1) + "\n")
     done = run_tool(scene, "--check")
     assert done.returncode == 0, done.stderr
-    assert "3 inputs, 1 parameter, 3 outputs" in done.stdout
+    assert "3 inputs, 1 parameter, 4 outputs" in done.stdout
     assert "scripts/build-scene my_press.toml" in readme
 
 
