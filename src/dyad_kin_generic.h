@@ -287,8 +287,8 @@ static inline void DYAD_KIN(dyad_kin_closure)(kin_state* st, dyad_ks distance, d
  * size. Norms of 1, whose rates are defined everywhere. */
 static inline dyad_ks DYAD_KIN(dyad_kin_amplification)(const kin_in* in, const kin_state* st)
 {
-    const dyad_ks own = ks_add(ks_add(ks_c(1), ks_div(ks_c(1), st->closure)),
-                               ks_div(ks_c(1), st->conditioning));
+    const dyad_ks own =
+        ks_add(ks_add(ks_c(1), ks_div(ks_c(1), st->closure)), ks_div(ks_c(1), st->conditioning));
     const dyad_ks far = ks_add(kv_norm1(in->k.point.pos), kv_norm1(in->p.point.pos));
     const dyad_ks ratio = ks_val(far) > 0 ? ks_div(far, st->size) : ks_c(0);
     const dyad_ks carried = ks_mul(in->mount_amp, ks_add(ks_c(1), ratio));

@@ -1565,8 +1565,7 @@ static double built_closure(dyad_type type, const kin_built* b)
     }
     case DYAD_RRT: {
         /* D_n from the line E runs on: through G_k + l_m i_m along i_k */
-        const double off =
-            fabs(cimag((b->d_n.v - b->g_k.v - l_m * b->i_m.v) * conj(b->i_k.v)));
+        const double off = fabs(cimag((b->d_n.v - b->g_k.v - l_m * b->i_m.v) * conj(b->i_k.v)));
         distance = l_n - off;
         size = l_n + off + norm1(b->g_k.v) + l_m + norm1(b->d_n.v);
         break;
@@ -2147,8 +2146,8 @@ static int test_kin_singular(void)
                   out.closure >= 0 && out.closure <= 1 &&
                   out.amplification == 1 + 1 / out.closure + 1 / out.conditioning &&
                   1 / out.amplification < cases[k].in.singular_threshold,
-              "%s case %zu: conditioning %g, closure %g, amplification %g", dyad_type_name(type),
-              k, (double)out.conditioning, (double)out.closure, (double)out.amplification);
+              "%s case %zu: conditioning %g, closure %g, amplification %g", dyad_type_name(type), k,
+              (double)out.conditioning, (double)out.closure, (double)out.amplification);
         CHECK(kin_all_nan(&out, 0) && out.failure == DYAD_KIN_CLOSES && out.gap == 0,
               "%s case %zu: outputs not NaN", dyad_type_name(type), k);
         CHECK(dyad_kinematics_tangent(type, &cases[k].in, &zero, &value, &rate) == s &&

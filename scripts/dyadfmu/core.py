@@ -8,7 +8,8 @@ else ``build/libdyadfmu.so`` of the checkout (:func:`library_candidates`).
 The kinematics (``dyadfmu/kinematics.h``) take a dict shaped like ``dyad_kin_input``:
 ``{"k": {"position", "velocity", "acceleration", "guide", "omega", "epsilon"}, "p": {...},
 "length_m", "length_n", "turn_m", "turn_n", "com_m", "com_n", "branch",
-"singular_threshold", "mount_amplification"}``; a missing key keeps the value of ``dyad_kin_input_default()``.
+"singular_threshold", "mount_amplification"}``; a missing key keeps the value of
+``dyad_kin_input_default()``.
 """
 
 from __future__ import annotations

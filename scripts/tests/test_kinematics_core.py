@@ -55,7 +55,8 @@ def test_slider_crank_matches_its_closed_form(core):
     assert out["conditioning"] == pytest.approx(abs(dx) / rod, rel=1e-13)
     # the rod's end E = D_m runs on the guide line, which passes r sin(theta) from the pin:
     # the closure is (rod - |dy|) over the size of the terms it is formed from
-    closure = (rod - abs(dy)) / (rod + abs(dy) + abs(r * math.cos(theta)) + abs(r * math.sin(theta)))
+    size = rod + abs(dy) + abs(r * math.cos(theta)) + abs(r * math.sin(theta))
+    closure = (rod - abs(dy)) / size
     assert out["closure"] == pytest.approx(closure, rel=1e-13)
     assert out["amplification"] == pytest.approx(
         1 + 1 / out["closure"] + 1 / out["conditioning"], rel=1e-15

@@ -8,7 +8,6 @@ the outputs lose half their digits and before the dyad stops closing."""
 
 import math
 
-import mpmath
 import numpy as np
 import pytest
 from dyadfmu.core import Core, library_path
