@@ -1503,7 +1503,7 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
     behaviour->derivative(instance->model, instance->input, instance->seed, instance->value,
                           instance->rate, &evaluation);
     if (evaluation.status != FMU_OK) {
-        fmu_log(instance, FMU_DISCARD, "%s: no derivative where the outputs are not defined: %s",
+        fmu_log(instance, FMU_DISCARD, "%s: no derivative at these inputs: %s",
                 function, evaluation.reason);
         for (k = 0; k < n_unknowns; ++k) {
             derivative[k] = NAN;

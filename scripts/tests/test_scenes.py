@@ -400,6 +400,22 @@ def test_a_mechanism_at_a_dead_point_is_singular(version, tmp_path):
 
 
 @pytest.mark.parametrize("version", VERSIONS)
+def test_a_derivative_that_overflows_says_so(version, tmp_path):
+    """A seed of 1e308 given twice for the same known: the press's reactions are fine,
+    their rates overflow; the derivative discards saying that, not that the reactions
+    overflow."""
+    s = Slave("press", version, tmp_path)
+    s.set({"crank.angle": 0.3, "ram.force.x": 100.0})
+    s.step()
+    with pytest.raises(FMICallException) as error:
+        s.slave.directional_derivative(("press.R_np.x",), ("ram.force.x",) * 2, (1e308, 1e308))
+    assert error.value.status == 2  # discard
+    assert "the directional derivative of dyad press is not finite" in s.log_text()
+    assert "overflow double" not in s.log_text()
+    assert s.status() == 0 and math.isfinite(s.get(["press.R_np.x"])[0])
+
+
+@pytest.mark.parametrize("version", VERSIONS)
 def test_tailored_fmu_rejects_a_bad_value_by_name(version, tmp_path):
     s = Slave("shaper", version, tmp_path)
     for name, value in (
