@@ -331,6 +331,7 @@ def test_near_limit_start_finds_the_float_search_roots(kind, branch, monkeypatch
         assert dk._near_limit_starts(m, 0) not in (None, [])
     near = dk.solve(inputs, dps=40)
     monkeypatch.setattr(dk, "_NEAR_LIMIT", 0.0)
+    monkeypatch.setattr(dk, "_LINEAR_NEAR", 0.0)
     with mpmath.workdps(50):
         assert dk._near_limit_starts(dk._model(inputs), 0) is None
     searched = dk.solve(inputs, dps=40)

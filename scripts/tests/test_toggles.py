@@ -6,7 +6,8 @@ assembly limits.
   with status 0 within 10 eps x amplification (the FMU's own output) of the peak of its
   unit over the motion.
 - Bisected to each assembly limit (the lift's ram where its arm and strut stretch out;
-  tests/scenes/toggles.toml's crank where its RRT rod and its RTR slot stop reaching):
+  tests/scenes/toggles.toml's crank where its RRT rod and its RTR slot stop reaching) and
+  to the TRT slot's dead centre (slot and guide parallel):
   going in, the status goes 0, then 1 (singular), and only past the last position that
   closes 4 (cannot assemble), never back; every output with status 0 within
   10 eps x amplification of the peak of its unit; at the last status 0 every output
@@ -218,3 +219,33 @@ def test_singular_before_the_limit_and_right_until_then(limit):
     for name_ in m.compared:
         error = _error(name_, m.units[name_], got, truth)
         assert error <= math.sqrt(EPS) * (largest[m.units[name_]] or 1.0), (limit, q, name_)
+
+
+@pytest.mark.parametrize("side", (1.0, -1.0))
+def test_singular_at_a_dead_centre_and_right_until_then(side):
+    """The TRT slot's crank turned to its guide (crank angle 0, slot and guide parallel:
+    the slides run to infinity) from either side in steps of 10^-k: the status goes from 0
+    to 1, never back, and is 1 at the dead centre; every status-0 output within
+    10 eps x amplification of its unit's peak, and within sqrt(eps) of it at the last."""
+    m = Mechanism("trt_slot")
+    try:
+        statuses, samples = [], []
+        for k in np.arange(1.0, 16.25, 0.25):
+            q = side * 10.0**-k
+            status, got, values = m.step(q)
+            statuses.append(status)
+            if status == 0:
+                samples.append((q, got, m.truth(values)))
+        statuses.append(m.step(0.0)[0])
+    finally:
+        m.close()
+    first_singular = statuses.index(1)
+    assert set(statuses[first_singular:]) == {1}, statuses
+    assert first_singular >= 4 and len(samples) == first_singular, statuses
+    worst = worst_against_bound(m, samples)
+    assert worst[0] <= 10, worst
+    q, got, truth = samples[-1]
+    largest = peaks(m, samples[-1:])
+    for name_ in m.compared:
+        error = _error(name_, m.units[name_], got, truth)
+        assert error <= math.sqrt(EPS) * (largest[m.units[name_]] or 1.0), (q, name_)

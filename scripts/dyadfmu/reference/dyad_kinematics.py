@@ -17,7 +17,7 @@ misses for roots) the roots are started instead from the figure's intersection (
 with circle, line with circle) at the working precision, then polished the same way (a
 start only: the roots are still the closure's): a negative discriminant means no real
 root, a zero one a double root (a dead point).  TRT
-and RTT within a sine of 1e-3 of parallel guides (or slot and guide), whose root runs
+and RTT within a sine of 0.5 of parallel guides (or slot and guide), whose root runs
 beyond the float search's steps, start from their closure solved as the linear system it
 is.  Elsewhere the float search's roots are kept.
 
@@ -514,6 +514,10 @@ def _roots(model: _Model, t: Real) -> list:
 #: Below this squared separation of its two roots (relative to the figure) a dyad is
 #: near its assembly limit: its roots are started from the figure's intersection.
 _NEAR_LIMIT = 1e-6
+#: Below this squared sine between the columns of TRT's and RTT's linear closure, its root
+#: is started from the closure solved as the linear system it is: already at a sine of
+#: 0.02 the root lies beyond the float search's steps.
+_LINEAR_NEAR = 0.25
 
 
 def _sub(a: Vec, b: Vec) -> tuple:
@@ -601,8 +605,9 @@ def _rtr_starts(model: _Model, d_m: Vec, d_n: Vec, size: mpf) -> list | None:
 
 def _linear_start(model: _Model, pk: Vec, ak: Real, pp: Vec, ap: Real) -> list | None:
     """TRT and RTT, whose closure is linear in q (the angles are fixed): u q[0] + v q[1] = b
-    solved by Cramer where the sine between u and v is below sqrt(_NEAR_LIMIT) (the root
-    runs far away, beyond the float search's steps); none where u and v are parallel."""
+    solved by Cramer at the working precision where the sine between u and v is below
+    sqrt(_LINEAR_NEAR), the start findroot polishes (the float search's steps do not reach
+    a root that runs far away as u and v turn parallel); none where they are parallel."""
     i_k, i_m = _unit(ak), _unit(ak + model.turn_m)
     if model.type == "TRT":  # s_k i_k - s_p i_p = G_p + l_n i_n - G_k - l_m i_m
         i_p = _unit(ap)
@@ -614,7 +619,7 @@ def _linear_start(model: _Model, pk: Vec, ak: Real, pp: Vec, ap: Real) -> list |
         u, v = i_k, i_m
         b = tuple(pp[c] + model.length_n * i_n[c] - pk[c] for c in (0, 1))
     det = _cross(u, v)
-    if det * det >= _NEAR_LIMIT:
+    if det * det >= _LINEAR_NEAR:
         return None
     return [] if det == 0 else [[_cross(b, v) / det, _cross(u, b) / det]]
 
