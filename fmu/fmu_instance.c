@@ -1503,8 +1503,8 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
     behaviour->derivative(instance->model, instance->input, instance->seed, instance->value,
                           instance->rate, &evaluation);
     if (evaluation.status != FMU_OK) {
-        fmu_log(instance, FMU_DISCARD, "%s: no derivative at these inputs: %s",
-                function, evaluation.reason);
+        fmu_log(instance, FMU_DISCARD, "%s: no derivative at these inputs: %s", function,
+                evaluation.reason);
         for (k = 0; k < n_unknowns; ++k) {
             derivative[k] = NAN;
         }
