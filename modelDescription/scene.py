@@ -2,7 +2,7 @@
 """Turn a scene into a tailored FMU: its variable table, its C model, both model
 descriptions and its documentation.
 
-A scene (TOML, see scenes/README.md for the schema) describes a mechanism: an
+A scene (TOML, see modelDescription/scenes/README.md for the schema) describes a mechanism: an
 optional crank and a chain of Assur dyads, how each dyad's external links k and
 p connect (the frame, the crank, a link of an earlier dyad, or an external link
 whose motion is an input), which effects are present (inertia, gravity, active

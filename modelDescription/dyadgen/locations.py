@@ -12,7 +12,7 @@ ROOT = MODEL_DESCRIPTION.parent
 #: probe scene and the golden model descriptions.
 INTERFACE_DIR = MODEL_DESCRIPTION / "interface"
 GOLDEN_DIR = INTERFACE_DIR / "golden"
-SCENES_DIR = ROOT / "scenes"
+SCENES_DIR = ROOT / "modelDescription" / "scenes"
 #: The scenes the build adds with its tests (fmu/CMakeLists.txt: tests/scenes/*.toml).
 TEST_SCENES_DIR = ROOT / "tests" / "scenes"
 #: The variable tables written by hand (interface/), each an FMU of the build.

@@ -11,7 +11,7 @@ import os
 import tempfile
 from pathlib import Path
 
-#: The checkout (the directory holding scripts/, scenes/, modelDescription/) where this
+#: The checkout (the directory holding scripts/, modelDescription/) where this
 #: package runs from one (in_checkout()); in an installed package, a folder outside it that
 #: nothing reads.
 ROOT = Path(__file__).resolve().parents[2]
@@ -40,13 +40,13 @@ def in_checkout() -> bool:
 
 
 def project_dir() -> Path:
-    """The project's sources (CMakeLists.txt, src/, fmu/, modelDescription/, scenes/): the
+    """The project's sources (CMakeLists.txt, src/, fmu/, modelDescription/): the
     checkout's, else those the installed package bundles."""
     return ROOT if in_checkout() else BUNDLED_PROJECT
 
 
-#: The scene files, scenes/*.toml.
-SCENES_DIR = project_dir() / "scenes"
+#: The scene files, modelDescription/scenes/*.toml.
+SCENES_DIR = project_dir() / "modelDescription" / "scenes"
 #: The scene generator, modelDescription/scene.py.
 GENERATOR = project_dir() / "modelDescription" / "scene.py"
 

@@ -87,7 +87,7 @@ def chain(name):
 
 @cache
 def scene(name):
-    with open(ROOT / "scenes" / f"{name}.toml", "rb") as f:
+    with open(ROOT / "modelDescription" / "scenes" / f"{name}.toml", "rb") as f:
         return tomllib.load(f)
 
 
@@ -125,7 +125,7 @@ def assert_close(got, want, rel, what, floor=0.0):
 def test_names_and_paths():
     assert chains.NAMES == NAMES
     for name in NAMES:
-        assert chains.scene_path(name) == ROOT / "scenes" / f"{name}.toml"
+        assert chains.scene_path(name) == ROOT / "modelDescription" / "scenes" / f"{name}.toml"
         assert chains.scene_path(name).is_file()
     with pytest.raises(ValueError, match="shaper"):
         chains.load("pendulum")

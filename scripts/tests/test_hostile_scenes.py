@@ -1,7 +1,7 @@
 """Scenes as untrusted input: the scene generator (modelDescription/scene.py) on hostile
 and careless scenes.
 
-* Each malformed hostile scene (scenes/malformed/hostile_*.toml) is refused with exactly
+* Each malformed hostile scene (modelDescription/scenes/malformed/hostile_*.toml) is refused with exactly
   the message its first line names: descriptions that would end a C comment or carry
   control or bidi characters, numbers beyond a double, names with a trailing newline,
   names too long, names that clash with C, the core or the generated code.
@@ -50,7 +50,7 @@ from dyadgen.scenefile.c_names import c_names  # noqa: E402
 from dyadgen.scenefile.problems import SceneError  # noqa: E402
 
 SCENE_TOOL = MD_DIR / "scene.py"
-SCENES_DIR = ROOT / "scenes"
+SCENES_DIR = ROOT / "modelDescription" / "scenes"
 HOSTILE = sorted((SCENES_DIR / "malformed").glob("hostile_*.toml"))
 SIXBAR = SCENES_DIR / "sixbar.toml"
 GCC = shutil.which("gcc")
@@ -526,7 +526,7 @@ class _Slave:
 @needs_gcc
 @pytest.mark.parametrize("tunable", ('["second.D_m"]', '["all"]'))
 def test_a_tunable_pair_point_is_a_parameter_that_works(tunable, tmp_path):
-    """scenes/README.md lists DYAD.D_m.x (a pair point `at`) among the tunable parameters:
+    """modelDescription/scenes/README.md lists DYAD.D_m.x (a pair point `at`) among the tunable parameters:
     with it tunable, the FMU gives the outputs of the baked scene at the same value, and
     other outputs at another value."""
     path = sixbar_with(tmp_path, "tunable.toml", tunable=tunable)

@@ -1,4 +1,4 @@
-"""The ram-driven lift (scenes/lift.toml, chains.toml [lift]) and what chains.py reads from
+"""The ram-driven lift (modelDescription/scenes/lift.toml, chains.toml [lift]) and what chains.py reads from
 a scene (frame pivots, guide points, branches, the crank's pivot).
 
 - the ram's stroke: its ends, and its velocity and acceleration against complex-step
@@ -34,7 +34,7 @@ H = 1e-30
 
 
 def scene_file(name="lift"):
-    with open(ROOT / "scenes" / f"{name}.toml", "rb") as f:
+    with open(ROOT / "modelDescription" / "scenes" / f"{name}.toml", "rb") as f:
         return tomllib.load(f)
 
 

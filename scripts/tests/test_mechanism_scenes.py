@@ -1,4 +1,4 @@
-"""The mechanism FMU scenes of the five built-in mechanisms (scenes/slider_crank.toml,
+"""The mechanism FMU scenes of the five built-in mechanisms (modelDescription/scenes/slider_crank.toml,
 four_bar, quick_return, scotch_yoke, trt_slot) against mechanisms.toml, through the
 mechanism objects of dyadfmu.mechanisms.builtin.
 
@@ -43,7 +43,7 @@ FRAME_POINT = {
 
 
 def scene(name):
-    with open(ROOT / "scenes" / f"{SCENES[name]}.toml", "rb") as f:
+    with open(ROOT / "modelDescription" / "scenes" / f"{SCENES[name]}.toml", "rb") as f:
         return tomllib.load(f)
 
 
@@ -182,10 +182,10 @@ def test_loads(name):
 
 
 def _internal_scenes() -> list[str]:
-    """The scenes of scenes/ whose kinematics are solved inside their FMU."""
+    """The scenes of modelDescription/scenes/ whose kinematics are solved inside their FMU."""
     return sorted(
         p.stem
-        for p in (ROOT / "scenes").glob("*.toml")
+        for p in (ROOT / "modelDescription" / "scenes").glob("*.toml")
         if tomllib.loads(p.read_text(encoding="utf-8"))["scene"].get("kinematics") == "internal"
     )
 
@@ -204,7 +204,7 @@ def test_external_inputs_of_every_mechanism_scene(name):
     inputs the scene's FMU would take with every link's motion an input, for every
     mechanism scene, the ram-driven lift among them. More inputs than the scene's own,
     each named once."""
-    scene = str(ROOT / "scenes" / f"{name}.toml")
+    scene = str(ROOT / "modelDescription" / "scenes" / f"{name}.toml")
     external = _generator(scene, "--external-inputs")
     assert external.returncode == 0, external.stderr[-600:]
     names = external.stdout.split()

@@ -44,9 +44,9 @@ from dyadgen.table import instantiation_token  # noqa: E402
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
 PAIRS = {"RRR": "RRR", "RRT": "TRR", "RTR": "RTR", "TRT": "TRT", "RTT": "TTR"}  # D_m, E, D_n
-SCENES_DIR = ROOT / "scenes"
+SCENES_DIR = ROOT / "modelDescription" / "scenes"
 #: The generic dyad FMUs' variable tables, as the scene generator makes them from
-#: scenes/dyad_<type>.toml, written to files (filled at the end of this module).
+#: modelDescription/scenes/dyad_<type>.toml, written to files (filled at the end of this module).
 TABLE_OF: dict = {}
 
 

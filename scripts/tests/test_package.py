@@ -165,7 +165,7 @@ def test_wheel_holds_core_and_fmus(wheel):
         "modelDescription/scene.py",
         "modelDescription/dyadgen/pipeline.py",
         "modelDescription/interface/dyad_interface.toml",
-        "scenes/engine.toml",
+        "modelDescription/scenes/engine.toml",
     ):
         assert f"dyadfmu/_project/{needed}" in project, needed
     assert any("/dyadgen/emit/templates/" in n for n in project)

@@ -27,8 +27,8 @@ from fmpy import read_model_description
 ROOT = paths.ROOT
 DOCUMENTS = [
     ROOT / "README.md",
-    ROOT / "scenes" / "README.md",
-    ROOT / "scenes" / "studies" / "README.md",
+    ROOT / "modelDescription" / "scenes" / "README.md",
+    ROOT / "modelDescription" / "scenes" / "studies" / "README.md",
 ]
 TYPES = ("rrr", "rrt", "rtr", "trt", "rtt")
 
@@ -80,7 +80,7 @@ def _example_errors() -> list[tuple[str, str]]:
 
 @pytest.mark.parametrize("file,line", _example_errors(), ids=lambda x: x[:40])
 def test_an_example_error_is_what_the_checker_prints(file, line):
-    done = _check_scene(ROOT / "scenes" / "malformed" / file)
+    done = _check_scene(ROOT / "modelDescription" / "scenes" / "malformed" / file)
     assert done.returncode != 0
     assert line in done.stderr.splitlines(), done.stderr
 

@@ -1,6 +1,6 @@
 """The mpmath reference of a whole mechanism FMU (dyadfmu.reference.scene_mp).
 
-- every Real output of every mechanism FMU of scenes/ (built, run through fmpy) against
+- every Real output of every mechanism FMU of modelDescription/scenes/ (built, run through fmpy) against
   the reference at a few driver positions, both branches where a branch is tunable,
   within 1e-12 of the largest output of its unit;
 - the lift bisected with the reference's own status to within 1e-15 m of the ram

@@ -22,7 +22,7 @@ from fmpy.validation import validate_fmu
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
-SCENES_DIR = ROOT / "scenes"
+SCENES_DIR = ROOT / "modelDescription" / "scenes"
 MALFORMED = sorted((SCENES_DIR / "malformed").glob("*.toml"))
 VERSIONS = (2, 3)
 GENERATED = paths.build_dir() / "generated"

@@ -242,13 +242,13 @@ def test_toml_text_reads_back_as_the_same_data(data):
 
 
 def test_every_builtin_scene_reads_back_through_toml_text():
-    for path in sorted((ROOT / "scenes").glob("*.toml")):
+    for path in sorted((ROOT / "modelDescription" / "scenes").glob("*.toml")):
         data = tomllib.loads(path.read_text())
         assert tomllib.loads(sources.toml_text(data)) == data, path
 
 
 def test_the_scene_copy_makes_the_study_parameters_tunable_and_passes_the_checks(tmp_path):
-    s = read_study(ROOT / "scenes" / "studies" / "engine_counterweight.toml")
+    s = read_study(ROOT / "modelDescription" / "scenes" / "studies" / "engine_counterweight.toml")
     path = sources.sweep_scene(s, tmp_path)
     scene = tomllib.loads(path.read_text())["scene"]
     assert scene["identifier"].startswith("engine_sweep_")
@@ -310,7 +310,7 @@ def test_a_local_cluster_of_two_gives_the_loop_s_table_and_failures_are_rows(tmp
 
 
 def test_a_driven_study_on_two_workers_equals_its_loop(tmp_path):
-    text = (ROOT / "scenes" / "studies" / "shaper_motor.toml").read_text()
+    text = (ROOT / "modelDescription" / "scenes" / "studies" / "shaper_motor.toml").read_text()
     shaper = paths.build_dir() / "fmus" / "shaper_fmi2.fmu"
     if not shaper.is_file():
         pytest.skip(f"{shaper} is not built")
@@ -804,7 +804,7 @@ def test_a_study_with_a_byte_order_mark_is_read(tmp_path):
 
 
 def test_a_misspelt_name_is_refused_before_the_scene_s_fmu_is_built(tmp_path, monkeypatch):
-    """scenes/studies/README.md: every problem is refused before anything runs; the
+    """modelDescription/scenes/studies/README.md: every problem is refused before anything runs; the
     mechanism FMU's build (tens of seconds) is not started for a misspelt figure."""
 
     def no_build(*args, **kwargs):

@@ -1,4 +1,4 @@
-"""The two example studies of the README (scenes/studies/), run as a user runs them: the
+"""The two example studies of the README (modelDescription/scenes/studies/), run as a user runs them: the
 mechanism FMU built from the scene with the study's parameters tunable, two local Dask
 workers. Their answers are checked by means the sweep does not use: the engine's
 main-bearing force against superposition (a counterweight only adds its own weight and
@@ -16,7 +16,7 @@ from dyadfmu.fmi.slave import Slave
 from dyadfmu.sweep import results, study
 
 ROOT = Path(__file__).resolve().parents[2]
-STUDIES = ROOT / "scenes" / "studies"
+STUDIES = ROOT / "modelDescription" / "scenes" / "studies"
 
 pytestmark = pytest.mark.skipif(
     shutil.which("cmake") is None, reason="building a study's scene needs CMake"

@@ -16,7 +16,7 @@ from dyadgen.scenefile.read import inputs_with_external_kinematics
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         description="Generate a tailored FMU's model descriptions, C model and documentation "
-        "from a scene (see scenes/README.md)."
+        "from a scene (see modelDescription/scenes/README.md)."
     )
     parser.add_argument("scene", type=Path, help="the scene file (TOML)")
     what = parser.add_mutually_exclusive_group(required=True)

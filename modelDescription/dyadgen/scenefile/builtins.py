@@ -1,5 +1,5 @@
 """The identifiers of the FMUs the build always makes (fmu/CMakeLists.txt): every scene in
-scenes/, the test scenes in tests/scenes/ and the variable tables written by hand
+modelDescription/scenes/, the test scenes in tests/scenes/ and the variable tables written by hand
 (the drive). A scene of another file may not take one: a build with both would define
 the CMake targets <identifier>_fmi2 and _fmi3 twice. Read from the files themselves,
 once per process."""
@@ -45,6 +45,6 @@ def builtin_identifiers() -> dict[str, Path]:
 
 
 def is_builtin(path: Path, identifier: str) -> bool:
-    """Whether `path` is the built-in file that `identifier` names (scenes/press.toml for
+    """Whether `path` is the built-in file that `identifier` names (modelDescription/scenes/press.toml for
     'press'): the one file that may use a built-in identifier."""
     return builtin_identifiers().get(identifier) == Path(path).resolve()

@@ -369,7 +369,7 @@ class Mechanism:
         if value is None and dyad.type != "RTR":
             self.p.add(
                 f"{label}: an {dyad.type} dyad closes in two ways: say which with branch = 1 "
-                "or -1 (see scenes/README.md)",
+                "or -1 (see modelDescription/scenes/README.md)",
                 "dyad",
                 dyad.index,
             )

@@ -1,4 +1,4 @@
-"""The tailored scene FMUs (scenes/*.toml) co-simulated with fmpy and checked output by
+"""The tailored scene FMUs (modelDescription/scenes/*.toml) co-simulated with fmpy and checked output by
 output against independent references.
 
 Two kinds of scene:
@@ -72,7 +72,7 @@ def fmu_path(name: str, version: int, build: Path | None = None) -> Path:
 
 
 def scene_data(name: str) -> dict:
-    """The parsed scene file scenes/<name>.toml."""
+    """The parsed scene file modelDescription/scenes/<name>.toml."""
     with open(SCENES_DIR / f"{name}.toml", "rb") as f:
         return tomllib.load(f)
 

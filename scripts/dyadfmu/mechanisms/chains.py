@@ -3,7 +3,7 @@ exact kinematics, active loads and a whole-mechanism Newton-Euler reference for 
 joint reactions.
 
 =============  ============================================================================
-name           mechanism (scene file ``scenes/<name>.toml``)
+name           mechanism (scene file ``modelDescription/scenes/<name>.toml``)
 =============  ============================================================================
 shaper         crank; dyad ``slot`` (RTR): slotted lever on the frame at O2 and a block on
                the crank pin; dyad ``ram`` (RRT): ram on a horizontal frame guide, rod from
@@ -129,7 +129,7 @@ def _solve2(c1: np.ndarray, c2: np.ndarray, rhs: np.ndarray):
 # data
 # ---------------------------------------------------------------------------
 def scene_path(name: str) -> Path:
-    """The scene file of mechanism ``name``: ``scenes/<name>.toml`` of the project."""
+    """The scene file of mechanism ``name``: ``modelDescription/scenes/<name>.toml`` of the project."""
     if name not in _ALL_NAMES:
         raise ValueError(
             f"unknown chain mechanism {name!r}; expected one of: {', '.join(_ALL_NAMES)}"

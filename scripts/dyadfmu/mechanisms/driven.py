@@ -48,7 +48,7 @@ from .motion import CrankMotion, RamMotion
 
 __all__ = ["SCENE_OF", "DrivenSeries", "driver_motion_inputs", "effective_inertia"]
 
-#: The mechanism FMU scene (``scenes/<name>.toml``) of each built-in mechanism.
+#: The mechanism FMU scene (``modelDescription/scenes/<name>.toml``) of each built-in mechanism.
 SCENE_OF = {
     "slider-crank": "slider_crank",
     "four-bar": "four_bar",
@@ -262,7 +262,7 @@ def driver_motion_inputs(
     ``motion``, and the reference values of its outputs, all by FMU name.
 
     ``mechanism``: a built-in mechanism (:func:`.builtin.load`; its scene, which names
-    its crank, dyad and links, is ``scenes/<SCENE_OF[name]>.toml`` unless ``scene`` is
+    its crank, dyad and links, is ``modelDescription/scenes/<SCENE_OF[name]>.toml`` unless ``scene`` is
     given, as a parsed table or a path) or a chain (:func:`.chains.load`; its own scene).
     ``branch``: the assembly branch of a built-in mechanism (default its own).
     Inputs: the driver's motion and the loads the scene lists. Outputs: see the

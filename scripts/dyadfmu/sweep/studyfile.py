@@ -3,7 +3,7 @@ ranges, how each design runs, the load case, the figures and the objective.
 
 Everything in a study file is untrusted input. A problem is refused as
 ``StudyError("FILE:LINE: what is wrong")``, naming the key; nothing runs then. The
-format is described in scenes/studies/README.md.
+format is described in modelDescription/scenes/studies/README.md.
 """
 
 from __future__ import annotations
