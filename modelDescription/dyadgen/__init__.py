@@ -1,7 +1,7 @@
 """dyadgen: everything an FMU of dyadfmu needs, generated from its single source.
 
-The source is a scene file (modelDescription/scenes/README.md: a crank and a chain of Assur dyads, their
-effects, outputs and tunable parameters) or, for the crank drive, a variable table
+The source is a scene file (modelDescription/scenes/README.md: a crank and a chain of Assur dyads,
+their effects, outputs and tunable parameters) or, for the crank drive, a variable table
 (interface/drive.toml). The generator works in stages, each module in one of them:
 
     scenefile/   read and check a scene: every problem with its file and line

@@ -31,7 +31,9 @@ SKIP = ("build", "out", ".venv", "node_modules", ".git")
 DOCUMENTS = sorted(
     p
     for p in ROOT.rglob("*.md")
-    if not any(part in SKIP or part.startswith(("build-", ".")) for part in p.relative_to(ROOT).parts)
+    if not any(
+        part in SKIP or part.startswith(("build-", ".")) for part in p.relative_to(ROOT).parts
+    )
 )
 LINK = re.compile(r"(?<!!)\[[^\]\n]*\]\(([^)\s]+)\)|!\[[^\]\n]*\]\(([^)\s]+)\)")
 FENCE = re.compile(r"^```([a-z]*)\n(.*?)^```", re.S | re.M)

@@ -196,7 +196,9 @@ def test_other_branch_and_scene_path():
     motion = mech.motion("constant", 1.0)
     t = np.linspace(0.0, motion.duration, 25)
     up = driven.driver_motion_inputs(mech, t, motion)
-    down = driven.driver_motion_inputs(mech, t, motion, ROOT / "modelDescription" / "scenes" / "four_bar.toml", -1)
+    down = driven.driver_motion_inputs(
+        mech, t, motion, ROOT / "modelDescription" / "scenes" / "four_bar.toml", -1
+    )
     assert not np.allclose(up.outputs["rocker.angle"], down.outputs["rocker.angle"])
     kin = mech.kinematics(t, motion, -1)
     assert np.array_equal(down.outputs["rocker.angle"], kin["m.angle"])

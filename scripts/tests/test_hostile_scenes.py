@@ -1,8 +1,8 @@
 """Scenes as untrusted input: the scene generator (modelDescription/scene.py) on hostile
 and careless scenes.
 
-* Each malformed hostile scene (modelDescription/scenes/malformed/hostile_*.toml) is refused with exactly
-  the message its first line names: descriptions that would end a C comment or carry
+* Each malformed hostile scene (modelDescription/scenes/malformed/hostile_*.toml) is refused
+  with exactly the message its first line names: descriptions that would end a C comment or carry
   control or bidi characters, numbers beyond a double, names with a trailing newline,
   names too long, names that clash with C, the core or the generated code.
 * Every name the generated code, the core or C uses is refused as a dyad's name; the
@@ -526,8 +526,8 @@ class _Slave:
 @needs_gcc
 @pytest.mark.parametrize("tunable", ('["second.D_m"]', '["all"]'))
 def test_a_tunable_pair_point_is_a_parameter_that_works(tunable, tmp_path):
-    """modelDescription/scenes/README.md lists DYAD.D_m.x (a pair point `at`) among the tunable parameters:
-    with it tunable, the FMU gives the outputs of the baked scene at the same value, and
+    """modelDescription/scenes/README.md lists DYAD.D_m.x (a pair point `at`) among the tunable
+    parameters: with it tunable, the FMU gives the outputs of the baked scene at the same value, and
     other outputs at another value."""
     path = sixbar_with(tmp_path, "tunable.toml", tunable=tunable)
     assert run_tool(path, "--check").returncode == 0

@@ -1,5 +1,5 @@
-"""The ram-driven lift (modelDescription/scenes/lift.toml, chains.toml [lift]) and what chains.py reads from
-a scene (frame pivots, guide points, branches, the crank's pivot).
+"""The ram-driven lift (modelDescription/scenes/lift.toml, chains.toml [lift]) and what chains.py
+reads from a scene (frame pivots, guide points, branches, the crank's pivot).
 
 - the ram's stroke: its ends, and its velocity and acceleration against complex-step
   derivatives of its position, for both motions;

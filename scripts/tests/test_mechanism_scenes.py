@@ -1,6 +1,6 @@
-"""The mechanism FMU scenes of the five built-in mechanisms (modelDescription/scenes/slider_crank.toml,
-four_bar, quick_return, scotch_yoke, trt_slot) against mechanisms.toml, through the
-mechanism objects of dyadfmu.mechanisms.builtin.
+"""The mechanism FMU scenes of the five built-in mechanisms
+(modelDescription/scenes/slider_crank.toml, four_bar, quick_return, scotch_yoke, trt_slot) against
+mechanisms.toml, through the mechanism objects of dyadfmu.mechanisms.builtin.
 
 Every number of each scene (crank pivot, length, mass, inertia, centre of mass; the frame
 pivot or guide and its point; the links' lengths, masses, inertias, centres of mass; the

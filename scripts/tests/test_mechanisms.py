@@ -545,7 +545,9 @@ def toml_names(dyad, causality):
     """The generic dyad FMU's variables, as the scene generator makes them."""
     from dyadgen import pipeline
 
-    table = pipeline.build_table(pipeline.load_scene(ROOT / "modelDescription" / "scenes" / f"dyad_{dyad.lower()}.toml"))
+    table = pipeline.build_table(
+        pipeline.load_scene(ROOT / "modelDescription" / "scenes" / f"dyad_{dyad.lower()}.toml")
+    )
     return [v.name for v in table.variables if v.causality == causality]
 
 

@@ -1,7 +1,7 @@
 """The mpmath reference of a whole mechanism FMU (dyadfmu.reference.scene_mp).
 
-- every Real output of every mechanism FMU of modelDescription/scenes/ (built, run through fmpy) against
-  the reference at a few driver positions, both branches where a branch is tunable,
+- every Real output of every mechanism FMU of modelDescription/scenes/ (built, run through
+  fmpy) against the reference at a few driver positions, both branches where a branch is tunable,
   within 1e-12 of the largest output of its unit;
 - the lift bisected with the reference's own status to within 1e-15 m of the ram
   position where its lever dyad stops closing: there, 50 and 80 digits agree to 30;

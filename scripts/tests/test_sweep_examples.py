@@ -1,5 +1,5 @@
-"""The two example studies of the README (modelDescription/scenes/studies/), run as a user runs them: the
-mechanism FMU built from the scene with the study's parameters tunable, two local Dask
+"""The two example studies of the README (modelDescription/scenes/studies/), run as a user runs
+them: the mechanism FMU built from the scene with the study's parameters tunable, two local Dask
 workers. Their answers are checked by means the sweep does not use: the engine's
 main-bearing force against superposition (a counterweight only adds its own weight and
 centrifugal force), the shaper's against the physics of a flywheel."""

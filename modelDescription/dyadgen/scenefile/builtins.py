@@ -45,6 +45,7 @@ def builtin_identifiers() -> dict[str, Path]:
 
 
 def is_builtin(path: Path, identifier: str) -> bool:
-    """Whether `path` is the built-in file that `identifier` names (modelDescription/scenes/press.toml for
-    'press'): the one file that may use a built-in identifier."""
+    """Whether `path` is the built-in file that `identifier` names
+    (modelDescription/scenes/press.toml for 'press'): the one file that may use a built-in
+    identifier."""
     return builtin_identifiers().get(identifier) == Path(path).resolve()

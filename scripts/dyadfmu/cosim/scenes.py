@@ -1,5 +1,5 @@
-"""The tailored scene FMUs (modelDescription/scenes/*.toml) co-simulated with fmpy and checked output by
-output against independent references.
+"""The tailored scene FMUs (modelDescription/scenes/*.toml) co-simulated with fmpy and checked
+output by output against independent references.
 
 Two kinds of scene:
 

@@ -129,7 +129,8 @@ def _solve2(c1: np.ndarray, c2: np.ndarray, rhs: np.ndarray):
 # data
 # ---------------------------------------------------------------------------
 def scene_path(name: str) -> Path:
-    """The scene file of mechanism ``name``: ``modelDescription/scenes/<name>.toml`` of the project."""
+    """The scene file of mechanism ``name``: ``modelDescription/scenes/<name>.toml`` of the
+    project."""
     if name not in _ALL_NAMES:
         raise ValueError(
             f"unknown chain mechanism {name!r}; expected one of: {', '.join(_ALL_NAMES)}"

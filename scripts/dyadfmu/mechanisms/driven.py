@@ -262,8 +262,8 @@ def driver_motion_inputs(
     ``motion``, and the reference values of its outputs, all by FMU name.
 
     ``mechanism``: a built-in mechanism (:func:`.builtin.load`; its scene, which names
-    its crank, dyad and links, is ``modelDescription/scenes/<SCENE_OF[name]>.toml`` unless ``scene`` is
-    given, as a parsed table or a path) or a chain (:func:`.chains.load`; its own scene).
+    its crank, dyad and links, is ``modelDescription/scenes/<SCENE_OF[name]>.toml`` unless ``scene``
+    is given, as a parsed table or a path) or a chain (:func:`.chains.load`; its own scene).
     ``branch``: the assembly branch of a built-in mechanism (default its own).
     Inputs: the driver's motion and the loads the scene lists. Outputs: see the
     module's docstring; ``J``, ``dJdq`` and ``torque0`` (``force0``) of the driver.

@@ -1,10 +1,10 @@
 """Independent high-precision reference of a whole mechanism FMU (mpmath).
 
-From a scene file with internal kinematics (``modelDescription/scenes/*.toml`` with a ``[crank]`` or a
-``[ram]``; schema in modelDescription/scenes/README.md) and the FMU's input values, :func:`evaluate` gives
-every Real output of the scene's mechanism FMU as an mpf at a chosen precision, and the
-status. It is built from the two independent references of this package, not from the C
-code or the generated code:
+From a scene file with internal kinematics (``modelDescription/scenes/*.toml`` with a
+``[crank]`` or a ``[ram]``; schema in modelDescription/scenes/README.md) and the FMU's input
+values, :func:`evaluate` gives every Real output of the scene's mechanism FMU as an mpf at a
+chosen precision, and the status. It is built from the two independent references of this
+package, not from the C code or the generated code:
 
 * kinematics, from the driver outwards: each dyad by :func:`.dyad_kinematics.solve`
   (the closure solved by findroot, rates by implicit differentiation), its mounts being
@@ -785,8 +785,8 @@ def _motion_outputs(s: MechanismScene, d: DyadSpec, r: dict) -> dict[str, mpf]:
 
 
 def _conditioning(d: DyadSpec, r: dict, chain: _Chain) -> mpf:
-    """The dyad's conditioning in [0, 1], as modelDescription/scenes/README.md and README.md define it:
-    RRR |i_m . j_n|, RRT |i_n . i_k|, RTR the smaller of |i_beta . i_m| and |D_m D_n| /
+    """The dyad's conditioning in [0, 1], as modelDescription/scenes/README.md and README.md
+    define it: RRR |i_m . j_n|, RRT |i_n . i_k|, RTR the smaller of |i_beta . i_m| and |D_m D_n| /
     (l_m + l_n), TRT |j_k . i_p|, RTT |j_k . i_m|."""
     i_m, i_n = r["i_m"], r["i_n"]
     i_k, i_p = chain.guides[d.name]

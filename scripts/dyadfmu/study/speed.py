@@ -234,7 +234,8 @@ def numpy_seconds_per_row(dyad: str, rows: np.ndarray, repeat: int, reuse: bool)
 
 
 def builtin_scenes(root: Path | None = None) -> list[str]:
-    """The identifiers of the scene FMUs built from modelDescription/scenes/*.toml, the dyads excluded."""
+    """The identifiers of the scene FMUs built from modelDescription/scenes/*.toml, the dyads
+    excluded."""
     folder = (root or paths.ROOT) / "modelDescription" / "scenes"
     return sorted(p.stem for p in folder.glob("*.toml") if not p.stem.startswith("dyad_"))
 
