@@ -2,11 +2,11 @@
  *
  * A simulated controller ticks every 1 ms. At each tick it reads the crank's angle,
  * speed and acceleration from a trajectory (an encoder and an observer in a real
- * drive) and calls the shaper's generated scene code (modelDescription/scenes/shaper.toml, built with
- * the float core): the kinematics of the chain are solved inside, so the crank's
- * motion and the cutting force are its only inputs. Out come the feed-forward motor
- * torque and the loads on the bearings (the crank's main bearing O, the lever's pivot
- * O2, the lever tip B), which a bearing-load monitor would compare with its limits.
+ * drive) and calls the shaper's generated scene code (modelDescription/scenes/shaper.toml, built
+ * with the float core): the kinematics of the chain are solved inside, so the crank's motion and
+ * the cutting force are its only inputs. Out come the feed-forward motor torque and the loads on
+ * the bearings (the crank's main bearing O, the lever's pivot O2, the lever tip B), which a
+ * bearing-load monitor would compare with its limits.
  *
  * The cutting force acts on the working stroke, while the ram moves towards -x: the
  * controller sees the ram's direction from the pair position the scene outputs at
