@@ -28,7 +28,7 @@ typedef struct fmu_drive_output {
     double speed;        /* rad/s */
     double acceleration; /* rad/s^2, for the current state and inputs */
     double motor_torque; /* N m */
-    int status;          /* 0 ok, 2 invalid input */
+    int status;          /* 0 ok, 2 invalid input, 3 out of range */
 } fmu_drive_output;
 
 extern const fmu_behaviour fmu_drive_behaviour;

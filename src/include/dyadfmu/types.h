@@ -202,8 +202,11 @@ typedef struct dyad_result {
     /** Conditioning in [0, 1] (-): |denominator|; for RTR the smaller of
      *  |i_beta.i_m| and |D_m D_n| / (l_m + l_n). Compared with the threshold. */
     dyad_real conditioning;
-    /** 1 / conditioning (-): the factor by which the reactions, and their
-     *  round-off, grow against the loads. +inf exactly at a singular position. */
+    /** The bound of the round-off (-): with status ok, every output is within
+     *  c eps amplification of the largest output of its unit (forces in N,
+     *  moments in N m); the cancellation of the load terms (the data factor)
+     *  over the conditioning (dyad_amplification.h). Otherwise 1 / conditioning,
+     *  +inf exactly at a singular position, NaN for an invalid input. */
     dyad_real amplification;
 } dyad_result;
 
