@@ -141,7 +141,8 @@ def _speed_command(sub: argparse._SubParsersAction) -> None:
 def _sweep_command(sub: argparse._SubParsersAction) -> None:
     sweep = sub.add_parser(
         "sweep",
-        help="a design study over many runs on Dask (a study file: modelDescription/scenes/studies/README.md)",
+        help="a design study over many runs on Dask (a study file: "
+        "modelDescription/scenes/studies/README.md)",
         description="Read a study file, draw its designs (grid, random or Latin hypercube), "
         "run each on the mechanism FMU (and the drive FMU for a driven study) on a local Dask "
         "cluster or an existing one, and write the table (results.csv), the best designs "
@@ -173,7 +174,8 @@ def _sweep_command(sub: argparse._SubParsersAction) -> None:
 def _scene_command(sub: argparse._SubParsersAction) -> None:
     scene = sub.add_parser(
         "scene",
-        help="co-simulate tailored scene FMUs (modelDescription/scenes/*.toml) against their reference",
+        help="co-simulate tailored scene FMUs (modelDescription/scenes/*.toml) against their "
+        "reference",
         description="Co-simulate each scene's tailored FMU over the crank's motion, print the "
         "error of every output against the independent reference, and write "
         "tables (Markdown, CSV) and, for the multi-dyad chains, a drawing with "
@@ -375,7 +377,10 @@ def _run(args: argparse.Namespace) -> int:
     if status == 0 and "slider-crank" in names:
         # the same engine as a mechanism FMU: the crank's motion and the gas force in, the
         # kinematics solved inside
-        print("\nThe slider-crank as a mechanism FMU (modelDescription/scenes/engine.toml), driven by the crank:")
+        print(
+            "\nThe slider-crank as a mechanism FMU (modelDescription/scenes/engine.toml), "
+            "driven by the crank:"
+        )
         args.out.mkdir(parents=True, exist_ok=True)
         status = _run_each(args, ["engine"], scenes.run, _scene_outputs)
     return status
