@@ -102,7 +102,7 @@ def _study_command(sub: argparse._SubParsersAction) -> None:
         "extreme and cancelling configurations; write report.md, CSVs and plots.",
     )
     study.add_argument(
-        "--quick", action="store_true", help="small input sets (for CI: under a minute)"
+        "--quick", action="store_true", help="small input sets (for CI: about 35 s of CPU time)"
     )
     study.add_argument(
         "--out",

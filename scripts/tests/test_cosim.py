@@ -32,6 +32,7 @@ import math
 import os
 from pathlib import Path
 
+import markdown_check
 import numpy as np
 import pytest
 
@@ -477,6 +478,9 @@ def test_quick_report_writes_its_files(tmp_path):
     assert len(rows) == len(result["rows"]) == 2 * 2 * 2 * 2  # mechanisms, ratios, schemes, steps
     text = (folder / "report.md").read_text()
     assert "stabilised" in text and "explicit" in text and "diverged" in text
+    # read back by a Markdown parser: the machines, the runs, the mechanism FMUs
+    _, runs, mechanism_fmus = markdown_check.check_file(folder / "report.md")
+    assert len(runs.rows) == 1 + len(rows) and len(mechanism_fmus.rows) == 1 + 3
     assert "For a user of the dyad FMU" in text
     assert not any(r["diverged"] == "True" for r in rows if r["scheme"] == "stabilised")
     assert any(

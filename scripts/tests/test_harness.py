@@ -4,12 +4,14 @@ torque against an energy balance, and the command line."""
 import subprocess
 import sys
 
+import markdown_check
 import numpy as np
 import pytest
 from dyadfmu.cosim import harness
 from dyadfmu.mechanisms import builtin as mechanisms
 from dyadfmu.mechanisms import crank
 from dyadfmu.reference import newton_euler as reference
+from dyadfmu.report import tables
 
 MECHANISMS = mechanisms.NAMES
 
@@ -113,6 +115,9 @@ def test_cli_runs_each_mechanism(mechanism, tmp_path):
         for suffix in ("errors.md", "errors.csv", "reactions.png", "mechanism.png"):
             path = tmp_path / f"{mechanism}_fmi{version}_{suffix}"
             assert path.is_file() and path.stat().st_size > 0, path
+        # the errors table read back by a Markdown parser: its five columns, every output
+        (errors,) = markdown_check.check_file(tmp_path / f"{mechanism}_fmi{version}_errors.md")
+        assert errors.texts(0) == tables.ERROR_HEADER and len(errors.rows) > 1
 
 
 def test_cli_help_list_and_errors(tmp_path):

@@ -28,6 +28,7 @@ from lxml import etree
 
 from .. import paths
 from ..fmi.simulate import CoSimSetup, setup_for, simulate
+from ..report import markdown
 from . import harness, mechanism_fmus, scenes
 
 DYADS = ("rrr", "rrt", "rtr", "trt", "rtt")
@@ -385,29 +386,48 @@ def fmutool_check(fmu: Path, executable: str) -> subprocess.CompletedProcess:
 # ---------------------------------------------------------------------------
 # The table of the README: python -m dyadfmu.cosim.importers
 # ---------------------------------------------------------------------------
-def table(workdir: Path, executable: str) -> list[str]:
-    """fmi-sim against fmpy for every FMU the build makes, as Markdown rows: over the
-    harness's signals, and with the same input values applied."""
+#: The table's header.
+TABLE_HEADER = (
+    "FMU",
+    "FMI",
+    "rows x outputs",
+    "max abs",
+    "max relative to peak",
+    "amplification / (eps a^2)",
+    "same inputs",
+)
+
+
+def table_lines(runs: list[tuple[str, int, Difference, Difference]]) -> list[str]:
+    """The Markdown table of (FMU name, FMI version, the difference over the harness's
+    signals, the difference with the same input values applied)."""
     rows = [
-        "| FMU | FMI | rows x outputs | max abs | max relative to peak "
-        "| amplification / (eps a^2) | same inputs |",
-        "|---|---|---|---|---|---|---|",
+        [
+            name,
+            str(version),
+            f"{raw.rows} x {raw.outputs}",
+            f"{raw.max_abs:.1e}",
+            f"{raw.max_relative:.1e}",
+            f"{raw.amplification_in_own_roundoff:.2g}",
+            "bit-identical" if exact.max_ulps == 0 else f"{exact.max_ulps:.0f} ulps",
+        ]
+        for name, version, raw, exact in runs
     ]
+    return markdown.table(TABLE_HEADER, rows)
+
+
+def table(workdir: Path, executable: str) -> list[str]:
+    """fmi-sim against fmpy for every FMU the build makes, as the lines of a Markdown
+    table: over the harness's signals, and with the same input values applied."""
+    runs = []
     for name in fmu_names():
         for version in VERSIONS:
             setup = setup_of(name, version)
             other = run_fmi_sim(setup, workdir, executable)
             raw = compare(setup, simulate(setup), other)
             same = as_applied_by_fmi_sim(setup)
-            exact = compare(same, simulate(same), other)
-            rows.append(
-                f"| {name} | {version} | {raw.rows} x {raw.outputs} | "
-                f"{raw.max_abs:.1e} | {raw.max_relative:.1e} | "
-                f"{raw.amplification_in_own_roundoff:.2g} | "
-                + ("bit-identical" if exact.max_ulps == 0 else f"{exact.max_ulps:.0f} ulps")
-                + " |"
-            )
-    return rows
+            runs.append((name, version, raw, compare(same, simulate(same), other)))
+    return table_lines(runs)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -26,6 +26,7 @@ from fmpy import read_model_description
 
 from .. import paths
 from ..fmi.simulate import CoSimSetup
+from ..report import markdown
 from . import importers
 
 __all__ = [
@@ -216,16 +217,37 @@ def main(argv: list | None = None) -> int:
     if wine_executable() is None:
         print("python -m dyadfmu.cosim.windows: wine is not installed", file=sys.stderr)
         return 2
-    rows = replay_all(args.work, args.build)
-    print("| FMU | steps | outputs | bit-identical | largest difference / peak | statuses |")
-    print("|---|---:|---:|---:|---:|---|")
-    for d in rows:
-        where = f" ({d.worst_output})" if d.worst_output else ""
-        print(
-            f"| {d.fmu} | {d.steps} | {d.outputs} | {d.identical} | {d.worst:.2g}{where} | "
-            f"{'equal' if d.same_status else 'DIFFER'} |"
-        )
+    print("\n".join(table_lines(replay_all(args.work, args.build))))
     return 0
+
+
+#: The table's header.
+TABLE_HEADER = (
+    "FMU",
+    "steps",
+    "outputs",
+    "bit-identical",
+    "largest difference / peak",
+    "statuses",
+)
+
+
+def table_lines(differences: list[Difference]) -> list[str]:
+    """The Markdown table of the Windows binaries against the Linux ones."""
+    rows = []
+    for d in differences:
+        where = f" ({d.worst_output})" if d.worst_output else ""
+        rows.append(
+            [
+                d.fmu,
+                str(d.steps),
+                str(d.outputs),
+                str(d.identical),
+                f"{d.worst:.2g}{where}",
+                "equal" if d.same_status else "DIFFER",
+            ]
+        )
+    return markdown.table(TABLE_HEADER, rows, "-rrrr-")
 
 
 if __name__ == "__main__":

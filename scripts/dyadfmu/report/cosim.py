@@ -21,6 +21,7 @@ from pathlib import Path
 from .. import paths
 from ..cosim import master as cosim
 from ..cosim import mechanism_drive
+from . import markdown as markup
 
 #: Inertia ratios (mean J over a revolution, crank included, / rotor inertia).
 RATIOS = (0.1, 1.0, 10.0, 100.0)
@@ -257,11 +258,12 @@ def _e(x: float) -> str:
     return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.2e}"
 
 
-def _status(r: dict) -> str:
+def _status(r: dict) -> markup.Markup:
+    """A run's outcome: ok, or where and why it stopped (the reason may be an FMU's
+    message: literal text)."""
     if not r["diverged"]:
-        return "ok"
-    reason = r["reason"].replace("|", "/")
-    return f"**diverged** at {r['diverged_at']:.4g} s: {reason}"
+        return markup.text("ok")
+    return markup.Markup(f"**diverged** at {r['diverged_at']:.4g} s: {markup.text(r['reason'])}")
 
 
 def _header(rows: list, quick: bool, elapsed: float, figure: Path, fmi_version: int) -> list[str]:
@@ -269,9 +271,9 @@ def _header(rows: list, quick: bool, elapsed: float, figure: Path, fmi_version: 
     return [
         "# Co-simulation of the drive FMU with a dyad FMU",
         "",
-        f"{'Quick' if quick else 'Full'} study, FMI {fmi_version}, drive: {drive}; "
-        f"{len(rows)} runs in {elapsed:.0f} s. Every figure is in `points.csv`; the plot "
-        f"is `{figure.name}`.",
+        f"{'Quick' if quick else 'Full'} study, FMI {fmi_version}, drive: "
+        f"{markup.text(drive)}; {len(rows)} runs in {elapsed:.0f} s. Every figure is in "
+        f"`points.csv`; the plot is {markup.code(figure.name)}.",
         "",
     ]
 
@@ -316,27 +318,71 @@ def _setup_section(names: list[str], quick: bool) -> list[str]:
         "tau_m = (J_r + J_cO) omega_0 / T_stall (`cosim.explicit_lag_factor`); "
         "max rho x exp(-h / tau_m) above 1 predicts divergence.",
         "",
-        "| mechanism | ratio | J_r (kg m2) | J_cO (kg m2) | rho max | rho geom. mean | "
-        "tau_m (s) | reference wall time (s) | mean speed (rad/s) | peak R_np (N) |",
-        "|---|---|---|---|---|---|---|---|---|---|",
     ]
+
+
+#: The machines' table's header.
+MACHINE_HEADER = (
+    "mechanism",
+    "ratio",
+    "J_r (kg m2)",
+    "J_cO (kg m2)",
+    "rho max",
+    "rho geom. mean",
+    "tau_m (s)",
+    "reference wall time (s)",
+    "mean speed (rad/s)",
+    "peak R_np (N)",
+)
+#: The runs' table's header.
+RESULTS_HEADER = (
+    "mechanism",
+    "ratio",
+    "scheme",
+    "step (s)",
+    "steps",
+    "wall time (s)",
+    "speed error",
+    "reaction error",
+    "rho max x exp(-h/tau_m)",
+    "run",
+)
+#: The mechanism FMUs' table's header.
+MECHANISM_HEADER = (
+    "mechanism FMU",
+    "step [s]",
+    "steps",
+    "max abs(phi error) [rad]",
+    "max abs(omega error) / mean omega",
+    "J vs crank.J",
+    "affine",
+    "wall time [s]",
+)
 
 
 def _machine_rows(rows: list, refs: dict, names: list[str], ratios: list[float]) -> list[str]:
     """One row per mechanism and inertia ratio: inertias, lag factors, the reference."""
-    lines = []
+    table = []
     for name in names:
         for ratio in ratios:
             r = next(x for x in rows if x["mechanism"] == name and x["ratio"] == ratio)
             ref = refs[(name, ratio)]
             jc = cosim.crank_inertia_about_pivot(cosim.setup(name, ratio).mech)
-            lines.append(
-                f"| {name} | {ratio:g} | {r['rotor_inertia']:.3e} | {jc:.3e} | "
-                f"{r['lag_factor_max']:.3g} | {r['lag_factor_geometric']:.3g} | "
-                f"{r['motor_time_constant']:.2e} | {ref.wall_time:.1f} | "
-                f"{ref.mean_speed:.2f} | {ref.peak_reaction:.4g} |"
+            table.append(
+                [
+                    name,
+                    f"{ratio:g}",
+                    f"{r['rotor_inertia']:.3e}",
+                    f"{jc:.3e}",
+                    f"{r['lag_factor_max']:.3g}",
+                    f"{r['lag_factor_geometric']:.3g}",
+                    f"{r['motor_time_constant']:.2e}",
+                    f"{ref.wall_time:.1f}",
+                    f"{ref.mean_speed:.2f}",
+                    f"{ref.peak_reaction:.4g}",
+                ]
             )
-    return lines
+    return markup.table(MACHINE_HEADER, table)
 
 
 def _results_section(rows: list) -> list[str]:
@@ -349,18 +395,25 @@ def _results_section(rows: list) -> list[str]:
         "the reference's mean speed, |R_np| relative to its peak (a diverged run's "
         "errors are over the points before it stopped).",
         "",
-        "| mechanism | ratio | scheme | step (s) | steps | wall time (s) | speed error "
-        "| reaction error | rho max x exp(-h/tau_m) | run |",
-        "|---|---|---|---|---|---|---|---|---|---|",
     ]
+    table = []
     for r in rows:
         lag = f"{r['lag_factor_effective']:.3g}" if r["scheme"] == "explicit" else "-"
-        lines.append(
-            f"| {r['mechanism']} | {r['ratio']:g} | {r['scheme']} | {r['step']:.0e} | "
-            f"{r['steps']} | {r['wall_time']:.3f} | {_e(r['speed_error'])} | "
-            f"{_e(r['reaction_error'])} | {lag} | {_status(r)} |"
+        table.append(
+            [
+                r["mechanism"],
+                f"{r['ratio']:g}",
+                r["scheme"],
+                f"{r['step']:.0e}",
+                str(r["steps"]),
+                f"{r['wall_time']:.3f}",
+                _e(r["speed_error"]),
+                _e(r["reaction_error"]),
+                lag,
+                _status(r),
+            ]
         )
-    return lines
+    return lines + markup.table(RESULTS_HEADER, table)
 
 
 def _advice() -> list[str]:
@@ -398,6 +451,17 @@ MECHANISM_STEPS = {
 def mechanism_section(quick: bool, fmi_version: int) -> list[str]:
     """The stabilised co-simulation on mechanism FMUs (cosim/mechanism_drive.py): the
     drive FMU and the whole mechanism in one FMU, J from its directional derivative."""
+    runs = []
+    for name, steps in MECHANISM_STEPS.items():
+        for step in steps[:1] if quick else steps:
+            r = mechanism_drive.run(name, step, fmi_version)
+            runs.append((name, step, r, mechanism_drive.errors(r)))
+    return mechanism_lines(runs)
+
+
+def mechanism_lines(runs: list) -> list[str]:
+    """The section on mechanism FMUs, its table one row per (name, step, run of
+    :func:`dyadfmu.cosim.mechanism_drive.run`, its errors)."""
     lines = [
         "",
         "## The stabilised coupling on mechanism FMUs",
@@ -412,19 +476,22 @@ def mechanism_section(quick: bool, fmi_version: int) -> list[str]:
         "derivative against the FMU's own effective inertia output; affine: |torque - "
         "(torque0 + J eps)| / |torque| at the solved eps.",
         "",
-        "| mechanism FMU | step [s] | steps | max abs(phi error) [rad] | max abs(omega error) "
-        "/ mean omega | J vs crank.J | affine | wall time [s] |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    for name, steps in MECHANISM_STEPS.items():
-        for step in steps[:1] if quick else steps:
-            r = mechanism_drive.run(name, step, fmi_version)
-            e = mechanism_drive.errors(r)
-            lines.append(
-                f"| {name} | {step:g} | {len(r.t) - 1} | {_e(e['phi'])} | {_e(e['omega'])} | "
-                f"{_e(r.inertia_mismatch)} | {_e(r.affine_residual)} | {r.wall_time:.2f} |"
-            )
-    return lines
+    table = []
+    for name, step, r, e in runs:
+        table.append(
+            [
+                name,
+                f"{step:g}",
+                str(len(r.t) - 1),
+                _e(e["phi"]),
+                _e(e["omega"]),
+                _e(r.inertia_mismatch),
+                _e(r.affine_residual),
+                f"{r.wall_time:.2f}",
+            ]
+        )
+    return lines + markup.table(MECHANISM_HEADER, table, "-" + "r" * 7)
 
 
 def markdown(
@@ -443,11 +510,11 @@ def markdown(
     steps = sorted({r["step"] for r in rows}, reverse=True)
     lines = _header(rows, quick, elapsed, figure, fmi_version) + _setup_section(names, quick)
     lines += _machine_rows(rows, refs, names, ratios) + _results_section(rows)
-    lines += ["", f"![error against run time]({figure.name})", "", "## Findings", ""]
+    lines += ["", markup.image("error against run time", figure.name), "", "## Findings", ""]
     lines += _findings(rows, steps)
     lines += list(mechanism_lines)
     lines += _advice()
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
 
@@ -612,7 +679,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--quick",
         action="store_true",
-        help="steps 1e-2 and 1e-3 s, ratios 1 and 100, a looser reference (about a minute)",
+        help="steps 1e-2 and 1e-3 s, ratios 1 and 100, a looser reference (about 16 s of "
+        "CPU time; the full study about 2.6 minutes)",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out)")
     p.add_argument(

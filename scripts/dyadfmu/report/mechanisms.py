@@ -94,44 +94,59 @@ def instructions(name: str, build: Path, work: Path, rows: int = 200) -> tuple[f
     return total / len(data), kinematics / len(data)
 
 
+#: The mechanism FMUs' table's header.
+HEADER = (
+    "mechanism FMU",
+    "branch",
+    "inputs before",
+    "inputs after",
+    "worst kinematic error",
+    "worst other error",
+    "instr./doStep",
+    "with kinematics",
+    "without",
+)
+
+
+def row(
+    name: str,
+    branch: int,
+    inputs: tuple[int, int],
+    kinematic: tuple[str, float],
+    other: tuple[str, float],
+    work: tuple[float, float],
+) -> list[str]:
+    """One row of the table: the FMU and branch, its inputs (before, after), its worst
+    kinematic and other errors (output, error), its instructions per doStep (in all, in
+    the kinematics)."""
+    total, inside = work
+    return [
+        name,
+        f"{branch:+d}",
+        str(inputs[0]),
+        str(inputs[1]),
+        f"{kinematic[1]:.1e} ({kinematic[0]})",
+        f"{other[1]:.1e} ({other[0]})",
+        f"{total:.0f}",
+        f"{inside:.0f}",
+        f"{total - inside:.0f}",
+    ]
+
+
 def rows(build: Path, quick: bool = False, log: Callable = print) -> list:
     """The mechanism FMUs' table: a header row, then one row per FMU and branch."""
-    table = [
-        [
-            "mechanism FMU",
-            "branch",
-            "inputs before",
-            "inputs after",
-            "worst kinematic error",
-            "worst other error",
-            "instr./doStep",
-            "with kinematics",
-            "without",
-        ]
-    ]
+    table = [list(HEADER)]
     revolutions, steps = (1.0, 180) if quick else (2.0, 360)
     with tempfile.TemporaryDirectory(prefix="dyadfmu_mechanisms_") as tmp:
         for name in mf.MECHANISM_FMUS:
             log(f"mechanism FMU {name}")
             before = len(inputs_before(name))
-            total, inside = instructions(name, build, Path(tmp))
+            work = instructions(name, build, Path(tmp))
             for branch in (1, -1) if name in mf.BRANCHES else (1,):
                 run = mf.run(name, 2, branch, "varying", revolutions, steps, build)
                 kin = run.worst_of(True) if any(map(mf.is_kinematic, run.errors)) else ("-", 0.0)
-                other = run.worst_of(False)
-                table.append(
-                    [
-                        name,
-                        f"{branch:+d}",
-                        str(before),
-                        str(len(run.inputs)),
-                        f"{kin[1]:.1e} ({kin[0]})",
-                        f"{other[1]:.1e} ({other[0]})",
-                        f"{total:.0f}",
-                        f"{inside:.0f}",
-                        f"{total - inside:.0f}",
-                    ]
-                )
+                inputs = (before, len(run.inputs))
+                table.append(row(name, branch, inputs, kin, run.worst_of(False), work))
     return table
 
 
@@ -146,4 +161,4 @@ REPORT_TEXT = (
     "motion, and the unit-rate pass behind J and dJ/dq) and without them:"
 )
 
-__all__ = ["REPORT_TEXT", "inputs_before", "instructions", "rows"]
+__all__ = ["HEADER", "REPORT_TEXT", "inputs_before", "instructions", "row", "rows"]

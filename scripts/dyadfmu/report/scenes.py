@@ -21,7 +21,7 @@ from pathlib import Path
 from .. import paths
 from ..cosim import scenes
 from ..study.footprint import measure
-from . import mechanisms
+from . import markdown, mechanisms
 from .tables import format_markdown, format_text
 
 
@@ -182,9 +182,12 @@ def _drawings(runs: list, out: Path) -> list[Path]:
     ]
 
 
-def _report_text(acc: list, foot: list, quick: bool, moving: list) -> list[str]:
-    """The report: the accuracy table, the footprint table, what they leave out."""
-    return [
+def report_text(
+    acc: list, foot: list, quick: bool, moving: list, drawings: tuple[Path, ...] = ()
+) -> str:
+    """The report: the accuracy table, the footprint table, what they leave out, the
+    mechanism FMUs' table and the drawings' file names."""
+    lines = [
         "# Scenes: tailored FMUs against the generic per-type FMUs",
         "",
         "Every example scene's tailored FMU, co-simulated with fmpy over "
@@ -216,6 +219,10 @@ def _report_text(acc: list, foot: list, quick: bool, moving: list) -> list[str]:
         format_markdown(moving),
         "",
     ]
+    if drawings:
+        names = ", ".join(markdown.code(p.name) for p in drawings)
+        lines += [f"Drawings with every reaction: {names}", ""]
+    return "\n".join(lines)
 
 
 #: The path arguments, checked before any work (dyadfmu.paths.parse_checked).
@@ -244,11 +251,8 @@ def main(argv: list[str] | None = None) -> int:
     acc = accuracy_rows(runs)
     foot = footprint_rows(results)
     moving = mechanisms.rows(build, args.quick, log=_log)
-    text = _report_text(acc, foot, args.quick, moving)
-    if drawings:
-        text += ["Drawings with every reaction: " + ", ".join(f"`{p.name}`" for p in drawings), ""]
     report = out / "report.md"
-    report.write_text("\n".join(text))
+    report.write_text(report_text(acc, foot, args.quick, moving, tuple(drawings)), encoding="utf-8")
     print(format_text(acc))
     print()
     print(format_text(foot))

@@ -13,6 +13,7 @@ from ..study.speed import (
     SceneSpeed,
     TypeSpeed,
 )
+from . import markdown as markup
 
 
 def _mark(met: bool) -> str:
@@ -28,50 +29,68 @@ def _per_row(seconds: float) -> str:
     return f"{seconds * 1e9:.0f} ns ({1 / seconds / 1e6:.1f} M/s)"
 
 
+#: The dyad types' table: its header and alignment.
+TYPE_HEADER = (
+    "type",
+    "closed-form flops",
+    "flops per solve (ratio)",
+    "instructions per solve",
+    "per FMU step, FMI 2 / 3",
+    "its evaluation",
+    "step / solve",
+    "step / (solve + directions)",
+    "per batch row",
+    "NumPy per row, new outputs",
+    "NumPy per row, out=",
+)
+#: The scenes' table: its header.
+SCENE_HEADER = (
+    "scene",
+    "per step, FMI 2 / 3",
+    "evaluation",
+    "directions",
+    "step / evaluation",
+    "step / (evaluation + directions)",
+)
+
+
 def _type_rows(types: list[TypeSpeed]) -> list[str]:
-    lines = [
-        "| type | closed-form flops | flops per solve (ratio) | instructions per solve "
-        "| per FMU step, FMI 2 / 3 | its evaluation | step / solve | step / (solve + directions) "
-        "| per batch row | NumPy per row, new outputs | NumPy per row, out= |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
-    ]
+    rows = []
     for t in types:
         two, three = t.steps[2], t.steps[3]
-        cells = [
-            t.dyad,
-            str(t.closed_form_flops),
-            f"{t.solve_flops:.0f} ({t.solve_flops / t.closed_form_flops:.2f})",
-            f"{t.solve_instructions:.0f}",
-            _both(two.step, three.step, 0),
-            f"{two.evaluate:.0f}",
-            _both(two.ratio, three.ratio),
-            _both(two.ratio_with_directions, three.ratio_with_directions),
-            f"{t.batch_instructions:.0f}",
-            _per_row(t.numpy_seconds_per_row[False]),
-            _per_row(t.numpy_seconds_per_row[True]),
-        ]
-        lines.append("| " + " | ".join(cells) + " |")
-    return lines
+        rows.append(
+            [
+                t.dyad,
+                str(t.closed_form_flops),
+                f"{t.solve_flops:.0f} ({t.solve_flops / t.closed_form_flops:.2f})",
+                f"{t.solve_instructions:.0f}",
+                _both(two.step, three.step, 0),
+                f"{two.evaluate:.0f}",
+                _both(two.ratio, three.ratio),
+                _both(two.ratio_with_directions, three.ratio_with_directions),
+                f"{t.batch_instructions:.0f}",
+                _per_row(t.numpy_seconds_per_row[False]),
+                _per_row(t.numpy_seconds_per_row[True]),
+            ]
+        )
+    return markup.table(TYPE_HEADER, rows, "-" + "r" * (len(TYPE_HEADER) - 1))
 
 
 def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
-    lines = [
-        "| scene | per step, FMI 2 / 3 | evaluation | directions | step / evaluation "
-        "| step / (evaluation + directions) |",
-        "|---|---:|---:|---:|---:|---:|",
-    ]
+    rows = []
     for s in scenes:
         two, three = s.steps[2], s.steps[3]
-        cells = [
-            s.scene,
-            _both(two.step, three.step, 0),
-            f"{two.evaluate:.0f}",
-            f"{two.directions:.0f}",
-            _both(two.ratio, three.ratio),
-            _both(two.ratio_with_directions, three.ratio_with_directions),
-        ]
-        lines.append("| " + " | ".join(cells) + " |")
-    return lines
+        rows.append(
+            [
+                s.scene,
+                _both(two.step, three.step, 0),
+                f"{two.evaluate:.0f}",
+                f"{two.directions:.0f}",
+                _both(two.ratio, three.ratio),
+                _both(two.ratio_with_directions, three.ratio_with_directions),
+            ]
+        )
+    return markup.table(SCENE_HEADER, rows, "-" + "r" * (len(SCENE_HEADER) - 1))
 
 
 def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:

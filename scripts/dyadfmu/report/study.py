@@ -14,6 +14,7 @@ import numpy as np  # noqa: E402
 
 from ..study.accuracy import EPS, LABELS, SETS, Results, Sizes  # noqa: E402
 from ..study.configurations import TYPES  # noqa: E402
+from . import markdown as markup  # noqa: E402
 from . import speed as speed_report  # noqa: E402
 
 MARKERS = {
@@ -160,24 +161,49 @@ def _intro(sizes: Sizes, quick: bool, elapsed: float) -> list[str]:
         "reaction of their unit: eps x A x that reaction bounds the error of every "
         "reaction of the unit (src/dyad_amplification.h).",
         "",
-        "| method | type | median error | worst error | worst componentwise | "
-        "time per configuration | instructions per solve | time / C core |",
-        "|---|---|---|---|---|---|---|---|",
     ]
+
+
+#: The summary table's header.
+SUMMARY_HEADER = (
+    "method",
+    "type",
+    "median error",
+    "worst error",
+    "worst componentwise",
+    "time per configuration",
+    "instructions per solve",
+    "time / C core",
+)
+#: The contract table's header.
+CONTRACT_HEADER = (
+    "method",
+    "random",
+    "near-singular",
+    "extreme",
+    "cancelling",
+    "inf/NaN with status ok",
+)
 
 
 def _summary_table(summary: list[dict], core_time: dict) -> list[str]:
     """One row per method and type: errors, time, instructions, time against the core."""
-    lines = []
+    rows = []
     for s in summary:
         instructions = s.get("instructions", math.nan)
-        lines.append(
-            f"| {_label(s['method'])} | {s['type']} | {s['median']:.1e} | {s['worst']:.1e} | "
-            f"{s['componentwise']:.1e} | {_fmt_time(s['seconds'])} | "
-            f"{'-' if math.isnan(instructions) else f'{instructions:.0f}'} | "
-            f"{s['seconds'] / core_time[s['type']]:.1f} |"
+        rows.append(
+            [
+                _label(s["method"]),
+                s["type"],
+                f"{s['median']:.1e}",
+                f"{s['worst']:.1e}",
+                f"{s['componentwise']:.1e}",
+                _fmt_time(s["seconds"]),
+                "-" if math.isnan(instructions) else f"{instructions:.0f}",
+                f"{s['seconds'] / core_time[s['type']]:.1f}",
+            ]
         )
-    return lines
+    return markup.table(SUMMARY_HEADER, rows)
 
 
 def _contract_table(contract: dict, silent: dict) -> list[str]:
@@ -190,9 +216,8 @@ def _contract_table(contract: dict, silent: dict) -> list[str]:
         "promises a digit (eps of the method's scalar type; the float core's own "
         "amplification, the double core's for the other methods):",
         "",
-        "| method | random | near-singular | extreme | cancelling | inf/NaN with status ok |",
-        "|---|---|---|---|---|---|",
     ]
+    rows = []
     for method in ("core", "core_float", "gsl_lu", "gsl_svd", "numpy"):
         cells = []
         for set_name in SETS:
@@ -203,9 +228,8 @@ def _contract_table(contract: dict, silent: dict) -> list[str]:
             ]
             cells.append(f"{max(values):.2g}" if values else "-")
         silent_total = sum(silent[(method, t, s)] for t in TYPES for s in SETS)
-        lines.append(f"| {LABELS[method]} | " + " | ".join(cells) + f" | {silent_total} |")
-
-    return lines
+        rows.append([LABELS[method], *cells, str(silent_total)])
+    return lines + markup.table(CONTRACT_HEADER, rows)
 
 
 def _facts(summary: list[dict], contract: dict, silent: dict, core_time: dict) -> dict:
@@ -313,9 +337,9 @@ def _limit_findings(f: dict, figures: dict) -> list[str]:
             "column): see points.csv."
         ),
         "",
-        f"![work-precision]({figures['work_precision'].name})",
+        markup.image("work-precision", figures["work_precision"].name),
         "",
-        f"![error against amplification]({figures['error_vs_amplification'].name})",
+        markup.image("error against amplification", figures["error_vs_amplification"].name),
         "",
         "Every measured point is in `points.csv`; this table in `summary.csv`.",
     ]
@@ -340,7 +364,7 @@ def markdown(
     lines += _limit_findings(facts, figures)
     lines += speed_report.markdown(*speed)
     path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
 

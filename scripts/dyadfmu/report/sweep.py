@@ -7,13 +7,11 @@ Every axis and colour scale whose values span more than LOG_DECADES decades is
 logarithmic (symmetric logarithmic where the signs mix or zero is among them): a
 peak torque from 1e-3 to 1e6 N m on a linear axis would show one point and a flat line.
 
-Names from the study file reach the Markdown through :func:`markdown_cell` (a study
-file is untrusted input)."""
+Names from the study file and units from its FMU reach the Markdown as literal text
+(:func:`dyadfmu.report.markdown.text`): a study file is untrusted input."""
 
 from __future__ import annotations
 
-import re
-import unicodedata
 from pathlib import Path
 
 import matplotlib
@@ -27,24 +25,13 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from ..sweep.results import Table, best_designs, feasible, pareto_front  # noqa: E402
 from ..sweep.studyfile import Constraint, Study  # noqa: E402
+from .markdown import table as markdown_table  # noqa: E402
+from .markdown import text as markdown_text  # noqa: E402
 
-__all__ = ["plot_study", "study_figure", "report_text", "markdown_cell", "scale_of", "LOG_DECADES"]
+__all__ = ["plot_study", "study_figure", "report_text", "scale_of", "LOG_DECADES"]
 
 #: Values whose magnitudes span more decades than this are drawn on a logarithmic scale.
 LOG_DECADES = 3.0
-
-
-def markdown_cell(text: str) -> str:
-    """Text safe in a Markdown table cell: one line, printable characters only (control
-    and format characters dropped), every markup character escaped (``$`` too: some
-    renderers read mathematics between two), ``&`` written ``&amp;`` (no entity), and a
-    list or rule marker at the start escaped."""
-    printable = "".join(ch if unicodedata.category(ch)[0] != "C" else " " for ch in str(text))
-    out = " ".join(printable.split()).replace("&", "&amp;")  # no entity reaches the reader
-    for ch in "\\|*_`<>[]#$~!":
-        out = out.replace(ch, "\\" + ch)
-    # what starts a list, a rule or a quote at the start of a line
-    return re.sub(r"^(\d*)([-+=.)])", r"\1\\\2", out)
 
 
 def _is_grid(table: Table) -> bool:
@@ -184,7 +171,7 @@ def plot_study(table: Table, study: Study, path: Path, units: dict | None = None
 
 def _constraint_text(c: Constraint) -> str:
     """A constraint as the report writes it: 'f <= 2', 'f >= 1', '1 <= f <= 2'."""
-    name = markdown_cell(c.figure)
+    name = markdown_text(c.figure)
     if c.minimum is not None and c.maximum is not None:
         return f"{c.minimum:g} <= {name} <= {c.maximum:g}"
     if c.minimum is not None:
@@ -216,20 +203,20 @@ def report_text(
     units = units or {}
     statuses = {s: table.status.count(s) for s in dict.fromkeys(table.status)}
     lines = [
-        f"# Study {markdown_cell(study.name)}",
+        f"# Study {markdown_text(study.name)}",
         "",
-        markdown_cell(study.description),
+        markdown_text(study.description),
         "",
         f"{len(table)} designs ({study.sampling.method}) run in {seconds:.1f} s on "
-        f"{markdown_cell(workers)} "
+        f"{markdown_text(workers)} "
         "(not counting a local cluster's start): "
         f"{len(table) / max(seconds, 1e-9):.1f} runs/s. Statuses: "
-        + ", ".join(f"{markdown_cell(s)} {n}" for s, n in statuses.items())
+        + ", ".join(f"{markdown_text(s)} {n}" for s, n in statuses.items())
         + ".",
         "",
         _digits_line(table, study),
         "",
-        f"Best designs by {markdown_cell(study.objective.minimize)}"
+        f"Best designs by {markdown_text(study.objective.minimize)}"
         + (
             " subject to " + ", ".join(_constraint_text(c) for c in study.objective.constraints)
             if study.objective.constraints
@@ -237,16 +224,15 @@ def report_text(
         )
         + ":",
         "",
-        "| design | "
-        + " | ".join(markdown_cell(_label(n, units)) for n in table.parameters + table.figure_names)
-        + " | digits |",
-        "|---:|" + "---:|" * (len(table.parameters) + len(table.figure_names) + 1),
     ]
+    header = ["design", *(_label(n, units) for n in table.parameters + table.figure_names)]
+    rows = []
     best = best_designs(table, study)
     for k in best:
         cells = [f"{v:.6g}" for v in (*table.values[k], *table.figures[k])]
         digits = f"{table.digits[k]:.1f}" if np.isfinite(table.digits[k]) else "-"
-        lines.append(f"| {k} | " + " | ".join(cells) + f" | {digits} |")
+        rows.append([str(k), *cells, digits])
+    lines += markdown_table([*header, "digits"], rows, "r" * (len(header) + 1))
     if not best:
         lines += ["", "No design ran and met every constraint: the table above is empty."]
     return "\n".join(lines) + "\n"

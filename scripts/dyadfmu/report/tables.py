@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..cosim.compare import OutputError
+from . import markdown
 
 #: The header of an error table.
 ERROR_HEADER = ["output", "unit", "peak |reference|", "max |FMU - reference|", "relative to peak"]
@@ -35,18 +36,19 @@ def format_text(rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
-def format_markdown(rows: list[list[str]]) -> str:
-    """The rows as a Markdown table, the first one its header."""
-    lines = ["| " + " | ".join(rows[0]) + " |", "|" + "---|" * len(rows[0])]
-    lines += ["| " + " | ".join(r) + " |" for r in rows[1:]]
-    return "\n".join(lines)
+def format_markdown(rows: list[list[str]], align: str = "") -> str:
+    """The rows as a Markdown table, the first one its header, every cell literal text
+    (:func:`dyadfmu.report.markdown.table`)."""
+    return "\n".join(markdown.table(rows[0], rows[1:], align))
 
 
 def write_error_tables(stem: Path, title: str, rows: list[list[str]]) -> list[Path]:
     """<stem>_errors.md (titled) and <stem>_errors.csv of an error table."""
     md = Path(f"{stem}_errors.md")
-    md.write_text(f"# {title}\n\n{format_markdown(rows)}\n")
+    md.write_text(
+        f"# {markdown.text(title)}\n\n{format_markdown(rows, '--rrr')}\n", encoding="utf-8"
+    )
     path_csv = Path(f"{stem}_errors.csv")
-    with open(path_csv, "w", newline="") as handle:
+    with open(path_csv, "w", newline="", encoding="utf-8") as handle:
         csv.writer(handle).writerows(rows)
     return [md, path_csv]

@@ -31,6 +31,7 @@ from pathlib import Path
 from .. import paths
 from ..argtypes import whole
 from ..paths import GENERATOR
+from ..report import markdown
 
 SIZES = (25, 50, 100, 200)
 #: The most dyads in one chain the generator takes (MAX_CHAIN of
@@ -200,17 +201,30 @@ def main(argv: list[str] | None = None) -> int:
     rows = measure(
         args.sizes, args.generator, log=lambda t: print(t, file=sys.stderr), chain=args.chain
     )
-    print(
-        "| dyads | --check: elapsed (s) | --check: CPU (s) | --out: elapsed (s) | --out: CPU (s) "
-        "| FMI 2 model description (MB) |"
-    )
-    print("|---|---|---|---|---|---|")
-    for n, check, out, size in rows:
-        print(
-            f"| {n} | {check[0]:.2f} | {check[1]:.2f} | {out[0]:.2f} | {out[1]:.2f} "
-            f"| {size / 1e6:.1f} |"
-        )
+    print("\n".join(table_lines(rows)))
     return 0
+
+
+#: The table's header.
+TABLE_HEADER = (
+    "dyads",
+    "--check: elapsed (s)",
+    "--check: CPU (s)",
+    "--out: elapsed (s)",
+    "--out: CPU (s)",
+    "FMI 2 model description (MB)",
+)
+
+
+def table_lines(rows: list) -> list[str]:
+    """The Markdown table of measure()'s rows: (dyads, --check (elapsed, CPU) s, --out
+    (elapsed, CPU) s, model description bytes)."""
+    cells = [
+        [str(n), f"{check[0]:.2f}", f"{check[1]:.2f}", f"{out[0]:.2f}", f"{out[1]:.2f}"]
+        + [f"{size / 1e6:.1f}"]
+        for n, check, out, size in rows
+    ]
+    return markdown.table(TABLE_HEADER, cells)
 
 
 if __name__ == "__main__":
