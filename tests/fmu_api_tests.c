@@ -3481,6 +3481,13 @@ int main(int argc, char** argv)
     char error[512];
     int failed, more = 0;
     const int first_name = 3;
+    if (argc == 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+        printf("usage: fmu_api_tests FMI2_FMU_DIR FMI3_FMU_DIR [test-name ...]\n"
+               "The FMI misuse matrix: every FMI 2 and FMI 3 entry point of one model's two "
+               "unpacked FMUs in every state, with bad arguments and crafted states; exits "
+               "non-zero if a check fails.\n");
+        return 0;
+    }
     if (argc < 3) {
         printf("usage: fmu_api_tests FMI2_FMU_DIR FMI3_FMU_DIR [test-name ...]\n");
         return 2;

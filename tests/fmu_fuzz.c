@@ -1476,6 +1476,13 @@ int main(int argc, char** argv)
     long episode;
     int failed = 0;
     struct timespec started, ended;
+    if (argc == 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+        printf("usage: fmu_fuzz [--steps N] [--seed S] [--replay SEED] [--verbose] FMU_DIR\n"
+               "Drives the FMU unpacked in FMU_DIR with random FMI calls, values and states "
+               "for N steps (seeded; --replay runs one episode again) and checks every answer; "
+               "exits non-zero on the first failure. scripts/run-fuzz runs it on every FMU.\n");
+        return 0;
+    }
     if (!parse_options(argc, argv, &options)) {
         printf("usage: fmu_fuzz [--steps N] [--seed S] [--replay SEED] [--verbose] FMU_DIR\n");
         return 2;

@@ -248,7 +248,10 @@ int main(int argc, char** argv)
     FILE* jobs;
     int ok = 1, runs = 0;
     if (argc != 2 || strcmp(argv[1], "--help") == 0) {
-        fprintf(stderr, "usage: fmu_replay JOBS (one line per run: FMU_DIR INPUT OUTPUT)\n");
+        fprintf(stderr, "usage: fmu_replay JOBS (one line per run: FMU_DIR INPUT OUTPUT)\n"
+                        "Drives each unpacked FMU over the inputs of its INPUT file and writes "
+                        "every output's bit pattern and each doStep's status to OUTPUT (the "
+                        "Windows comparison runs it under Wine and natively).\n");
         return argc == 2 ? 0 : 2;
     }
     jobs = fopen(argv[1], "r");

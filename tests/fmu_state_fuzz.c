@@ -822,6 +822,13 @@ int main(int argc, char** argv)
     static fmu f;
     long failures = 0;
     int version;
+    if (argc == 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+        printf("usage: fmu_state_fuzz FMI2_FMU_DIR FMI3_FMU_DIR\n"
+               "Serialized FMU states of one model's two unpacked FMUs changed one value at a "
+               "time, the checksum recomputed: every state accepted must give a fresh "
+               "instance's outputs bit for bit; exits non-zero if one does not.\n");
+        return 0;
+    }
     if (argc != 3) {
         printf("usage: fmu_state_fuzz FMI2_FMU_DIR FMI3_FMU_DIR\n");
         return 2;

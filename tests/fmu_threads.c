@@ -277,6 +277,13 @@ int main(int argc, char** argv)
     step_counts alone = {0, 0, 0};
     int a, failed = 0, r;
     size_t k, length;
+    if (argc == 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+        printf("usage: fmu_threads [--threads N] [--steps N] [--seed S] FMU_DIR\n"
+               "N instances of the unpacked FMU stepped in threads at once, each against the "
+               "same program run alone: their outputs must be equal bit for bit (run under "
+               "ThreadSanitizer by scripts/run-tests); exits non-zero if they differ.\n");
+        return 0;
+    }
     for (a = 1; a < argc; ++a) {
         if (strcmp(argv[a], "--threads") == 0 && a + 1 < argc) {
             threads = strtol(argv[++a], NULL, 10);

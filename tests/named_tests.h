@@ -36,6 +36,14 @@ static int run_named_tests(const named_test tests[], size_t count, const char* l
 {
     int failed = 0, passed = 0, a;
     size_t k;
+    if (count_names == 1 && (strcmp(names[0], "--help") == 0 || strcmp(names[0], "-h") == 0)) {
+        printf("usage: TESTS [NAME ...]\nRuns the named tests (all without a name) and prints "
+               "each one's result; exits non-zero if one fails. The tests:\n");
+        for (k = 0; k < count; ++k) {
+            printf("  %s\n", tests[k].name);
+        }
+        return 0;
+    }
     for (k = 0; k < count; ++k) {
         int selected = count_names == 0;
         for (a = 0; a < count_names; ++a) {

@@ -118,7 +118,8 @@ def examples() -> list[tuple[Path, int, str, str, str | None]]:
 def _environment() -> dict:
     env = dict(os.environ)
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
-    env.setdefault("DYADFMU_BUILD", str(paths.build_dir()))
+    # absolute: the Python examples run from a temporary folder
+    env["DYADFMU_BUILD"] = str((ROOT / paths.build_dir()).resolve())
     return env
 
 

@@ -12,6 +12,7 @@ before pytest (build/study-quick/report.md) here."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -311,7 +312,8 @@ def test_the_cosim_report_shows_an_fmus_message_in_one_cell(tmp_path):
         _only_text(statuses[1], ("strong_open", "strong_close")) == f"diverged at 0.25 s: {SHOWN}"
     )
     assert _cell(found[2], 1, 0) == SHOWN
-    intro = mc.paragraphs(text)[1]
+    stamp, intro = mc.paragraphs(text)[1:3]
+    assert _only_text(stamp, ("code_inline",)).startswith("Measured 20")  # when, on what
     assert f"drive: {SHOWN};" in _only_text(intro, ("code_inline",))
 
 
@@ -341,8 +343,9 @@ def test_the_sweep_report_shows_the_study_files_names_literally(tmp_path):
     (found,) = mc.tables(text)
     assert found.texts(0) == ["design", "crank.mass [kg|`<b>`]", "peak [N m]", "digits"]
     assert found.texts(1) == ["0", "1", "3", "-"]
-    title, said, ran = mc.paragraphs(text)[:3]
+    title, stamp, said, ran = mc.paragraphs(text)[:4]
     assert mc.literal(title) == "Study " + name.replace("\n", "<U+000A>")
+    assert mc.literal(stamp).endswith(f"by dyadfmu sweep {name.replace(chr(10), '<U+000A>')}.toml.")
     assert mc.literal(said) == " ".join(description.split())
     assert f"on {SHOWN} (not counting" in mc.literal(ran)
 
@@ -376,3 +379,15 @@ def test_the_quick_study_report_of_the_test_run_reads_as_tables():
         study_report.SUMMARY_HEADER,
         study_report.CONTRACT_HEADER,
     ]
+
+
+def test_a_report_says_when_on_what_and_by_which_command():
+    """Every report's first paragraph: the time (UTC), this machine's processor and cores,
+    and the command that regenerates it."""
+    line = str(markdown.provenance("scripts/run-study --quick"))
+    assert re.fullmatch(
+        r"Measured 20\d\d-\d\d-\d\d \d\d:\d\d UTC on .+, \d+ cores, .+ by "
+        r"`scripts/run-study --quick`\.",
+        line,
+    ), line
+    assert markdown.machine() in line.replace("\\", "")

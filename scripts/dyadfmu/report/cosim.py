@@ -271,6 +271,8 @@ def _header(rows: list, quick: bool, elapsed: float, figure: Path, fmi_version: 
     return [
         "# Co-simulation of the drive FMU with a dyad FMU",
         "",
+        markup.provenance(f"scripts/run-cosim{' --quick' if quick else ''}"),
+        "",
         f"{'Quick' if quick else 'Full'} study, FMI {fmi_version}, drive: "
         f"{markup.text(drive)}; {len(rows)} runs in {elapsed:.0f} s. Every figure is in "
         f"`points.csv`; the plot is {markup.code(figure.name)}.",

@@ -9,6 +9,7 @@ they are :class:`Markup`, Markdown the project wrote itself.
     code(value)           a code span where the value can be one, else text(value)
     image(alt, target)    an image of a file beside the report
     table(header, rows)   a table as lines, the same number of cells in every row
+    provenance(command)   the line under a report's title: when, on what, by which command
 
 As in the scene generator's escaping (modelDescription/dyadgen/textsafe.py), a character
 that is not shown as itself (a control, format, bidi, private-use, unassigned or
@@ -25,12 +26,15 @@ item, a rule, a setext underline).
 
 from __future__ import annotations
 
+import datetime
+import os
+import platform
 import re
 import unicodedata
 from collections.abc import Iterable, Sequence
 from urllib.parse import quote
 
-__all__ = ["Markup", "code", "hidden", "image", "table", "text"]
+__all__ = ["Markup", "code", "hidden", "image", "machine", "provenance", "table", "text"]
 
 #: Unicode categories of characters not shown as themselves (as in textsafe.py).
 HIDDEN_CATEGORIES = frozenset({"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"})
@@ -127,3 +131,26 @@ def table(
             raise ValueError(f"Markdown table row {k} has {len(row)} cells, its header {width}")
         lines.append(Markup("| " + " | ".join(map(_cell, row)) + " |"))
     return lines
+
+
+def machine() -> str:
+    """This machine as a report names it: its processor, cores, system and Python."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            names = [line.split(":", 1)[1].strip() for line in f if line.startswith("model name")]
+        cpu = names[0] if names else cpu
+    except OSError:
+        pass
+    return (
+        f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}, "
+        f"Python {platform.python_version()}"
+    )
+
+
+def provenance(command: str) -> Markup:
+    """The line under a report's title: when (UTC), on which machine and by which command
+    its figures were measured, so that a figure quoted elsewhere can be traced and
+    measured again."""
+    now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    return Markup(f"Measured {now} on {text(machine())} by {code(command)}.")

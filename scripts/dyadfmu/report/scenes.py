@@ -190,6 +190,8 @@ def report_text(
     lines = [
         "# Scenes: tailored FMUs against the generic per-type FMUs",
         "",
+        markdown.provenance(f"scripts/run-scenes{' --quick' if quick else ''}"),
+        "",
         "Every example scene's tailored FMU, co-simulated with fmpy over "
         f"{'one crank turn (180' if quick else 'two crank turns (360'} steps per "
         "turn) and compared output by output with its independent reference. Errors are "

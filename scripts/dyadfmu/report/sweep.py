@@ -25,6 +25,7 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from ..sweep.results import Table, best_designs, feasible, pareto_front  # noqa: E402
 from ..sweep.studyfile import Constraint, Study  # noqa: E402
+from .markdown import provenance as markdown_provenance  # noqa: E402
 from .markdown import table as markdown_table  # noqa: E402
 from .markdown import text as markdown_text  # noqa: E402
 
@@ -204,6 +205,8 @@ def report_text(
     statuses = {s: table.status.count(s) for s in dict.fromkeys(table.status)}
     lines = [
         f"# Study {markdown_text(study.name)}",
+        "",
+        markdown_provenance(f"dyadfmu sweep {study.name}.toml"),
         "",
         markdown_text(study.description),
         "",

@@ -46,7 +46,9 @@ def write_error_tables(stem: Path, title: str, rows: list[list[str]]) -> list[Pa
     """<stem>_errors.md (titled) and <stem>_errors.csv of an error table."""
     md = Path(f"{stem}_errors.md")
     md.write_text(
-        f"# {markdown.text(title)}\n\n{format_markdown(rows, '--rrr')}\n", encoding="utf-8"
+        f"# {markdown.text(title)}\n\n{markdown.provenance('scripts/run-main')}\n\n"
+        f"{format_markdown(rows, '--rrr')}\n",
+        encoding="utf-8",
     )
     path_csv = Path(f"{stem}_errors.csv")
     with open(path_csv, "w", newline="", encoding="utf-8") as handle:
