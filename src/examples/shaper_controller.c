@@ -3,9 +3,10 @@
  * A simulated controller ticks every 1 ms. At each tick it reads the crank's angle,
  * speed and acceleration from a trajectory (an encoder and an observer in a real
  * drive) and calls shaper_evaluate, the shaper's generated scene code
- * (modelDescription/scenes/shaper.toml, built with the float core): the kinematics of
- * the chain are solved inside, so the crank's motion and the cutting force are its only
- * inputs. Out come the feed-forward motor
+ * (modelDescription/scenes/shaper.toml) as its bundle for firmware holds it
+ * (scripts/build-scene --bundle: the scene's code and the core's files it calls, built
+ * in float): the kinematics of the chain are solved inside, so the crank's motion and
+ * the cutting force are its only inputs. Out come the feed-forward motor
  * torque and the loads on the bearings (the crank's main bearing O, the lever's pivot
  * O2, the lever tip B), which a bearing-load monitor would compare with its limits.
  *
