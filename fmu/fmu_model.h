@@ -8,6 +8,9 @@
 
 #include <stddef.h>
 
+/* fmu_status and fmu_evaluation, which a scene's generated code reports with too */
+#include "dyadfmu/evaluation.h"
+
 /* A path that is rarely taken (a refusal, a log message) kept out of the function that
  * calls it, so that the common path saves and restores fewer registers. */
 #if defined(__GNUC__)
@@ -23,15 +26,6 @@
 #else
 #define FMU_INLINE static inline
 #endif
-
-/* Same numbering as fmi2Status and fmi3Status. */
-typedef enum fmu_status {
-    FMU_OK = 0,
-    FMU_WARNING = 1,
-    FMU_DISCARD = 2,
-    FMU_ERROR = 3,
-    FMU_FATAL = 4
-} fmu_status;
 
 typedef enum fmu_causality {
     FMU_PARAMETER = 0, /* fixed: settable until initialization ends */
@@ -92,15 +86,6 @@ typedef struct fmu_variable {
 } fmu_variable;
 
 struct fmu_model;
-
-/* How an evaluation went: FMU_OK; FMU_DISCARD where the model has no answer
- * for these inputs (outputs NaN, e.g. a singular dyad); FMU_ERROR for an input
- * the model rejects, naming the variable. `reason` is logged. */
-typedef struct fmu_evaluation {
-    fmu_status status;
-    int bad_variable; /* index of the variable to blame, or -1 */
-    char reason[200];
-} fmu_evaluation;
 
 /* One state of a model with states: a double of its input block that its start sets
  * and its steps advance (the drive: the crank's angle and speed). An FMU state keeps

@@ -48,15 +48,13 @@
  * (the amplification), which scripts/tests/test_kinematics_vs_mpmath.py holds
  * against mpmath on the way to either toggle.
  *
- * This file is compiled once per scalar (dyad_kin_generic.h): the public
- * functions first, the formulas below, included twice.
+ * The formulas below are written over a scalar of choice (dyad_kin_generic.h):
+ * this file compiles them over dyad_real for dyad_kinematics_rrr, and
+ * dyad_kin_rrr_tangent.c includes them over the dual numbers for the tangent.
  */
 #ifndef DYAD_KIN_FORMULAS
 #include "dyad_kin_internal.h"
 #define DYAD_KIN_FORMULAS
-#include "dyad_kin_generic.h"
-#include "dyad_kin_rrr.c"
-#define DYAD_KIN_DUAL
 #include "dyad_kin_generic.h"
 #include "dyad_kin_rrr.c"
 
@@ -64,13 +62,6 @@ dyad_status dyad_kinematics_rrr(const dyad_kin_input* input, dyad_kin_result* re
 {
     return dyad_kin_run_plain(DYAD_RRR, rrr_position_plain, rrr_motion_plain, input, input, result,
                               result);
-}
-
-dyad_status dyad_kinematics_tangent_rrr(const dyad_kin_input* input, const dyad_kin_input* seed,
-                                        dyad_kin_result* value, dyad_kin_result* derivative)
-{
-    return dyad_kin_run_dual(DYAD_RRR, rrr_position_dual, rrr_motion_dual, input, seed, value,
-                             derivative);
 }
 
 #else /* the formulas, over the pass's scalar */

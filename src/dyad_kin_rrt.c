@@ -46,21 +46,11 @@
 #define DYAD_KIN_FORMULAS
 #include "dyad_kin_generic.h"
 #include "dyad_kin_rrt.c"
-#define DYAD_KIN_DUAL
-#include "dyad_kin_generic.h"
-#include "dyad_kin_rrt.c"
 
 dyad_status dyad_kinematics_rrt(const dyad_kin_input* input, dyad_kin_result* result)
 {
     return dyad_kin_run_plain(DYAD_RRT, rrt_position_plain, rrt_motion_plain, input, input, result,
                               result);
-}
-
-dyad_status dyad_kinematics_tangent_rrt(const dyad_kin_input* input, const dyad_kin_input* seed,
-                                        dyad_kin_result* value, dyad_kin_result* derivative)
-{
-    return dyad_kin_run_dual(DYAD_RRT, rrt_position_dual, rrt_motion_dual, input, seed, value,
-                             derivative);
 }
 
 #else /* the formulas, over the pass's scalar */

@@ -48,21 +48,11 @@
 #define DYAD_KIN_FORMULAS
 #include "dyad_kin_generic.h"
 #include "dyad_kin_rtr.c"
-#define DYAD_KIN_DUAL
-#include "dyad_kin_generic.h"
-#include "dyad_kin_rtr.c"
 
 dyad_status dyad_kinematics_rtr(const dyad_kin_input* input, dyad_kin_result* result)
 {
     return dyad_kin_run_plain(DYAD_RTR, rtr_position_plain, rtr_motion_plain, input, input, result,
                               result);
-}
-
-dyad_status dyad_kinematics_tangent_rtr(const dyad_kin_input* input, const dyad_kin_input* seed,
-                                        dyad_kin_result* value, dyad_kin_result* derivative)
-{
-    return dyad_kin_run_dual(DYAD_RTR, rtr_position_dual, rtr_motion_dual, input, seed, value,
-                             derivative);
 }
 
 #else /* the formulas, over the pass's scalar */

@@ -1,10 +1,9 @@
-/* dyadfmu: the kinematics' public helpers (defaults, names, dispatch, the
- * motion of a point on a link), the validation that names a bad field, and
- * rejection. Each type's closed forms are in its own file, dyad_kin_<type>.c;
- * the formulas they share in dyad_kin_generic.h. */
+/* dyadfmu: the kinematics' public helpers (defaults, names, the motion of a
+ * point on a link), the validation that names a bad field, and rejection. Each
+ * type's closed forms are in its own file, dyad_kin_<type>.c, their tangents in
+ * dyad_kin_<type>_tangent.c and the motion of a point on dual numbers in
+ * dyad_kinematics_tangent.c; the formulas they share in dyad_kin_generic.h. */
 #include "dyad_kin_internal.h"
-#include "dyad_kin_generic.h"
-#define DYAD_KIN_DUAL
 #include "dyad_kin_generic.h"
 
 static const char* const kin_field_names[DYAD_KIN_FIELD_COUNT] = {
@@ -78,25 +77,6 @@ dyad_point_motion dyad_point_on_link(const dyad_point_motion* origin, dyad_vec2 
     r.position = p.pos;
     r.velocity = p.vel;
     r.acceleration = p.acc;
-    return r;
-}
-
-dyad_dual_point_motion dyad_point_on_link_dual(dyad_dual_point_motion origin, dyad_dual_vec2 dir,
-                                               dyad_dual omega, dyad_dual epsilon,
-                                               dyad_dual_vec2 at)
-{
-    dyad_kin_motion_dual o, p;
-    dyad_dual_point_motion r;
-    o.pos = dyad_kdv_in(origin.v.position, origin.d.position);
-    o.vel = dyad_kdv_in(origin.v.velocity, origin.d.velocity);
-    o.acc = dyad_kdv_in(origin.v.acceleration, origin.d.acceleration);
-    p = dyad_kin_on_link_dual(&o, dir, omega, epsilon, at);
-    r.v.position = p.pos.v;
-    r.d.position = p.pos.d;
-    r.v.velocity = p.vel.v;
-    r.d.velocity = p.vel.d;
-    r.v.acceleration = p.acc.v;
-    r.d.acceleration = p.acc.d;
     return r;
 }
 

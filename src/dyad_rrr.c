@@ -39,7 +39,7 @@
  * Closed forms: 122 flops. The solve adds the checks of its inputs and of
  * its outputs (scripts/run-study counts what it executes).
  */
-#include "dyad_tangent.h"
+#include "dyad_internal.h"
 
 DYAD_CLOSED_FORM dyad_status rrr_reactions(const dyad_loaded* p, dyad_result* result)
 {
@@ -86,25 +86,4 @@ dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
         return status;
     }
     return dyad_name_failure(DYAD_RRR, input, rrr_reactions(&p, result), result);
-}
-
-/* The rate of the conditioning d = i_m . j_n as the directions turn. */
-static dyad_dual rrr_conditioning_rate(const dyad_input* input, const dyad_input* seed,
-                                       const dyad_turning* t, const dyad_result* value,
-                                       dyad_result* derivative)
-{
-    const dyad_real dc = t->dth_m * dyad_dot(dyad_perp(t->i_m), dyad_perp(t->i_n)) -
-                         t->dth_n * dyad_dot(t->i_m, t->i_n);
-    (void)input;
-    (void)seed;
-    return dyad_denominator_rate(value, dc, derivative);
-}
-
-const dyad_tangent_type dyad_tangent_rrr = {DYAD_RRR, dyad_solve_rrr, dyad_react_rrr,
-                                            dyad_sizes_rrr, rrr_conditioning_rate};
-
-dyad_status dyad_react_tangent_rrr(const dyad_loaded* dyad, const dyad_loaded* seed,
-                                   dyad_result* value, dyad_result* derivative)
-{
-    return dyad_react_tangent_of(&dyad_tangent_rrr, dyad, seed, value, derivative);
 }

@@ -38,7 +38,7 @@
  * Closed forms: 137 flops. The solve adds the checks of its inputs and of
  * its outputs (scripts/run-study counts what it executes).
  */
-#include "dyad_tangent.h"
+#include "dyad_internal.h"
 
 DYAD_CLOSED_FORM dyad_status rrt_reactions(const dyad_loaded* p, dyad_result* result)
 {
@@ -87,25 +87,4 @@ dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
         return status;
     }
     return dyad_name_failure(DYAD_RRT, input, rrt_reactions(&p, result), result);
-}
-
-/* The rate of the conditioning d = i_n . i_k as the directions turn. */
-static dyad_dual rrt_conditioning_rate(const dyad_input* input, const dyad_input* seed,
-                                       const dyad_turning* t, const dyad_result* value,
-                                       dyad_result* derivative)
-{
-    const dyad_real dc = t->dth_n * dyad_dot(dyad_perp(t->i_n), t->i_k) +
-                         t->dth_k * dyad_dot(t->i_n, dyad_perp(t->i_k));
-    (void)input;
-    (void)seed;
-    return dyad_denominator_rate(value, dc, derivative);
-}
-
-const dyad_tangent_type dyad_tangent_rrt = {DYAD_RRT, dyad_solve_rrt, dyad_react_rrt,
-                                            dyad_sizes_rrt, rrt_conditioning_rate};
-
-dyad_status dyad_react_tangent_rrt(const dyad_loaded* dyad, const dyad_loaded* seed,
-                                   dyad_result* value, dyad_result* derivative)
-{
-    return dyad_react_tangent_of(&dyad_tangent_rrt, dyad, seed, value, derivative);
 }

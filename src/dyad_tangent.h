@@ -1,9 +1,9 @@
 /* dyadfmu: what the directional derivative (dyad_tangent.c) asks of each dyad
- * type. The derivation is shared; three things differ by type and live in the
- * type's own file: its solver, the sizes of its outputs (the amplification's
- * formulas) and the rate of its conditioning: the dyad_tangent_<type> of the
- * type's file. Its reactions on reduced loads (react) serve the tangent of
- * dyad_react_<type>. Not part of the public API. */
+ * type. The derivation is shared; three things differ by type: its solver, the
+ * sizes of its outputs (the amplification's formulas) and the rate of its
+ * conditioning, gathered in the dyad_tangent_<type> of the type's
+ * dyad_<type>_tangent.c. Its reactions on reduced loads (react) serve the
+ * tangent of dyad_react_<type>. Not part of the public API. */
 #ifndef DYADFMU_TANGENT_H
 #define DYADFMU_TANGENT_H
 

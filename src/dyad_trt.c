@@ -26,7 +26,7 @@
  * 153 flops. The solve adds the checks of its inputs and of its outputs (scripts/run-study counts
  * what it executes).
  */
-#include "dyad_tangent.h"
+#include "dyad_internal.h"
 
 DYAD_CLOSED_FORM dyad_status trt_reactions(const dyad_loaded* p, dyad_result* result)
 {
@@ -80,25 +80,4 @@ dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
         return status;
     }
     return dyad_name_failure(DYAD_TRT, input, trt_reactions(&p, result), result);
-}
-
-/* The rate of the conditioning d = j_k . i_p as the directions turn. */
-static dyad_dual trt_conditioning_rate(const dyad_input* input, const dyad_input* seed,
-                                       const dyad_turning* t, const dyad_result* value,
-                                       dyad_result* derivative)
-{
-    const dyad_real dc = -t->dth_k * dyad_dot(t->i_k, t->i_p) +
-                         t->dth_p * dyad_dot(dyad_perp(t->i_k), dyad_perp(t->i_p));
-    (void)input;
-    (void)seed;
-    return dyad_denominator_rate(value, dc, derivative);
-}
-
-const dyad_tangent_type dyad_tangent_trt = {DYAD_TRT, dyad_solve_trt, dyad_react_trt,
-                                            dyad_sizes_trt, trt_conditioning_rate};
-
-dyad_status dyad_react_tangent_trt(const dyad_loaded* dyad, const dyad_loaded* seed,
-                                   dyad_result* value, dyad_result* derivative)
-{
-    return dyad_react_tangent_of(&dyad_tangent_trt, dyad, seed, value, derivative);
 }

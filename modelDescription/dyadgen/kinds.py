@@ -22,10 +22,11 @@ from dyadgen.catalogue import (
     dyad_catalogue,
     setting_entry,
 )
+from dyadgen.corefiles import dyad_core_sources, scene_core_sources
 from dyadgen.dyadtypes import PAIRS
 from dyadgen.emit import documentation, fmi2, fmi3
 from dyadgen.emit.c_table import model_c
-from dyadgen.emit.scene_c import scene_c, scene_header
+from dyadgen.emit.scene_c import scene_c, scene_header, scene_tangent_c
 from dyadgen.model import Input, Param, Scene
 from dyadgen.scenefile.problems import SceneError
 from dyadgen.settings import ON_SINGULAR
@@ -102,6 +103,8 @@ class Kind(Structs):
     #: How a scene of this kind is realised (scene.py --cmake-info) and named (--check).
     realisation = ""
     label = ""
+    #: The headers its variable table (<identifier>_model.c) includes beyond its own.
+    model_includes: tuple = ()
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The C files an importer compiles to rebuild the FMI `version` binary."""
@@ -197,9 +200,7 @@ class DyadKind(Kind):
     def source_files(self, table: Table, version: int) -> list[str]:
         """The dyad's solver, its derivatives and the dyad behaviour."""
         return [
-            "dyad_common.c",
-            f"dyad_{table.type.lower()}.c",
-            "dyad_tangent.c",
+            *dyad_core_sources(table.type.lower()),
             "fmu_dyad.c",
             "fmu_instance.c",
             "fmu_state.c",
@@ -310,6 +311,7 @@ class SceneKind(Kind):
     realisation = "tailored"
     label = "tailored"
     log_categories = SCENE_LOG_CATEGORIES
+    model_includes = ("<string.h>", '"fmu_model.h"')
 
     def __init__(self, scene: Scene) -> None:
         ident = scene.identifier
@@ -332,24 +334,16 @@ class SceneKind(Kind):
             self.label = "mechanism"
 
     def source_files(self, table: Table, version: int) -> list[str]:
-        """The closed forms of the scene's dyad types and its generated code."""
-        types = sorted({d.type.lower() for d in table.scene.dyads})
-        kinematics = []
-        if table.scene.internal():
-            kinematics = ["dyad_kinematics.c"] + [f"dyad_kin_{t}.c" for t in types]
-        return (
-            ["dyad_common.c"]
-            + [f"dyad_{t}.c" for t in types]
-            + kinematics
-            + ["dyad_tangent.c"]
-            + [
-                f"{table.identifier}_scene.c",
-                "fmu_instance.c",
-                "fmu_state.c",
-                *SHIM_FILES[version],
-                f"{table.identifier}_model.c",
-            ]
-        )
+        """The closed forms of the scene's dyad types with their tangents, and its
+        generated code."""
+        return scene_core_sources(table.scene, derivatives=True) + [
+            f"{table.identifier}_scene.c",
+            f"{table.identifier}_scene_tangent.c",
+            "fmu_instance.c",
+            "fmu_state.c",
+            *SHIM_FILES[version],
+            f"{table.identifier}_model.c",
+        ]
 
     def subject(self, table: Table) -> str:
         """The scene."""
@@ -360,11 +354,17 @@ class SceneKind(Kind):
         return f"scene {table.path.name}"
 
     def own_sources(self, table: Table) -> dict[str, str]:
-        """The scene's C and header."""
+        """The scene's C (its evaluation and, apart, its derivative) and header."""
         return {
             f"{table.identifier}_scene.c": scene_c(table.scene),
+            f"{table.identifier}_scene_tangent.c": scene_tangent_c(table.scene),
             f"{table.identifier}_scene.h": scene_header(table),
         }
+
+    def model_data(self, table: Table) -> tuple[list[str], str]:
+        """The scene's behaviour: its functions (<identifier>_scene.h) on the FMU
+        layer's untyped blocks."""
+        return scene_behaviour(table.identifier), "NULL"
 
     def documentation(self, table: Table) -> str:
         """The page of the scene."""
@@ -395,6 +395,40 @@ DRIVE = DriveKind(
 )
 #: The kinds a table file may name in [model] kind.
 KINDS = {"dyad": DYAD, "drive": DRIVE}
+
+
+def scene_behaviour(ident: str) -> list[str]:
+    """The C of a scene's fmu_behaviour, <identifier>_behaviour: its initialise, and its
+    evaluate and derivative on the scene's functions."""
+    return [
+        f"/* The scene's functions ({ident}_scene.c, {ident}_scene_tangent.c) as the FMU",
+        " * layer calls them. */",
+        "static void initialise(const fmu_model* model, void* input)",
+        "{",
+        "    (void)model;",
+        f"    memset(input, 0, sizeof({ident}_input));",
+        "}",
+        "",
+        "static void evaluate(const fmu_model* model, const void* input, void* output,",
+        "                     fmu_evaluation* evaluation)",
+        "{",
+        "    (void)model;",
+        f"    {ident}_evaluate((const {ident}_input*)input, ({ident}_output*)output, evaluation);",
+        "}",
+        "",
+        "static void derivative(const fmu_model* model, const void* input, const void* seed,",
+        "                       void* output, void* rate, fmu_evaluation* evaluation)",
+        "{",
+        "    (void)model;",
+        f"    {ident}_derivative((const {ident}_input*)input, (const {ident}_input*)seed,",
+        f"                       ({ident}_output*)output, ({ident}_output*)rate, evaluation);",
+        "}",
+        "",
+        f"static const fmu_behaviour {ident}_behaviour = {{sizeof({ident}_input),",
+        f"                                                sizeof({ident}_output), initialise,",
+        "                                                evaluate, NULL, NULL, derivative, NULL};",
+        "",
+    ]
 
 
 class SceneTable(Table):

@@ -237,7 +237,8 @@ def test_the_refused_names_cover_the_generated_code(path):
     sc = pipeline.load_scene(path)
     table = pipeline.build_table(sc)
     derived = {c for kind, name in _scene_objects(sc) for _, c in names.derived(kind, name)}
-    code = [t.text for t in cnames.identifiers(scene_emit.scene_c(table.scene)) if not t.member]
+    generated = scene_emit.scene_c(table.scene) + scene_emit.scene_tangent_c(table.scene)
+    code = [t.text for t in cnames.identifiers(generated) if not t.member]
     declared = sorted(cnames.declared_names(scene_emit.scene_header(table)))
     for name in code + declared:
         assert name in names.reserved or name in derived, (path.name, name)
@@ -415,15 +416,20 @@ def _build_fmu(table, tmp_path, name) -> Path:
     types = sorted({d.type.lower() for d in table.scene.dyads})
     kinematics = []
     if table.scene.internal():  # a mechanism FMU: the types' kinematics too
-        kinematics = [ROOT / "src" / "dyad_kinematics.c"]
-        kinematics += [ROOT / "src" / f"dyad_kin_{t}.c" for t in types]
+        kinematics = [
+            ROOT / "src" / "dyad_kinematics.c",
+            ROOT / "src" / "dyad_kinematics_tangent.c",
+        ]
+        kinematics += [ROOT / "src" / f"dyad_kin_{t}{s}.c" for t in types for s in ("", "_tangent")]
     sources = (
         [ROOT / "src" / "dyad_common.c"]
         + [ROOT / "src" / f"dyad_{t}.c" for t in types]
         + kinematics
         + [ROOT / "src" / "dyad_tangent.c"]  # the closed forms' tangents (the derivative)
+        + [ROOT / "src" / f"dyad_{t}_tangent.c" for t in types]
         + [
             gen / f"{ident}_scene.c",
+            gen / f"{ident}_scene_tangent.c",
             ROOT / "fmu" / "fmu_instance.c",
             ROOT / "fmu" / "fmu_state.c",
             ROOT / "fmu" / "fmi2_functions.c",

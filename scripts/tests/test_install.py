@@ -30,7 +30,16 @@ PROGRAMS = {
     "consumer_shared": "double",
     "consumer_float_shared": "float",
 }
-HEADERS = ["angle.h", "batch.h", "dual.h", "dyad.h", "kinematics.h", "loaded.h", "types.h"]
+HEADERS = [
+    "angle.h",
+    "batch.h",
+    "dual.h",
+    "dyad.h",
+    "evaluation.h",
+    "kinematics.h",
+    "loaded.h",
+    "types.h",
+]
 
 
 def _run(*command: str | Path, env: dict[str, str] | None = None) -> str:

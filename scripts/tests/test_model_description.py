@@ -490,6 +490,7 @@ def test_fmpy_validates_and_interface_is_right(generated, dyad_type, tmp_path):
             "dyad_common.c",
             f"dyad_{dyad_type.lower()}.c",
             "dyad_tangent.c",
+            f"dyad_{dyad_type.lower()}_tangent.c",
             "fmu_dyad.c",
             "fmu_instance.c",
             "fmu_state.c",
@@ -1189,6 +1190,7 @@ def test_drive_c_table_compiles(generated_drive, tmp_path):
             "-Werror",
             f"-I{ROOT / 'fmu'}",
             f"-I{ROOT / 'fmu' / 'models'}",
+            f"-I{ROOT / 'src' / 'include'}",  # fmu_model.h: dyadfmu/evaluation.h
             "-c",
             str(generated_drive / "drive_model.c"),
             "-o",

@@ -157,7 +157,7 @@ def test_static_press_takes_no_motion_and_computes_no_inertia_or_weight():
     assert v["parameter"] == ["on_singular"]  # the FMU layer's setting alone
     assert v["output"] == ["press.N_mk", "press.R_np.x", "press.R_np.y", "crank.torque", "status"]
     code = (GENERATED / "press" / "press_scene.c").read_text()
-    body = code[code.index("static void evaluate") :]
+    body = code[code.index("void press_evaluate(") :]
     for absent in ("omega", "epsilon", "gravity", "accel", "crank_r_o"):
         assert absent not in body, absent
     # baked constants, not parameters: the rod length and the crank radius
@@ -170,7 +170,7 @@ def test_horizontal_monitor_has_no_weight_and_one_reaction():
     assert v["parameter"] == ["rocker.mass", "on_singular"]
     assert not any("gravity" in n for n in v["input"] + v["parameter"])
     code = (GENERATED / "monitor" / "monitor_scene.c").read_text()
-    body = code[code.index("static void evaluate") :]
+    body = code[code.index("void monitor_evaluate(") :]
     assert "gravity" not in body
     assert "crank_torque" not in body and "crank_r_o" not in body  # no crank balance
     assert "in->rocker_mass" in body

@@ -2,11 +2,13 @@
  *
  * A simulated controller ticks every 1 ms. At each tick it reads the crank's angle,
  * speed and acceleration from a trajectory (an encoder and an observer in a real
- * drive) and calls the shaper's generated scene code (modelDescription/scenes/shaper.toml, built
- * with the float core): the kinematics of the chain are solved inside, so the crank's motion and
- * the cutting force are its only inputs. Out come the feed-forward motor torque and the loads on
- * the bearings (the crank's main bearing O, the lever's pivot O2, the lever tip B), which a
- * bearing-load monitor would compare with its limits.
+ * drive) and calls shaper_evaluate, the shaper's generated scene code
+ * (modelDescription/scenes/shaper.toml) as its bundle for firmware holds it
+ * (scripts/build-scene --bundle: the scene's code and the core's files it calls, built
+ * in float): the kinematics of the chain are solved inside, so the crank's motion and
+ * the cutting force are its only inputs. Out come the feed-forward motor
+ * torque and the loads on the bearings (the crank's main bearing O, the lever's pivot
+ * O2, the lever tip B), which a bearing-load monitor would compare with its limits.
  *
  * The cutting force acts on the working stroke, while the ram moves towards -x: the
  * controller sees the ram's direction from the pair position the scene outputs at
@@ -88,7 +90,7 @@ int main(int argc, char** argv)
     if (!parse_arguments(argc, argv, &ticks, &every)) {
         return 2;
     }
-    shaper_behaviour.initialise(NULL, &in);
+    memset(&in, 0, sizeof in);
     in.slider_mass = 12.0;
     in.gravity_x = 0.0;
     in.gravity_y = -9.81;
@@ -103,7 +105,7 @@ int main(int argc, char** argv)
         /* the cutting force on the working stroke (ram moving towards -x); NaN compares false */
         in.slider_force_x = ram_x_now < ram_x_before ? 2000.0 : 0.0; /* opposes the ram */
         in.slider_force_y = 0.0;
-        shaper_behaviour.evaluate(NULL, &in, &out, &evaluation);
+        shaper_evaluate(&in, &out, &evaluation);
         if (evaluation.status != FMU_OK) {
             ++refused;
             fprintf(stderr, "tick %ld: %s\n", k, evaluation.reason);

@@ -1,4 +1,5 @@
-"""scene.py: check a scene, or generate the files of its FMU."""
+"""scene.py: check a scene, generate the files of its FMU, or write its bundle for
+firmware."""
 
 from __future__ import annotations
 
@@ -8,9 +9,12 @@ import sys
 import tempfile
 from pathlib import Path
 
+from dyadgen.bundle import BundleError, write_bundle
+from dyadgen.model import Scene
 from dyadgen.pipeline import build_table, load_scene, outputs_of, write_files
 from dyadgen.scenefile.problems import SceneError
 from dyadgen.scenefile.read import inputs_with_external_kinematics
+from dyadgen.table import Table
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -36,6 +40,26 @@ def _parser() -> argparse.ArgumentParser:
         "--cmake-info",
         action="store_true",
         help="print 'identifier;type;...' (its dyad types, lower case) for CMake",
+    )
+    what.add_argument(
+        "--bundle",
+        type=Path,
+        metavar="DIR",
+        help="write DIR/<identifier>/: the C files and headers a firmware needs to call "
+        "<identifier>_evaluate (the scene's code and the core's), a CMakeLists.txt, an "
+        "example and a README.md; an earlier bundle there is replaced",
+    )
+    parser.add_argument(
+        "--with-derivatives",
+        action="store_true",
+        help="with --bundle: also <identifier>_derivative (the exact directional "
+        "derivative) and the core's tangents, which an evaluate-only bundle leaves out",
+    )
+    parser.add_argument(
+        "--measure",
+        action="store_true",
+        help="with --bundle: build the example with cc at -O2, in double and in float, "
+        "and give its size (size(1)'s text, bytes) in the README",
     )
     return parser
 
@@ -73,12 +97,19 @@ def _path_problem(args: argparse.Namespace) -> str | None:
     problem = _scene_problem(args.scene)
     if problem:
         return f"{args.scene}: {problem}"
-    problem = _out_problem(args.out) if args.out is not None else None
-    return f"--out {args.out}: {problem}" if problem else None
+    for option, folder in (("--out", args.out), ("--bundle", args.bundle)):
+        problem = _out_problem(folder) if folder is not None else None
+        if problem:
+            return f"{option} {folder}: {problem}"
+    if args.bundle is None and (args.with_derivatives or args.measure):
+        given = "--with-derivatives" if args.with_derivatives else "--measure"
+        return f"{given} is an option of --bundle, which is not given"
+    return None
 
 
 def main(argv: list[str] | None = None) -> int:
-    """scene.py SCENE --out DIR | --check | --external-inputs | --cmake-info."""
+    """scene.py SCENE --out DIR | --check | --external-inputs | --cmake-info |
+    --bundle DIR [--with-derivatives] [--measure]."""
     parser = _parser()
     args = parser.parse_args(argv)
     problem = _path_problem(args)
@@ -100,6 +131,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.external_inputs:
         print("\n".join(inputs_with_external_kinematics(scene)))
         return 0
+    if args.bundle is not None:
+        return _bundle(args, scene, table, parser.prog)
     if args.check:
         n = table.counts()
         counts = ", ".join(_counted(n[c], c) for c in ("input", "parameter", "output"))
@@ -116,3 +149,27 @@ def main(argv: list[str] | None = None) -> int:
 def _counted(count: int, noun: str) -> str:
     """'1 parameter', '4 parameters'."""
     return f"{count} {noun}{'' if count == 1 else 's'}"
+
+
+def _bundle(args: argparse.Namespace, scene: Scene, table: Table, prog: str) -> int:
+    """Write the scene's bundle (--bundle); 1 for a scene that has no code of its own to
+    bundle, 2 where the folder or the measurement fails."""
+    if table.kind.realisation == "generic":
+        dyad = scene.dyads[0].type
+        print(
+            f"error: {args.scene}: the scene {table.identifier} is one whole {dyad} dyad "
+            f"(realisation generic): its FMU runs the core's dyad_solve_{dyad.lower()} and "
+            "there is no generated code to bundle; call that function of the installed core",
+            file=sys.stderr,
+        )
+        return 1
+    try:
+        folder = write_bundle(table, args.bundle, args.with_derivatives, args.measure)
+    except BundleError as error:
+        print(f"{prog}: error: {error.args[0]}", file=sys.stderr)
+        return 2
+    except OSError as error:
+        print(f"{prog}: error: {error.filename}: {error.strerror or error}", file=sys.stderr)
+        return 2
+    print(folder)
+    return 0

@@ -195,12 +195,18 @@ def kinematics_body(scene: Scene, dyads: list[Dyad]) -> list[str]:
     return body
 
 
+def kinematics_type(scene: Scene) -> str:
+    """The kinematics block type: one dyad_kin_result per dyad."""
+    ident = scene.identifier
+    members = [f"    dyad_kin_result {kin_name(d)};" for d in scene.dyads]
+    return "\n".join([f"typedef struct {ident}_kinematics {{", *members, f"}} {ident}_kinematics;"])
+
+
 def kinematics_function(scene: Scene, dyads: list[Dyad]) -> str:
     """The kinematics block type and the function that fills it."""
     ident = scene.identifier
-    members = [f"    dyad_kin_result {kin_name(d)};" for d in scene.dyads]
     body = kinematics_body(scene, dyads)
-    lines = [f"typedef struct {ident}_kinematics {{", *members, f"}} {ident}_kinematics;", ""]
+    lines = [kinematics_type(scene), ""]
     lines += [
         "/* The chain's kinematics from the driver outwards, the driver at its position in",
         " * `in` moving at `rate` with `accel` (rad/s and rad/s2, or m/s and m/s2 for a ram).",

@@ -32,6 +32,18 @@ TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c.in"
 #: the output member of a mechanism FMU's own amplification
 MECHANISM_AMPLIFICATION = "amplification"
 KINEMATICS_TEMPLATE = TEMPLATE.with_name("scene_kinematics.c.in")
+#: what both files of a scene (<identifier>_scene.c and _scene_tangent.c) report a failure with
+HELPERS_TEMPLATE = TEMPLATE.with_name("scene_helpers.c.in")
+TANGENT_TEMPLATE = TEMPLATE.with_name("scene_tangent.c.in")
+FIXED_POINT_TEMPLATE = TEMPLATE.with_name("scene_fixed_point.c.in")
+#: the failure of a dyad whose values solve while their rates overflow: the derivative's alone
+DERIVATIVE_CASE = """    } else if (dyad->status == DYAD_STATUS_OK) {
+        /* the values solve, their rates overflow */
+        out->status = 0;
+        snprintf(evaluation->reason, sizeof evaluation->reason,
+                 "the directional derivative of dyad %s is not finite at these inputs", name);
+"""
+KINEMATICS_INCLUDE = '#include "dyadfmu/dyad.h"\n#include "dyadfmu/kinematics.h"\n'
 
 
 def _vec(x: str, y: str) -> str:
@@ -664,15 +676,36 @@ def _template(path: Path = TEMPLATE) -> Template:
     return Template(path.read_text(encoding="utf-8"))
 
 
-def _kinematics_code(plan: Plan) -> str:
-    """The kinematics function and its failure report, for internal kinematics."""
+def _kinematics_code(plan: Plan, tangent: bool = False, later: str = "") -> str:
+    """The kinematics function (for the tangent's file, the block type alone) and its
+    failure report, for internal kinematics; `fixed_point` where it or `later` (the
+    code that follows) calls it."""
     if not plan.kinematic:
         return ""
     scene = plan.scene
+    if tangent:
+        function = kinematics_c.kinematics_type(scene)
+    else:
+        function = kinematics_c.kinematics_function(scene, plan.kinematic)
+    fixed = "fixed_point(" in function + later
     return _template(KINEMATICS_TEMPLATE).substitute(
         ident=scene.identifier,
-        kinematics_function=kinematics_c.kinematics_function(scene, plan.kinematic),
+        fixed_point=_template(FIXED_POINT_TEMPLATE).template + "\n" if fixed else "",
+        kinematics_function=function,
         names=kinematics_c.failure_names(scene),
+    )
+
+
+def _helpers(plan: Plan, tangent: bool = False, later: str = "") -> str:
+    """What a file of the scene reports a failure with: set_nan, fail, the kinematics
+    (see _kinematics_code) and check."""
+    reals = [o.member for o in plan.scene.outputs if not o.integer]
+    return _template(HELPERS_TEMPLATE).substitute(
+        ident=plan.scene.identifier,
+        nan_lines="\n".join(f"    out->{m} = NAN;" for m in reals),
+        derivative_case=DERIVATIVE_CASE if tangent else "",
+        kinematics_code=_kinematics_code(plan, tangent, later),
+        check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
     )
 
 
@@ -694,27 +727,48 @@ def inputs_read(scene: Scene) -> set[str]:
     return set(re.findall(r"\bin->([A-Za-z0-9_]+)", text))
 
 
+def _file_fields(plan: Plan) -> dict[str, str]:
+    """The template fields both files of a scene fill alike."""
+    scene = plan.scene
+    return {
+        "ident": scene.identifier,
+        "scene_file": textsafe.c_comment(scene.path.name),
+        "kinematics_include": KINEMATICS_INCLUDE if plan.kinematic else "",
+    }
+
+
 def scene_c(scene: Scene) -> str:
-    """<identifier>_scene.c: the computation of the scene (of its current outputs)."""
+    """<identifier>_scene.c: the computation of the scene (of its current outputs),
+    <identifier>_evaluate."""
     plan, dyad_decls, crank_decls, body = _evaluation(scene)
-    reals = [o.member for o in scene.outputs if not o.integer]
-    tangent = tangent_c.scene_tangent(scene, plan.kinematic, dyad_decls + crank_decls + body)
     return _template().substitute(
-        ident=scene.identifier,
-        scene_file=textsafe.c_comment(scene.path.name),
+        _file_fields(plan),
         description=textsafe.c_comment(scene.description),
         inertia="on" if scene.inertia else "off",
         gravity="on" if scene.gravity else "off",
-        nan_lines="\n".join(f"    out->{m} = NAN;" for m in reals),
-        check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
+        helpers=_helpers(plan),
+        evaluate_indent=" " * len(f"void {scene.identifier}_evaluate("),
         dyad_decls="\n".join(dyad_decls),
         crank_decls="\n".join(crank_decls),
-        kinematics_include=(
-            '#include "dyadfmu/dyad.h"\n#include "dyadfmu/kinematics.h"\n' if plan.kinematic else ""
-        ),
-        kinematics_code=_kinematics_code(plan),
         body="\n".join(body),
-        tangent_code=tangent,
+    )
+
+
+def scene_tangent_c(scene: Scene) -> str:
+    """<identifier>_scene_tangent.c: the directional derivative of the scene's
+    computation, <identifier>_derivative."""
+    plan, dyad_decls, crank_decls, body = _evaluation(scene)
+    kinematics, derivative = tangent_c.scene_tangent(
+        scene, plan.kinematic, dyad_decls + crank_decls + body
+    )
+    reals = [o.member for o in scene.outputs if not o.integer]
+    return _template(TANGENT_TEMPLATE).substitute(
+        _file_fields(plan),
+        helpers=_helpers(plan, tangent=True, later=kinematics + derivative),
+        kinematics_tangent=kinematics,
+        rate_check_terms=" + ".join(f"(rate->{m} - rate->{m})" for m in reals) or "0.0",
+        derivative_indent=" " * len(f"void {scene.identifier}_derivative("),
+        body=derivative,
     )
 
 
@@ -724,14 +778,16 @@ def scene_header(table: Table) -> str:
     ident = scene.identifier
     guard = f"DYADFMU_SCENE_{ident.upper()}_H"
     lines = [
-        f"/* {ident}_scene.h: the input and output blocks of the scene {ident}.",
-        f" * Generated by modelDescription/scene.py from "
-        f"{textsafe.c_comment(scene.path.name)}; do not edit. */",
+        f"/* {ident}_scene.h: the scene {ident} in C: its input and output blocks, the",
+        f" * function that computes it ({ident}_scene.c) and the one that also gives its",
+        f" * directional derivative ({ident}_scene_tangent.c). Plain C99 on the dyadfmu core,",
+        " * nothing of FMI. Generated by modelDescription/scene.py from",
+        f" * {textsafe.c_comment(scene.path.name)}; do not edit. */",
         f"#ifndef {guard}",
         f"#define {guard}",
         "",
+        '#include "dyadfmu/evaluation.h"',
         '#include "dyadfmu/vec2.h"',
-        '#include "fmu_model.h"',
         "",
         "/* Inputs and tunable parameters; an angle is kept as its unit vector. */",
         f"typedef struct {ident}_input {{",
@@ -749,11 +805,28 @@ def scene_header(table: Table) -> str:
             lines.append(f"    int {name}; /* 0 ok, 1 singular, 3 out of range{cannot} */")
         else:
             lines.append(f"    double {name}; /* {units.get(name) or '-'} */")
-    lines += [
-        f"}} {ident}_output;",
-        "",
-        f"extern const fmu_behaviour {ident}_behaviour;",
-        "",
-        f"#endif /* {guard} */",
-    ]
+    lines += [f"}} {ident}_output;", "", *_prototypes(ident), "", f"#endif /* {guard} */"]
     return "\n".join(lines) + "\n"
+
+
+def _prototypes(ident: str) -> list[str]:
+    """The header's functions, each with what it promises."""
+    evaluate = f"void {ident}_evaluate("
+    derivative = f"void {ident}_derivative("
+    return [
+        "/* The outputs at the inputs `in`, every one of `out`; `evaluation` says how it went:",
+        " * status FMU_OK, or FMU_DISCARD where the scene has no answer at these inputs (every",
+        " * Real output NaN, out->status saying why, evaluation->reason in one line). Nothing",
+        " * allocates and nothing is kept between calls. */",
+        f"{evaluate}const {ident}_input* in, {ident}_output* out,",
+        f"{' ' * len(evaluate)}fmu_evaluation* evaluation);",
+        "",
+        f"/* {ident}_evaluate, and in `rate` the exact directional derivative of every Real",
+        " * output along `seed`: the rates of the inputs (an angle's as the rate of its unit",
+        " * vector; a tunable parameter's is not read). FMU_DISCARD too where the rates are not",
+        f" * finite. Defined in {ident}_scene_tangent.c, which a program that only evaluates",
+        " * leaves out, with the core's *_tangent.c files. */",
+        f"{derivative}const {ident}_input* in, const {ident}_input* seed,",
+        f"{' ' * len(derivative)}{ident}_output* out, {ident}_output* rate,",
+        f"{' ' * len(derivative)}fmu_evaluation* evaluation);",
+    ]

@@ -598,16 +598,12 @@ def _kinematics_tangent(scene: Scene, dyads: list[Dyad], evaluate_text: str) -> 
     )
 
 
-def scene_tangent(scene: Scene, dyads: list[Dyad], evaluate_lines: list[str]) -> str:
-    """The scene's `derivative` (and `kinematics_tangent` where the kinematics are
-    internal) from the lines of its `evaluate`; dyads: those whose kinematics it runs."""
+def scene_tangent(scene: Scene, dyads: list[Dyad], evaluate_lines: list[str]) -> tuple[str, str]:
+    """The parts of the scene's `<identifier>_derivative` from the lines of its
+    `<identifier>_evaluate`: the code before it (`kinematics_tangent` and its helpers
+    where the kinematics are internal, else "") and its body; dyads: those whose
+    kinematics it runs."""
     body = Differentiation(scene.identifier, Names(_inputs(scene))).lines(evaluate_lines)
-    reals = [o.member for o in scene.outputs if not o.integer]
-    code = _template("scene_tangent.c.in").substitute(
-        ident=scene.identifier,
-        rate_check_terms=" + ".join(f"(rate->{m} - rate->{m})" for m in reals) or "0.0",
-        body=_indented(body),
-    )
     if not dyads:
-        return code
-    return _kinematics_tangent(scene, dyads, "\n".join(body)) + "\n" + code
+        return "", _indented(body)
+    return _kinematics_tangent(scene, dyads, "\n".join(body)), _indented(body)

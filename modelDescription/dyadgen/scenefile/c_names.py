@@ -9,13 +9,15 @@ import re
 
 from dyadgen import cnames
 from dyadgen.emit.c_table import model_c
-from dyadgen.emit.scene_c import scene_c, scene_header
+from dyadgen.emit.scene_c import scene_c, scene_header, scene_tangent_c
 from dyadgen.kinds import SceneKind
 from dyadgen.locations import C_NAMES_PROBES, HEADER_DIRS
 from dyadgen.scenefile.names import CNames
 from dyadgen.scenefile.read import read_scene
 
 _PROBE_NAME = re.compile(r"zq[a-z]{2}", re.IGNORECASE)
+#: the files whose names of links, dyads and the crank are locals, not block members
+_CODE_FILES = ("scene.c", "scene_tangent.c")
 _C_NAMES: list = []
 
 
@@ -40,7 +42,12 @@ def _learn_from(path: object, reserved: set, patterns: dict) -> None:
     probe = read_scene(path, c_names=None)
     table = SceneKind(probe).table_of_scene(probe)
     header = f"{probe.identifier}_scene.h"
-    files = {"scene.c": scene_c(probe), "scene.h": scene_header(table), "model.c": model_c(table)}
+    files = {
+        "scene.c": scene_c(probe),
+        "scene_tangent.c": scene_tangent_c(probe),
+        "scene.h": scene_header(table),
+        "model.c": model_c(table),
+    }
     kind_of = {probe.identifier: "identifier", probe.crank.name: "crank"}
     kind_of.update({d.name: "dyad" for d in probe.dyads})
     kind_of.update({g: "link" for g in probe.links})
@@ -59,7 +66,7 @@ def _learn_from(path: object, reserved: set, patterns: dict) -> None:
             kind = kind_of[found.group().lower()]
             # a link's, dyad's or crank's name in the header or the variable table is a
             # member of the input or output block; in the code, after '.' or '->'
-            member = t.member or (kind != "identifier" and file != "scene.c")
+            member = t.member or (kind != "identifier" and file not in _CODE_FILES)
             patterns[kind].add(
                 (
                     "member" if member else "code",

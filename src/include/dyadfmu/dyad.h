@@ -67,8 +67,8 @@ dyad_status dyad_solve_tangent(dyad_type type, const dyad_input* input, const dy
 
 /** What the directional derivative needs of one dyad type (its solver, the
  *  sizes of its outputs, the rate of its conditioning), defined in the type's
- *  own source file: passing dyad_tangent_rrt to dyad_solve_tangent_of links
- *  only the RRT solver. */
+ *  own source file (dyad_<type>_tangent.c): passing dyad_tangent_rrt to
+ *  dyad_solve_tangent_of links only the RRT solver. */
 typedef struct dyad_tangent_type dyad_tangent_type;
 extern const dyad_tangent_type dyad_tangent_rrr;
 extern const dyad_tangent_type dyad_tangent_rrt;

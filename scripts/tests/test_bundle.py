@@ -1,0 +1,458 @@
+"""A scene's bundle for firmware (scripts/build-scene --bundle, modelDescription/scene.py
+--bundle): the folder holds exactly the C a firmware compiles to call <id>_evaluate.
+
+For two mechanisms (the shaper and the lift, whose FMUs the build makes) and a tailored
+scene of all five dyad types (the C names probe, whose FMU is built here from the list
+its build description gives) the bundle, copied to a folder of its own, is compiled
+alone (nothing of the checkout on the include path) with -std=c99 -Wall -Wextra
+-Wpedantic -Werror, in double and in float, with a main that fills the input block,
+evaluates and prints every output; those agree with the FMU's at the same inputs, and
+with --with-derivatives so do the rates with the FMU's directional derivative. nm shows
+that an evaluate-only link holds no tangent or dual code and that each core file of the
+bundle is needed. The bundle's own CMakeLists.txt builds, on its core/ and on the core
+that `cmake --install` installs (as tests/consumer uses it), and build-scene measures
+the size into the README.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+from dyadfmu import paths
+from dyadfmu.fmi.slave import Slave
+from dyadgen import pipeline
+from dyadgen.locations import C_NAMES_PROBE, SCENES_DIR
+from tool_checks import required_tool
+
+ROOT = paths.ROOT
+BUILD_SCENE = ROOT / "scripts" / "build-scene"
+SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
+WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-O1"]
+FLOAT = "-DDYAD_REAL_FLOAT"
+#: the scenes bundled: two mechanisms, and a tailored scene of every dyad type
+SCENES = {
+    "shaper": SCENES_DIR / "shaper.toml",
+    "lift": SCENES_DIR / "lift.toml",
+    "zqid": C_NAMES_PROBE,
+}
+#: the names of the derivative's code (dyad_react_tangent_of, dyad_point_on_link_dual,
+#: dyad_force_size_rate, ...): nothing of it in an evaluate-only link
+DERIVATIVE_SYMBOL = re.compile(r"tangent|dual|_rate$", re.IGNORECASE)
+
+
+def _run(*command: object, cwd: Path | None = None) -> str:
+    done = subprocess.run(
+        [str(c) for c in command], capture_output=True, text=True, cwd=cwd, check=False
+    )
+    assert done.returncode == 0, (
+        f"{' '.join(map(str, command))} exited with {done.returncode}:\n"
+        f"{done.stdout[-3000:]}\n{done.stderr[-3000:]}"
+    )
+    return done.stdout
+
+
+def _table(name: str):
+    return pipeline.build_table(pipeline.load_scene(SCENES[name], check_c_names=False))
+
+
+# ---------------------------------------------------------------------------
+# The inputs, the test's main and the FMU
+# ---------------------------------------------------------------------------
+def _block_inputs(table) -> list:
+    targets = ("FMU_TARGET_INPUT_REAL", "FMU_TARGET_INPUT_ANGLE")
+    return [v for v in table.variables if v.lives.target in targets]
+
+
+def _outputs(table) -> list:
+    return [v for v in table.variables if v.lives.target == "FMU_TARGET_RESULT_REAL"]
+
+
+def _inputs_at(table) -> dict[str, float]:
+    """Values of the inputs away from their starts (parameters stay at theirs): an angle
+    turned, a position moved a little, a rate or a load made non-zero."""
+    values = {}
+    inputs = [v for v in _block_inputs(table) if v.causality == "input"]
+    for k, v in enumerate(inputs):
+        start = float(v.start)
+        if v.lives.target == "FMU_TARGET_INPUT_ANGLE":
+            values[v.name] = start + 0.7 + 0.37 * k
+        elif v.unit == "m":
+            values[v.name] = start + 0.01 * (k + 1)
+        else:
+            values[v.name] = start + (1.0 + 0.5 * k) * {"N": 100.0, "N.m": 10.0}.get(v.unit, 1.0)
+    return values
+
+
+def _main_c(table, values: dict[str, float], derivative: bool) -> str:
+    """A program that fills the input block (the parameters at their starts), evaluates,
+    prints every Real output and, with `derivative`, the rates along the first input."""
+    ident = table.identifier
+    lines = ["#include <stdio.h>", "#include <string.h>", f'#include "{ident}_scene.h"', ""]
+    lines += ["int main(void)", "{", f"    {ident}_input in;", f"    {ident}_output out;"]
+    lines.append("    fmu_evaluation evaluation;")
+    if derivative:
+        lines += [f"    {ident}_input seed;", f"    {ident}_output rate;"]
+        lines.append("    memset(&seed, 0, sizeof seed);")
+    for v in _block_inputs(table):
+        value = repr(values.get(v.name, float(v.start)))
+        if v.lives.target == "FMU_TARGET_INPUT_ANGLE":
+            value = f"dyad_dir_from_angle({value})"
+        lines.append(f"    in.{v.lives.path} = {value};")
+    call = f"{ident}_evaluate(&in, &out, &evaluation);"
+    if derivative:
+        first = next(v for v in _block_inputs(table) if v.name == next(iter(values)))
+        m = first.lives.path
+        if first.lives.target == "FMU_TARGET_INPUT_ANGLE":
+            lines.append(f"    seed.{m} = dyad_vec2_make(-in.{m}.y, in.{m}.x);")
+        else:
+            lines.append(f"    seed.{m} = 1.0;")
+        call = f"{ident}_derivative(&in, &seed, &out, &rate, &evaluation);"
+    lines += [f"    {call}", '    printf("status %d %d\\n", (int)evaluation.status, out.status);']
+    for v in _outputs(table):
+        lines.append(f'    printf("out {v.name} %.17g\\n", out.{v.lives.path});')
+        if derivative:
+            lines.append(f'    printf("rate {v.name} %.17g\\n", rate.{v.lives.path});')
+    return "\n".join(lines + ["    return 0;", "}", ""])
+
+
+def _printed(text: str) -> dict[str, float]:
+    found = {}
+    for line in text.splitlines():
+        kind, name, value = line.split(" ", 2)
+        found[f"{kind} {name}"] = float(value) if kind != "status" else value
+    return found
+
+
+def _fmu_of_probe(table, tmp: Path) -> Path:
+    """The probe's FMI 2 FMU, compiled as CMake compiles an FMU from the C files its build
+    description lists (an undefined symbol fails the link)."""
+    from fmpy import __file__ as fmpy_init
+
+    gen = tmp / "generated"
+    pipeline.write_files(gen, pipeline.outputs_of(table))
+    places = (ROOT / "src", ROOT / "fmu", gen)
+    sources = [
+        next(p / f for p in places if (p / f).is_file()) for f in table.kind.source_files(table, 2)
+    ]
+    binary = tmp / "binaries" / "linux64" / f"{table.identifier}.so"
+    binary.parent.mkdir(parents=True)
+    includes = [ROOT / "src" / "include", ROOT / "src", ROOT / "fmu", gen]
+    includes.append(Path(fmpy_init).parent / "c-code")
+    _run(
+        "cc", *WARNINGS, "-fPIC", "-shared", "-fvisibility=hidden", "-Wl,--no-undefined",
+        f"-Wl,--version-script={ROOT / 'fmu' / 'exports.map'}", *[f"-I{i}" for i in includes],
+        *sources, "-o", binary, "-lm",
+    )  # fmt: skip
+    fmu = tmp / f"{table.identifier}_fmi2.fmu"
+    with zipfile.ZipFile(fmu, "w") as archive:
+        archive.write(gen / "fmi2" / "modelDescription.xml", "modelDescription.xml")
+        archive.write(binary, f"binaries/linux64/{table.identifier}.so")
+    return fmu
+
+
+@pytest.fixture(scope="module")
+def fmu_results(tmp_path_factory):
+    """Per scene: the FMU's outputs and their rates along the first input, at the inputs
+    of _inputs_at, keyed as the test's main prints them."""
+    cache: dict[str, dict] = {}
+
+    def results(name: str) -> dict[str, float]:
+        if name not in cache:
+            table = _table(name)
+            if name == "zqid":
+                path = _fmu_of_probe(table, tmp_path_factory.mktemp("probe_fmu"))
+            else:
+                path = paths.built_fmu(name, 2, None, how="scripts/run-tests")
+            cache[name] = _fmu_at(path, table)
+        return cache[name]
+
+    return results
+
+
+def _fmu_at(path: Path, table) -> dict[str, float]:
+    values = _inputs_at(table)
+    outputs = tuple(v.name for v in _outputs(table))
+    slave = Slave(path, instance_name=table.identifier)
+    try:
+        slave.initialize()
+        slave.set(tuple(values), list(values.values()))
+        slave.do_step(0.0, 1e-3)
+        assert slave.get_status() == 0, "the FMU has no answer at the test's inputs"
+        found = dict(zip((f"out {n}" for n in outputs), slave.get(outputs), strict=True))
+        rates = slave.directional_derivative(outputs, (next(iter(values)),), [1.0])
+        found.update(zip((f"rate {n}" for n in outputs), rates, strict=True))
+    finally:
+        slave.close()
+    return found
+
+
+# ---------------------------------------------------------------------------
+# The bundles
+# ---------------------------------------------------------------------------
+def _scene_tool(*args: object) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, str(SCENE_TOOL), *map(str, args)], capture_output=True, text=True
+    )
+
+
+@pytest.fixture(scope="module")
+def bundle(tmp_path_factory):
+    """The bundle of a scene, with or without derivatives, written by scene.py --bundle and
+    then copied to a folder of its own (so that no path leads back to the checkout)."""
+    cache: dict[tuple, Path] = {}
+
+    def make(name: str, derivatives: bool) -> Path:
+        if (name, derivatives) not in cache:
+            out = tmp_path_factory.mktemp("written")
+            extra = ["--with-derivatives"] if derivatives else []
+            done = _scene_tool(SCENES[name], "--bundle", out, *extra)
+            assert done.returncode == 0, done.stderr
+            ident = _table(name).identifier
+            assert done.stdout.strip() == str(out / ident)
+            alone = tmp_path_factory.mktemp("alone") / ident
+            shutil.copytree(out / ident, alone)
+            cache[name, derivatives] = alone
+        return cache[name, derivatives]
+
+    return make
+
+
+def _compile(folder: Path, table, flags: list[str], work: Path, derivative: bool) -> Path:
+    """The test's main on the bundle's scene/ and core/src/, compiled alone and linked."""
+    work.mkdir(parents=True, exist_ok=True)
+    (work / "main.c").write_text(_main_c(table, _inputs_at(table), derivative))
+    sources = sorted(folder.glob("scene/*.c")) + sorted(folder.glob("core/src/*.c"))
+    objects = []
+    for source in [work / "main.c", *sources]:
+        objects.append(work / f"{source.stem}.o")
+        _run(
+            "cc", *WARNINGS, *flags, f"-I{folder / 'scene'}", f"-I{folder / 'core' / 'include'}",
+            "-c", source, "-o", objects[-1],
+        )  # fmt: skip
+    _run("cc", "-o", work / "main", *objects, "-lm")
+    return work / "main"
+
+
+def _symbols(program: Path) -> list[str]:
+    return [line.split()[-1] for line in _run("nm", program).splitlines() if line.split()]
+
+
+def _derivative_symbols(program: Path) -> list[str]:
+    return [n for n in _symbols(program) if DERIVATIVE_SYMBOL.search(n)]
+
+
+def _agree(found: dict, expected: dict, kinds: tuple, table, tolerance: float) -> None:
+    """Every printed value of `kinds` within `tolerance` of the largest of its unit."""
+    unit = {v.name: v.unit for v in _outputs(table)}
+    for kind in kinds:
+        keys = [k for k in expected if k.startswith(kind + " ")]
+        scale: dict[str, float] = {}
+        for k in keys:
+            u = unit[k.split(" ", 1)[1]]
+            scale[u] = max(scale.get(u, 0.0), abs(expected[k]))
+        for k in keys:
+            limit = tolerance * max(scale[unit[k.split(" ", 1)[1]]], 1e-30)
+            assert math.isfinite(found[k]) and abs(found[k] - expected[k]) <= limit, (
+                k, found[k], expected[k],
+            )  # fmt: skip
+
+
+# ---------------------------------------------------------------------------
+# The tests
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("derivatives", [False, True], ids=["evaluate", "derivatives"])
+@pytest.mark.parametrize("real", ["double", "float"])
+@pytest.mark.parametrize("name", list(SCENES))
+def test_the_bundle_compiles_alone_and_agrees_with_the_fmu(
+    name, real, derivatives, bundle, fmu_results, tmp_path
+):
+    required_tool("cc")
+    required_tool("nm")
+    table = _table(name)
+    folder = bundle(name, derivatives)
+    flags = [FLOAT] if real == "float" else []
+    program = _compile(folder, table, flags, tmp_path / "build", derivatives)
+    found = _printed(_run(program))
+    assert found["status 0"] == "0", found["status 0"]  # FMU_OK, out.status 0
+    tolerance = 1e-9 if real == "double" else 1e-3
+    kinds = ("out", "rate") if derivatives else ("out",)
+    _agree(found, fmu_results(name), kinds, table, tolerance)
+    symbols = _symbols(program)
+    derivative = [n for n in symbols if DERIVATIVE_SYMBOL.search(n)]
+    if derivatives:
+        assert f"{table.identifier}_derivative" in symbols
+        assert "dyad_react_tangent_of" in derivative and "dyad_force_size_rate" in derivative
+    else:
+        assert f"{table.identifier}_evaluate" in symbols and derivative == [], derivative
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_the_bundle_holds_exactly_the_files_evaluate_needs(name, bundle, tmp_path):
+    """Each core source of an evaluate-only bundle is needed (the link fails without it),
+    each header is included by a file of the bundle, nothing is a derivative's, and
+    --with-derivatives adds the scene's and the core's tangents and nothing else."""
+    required_tool("cc")
+    table = _table(name)
+    folder = bundle(name, False)
+    files = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()}
+    assert not [f for f in files if "tangent" in f], sorted(files)
+    ident = table.identifier
+    top = {"README.md", "CMakeLists.txt", "LICENSE", f"example/{ident}_example.c"}
+    scene = {f"scene/{ident}_scene.h", f"scene/{ident}_scene.c"}
+    assert top | scene <= files
+    texts = [(folder / f).read_text() for f in files if f.endswith((".c", ".h"))]
+    included = {Path(n).name for t in texts for n in re.findall(r'#include "([^"]+)"', t)}
+    headers = {Path(f).name for f in files if f.startswith("core/") and f.endswith(".h")}
+    assert headers <= included, sorted(headers - included)
+    program = _compile(folder, table, [], tmp_path / "all", derivative=False)
+    objects = sorted(program.parent.glob("dyad_*.o"))
+    assert objects and len(objects) == len(
+        [f for f in files if f.startswith("core/src/") and f.endswith(".c")]
+    )
+    for left_out in objects:
+        rest = [o for o in program.parent.glob("*.o") if o != left_out]
+        done = subprocess.run(
+            ["cc", "-o", tmp_path / "x", *rest, "-lm"], capture_output=True, text=True
+        )
+        assert done.returncode != 0 and "undefined reference" in done.stderr, left_out.name
+    with_derivatives = bundle(name, True)
+    more = {
+        p.relative_to(with_derivatives).as_posix()
+        for p in with_derivatives.rglob("*")
+        if p.is_file()
+    }
+    added = more - files
+    assert f"scene/{ident}_scene_tangent.c" in added and "core/src/dyad_tangent.c" in added
+    assert all("tangent" in f for f in added), sorted(added)
+    assert files - more == set()
+
+
+def test_the_bundle_builds_with_its_own_cmakelists(bundle, fmu_results, tmp_path):
+    """cmake on the bundle alone, in float: its example runs and prints the shaper's
+    outputs at the scene's start values, as the FMU gives them there."""
+    required_tool("cmake")
+    folder = bundle("shaper", True)
+    build = tmp_path / "build"
+    _run("cmake", "-S", folder, "-B", build, "-DDYADFMU_FLOAT=ON", "-DCMAKE_BUILD_TYPE=Release")
+    _run("cmake", "--build", build)
+    printed = _run(build / "shaper_example")
+    torque = float(re.search(r"^crank\.torque +(\S+) N\.m$", printed, re.M).group(1))
+    slave = Slave(paths.built_fmu("shaper", 2, None, how="scripts/run-tests"))
+    try:
+        slave.initialize()
+        slave.do_step(0.0, 1e-3)
+        expected = slave.get("crank.torque")
+    finally:
+        slave.close()
+    assert expected != 0 and abs(torque - expected) <= 1e-4 * abs(expected), (torque, expected)
+    assert re.search(r"^d/d crank\.angle$", printed, re.M)
+    assert _derivative_symbols(build / "shaper_example")
+
+
+@pytest.fixture(scope="module")
+def prefix(tmp_path_factory):
+    """The core configured, built and installed alone into <tmp>/prefix (as
+    scripts/tests/test_install.py installs it)."""
+    required_tool("cmake")
+    tmp = tmp_path_factory.mktemp("install")
+    options = ["-DDYADFMU_BUILD_FMUS=OFF", "-DDYADFMU_BUILD_TESTS=OFF", "-DDYADFMU_BUILD_BENCH=OFF"]
+    _run("cmake", "-S", ROOT, "-B", tmp / "build", "-DCMAKE_BUILD_TYPE=Release", *options)
+    _run("cmake", "--build", tmp / "build", "-j", str(os.cpu_count() or 2))
+    _run("cmake", "--install", tmp / "build", "--prefix", tmp / "prefix")
+    return tmp / "prefix"
+
+
+@pytest.mark.parametrize("real", ["double", "float"])
+@pytest.mark.parametrize("name", ["shaper", "zqid"])
+def test_the_scene_builds_on_the_installed_core(name, real, prefix, bundle, fmu_results, tmp_path):
+    """scene/ of the bundle with the installed headers and static library instead of core/:
+    the same outputs as the FMU, and nothing of the derivative linked."""
+    required_tool("nm")
+    table = _table(name)
+    folder = bundle(name, False)
+    lib = next(p for p in prefix.iterdir() if p.name.startswith("lib"))
+    flags, library = ([FLOAT], "libdyadfmu_float.a") if real == "float" else ([], "libdyadfmu.a")
+    (tmp_path / "main.c").write_text(_main_c(table, _inputs_at(table), derivative=False))
+    program = tmp_path / "main"
+    _run(
+        "cc", *WARNINGS, *flags, f"-I{folder / 'scene'}", f"-I{prefix / 'include'}", "-o", program,
+        tmp_path / "main.c", *sorted(folder.glob("scene/*.c")), lib / library, "-lm",
+    )  # fmt: skip
+    found = _printed(_run(program))
+    assert found["status 0"] == "0"
+    _agree(found, fmu_results(name), ("out",), table, 1e-9 if real == "double" else 1e-3)
+    assert _derivative_symbols(program) == []
+
+
+def test_the_bundles_cmakelists_builds_on_the_installed_core(prefix, bundle, tmp_path):
+    required_tool("cmake")
+    folder = bundle("shaper", True)
+    build = tmp_path / "build"
+    _run(
+        "cmake", "-S", folder, "-B", build, "-DDYADFMU_INSTALLED_CORE=ON",
+        f"-DCMAKE_PREFIX_PATH={prefix}",
+    )  # fmt: skip
+    _run("cmake", "--build", build)
+    assert f"dyadfmu_DIR:PATH={prefix}" in (build / "CMakeCache.txt").read_text()
+    assert not list(build.rglob("*shaper_core*")), "the bundled core was built too"
+    assert "crank.torque" in _run(build / "shaper_example")
+
+
+def _text_sizes(readme: str) -> dict[str, tuple[int, int]]:
+    rows = re.findall(r"^\| (double|float) \| (\d+) \| (\d+) \|$", readme, re.M)
+    return {real: (int(objects), int(linked)) for real, objects, linked in rows}
+
+
+def test_build_scene_writes_the_bundle_and_measures_its_size(tmp_path):
+    """scripts/build-scene --bundle: the folder DIR/<id>/, the README with the example's
+    size in double and float, the derivative's code adding to it; written again, an
+    earlier bundle is replaced (no tangent file left from the one before)."""
+    required_tool("cc")
+    required_tool("size")
+    out = tmp_path / "bundles"
+    sizes = {}
+    for extra in (["--with-derivatives"], []):
+        done = subprocess.run(
+            [str(BUILD_SCENE), "--bundle", str(out), *extra, str(SCENES["shaper"])],
+            capture_output=True, text=True, check=False,
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr[-3000:]
+        assert done.stdout.splitlines()[-1] == str(out / "shaper")
+        readme = (out / "shaper" / "README.md").read_text()
+        sizes[bool(extra)] = _text_sizes(readme)
+        assert set(sizes[bool(extra)]) == {"double", "float"}, readme[-1500:]
+        assert ("shaper_derivative`: the" in readme) == bool(extra)
+    assert not list(out.rglob("*tangent*"))
+    for real in ("double", "float"):
+        evaluate, derivatives = sizes[False][real], sizes[True][real]
+        assert 0 < evaluate[0] < evaluate[1] and derivatives[1] > evaluate[1] + 20000, sizes
+
+
+def test_bundle_options_are_checked(tmp_path):
+    generic = SCENES_DIR / "dyad_rrt.toml"
+    done = _scene_tool(generic, "--bundle", tmp_path)
+    assert done.returncode == 1
+    assert "realisation generic" in done.stderr and "dyad_solve_rrt" in done.stderr
+    done = _scene_tool(SCENES["shaper"], "--check", "--with-derivatives")
+    assert done.returncode == 2 and "--with-derivatives is an option of --bundle" in done.stderr
+    (tmp_path / "shaper").mkdir()
+    (tmp_path / "shaper" / "notes.txt").write_text("mine\n")
+    done = _scene_tool(SCENES["shaper"], "--bundle", tmp_path)
+    assert done.returncode == 2 and "holds no bundle" in done.stderr
+    assert (tmp_path / "shaper" / "notes.txt").read_text() == "mine\n"
+    assert "--bundle DIR" in _scene_tool("--help").stdout
+    help_text = _run(BUILD_SCENE, "--help")
+    assert "--bundle DIR" in help_text and "--with-derivatives" in help_text
+    done = subprocess.run(
+        [str(BUILD_SCENE), "--with-derivatives", str(SCENES["shaper"])],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert done.returncode == 2 and "--with-derivatives is an option of --bundle" in done.stderr
