@@ -1,14 +1,14 @@
-"""The README says what the build does: its counts, example messages and commands are
-checked against the build and the tools, so that a change that makes one untrue fails
-here instead of misleading a user.
+"""The documentation says what the build does: its counts, example messages and commands
+are checked against the build and the tools, so that a change that makes one untrue fails
+here instead of misleading a user (test_docs.py runs the examples and checks the links).
 
-- the number of variables of the generic dyad FMUs;
-- every example error of the scene checker (``error: FILE.toml:LINE: ...``), which the
-  checker must print word for word for the malformed scene of that name;
-- the example scene ``my_press.toml``: its inputs, parameters and outputs;
+- README.md is a front door: at most 250 lines, and every user task of its table is one
+  click from the top;
+- every example error of the scene checker (``error: FILE.toml:LINE: ...``) in any
+  document is what the checker prints word for word for the malformed scene of that name;
 - every command shown in a code block that runs a file of the checkout: the file exists
   and is executable, or is run through the venv's Python;
-- the Windows comparison's counts of FMUs, models and outputs.
+- the Windows comparison's count of FMUs (fmu/README.md).
 """
 
 from __future__ import annotations
@@ -22,23 +22,37 @@ from pathlib import Path
 import pytest
 from dyadfmu import paths
 from dyadfmu.cosim import importers
-from fmpy import read_model_description
+from test_docs import DOCUMENTS, anchors, links
 
 ROOT = paths.ROOT
-DOCUMENTS = [
-    ROOT / "README.md",
-    ROOT / "modelDescription" / "scenes" / "README.md",
-    ROOT / "modelDescription" / "scenes" / "studies" / "README.md",
-]
-TYPES = ("rrr", "rrt", "rtr", "trt", "rtt")
+README = ROOT / "README.md"
 
 
-def _text(path: Path = ROOT / "README.md") -> str:
+def _text(path: Path = README) -> str:
     return path.read_text(encoding="utf-8")
 
 
 def _code_blocks(text: str) -> list[str]:
-    return re.findall(r"^```[a-z]*\n(.*?)^```", text, re.S | re.M)
+    """The shell blocks: what a reader types (other blocks show output, files, C)."""
+    return re.findall(r"^```(?:sh|bash)\n(.*?)^```", text, re.S | re.M)
+
+
+def test_the_readme_is_a_front_door():
+    """At most 250 lines; its table of tasks leads in one click to a section of its own
+    that shows a complete example or links to the reference that has one."""
+    text = _text()
+    assert len(text.splitlines()) <= 250
+    table = text[text.index("## Where to start") :].split("\n## ", 1)[0]
+    targets = re.findall(r"\]\(#([^)]+)\)", table)
+    assert len(targets) >= 6, targets
+    own = anchors(README)
+    for target in targets:
+        assert target in own, target
+    blocks = len(re.findall(r"^<!-- example -->$", text, re.M))
+    assert blocks >= 4, "the front door shows tested examples"
+    for _, target in links(README):
+        if not re.match(r"^[a-z]+:", target):
+            assert (ROOT / target.partition("#")[0]).exists() or target.startswith("#"), target
 
 
 def _check_scene(path: Path) -> subprocess.CompletedProcess:
@@ -47,25 +61,6 @@ def _check_scene(path: Path) -> subprocess.CompletedProcess:
         capture_output=True,
         text=True,
     )
-
-
-def _built(name: str) -> Path:
-    path = paths.build_dir() / "fmus" / f"{name}.fmu"
-    if not path.is_file():
-        pytest.fail(f"{path} is missing: build the FMUs first (scripts/run-tests does)")
-    return path
-
-
-def test_the_generic_dyads_variable_counts():
-    said = re.search(r"carries every variable of its type: (\d+) to (\d+) of them", _text())
-    assert said, "the README no longer states the generic dyads' variable counts"
-    counts = [
-        len(read_model_description(str(_built(f"dyad_{t}_fmi2"))).modelVariables) for t in TYPES
-    ]
-    assert (int(said.group(1)), int(said.group(2))) == (min(counts), max(counts)), counts
-    for t in TYPES:  # FMI 3 adds the independent variable time
-        md3 = read_model_description(str(_built(f"dyad_{t}_fmi3")))
-        assert len(md3.modelVariables) == counts[TYPES.index(t)] + 1
 
 
 def _example_errors() -> list[tuple[str, str]]:
@@ -85,27 +80,6 @@ def test_an_example_error_is_what_the_checker_prints(file, line):
     assert line in done.stderr.splitlines(), done.stderr
 
 
-def test_the_example_scene_has_the_variables_the_readme_names(tmp_path):
-    text = _text()
-    scene = re.search(r"cat > my_press\.toml <<'TOML'\n(.*?)\nTOML\n", text, re.S)
-    assert scene, "the README no longer has the my_press example"
-    path = tmp_path / "my_press.toml"
-    path.write_text(scene.group(1) + "\n")
-    done = _check_scene(path)
-    assert done.returncode == 0, done.stderr
-    counts = re.search(
-        r"(\d+) inputs?, (\d+) parameters?, (\d+) outputs?", done.stdout + done.stderr
-    )
-    said = re.search(
-        r"(\d+) inputs \(.*?\),\s+(no|\d+)\s+parameters?\b.*?,\s+and\s+(\d+)\s+outputs",
-        text,
-        re.S,
-    )
-    assert counts and said
-    stated = tuple(0 if g == "no" else int(g) for g in said.groups())
-    assert tuple(map(int, counts.groups())) == stated
-
-
 def _commands() -> list[tuple[str, str]]:
     commands = []
     for document in DOCUMENTS:
@@ -114,7 +88,7 @@ def _commands() -> list[tuple[str, str]]:
                 line = line.removeprefix("$ ").strip()
                 first = line.split(" ", 1)[0]
                 if first.startswith(("scripts/", "modelDescription/", ".venv/bin/")):
-                    commands.append((document.name, line))
+                    commands.append((str(document.relative_to(ROOT)), line))
     return commands
 
 
@@ -124,7 +98,7 @@ def test_a_command_shown_runs_a_file_that_exists(document, command):
     program = ROOT / words[0]
     if words[0].startswith(".venv/bin/"):
         name = words[0].removeprefix(".venv/bin/")
-        assert name in ("python", "pip", "dyadfmu", "fmpy"), f"{document}: {command}"
+        assert name in ("python", "pip", "dyadfmu", "fmpy", "fmutool"), f"{document}: {command}"
         if name == "python" and len(words) > 1 and not words[1].startswith("-"):
             assert (ROOT / words[1]).is_file(), f"{document}: {command}"
         return
@@ -133,18 +107,9 @@ def test_a_command_shown_runs_a_file_that_exists(document, command):
 
 
 def test_the_windows_comparison_counts():
+    """fmu/README.md's count of the FMUs the Windows comparison covers is the importers'."""
     said = re.search(
-        r"all (\d+) FMUs \((\d+) models, FMI 2 and 3; (\d+) outputs\)", " ".join(_text().split())
+        r"all (\d+) FMUs it covers", " ".join(_text(ROOT / "fmu" / "README.md").split())
     )
-    assert said, "the README no longer states the Windows comparison's counts"
-    names = importers.fmu_names()
-    outputs = 0
-    for name in names:
-        for version in importers.VERSIONS:
-            md = read_model_description(str(_built(f"{name}_fmi{version}")))
-            outputs += sum(
-                1
-                for v in md.modelVariables
-                if v.causality == "output" and v.type in ("Real", "Float64")
-            )
-    assert tuple(map(int, said.groups())) == (2 * len(names), len(names), outputs)
+    assert said, "fmu/README.md no longer states the Windows comparison's count"
+    assert int(said.group(1)) == 2 * len(importers.fmu_names())

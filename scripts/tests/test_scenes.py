@@ -429,20 +429,6 @@ def test_tailored_fmu_rejects_a_bad_value_by_name(version, tmp_path):
     assert s.status() == 0
 
 
-def test_the_readme_scene_builds_as_described(tmp_path):
-    """The README's two-command example: the scene in it is valid and has the variables
-    the README says."""
-    readme = (ROOT / "README.md").read_text()
-    found = re.search(r"cat > my_press.toml <<'TOML'\n(.*?)\nTOML\n", readme, re.S)
-    assert found, "the README lost its scene example"
-    scene = tmp_path / "my_press.toml"
-    scene.write_text(found.group(1) + "\n")
-    done = run_tool(scene, "--check")
-    assert done.returncode == 0, done.stderr
-    assert "3 inputs, 1 parameter, 4 outputs" in done.stdout
-    assert "scripts/build-scene my_press.toml" in readme
-
-
 @pytest.mark.parametrize("version", VERSIONS)
 @pytest.mark.parametrize("dyad", ("rrr", "rrt", "rtr", "trt", "rtt"))
 def test_generated_code_agrees_with_the_generic_fmu(dyad, version, tmp_path):
