@@ -105,6 +105,8 @@ class Kind(Structs):
     label = ""
     #: The headers its variable table (<identifier>_model.c) includes beyond its own.
     model_includes: tuple = ()
+    #: The command that generates its files from its table (named in their comments).
+    tool = "modelDescription/scene.py"
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The C files an importer compiles to rebuild the FMI `version` binary."""
@@ -115,8 +117,9 @@ class Kind(Structs):
         raise NotImplementedError
 
     def table_source(self, table: Table) -> str:
-        """Where the table comes from, for the C variable table's comment."""
-        return f"modelDescription/{table.path.name}"
+        """Where the table comes from, for the C variable table's comment: a scene file
+        (a generic dyad's is modelDescription/scenes/dyad_<type>.toml)."""
+        return f"scene {table.path.name}"
 
     def model_data(self, table: Table) -> tuple[list[str], str]:
         """The C lines of the model data the behaviour needs, and its address."""
@@ -261,6 +264,8 @@ class DyadKind(Kind):
 
 class DriveKind(Kind):
     """The crank drive (fmu/models/fmu_drive.c), from its table interface/drive.toml."""
+
+    tool = "modelDescription/generate.py"
 
     log_categories = DRIVE_LOG_CATEGORIES
 
