@@ -262,9 +262,10 @@ dyadfmu_job() {
 }
 
 # dyadfmu_job_wait JOB: waits for a background job and shows its log; if it failed, the
-# shell exits with its status.
+# shell exits with its status. Nothing to do for a job already collected.
 dyadfmu_job_wait() {
     local job=$1 rc
+    [ -n "${DYADFMU_JOBS[$job]:-}" ] || return 0
     set +e
     wait "${DYADFMU_JOBS[$job]}"
     rc=$?
