@@ -287,14 +287,20 @@ dyadfmu_jobs_collect() {   # waits for the background jobs that have already end
     done
 }
 
-# dyadfmu_stages_summary: (the EXIT trap) ends the background jobs still running, then
-# prints each stage's start, wall and CPU seconds and result, and the run's totals.
+# dyadfmu_stages_summary: (the EXIT trap) ends the background jobs still running, shows the
+# log of one that has failed too, then prints each stage's start, wall and CPU seconds and
+# result, and the run's totals.
 dyadfmu_stages_summary() {
     local rc=$? job name t0 end load1
     for job in "${!DYADFMU_JOBS[@]}"; do
-        dyadfmu_log "stopping background job $job (log: $DYADFMU_STAGES/$job.log)"
-        kill -TERM -- "-${DYADFMU_JOBS[$job]}" 2>/dev/null || true
-        wait "${DYADFMU_JOBS[$job]}" 2>/dev/null || true
+        if kill -0 "${DYADFMU_JOBS[$job]}" 2>/dev/null; then
+            dyadfmu_log "stopping background job $job (log: $DYADFMU_STAGES/$job.log)"
+            kill -TERM -- "-${DYADFMU_JOBS[$job]}" 2>/dev/null || true
+            wait "${DYADFMU_JOBS[$job]}" 2>/dev/null || true
+        elif ! wait "${DYADFMU_JOBS[$job]}"; then
+            dyadfmu_log "job $job failed too; its log:"
+            cat "$DYADFMU_STAGES/$job.log" >&2
+        fi
     done
     dyadfmu_cpu_ticks
     read -r load1 _ </proc/loadavg

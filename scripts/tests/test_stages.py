@@ -108,19 +108,21 @@ def test_a_failed_background_job_fails_the_run_with_its_log_shown(tmp_path):
     assert rows["total"][3] == "FAILED: second"
 
 
-def test_a_run_that_stops_ends_the_jobs_still_running(tmp_path):
+def test_a_run_that_stops_ends_the_jobs_still_running_and_shows_a_failed_ones_log(tmp_path):
     pid_file = tmp_path / "sleeper.pid"
     done, rows = _run(
         tmp_path,
         f"""
         sleeper() {{ sleep 60 & echo $! > "{pid_file}"; wait; }}
         dyadfmu_job slow dyadfmu_stage sleeper sleeper
+        dyadfmu_job failing dyadfmu_stage early sh -c 'echo why the job failed; exit 5'
         while [ ! -s "{pid_file}" ]; do sleep 0.05; done
-        dyadfmu_stage broken sh -c 'exit 4'
+        dyadfmu_stage broken sh -c 'sleep 0.5; exit 4'
         """,
     )
     assert done.returncode == 4
-    assert rows["sleeper"][3] == "stopped (the run ended)"
+    assert "job failing failed too; its log:\n== stage early\nwhy the job failed\n" in done.stderr
+    assert rows["sleeper"][3] == "stopped (the run ended)" and rows["early"][3] == "FAILED (exit 5)"
     assert rows["broken"][3] == "FAILED (exit 4)"
     assert float(rows["total"][1]) < 30
     assert not _alive(int(pid_file.read_text()))
