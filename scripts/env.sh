@@ -136,15 +136,29 @@ dyadfmu_fmi_sim_installed() {   # the version of the fmi-sim at $1, or nothing
     RUST_BACKTRACE=0 "$1" --version 2>&1 | sed -n 's/.*fmi-sim \([0-9][0-9.]*\).*/\1/p' | head -n 1
 }
 
-dyadfmu_ensure_fmi_sim() {
-    local want root bin cargo missing=()
+dyadfmu_fmi_sim_bin() {   # where cargo install puts fmi-sim
+    printf '%s/bin/fmi-sim\n' "${CARGO_INSTALL_ROOT:-${CARGO_HOME:-$HOME/.cargo}}"
+}
+
+# dyadfmu_fmi_sim_found: exports DYADFMU_FMI_SIM if the pinned fmi-sim is installed (after
+# dyadfmu_ensure_fmi_sim ran in a subshell, whose export the caller does not see).
+dyadfmu_fmi_sim_found() {
+    local want bin
     want=$(dyadfmu_fmi_sim_pin)
-    root=${CARGO_INSTALL_ROOT:-${CARGO_HOME:-$HOME/.cargo}}
-    bin="$root/bin/fmi-sim"
+    bin=$(dyadfmu_fmi_sim_bin)
     if [ -n "$want" ] && [ "$(dyadfmu_fmi_sim_installed "$bin")" = "$want" ]; then
         export DYADFMU_FMI_SIM="$bin"
         return 0
     fi
+    return 1
+}
+
+dyadfmu_ensure_fmi_sim() {
+    local want root bin cargo missing=()
+    dyadfmu_fmi_sim_found && return 0
+    want=$(dyadfmu_fmi_sim_pin)
+    root=${CARGO_INSTALL_ROOT:-${CARGO_HOME:-$HOME/.cargo}}
+    bin=$(dyadfmu_fmi_sim_bin)
     cargo=$(command -v cargo 2>/dev/null || true)
     if [ -z "$cargo" ] && [ -x "${CARGO_HOME:-$HOME/.cargo}/bin/cargo" ]; then
         cargo="${CARGO_HOME:-$HOME/.cargo}/bin/cargo"
@@ -169,4 +183,135 @@ dyadfmu_ensure_fmi_sim() {
         return
     fi
     export DYADFMU_FMI_SIM="$bin"
+}
+
+# ---- timed stages (scripts/run-tests) ------------------------------------------------
+# A stage is one named step of a run, executed in a subshell with `set -e`. Its start, its
+# end, its CPU time (user + system of the subshell and of every process it waited for, read
+# from /proc, so that a stage in the background counts only its own processes) and its exit
+# status go to files in $DYADFMU_STAGES: a stage run inside a background job reports as
+# one in the foreground does. At exit, the run prints them as a table.
+
+# dyadfmu_stages_init DIR: starts the clock, empties DIR (the stages' records and the logs of
+# background jobs) and prints the table of stages when the shell exits.
+dyadfmu_stages_init() {
+    DYADFMU_STAGES=$1
+    DYADFMU_STAGES_T0=$EPOCHREALTIME
+    DYADFMU_STAGES_SHELL=$BASHPID
+    read -r DYADFMU_STAGES_LOAD0 _ </proc/loadavg
+    declare -gA DYADFMU_JOBS=()
+    rm -rf "$DYADFMU_STAGES"
+    mkdir -p "$DYADFMU_STAGES"
+    trap dyadfmu_stages_summary EXIT
+}
+
+# dyadfmu_cpu_ticks: sets REPLY to the user + system clock ticks of this shell and of the
+# children it has waited for (/proc/PID/stat: utime, stime, cutime, cstime).
+dyadfmu_cpu_ticks() {
+    local stat fields
+    read -r stat <"/proc/$BASHPID/stat"
+    read -r -a fields <<<"${stat##*) }"
+    REPLY=$((fields[11] + fields[12] + fields[13] + fields[14]))
+}
+
+_dyadfmu_stage_end() {   # in the stage's subshell, at its exit: end time, CPU, status (or stopped)
+    local rc=$1
+    dyadfmu_cpu_ticks
+    printf '%s %s %s\n' "$EPOCHREALTIME" "$REPLY" "$rc" >"$DYADFMU_STAGES/$DYADFMU_STAGE.end"
+}
+
+# dyadfmu_stage NAME COMMAND...: runs COMMAND (a function or program) as stage NAME; if it
+# fails, the shell exits with its status. In the run's own shell, a background job that has
+# ended is collected first (dyadfmu_job_wait), so that its failure stops the run early.
+dyadfmu_stage() {
+    local name=$1 rc
+    shift
+    printf '%s\n' "$EPOCHREALTIME" >"$DYADFMU_STAGES/$name.start"
+    dyadfmu_log "stage $name"
+    set +e
+    (
+        set -e
+        DYADFMU_STAGE=$name
+        trap '_dyadfmu_stage_end $?' EXIT
+        trap 'trap - EXIT; _dyadfmu_stage_end stopped; exit 143' TERM
+        "$@"
+    )
+    rc=$?
+    set -e
+    if [ "$rc" -ne 0 ]; then
+        dyadfmu_log "stage $name failed (exit $rc)"
+        exit "$rc"
+    fi
+    [ "$BASHPID" != "$DYADFMU_STAGES_SHELL" ] || dyadfmu_jobs_collect
+}
+
+# dyadfmu_job JOB COMMAND...: runs COMMAND (usually one or more dyadfmu_stage calls) in the
+# background, in its own process group (so that a run that stops ends all of it), its
+# output to $DYADFMU_STAGES/JOB.log.
+dyadfmu_job() {
+    local job=$1
+    shift
+    dyadfmu_log "job $job started in the background (log: $DYADFMU_STAGES/$job.log)"
+    set -m
+    (
+        set -e
+        "$@"
+    ) >"$DYADFMU_STAGES/$job.log" 2>&1 </dev/null &
+    DYADFMU_JOBS[$job]=$!
+    set +m
+}
+
+# dyadfmu_job_wait JOB: waits for a background job and shows its log; if it failed, the
+# shell exits with its status. Nothing to do for a job already collected.
+dyadfmu_job_wait() {
+    local job=$1 rc
+    [ -n "${DYADFMU_JOBS[$job]:-}" ] || return 0
+    set +e
+    wait "${DYADFMU_JOBS[$job]}"
+    rc=$?
+    set -e
+    unset "DYADFMU_JOBS[$job]"
+    if [ "$rc" -ne 0 ]; then
+        dyadfmu_log "job $job failed (exit $rc); its log:"
+        cat "$DYADFMU_STAGES/$job.log" >&2
+        exit "$rc"
+    fi
+    dyadfmu_log "job $job done; its log:"
+    sed 's/^/  | /' "$DYADFMU_STAGES/$job.log"
+}
+
+dyadfmu_jobs_collect() {   # waits for the background jobs that have already ended
+    local job
+    for job in "${!DYADFMU_JOBS[@]}"; do
+        kill -0 "${DYADFMU_JOBS[$job]}" 2>/dev/null || dyadfmu_job_wait "$job"
+    done
+}
+
+# dyadfmu_stages_summary: (the EXIT trap) ends the background jobs still running, shows the
+# log of one that has failed too, then prints each stage's start, wall and CPU seconds and
+# result, and the run's totals.
+dyadfmu_stages_summary() {
+    local rc=$? job name t0 end load1
+    for job in "${!DYADFMU_JOBS[@]}"; do
+        if kill -0 "${DYADFMU_JOBS[$job]}" 2>/dev/null; then
+            dyadfmu_log "stopping background job $job (log: $DYADFMU_STAGES/$job.log)"
+            kill -TERM -- "-${DYADFMU_JOBS[$job]}" 2>/dev/null || true
+            wait "${DYADFMU_JOBS[$job]}" 2>/dev/null || true
+        elif ! wait "${DYADFMU_JOBS[$job]}"; then
+            dyadfmu_log "job $job failed too; its log:"
+            cat "$DYADFMU_STAGES/$job.log" >&2
+        fi
+    done
+    dyadfmu_cpu_ticks
+    read -r load1 _ </proc/loadavg
+    for name in "$DYADFMU_STAGES"/*.start; do
+        [ -f "$name" ] || continue
+        read -r t0 <"$name"
+        end="- - -"
+        [ -f "${name%.start}.end" ] && read -r end <"${name%.start}.end"
+        printf '%s %s %s\n' "$t0" "$(basename "$name" .start)" "$end"
+    done | sort -n | awk -v t0="$DYADFMU_STAGES_T0" -v t1="$EPOCHREALTIME" -v rc="$rc" \
+        -v hz="$(getconf CLK_TCK)" -v cpu="$REPLY" -v cores="$(nproc)" \
+        -v load0="$DYADFMU_STAGES_LOAD0" -v load1="$load1" -f "$DYADFMU_ROOT/scripts/stages.awk"
+    exit "$rc"
 }
