@@ -456,3 +456,41 @@ def test_bundle_options_are_checked(tmp_path):
         capture_output=True, text=True, check=False,
     )  # fmt: skip
     assert done.returncode == 2 and "--with-derivatives is an option of --bundle" in done.stderr
+
+
+def test_build_scene_refuses_an_identifier_twice(tmp_path):
+    """A scene with a built-in scene's identifier, or two given scenes with one, is refused
+    in one line before CMake would define their targets twice."""
+    press = SCENES_DIR / "press.toml"
+    mine = tmp_path / "my_press.toml"
+    mine.write_text(press.read_text())
+    done = subprocess.run(
+        [str(BUILD_SCENE), str(mine)], capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 1, done.stderr[-2000:]
+    assert "identifier 'press' names a built-in FMU" in done.stderr
+    other = tmp_path / "other.toml"
+    text = press.read_text().replace('identifier = "press"', 'identifier = "my_press"')
+    assert 'identifier = "my_press"' in text
+    mine.write_text(text)
+    other.write_text(text)
+    done = subprocess.run(
+        [str(BUILD_SCENE), str(mine), str(other)], capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert f"{other}: identifier 'my_press' is also that of {mine}" in done.stderr
+
+
+def test_build_scene_builds_a_built_in_scene():
+    """A built-in scene given to build-scene is built like any other (CMake has its targets
+    already: given again, they were defined twice)."""
+    required_tool("cmake")
+    done = subprocess.run(
+        [str(BUILD_SCENE), str(SCENES_DIR / "press.toml")],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    for version in (2, 3):
+        assert f"press_fmi{version}.fmu: 4 inputs, 1 parameter, 5 outputs; valid" in done.stdout
