@@ -17,6 +17,7 @@ C compiler (cc) in double and in float and its size goes into the README.
 from __future__ import annotations
 
 import datetime
+import os
 import platform
 import re
 import shutil
@@ -387,6 +388,15 @@ NOT_MEASURED = (
 # ---------------------------------------------------------------------------
 # Writing it
 # ---------------------------------------------------------------------------
+def _holds_something(folder: Path) -> bool:
+    """Whether `folder` holds a file or a link: empty folders, which a build tool makes
+    for the outputs it expects (Ninja does), count as nothing."""
+    for where, folders, files in os.walk(folder):
+        if files or any(os.path.islink(os.path.join(where, name)) for name in folders):
+            return True
+    return False
+
+
 def _clear(folder: Path) -> None:
     """Make way for a bundle in `folder`: nothing there, or an earlier bundle, whose
     entries go; BundleError for a folder that holds something else."""
@@ -396,7 +406,7 @@ def _clear(folder: Path) -> None:
         raise BundleError(f"{folder}: is a file, not a folder")
     mark = folder / "CMakeLists.txt"
     earlier = mark.is_file() and mark.read_text(encoding="utf-8").startswith(MARK)
-    if any(folder.iterdir()) and not earlier:
+    if _holds_something(folder) and not earlier:
         raise BundleError(
             f"{folder}: is not empty and holds no bundle (its CMakeLists.txt does not start "
             f"with '{MARK}'): give a new or empty folder"

@@ -448,6 +448,17 @@ def test_bundle_options_are_checked(tmp_path):
     done = _scene_tool(SCENES["shaper"], "--bundle", tmp_path)
     assert done.returncode == 2 and "holds no bundle" in done.stderr
     assert (tmp_path / "shaper" / "notes.txt").read_text() == "mine\n"
+    (tmp_path / "shaper" / "notes.txt").unlink()
+    (tmp_path / "shaper" / "scene").mkdir()
+    (tmp_path / "shaper" / "core" / "src").mkdir(parents=True)
+    (tmp_path / "shaper" / "core" / "src" / "link").symlink_to(tmp_path)
+    done = _scene_tool(SCENES["shaper"], "--bundle", tmp_path)
+    assert done.returncode == 2 and "holds no bundle" in done.stderr, "a link is something"
+    (tmp_path / "shaper" / "core" / "src" / "link").unlink()
+    # empty folders, as Ninja makes them for the outputs it expects, are nothing
+    done = _scene_tool(SCENES["shaper"], "--bundle", tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "shaper" / "scene" / "shaper_scene.c").is_file()
     assert "--bundle DIR" in _scene_tool("--help").stdout
     help_text = _run(BUILD_SCENE, "--help")
     assert "--bundle DIR" in help_text and "--with-derivatives" in help_text
