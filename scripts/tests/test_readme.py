@@ -113,3 +113,33 @@ def test_the_windows_comparison_counts():
     )
     assert said, "fmu/README.md no longer states the Windows comparison's count"
     assert int(said.group(1)) == 2 * len(importers.fmu_names())
+
+
+def _durations(text: str, about: str = "") -> set[tuple[float, str]]:
+    """Every duration a text gives after `about`: (number, 's' or 'min')."""
+    pattern = about + r"(\d+(?:\.\d+)?) ?(s|min|minutes?)\b"
+    found = re.findall(pattern, " ".join(text.split()), re.IGNORECASE)
+    return {(float(n), "s" if unit == "s" else "min") for n, unit in found}
+
+
+def _help(*command: str) -> str:
+    return subprocess.run(command, capture_output=True, text=True, check=True).stdout
+
+
+@pytest.mark.parametrize("name", ["study", "cosim"])
+def test_a_commands_time_is_the_same_wherever_it_is_given(name):
+    """The durations of run-study and run-cosim: scripts/README.md's table and 'dyadfmu
+    NAME --help' give those that the script's --help gives."""
+    script = _help(str(ROOT / "scripts" / f"run-{name}"), "--help")
+    given = _durations(script, "about ")
+    assert len(given) >= 3, script  # the full run, --quick, the build's check
+    row = next(
+        line
+        for line in _text(ROOT / "scripts" / "README.md").splitlines()
+        if line.startswith(f"| `scripts/run-{name}")
+    )
+    table = _durations(re.split(r"(?<!\\)\|", row)[4])
+    assert table and table <= given, (row, given)
+    command = _help(sys.executable, "-m", "dyadfmu", name, "--help")
+    stated = _durations(command, "about ")
+    assert stated and stated <= given, (command, given)

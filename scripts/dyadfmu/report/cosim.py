@@ -681,8 +681,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--quick",
         action="store_true",
-        help="steps 1e-2 and 1e-3 s, ratios 1 and 100, a looser reference (about 16 s of "
-        "CPU time; the full study about 2.6 minutes)",
+        help="steps 1e-2 and 1e-3 s, ratios 1 and 100, a looser reference (about 20 s of "
+        "CPU time; the full study about 3.3 minutes)",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out)")
     p.add_argument(
