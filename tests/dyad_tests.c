@@ -2649,6 +2649,8 @@ static int test_angle_pair_matches_single(void)
     return fails;
 }
 
+#include "dyad_cylinder_tests.h"
+
 static const named_test tests[] = {
     {"equilibrium_random", test_equilibrium_random},
     {"rrr_symmetric_truss", test_rrr_symmetric_truss},
@@ -2683,6 +2685,12 @@ static const named_test tests[] = {
     {"kin_invalid_pointers", test_kin_invalid_pointers},
     {"kin_point_on_link", test_kin_point_on_link},
     {"kin_names", test_kin_names},
+    {"cylinder_equilibrium", test_cylinder_equilibrium},
+    {"cylinder_kinematics", test_cylinder_kinematics},
+    {"cylinder_energy", test_cylinder_energy},
+    {"cylinder_tangent", test_cylinder_tangent},
+    {"cylinder_statuses", test_cylinder_statuses},
+    {"cylinder_invalid", test_cylinder_invalid},
 };
 
 int main(int argc, char** argv)
