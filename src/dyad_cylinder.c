@@ -65,8 +65,10 @@
  * what tests/dyad_tests.c checks on the outputs.
  *
  * Round-off. The motion is the RRR dyad's: within eps kin_amplification of
- * its largest output of each unit, kin_amplification = 1 + 1 / closure +
- * 1 / conditioning, closure = min(P, Q) / (r_B + s + L). The status is
+ * its largest output of each unit, kin_amplification = (1 + 1 / closure +
+ * 1 / conditioning) (1 + mount_amplification (1 + (|A|_1 + |O|_1) / size)),
+ * closure = min(P, Q) / size, size = r_B + s + L, the mounts' own round-off
+ * carried in as dyad_kin_generic.h does for the dyads. The status is
  * singular where 1 / kin_amplification falls below singular_threshold, which
  * with the default threshold comes before the motion (and the reactions built
  * on it) lose half their digits, and always before the triangle fails. The
@@ -117,6 +119,7 @@ static const char* const cylinder_field_names[DYAD_CYL_FIELD_COUNT] = {
     [DYAD_CYL_FIELD_LINK_MOMENT] = "link.moment",
     [DYAD_CYL_FIELD_GRAVITY] = "gravity",
     [DYAD_CYL_FIELD_SINGULAR_THRESHOLD] = "singular_threshold",
+    [DYAD_CYL_FIELD_MOUNT_AMPLIFICATION] = "mount_amplification",
 };
 
 dyad_cylinder_input dyad_cylinder_input_default(void)
@@ -194,6 +197,8 @@ dyad_cylinder_field dyad_cyl_first_bad_field(const dyad_cylinder_input* in)
            : !cyl_finite2(in->gravity)                    ? DYAD_CYL_FIELD_GRAVITY
            : !(in->singular_threshold > 0 && in->singular_threshold < 1)
                ? DYAD_CYL_FIELD_SINGULAR_THRESHOLD
+           : !(cyl_finite(in->mount_amplification) && in->mount_amplification >= 0)
+               ? DYAD_CYL_FIELD_MOUNT_AMPLIFICATION
                : DYAD_CYL_FIELD_NONE;
 }
 
@@ -290,13 +295,14 @@ typedef struct DYAD_KIN(cyl_in) {
     dyad_ks com_c, com_r;
     dyad_kv com_l;
     DYAD_KIN(cyl_body) barrel, rod, link;
+    dyad_ks mount_amp;
     dyad_real branch, threshold;
 } DYAD_KIN(cyl_in);
 
 /* What the formulas find. */
 typedef struct DYAD_KIN(cyl_state) {
     dyad_kin_failure failure;
-    dyad_ks gap, conditioning, closure, kin_amp, amp, den, r_b;
+    dyad_ks gap, conditioning, closure, size, kin_amp, amp, den, r_b;
     dyad_kv e, u, i_l;
     dyad_ks w_l, e_l, w_c, e_c;
     kin_motion b, s_c, s_r, s_l;
@@ -344,6 +350,7 @@ static void DYAD_KIN(cyl_load_input)(const dyad_cylinder_input* v, const dyad_cy
     in->link = DYAD_KIN(cyl_body_in)(v->link.mass, s->link.mass, v->link.inertia, s->link.inertia);
     in->link.force = kv_in(v->link.force, s->link.force);
     in->link.moment = ks_in(v->link.moment, s->link.moment);
+    in->mount_amp = ks_in(v->mount_amplification, s->mount_amplification);
     in->branch = (dyad_real)v->branch;
     in->threshold = v->singular_threshold;
 }
@@ -367,7 +374,8 @@ static dyad_kin_failure DYAD_KIN(cyl_position)(const DYAD_KIN(cyl_in) * in,
         st->gap = ks_neg(ks_val(far) < 0 ? far : near);
         return st->failure;
     }
-    st->closure = ks_div(ks_val(far) < ks_val(near) ? far : near, ks_add(reach, len));
+    st->size = ks_add(reach, len);
+    st->closure = ks_div(ks_val(far) < ks_val(near) ? far : near, st->size);
     if (ks_val(len) == 0) {
         st->conditioning = st->den = ks_c(0); /* A on O: B anywhere on its circle */
         return DYAD_KIN_CLOSES;
@@ -386,6 +394,19 @@ static dyad_kin_failure DYAD_KIN(cyl_position)(const DYAD_KIN(cyl_in) * in,
     st->den = ks_div(ks_mul(h, len), ks_mul(r, s)); /* e x u */
     st->conditioning = ks_abs(st->den);
     return DYAD_KIN_CLOSES;
+}
+
+/* The motion's round-off bound: the triangle's own, and the mounts' carried in,
+ * their positions' round-off (relative to their distance from the origin) taken
+ * relative to the triangle's size (dyad_kin_amplification does the same). */
+static dyad_ks DYAD_KIN(cyl_kin_amplification)(const DYAD_KIN(cyl_in) * in,
+                                               const DYAD_KIN(cyl_state) * st)
+{
+    const dyad_ks own =
+        ks_add(ks_add(ks_c(1), ks_div(ks_c(1), st->closure)), ks_div(ks_c(1), st->conditioning));
+    const dyad_ks far = ks_add(kv_norm1(in->a.pos), kv_norm1(in->o.pos));
+    const dyad_ks carried = ks_mul(in->mount_amp, ks_add(ks_c(1), ks_div(far, st->size)));
+    return ks_mul(own, ks_add(ks_c(1), carried));
 }
 
 /* B from O along the link and from A along the cylinder, with the rates in st. */
@@ -577,8 +598,7 @@ static dyad_status DYAD_KIN(cyl_run)(const dyad_cylinder_input* input,
         ks_put(st.gap, &value->gap, &rate->gap);
         return DYAD_STATUS_CANNOT_ASSEMBLE;
     }
-    st.kin_amp =
-        ks_add(ks_add(ks_c(1), ks_div(ks_c(1), st.closure)), ks_div(ks_c(1), st.conditioning));
+    st.kin_amp = DYAD_KIN(cyl_kin_amplification)(&in, &st);
     if (!(ks_val(st.kin_amp) * in.threshold <= 1)) {
         dyad_cyl_reject(value, rate, DYAD_STATUS_SINGULAR, DYAD_CYL_FIELD_NONE, 1);
         DYAD_KIN(cyl_put_figures)(&st, value, rate);

@@ -297,7 +297,7 @@ static int test_cylinder_energy(void)
     return fails;
 }
 
-#define CYL_OUTPUTS 37
+#define CYL_OUTPUTS 44
 
 static void cyl_outputs(const dyad_cylinder_result* r, double v[CYL_OUTPUTS])
 {
@@ -312,6 +312,9 @@ static void cyl_outputs(const dyad_cylinder_result* r, double v[CYL_OUTPUTS])
     v[n++] = r->cylinder_epsilon, v[n++] = r->axial_force, v[n++] = r->r_a.x, v[n++] = r->r_a.y;
     v[n++] = r->r_b.x, v[n++] = r->r_b.y, v[n++] = r->r_o.x, v[n++] = r->r_o.y;
     v[n++] = r->n_rod, v[n++] = r->m_rod;
+    v[n++] = r->link_dir.x, v[n++] = r->link_dir.y, v[n++] = r->axis.x, v[n++] = r->axis.y;
+    /* not the amplification: its data factor jumps where a largest output changes */
+    v[n++] = r->conditioning, v[n++] = r->closure, v[n++] = r->kin_amplification;
 }
 
 /* input + t seed, field by field (the seed has the input's layout; branch and
@@ -392,6 +395,8 @@ static int test_cylinder_tangent(void)
 
 static dyad_cylinder_input cyl_line_input;
 
+static int cyl_expect_invalid(const dyad_cylinder_input* in, dyad_cylinder_field field);
+
 /* O at the origin, A at (1, 0), B on the x axis of the link. */
 static dyad_status cyl_line(double s, double b_dist, dyad_cylinder_result* out)
 {
@@ -446,6 +451,23 @@ static int test_cylinder_statuses(void)
     }
     CHECK(cyl_line(0.9, 0.5, &out) == DYAD_STATUS_OK && out.conditioning > 0.3,
           "mid-stroke: %s, conditioning %g", dyad_status_name(out.status), out.conditioning);
+    {
+        /* the mounts' round-off carried in: |A|_1 + |O|_1 = 1, size 0.5 + 0.9 + 1 = 2.4 */
+        const double own = 1 + 1 / out.closure + 1 / out.conditioning;
+        dyad_cylinder_input in = cyl_line_input;
+        dyad_cylinder_result moved;
+        in.mount_amplification = 100;
+        CHECK(dyad_cylinder(&in, &moved) == DYAD_STATUS_OK &&
+                  fabs(moved.kin_amplification / (own * (1 + 100 * (1 + 1 / 2.4))) - 1) < 1e-5,
+              "mount amplification 100: kin_amplification %g, own %g", moved.kin_amplification,
+              own);
+        in.mount_amplification = 1 / (4 * in.singular_threshold);
+        CHECK(dyad_cylinder(&in, &moved) == DYAD_STATUS_SINGULAR,
+              "mount amplification 1 / (4 threshold) not singular: %s",
+              dyad_status_name(moved.status));
+        in.mount_amplification = -1;
+        fails += cyl_expect_invalid(&in, DYAD_CYL_FIELD_MOUNT_AMPLIFICATION);
+    }
     return fails;
 }
 

@@ -55,6 +55,7 @@ class Input(ctypes.Structure):
         ("link", Link),
         ("gravity", Vec2),
         ("singular_threshold", ctypes.c_double),
+        ("mount_amplification", ctypes.c_double),
     ]
 
 

@@ -72,6 +72,11 @@ typedef struct dyad_cylinder_input {
     /** The result is DYAD_STATUS_SINGULAR where 1 / kin_amplification falls
      *  below it (-), in (0, 1). Default DYAD_DEFAULT_SINGULAR_THRESHOLD. */
     dyad_real singular_threshold;
+    /** The amplification the mounts' motion carries in (-), >= 0, as
+     *  dyad_kin_input.mount_amplification: 0 (the default) for A and O known to
+     *  the last bit (the frame, a driver's given motion); where they are points
+     *  of solved links, the kin amplification of what moved them. */
+    dyad_real mount_amplification;
 } dyad_cylinder_input;
 
 /** Input fields, to name the one that made a call invalid. */
@@ -102,6 +107,7 @@ typedef enum dyad_cylinder_field {
     DYAD_CYL_FIELD_LINK_MOMENT,
     DYAD_CYL_FIELD_GRAVITY,
     DYAD_CYL_FIELD_SINGULAR_THRESHOLD,
+    DYAD_CYL_FIELD_MOUNT_AMPLIFICATION,
     DYAD_CYL_FIELD_COUNT
 } dyad_cylinder_field;
 
@@ -145,7 +151,9 @@ typedef struct dyad_cylinder_result {
     /** The triangle's distance from failing over its size (-), in [0, 1]:
      *  min(|OB| + s - |OA|, |OA| - ||OB| - s|) / (|OB| + s + |OA|). */
     dyad_real closure;
-    /** The motion's round-off bound (-), 1 + 1 / closure + 1 / conditioning:
+    /** The motion's round-off bound (-), as the dyads' (kinematics.h):
+     *      (1 + 1 / closure + 1 / conditioning)
+     *      (1 + mount_amplification (1 + (|A|_1 + |O|_1) / (|OB| + s + |OA|))),
      *  every motion output within c eps kin_amplification of the largest of its
      *  unit. The status is singular where 1 / kin_amplification is below the
      *  threshold. Filled whenever the triangle closes. */
