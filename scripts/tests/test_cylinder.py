@@ -7,6 +7,7 @@ bodies with moments about their centres of mass. Through ctypes on the double co
 import ctypes
 import math
 
+import mpmath
 import numpy as np
 import pytest
 from dyadfmu.core import library_path
@@ -101,8 +102,29 @@ def lib():
     return found
 
 
-def v2(a):
-    return np.array([a.x, a.y])
+class Backend:
+    """The arithmetic of a reference: NumPy in double, or mpmath at 40 digits on NumPy
+    arrays of mpf (the same formulas, the solves by LU)."""
+
+    def __init__(self, num, solve, scalar):
+        self.num, self.solve, self.scalar = num, solve, scalar
+
+    def vec(self, x, y):
+        return np.array(
+            [self.scalar(x), self.scalar(y)], dtype=object if self.num is mpmath else float
+        )
+
+
+def _mp_solve(k, f):
+    return np.array(list(mpmath.lu_solve(mpmath.matrix(k.tolist()), mpmath.matrix(list(f)))))
+
+
+DOUBLE = Backend(math, np.linalg.solve, float)
+MP = Backend(mpmath, _mp_solve, mpmath.mpf)
+
+
+def v2(a, bk=DOUBLE):
+    return bk.vec(a.x, a.y)
 
 
 def cross(a, b):
@@ -113,8 +135,8 @@ def perp(a):
     return np.array([-a[1], a[0]])
 
 
-def rot(angle):
-    return np.array([math.cos(angle), math.sin(angle)])
+def rot(angle, bk=DOUBLE):
+    return bk.vec(bk.num.cos(angle), bk.num.sin(angle))
 
 
 def random_case(rng, lib):
@@ -146,28 +168,29 @@ def random_case(rng, lib):
     return c
 
 
-def reference_motion(c):
+def reference_motion(c, bk=DOUBLE):
     """The motion by the law of cosines and two linear solves."""
-    o, a = v2(c.o.position), v2(c.a.position)
-    rb, s = math.hypot(c.pin_b.x, c.pin_b.y), c.length
+    num, p = bk.num, bk.scalar
+    o, a = v2(c.o.position, bk), v2(c.a.position, bk)
+    rb, s = num.sqrt(p(c.pin_b.x) ** 2 + p(c.pin_b.y) ** 2), p(c.length)
     d = a - o
-    dist = math.hypot(*d)
-    alpha = math.acos((rb**2 + dist**2 - s**2) / (2 * rb * dist))
-    e = rot(math.atan2(d[1], d[0]) + c.branch * alpha)  # O towards B
+    dist = num.sqrt(d[0] ** 2 + d[1] ** 2)
+    alpha = num.acos((rb**2 + dist**2 - s**2) / (2 * rb * dist))
+    e = rot(num.atan2(d[1], d[0]) + c.branch * alpha, bk)  # O towards B
     b = o + rb * e
     u = (b - a) / s
     cols = np.column_stack([rb * perp(e), -s * perp(u)])
-    w_l, w_c = np.linalg.solve(cols, v2(c.a.velocity) + c.rate * u - v2(c.o.velocity))
+    w_l, w_c = bk.solve(cols, v2(c.a.velocity, bk) + p(c.rate) * u - v2(c.o.velocity, bk))
     rhs = (
-        v2(c.a.acceleration)
-        + c.accel * u
-        + 2 * c.rate * w_c * perp(u)
+        v2(c.a.acceleration, bk)
+        + p(c.accel) * u
+        + 2 * p(c.rate) * w_c * perp(u)
         - s * w_c**2 * u
-        - v2(c.o.acceleration)
+        - v2(c.o.acceleration, bk)
         + rb * w_l**2 * e
     )
-    e_l, e_c = np.linalg.solve(cols, rhs)
-    i_l = rot(math.atan2(e[1], e[0]) - math.atan2(c.pin_b.y, c.pin_b.x))
+    e_l, e_c = bk.solve(cols, rhs)
+    i_l = rot(num.atan2(e[1], e[0]) - num.atan2(p(c.pin_b.y), p(c.pin_b.x)), bk)
     return {"o": o, "a": a, "b": b, "e": e, "u": u, "i_l": i_l, "w": (w_l, w_c, e_l, e_c)}
 
 
@@ -176,34 +199,41 @@ def point_accel(base_acc, q, w, eps):
     return base_acc + eps * perp(q) - w**2 * q
 
 
-def body_terms(c, m):
+def body_terms(c, m, bk=DOUBLE):
     """Each body's centre of mass, its acceleration and the applied load (weight,
     active load) as (mass, com, a_com, J, epsilon, force, moment)."""
     w_l, w_c, e_l, e_c = m["w"]
-    u, i_l, g = m["u"], m["i_l"], v2(c.gravity)
-    q_l = c.link.com.x * i_l + c.link.com.y * perp(i_l)
-    a_a, a_o = v2(c.a.acceleration), v2(c.o.acceleration)
+    p = bk.scalar
+    u, i_l, g = m["u"], m["i_l"], v2(c.gravity, bk)
+    q_l = p(c.link.com.x) * i_l + p(c.link.com.y) * perp(i_l)
+    a_a, a_o = v2(c.a.acceleration, bk), v2(c.o.acceleration, bk)
     a_b = point_accel(a_o, m["b"] - m["o"], w_l, e_l)
-    q_c = c.barrel.com * u
+    q_c = p(c.barrel.com) * u
     bodies = {
         "barrel": (c.barrel, m["a"] + q_c, point_accel(a_a, q_c, w_c, e_c), e_c),
-        "rod": (c.rod, m["b"] - c.rod.com * u, point_accel(a_b, -c.rod.com * u, w_c, e_c), e_c),
+        "rod": (
+            c.rod,
+            m["b"] - p(c.rod.com) * u,
+            point_accel(a_b, -p(c.rod.com) * u, w_c, e_c),
+            e_c,
+        ),
         "link": (c.link, m["o"] + q_l, point_accel(a_o, q_l, w_l, e_l), e_l),
     }
     out = {}
     for name, (part, com, acc, eps) in bodies.items():
-        force = part.mass * g + (v2(c.link.force) if name == "link" else 0)
-        moment = c.link.moment if name == "link" else 0.0
-        out[name] = (part.mass, com, acc, part.inertia, eps, force, moment)
+        force = p(part.mass) * g + (v2(c.link.force, bk) if name == "link" else 0)
+        moment = p(c.link.moment) if name == "link" else p(0)
+        out[name] = (p(part.mass), com, acc, p(part.inertia), eps, force, moment)
     return out
 
 
-def reference_reactions(c, m):
+def reference_reactions(c, m, bk=DOUBLE):
     """The nine unknowns x = [R_A, R_B, R_O, F_ax, N, M] from K x = f: per body its
     forces and its moment about its own centre of mass, m a = sum F, J eps = sum M."""
     u, j, a, b, o = m["u"], perp(m["u"]), m["a"], m["b"], m["o"]
-    bodies = body_terms(c, m)
-    k, f = np.zeros((9, 9)), np.zeros(9)
+    bodies = body_terms(c, m, bk)
+    kind = object if bk is MP else float
+    k, f = np.zeros((9, 9), dtype=kind) + bk.scalar(0), np.zeros(9, dtype=kind) + bk.scalar(0)
     # Each force acting on a body: (body, point, column, 2 x 1 direction or identity).
     rows = {"barrel": 0, "rod": 3, "link": 6}
     eye = np.eye(2)
@@ -227,7 +257,7 @@ def reference_reactions(c, m):
         mass, _, acc, inertia, eps, force, moment = bodies[body]
         f[row : row + 2] = mass * acc - force
         f[row + 2] = inertia * eps - moment
-    return np.linalg.solve(k, f)
+    return bk.solve(k, f)
 
 
 def solve_c(lib, c):
@@ -236,11 +266,12 @@ def solve_c(lib, c):
     return status, r
 
 
-def scaled_errors(c, r):
+def scaled_errors(c, r, bk=DOUBLE):
     """The C outputs against the reference, in eps x amplification of their unit's
     largest output: motion (kin_amplification) and forces, moment (amplification)."""
-    m = reference_motion(c)
-    x = reference_reactions(c, m)
+    m = reference_motion(c, bk)
+    x = np.array([float(v) for v in reference_reactions(c, m, bk)])
+    m = {key: np.array([float(v) for v in value]) for key, value in m.items()}
     forces_c = np.array([*v2(r.r_a), *v2(r.r_b), *v2(r.r_o), r.axial_force, r.n_rod])
     forces_ref = x[:8]
     angles = np.array([*v2(r.link_dir), *v2(r.axis), *v2(r.b.position)])
@@ -272,6 +303,24 @@ def test_matches_numpy_newton_euler(lib):
         for key, value in scaled_errors(c, r).items():
             worst[key] = max(worst[key], value)
     print("worst error in eps x amplification:", {k: f"{v:.3g}" for k, v in worst.items()})
+    assert max(worst.values()) < 16, worst
+
+
+def test_random_cases_match_mpmath(lib):
+    """The same random cylinders against the 40-digit reference: what is left is the C
+    core's own round-off, without the double reference's."""
+    rng = np.random.default_rng(35)
+    worst = dict.fromkeys(("position", "rate", "accel", "force", "moment"), 0.0)
+    with mpmath.workdps(40):
+        for _ in range(300):
+            c = random_case(rng, lib)
+            status, r = solve_c(lib, c)
+            assert status == OK
+            for key, value in scaled_errors(c, r, MP).items():
+                worst[key] = max(worst[key], value)
+    print(
+        "against mpmath, worst in eps x amplification:", {k: f"{v:.3g}" for k, v in worst.items()}
+    )
     assert max(worst.values()) < 16, worst
 
 
@@ -307,3 +356,35 @@ def test_beyond_the_stroke_names_the_gap(lib):
     c.length = 1.5 - 1e-10
     status, r = solve_c(lib, c)
     assert status == SINGULAR and r.conditioning < 1e-4
+
+
+def test_matches_mpmath_on_the_way_to_both_toggles(lib):
+    """Closing on a toggle (O, A, B in line, either way) from 1e-2 to 1e-15 of the
+    triangle's size: every output with status ok within 16 eps x amplification of the
+    40-digit reference; once not, singular (never a wrong number)."""
+    rng = np.random.default_rng(3535)
+    worst = dict.fromkeys(("position", "rate", "accel", "force", "moment"), 0.0)
+    statuses = set()
+    with mpmath.workdps(40):
+        for _ in range(40):
+            c = random_case(rng, lib)
+            rb = math.hypot(c.pin_b.x, c.pin_b.y)
+            dist = math.dist((c.a.position.x, c.a.position.y), (c.o.position.x, c.o.position.y))
+            upper = rng.uniform() < 0.5  # the longest stroke, or the shortest
+            end, inward = (rb + dist, -1.0) if upper else (abs(dist - rb), 1.0)
+            for k in range(2, 16):
+                c.length = end + inward * 10.0**-k
+                if c.length <= 0:
+                    continue
+                status, r = solve_c(lib, c)
+                statuses.add(status)
+                if status != OK:
+                    assert status == SINGULAR, status
+                    continue
+                for key, value in scaled_errors(c, r, MP).items():
+                    worst[key] = max(worst[key], value)
+    print(
+        "near the toggles, worst in eps x amplification:", {k: f"{v:.3g}" for k, v in worst.items()}
+    )
+    assert statuses == {OK, SINGULAR}
+    assert max(worst.values()) < 16, worst
