@@ -6,6 +6,10 @@
 - a load at a point equals the same load at the centre of mass plus its moment r x F;
 - a follower force on the crank turns with it: its torque about O is the same at every
   angle, its share of R_O turns with the crank;
+- the generated directional derivative along every input, the loads' included, against
+  central differences of the FMU's outputs;
+- the energy balance over the turn: the driver's and the loads' power equal the rate of
+  kinetic and potential energy;
 - the refusals of malformed [[load]] tables, each at its file:line.
 """
 
@@ -16,8 +20,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from dyadfmu.reference import scene_mp
+from test_scene_derivatives import DIFFERENCE_LIMIT, _central, _names, _outputs, _slave
 from test_scene_mp import inputs_at, run_fmu, scene_file, unit_errors
 
 NAME = "four_bar_payload"
@@ -132,3 +138,127 @@ def test_malformed_loads_are_refused_at_their_line(case, tmp_path):
     where = found[0].removeprefix("error: ")
     assert where.startswith("bad.toml:"), found
     assert line <= int(where.split(":")[1]) <= line + 4, (line, found)
+
+
+def _rot(theta, p):
+    c, s = math.cos(theta), math.sin(theta)
+    return (c * p[0] - s * p[1], s * p[0] + c * p[1])
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1]
+
+
+class _Body:
+    """A link at one instant, from the FMU's outputs: origin D with its velocity and
+    acceleration, angle, angular velocity and acceleration."""
+
+    def __init__(self, d, v_d, a_d, theta, w, e):
+        self.d, self.v_d, self.a_d, self.theta, self.w, self.e = d, v_d, a_d, theta, w, e
+
+    def velocity(self, p):
+        r = _rot(self.theta, p)
+        return (self.v_d[0] - self.w * r[1], self.v_d[1] + self.w * r[0])
+
+    def acceleration(self, p):
+        r = _rot(self.theta, p)
+        w2 = self.w * self.w
+        return (
+            self.a_d[0] - self.e * r[1] - w2 * r[0],
+            self.a_d[1] + self.e * r[0] - w2 * r[1],
+        )
+
+
+#: (mass kg, inertia kg m2, centre of mass m) of the scene's links
+LINKS = {
+    "crank": (0.25, 8.0e-5, (0.02, 0.003)),
+    "rocker": (0.30, 4.0e-4, (0.05, -0.008)),
+    "coupler": (0.35, 6.6e-4, COM),
+}
+
+
+def _bodies(values, got):
+    """The three moving links from the crank's inputs and the FMU's outputs alone."""
+    q, w, e = values["crank.angle"], values["crank.omega"], values["crank.epsilon"]
+    zero = (0.0, 0.0)
+    crank = _Body(zero, zero, zero, q, w, e)
+    a_pin = (got["linkage.D_n.position.x"], got["linkage.D_n.position.y"])
+    o4 = (got["linkage.D_m.position.x"], got["linkage.D_m.position.y"])
+    pin_local = _rot(-q, a_pin)
+    coupler = _Body(
+        a_pin,
+        crank.velocity(pin_local),
+        crank.acceleration(pin_local),
+        got["coupler.angle"],
+        got["coupler.omega"],
+        got["coupler.epsilon"],
+    )
+    rocker = _Body(o4, zero, zero, got["rocker.angle"], got["rocker.omega"], got["rocker.epsilon"])
+    return {"crank": crank, "rocker": rocker, "coupler": coupler}
+
+
+def _power_terms(values, got, at):
+    """(rate of kinetic + potential energy, driver's power, loads' powers) in W."""
+    bodies = _bodies(values, got)
+    gravity = (0.0, -9.81)
+    rate = 0.0
+    for name, (mass, inertia, com) in LINKS.items():
+        b = bodies[name]
+        a = b.acceleration(com)
+        rate += mass * _dot(b.velocity(com), (a[0] - gravity[0], a[1] - gravity[1]))
+        rate += inertia * b.w * b.e
+    c, k = bodies["crank"], bodies["coupler"]
+    loads = [
+        values["rocker.moment"] * bodies["rocker"].w,
+        _dot((values["payload.force.x"], values["payload.force.y"]), k.velocity(at)),
+        values["payload.moment"] * k.w,
+        _dot(_rot(k.theta, (values["drag.force.x"], values["drag.force.y"])), k.velocity(COM)),
+        _dot(_rot(c.theta, (values["tool.force.x"], values["tool.force.y"])), c.velocity(TOOL_AT)),
+        values["tool.moment"] * c.w,
+    ]
+    return rate, got["crank.torque"] * c.w, loads
+
+
+def test_energy_balance_over_the_turn():
+    """The driver's power plus the loads' power equals the rate of kinetic and potential
+    energy, every term from the crank's inputs and the FMU's outputs (no reference
+    kinematics), within 1e-9 of the peak power over the turn."""
+    scene = scene_mp.read_scene(scene_file(NAME))
+    rows = []
+    for k, q in enumerate(ANGLES):
+        values = inputs_at(scene, q)
+        for n, key in enumerate(sorted(values)):
+            if values[key] in (-850.0, 420.0, -3.5):  # every load its own number
+                values[key] *= 1.0 + 0.37 * ((n + k) % 5)
+        rows.append(values)
+    at = (0.11, 0.045)
+    runs = run_fmu(NAME, [({}, rows)])
+    residuals, peak = [], 0.0
+    for values, (_, got, _) in zip(rows, runs, strict=True):
+        rate, driver, loads = _power_terms(values, got, at)
+        residuals.append(abs(driver + sum(loads) - rate))
+        peak = max(peak, abs(rate), abs(driver), *(abs(x) for x in loads))
+    print("energy balance, worst residual / peak power:", max(residuals) / peak)
+    assert max(residuals) < 1e-9 * peak
+
+
+def test_directional_derivative_along_every_input():
+    """Every Real output's exact rate along every input (the loads' and their points'
+    terms included) against fourth-order central differences, at three crank angles."""
+    scene = scene_mp.read_scene(scene_file(NAME))
+    s = _slave(NAME)
+    inputs, outputs = _names(s)
+    worst = 0.0
+    try:
+        for q in (0.7, 2.9, 5.1):
+            values = inputs_at(scene, q)
+            _outputs(s, values, outputs)
+            for known in inputs:
+                exact = np.array(s.directional_derivative(tuple(outputs), (known,), [1.0]))
+                fd = _central(s, values, known, outputs)
+                error = np.max(np.abs(exact - fd)) / max(np.max(np.abs(fd)), 1e-300)
+                worst = max(worst, error)
+                assert error < DIFFERENCE_LIMIT, (known, q, error)
+    finally:
+        s.close()
+    print(f"derivatives: worst difference {worst:.2e} of the largest rate")
