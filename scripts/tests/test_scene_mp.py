@@ -45,6 +45,7 @@ SCENES = dict.fromkeys(
     (0.7, 1.9, 2.8),  # crank angles (rad), inside (0, pi) for trt_slot's slot
 )
 SCENES["lift"] = (0.13, 0.25, 0.38)  # ram positions (m) over its stroke
+SCENES["lift_loads"] = SCENES["lift"]
 #: the scenes with a tunable branch
 BRANCHES = {
     "slider_crank": "engine.branch",
