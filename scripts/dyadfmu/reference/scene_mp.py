@@ -14,7 +14,9 @@ package, not from the C code or the generated code:
 * kinetostatics, from the last dyad back: each dyad's Newton-Euler equations (the system
   of :func:`.newton_euler.equilibrium_system`, solved by ``mpmath.lu_solve``), every later
   dyad's reactions loading the earlier link or driver it hangs on, at its pair point (a
-  sliding pair's reactive moment too);
+  sliding pair's reactive moment too); each ``[[load]]`` of the scene as a force at its
+  point of its link (the driver included) and a couple, its force global or turned by
+  the link's angle (a follower force);
 * the driver's balance: a crank's torque about O and the frame's force R_O on it; a ram's
   actuator force along its guide i_r, the guide's normal force N along j_r and reactive
   moment M about R;
