@@ -84,6 +84,20 @@ class Link:
 
 
 @dataclass(eq=False)
+class PointLoad:
+    """A load where it acts ([[load]]): a force at a point of a link, its components
+    global or the link's own (a follower force), and/or a pure moment."""
+
+    name: str  # the prefix of its inputs and parameters
+    link: str  # the loaded link: a dyad's link or the driver
+    at: tuple  # (Param, Param): the point in the link's frame (m)
+    components: str  # "global" or "link"
+    force: bool
+    moment: bool
+    line: int | None = None
+
+
+@dataclass(eq=False)
 class Dyad:
     """A dyad of the chain: its type, links and outer attachments."""
 
@@ -174,6 +188,7 @@ class Scene:
     inputs: list = field(default_factory=list)  # Input, in table order
     #: dyad index -> the dyads that load it (see loaders), computed once
     loaders: dict = field(default_factory=dict, repr=False)
+    point_loads: list = field(default_factory=list)  # PointLoad, in file order
 
     def parameters(self) -> list:
         """Every Param of the scene in table order."""
@@ -190,6 +205,8 @@ class Scene:
                     out.append(a.guide)
             if d.branch:
                 out.append(d.branch)
+        for load in self.point_loads:
+            out += load.at
         if self.gravity_params:
             out += self.gravity_params
         out.append(self.threshold)

@@ -122,6 +122,37 @@ def _load_inputs(link: Link) -> list[Input]:
     return out
 
 
+def point_load_inputs(scene: Scene) -> list[Input]:
+    """The force and moment inputs of the scene's [[load]] tables, in file order."""
+    out = []
+    for load in scene.point_loads:
+        n, g = load.name, load.link
+        frame = "global" if load.components == "global" else f"along {g}'s"
+        if load.force:
+            for c, axis in (("x", "i"), ("y", "j")):
+                text = f"{c}" if load.components == "global" else f"{axis} ({c} in its frame)"
+                out.append(
+                    Input(
+                        f"{n}.force.{c}",
+                        "N",
+                        f"Force of load {n} on {g} at its point {n}.at, {frame} {text}",
+                        f"{member(n)}_force_{c}",
+                        owner=g,
+                    )
+                )
+        if load.moment:
+            out.append(
+                Input(
+                    f"{n}.moment",
+                    "N.m",
+                    f"Moment of load {n} on {g}, counter-clockwise",
+                    f"{member(n)}_moment",
+                    owner=g,
+                )
+            )
+    return out
+
+
 def _link_inputs(scene: Scene, link: Link) -> list[Input]:
     g = link.name
     out = _motion_inputs(scene, link) + _load_inputs(link)
@@ -226,7 +257,7 @@ def derive_inputs(scene: Scene) -> None:
         for d in scene.dyads:
             for g in (d.m, d.n):
                 inputs += _load_inputs(scene.links[g])
-        scene.inputs = inputs
+        scene.inputs = inputs + point_load_inputs(scene)
         scene.computed = computed_motion(scene)
         return
     inputs = []
@@ -236,7 +267,7 @@ def derive_inputs(scene: Scene) -> None:
         for g in (d.m, d.n):
             inputs += _link_inputs(scene, scene.links[g])
         inputs += _guide_inputs(d)
-    scene.inputs = inputs
+    scene.inputs = inputs + point_load_inputs(scene)
 
 
 def kin_name(d: Dyad) -> str:
@@ -299,7 +330,8 @@ class _Index:
 
 def _driver_inputs(scene: Scene, upto: int) -> list[str]:
     """The first `upto` inputs of the driver's motion: its position, velocity, acceleration."""
-    return [i.name for i in scene.inputs if i.owner == scene.crank.name][:upto]
+    motion = [i for i in scene.inputs if i.owner == scene.crank.name]
+    return [i.name for i in motion if i.unit not in ("N", "N.m")][:upto]
 
 
 def _dependencies(scene: Scene, d: Dyad, index: _Index) -> tuple[list, list]:

@@ -40,12 +40,18 @@ SCENES = dict.fromkeys(
         "shaper",
         "sixbar",
         "rocker_slider",
+        "four_bar_payload",
     ),
     (0.7, 1.9, 2.8),  # crank angles (rad), inside (0, pi) for trt_slot's slot
 )
 SCENES["lift"] = (0.13, 0.25, 0.38)  # ram positions (m) over its stroke
+SCENES["lift_loads"] = SCENES["lift"]
 #: the scenes with a tunable branch
-BRANCHES = {"slider_crank": "engine.branch", "four_bar": "linkage.branch"}
+BRANCHES = {
+    "slider_crank": "engine.branch",
+    "four_bar": "linkage.branch",
+    "four_bar_payload": "linkage.branch",
+}
 #: the driver's rates and the loads: arbitrary, nonzero
 RATES = {"omega": 9.5, "epsilon": -23.0, "velocity": 0.35, "acceleration": -1.7}
 LOADS = {"force.x": -850.0, "force.y": 420.0, "moment": -3.5}

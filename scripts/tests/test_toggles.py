@@ -40,10 +40,12 @@ MOTION = {
         "shaper",
         "sixbar",
         "rocker_slider",
+        "four_bar_payload",
     )
 }
 MOTION["trt_slot"] = np.linspace(0.1, 3.0, 8)  # the slot's cross slide only in (0, pi)
 MOTION["lift"] = np.linspace(0.1, 0.7, 8)  # m, the ram's stroke up to its limit
+MOTION["lift_loads"] = MOTION["lift"]
 MOTION["toggles"] = np.linspace(-0.9, 0.85, 8)  # rad, between its two limits
 #: the driver's rates and the loads: arbitrary, nonzero
 RATES = {"omega": 9.5, "epsilon": -23.0, "velocity": 0.35, "acceleration": -1.7}

@@ -311,6 +311,35 @@ def _moment_terms(plan: Plan, g: str) -> tuple[list, list]:
     return terms, sizes
 
 
+def _point_loads(plan: Plan, g: str, r: str | None) -> tuple[list, list, list, list]:
+    """The terms of the [[load]] tables on link g: each force F (global, or R(theta) F
+    for a follower force) joins the resultant, and its moment about the centre of mass
+    C, (P - C) x F with P - C = R(theta) at - r, joins the moment; a pure moment joins
+    as it is. Returns (force terms, their sizes, moment terms, their sizes)."""
+    c = member(g)
+    forces, force_sizes, moments, moment_sizes = [], [], [], []
+    for load in plan.scene.point_loads:
+        if load.link != g:
+            continue
+        n = load.name
+        if load.force:
+            fx, fy = plan.inp(f"{n}.force.x"), plan.inp(f"{n}.force.y")
+            f = _vec(fx, fy)
+            if load.components == "link":  # a follower force turns with its link
+                f = f"dyad_combine({fx}, {c}_i, {fy}, {c}_j)"
+            forces.append(f)
+            force_sizes.append(f"dyad_norm1({f})")
+            p = plan.point(g, load.at)
+            arm = p if r is None else f"dyad_neg({c}_r)" if p is None else f"dyad_sub({p}, {c}_r)"
+            if arm is not None:
+                moments.append(f"dyad_cross({arm}, {f})")
+                moment_sizes.append(f"dyad_norm1({arm}) * dyad_norm1({f})")
+        if load.moment:
+            moments.append(plan.inp(f"{n}.moment"))
+            moment_sizes.append(f"fabs({moments[-1]})")
+    return forces, force_sizes, moments, moment_sizes
+
+
 def _resultant(plan: Plan, code: _Code, g: str) -> None:
     c = member(g)
     r = None
@@ -319,8 +348,13 @@ def _resultant(plan: Plan, code: _Code, g: str) -> None:
         r = plan.point(g, (params["com.x"], params["com.y"]))
         code(f"const dyad_vec2 {c}_r = {r};")
     force_terms, force_sizes = _force_terms(plan, g, r)
+    placed, placed_sizes, placed_moments, placed_moment_sizes = _point_loads(plan, g, r)
+    force_terms += placed
+    force_sizes += placed_sizes
     code(f"dyad_vec2 {c}_f = {_sum(force_terms)};")
     moment_terms, moment_sizes = _moment_terms(plan, g)
+    moment_terms += placed_moments
+    moment_sizes += placed_moment_sizes
     code(f"double {c}_m = {' + '.join(moment_terms) if moment_terms else '0.0'};")
     if r is not None and force_terms:
         code(f"double {c}_m_d = {c}_m + dyad_cross({c}_r, {c}_f);")

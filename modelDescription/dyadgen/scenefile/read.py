@@ -16,6 +16,7 @@ from pathlib import Path
 from dyadgen.emit.scene_c import inputs_read
 from dyadgen.model import Crank, Scene
 from dyadgen.needs import derive_inputs, derive_outputs
+from dyadgen.scenefile import loads as point_loads
 from dyadgen.scenefile import mechanism, sections
 from dyadgen.scenefile.locator import Locator
 from dyadgen.scenefile.names import CNames, c_name_clashes, identifier_problem
@@ -99,6 +100,8 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
         objects = _named_objects(identifier, found, crank)
         c_name_clashes(p, objects, c_names())
     sections.loads(p, data, found.links, found.known())
+    names = {o[1] for o in _named_objects(identifier, found, crank)}
+    placed = point_loads.point_loads(p, data, crank, found.links, names | found.known())
     scene = Scene(
         path=path,
         identifier=identifier,
@@ -111,6 +114,7 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
         gravity_params=gravity_params,
         threshold=threshold,
         kinematics=kinematics,
+        point_loads=placed,
     )
     sections.tunable(p, scene_t, scene, found.tables_of_names(data.get("dyad", [])))
     if not p.items:

@@ -37,7 +37,7 @@ EFFECT_KEYS = {"inertia", "gravity"}
 CRANK_KEYS = {"name", "length", "com", "mass", "inertia", "at"}
 RAM_KEYS = {"name", "guide", "at", "com", "mass", "inertia"}
 LOAD_KEYS = {"force", "moment"}
-TOP_KEYS = {"scene", "effects", "gravity", "crank", "ram", "dyad", "link", "loads", "start"}
+TOP_KEYS = {"scene", "effects", "gravity", "crank", "ram", "dyad", "link", "loads", "load", "start"}
 KINEMATICS = ("internal", "external")
 #: sqrt(DBL_EPSILON), where round-off still leaves half of the digits.
 DEFAULT_THRESHOLD = 1.4901161193847656e-8

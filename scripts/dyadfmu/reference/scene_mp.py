@@ -14,7 +14,9 @@ package, not from the C code or the generated code:
 * kinetostatics, from the last dyad back: each dyad's Newton-Euler equations (the system
   of :func:`.newton_euler.equilibrium_system`, solved by ``mpmath.lu_solve``), every later
   dyad's reactions loading the earlier link or driver it hangs on, at its pair point (a
-  sliding pair's reactive moment too);
+  sliding pair's reactive moment too); each ``[[load]]`` of the scene as a force at its
+  point of its link (the driver included) and a couple, its force global or turned by
+  the link's angle (a follower force);
 * the driver's balance: a crank's torque about O and the frame's force R_O on it; a ram's
   actuator force along its guide i_r, the guide's normal force N along j_r and reactive
   moment M about R;
@@ -156,6 +158,8 @@ class MechanismScene:
     moments: tuple[str, ...]
     inputs: dict[str, float]
     parameters: dict[str, float]
+    #: the [[load]] tables: (name, link, components, force?, moment?) each
+    point_loads: tuple = ()
 
     @property
     def motion_inputs(self) -> tuple[str, ...]:
@@ -375,6 +379,28 @@ def _loads(rd: _Reader, links: dict) -> tuple[tuple, tuple]:
     return out[0], out[1]
 
 
+def _point_loads(rd: _Reader, links: dict, driver: str) -> tuple:
+    """The [[load]] tables: each load's inputs (N, N m) and its point (m, the link's frame;
+    default the link's centre of mass) as parameters NAME.at.x, NAME.at.y."""
+    rows = rd.data.get("load", [])
+    if not isinstance(rows, list):
+        rd.fail("[[load]]", "must be an array of tables")
+    out = []
+    for row in rows:
+        name, link = row.get("name"), row.get("link")
+        where = f"load {name!r}"
+        if not isinstance(name, str) or (link not in links and link != driver):
+            rd.fail(where, "needs a name and the link it acts on (a dyad's link or the driver)")
+        com = (rd.params[f"{link}.com.x"], rd.params[f"{link}.com.y"])
+        rd.param_pair(f"{name}.at", rd.pair(row, "at", where, com))
+        components = row.get("components", "global")
+        force, moment = bool(row.get("force", True)), bool(row.get("moment", False))
+        for key in (("force.x", "force.y") if force else ()) + (("moment",) if moment else ()):
+            rd.inputs[f"{name}.{key}"] = 0.0
+        out.append((name, link, components, force, moment))
+    return tuple(out)
+
+
 def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
     """A scene file (path) or its parsed table read for :func:`evaluate`."""
     if isinstance(scene, Mapping):
@@ -392,6 +418,7 @@ def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
     links = rd.links(inertia or gravity, inertia)
     dyads, translating = _dyads(rd, links, kind, name)
     forces, moments = _loads(rd, links)
+    placed = _point_loads(rd, links, name)
     start = rd.table("start")
     for key, value in start.items():
         if key in rd.inputs:
@@ -408,6 +435,7 @@ def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
         moments=moments,
         inputs=dict(rd.inputs),
         parameters=dict(rd.params),
+        point_loads=placed,
     )
 
 
@@ -756,8 +784,24 @@ class _Kinetostatics:
         out[f"{c}.N"] = -_dot(force, _perp(body.i))
         out[f"{c}.M"] = -moment
 
+    def place(self) -> None:
+        """Each [[load]] as a force at its point P (the body's point `at`: global
+        components, or the body's own turned by its angle) and a couple on its body."""
+        ev = self.ev
+        for name, link, components, has_force, has_moment in ev.s.point_loads:
+            body = self.bodies[link]
+            point, _, _ = body.point(ev.vec(f"{name}.at"))
+            zero = mpf(0)
+            local = (ev.inp[f"{name}.force.x"], ev.inp[f"{name}.force.y"]) if has_force else None
+            force = (zero, zero) if local is None else local
+            if local is not None and components == "link":
+                force = body.arm(local)  # local[0] i + local[1] j
+            couple = ev.inp[f"{name}.moment"] if has_moment else zero
+            self.loads.add(link, point, force, couple)
+
     def run(self) -> dict:
         """The outputs: by dyad name, the driver's under None."""
+        self.place()
         for d in reversed(self.ev.s.dyads):
             self.dyad(d)
         self.driver()
