@@ -203,6 +203,9 @@ dyadfmu_stages_init() {
     rm -rf "$DYADFMU_STAGES"
     mkdir -p "$DYADFMU_STAGES"
     trap dyadfmu_stages_summary EXIT
+    # stopped by a signal, the run's status says so (the EXIT trap would see 0)
+    trap 'exit 143' TERM
+    trap 'exit 130' INT
 }
 
 # dyadfmu_cpu_ticks: sets REPLY to the user + system clock ticks of this shell and of the

@@ -139,3 +139,20 @@ def _alive(pid: int) -> bool:
             return False
         time.sleep(0.1)
     return True
+
+
+def test_a_run_stopped_by_a_signal_says_so(tmp_path):
+    """A run that receives SIGTERM ends when its stage does, its status 143 and its table's
+    total FAILED, not ok."""
+    done, rows = _run(
+        tmp_path,
+        """
+        main=$$
+        dyadfmu_stage first true
+        dyadfmu_stage doomed sh -c "kill -TERM $main; sleep 0.3"
+        dyadfmu_stage after true
+        """,
+    )
+    assert done.returncode == 143
+    assert rows["first"][3] == "ok" and "after" not in rows
+    assert rows["total"][3] == "FAILED (exit 143)"
