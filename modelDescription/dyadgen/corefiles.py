@@ -26,10 +26,15 @@ def scene_core_sources(scene: Scene, derivatives: bool) -> list[str]:
     `derivatives`, <identifier>_scene_tangent.c) calls into, in link order."""
     types = scene_types(scene)
     files = ["dyad_common.c"] + [f"dyad_{t}.c" for t in types]
+    cylinder = bool(scene.crank and scene.crank.is_cylinder())
     if scene.internal():
         files += ["dyad_kinematics.c"] + [f"dyad_kin_{t}.c" for t in types]
+    if cylinder:
+        files.append("dyad_cylinder.c")
     if derivatives:
         files += ["dyad_tangent.c"] + [f"dyad_{t}_tangent.c" for t in types]
         if scene.internal():
             files += ["dyad_kinematics_tangent.c"] + [f"dyad_kin_{t}_tangent.c" for t in types]
+        if cylinder:
+            files.append("dyad_cylinder_tangent.c")
     return files

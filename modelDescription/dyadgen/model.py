@@ -123,17 +123,34 @@ class Dyad:
 
 @dataclass
 class Crank:
-    """The driver: a crank turning about the frame pivot O, or a ram (a linear actuator)
-    sliding on a frame guide (kind "ram")."""
+    """The driver: a crank turning about the frame pivot O, a ram (a linear actuator)
+    sliding on a frame guide (kind "ram"), or a hydraulic cylinder between a frame pin A
+    and a pin B of a link it turns about the frame pivot O (kind "cylinder": `name` is
+    the driven link, which dyads and loads name as they name a crank, and `actuator`
+    the cylinder, which names the driver's inputs and its balance)."""
 
     name: str
     line: int | None
     params: dict = field(default_factory=dict)
     kind: str = "crank"
+    actuator: str = ""
 
     def is_ram(self) -> bool:
         """Whether the driver is a ram: it translates, and balances with a force."""
         return self.kind == "ram"
+
+    def is_cylinder(self) -> bool:
+        """Whether the driver is a cylinder between two pins: its length is the driver's
+        coordinate, and it balances with its axial force."""
+        return self.kind == "cylinder"
+
+    def balances_with_force(self) -> bool:
+        """Whether the driver's effort is a force (N), not a torque."""
+        return self.kind in ("ram", "cylinder")
+
+    def driver_name(self) -> str:
+        """The name of the driver's inputs and effort: the cylinder's for a cylinder."""
+        return self.actuator or self.name
 
 
 @dataclass(eq=False)

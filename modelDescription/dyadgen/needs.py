@@ -248,12 +248,37 @@ def _ram_inputs(scene: Scene) -> list[Input]:
     return inputs
 
 
+def _cylinder_inputs(scene: Scene) -> list[Input]:
+    """A cylinder's length and, with inertia, its rate and acceleration: the inputs of
+    the driver's motion, owned by the link it turns."""
+    c, link = scene.crank.actuator, scene.crank.name
+    motion = [("length", "m", "Cylinder length s = |A B| between its pins")]
+    if scene.inertia:
+        motion += [
+            ("velocity", "m/s", "Cylinder extension rate ds/dt"),
+            ("acceleration", "m/s2", "Cylinder extension acceleration d2s/dt2"),
+        ]
+    inputs = [
+        Input(f"{c}.{key}", unit, text, f"{member(c)}_{key}", owner=link)
+        for key, unit, text in motion
+    ]
+    inputs[0].domain = {"min": 0.0, "min_exclusive": True}
+    return inputs
+
+
+def _driver_motion_inputs(scene: Scene) -> list[Input]:
+    """The inputs of the driver's motion."""
+    if scene.crank.is_cylinder():
+        return _cylinder_inputs(scene)
+    return _ram_inputs(scene) if scene.crank.is_ram() else _crank_inputs(scene)
+
+
 def derive_inputs(scene: Scene) -> None:
     """Every candidate input of the scene, in table order. With internal kinematics they
     are the driver's motion and the loads; every link's motion is computed (its C
     expressions are in scene.computed)."""
     if scene.internal():
-        inputs = _ram_inputs(scene) if scene.crank.is_ram() else _crank_inputs(scene)
+        inputs = _driver_motion_inputs(scene)
         for d in scene.dyads:
             for g in (d.m, d.n):
                 inputs += _load_inputs(scene.links[g])
@@ -262,7 +287,7 @@ def derive_inputs(scene: Scene) -> None:
         return
     inputs = []
     if scene.crank:
-        inputs = _ram_inputs(scene) if scene.crank.is_ram() else _crank_inputs(scene)
+        inputs = _driver_motion_inputs(scene)
     for d in scene.dyads:
         for g in (d.m, d.n):
             inputs += _link_inputs(scene, scene.links[g])
@@ -295,7 +320,17 @@ def computed_motion(scene: Scene) -> dict[str, str]:
     if scene.crank.is_ram():
         guide = scene.crank.params["guide"]
         out[f"{scene.crank.name}.angle"] = unit_vector_c(guide)
+    if scene.crank.is_cylinder():
+        g, cyl = scene.crank.name, f"kin.{kin_name_of_cylinder(scene)}"
+        out[f"{g}.angle"] = f"{cyl}.link_dir"
+        out[f"{g}.omega"] = f"{cyl}.link_omega"
+        out[f"{g}.epsilon"] = f"{cyl}.link_epsilon"
     return out
+
+
+def kin_name_of_cylinder(scene: Scene) -> str:
+    """The member of the generated kinematics block that holds the cylinder's result."""
+    return member(scene.crank.actuator) + "_cylinder"
 
 
 # ---------------------------------------------------------------------------
@@ -489,8 +524,8 @@ def _kinematic_outputs(offer: _Offer, scene: Scene, d: Dyad) -> None:
 def _driver_inertia_outputs(offer: _Offer, scene: Scene) -> None:
     """Internal kinematics with inertia: the effective inertia at the driver and the
     balancing torque (force) at zero driver acceleration."""
-    c = scene.crank.name
-    ram = scene.crank.is_ram()
+    c = scene.crank.driver_name()
+    ram = scene.crank.balances_with_force()
     unit, rate = ("kg", "m") if ram else ("kg.m2", "rad")
     balance, bunit = ("force", "N") if ram else ("torque", "N.m")
     every = [i.name for i in scene.inputs]
@@ -506,6 +541,81 @@ def _driver_inertia_outputs(offer: _Offer, scene: Scene) -> None:
         if not key.endswith("0"):
             c_member = f"{member(c)}_reduced_{key.lower()}"  # not the frame's local c_j
         _motion_output(offer, f"{c}.{key}", u, text, c_member, depends, source)
+
+
+def _cylinder_motion_outputs(offer: _Offer, scene: Scene) -> None:
+    """The motion of the link a cylinder turns and of the cylinder itself, pin B, and the
+    triangle's conditioning."""
+    link, c = scene.crank.name, scene.crank.actuator
+    rates = _driver_inputs(scene, 3)
+    bodies = (
+        (link, member(link), f"Direction of {link}: angle of its i, in (-pi, pi]", f"{link}"),
+        (c, member(c), f"Direction of cylinder {c}: angle of its axis from A towards B, in (-pi, pi]", f"cylinder {c}"),
+    )
+    for name, cm, text, label in bodies:
+        _motion_output(offer, f"{name}.angle", "rad", text, f"{cm}_angle", rates[:1], "crank")
+        if scene.inertia:
+            for key, unit, what, upto in (
+                ("omega", "rad/s", "Angular velocity", 2),
+                ("epsilon", "rad/s2", "Angular acceleration", 3),
+            ):
+                _motion_output(
+                    offer, f"{name}.{key}", unit, f"{what} of {label}", f"{cm}_{key}", rates[:upto], "crank"
+                )
+    group = [
+        Output(
+            f"{c}.B.position.{x}",
+            "m",
+            f"Position of the rod's pin B of cylinder {c}, global {x}",
+            f"{member(c)}_b_position_{x}",
+            depends=rates[:1],
+            source="crank",
+        )
+        for x in "xy"
+    ]
+    offer.add(f"{c}.B.position", group)
+    _motion_output(
+        offer,
+        f"{c}.conditioning",
+        None,
+        f"Conditioning of cylinder {c} in [0, 1]: |sin| of the angle between O B and A B, 0 "
+        "where O, A and B fall in line (the toggle, where the cylinder cannot turn the link)",
+        f"{member(c)}_conditioning",
+        rates[:1],
+        "crank",
+    )
+
+
+def _cylinder_outputs(offer: _Offer, scene: Scene) -> None:
+    """A cylinder's axial force, its pins' reactions and the barrel's action on the rod,
+    and the frame's force on the link it turns."""
+    link, c = scene.crank.name, scene.crank.actuator
+    every = [i.name for i in scene.inputs]
+    _motion_output(
+        offer,
+        f"{c}.force",
+        "N",
+        f"Axial force of cylinder {c}: positive pushes its pins apart (the rod in compression)",
+        f"{member(c)}_force",
+        every,
+        "crank",
+    )
+    pins = (
+        (f"{c}.R_A", f"{member(c)}_r_a", f"Force on the barrel of {c} from the frame at A"),
+        (f"{c}.R_B", f"{member(c)}_r_b", f"Force on {link} from the rod of {c} at B"),
+        (f"{link}.R_O", f"{member(link)}_r_o", f"Force on {link} from the frame at O"),
+    )
+    for name, cm, text in pins:
+        group = [
+            Output(f"{name}.{x}", "N", f"{text}, global {x}", f"{cm}_{x}", depends=every, source="crank")
+            for x in "xy"
+        ]
+        offer.add(name, group)
+    for key, unit, text in (
+        ("N", "N", f"Force of the barrel of {c} on its rod across the axis at B, along k0 x u"),
+        ("M", "N.m", f"Moment of the barrel of {c} on its rod, counter-clockwise"),
+    ):
+        _motion_output(offer, f"{c}.{key}", unit, text, f"{member(c)}_{key.lower()}_rod", every, "crank")
 
 
 def _ram_outputs(offer: _Offer, scene: Scene) -> None:
@@ -561,6 +671,11 @@ def why_not(scene: Scene, wanted: str) -> str:
                 f"dyad '{d.name}' has no output '{tail}' (it has R_mk, R_np, R_mn, "
                 "conditioning, amplification and N_/M_ of its sliding pairs)"
             )
+    if scene.crank and scene.crank.is_cylinder() and head in (scene.crank.name, scene.crank.actuator):
+        return (
+            f"the cylinder has 'force', 'R_A', 'R_B', 'N', 'M', its motion and 'B.position'; "
+            f"its link '{scene.crank.name}' its motion and 'R_O'"
+        )
     if scene.crank and head == scene.crank.name:
         return "the crank has only 'torque' and 'R_O'"
     names = [d.name for d in scene.dyads] + ([scene.crank.name] if scene.crank else [])
@@ -600,7 +715,10 @@ def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
             _kinematic_outputs(offer, scene, d)
         deps, own_geometry = _dependencies(scene, d, index)
         _dyad_outputs(offer, d, deps, own_geometry, scene.internal())
-    if scene.crank and scene.crank.is_ram():
+    if scene.crank and scene.crank.is_cylinder():
+        _cylinder_motion_outputs(offer, scene)
+        _cylinder_outputs(offer, scene)
+    elif scene.crank and scene.crank.is_ram():
         _ram_outputs(offer, scene)
     elif scene.crank:
         _crank_outputs(offer, scene)
@@ -622,6 +740,11 @@ def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
     status_text = "0 ok, 1 a dyad is singular, 3 a reaction overflows"
     if scene.internal():
         status_text += ", 4 a dyad cannot assemble"
+    if scene.crank and scene.crank.is_cylinder():
+        status_text = (
+            "0 ok, 1 a dyad or the cylinder is singular, 3 a reaction overflows, 4 a dyad or "
+            "the cylinder cannot assemble"
+        )
     status = Output(
         "status",
         None,

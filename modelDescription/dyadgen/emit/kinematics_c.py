@@ -15,7 +15,7 @@ import math
 
 from dyadgen import textsafe
 from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, member
-from dyadgen.needs import kin_name
+from dyadgen.needs import kin_name, kin_name_of_cylinder
 
 #: the core's failure statuses and the scene status each one reports
 FAILURE_TEXT = "0 ok, 1 singular, 3 out of range, 4 cannot assemble"
@@ -56,6 +56,9 @@ class _Mounts:
 
     def carrier(self, link: str) -> tuple[str, str, str, str]:
         """(origin motion, direction, omega, epsilon) of a moving link, in C."""
+        if link == self.driver and self.scene.crank.is_cylinder():
+            res = f"kin->{kin_name_of_cylinder(self.scene)}"
+            return f"&{member(link)}_o", f"{res}.link_dir", f"{res}.link_omega", f"{res}.link_epsilon"
         if link == self.driver:
             c = member(link)
             rate = "0.0" if self.scene.crank.is_ram() else "rate"
@@ -93,14 +96,21 @@ class _Mounts:
                 owner = self.owner[att.link][0]
                 if owner not in owners:
                     owners.append(owner)
-        if not owners:
-            return None
-        return " + ".join(f"kin->{kin_name(o)}.amplification" for o in owners)
+        terms = [f"kin->{kin_name(o)}.amplification" for o in owners]
+        if self.scene.crank.is_cylinder() and any(
+            att.kind == "crank" for att in (d.k, d.p)
+        ):
+            # the link the cylinder turns carries the triangle's round-off
+            terms.append(f"kin->{kin_name_of_cylinder(self.scene)}.kin_amplification")
+        return " + ".join(terms) if terms else None
 
     def offset(self, att: Attachment) -> str:
         """The pair's point (a guide's point) in its carrier's frame."""
         if att.at is not None:
             return _point(att.at)
+        if att.kind == "crank" and self.scene.crank.is_cylinder():
+            params = self.scene.crank.params  # the rod's pin B
+            return _vec(params["pin.x"].c(), params["pin.y"].c())
         if att.kind == "crank" and not self.scene.crank.is_ram():
             return _vec(self.scene.crank.params["length"].c(), "0.0")
         return _vec("0.0", "0.0")
@@ -166,9 +176,69 @@ def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad) -> list[str]:
     return out
 
 
+def _cylinder_part_lines(params: dict, target: str) -> list[str]:
+    """The barrel's and the rod's centres of mass (and with `target` "cin", where the
+    kinematics alone are wanted, nothing more; else their masses and inertias too)."""
+    out = []
+    for part in ("barrel", "rod"):
+        keys = ("com",) if target == "cin" else ("mass", "com", "inertia")
+        for key in keys:
+            value = params.get(f"{part}.{key}")
+            if value is not None and not value.is_zero():
+                out.append(f"{target}.{part}.{key} = {value.c()};")
+    return out
+
+
+def cylinder_input_lines(
+    scene: Scene, target: str, rates: tuple[str, str], pivot: str
+) -> list[str]:
+    """The assignments of a dyad_cylinder_input `target`: the frame pins (O's motion
+    `pivot`), the pin B, the length and its `rates`, the branch and, for the kinematics
+    alone (`target` "cin"), the centres of mass, or for the forces every mass of the
+    barrel and the rod (the link's resultant is the scene's, at O)."""
+    driver = scene.crank
+    params = driver.params
+    branch = params["branch"]
+    rate, accel = rates
+    out = [
+        f"{target} = dyad_cylinder_input_default();",
+        f"{target}.a = fixed_point({_vec(params['base.x'].c(), params['base.y'].c())});",
+        f"{target}.o = {pivot};",
+        f"{target}.pin_b = {_vec(params['pin.x'].c(), params['pin.y'].c())};",
+        f"{target}.length = in->{member(driver.actuator)}_length;",
+        f"{target}.rate = {rate};",
+        f"{target}.accel = {accel};",
+        f"{target}.branch = {branch.c()} < 0 ? -1 : 1;"
+        if branch.tunable
+        else f"{target}.branch = {int(branch.value)};",
+        f"{target}.singular_threshold = {scene.threshold.c()};",
+    ]
+    if "com.x" in params and target == "cin":
+        out.append(f"{target}.link.com = {_vec(params['com.x'].c(), params['com.y'].c())};")
+    return out + _cylinder_part_lines(params, target)
+
+
+def _cylinder_lines(scene: Scene) -> list[str]:
+    """The cylinder's motion and that of the link it turns, first."""
+    c = member(scene.crank.name)
+    at = _vec(scene.crank.params["at.x"].c(), scene.crank.params["at.y"].c())
+    result = f"kin->{kin_name_of_cylinder(scene)}"
+    out = [f"const dyad_point_motion {c}_o = fixed_point({at});", "dyad_cylinder_input cin;"]
+    out += cylinder_input_lines(scene, "cin", ("rate", "accel"), f"{c}_o")
+    out += [
+        f"if (dyad_cylinder(&cin, &{result}) != DYAD_STATUS_OK) {{",
+        f"    *failed = {len(scene.dyads)};",
+        f"    return cylinder_failure(&{result}, &kin->cylinder_failure);",
+        "}",
+    ]
+    return out
+
+
 def _driver_lines(scene: Scene) -> list[str]:
     """The driver's frame and the motion of its origin (O or R)."""
     driver = scene.crank
+    if driver.is_cylinder():
+        return _cylinder_lines(scene)
     c = member(driver.name)
     at = _vec(driver.params["at.x"].c(), driver.params["at.y"].c())
     if driver.is_ram():
@@ -199,6 +269,9 @@ def kinematics_type(scene: Scene) -> str:
     """The kinematics block type: one dyad_kin_result per dyad."""
     ident = scene.identifier
     members = [f"    dyad_kin_result {kin_name(d)};" for d in scene.dyads]
+    if scene.crank and scene.crank.is_cylinder():
+        members.append(f"    dyad_cylinder_result {kin_name_of_cylinder(scene)};")
+        members.append("    dyad_kin_result cylinder_failure; /* its failure, as a dyad's */")
     return "\n".join([f"typedef struct {ident}_kinematics {{", *members, f"}} {ident}_kinematics;"])
 
 
@@ -223,18 +296,55 @@ def kinematics_function(scene: Scene, dyads: list[Dyad]) -> str:
 
 
 def failure_names(scene: Scene) -> str:
-    """The dyads' names by index, for the log, as a C array initialiser."""
-    return ", ".join(textsafe.c_string(d.name or d.type) for d in scene.dyads)
+    """The dyads' names by index (the cylinder's last), for the log, as a C array
+    initialiser."""
+    names = [f"dyad {d.name or d.type}" for d in scene.dyads]
+    if scene.crank and scene.crank.is_cylinder():
+        names.append(f"cylinder {scene.crank.actuator}")
+    return ", ".join(textsafe.c_string(n) for n in names)
 
 
 def driver_rates(scene: Scene) -> tuple[str, str]:
     """The C expressions of the driver's rate and acceleration (0 without inertia)."""
-    c = member(scene.crank.name)
+    c = member(scene.crank.driver_name())
     if not scene.inertia:
         return "0.0", "0.0"
-    if scene.crank.is_ram():
+    if scene.crank.balances_with_force():
         return f"in->{c}_velocity", f"in->{c}_acceleration"
     return f"in->{c}_omega", f"in->{c}_epsilon"
+
+
+def _body_terms(mass: Param | None, inertia: Param | None, com: str, w: str) -> tuple[list, list]:
+    """m V.V + I W^2 and m V.V' + I W W' of one body, from its centre of mass's motion
+    `com` and its angular motion `w` (a prefix of _omega and _epsilon) at unit rate."""
+    j_terms, dj_terms = [], []
+    if mass is not None and not mass.is_zero():
+        v, a = f"{com}.velocity", f"{com}.acceleration"
+        j_terms.append(f"{mass.c()} * dyad_dot({v}, {v})")
+        dj_terms.append(f"{mass.c()} * dyad_dot({v}, {a})")
+    if inertia is not None and not inertia.is_zero():
+        j_terms.append(f"{inertia.c()} * {w}_omega * {w}_omega")
+        dj_terms.append(f"{inertia.c()} * {w}_omega * {w}_epsilon")
+    return j_terms, dj_terms
+
+
+def _cylinder_inertia_terms(scene: Scene) -> tuple[list[str], list[str]]:
+    """The link's, the barrel's and the rod's terms of J and of dJ/dq."""
+    params = scene.crank.params
+    res = f"unit.{kin_name_of_cylinder(scene)}"
+    j_terms, dj_terms = _body_terms(
+        params.get("mass"), params.get("inertia"), f"{res}.link_com", f"{res}.link"
+    )
+    for part in ("barrel", "rod"):
+        j, dj = _body_terms(
+            params.get(f"{part}.mass"),
+            params.get(f"{part}.inertia"),
+            f"{res}.{part}_com",
+            f"{res}.cylinder",
+        )
+        j_terms += j
+        dj_terms += dj
+    return j_terms, dj_terms
 
 
 def inertia_terms(scene: Scene, dyads: list[Dyad]) -> tuple[list[str], list[str]]:
@@ -243,7 +353,9 @@ def inertia_terms(scene: Scene, dyads: list[Dyad]) -> tuple[list[str], list[str]
     driver = scene.crank
     mass = driver.params.get("mass")
     j_terms, dj_terms = [], []
-    if driver.is_ram():
+    if driver.is_cylinder():
+        j_terms, dj_terms = _cylinder_inertia_terms(scene)
+    elif driver.is_ram():
         if mass is not None and not mass.is_zero():
             j_terms.append(mass.c())
     else:

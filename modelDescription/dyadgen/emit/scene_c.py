@@ -26,6 +26,7 @@ from string import Template
 from dyadgen import textsafe
 from dyadgen.emit import kinematics_c, tangent_c
 from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, loaders, member
+from dyadgen.needs import kin_name_of_cylinder
 from dyadgen.table import Table
 
 TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c.in"
@@ -44,6 +45,9 @@ DERIVATIVE_CASE = """    } else if (dyad->status == DYAD_STATUS_OK) {
                  "the directional derivative of dyad %s is not finite at these inputs", name);
 """
 KINEMATICS_INCLUDE = '#include "dyadfmu/dyad.h"\n#include "dyadfmu/kinematics.h"\n'
+CYLINDER_INCLUDE = '#include "dyadfmu/cylinder.h"\n'
+CYLINDER_FAILURE_TEMPLATE = TEMPLATE.with_name("cylinder_failure.c.in")
+FAIL_CYLINDER_TEMPLATE = TEMPLATE.with_name("fail_cylinder.c.in")
 
 
 def _vec(x: str, y: str) -> str:
@@ -106,6 +110,8 @@ class Plan:
             if scene.internal()
             else []
         )
+        #: the kinematics function runs: for the dyads' motion, or a cylinder's
+        self.runs_kinematics = bool(self.kinematic) or bool(self.crank and self.crank.is_cylinder())
         self.accel: dict[str, str | None] = {}  # link -> C name of a_D or None for zero
         self.accel_size: dict[str, str] = {}  # link -> C expression of the size of a_D's terms
 
@@ -148,6 +154,9 @@ class Plan:
         """The pair's point (for a sliding pair: the guide's point) from the carrier's D."""
         if att.kind == "crank" and att.at is None and self.crank.is_ram():
             return None  # the ram's origin R
+        if att.kind == "crank" and att.at is None and self.crank.is_cylinder():
+            params = self.crank.params  # the rod's pin B
+            return self.point(att.link, (params["pin.x"], params["pin.y"]))
         if att.kind == "crank" and att.at is None:
             length = self.crank.params["length"]
             return self.point(att.link, (length, Param("", 0.0, "m", "")))
@@ -165,7 +174,7 @@ class Plan:
 # ---------------------------------------------------------------------------
 def _kinematics(plan: Plan, code: _Code) -> None:
     """Internal kinematics: the chain's motion from the driver's, first."""
-    if not plan.kinematic:
+    if not plan.runs_kinematics:
         return
     scene = plan.scene
     rate, accel = kinematics_c.driver_rates(scene)
@@ -482,6 +491,11 @@ def mechanism_amplification(plan: Plan) -> str:
     its motion's (the accelerations and the effective inertia square the rates)."""
     solved = {d.index for d in plan.solved}
     terms = ["1.0"] + [f"{member(d.name or 'dyad')}_bound" for d in plan.solved]
+    if plan.crank and plan.crank.is_cylinder():
+        kin = f"kin.{kin_name_of_cylinder(plan.scene)}"
+        terms.append(f"3.0 * {kin}.kin_amplification")
+        if plan.crank_needed:
+            terms.append(f"{member(plan.crank.actuator)}_bound")
     terms += [
         f"3.0 * kin.{kinematics_c.kin_name(d)}.amplification"
         for d in plan.kinematic
@@ -525,7 +539,8 @@ def _crank_outputs(plan: Plan) -> tuple[bool, bool]:
 
 def _wanted(plan: Plan, key: str) -> bool:
     """Whether the driver's output `key` (its member's suffix) is wanted."""
-    return any(o.member == f"{member(plan.crank.name)}_{key}" for o in plan.scene.outputs)
+    c = member(plan.crank.driver_name())
+    return any(o.member == f"{c}_{key}" for o in plan.scene.outputs)
 
 
 def _ram(plan: Plan, code: _Code) -> None:
@@ -540,8 +555,60 @@ def _ram(plan: Plan, code: _Code) -> None:
     code(f"{c}_guide_m = -{c}_m_d;")
 
 
+def _cylinder_bound(plan: Plan) -> str:
+    """The bound of the cylinder's forces: the core's (its own terms) and the round-off
+    of the loads on the link, which reach it summed (their sizes over the largest force,
+    the sum of the forces' norms standing for the largest within a factor 4), both
+    carrying the triangle's."""
+    c, link = member(plan.crank.actuator), member(plan.crank.name)
+    params = plan.crank.params
+    pin = f"dyad_norm1({kinematics_c._vec(params['pin.x'].c(), params['pin.y'].c())})"
+    forces = " + ".join(
+        [f"fabs({c}_cyl.axial_force)"] + [f"dyad_norm1({c}_cyl.r_{p})" for p in "abo"]
+    )
+    sizes = f"{link}_f_size + {link}_m_d_size / {pin}"
+    return (
+        f"{c}_cyl.amplification + {c}_cyl.kin_amplification * "
+        f"(1.0 + 4.0 * ({sizes}) / ({forces} + 2.2250738585072014e-308))"
+    )
+
+
+def _cylinder(plan: Plan, code: _Code) -> None:
+    """The cylinder: the loads on its link (its resultant about O, every dyad's reaction
+    on it included) and the barrel's and the rod's own, balanced by the axial force and
+    the pins' reactions (dyadfmu/cylinder.h)."""
+    scene = plan.scene
+    c, link = member(plan.crank.actuator), member(plan.crank.name)
+    rate, accel = kinematics_c.driver_rates(scene)
+    code()
+    code("/* The cylinder: its link's resultant (at O, with its moment about O) and the")
+    code(" * barrel's and the rod's weight and inertia balanced by the axial force and the")
+    code(" * pins' reactions. */")
+    code("{")
+    code("    dyad_cylinder_input cyl_in;")
+    params = plan.crank.params
+    pivot = f"fixed_point({_vec(params['at.x'].c(), params['at.y'].c())})"
+    for line in kinematics_c.cylinder_input_lines(scene, "cyl_in", (rate, accel), pivot):
+        code("    " + line)
+    code(f"    cyl_in.link.force = {link}_f;")
+    code(f"    cyl_in.link.moment = {link}_m_d;")
+    if scene.gravity:
+        gx, gy = scene.gravity_params
+        code(f"    cyl_in.gravity = {_vec(gx.c(), gy.c())};")
+    code(f"    if (dyad_cylinder(&cyl_in, &{c}_cyl) != DYAD_STATUS_OK) {{")
+    code(f"        fail_cylinder(out, &{c}_cyl, {textsafe.c_string(plan.crank.actuator)}, evaluation);")
+    code("        return;")
+    code("    }")
+    code("}")
+    code(f"{c}_force = {c}_cyl.axial_force;")
+    code(f"const double {c}_bound = {_cylinder_bound(plan)};")
+
+
 def _crank(plan: Plan, code: _Code) -> None:
     if not plan.crank_needed:
+        return
+    if plan.crank.is_cylinder():
+        _cylinder(plan, code)
         return
     if plan.crank.is_ram():
         _ram(plan, code)
@@ -562,7 +629,7 @@ def _driver_inertia(plan: Plan, code: _Code) -> None:
     if not plan.inertia_needed:
         return
     scene = plan.scene
-    c = member(scene.crank.name)
+    c = member(scene.crank.driver_name())
     j_terms, dj_terms = kinematics_c.inertia_terms(scene, plan.kinematic)
     code()
     code("/* The effective inertia at the driver: at unit rate and zero acceleration the")
@@ -581,7 +648,7 @@ def _driver_inertia(plan: Plan, code: _Code) -> None:
     code(f"const double {c}_reduced_j = {' + '.join(j_terms) or '0.0'};")
     code(f"const double {c}_reduced_djdq = 2.0 * ({' + '.join(dj_terms) or '0.0'});")
     _, accel = kinematics_c.driver_rates(scene)
-    balance = "force" if scene.crank.is_ram() else "torque"
+    balance = "force" if scene.crank.balances_with_force() else "torque"
     if _wanted(plan, f"{balance}0"):
         code(f"const double {c}_{balance}0 = {c}_{balance} - {c}_reduced_j * {accel};")
 
@@ -603,9 +670,31 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
                 exprs[f"{pre}{pair}_position_{x}"] = f"{kin}.{point}.position.{x}"
         for side in "kp":
             exprs[f"{pre}slide_{side}"] = f"{kin}.slide_{side}.s"
-    c = member(scene.crank.name)
+    c = member(scene.crank.driver_name())
     for key in ("torque0", "force0", "reduced_j", "reduced_djdq"):
         exprs[f"{c}_{key}"] = f"{c}_{key}"
+    if scene.crank.is_cylinder():
+        exprs.update(_cylinder_exprs(scene))
+    return exprs
+
+
+def _cylinder_exprs(scene: Scene) -> dict[str, str]:
+    """The C expressions of a cylinder's outputs and of its link's."""
+    c, link = member(scene.crank.actuator), member(scene.crank.name)
+    kin = f"kin.{kin_name_of_cylinder(scene)}"
+    exprs = {}
+    for key in ("angle", "omega", "epsilon"):
+        exprs[f"{link}_{key}"] = f"{kin}.link_{key}"
+        exprs[f"{c}_{key}"] = f"{kin}.cylinder_{key}"
+    for x in "xy":
+        exprs[f"{c}_b_position_{x}"] = f"{kin}.b.position.{x}"
+        exprs[f"{c}_r_a_{x}"] = f"{c}_cyl.r_a.{x}"
+        exprs[f"{c}_r_b_{x}"] = f"{c}_cyl.r_b.{x}"
+        exprs[f"{link}_r_o_{x}"] = f"{c}_cyl.r_o.{x}"
+    exprs[f"{c}_conditioning"] = f"{kin}.conditioning"
+    exprs[f"{c}_force"] = f"{c}_force"
+    exprs[f"{c}_n_rod"] = f"{c}_cyl.n_rod"
+    exprs[f"{c}_m_rod"] = f"{c}_cyl.m_rod"
     return exprs
 
 
@@ -692,7 +781,10 @@ PASSES = (
 def _declarations(plan: Plan) -> tuple[list[str], list[str]]:
     dyads = [f"    dyad_result {member(d.name or 'dyad')};" for d in plan.solved]
     crank = []
-    if plan.crank_needed and plan.crank.is_ram():
+    if plan.crank_needed and plan.crank.is_cylinder():
+        c = member(plan.crank.actuator)
+        crank += [f"    dyad_cylinder_result {c}_cyl;", f"    double {c}_force;"]
+    elif plan.crank_needed and plan.crank.is_ram():
         c = member(plan.crank.name)
         crank += [f"    double {c}_{key};" for key in ("force", "guide_n", "guide_m")]
     elif plan.crank_needed:
@@ -714,7 +806,7 @@ def _kinematics_code(plan: Plan, tangent: bool = False, later: str = "") -> str:
     """The kinematics function (for the tangent's file, the block type alone) and its
     failure report, for internal kinematics; `fixed_point` where it or `later` (the
     code that follows) calls it."""
-    if not plan.kinematic:
+    if not plan.runs_kinematics:
         return ""
     scene = plan.scene
     if tangent:
@@ -727,7 +819,33 @@ def _kinematics_code(plan: Plan, tangent: bool = False, later: str = "") -> str:
         fixed_point=_template(FIXED_POINT_TEMPLATE).template + "\n" if fixed else "",
         kinematics_function=function,
         names=kinematics_c.failure_names(scene),
+        cylinder_failure=_template(CYLINDER_FAILURE_TEMPLATE).template
+        if scene.crank.is_cylinder()
+        else "",
+        failure_text=_failure_text(scene),
     )
+
+
+def _failure_text(scene: Scene) -> str:
+    """failure_text: how a dyad's (or the cylinder's) triangle fails to close, in words."""
+    lines = [
+        "/* How the failing dyad's (or cylinder's) closure fails, in words. */",
+        "static const char* failure_text(const dyad_kin_result* dyad, int index)",
+        "{",
+    ]
+    if scene.crank.is_cylinder():
+        lines += [
+            f"    if (index == {len(scene.dyads)}) {{",
+            "        return dyad->failure == DYAD_KIN_TOO_FAR",
+            '                   ? "the cylinder is too short to reach, |O A| > |O B| + s"',
+            '                   : "the triangle of its pins does not close, '
+            '|O A| < ||O B| - s|";',
+            "    }",
+        ]
+    else:
+        lines.append("    (void)index;")
+    lines += ["    return dyad_kin_failure_name(dyad->failure);", "}", ""]
+    return "\n".join(lines)
 
 
 def _helpers(plan: Plan, tangent: bool = False, later: str = "") -> str:
@@ -739,6 +857,9 @@ def _helpers(plan: Plan, tangent: bool = False, later: str = "") -> str:
         nan_lines="\n".join(f"    out->{m} = NAN;" for m in reals),
         derivative_case=DERIVATIVE_CASE if tangent else "",
         kinematics_code=_kinematics_code(plan, tangent, later),
+        fail_cylinder=_template(FAIL_CYLINDER_TEMPLATE).substitute(ident=plan.scene.identifier)
+        if plan.crank_needed and plan.crank.is_cylinder()
+        else "",
         check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
     )
 
@@ -767,7 +888,8 @@ def _file_fields(plan: Plan) -> dict[str, str]:
     return {
         "ident": scene.identifier,
         "scene_file": textsafe.c_comment(scene.path.name),
-        "kinematics_include": KINEMATICS_INCLUDE if plan.kinematic else "",
+        "kinematics_include": (KINEMATICS_INCLUDE if plan.runs_kinematics else "")
+        + (CYLINDER_INCLUDE if scene.crank and scene.crank.is_cylinder() else ""),
     }
 
 
@@ -793,7 +915,7 @@ def scene_tangent_c(scene: Scene) -> str:
     computation, <identifier>_derivative."""
     plan, dyad_decls, crank_decls, body = _evaluation(scene)
     kinematics, derivative = tangent_c.scene_tangent(
-        scene, plan.kinematic, dyad_decls + crank_decls + body
+        scene, plan.kinematic, dyad_decls + crank_decls + body, plan.runs_kinematics
     )
     reals = [o.member for o in scene.outputs if not o.integer]
     return _template(TANGENT_TEMPLATE).substitute(

@@ -40,6 +40,8 @@ _DECLARED = {
     "dyad_loaded": STRUCT,
     "dyad_result": STRUCT,
     "dyad_kin_input": STRUCT,
+    "dyad_cylinder_input": STRUCT,
+    "dyad_cylinder_result": STRUCT,
 }
 _DUAL_TYPE = {REAL: "dyad_dual", VEC: "dyad_dual_vec2", POINT: "dyad_dual_point_motion"}
 #: struct members that are vectors, or a point's motion; every other leaf is a scalar
@@ -49,6 +51,28 @@ _VEC_FIELDS = frozenset(
 )
 _POINT_FIELDS = frozenset("point d e com".split())
 _INT_FIELDS = frozenset(["branch"])
+#: the members of a cylinder's input and result (dyadfmu/cylinder.h) that are vectors or
+#: a point's motion, by their last one or two names: their names mean other things in
+#: the dyads' structs
+_CYLINDER_FIELDS = {
+    "link.force": VEC,
+    "link.com": VEC,
+    "barrel.com": REAL,
+    "rod.com": REAL,
+    "a": POINT,
+    "o": POINT,
+    "b": POINT,
+    "barrel_com": POINT,
+    "rod_com": POINT,
+    "link_com": POINT,
+    "pin_b": VEC,
+    "gravity": VEC,
+    "link_dir": VEC,
+    "axis": VEC,
+    "r_a": VEC,
+    "r_b": VEC,
+    "r_o": VEC,
+}
 #: the dual counterpart of each function on dual arguments, with its result's type
 _DUAL_FUNCTIONS = {
     "dyad_vec2_make": ("dyad_kdv_make", VEC),
@@ -73,6 +97,7 @@ _CONSTANT_FUNCTIONS = {
     "dyad_dir_from_angle": VEC,
     "fixed_point": POINT,
     "dyad_kin_input_default": STRUCT,
+    "dyad_cylinder_input_default": STRUCT,
 }
 _SIZE_FUNCTIONS = {
     "dyad_force_size": "dyad_force_size_rate",
@@ -274,6 +299,10 @@ class Dual:
 
 def _field_type(steps: tuple) -> str:
     last = steps[-1][1]
+    two = ".".join(name for _, name in steps[-2:])
+    for key in (two, last):
+        if key in _CYLINDER_FIELDS:
+            return _CYLINDER_FIELDS[key]
     if last in _INT_FIELDS:
         return INT
     return VEC if last in _VEC_FIELDS else POINT if last in _POINT_FIELDS else REAL
@@ -398,6 +427,9 @@ _CORE_CALL = re.compile(
     r"^if \((?P<call>dyad_(?:react|kinematics))_(?P<type>[a-z]{3})\(&(?P<a>[^,]+), &(?P<b>[^)]+)\)"
     r" != DYAD_STATUS_OK\) \{$"
 )
+_CYLINDER_CALL = re.compile(
+    r"^if \(dyad_cylinder\(&(?P<a>[^,]+), &(?P<b>[^)]+)\) != DYAD_STATUS_OK\) \{$"
+)
 _DRIVER_CALL = re.compile(
     r"^const dyad_kin_result\* bad = kinematics\(in, (?P<rate>[^,]+), (?P<accel>[^,]+), "
     r"&(?P<kin>[a-z_]+), &failed\);$"
@@ -405,7 +437,7 @@ _DRIVER_CALL = re.compile(
 #: statements whose values the derivative needs as they are
 _VERBATIM = re.compile(
     r"^(?:[{}]|return(?: [^;]*)?;|\(void\)[A-Za-z0-9_]+;|\*failed = \d+;|if \(bad != NULL\) \{|"
-    r"(?:fail|fail_kinematics)\(.*\);|out->status = \d+;|int failed = 0;)$"
+    r"(?:fail|fail_kinematics|fail_cylinder)\(.*\);|out->status = \d+;|int failed = 0;)$"
 )
 
 
@@ -448,6 +480,7 @@ class Differentiation:
             return ["check_tangent(out, rate, evaluation);"]
         for pattern, write in (
             (_CORE_CALL, self._core_call),
+            (_CYLINDER_CALL, self._cylinder_call),
             (_DRIVER_CALL, self._driver_call),
             (_DECLARATION, self._declaration),
             (_ASSIGNMENT, self._assignment),
@@ -461,6 +494,11 @@ class Differentiation:
         a, b = parse(m["a"]), parse(m["b"])
         args = f"&{plain(a)}, &{rate_of(a)}, &{plain(b)}, &{rate_of(b)}"
         return [f"if ({m['call']}_tangent_{m['type']}({args}) != DYAD_STATUS_OK) {{"]
+
+    def _cylinder_call(self, m: re.Match) -> list[str]:
+        a, b = parse(m["a"]), parse(m["b"])
+        args = f"&{plain(a)}, &{rate_of(a)}, &{plain(b)}, &{rate_of(b)}"
+        return [f"if (dyad_cylinder_tangent({args}) != DYAD_STATUS_OK) {{"]
 
     def _driver_call(self, m: re.Match) -> list[str]:
         rate = dual(parse(m["rate"]), self.names).lifted()
@@ -598,12 +636,14 @@ def _kinematics_tangent(scene: Scene, dyads: list[Dyad], evaluate_text: str) -> 
     )
 
 
-def scene_tangent(scene: Scene, dyads: list[Dyad], evaluate_lines: list[str]) -> tuple[str, str]:
+def scene_tangent(
+    scene: Scene, dyads: list[Dyad], evaluate_lines: list[str], runs_kinematics: bool
+) -> tuple[str, str]:
     """The parts of the scene's `<identifier>_derivative` from the lines of its
     `<identifier>_evaluate`: the code before it (`kinematics_tangent` and its helpers
     where the kinematics are internal, else "") and its body; dyads: those whose
     kinematics it runs."""
     body = Differentiation(scene.identifier, Names(_inputs(scene))).lines(evaluate_lines)
-    if not dyads:
+    if not runs_kinematics:
         return "", _indented(body)
     return _kinematics_tangent(scene, dyads, "\n".join(body)), _indented(body)

@@ -35,7 +35,12 @@ def _named_objects(identifier: str, found: mechanism.Mechanism, crank: Crank | N
                 ("scene", 0, "identifier"),
             )
         )
-    if crank is not None:
+    if crank is not None and crank.is_cylinder():
+        where = ("cylinder", 0, "name")
+        label = f"cylinder '{crank.actuator}'"
+        objects.append(("crank", crank.actuator, label, where))
+        objects.append(("crank", crank.name, f"link '{crank.name}'", ("cylinder", 0, "link")))
+    elif crank is not None:
         where = (crank.kind, 0, "name")
         objects.append(("crank", crank.name, f"{crank.kind} '{crank.name}'", where))
     objects += [
@@ -86,10 +91,12 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     needs_mass = inertia or gravity
     gravity_params = sections.gravity(p, data, gravity)
     threshold = sections.threshold(p, scene_t)
-    kinematics = sections.kinematics(p, scene_t, "crank" in data or "ram" in data)
+    kinematics = sections.kinematics(p, scene_t, any(d in data for d in sections.DRIVERS))
     internal = kinematics == "internal"
-    crank = sections.crank(p, data, inertia, needs_mass, internal) or sections.ram(
-        p, data, needs_mass, internal
+    crank = (
+        sections.crank(p, data, inertia, needs_mass, internal)
+        or sections.ram(p, data, needs_mass, internal)
+        or sections.cylinder(p, data, inertia, needs_mass, internal)
     )
     refused: dict[str, int] = {}
     tables = mechanism.link_tables(p, data, crank, refused)

@@ -36,8 +36,12 @@ SCENE_KEYS = {
 EFFECT_KEYS = {"inertia", "gravity"}
 CRANK_KEYS = {"name", "length", "com", "mass", "inertia", "at"}
 RAM_KEYS = {"name", "guide", "at", "com", "mass", "inertia"}
+CYLINDER_KEYS = {"name", "link", "at", "base", "pin", "branch", "com", "mass", "inertia"}
+CYLINDER_KEYS |= {"barrel", "rod"}
+CYLINDER_PART_KEYS = {"mass", "com", "inertia"}
+DRIVERS = ("crank", "ram", "cylinder")
 LOAD_KEYS = {"force", "moment"}
-TOP_KEYS = {"scene", "effects", "gravity", "crank", "ram", "dyad", "link", "loads", "load", "start"}
+TOP_KEYS = {"scene", "effects", "gravity", "dyad", "link", "loads", "load", "start", *DRIVERS}
 KINEMATICS = ("internal", "external")
 #: sqrt(DBL_EPSILON), where round-off still leaves half of the digits.
 DEFAULT_THRESHOLD = 1.4901161193847656e-8
@@ -162,7 +166,8 @@ def kinematics(p: Problems, scene_t: dict, driven: bool) -> str:
         return "external"
     if value == "internal" and not driven:
         p.add(
-            "[scene]: kinematics = 'internal' needs a driver ([crank] or [ram]) whose motion "
+            "[scene]: kinematics = 'internal' needs a driver ([crank], [ram] or [cylinder]) whose "
+            "motion "
             "the chain follows; without one every link's motion is an input ('external')",
             "scene",
             0,
@@ -195,27 +200,36 @@ def _crank_params(
             "Crank radius |O A|: the crank pin A lies at (length, 0) in the crank frame",
             {"min": 0.0, "min_exclusive": True},
         )
-    com = pair_of_numbers(p, crank_t, "com", where, "crank", 0, required=needs_mass)
+    _crank_mass(p, crank, crank_t, "crank", inertia, needs_mass)
+
+
+def _crank_mass(
+    p: Problems, driver: Crank, table: dict, section: str, inertia: bool, needs_mass: bool
+) -> None:
+    """The mass, centre of mass (in its frame {O; i, j}) and inertia of a link turning
+    about the frame pivot O: a crank, or the link a cylinder turns."""
+    name = driver.name
+    label = "Crank" if section == "crank" else f"Link {name}"
+    frame = "crank frame {O; i_c, j_c}" if section == "crank" else f"frame of {name} {{O; i, j}}"
+    where = f"{section} '{driver.driver_name()}'"
+    com = pair_of_numbers(p, table, "com", where, section, 0, required=needs_mass)
     if com is not None and needs_mass:
-        crank.params["com.x"] = Param(
-            f"{cname}.com.x",
-            com[0],
-            "m",
-            "Crank's centre of mass, x in the crank frame {O; i_c, j_c}",
+        driver.params["com.x"] = Param(
+            f"{name}.com.x", com[0], "m", f"{label}'s centre of mass, x in the {frame}"
         )
-        crank.params["com.y"] = Param(
-            f"{cname}.com.y", com[1], "m", "Crank's centre of mass, y in the crank frame"
+        driver.params["com.y"] = Param(
+            f"{name}.com.y", com[1], "m", f"{label}'s centre of mass, y in the {frame.split(' {')[0]}"
         )
-    mass = number(p, crank_t, "mass", where, "crank", 0, nonnegative=True, required=needs_mass)
+    mass = number(p, table, "mass", where, section, 0, nonnegative=True, required=needs_mass)
     if mass is not None and needs_mass:
-        crank.params["mass"] = Param(f"{cname}.mass", mass, "kg", "Crank's mass", {"min": 0.0})
-    inert = number(p, crank_t, "inertia", where, "crank", 0, nonnegative=True, required=inertia)
+        driver.params["mass"] = Param(f"{name}.mass", mass, "kg", f"{label}'s mass", {"min": 0.0})
+    inert = number(p, table, "inertia", where, section, 0, nonnegative=True, required=inertia)
     if inert is not None and inertia:
-        crank.params["inertia"] = Param(
-            f"{cname}.inertia",
+        driver.params["inertia"] = Param(
+            f"{name}.inertia",
             inert,
             "kg.m2",
-            "Crank's moment of inertia about its centre of mass",
+            f"{label}'s moment of inertia about its centre of mass",
             {"min": 0.0},
         )
 
@@ -294,11 +308,150 @@ def ram(p: Problems, data: dict, needs_mass: bool, internal: bool) -> Crank | No
     if "crank" in data:
         p.add("[ram]: a scene has one driver, a [crank] or a [ram], not both", "ram", 0)
         return None
+    if "cylinder" in data:
+        p.add("[ram]: a scene has one driver, a [ram] or a [cylinder], not both", "ram", 0)
+        return None
     if not internal:
         p.add("[ram]: a ram drives the chain only with kinematics = 'internal'", "ram", 0)
         return None
     found = Crank(name, p.loc.line("ram"), kind="ram")
     _ram_params(p, ram_t, found, needs_mass)
+    return found
+
+
+def _part_number(p: Problems, part_t: dict, key: str, part: str, required: bool) -> float | None:
+    """A number of the cylinder's barrel or rod table (located at that table's line)."""
+    where = f"[cylinder] {part}"
+    if key not in part_t:
+        if required:
+            p.add(f"{where}: missing '{key}'", "cylinder", 0, part)
+        return None
+    value = real(part_t[key])
+    if value is None or (key != "com" and not value >= 0):
+        what = "a finite number" if key == "com" else "a finite number, not negative"
+        p.add(f"{where}: '{key}' must be {what}, not {shown(part_t[key])}", "cylinder", 0, part)
+        return None
+    return value
+
+
+_PART_TEXT = {
+    "barrel": ("Barrel", "from A along the cylinder's axis towards B"),
+    "rod": ("Rod (with its piston)", "from B along the cylinder's axis towards A"),
+}
+
+
+def _cylinder_part(p: Problems, table: dict, found: Crank, part: str, inertia: bool) -> None:
+    """The barrel's or the rod's mass, centre of mass on the axis and inertia, where the
+    table gives them (a part left out is massless)."""
+    if part not in table:
+        return
+    part_t = table[part]
+    if not isinstance(part_t, dict):
+        p.add(
+            f"[cylinder]: '{part}' must be a table {{ mass = ..., com = ..., inertia = ... }}",
+            "cylinder",
+            0,
+            part,
+        )
+        return
+    unknown = sorted(set(part_t) - CYLINDER_PART_KEYS)
+    if unknown:
+        p.add(
+            f"[cylinder] {part}: unknown key '{textsafe.plain(str(unknown[0]))}' (known: "
+            f"{', '.join(sorted(CYLINDER_PART_KEYS))})",
+            "cylinder",
+            0,
+            part,
+        )
+    label, along = _PART_TEXT[part]
+    name = f"{found.actuator}.{part}"
+    mass = _part_number(p, part_t, "mass", part, required=True)
+    com = _part_number(p, part_t, "com", part, required=True)
+    inert = _part_number(p, part_t, "inertia", part, required=inertia)
+    if mass is not None:
+        found.params[f"{part}.mass"] = Param(
+            f"{name}.mass", mass, "kg", f"{label}'s mass", {"min": 0.0}
+        )
+    if com is not None:
+        found.params[f"{part}.com"] = Param(
+            f"{name}.com", com, "m", f"{label}'s centre of mass on the axis, {along}"
+        )
+    if inert is not None and inertia:
+        found.params[f"{part}.inertia"] = Param(
+            f"{name}.inertia",
+            inert,
+            "kg.m2",
+            f"{label}'s moment of inertia about its centre of mass",
+            {"min": 0.0},
+        )
+
+
+def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
+    """The frame pins O and A, the pin B in the link's frame and the branch."""
+    name, link = found.actuator, found.name
+    _pivot(p, found, table, "cylinder", f"The pivot O of {link} on the frame")
+    where = f"cylinder '{name}'"
+    texts = (
+        ("base", f"{name}.base", "The barrel's pin A on the frame", "global"),
+        ("pin", f"{name}.pin", f"The rod's pin B on {link}", f"in {link}'s frame"),
+    )
+    for key, prefix, text, frame in texts:
+        point = pair_of_numbers(p, table, key, where, "cylinder", 0)
+        if point is None:
+            continue
+        if key == "pin" and point == (0.0, 0.0):
+            p.add(f"{where}: 'pin' must not be O itself, [0, 0]", "cylinder", 0, key)
+            continue
+        for axis, value in zip("xy", point, strict=True):
+            found.params[f"{key}.{axis}"] = Param(
+                f"{prefix}.{axis}", value, "m", f"{text}, {frame} {axis}"
+            )
+    branch = table.get("branch")
+    if branch not in (1, -1) or isinstance(branch, bool):
+        p.add(
+            f"{where}: 'branch' must be 1 (B to the left of the line from O to A) or -1 "
+            f"(to its right), not {shown(branch)}",
+            "cylinder",
+            0,
+            "branch" if "branch" in table else None,
+        )
+        branch = 1
+    found.params["branch"] = Param(
+        f"{name}.branch",
+        float(branch),
+        None,
+        "Assembly branch of the cylinder's triangle O, A, B: +1 puts B to the left of the "
+        "line from O to A, -1 to its right",
+    )
+
+
+def cylinder(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool) -> Crank | None:
+    """[cylinder], if any: a hydraulic cylinder between the frame pin A and the pin B of
+    a link that it turns about the frame pivot O, the driver."""
+    found_table = _driver_table(p, data, "cylinder", CYLINDER_KEYS)
+    if found_table is None:
+        return None
+    table, name = found_table
+    if "crank" in data:
+        p.add("[cylinder]: a scene has one driver, a [crank] or a [cylinder], not both", "cylinder", 0)
+        return None
+    if not internal:
+        p.add("[cylinder]: a cylinder drives the chain only with kinematics = 'internal'", "cylinder", 0)
+        return None
+    link = table.get("link")
+    problem = name_problem(link) if isinstance(link, str) else "must be a name (a string)"
+    if link is None:
+        problem = "is missing: the name of the link the cylinder turns"
+    if problem:
+        p.add(f"[cylinder]: link {problem}", "cylinder", 0, "link" if link is not None else None)
+        link = f"{name}_link"
+    if link == name:
+        p.add(f"[cylinder]: the link and the cylinder must have names of their own, not both '{name}'", "cylinder", 0, "link")
+    found = Crank(link, p.loc.line("cylinder"), kind="cylinder", actuator=name)
+    _cylinder_geometry(p, table, found)
+    _crank_mass(p, found, table, "cylinder", inertia, needs_mass)
+    for part in ("barrel", "rod"):
+        _cylinder_part(p, table, found, part, inertia)
     return found
 
 
