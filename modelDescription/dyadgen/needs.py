@@ -550,7 +550,12 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene) -> None:
     rates = _driver_inputs(scene, 3)
     bodies = (
         (link, member(link), f"Direction of {link}: angle of its i, in (-pi, pi]", f"{link}"),
-        (c, member(c), f"Direction of cylinder {c}: angle of its axis from A towards B, in (-pi, pi]", f"cylinder {c}"),
+        (
+            c,
+            member(c),
+            f"Direction of cylinder {c}: angle of its axis from A towards B, in (-pi, pi]",
+            f"cylinder {c}",
+        ),
     )
     for name, cm, text, label in bodies:
         _motion_output(offer, f"{name}.angle", "rad", text, f"{cm}_angle", rates[:1], "crank")
@@ -560,7 +565,13 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene) -> None:
                 ("epsilon", "rad/s2", "Angular acceleration", 3),
             ):
                 _motion_output(
-                    offer, f"{name}.{key}", unit, f"{what} of {label}", f"{cm}_{key}", rates[:upto], "crank"
+                    offer,
+                    f"{name}.{key}",
+                    unit,
+                    f"{what} of {label}",
+                    f"{cm}_{key}",
+                    rates[:upto],
+                    "crank",
                 )
     group = [
         Output(
@@ -607,7 +618,14 @@ def _cylinder_outputs(offer: _Offer, scene: Scene) -> None:
     )
     for name, cm, text in pins:
         group = [
-            Output(f"{name}.{x}", "N", f"{text}, global {x}", f"{cm}_{x}", depends=every, source="crank")
+            Output(
+                f"{name}.{x}",
+                "N",
+                f"{text}, global {x}",
+                f"{cm}_{x}",
+                depends=every,
+                source="crank",
+            )
             for x in "xy"
         ]
         offer.add(name, group)
@@ -615,7 +633,9 @@ def _cylinder_outputs(offer: _Offer, scene: Scene) -> None:
         ("N", "N", f"Force of the barrel of {c} on its rod across the axis at B, along k0 x u"),
         ("M", "N.m", f"Moment of the barrel of {c} on its rod, counter-clockwise"),
     ):
-        _motion_output(offer, f"{c}.{key}", unit, text, f"{member(c)}_{key.lower()}_rod", every, "crank")
+        _motion_output(
+            offer, f"{c}.{key}", unit, text, f"{member(c)}_{key.lower()}_rod", every, "crank"
+        )
 
 
 def _ram_outputs(offer: _Offer, scene: Scene) -> None:
@@ -671,7 +691,11 @@ def why_not(scene: Scene, wanted: str) -> str:
                 f"dyad '{d.name}' has no output '{tail}' (it has R_mk, R_np, R_mn, "
                 "conditioning, amplification and N_/M_ of its sliding pairs)"
             )
-    if scene.crank and scene.crank.is_cylinder() and head in (scene.crank.name, scene.crank.actuator):
+    if (
+        scene.crank
+        and scene.crank.is_cylinder()
+        and head in (scene.crank.name, scene.crank.actuator)
+    ):
         return (
             f"the cylinder has 'force', 'R_A', 'R_B', 'N', 'M', its motion and 'B.position'; "
             f"its link '{scene.crank.name}' its motion and 'R_O'"

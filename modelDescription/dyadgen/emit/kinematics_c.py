@@ -58,7 +58,12 @@ class _Mounts:
         """(origin motion, direction, omega, epsilon) of a moving link, in C."""
         if link == self.driver and self.scene.crank.is_cylinder():
             res = f"kin->{kin_name_of_cylinder(self.scene)}"
-            return f"&{member(link)}_o", f"{res}.link_dir", f"{res}.link_omega", f"{res}.link_epsilon"
+            return (
+                f"&{member(link)}_o",
+                f"{res}.link_dir",
+                f"{res}.link_omega",
+                f"{res}.link_epsilon",
+            )
         if link == self.driver:
             c = member(link)
             rate = "0.0" if self.scene.crank.is_ram() else "rate"
@@ -97,9 +102,7 @@ class _Mounts:
                 if owner not in owners:
                     owners.append(owner)
         terms = [f"kin->{kin_name(o)}.amplification" for o in owners]
-        if self.scene.crank.is_cylinder() and any(
-            att.kind == "crank" for att in (d.k, d.p)
-        ):
+        if self.scene.crank.is_cylinder() and any(att.kind == "crank" for att in (d.k, d.p)):
             # the link the cylinder turns carries the triangle's round-off
             terms.append(f"kin->{kin_name_of_cylinder(self.scene)}.kin_amplification")
         return " + ".join(terms) if terms else None
@@ -258,7 +261,7 @@ def _driver_lines(scene: Scene) -> list[str]:
 def kinematics_body(scene: Scene, dyads: list[Dyad]) -> list[str]:
     """The statements of the function `kinematics`."""
     mounts = _Mounts(scene)
-    body = _driver_lines(scene) + ["dyad_kin_input k;"]
+    body = _driver_lines(scene) + (["dyad_kin_input k;"] if dyads else [])
     for d in dyads:
         body += _dyad_lines(scene, mounts, d)
     body.append("return NULL;")

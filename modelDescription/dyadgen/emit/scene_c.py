@@ -45,6 +45,7 @@ DERIVATIVE_CASE = """    } else if (dyad->status == DYAD_STATUS_OK) {
                  "the directional derivative of dyad %s is not finite at these inputs", name);
 """
 KINEMATICS_INCLUDE = '#include "dyadfmu/dyad.h"\n#include "dyadfmu/kinematics.h"\n'
+FAIL_TEMPLATE = TEMPLATE.with_name("scene_fail.c.in")
 CYLINDER_INCLUDE = '#include "dyadfmu/cylinder.h"\n'
 CYLINDER_FAILURE_TEMPLATE = TEMPLATE.with_name("cylinder_failure.c.in")
 FAIL_CYLINDER_TEMPLATE = TEMPLATE.with_name("fail_cylinder.c.in")
@@ -596,7 +597,8 @@ def _cylinder(plan: Plan, code: _Code) -> None:
         gx, gy = scene.gravity_params
         code(f"    cyl_in.gravity = {_vec(gx.c(), gy.c())};")
     code(f"    if (dyad_cylinder(&cyl_in, &{c}_cyl) != DYAD_STATUS_OK) {{")
-    code(f"        fail_cylinder(out, &{c}_cyl, {textsafe.c_string(plan.crank.actuator)}, evaluation);")
+    name = textsafe.c_string(plan.crank.actuator)
+    code(f"        fail_cylinder(out, &{c}_cyl, {name}, evaluation);")
     code("        return;")
     code("    }")
     code("}")
@@ -838,8 +840,7 @@ def _failure_text(scene: Scene) -> str:
             f"    if (index == {len(scene.dyads)}) {{",
             "        return dyad->failure == DYAD_KIN_TOO_FAR",
             '                   ? "the cylinder is too short to reach, |O A| > |O B| + s"',
-            '                   : "the triangle of its pins does not close, '
-            '|O A| < ||O B| - s|";',
+            '                   : "the triangle of its pins does not close, |O A| < ||O B| - s|";',
             "    }",
         ]
     else:
@@ -855,7 +856,11 @@ def _helpers(plan: Plan, tangent: bool = False, later: str = "") -> str:
     return _template(HELPERS_TEMPLATE).substitute(
         ident=plan.scene.identifier,
         nan_lines="\n".join(f"    out->{m} = NAN;" for m in reals),
-        derivative_case=DERIVATIVE_CASE if tangent else "",
+        fail_dyad=_template(FAIL_TEMPLATE).substitute(
+            ident=plan.scene.identifier, derivative_case=DERIVATIVE_CASE if tangent else ""
+        )
+        if plan.solved
+        else "",
         kinematics_code=_kinematics_code(plan, tangent, later),
         fail_cylinder=_template(FAIL_CYLINDER_TEMPLATE).substitute(ident=plan.scene.identifier)
         if plan.crank_needed and plan.crank.is_cylinder()

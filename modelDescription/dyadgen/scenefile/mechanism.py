@@ -273,8 +273,14 @@ class Mechanism:
     def parse(self, data: dict) -> None:
         """Every [[dyad]] table."""
         rows = data.get("dyad", [])
-        if not isinstance(rows, list) or not rows:
-            self.p.add("no [[dyad]] tables: a scene has at least one dyad", "scene", 0)
+        cylinder = self.crank is not None and self.crank.is_cylinder()
+        if not isinstance(rows, list) or not (rows or cylinder):
+            # a cylinder and the link it turns are a mechanism of their own (a tipper body)
+            self.p.add(
+                "no [[dyad]] tables: a scene has at least one dyad (or a [cylinder])",
+                "scene",
+                0,
+            )
             rows = []
         for i, row in enumerate(rows):
             if not isinstance(row, dict):

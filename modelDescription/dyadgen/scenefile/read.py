@@ -93,6 +93,8 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     threshold = sections.threshold(p, scene_t)
     kinematics = sections.kinematics(p, scene_t, any(d in data for d in sections.DRIVERS))
     internal = kinematics == "internal"
+    if "crank" in data and "cylinder" in data:
+        p.add("[cylinder]: a scene has one driver, a [crank] or a [cylinder], not both", "cylinder")
     crank = (
         sections.crank(p, data, inertia, needs_mass, internal)
         or sections.ram(p, data, needs_mass, internal)

@@ -218,7 +218,10 @@ def _crank_mass(
             f"{name}.com.x", com[0], "m", f"{label}'s centre of mass, x in the {frame}"
         )
         driver.params["com.y"] = Param(
-            f"{name}.com.y", com[1], "m", f"{label}'s centre of mass, y in the {frame.split(' {')[0]}"
+            f"{name}.com.y",
+            com[1],
+            "m",
+            f"{label}'s centre of mass, y in the {frame.split(' {')[0]}",
         )
     mass = number(p, table, "mass", where, section, 0, nonnegative=True, required=needs_mass)
     if mass is not None and needs_mass:
@@ -425,18 +428,21 @@ def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
     )
 
 
-def cylinder(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool) -> Crank | None:
+def cylinder(
+    p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool
+) -> Crank | None:
     """[cylinder], if any: a hydraulic cylinder between the frame pin A and the pin B of
     a link that it turns about the frame pivot O, the driver."""
     found_table = _driver_table(p, data, "cylinder", CYLINDER_KEYS)
     if found_table is None:
         return None
     table, name = found_table
-    if "crank" in data:
-        p.add("[cylinder]: a scene has one driver, a [crank] or a [cylinder], not both", "cylinder", 0)
-        return None
     if not internal:
-        p.add("[cylinder]: a cylinder drives the chain only with kinematics = 'internal'", "cylinder", 0)
+        p.add(
+            "[cylinder]: a cylinder drives the chain only with kinematics = 'internal'",
+            "cylinder",
+            0,
+        )
         return None
     link = table.get("link")
     problem = name_problem(link) if isinstance(link, str) else "must be a name (a string)"
@@ -446,7 +452,12 @@ def cylinder(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal:
         p.add(f"[cylinder]: link {problem}", "cylinder", 0, "link" if link is not None else None)
         link = f"{name}_link"
     if link == name:
-        p.add(f"[cylinder]: the link and the cylinder must have names of their own, not both '{name}'", "cylinder", 0, "link")
+        p.add(
+            f"[cylinder]: the link and the cylinder need names of their own, not both '{name}'",
+            "cylinder",
+            0,
+            "link",
+        )
     found = Crank(link, p.loc.line("cylinder"), kind="cylinder", actuator=name)
     _cylinder_geometry(p, table, found)
     _crank_mass(p, found, table, "cylinder", inertia, needs_mass)
