@@ -31,13 +31,16 @@ from dyadfmu.mechanisms import chains
 
 SCENES = ("four_bar_payload", "lift_loads")
 #: (scene, load, the point where the load is placed for the comparison: the scene's
-#: own, or for a load the scene puts at the centre of mass a point off it)
+#: own, or for a load the scene puts at the centre of mass a point off it; the ram's
+#: guide angle, rad: the scene's, or turned so that the ram's frame is not the global
+#: one and its follower force differs from a global one)
 PLACED = [
-    ("four_bar_payload", "payload", None),
-    ("four_bar_payload", "drag", (0.12, -0.015)),
-    ("four_bar_payload", "tool", None),
-    ("lift_loads", "push", None),
-    ("lift_loads", "payload", None),
+    ("four_bar_payload", "payload", None, None),
+    ("four_bar_payload", "drag", (0.12, -0.015), None),
+    ("four_bar_payload", "tool", None, None),
+    ("lift_loads", "push", None, None),
+    ("lift_loads", "push", None, 0.3),
+    ("lift_loads", "payload", None, None),
 ]
 
 
@@ -142,14 +145,16 @@ def test_the_fmus_agree_with_chains_over_the_motion(name, version, branch):
 # ---------------------------------------------------------------------------
 # a load at P = the load at C plus (P - C) x F
 # ---------------------------------------------------------------------------
-def _chain_with(name, edit):
+def _chain_with(name, edit, guide):
     sc = copy.deepcopy(scene(name))
     edit(sc)
+    if guide is not None:
+        sc["ram"]["guide"] = guide
     return chains.Chain(name, sc, harness(name))
 
 
-@pytest.mark.parametrize(("name", "load", "point"), PLACED)
-def test_a_load_at_a_point_is_the_load_at_the_centre_of_mass_plus_r_x_f(name, load, point):
+@pytest.mark.parametrize(("name", "load", "point", "guide"), PLACED)
+def test_a_load_at_a_point_is_the_load_at_the_centre_of_mass_plus_r_x_f(name, load, point, guide):
     """chains.py with the load at P against chains.py with it at the centre of mass C of
     its link and its moment input raised by (P - C) x F: every output alike to
     round-off (1e-13 of its unit's peak) over a cycle at a varying speed; without the
@@ -166,7 +171,7 @@ def test_a_load_at_a_point_is_the_load_at_the_centre_of_mass_plus_r_x_f(name, lo
         moved = next(r for r in sc["load"] if r["name"] == load)
         moved["at"], moved["moment"] = list(com), True
 
-    placed, centred = _chain_with(name, at_point), _chain_with(name, at_com)
+    placed, centred = _chain_with(name, at_point, guide), _chain_with(name, at_com, guide)
     motion = placed.motion("varying", 1.0)
     t = (np.arange(90) + 0.3) * motion.duration / 90
     kin_p, kin_c = placed.kinematics(t, motion), centred.kinematics(t, motion)
