@@ -123,8 +123,9 @@ def assert_close(got, want, rel, what, floor=0.0):
 # data
 # ---------------------------------------------------------------------------
 def test_names_and_paths():
-    assert chains.NAMES == NAMES
-    for name in NAMES:
+    assert chains.NAMES == (*NAMES, "four_bar_payload")
+    assert chains.RAM_NAMES == ("lift", "lift_loads")
+    for name in chains.NAMES + chains.RAM_NAMES:
         assert chains.scene_path(name) == ROOT / "modelDescription" / "scenes" / f"{name}.toml"
         assert chains.scene_path(name).is_file()
     with pytest.raises(ValueError, match="shaper"):

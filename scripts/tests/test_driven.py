@@ -1,9 +1,9 @@
 """The input series and reference outputs of the mechanism FMUs
 (dyadfmu.mechanisms.driven.driver_motion_inputs), for the five built-in mechanisms, the
-crank chains and the ram-driven lift.
+crank chains and the ram-driven chains (the lift), with loads where they act among them.
 
-- the inputs are exactly the driver's motion and the loads the scene lists, with the
-  motion's values;
+- the inputs are exactly the driver's motion and the loads the scene lists ([loads] and
+  [[load]]), with the motion's values;
 - the outputs are named as the FMU names them (written out here per dyad type) and
   equal the kinematics where they are kinematics;
 - J = sum m |v_S|^2 / q'^2 + I omega^2 / q'^2 from the kinematics at the samples
@@ -64,6 +64,11 @@ def test_inputs(kind, name):
         want |= {f"{link}.force.x", f"{link}.force.y"}
     for link in sc.get("loads", {}).get("moment", []):
         want.add(f"{link}.moment")
+    for placed in sc.get("load", []):  # [[load]]: a force unless force = false, a moment
+        if placed.get("force", True):
+            want |= {f"{placed['name']}.force.x", f"{placed['name']}.force.y"}
+        if placed.get("moment", False):
+            want.add(f"{placed['name']}.moment")
     assert set(series.inputs) == want
     fns = (
         (motion.position, motion.velocity, motion.acceleration)

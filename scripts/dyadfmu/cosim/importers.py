@@ -24,7 +24,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-from fmpy import read_model_description
 from lxml import etree
 
 from .. import paths
@@ -43,9 +42,6 @@ MECHANISM_OF = {
 }
 #: The tailored test FMUs (tests/scenes/tailored_<type>.toml) have the generic dyad's inputs.
 TAILORED = tuple(f"tailored_{d}" for d in DYADS)
-#: the scenes with loads where they act ([[load]]) and the mechanism FMU whose motion they
-#: run over: the same links, the loads swinging about zero
-LOADED = {"four_bar_payload": "four_bar", "lift_loads": "lift"}
 VERSIONS = (2, 3)
 #: The fmi-sim this comparison is made with (scripts/env.sh installs it).
 FMI_SIM_VERSION = "0.7.0"
@@ -104,12 +100,7 @@ def fmu_names() -> list[str]:
     """Every FMU the build makes, without the _fmi<v> suffix."""
     mechanisms = [n for n in mechanism_fmus.MECHANISM_FMUS if n not in scenes.NAMES]
     return (
-        [f"dyad_{d}" for d in DYADS]
-        + list(scenes.NAMES)
-        + mechanisms
-        + list(LOADED)
-        + list(TAILORED)
-        + ["drive"]
+        [f"dyad_{d}" for d in DYADS] + list(scenes.NAMES) + mechanisms + list(TAILORED) + ["drive"]
     )
 
 
@@ -146,28 +137,9 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
         )[0]
         path = (build or paths.build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
         return setup_for(path, generic.time, generic.inputs)
-    if name in LOADED:
-        return loaded_setup(name, version, build, steps)
-    if name not in scenes.NAMES:  # a mechanism FMU of a built-in mechanism, or the lift
+    if name not in scenes.NAMES:  # a mechanism FMU of a built-in mechanism or a chain
         return mechanism_fmus.setup(name, version, revolutions=1.0, steps=steps, build=build)[0]
     return scenes.setup(name, version, 1.0, steps, build=build)[0]
-
-
-def loaded_setup(name: str, version: int, build: Path | None, steps: int) -> CoSimSetup:
-    """A scene with loads where they act over the motion of the mechanism it loads: the
-    driver's inputs of that mechanism's setup, every other input (the loads, N and N.m) a
-    sine of its own amplitude and phase over the run."""
-    base = mechanism_fmus.setup(LOADED[name], version, revolutions=1.0, steps=steps, build=build)[0]
-    path = (build or paths.build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
-    names = [
-        v.name for v in read_model_description(str(path)).modelVariables if v.causality == "input"
-    ]
-    phase = 2 * math.pi * base.time / base.time[-1]
-    inputs = {}
-    for k, input_name in enumerate(names):
-        swing = 40.0 * (k + 1) * np.sin(phase + k)
-        inputs[input_name] = base.inputs.get(input_name, swing)
-    return setup_for(path, base.time, inputs)
 
 
 # ---------------------------------------------------------------------------

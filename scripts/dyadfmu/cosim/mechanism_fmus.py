@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from fmpy import read_model_description
 
 from .. import paths
 from ..fmi.simulate import CoSimSetup, setup_for
@@ -33,12 +34,19 @@ MECHANISM_FMUS = {
     "sixbar": ("chain", "sixbar"),
     "rocker_slider": ("chain", "rocker_slider"),
     "lift": ("chain", "lift"),
+    "four_bar_payload": ("chain", "four_bar_payload"),
+    "lift_loads": ("chain", "lift_loads"),
 }
 
 #: The mechanisms that close in two ways: their FMU's tunable branch parameter, and the
 #: sign that turns the harness's branch into the scene's (the four-bar of mechanisms.toml
-#: counts E's side along A -> O4, the scene along D_m -> D_n = O4 -> A).
-BRANCHES = {"slider_crank": ("engine.branch", 1), "four_bar": ("linkage.branch", -1)}
+#: counts E's side along A -> O4, the scene along D_m -> D_n = O4 -> A; the loaded
+#: four-bar, a chain, takes the scene's branch, and its branch 1 is the four-bar's).
+BRANCHES = {
+    "slider_crank": ("engine.branch", 1),
+    "four_bar": ("linkage.branch", -1),
+    "four_bar_payload": ("linkage.branch", -1),
+}
 
 
 @dataclass
@@ -85,10 +93,15 @@ def is_kinematic(output: str) -> bool:
     )
 
 
-def mechanism_of(name: str) -> builtin.Mechanism | chains.Chain:
+def mechanism_of(name: str, branch: int = 1) -> builtin.Mechanism | chains.Chain:
     """The harness mechanism behind a mechanism FMU, with the scene's effects (a scene
-    without gravity, the monitor's horizontal four-bar, gets a weightless mechanism)."""
+    without gravity, the monitor's horizontal four-bar, gets a weightless mechanism); a
+    chain of BRANCHES on the harness's assembly ``branch`` (a built-in mechanism takes
+    its branch with its kinematics)."""
     kind, harness = MECHANISM_FMUS[name]
+    if kind == "chain" and name in BRANCHES:
+        parameter, sign = BRANCHES[name]
+        return chains.load(harness, branches={parameter.split(".")[0]: sign * branch})
     if kind == "chain":
         return chains.load(harness)
     with open(paths.SCENES_DIR / f"{name}.toml", "rb") as f:
@@ -120,7 +133,7 @@ def setup(
     duration)."""
     if branch != 1 and name not in BRANCHES:
         raise ValueError(f"{name} closes in one way only: branch must be 1, not {branch}")
-    mechanism = mechanism_of(name)
+    mechanism = mechanism_of(name, branch)
     drive = mechanism.motion(motion, revolutions)
     t = communication_grid(drive.duration, revolutions, steps)
     kw = {"branch": branch} if name in BRANCHES else {}
@@ -132,6 +145,13 @@ def setup(
         parameter, sign = BRANCHES[name]
         start[parameter] = float(sign * branch)
     path = paths.built_fmu(name, fmi_version, build, how="scripts/run-tests")
+    variables = read_model_description(str(path)).modelVariables
+    given, wanted = set(series.inputs), {v.name for v in variables if v.causality == "input"}
+    if given != wanted:  # an input left at its start value would go untested
+        raise ValueError(
+            f"{path.name}: the harness gives {sorted(given - wanted)}, which are no inputs "
+            f"of the FMU, and no series for its inputs {sorted(wanted - given)}"
+        )
     return setup_for(path, t, series.inputs, start), series, drive.duration
 
 

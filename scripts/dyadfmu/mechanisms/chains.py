@@ -19,6 +19,12 @@ lift           a ram (hydraulic cylinder) on a horizontal frame guide; dyad ``le
                an arm pivoted on the frame and a strut from the ram's pin; dyad ``hoist``
                (RRT): a platform on a vertical frame guide held by a rod from the arm's tip.
                Payload on the platform.
+four_bar_      crank; dyad ``linkage`` (RRR): the crank-rocker four-bar of four_bar.toml.
+payload        Loads where they act: a payload at a coupler point, a drag along the
+               coupler, a follower force and a moment on the crank beyond its pin;
+               resisting torque on the rocker.
+lift_loads     the lift, loads where they act: a follower force and a moment on the ram,
+               a payload at the platform's far edge.
 =============  ============================================================================
 
 The scene file gives the topology, lengths, mass properties, points of attachment on
@@ -37,6 +43,15 @@ guide acts on it with a normal force N (along j_guide) and a moment M (about R),
 ``<ram>.N`` and ``<ram>.M``; its actuator force along the guide at R, ``<ram>.force``,
 takes the place of the crank's driving torque. ``k`` or ``p = "ram"`` attaches a dyad at
 R; ``{ link = "ram", at = [x, y] }`` at another point of the ram.
+
+Loads. A link the scene lists under ``[loads]`` carries a force at its centre of mass
+and a moment, from the model chains.toml gives it. Each ``[[load]]`` table of the scene
+is a force at the point P = ``at`` of its link's frame (default the centre of mass) on
+any moving body, the driver included, and/or a pure moment; its inputs
+``NAME.force.x/.y`` are global components, or with ``components = "link"`` components
+along the link's i and j (a follower force, F = fx i + fy j). It adds F to its body's
+forces and (P - S) x F + M to its moments about S; chains.toml's model "swinging" gives
+its inputs over the motion.
 
 Conventions (those of the FMUs): global frame x, y, z out of the plane; angles
 counter-clockwise from +x; moments are z components. The crank turns about O (default (0, 0)),
@@ -97,9 +112,9 @@ from .motion import CrankMotion
 __all__ = ["NAMES", "RAM_NAMES", "Chain", "load", "scene_path", "default_data"]
 
 #: The chain mechanisms driven by a crank.
-NAMES = ("shaper", "sixbar", "rocker_slider")
+NAMES = ("shaper", "sixbar", "rocker_slider", "four_bar_payload")
 #: The chain mechanisms driven by a ram (a linear actuator on a frame guide).
-RAM_NAMES = ("lift",)
+RAM_NAMES = ("lift", "lift_loads")
 _ALL_NAMES = NAMES + RAM_NAMES
 
 #: The attachments that are guides (a translational pair at the dyad's outer pair).
@@ -157,6 +172,40 @@ def _require_listed(listed: list, lname: str, what: str, where: str) -> None:
         raise ValueError(f"{where}: the scene lists no {what} on {lname!r} ([loads].{what})")
 
 
+#: The keys of model "swinging", by the input they shape.
+_SWINGING = {"force": ("force", "force_swing"), "moment": ("moment", "moment_swing")}
+
+
+def _swinging(model: Mapping, placed: Mapping, where: str) -> dict:
+    """Model "swinging" of a [[load]]: each of its inputs a mean plus a swing times
+    sin(omega t + phase), omega the motion's; keys only for the inputs the load has."""
+    kind = model.get("model")
+    if kind != "swinging":
+        raise ValueError(f"{where}.model: a [[load]] takes model 'swinging', got {kind!r}")
+    allowed = {"model", "phase"}
+    for what, keys in _SWINGING.items():
+        if placed[what]:
+            allowed.update(keys)
+    stray = sorted(set(model) - allowed)
+    if stray:
+        raise ValueError(
+            f"{where}.{stray[0]}: not a key of this load's model (its inputs: "
+            f"{', '.join(w for w in _SWINGING if placed[w])})"
+        )
+
+    def pair(key: str) -> tuple[float, float]:
+        return geo.pair(model, key, where) if key in model else (0.0, 0.0)
+
+    return {
+        "model": kind,
+        "force": pair("force"),
+        "force_swing": pair("force_swing"),
+        "moment": geo.number(model, "moment", where, default=0.0),
+        "moment_swing": geo.number(model, "moment_swing", where, default=0.0),
+        "phase": geo.number(model, "phase", where, default=0.0),
+    }
+
+
 # ---------------------------------------------------------------------------
 # the chains
 # ---------------------------------------------------------------------------
@@ -208,7 +257,9 @@ class Chain:
     ``effects`` {"inertia": bool, "gravity": bool}; ``plan`` (the dyads resolved: per
     dyad its name, type, links m and n, the attachments k and p, lengths and branch);
     ``pairs`` (every pair of the mechanism, crank pivot first, as used by
-    :meth:`reference`); ``bodies`` (the moving bodies: the crank, then the dyads' links).
+    :meth:`reference`); ``bodies`` (the moving bodies: the crank, then the dyads' links);
+    ``point_loads`` (name -> the scene's [[load]] read: its link, point ``at``,
+    ``follower``, which inputs it has, its model).
     """
 
     def __init__(self, name: str, scene: Mapping, table: Mapping):
@@ -487,59 +538,113 @@ class Chain:
         self.bodies = [self.crank_name] + [g for e in self.plan for g in (e["m"], e["n"])]
 
     def _resolve_loads(self):
+        """The load models of chains.toml's [.load]: one per link the scene's [loads]
+        lists, one per [[load]] of the scene (by its name)."""
         loads = self.scene.get("loads", {})
-        forces, moments = list(loads.get("force", [])), list(loads.get("moment", []))
-        models = self.data.get("load") or {}
+        listed = {"force": list(loads.get("force", [])), "moment": list(loads.get("moment", []))}
+        self.point_loads = self._read_point_loads()
         self._loads = {}
-        for lname, model in models.items():
-            where = f"{self.name}.load.{lname}"
-            if lname not in self.links:
-                raise ValueError(f"{where}: unknown link {lname!r}")
-            kind = model.get("model")
-            if kind == "cutting":
-                _require_listed(forces, lname, "force", where)
-                self._loads[lname] = {
-                    "model": kind,
-                    "F0": geo.number(model, "F0", where),
-                    "v_ref": geo.number(model, "v_ref", where, positive=True),
-                    "s": _sign(model, "s", where) if "s" in model else 1.0,
-                }
-            elif kind == "resisting-torque":
-                _require_listed(moments, lname, "moment", where)
-                self._loads[lname] = {
-                    "model": kind,
-                    "T0": geo.number(model, "T0", where),
-                    "w_ref": geo.number(model, "w_ref", where, positive=True),
-                    "c": geo.number(model, "c", where),
-                }
-            elif kind == "payload":
-                _require_listed(forces, lname, "force", where)
-                self._loads[lname] = {"model": kind, "force": geo.pair(model, "force", where)}
-            elif kind == "resisting-force":
-                _require_listed(forces, lname, "force", where)
-                dyad = next((e for e in self.plan if e["type"] == "RRT" and e["m"] == lname), None)
-                if dyad is None:
-                    raise ValueError(
-                        f"{where}: model 'resisting-force' needs a slider (link m "
-                        f"of an RRT dyad); {lname!r} is none"
-                    )
-                self._loads[lname] = {
-                    "model": kind,
-                    "F0": geo.number(model, "F0", where),
-                    "v_ref": geo.number(model, "v_ref", where, positive=True),
-                    "dyad": dyad["name"],
-                }
+        for key, model in (self.data.get("load") or {}).items():
+            where = f"{self.name}.load.{key}"
+            if key in self.point_loads:
+                self.point_loads[key]["model"] = _swinging(model, self.point_loads[key], where)
+            elif key in self.links:
+                self._loads[key] = self._link_model(key, model, listed, where)
             else:
-                raise ValueError(
-                    f"{where}.model: expected 'cutting', 'resisting-torque', "
-                    f"'resisting-force' or 'payload', got {kind!r}"
-                )
-        for lname in forces + moments:
+                raise ValueError(f"{where}: unknown link or [[load]] {key!r}")
+        for lname in listed["force"] + listed["moment"]:
             if lname not in self._loads:
                 raise ValueError(
                     f"{self.name}.load: the scene loads link {lname!r} but "
                     f"chains.toml has no model for it"
                 )
+        for name, placed in self.point_loads.items():
+            if "model" not in placed:
+                raise ValueError(
+                    f"{self.name}.load: the scene has the [[load]] {name!r} but "
+                    f"chains.toml has no model for it"
+                )
+
+    def _link_model(self, lname: str, model: Mapping, listed: Mapping, where: str) -> dict:
+        """The load model of a link the scene lists under [loads]."""
+        kind = model.get("model")
+        if kind == "cutting":
+            _require_listed(listed["force"], lname, "force", where)
+            return {
+                "model": kind,
+                "F0": geo.number(model, "F0", where),
+                "v_ref": geo.number(model, "v_ref", where, positive=True),
+                "s": _sign(model, "s", where) if "s" in model else 1.0,
+            }
+        if kind == "resisting-torque":
+            _require_listed(listed["moment"], lname, "moment", where)
+            return {
+                "model": kind,
+                "T0": geo.number(model, "T0", where),
+                "w_ref": geo.number(model, "w_ref", where, positive=True),
+                "c": geo.number(model, "c", where),
+            }
+        if kind == "payload":
+            _require_listed(listed["force"], lname, "force", where)
+            return {"model": kind, "force": geo.pair(model, "force", where)}
+        if kind == "resisting-force":
+            _require_listed(listed["force"], lname, "force", where)
+            dyad = next((e for e in self.plan if e["type"] == "RRT" and e["m"] == lname), None)
+            if dyad is None:
+                raise ValueError(
+                    f"{where}: model 'resisting-force' needs a slider (link m "
+                    f"of an RRT dyad); {lname!r} is none"
+                )
+            return {
+                "model": kind,
+                "F0": geo.number(model, "F0", where),
+                "v_ref": geo.number(model, "v_ref", where, positive=True),
+                "dyad": dyad["name"],
+            }
+        raise ValueError(
+            f"{where}.model: expected 'cutting', 'resisting-torque', "
+            f"'resisting-force' or 'payload', got {kind!r}"
+        )
+
+    def _read_point_loads(self) -> dict:
+        """The scene's [[load]] tables, by name: a force at a point ``at`` of a moving link
+        (the driver included; default its centre of mass), its components global or the
+        link's own (``components = "link"``: a follower force), and a pure moment."""
+        rows = self.scene.get("load", [])
+        if not isinstance(rows, list) or not all(isinstance(r, Mapping) for r in rows):
+            raise ValueError(f"scene {self.name}: [[load]] must be an array of tables")
+        taken = set(self.links) | {self.crank_name, "frame", "gravity"}
+        taken |= {e["name"] for e in self.plan}
+        out = {}
+        for row in rows:
+            name = row.get("name")
+            where = f"scene {self.name}.load[{name}]"
+            if not isinstance(name, str) or not name.isidentifier() or name in taken | set(out):
+                raise ValueError(
+                    f"{where}.name: expected an identifier that names no link, dyad, "
+                    "driver or other load"
+                )
+            link = row.get("link")
+            if link != self.crank_name and link not in self.links:
+                raise ValueError(f"{where}.link: unknown link {link!r}")
+            com = self._crank_com if link == self.crank_name else self.links[link]["com"]
+            components = row.get("components", "global")
+            if components not in ("global", "link"):
+                raise ValueError(
+                    f"{where}.components: expected 'global' or 'link', got {components!r}"
+                )
+            force, moment = row.get("force", True), row.get("moment", False)
+            if not (isinstance(force, bool) and isinstance(moment, bool) and (force or moment)):
+                raise ValueError(f"{where}: 'force' and 'moment' are true or false, one true")
+            out[name] = {
+                "name": name,
+                "link": link,
+                "at": geo.pair(row, "at", where) if "at" in row else tuple(com),
+                "follower": components == "link",
+                "force": force,
+                "moment": moment,
+            }
+        return out
 
     def _build_pairs(self):
         """Every pair: output key, kind, the body named first (it receives +R), the other
@@ -633,6 +738,9 @@ class Chain:
         ``L.moment``; points ``O``, ``A``, ``S_crank``, ``S_L``, ``<dyad>.D_m``,
         ``<dyad>.E``, ``<dyad>.D_n``; velocities ``v_A``, ``v_S_crank``, ``v_S_L``;
         accelerations ``a_A``, ``a_S_crank``, ``a_S_L``; ``<dyad>.conditioning``;
+        per [[load]] NAME its inputs ``NAME.force.x``, ``NAME.force.y``, ``NAME.moment``
+        (those it has, components as the scene gives them) and its point ``P_NAME`` with
+        its velocity ``v_P_NAME``;
         ``<dyad>.guide_k.angle`` for a guide on link k; for a guide on a moving link also
         ``<dyad>.slide_k``, ``<dyad>.slide_k_rate``, ``<dyad>.slide_k_accel``.
         Non-array entries: ``frame`` ({"pivots": {label: (x, y)}, "guides": {label:
@@ -730,6 +838,20 @@ class Chain:
             force = geo.col(-model["F0"] * np.tanh(v_rel / model["v_ref"])) * i_k
         return force, moment
 
+    def _place_load(self, placed: dict, state: dict, kin: dict, zero: np.ndarray) -> None:
+        """A [[load]] over the samples: its point P with P's velocity (``P_NAME``,
+        ``v_P_NAME``) and its inputs from its model, ``NAME.force.x/.y`` (as the scene's
+        components say: global, or along the link's i and j) and ``NAME.moment``: each
+        a mean plus a swing times sin(omega t + phase), omega the motion's."""
+        name, model = placed["name"], placed["model"]
+        kin[f"P_{name}"], kin[f"v_P_{name}"], _ = self._material(state, placed["at"])
+        wave = np.sin(self._w0 * geo.inexact(kin["t"]) + model["phase"]) + zero
+        if placed["force"]:
+            for k, c in enumerate("xy"):
+                kin[f"{name}.force.{c}"] = model["force"][k] + model["force_swing"][k] * wave
+        if placed["moment"]:
+            kin[f"{name}.moment"] = model["moment"] + model["moment_swing"] * wave
+
     def _driver(self, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple:
         """The driver's state (as a body) and its kinematics entries, from its coordinate
         q (crank angle or ram position) and its first two time derivatives."""
@@ -772,6 +894,8 @@ class Chain:
             kin[f"S_{b}"], kin[f"v_S_{b}"], kin[f"a_S_{b}"] = self._material(states[b], com)
         for g in self.links:
             kin[f"{g}.force"], kin[f"{g}.moment"] = self._active_load(g, kin, zero, z2)
+        for placed in self.point_loads.values():
+            self._place_load(placed, states[placed["link"]], kin, zero)
         # scalar views with the FMU input names
         for g in self.links:
             for key in ("accel_d", "force"):
@@ -870,7 +994,8 @@ class Chain:
     # ---- dynamics ---------------------------------------------------------
     def _body_data(self, kin: dict):
         """Per body: mass, inertia, S (N, 2), a_S (N, 2) from accel_d, omega, epsilon and
-        the centre of mass, epsilon, omega, velocity of S."""
+        the centre of mass, epsilon, the load of its [loads] model (at S) and the
+        [[load]]s on it, (P, F, M) each (:meth:`placed_load`)."""
         c = self.crank_name
         out = {}
         for b in self.bodies:
@@ -895,8 +1020,30 @@ class Chain:
                 "epsilon": e,
                 "force": force,
                 "moment": moment,
+                "placed": [
+                    tuple(np.real(v) for v in self.placed_load(name, kin))
+                    for name, placed in self.point_loads.items()
+                    if placed["link"] == b
+                ],
             }
         return out
+
+    def placed_load(self, name: str, kin: dict) -> tuple:
+        """(P, F, M) of the [[load]] ``name`` over the samples of ``kin``: its point P
+        (N, 2), its force F (N, 2) in global components (a follower force's inputs,
+        along its link's i and j, turned by the link's angle) and its moment M (N,);
+        zero where the load has no such input."""
+        placed = self.point_loads[name]
+        angle = geo.inexact(kin[f"{placed['link']}.angle"])
+        zero = np.zeros_like(angle)
+        f = zero[..., None] + np.zeros(2)
+        if placed["force"]:
+            f = geo.vec(kin[f"{name}.force.x"], kin[f"{name}.force.y"])
+        if placed["follower"]:
+            i = geo.unit(angle)
+            f = geo.col(f[..., 0]) * i + geo.col(f[..., 1]) * geo.rot90(i)
+        moment = geo.inexact(kin[f"{name}.moment"]) if placed["moment"] else zero
+        return geo.inexact(kin[f"P_{name}"]), f, moment + zero
 
     def _known(self, bd: dict):
         """The known terms of body bd: forces (at S) and moments: weight, active load,
@@ -971,6 +1118,9 @@ class Chain:
             r = row[b]
             rhs[:, r : r + 2] -= sum(forces)  # all act at S: no moment about S
             rhs[:, r + 2] -= sum(moments)
+            for P, f, mu in bd["placed"]:  # a force at P: its moment about S too
+                rhs[:, r : r + 2] -= f
+                rhs[:, r + 2] -= geo.cross(P - bd["S"], f) + mu
         return K, rhs
 
     def _outputs(self, kin: dict, x: np.ndarray) -> dict:
@@ -1004,6 +1154,9 @@ class Chain:
             for f in forces:
                 balance.force(b, bd["S"], f)
             for mu in moments:
+                balance.couple(b, mu)
+            for P, f, mu in bd["placed"]:
+                balance.force(b, P, f)
                 balance.couple(b, mu)
         for pr in self.pairs:
             P = np.asarray(kin[pr["point"]], dtype=float)
@@ -1065,11 +1218,16 @@ class Chain:
         return geo.inexact(total)
 
     def load_power(self, kin: dict) -> np.ndarray:
-        """Power [W] of the active loads (weights excluded): sum F . v_S + M omega."""
+        """Power [W] of the active loads (weights excluded): sum F . v_S + M omega over
+        the links' loads, F . v_P + M omega over the [[load]]s (P their points)."""
         total = 0.0
         for g in self.links:
             total = total + geo.dot(geo.inexact(kin[f"{g}.force"]), geo.inexact(kin[f"v_S_{g}"]))
             total = total + geo.inexact(kin[f"{g}.moment"]) * geo.inexact(kin[f"{g}.omega"])
+        for name, placed in self.point_loads.items():
+            _, f, mu = self.placed_load(name, kin)
+            total = total + geo.dot(f, geo.inexact(kin[f"v_P_{name}"]))
+            total = total + mu * geo.inexact(kin[f"{placed['link']}.omega"])
         return geo.inexact(total)
 
     def __repr__(self):
@@ -1268,11 +1426,14 @@ def _rtr(
 # ---------------------------------------------------------------------------
 # loading
 # ---------------------------------------------------------------------------
-def load(name: str, data: Mapping | None = None) -> Chain:
+def load(
+    name: str, data: Mapping | None = None, branches: Mapping[str, int] | None = None
+) -> Chain:
     """The chain ``name`` (one of :data:`NAMES`): its scene file plus its table of the
     packaged ``chains.toml``. ``data`` overrides that table key by key (nested tables
     merged): a mapping, either the whole document (with a table ``name``) or the
-    mechanism's own table, or the path of a TOML file of the same form."""
+    mechanism's own table, or the path of a TOML file of the same form. ``branches``
+    {dyad: +1 or -1} takes the place of the scene's branch of those dyads."""
     if name not in _ALL_NAMES:
         raise ValueError(
             f"unknown chain mechanism {name!r}; expected one of: {', '.join(_ALL_NAMES)}"
@@ -1280,4 +1441,9 @@ def load(name: str, data: Mapping | None = None) -> Chain:
     table = geo.overridden(default_data()[name], name, data)
     with open(scene_path(name), "rb") as f:
         scene = tomllib.load(f)
+    dyads = {str(d.get("name")): d for d in scene.get("dyad", [])}
+    for dyad, branch in (branches or {}).items():
+        if dyad not in dyads:
+            raise ValueError(f"branches: {name} has no dyad {dyad!r}")
+        dyads[dyad]["branch"] = branch
     return Chain(name, scene, table)

@@ -4,7 +4,8 @@ driver's motion and the active loads) and the reference values of its outputs.
 A mechanism FMU (a scene with ``kinematics = "internal"``) takes only the driver's
 motion, ``crank.angle``, ``crank.omega``, ``crank.epsilon`` or ``ram.position``,
 ``ram.velocity``, ``ram.acceleration``, and the loads the scene lists
-(``LINK.force.x/.y``, ``LINK.moment``), and solves the kinematics itself. Its outputs:
+(``LINK.force.x/.y``, ``LINK.moment``, and ``NAME.force.x/.y``, ``NAME.moment`` of each
+``[[load]]``), and solves the kinematics itself. Its outputs:
 ``LINK.angle``, ``LINK.omega``, ``LINK.epsilon``; ``DYAD.D_m.position.x/.y``,
 ``DYAD.E.position.x/.y``, ``DYAD.D_n.position.x/.y`` (pair points, m); the reactions
 ``DYAD.R_mk.x/.y`` ... and
@@ -159,14 +160,22 @@ def generalized_gravity(
 
 
 def _loads_in(scene: Mapping, kin: dict, role: Mapping) -> dict:
-    """The load inputs the scene lists, by FMU name; ``role`` maps a scene link to its
-    key prefix in ``kin``."""
+    """The load inputs the scene lists, by FMU name: those of [loads] (``role`` maps a
+    scene link to its key prefix in ``kin``) and those of each [[load]] (under their
+    own names in ``kin``, which only a chain's kinematics hold)."""
     loads, out = scene.get("loads", {}), {}
     for link in loads.get("force", []):
         force = np.real(kin[f"{role[link]}.force"])
         out[f"{link}.force.x"], out[f"{link}.force.y"] = force[:, 0].copy(), force[:, 1].copy()
     for link in loads.get("moment", []):
         out[f"{link}.moment"] = np.real(np.asarray(kin[f"{role[link]}.moment"])).copy()
+    for placed in scene.get("load", []):
+        keys = ("force.x", "force.y") if placed.get("force", True) else ()
+        keys += ("moment",) if placed.get("moment", False) else ()
+        for key in (f"{placed['name']}.{k}" for k in keys):
+            if key not in kin:
+                raise ValueError(f"{key}: the mechanism has no model of this [[load]] input")
+            out[key] = np.real(np.asarray(kin[key])).copy()
     return out
 
 
