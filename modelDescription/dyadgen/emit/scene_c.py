@@ -335,15 +335,18 @@ def _point_loads(plan: Plan, g: str, r: str | None) -> tuple[list, list, list, l
         if load.force:
             fx, fy = plan.inp(f"{n}.force.x"), plan.inp(f"{n}.force.y")
             f = _vec(fx, fy)
+            size = f"dyad_norm1({f})"
             if load.components == "link":  # a follower force turns with its link
                 f = f"dyad_combine({fx}, {c}_i, {fy}, {c}_j)"
+                # its components' sizes: the turn's products may cancel
+                size = f"fabs({fx}) * dyad_norm1({c}_i) + fabs({fy}) * dyad_norm1({c}_j)"
             forces.append(f)
-            force_sizes.append(f"dyad_norm1({f})")
+            force_sizes.append(size)
             p = plan.point(g, load.at)
             arm = p if r is None else f"dyad_neg({c}_r)" if p is None else f"dyad_sub({p}, {c}_r)"
             if arm is not None:
                 moments.append(f"dyad_cross({arm}, {f})")
-                moment_sizes.append(f"dyad_norm1({arm}) * dyad_norm1({f})")
+                moment_sizes.append(f"dyad_norm1({arm}) * ({size})")
         if load.moment:
             moments.append(plan.inp(f"{n}.moment"))
             moment_sizes.append(f"fabs({moments[-1]})")
