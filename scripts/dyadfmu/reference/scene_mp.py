@@ -1,11 +1,17 @@
 """Independent high-precision reference of a whole mechanism FMU (mpmath).
 
 From a scene file with internal kinematics (``modelDescription/scenes/*.toml`` with a
-``[crank]`` or a ``[ram]``; schema in modelDescription/scenes/README.md) and the FMU's input
-values, :func:`evaluate` gives every Real output of the scene's mechanism FMU as an mpf at a
-chosen precision, and the status. It is built from the two independent references of this
-package, not from the C code or the generated code:
+``[crank]``, a ``[ram]`` or a ``[cylinder]``; schema in modelDescription/scenes/README.md)
+and the FMU's input values, :func:`evaluate` gives every Real output of the scene's
+mechanism FMU as an mpf at a chosen precision, and the status. It is built from the two
+independent references of this package and the cylinder's equations below, not from the
+C code or the generated code:
 
+* a cylinder's triangle: pin B on the circle of radius |pin| about the link's pivot O
+  and on the circle of radius s about the barrel's pin A, on the branch's side of the
+  directed line O -> A; the link's angle turns ``pin`` (B in the link's frame) onto
+  B - O; the rates by implicit differentiation of the closure O + B(theta) - A - s u(psi)
+  = 0 (two 2 x 2 linear solves, ``mpmath.lu_solve``);
 * kinematics, from the driver outwards: each dyad by :func:`.dyad_kinematics.solve`
   (the closure solved by findroot, rates by implicit differentiation), its mounts being
   points and guides of the driver or of the links of earlier dyads, moved as rigid
@@ -19,26 +25,46 @@ package, not from the C code or the generated code:
   the link's angle (a follower force);
 * the driver's balance: a crank's torque about O and the frame's force R_O on it; a ram's
   actuator force along its guide i_r, the guide's normal force N along j_r and reactive
-  moment M about R;
+  moment M about R; a cylinder's three bodies, the barrel (pinned at A, its centre of
+  mass at A + com u), the rod (pinned to the link at B, at B - com u; both turn with the
+  axis u, the rod slides along it) and the link (about O), each with its weight and
+  d'Alembert force and couple, the link with its [[load]] tables and the reactions of the
+  dyads on it: 9 equations in R_A, R_B, R_O, the axial force, N and M, solved by
+  ``mpmath.lu_solve``;
 * with inertia, the effective inertia J = sum m V.V + I W^2 over every moving body (the
   driver included) and dJ/dq = 2 sum (m V.V' + I W W'), V, W the centre of mass's
   velocity and the angular velocity per unit driver rate, V', W' their derivatives in the
   driver's coordinate q: the kinematics evaluated again at unit driver rate and zero
-  driver acceleration; torque0 = torque - J q'' (a ram's force0 likewise).
+  driver acceleration; torque0 = torque - J q'' (a ram's and a cylinder's force0
+  likewise; a cylinder's J counts the link, the barrel, the rod and every dyad link).
+
+A cylinder's link carries dyads and [[load]] tables as a crank does: a dyad names it
+``{ link = "body", at = [x, y] }`` (a point of its frame {O; i, j}) or ``"body"`` alone,
+which is pin B (as ``"crank"`` alone is a crank's pin A). Its outputs: ``body.angle``,
+``hoist.angle`` (the axis u), with inertia their ``omega`` and ``epsilon``,
+``hoist.B.position.x/.y``, ``hoist.force`` (> 0 pushes the pins apart), ``hoist.R_A``
+(on the barrel from the frame), ``hoist.R_B`` (on the link from the rod), ``body.R_O``,
+``hoist.N``, ``hoist.M`` (the barrel's action on the rod across the axis, at B),
+``hoist.conditioning`` (|sin| of the angle between OB and AB) and, with inertia,
+``hoist.J``, ``hoist.dJdq``, ``hoist.force0`` (``body`` and ``hoist`` standing for the
+scene's names).
 
 Every input is taken as the exact binary value of its float; every number of the scene
 (and each parameter given with the inputs) likewise; trigonometric functions of them are
 evaluated exactly. The arithmetic runs at ``dps + 20`` digits and the outputs are rounded
 to ``dps``.
 
-Units: m, s, rad, kg, N, N m. Driver coordinate q: the crank's angle (rad) or the ram's
-position (m); J in kg m2 (crank) or kg (ram); dJdq in kg m2/rad or kg/m.
+Units: m, s, rad, kg, N, N m. Driver coordinate q: the crank's angle (rad), the ram's
+position or the cylinder's length s (m); J in kg m2 (crank) or kg (ram, cylinder); dJdq
+in kg m2/rad or kg/m.
 
 Status (:class:`Result`): ``"ok"``; ``"cannot assemble"`` (the first dyad, from the
-driver, whose closure has no real solution on its branch); ``"singular"`` (a dyad at a
-dead point: its closure's Jacobian vanishes to the working precision, which for the
-float inputs of an FMU means conditioning exactly 0, or TRT / RTT guides exactly
-parallel). The outputs are empty unless the status is ok.
+driver, whose closure has no real solution on its branch; or the cylinder, named by its
+name, whose triangle does not close: s <= 0 or outside [| |OA| - |OB| |, |OA| + |OB|]);
+``"singular"`` (a dyad at a dead point: its closure's Jacobian vanishes to the working
+precision, which for the float inputs of an FMU means conditioning exactly 0, or TRT /
+RTT guides exactly parallel; or the cylinder at its toggle, O, A and B in line, alike).
+The outputs are empty unless the status is ok.
 
 Not reproduced: ``amplification`` (a bound on the FMU's round-off, not a property of the
 mechanism) and ``status``; ``singular_threshold`` and ``on_singular`` are accepted and
@@ -55,6 +81,7 @@ Example::
 from __future__ import annotations
 
 import os
+import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -91,7 +118,10 @@ _SLIDES = {t: (PAIRS[t][0] == "T", PAIRS[t][2] == "T") for t in PAIRS}
 _TWO_BRANCHES = ("RRR", "RRT", "RTR")
 _CRANK_MOTION = ("angle", "omega", "epsilon")
 _RAM_MOTION = ("position", "velocity", "acceleration")
+_CYLINDER_MOTION = ("length", "velocity", "acceleration")
+_DRIVERS = ("crank", "ram", "cylinder")
 _IGNORED = ("singular_threshold", "on_singular")
+_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")
 
 Vec = tuple
 
@@ -140,11 +170,12 @@ class DyadSpec:
 class MechanismScene:
     """A scene read for :func:`evaluate`.
 
-    ``driver`` is ``"crank"`` or ``"ram"``, ``driver_name`` its name in the FMU's
-    variables; ``inputs`` the FMU's inputs with their start values (the driver's motion:
-    rad, rad/s, rad/s2 or m, m/s, m/s2; the loads: N, N m); ``parameters`` every
-    parameter of the scene under the FMU's names (tunable or baked) with its value;
-    ``translating``: the links that slide on a frame guide (no angle output).
+    ``driver`` is ``"crank"``, ``"ram"`` or ``"cylinder"``, ``driver_name`` its name in
+    the FMU's variables; ``driven`` the link a cylinder turns ("" for a crank or a ram);
+    ``inputs`` the FMU's inputs with their start values (the driver's motion: rad, rad/s,
+    rad/s2 or m, m/s, m/s2; the loads: N, N m); ``parameters`` every parameter of the
+    scene under the FMU's names (tunable or baked) with its value; ``translating``: the
+    links that slide on a frame guide (no angle output).
     """
 
     label: str
@@ -160,11 +191,18 @@ class MechanismScene:
     parameters: dict[str, float]
     #: the [[load]] tables: (name, link, components, force?, moment?) each
     point_loads: tuple = ()
+    driven: str = ""
+
+    @property
+    def carrier(self) -> str:
+        """The moving body the first dyads and [[load]] tables may name: the crank, the
+        ram, or the link a cylinder turns."""
+        return self.driven or self.driver_name
 
     @property
     def motion_inputs(self) -> tuple[str, ...]:
         """The driver's coordinate, rate and acceleration inputs (the rates with inertia)."""
-        names = _RAM_MOTION if self.driver == "ram" else _CRANK_MOTION
+        names = {"ram": _RAM_MOTION, "cylinder": _CYLINDER_MOTION}.get(self.driver, _CRANK_MOTION)
         return tuple(f"{self.driver_name}.{k}" for k in names[: 3 if self.inertia else 1])
 
     def split(self, values: Mapping[str, float]) -> tuple[dict, dict]:
@@ -246,10 +284,18 @@ class _Reader:
             self.param("gravity.y", self.number(g, "y", "[gravity]"))
         return inertia, gravity
 
-    def driver(self, needs_mass: bool, inertia: bool) -> tuple[str, str]:
-        if ("crank" in self.data) == ("ram" in self.data):
-            self.fail("[crank]/[ram]", "a mechanism FMU has exactly one driver")
-        kind = "crank" if "crank" in self.data else "ram"
+    def driver(self, needs_mass: bool, inertia: bool) -> tuple[str, str, str]:
+        """(kind, name, the link a cylinder turns or ""), the driver's parameters and
+        motion inputs recorded."""
+        kinds = [k for k in _DRIVERS if k in self.data]
+        if len(kinds) != 1:
+            self.fail("[crank]/[ram]/[cylinder]", "a mechanism FMU has exactly one driver")
+        kind = kinds[0]
+        if kind == "cylinder":
+            name, link = _cylinder(self, needs_mass, inertia)
+            for key in _CYLINDER_MOTION[: 3 if inertia else 1]:
+                self.inputs[f"{name}.{key}"] = 0.0
+            return kind, name, link
         t = self.table(kind, required=True)
         name = str(t.get("name", kind))
         where = f"[{kind}]"
@@ -265,7 +311,7 @@ class _Reader:
         motion = _RAM_MOTION if kind == "ram" else _CRANK_MOTION
         for key in motion[: 3 if inertia else 1]:
             self.inputs[f"{name}.{key}"] = 0.0
-        return kind, name
+        return kind, name, ""
 
     def links(self, needs_mass: bool, inertia: bool) -> dict[str, dict]:
         rows = self.data.get("link", [])
@@ -284,6 +330,59 @@ class _Reader:
         return links
 
 
+_CYLINDER_KEYS = frozenset(
+    ("name", "link", "at", "base", "pin", "branch", "com", "mass", "inertia", "barrel", "rod")
+)
+
+
+def _cylinder(rd: _Reader, needs_mass: bool, inertia: bool) -> tuple[str, str]:
+    """(the cylinder's name, the link it turns): a [cylinder]'s geometry, the link's mass
+    and the barrel's and the rod's, as parameters under the FMU's names."""
+    t, where = rd.table("cylinder", required=True), "[cylinder]"
+    unknown = sorted(set(t) - _CYLINDER_KEYS)
+    if unknown:
+        rd.fail(where, f"unknown key {unknown[0]!r} (keys: {', '.join(sorted(_CYLINDER_KEYS))})")
+    name, link = t.get("name"), t.get("link")
+    for key, value in (("name", name), ("link", link)):
+        if not isinstance(value, str) or not _NAME.fullmatch(value) or value == "frame":
+            rd.fail(f"{where}.{key}", f"must be a lower-case name, not {value!r}")
+    if name == link:
+        rd.fail(where, f"the cylinder and the link it turns are both named {name!r}")
+    rd.param_pair(f"{link}.at", rd.pair(t, "at", where))
+    base, pin = rd.pair(t, "base", where), rd.pair(t, "pin", where)
+    if pin == (0.0, 0.0):
+        rd.fail(f"{where}.pin", "must not be [0, 0]: B must be off the pivot O (|pin| > 0)")
+    if base == (rd.params[f"{link}.at.x"], rd.params[f"{link}.at.y"]):
+        rd.fail(f"{where}.base", "A must differ from the link's pivot O ('at')")
+    rd.param_pair(f"{name}.base", base)
+    rd.param_pair(f"{name}.pin", pin)
+    branch = t.get("branch")
+    if branch not in (1, -1) or isinstance(branch, bool):
+        rd.fail(f"{where}.branch", f"must be 1 or -1, not {branch!r}")
+    rd.param(f"{name}.branch", float(branch))
+    _cylinder_masses(rd, t, name, link, (needs_mass, inertia))
+    return name, link
+
+
+def _cylinder_masses(rd: _Reader, t: dict, name: str, link: str, needs: tuple) -> None:
+    """The link's centre of mass, mass and inertia and the barrel's and the rod's (zero
+    where the scene has no inertia or gravity, or no barrel or rod)."""
+    needs_mass, inertia = needs
+    where = "[cylinder]"
+    rd.param_pair(f"{link}.com", rd.pair(t, "com", where) if needs_mass else (0.0, 0.0))
+    rd.param(f"{link}.mass", rd.number(t, "mass", where) if needs_mass else 0.0)
+    rd.param(f"{link}.inertia", rd.number(t, "inertia", where) if inertia else 0.0)
+    for part in ("barrel", "rod"):
+        spec, here = t.get(part, {}), f"{where}.{part}"
+        if not isinstance(spec, Mapping) or set(spec) - {"mass", "com", "inertia"}:
+            rd.fail(here, "must be { mass = kg, com = m, inertia = kg m2 }")
+        given = needs_mass and part in t
+        rd.param(f"{name}.{part}.mass", rd.number(spec, "mass", here) if given else 0.0)
+        rd.param(f"{name}.{part}.com", rd.number(spec, "com", here) if given else 0.0)
+        held = inertia and part in t
+        rd.param(f"{name}.{part}.inertia", rd.number(spec, "inertia", here) if held else 0.0)
+
+
 def _attachment(rd: _Reader, spec: object, side: str, dyad: str, ctx: dict) -> Attachment:
     """The external link of pair D_m (side k) or D_n (side p) of a dyad, its parameters
     recorded under the FMU's names."""
@@ -296,7 +395,9 @@ def _attachment(rd: _Reader, spec: object, side: str, dyad: str, ctx: dict) -> A
     body = spec["link"]
     if body == "crank" and ctx["driver"] == "crank":
         body = ctx["driver_name"]
-    if body != "frame" and body != ctx["driver_name"] and body not in ctx["done"]:
+    if ctx["driver"] == "cylinder" and body == ctx["driver_name"]:
+        rd.fail(where, f"a dyad hangs on the link the cylinder turns, {ctx['carrier']!r}")
+    if body != "frame" and body != ctx["carrier"] and body not in ctx["done"]:
         rd.fail(where, f"{body!r} is not the frame, the driver nor a link of an earlier dyad")
     pair = "D_m" if side == "k" else "D_n"
     if slides:
@@ -312,7 +413,7 @@ def _attachment(rd: _Reader, spec: object, side: str, dyad: str, ctx: dict) -> A
     if "at" not in spec:
         if body == "frame" or body in ctx["done"]:
             rd.fail(where, f"{pair} needs at = [x, y] (m)")
-        return Attachment(body, None, None)  # the crank's pin, or the ram's R
+        return Attachment(body, None, None)  # the crank's pin A, the ram's R, or pin B
     rd.param_pair(f"{pre}{pair}", rd.pair(spec, "at", where))
     return Attachment(None if body == "frame" else body, None, f"{pre}{pair}")
 
@@ -336,11 +437,13 @@ def _link_geometry(rd: _Reader, d: DyadSpec, links: dict, translating: set) -> N
             rd.param(f"{g}.turn", rd.number(row, "turn", where, 0.0))
 
 
-def _dyads(rd: _Reader, links: dict, kind: str, name: str) -> tuple[list, set]:
+def _dyads(rd: _Reader, links: dict, kind: str, names: tuple) -> tuple[list, set]:
     rows = rd.data.get("dyad", [])
     if not isinstance(rows, list) or not rows:
         rd.fail("[[dyad]]", "a scene has at least one dyad")
-    ctx = {"driver": kind, "driver_name": name, "done": set(), "type": ""}
+    name, driven = names
+    ctx = {"driver": kind, "driver_name": name, "carrier": driven or name}
+    ctx.update(done=set(), type="")
     dyads, translating = [], set()
     for row in rows:
         dname = str(row.get("name", "")) if isinstance(row, Mapping) else ""
@@ -414,11 +517,14 @@ def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
             raise SceneError(f"{label}: cannot read the scene: {exc}") from None
     rd = _Reader(data, label)
     inertia, gravity = rd.effects()
-    kind, name = rd.driver(inertia or gravity, inertia)
+    kind, name, driven = rd.driver(inertia or gravity, inertia)
     links = rd.links(inertia or gravity, inertia)
-    dyads, translating = _dyads(rd, links, kind, name)
+    for taken in (name, driven):
+        if taken in links:
+            rd.fail(f"link '{taken}'", "a [[link]] named like the driver or the link it turns")
+    dyads, translating = _dyads(rd, links, kind, (name, driven))
     forces, moments = _loads(rd, links)
-    placed = _point_loads(rd, links, name)
+    placed = _point_loads(rd, links, driven or name)
     start = rd.table("start")
     for key, value in start.items():
         if key in rd.inputs:
@@ -436,6 +542,7 @@ def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
         inputs=dict(rd.inputs),
         parameters=dict(rd.params),
         point_loads=placed,
+        driven=driven,
     )
 
 
@@ -493,6 +600,34 @@ class _Body:
         )
 
 
+@dataclass(frozen=True)
+class _Axis:
+    """A cylinder's axis at one instant: the barrel's pin A, the unit vector u from A
+    towards B, the length s = |AB| and its rates, and the axis's angular velocity and
+    acceleration (the barrel's and the rod's: they turn together); ``conditioning`` is
+    |sin| of the angle between OB and AB."""
+
+    base: Vec
+    u: Vec
+    length: mpf
+    rate: mpf
+    accel: mpf
+    omega: mpf
+    epsilon: mpf
+    conditioning: mpf
+
+    def point(self, x: mpf, on_rod: bool) -> tuple:
+        """(position, velocity, acceleration) of the point at x (m) from A along u: fixed
+        on the barrel, or on the rod, where x = s - c grows at s' and s''."""
+        x1, x2 = (self.rate, self.accel) if on_rod else (mpf(0), mpf(0))
+        w, e, u, n = self.omega, self.epsilon, self.u, _perp(self.u)
+        return (
+            _add(self.base, _scale(x, u)),
+            _add(_scale(x1, u), _scale(x * w, n)),
+            _add(_scale(x2 - x * w * w, u), _scale(2 * x1 * w + x * e, n)),
+        )
+
+
 # ---------------------------------------------------------------------------
 # the evaluation
 # ---------------------------------------------------------------------------
@@ -500,8 +635,8 @@ class _Body:
 class Result:
     """What :func:`evaluate` gives: ``status`` (:data:`OK`, :data:`CANNOT_ASSEMBLE` or
     :data:`SINGULAR`), ``dyad`` (the name of the dyad that failed, "" for a scene's only,
-    unnamed dyad; None when ok), ``reason`` (why, "" when ok) and ``outputs`` (FMU output
-    name -> mpf in the FMU's unit; empty unless ok)."""
+    unnamed dyad, the cylinder's name for its triangle; None when ok), ``reason`` (why, ""
+    when ok) and ``outputs`` (FMU output name -> mpf in the FMU's unit; empty unless ok)."""
 
     status: str
     dyad: str | None
@@ -517,10 +652,11 @@ class _Chain:
     bodies: dict
     results: dict
     guides: dict
+    axis: _Axis | None = None  # a cylinder's
 
 
 class _Failure(Exception):
-    """A dyad that does not close: status, dyad name, reason."""
+    """A dyad (or the cylinder's triangle) that does not close: status, name, reason."""
 
 
 class _Evaluation:
@@ -538,16 +674,69 @@ class _Evaluation:
         return (self.par[f"{name}.x"], self.par[f"{name}.y"])
 
     # ---- kinematics ---------------------------------------------------------------------
-    def driver_body(self, q: mpf, rate: mpf, accel: mpf) -> _Body:
-        """The driver at coordinate q moving at ``rate`` with ``accel``."""
+    def driver_body(self, q: mpf, rate: mpf, accel: mpf) -> tuple[_Body, _Axis | None]:
+        """The body the first dyads hang on (the crank, the ram or the link a cylinder
+        turns) with the driver at coordinate q moving at ``rate`` with ``accel``, and a
+        cylinder's axis (None for a crank or a ram)."""
+        if self.s.driver == "cylinder":
+            return self.cylinder(q, rate, accel)
         c = self.s.driver_name
         at = self.vec(f"{c}.at")
         zero = mpf(0)
         if self.s.driver == "crank":
             i = (mpmath.cos(q), mpmath.sin(q))
-            return _Body(at, (zero, zero), (zero, zero), i, rate, accel)
+            return _Body(at, (zero, zero), (zero, zero), i, rate, accel), None
         i = (mpmath.cos(self.par[f"{c}.guide"]), mpmath.sin(self.par[f"{c}.guide"]))
-        return _Body(_add(at, _scale(q, i)), _scale(rate, i), _scale(accel, i), i, zero, zero)
+        body = _Body(_add(at, _scale(q, i)), _scale(rate, i), _scale(accel, i), i, zero, zero)
+        return body, None
+
+    def triangle(self, s: mpf) -> tuple[Vec, Vec, mpf]:
+        """(A - O, B - O, |sin| of the angle between OB and AB) of the cylinder at length s:
+        B on the circle of radius |pin| about O and of radius s about A, on the branch's
+        side of the directed line O -> A; _Failure where they do not meet or touch."""
+        c, g = self.s.driver_name, self.s.driven
+        pin, o, a = self.vec(f"{c}.pin"), self.vec(f"{g}.at"), self.vec(f"{c}.base")
+        with mpmath.extraprec(mpmath.mp.prec + 64):  # exact on the inputs' digits: 0 is 0
+            d = (a[0] - o[0], a[1] - o[1])
+            dd, rr = _dot(d, d), _dot(pin, pin)
+            along = (dd + rr - s * s) / 2  # (B - O).(A - O)
+            disc = rr * dd - along * along  # ((A - O) x (B - O))^2
+        for value, name in ((rr, f"{c}.pin"), (dd, f"{c}.base")):
+            if value == 0:
+                raise SceneError(f"{self.s.label}: {name}: O, A and B must be distinct points")
+        if s <= 0 or disc < 0:
+            span = (abs(mpmath.sqrt(dd) - mpmath.sqrt(rr)), mpmath.sqrt(dd) + mpmath.sqrt(rr))
+            reason = f"its length {mpmath.nstr(s, 12)} m is outside the triangle's reach "
+            reason += f"[{mpmath.nstr(span[0], 12)}, {mpmath.nstr(span[1], 12)}] m"
+            raise _Failure(CANNOT_ASSEMBLE, c, reason)
+        h = mpmath.sqrt(disc) * (-1 if self.par[f"{c}.branch"] < 0 else 1)
+        b = ((along * d[0] - h * d[1]) / dd, (along * d[1] + h * d[0]) / dd)
+        sine = abs(h) / (mpmath.sqrt(rr) * s)
+        if sine < mpf(2) ** (-mpmath.mp.prec // 3):
+            raise _Failure(SINGULAR, c, "O, A and B are in line (the toggle)")
+        return d, b, sine
+
+    def cylinder(self, s: mpf, rate: mpf, accel: mpf) -> tuple[_Body, _Axis]:
+        """The link a cylinder turns and the cylinder's axis at length s, s', s'': the
+        closure O + B(theta) - A - s u(psi) = 0 differentiated once and twice in time,
+        J (omega, psi')' = s' u and J (epsilon, psi'')' = s'' u + 2 s' psi' perp(u)
+        - s psi'^2 u + omega^2 (B - O), J = [perp(B - O), -s perp(u)]."""
+        c, g = self.s.driver_name, self.s.driven
+        d, b, sine = self.triangle(s)
+        pin = self.vec(f"{c}.pin")
+        rr = _dot(pin, pin)
+        u = ((b[0] - d[0]) / s, (b[1] - d[1]) / s)
+        n, nb = _perp(u), _perp(b)
+        jac = mpmath.matrix([[nb[0], -s * n[0]], [nb[1], -s * n[1]]])
+        omega, psi1 = mpmath.lu_solve(jac, mpmath.matrix([rate * u[0], rate * u[1]]))
+        rhs = _add(_scale(accel - s * psi1 * psi1, u), _scale(2 * rate * psi1, n))
+        rhs = _add(rhs, _scale(omega * omega, b))
+        eps, psi2 = mpmath.lu_solve(jac, mpmath.matrix(list(rhs)))
+        i = (_dot(pin, b) / rr, _cross(pin, b) / rr)  # R(theta) pin = B - O
+        zero = (mpf(0), mpf(0))
+        body = _Body(self.vec(f"{g}.at"), zero, zero, i, omega, eps)
+        a = self.vec(f"{c}.base")
+        return body, _Axis(a, u, s, rate, accel, psi1, psi2, sine)
 
     def mount(self, att: Attachment, bodies: dict) -> dk.Mount:
         """The motion of an outer pair's external link where the dyad meets it."""
@@ -559,6 +748,8 @@ class _Evaluation:
             local = self.vec(att.at)
         elif att.body == self.s.driver_name and self.s.driver == "crank":
             local = (self.par[f"{att.body}.length"], mpf(0))  # the crank's pin A
+        elif att.body == self.s.driven:
+            local = self.vec(f"{self.s.driver_name}.pin")  # the cylinder's pin B
         else:
             local = (mpf(0), mpf(0))  # the ram's R
         pos, vel, acc = body.point(local)
@@ -594,7 +785,8 @@ class _Evaluation:
     def kinematics(self, q: mpf, rate: mpf, accel: mpf) -> _Chain:
         """The chain's motion, from the driver outwards; _Failure where a dyad does not
         close."""
-        chain = _Chain({self.s.driver_name: self.driver_body(q, rate, accel)}, {}, {})
+        body, axis = self.driver_body(q, rate, accel)
+        chain = _Chain({self.s.carrier: body}, {}, {}, axis)
         for d in self.s.dyads:
             inputs = self.dyad_inputs(d, chain.bodies)
             if _parallel(inputs):
@@ -629,11 +821,17 @@ class _Evaluation:
         """(J, dJ/dq) from the chain moved at unit driver rate and zero driver acceleration,
         where a centre of mass's velocity and acceleration are V and V' and a body's omega
         and epsilon W and W'."""
-        c = self.s.driver_name
+        c = self.s.carrier
         _, v, a = unit.bodies[c].point(self.vec(f"{c}.com"))
         inertia = self.par.get(f"{c}.inertia", mpf(0))
         w = unit.bodies[c].omega
         terms = [(self.par[f"{c}.mass"], inertia, v, a, w, unit.bodies[c].epsilon)]
+        axis, h = unit.axis, self.s.driver_name
+        for part, on_rod in (("barrel", False), ("rod", True)) if axis else ():
+            com = self.par[f"{h}.{part}.com"]
+            _, v, a = axis.point(axis.length - com if on_rod else com, on_rod)
+            mass, inertia = self.par[f"{h}.{part}.mass"], self.par[f"{h}.{part}.inertia"]
+            terms.append((mass, inertia, v, a, axis.omega, axis.epsilon))
         for d in self.s.dyads:
             r = unit.results[d.name]
             for g, tag in ((d.m, "m"), (d.n, "n")):
@@ -655,12 +853,31 @@ class _Evaluation:
             out.update(reactions[d.name])
             out[f"{d.prefix}conditioning"] = _conditioning(d, chain.results[d.name], chain)
         c = self.s.driver_name
+        if chain.axis is not None:
+            out.update(self.cylinder_outputs(chain))
         out.update(reactions[None])
         if self.s.inertia:
             j, dj = self.effective_inertia(self.kinematics(q, mpf(1), mpf(0)))
             effort = "torque" if self.s.driver == "crank" else "force"
             out[f"{c}.J"], out[f"{c}.dJdq"] = j, dj
             out[f"{c}.{effort}0"] = out[f"{c}.{effort}"] - j * accel
+        return out
+
+    def cylinder_outputs(self, chain: _Chain) -> dict[str, mpf]:
+        """The link's and the cylinder's angles (rad) and, with inertia, their rates (rad/s,
+        rad/s2); pin B (m); the triangle's conditioning."""
+        c, g = self.s.driver_name, self.s.driven
+        body, axis = chain.bodies[g], chain.axis
+        out = {}
+        for name, i, w, e in (
+            (g, body.i, body.omega, body.epsilon),
+            (c, axis.u, axis.omega, axis.epsilon),
+        ):
+            out[f"{name}.angle"] = mpmath.atan2(i[1], i[0])
+            if self.s.inertia:
+                out[f"{name}.omega"], out[f"{name}.epsilon"] = w, e
+        out[f"{c}.B.position.x"], out[f"{c}.B.position.y"] = axis.point(axis.length, True)[0]
+        out[f"{c}.conditioning"] = axis.conditioning
         return out
 
 
@@ -701,7 +918,7 @@ class _Kinetostatics:
 
     def __init__(self, ev: _Evaluation, chain: _Chain) -> None:
         self.ev, self.bodies, self.results = ev, chain.bodies, chain.results
-        self.guides = chain.guides
+        self.guides, self.axis = chain.guides, chain.axis
         self.loads = _Loads()
         self.out: dict[str | None, dict[str, mpf]] = {}  # by dyad name; None: the driver
 
@@ -763,6 +980,9 @@ class _Kinetostatics:
     def driver(self) -> None:
         """The driver's balance: a crank's torque and R_O, a ram's force, N and M."""
         ev = self.ev
+        if ev.s.driver == "cylinder":
+            self.cylinder()
+            return
         c, body = ev.s.driver_name, self.bodies[ev.s.driver_name]
         mass = ev.par[f"{c}.mass"]
         arm = body.arm(ev.vec(f"{c}.com"))
@@ -783,6 +1003,71 @@ class _Kinetostatics:
         out[f"{c}.force"] = -_dot(force, body.i)  # the forces on the ram sum to 0
         out[f"{c}.N"] = -_dot(force, _perp(body.i))
         out[f"{c}.M"] = -moment
+
+    def cylinder(self) -> None:
+        """The balance of the barrel (pinned at A, moments about A), the rod (pinned to the
+        link at B, moments about B) and the link (about O, moments about O): 9 equations
+        in x = (R_A, R_B, R_O, the axial force, N, M), solved by mpmath.lu_solve."""
+        ev, axis = self.ev, self.axis
+        h, g = ev.s.driver_name, ev.s.driven
+        link, zero = self.bodies[g], mpf(0)
+        u, n = axis.u, _perp(axis.u)
+        a_pin, b_pin, o_pin = axis.base, axis.point(axis.length, True)[0], link.position
+        ex, ey, none = (mpf(1), zero), (zero, mpf(1)), (zero, zero)
+        minus = lambda v: (-v[0], -v[1])  # noqa: E731
+        # each body: its moment centre, the unknowns' forces on it (index, force per unit,
+        # point, couple per unit), and its known force and moment about the centre
+        barrel = [(0, ex, a_pin, 0), (1, ey, a_pin, 0), (6, minus(u), b_pin, 0)]
+        barrel += [(7, minus(n), b_pin, 0), (8, none, b_pin, -1)]
+        rod = [(2, minus(ex), b_pin, 0), (3, minus(ey), b_pin, 0), (6, u, b_pin, 0)]
+        rod += [(7, n, b_pin, 0), (8, none, b_pin, 1)]
+        body = [(2, ex, b_pin, 0), (3, ey, b_pin, 0), (4, ex, o_pin, 0), (5, ey, o_pin, 0)]
+        parts = [
+            (a_pin, barrel, self.part_known(f"{h}.barrel", a_pin, False)),
+            (b_pin, rod, self.part_known(f"{h}.rod", b_pin, True)),
+            (o_pin, body, self.link_known(g)),
+        ]
+        rows, rhs = [], []
+        for centre, unknowns, (force, moment) in parts:
+            fx, fy, mz = ([zero] * 9 for _ in range(3))
+            for k, f, point, couple in unknowns:
+                fx[k], fy[k] = fx[k] + f[0], fy[k] + f[1]
+                mz[k] += _cross(_add(point, minus(centre)), f) + couple
+            rows += [fx, fy, mz]
+            rhs += [-force[0], -force[1], -moment]
+        x = mpmath.lu_solve(mpmath.matrix(rows), mpmath.matrix(rhs))
+        out = self.out.setdefault(None, {})
+        out[f"{h}.force"], out[f"{h}.N"], out[f"{h}.M"] = x[6], x[7], x[8]
+        for name, k in ((f"{h}.R_A", 0), (f"{h}.R_B", 2), (f"{g}.R_O", 4)):
+            out[f"{name}.x"], out[f"{name}.y"] = x[k], x[k + 1]
+
+    def part_known(self, prefix: str, centre: Vec, on_rod: bool) -> tuple[tuple, mpf]:
+        """The barrel's or the rod's weight and d'Alembert force and moment: (force, moment
+        about ``centre``)."""
+        ev, axis = self.ev, self.axis
+        mass, com = ev.par[f"{prefix}.mass"], ev.par[f"{prefix}.com"]
+        point, _, acc = axis.point(axis.length - com if on_rod else com, on_rod)
+        return self.known(mass, ev.par[f"{prefix}.inertia"], point, acc, axis.epsilon, centre)
+
+    def link_known(self, g: str) -> tuple[tuple, mpf]:
+        """The cylinder's link's weight, d'Alembert force and moment, its [[load]] tables and
+        the reactions of the dyads on it: (force, moment about its pivot O)."""
+        ev, link = self.ev, self.bodies[g]
+        point, _, acc = link.point(ev.vec(f"{g}.com"))
+        mass, inertia = ev.par[f"{g}.mass"], ev.par[f"{g}.inertia"]
+        force, moment = self.known(mass, inertia, point, acc, link.epsilon, link.position)
+        extra, extra_moment = self.loads.about(g, link.position)
+        return _add(force, extra), moment + extra_moment
+
+    def known(self, mass: mpf, inertia: mpf, point: Vec, acc: Vec, eps: mpf, centre: Vec) -> tuple:
+        """A body's weight and d'Alembert force m (g - a) at its centre of mass ``point``,
+        and their moment about ``centre`` with the d'Alembert couple -I epsilon."""
+        zero = mpf(0)
+        if not self.ev.s.inertia:
+            acc, eps = (zero, zero), zero
+        force = _scale(mass, _add(self.ev.gravity, (-acc[0], -acc[1])))
+        moment = _cross((point[0] - centre[0], point[1] - centre[1]), force) - inertia * eps
+        return force, moment
 
     def place(self) -> None:
         """Each [[load]] as a force at its point P (the body's point `at`: global
@@ -887,7 +1172,8 @@ def evaluate(
     when called often). ``values``: FMU variable name -> float, the inputs (the driver's
     motion in rad, rad/s, rad/s2 or m, m/s, m/s2; the loads in N and N m; an input left out
     keeps its start value) and, optionally, any parameter of the scene under its FMU name
-    (``gravity.y`` m/s2, ``engine.branch``, ``rocker.mass`` kg, ...; tunable or baked).
+    (``gravity.y`` m/s2, ``engine.branch``, ``rocker.mass`` kg, ``hoist.pin.x`` m, ...;
+    tunable or baked).
     Returns a :class:`Result`; its ``outputs`` (when ok) are named and scaled as the FMU's.
     """
     return _run(scene, values, dps, "outputs")
