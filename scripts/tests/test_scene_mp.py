@@ -46,6 +46,9 @@ SCENES = dict.fromkeys(
 )
 SCENES["lift"] = (0.13, 0.25, 0.38)  # ram positions (m) over its stroke
 SCENES["lift_loads"] = SCENES["lift"]
+SCENES["tipper"] = (1.4, 3.0, 4.6)  # cylinder lengths (m) over its stroke
+SCENES["cylinder_arm"] = (0.4, 1.2, 2.0)
+SCENES["cylinder_boom"] = (0.95, 1.2, 1.45)
 #: the scenes with a tunable branch
 BRANCHES = {
     "slider_crank": "engine.branch",
@@ -61,7 +64,9 @@ LIFT_LIMIT = 0.712348  # m, about where the lift's arm and strut stretch out
 
 
 def scene_file(name):
-    return paths.SCENES_DIR / f"{name}.toml"
+    """A shipped scene's file, or a test scene's (tests/scenes/)."""
+    shipped = paths.SCENES_DIR / f"{name}.toml"
+    return shipped if shipped.is_file() else paths.ROOT / "tests" / "scenes" / f"{name}.toml"
 
 
 def inputs_at(scene, q):

@@ -47,6 +47,9 @@ MOTION["trt_slot"] = np.linspace(0.1, 3.0, 8)  # the slot's cross slide only in 
 MOTION["lift"] = np.linspace(0.1, 0.7, 8)  # m, the ram's stroke up to its limit
 MOTION["lift_loads"] = MOTION["lift"]
 MOTION["toggles"] = np.linspace(-0.9, 0.85, 8)  # rad, between its two limits
+MOTION["tipper"] = np.linspace(1.25, 4.75, 8)  # m, the cylinder's stroke
+MOTION["cylinder_arm"] = np.linspace(0.25, 2.18, 8)  # m, close to both toggles
+MOTION["cylinder_boom"] = np.linspace(0.95, 1.45, 6)  # m, where its platform hangs
 #: the driver's rates and the loads: arbitrary, nonzero
 RATES = {"omega": 9.5, "epsilon": -23.0, "velocity": 0.35, "acceleration": -1.7}
 LOADS = {"force.x": -850.0, "force.y": 420.0, "moment": -3.5}
@@ -55,6 +58,9 @@ LIMITS = {
     "lift": ("lift", 0.70, 0.72),
     "toggles rtr": ("toggles", 0.80, 0.90),
     "toggles rrt": ("toggles", -0.90, -0.95),
+    # the cylinder's triangle stretched out and folded (O, A and B in line)
+    "cylinder long": ("cylinder_arm", 2.2, 2.25),
+    "cylinder short": ("cylinder_arm", 0.25, 0.2),
 }
 
 
