@@ -19,11 +19,12 @@ TEST_SCENES_DIR = ROOT / "tests" / "scenes"
 HAND_TABLES = ("drive.toml",)
 #: A scene with every feature of the generated code (see the file and scenefile.c_names).
 C_NAMES_PROBE = INTERFACE_DIR / "c_names_probe.toml"
-#: every probe: external kinematics, internal with a crank, internal with a ram
+#: every probe: external kinematics, internal with a crank, a ram, a cylinder
 C_NAMES_PROBES = (
     C_NAMES_PROBE,
     INTERFACE_DIR / "c_names_probe_internal.toml",
     INTERFACE_DIR / "c_names_probe_ram.toml",
+    INTERFACE_DIR / "c_names_probe_cylinder.toml",
 )
 #: Where the headers the generated code includes are found.
 HEADER_DIRS = (ROOT / "src" / "include", ROOT / "src", ROOT / "fmu")

@@ -210,6 +210,8 @@ def _scene_objects(sc) -> list[tuple[str, str]]:
     objects = [("identifier", sc.identifier)]
     if sc.crank:
         objects.append(("crank", sc.crank.name))
+    if sc.crank and sc.crank.actuator:  # a cylinder's name is the driver's too
+        objects.append(("crank", sc.crank.actuator))
     # an unnamed dyad is "dyad" in the generated C (its result, and d_dyad its rate)
     objects += [("dyad", d.name or "dyad") for d in sc.dyads]
     objects += [("link", g) for g in sc.links]
