@@ -412,6 +412,40 @@ static dyad_status cyl_line(double s, double b_dist, dyad_cylinder_result* out)
     return dyad_cylinder(&in, out);
 }
 
+/* The frame pins 1 mm apart (10 cm in float, whose threshold is higher) and the link 1 m
+ * long: the triangle is thin, its conditioning about 1e-3, and every body still balances
+ * within 16 eps x amplification. */
+static int test_cylinder_pins_close(void)
+{
+    int fails = 0, k;
+    for (k = 0; k < 5; ++k) {
+        dyad_cylinder_input in = dyad_cylinder_input_default();
+        dyad_cylinder_result out;
+#ifdef DYAD_REAL_FLOAT
+        in.a.position = vec(0.1, 0);
+#else
+        in.a.position = vec(1e-3, 0);
+#endif
+        in.pin_b = vec(1, 0);
+        in.length = (dyad_real)(0.9995 + 0.00025 * k);
+        in.rate = (dyad_real)0.1;
+        in.accel = (dyad_real)-0.2;
+        in.link.force = vec(30, 100);
+        in.link.moment = -5;
+        in.rod.mass = 2;
+        in.barrel.mass = 3;
+        in.gravity = vec(0, -9.81);
+        CHECK(dyad_cylinder(&in, &out) == DYAD_STATUS_OK, "length %g: %s", (double)in.length,
+              dyad_status_name(out.status));
+        if (out.status == DYAD_STATUS_OK) {
+            const double worst = cyl_worst_imbalance(&in, &out, 0.3);
+            CHECK(worst < 16 * CYL_EPS * out.amplification,
+                  "length %g: imbalance %g above 16 eps x amplification %g", (double)in.length,
+                  worst, 16 * CYL_EPS * out.amplification);
+        }
+    }
+    return fails;
+}
 /* Near and beyond the toggle and the stroke. */
 static int test_cylinder_statuses(void)
 {

@@ -2690,6 +2690,7 @@ static const named_test tests[] = {
     {"cylinder_energy", test_cylinder_energy},
     {"cylinder_tangent", test_cylinder_tangent},
     {"cylinder_statuses", test_cylinder_statuses},
+    {"cylinder_pins_close", test_cylinder_pins_close},
     {"cylinder_invalid", test_cylinder_invalid},
 };
 

@@ -71,6 +71,7 @@ def test_every_example_scene_is_accepted(path, tmp_path):
 DRIVER_MOTION = {
     "crank": ("angle", "omega", "epsilon"),
     "ram": ("position", "velocity", "acceleration"),
+    "cylinder": ("length", "velocity", "acceleration"),
 }
 
 
@@ -95,7 +96,7 @@ def test_the_documentation_says_what_the_fmu_takes(path):
         return
     assert "current kinematics" not in page
     driver = scene.crank
-    motion = [f"{driver.name}.{q}" for q in DRIVER_MOTION[driver.kind]]
+    motion = [f"{driver.driver_name()}.{q}" for q in DRIVER_MOTION[driver.kind]]
     loads = [n for n in inputs if n not in motion]
     assert set(motion) <= set(inputs)
     assert all(re.fullmatch(r"\w+\.(force\.[xy]|moment)", n) for n in loads), loads

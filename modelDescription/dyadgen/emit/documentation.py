@@ -152,7 +152,8 @@ def _param_text(prm: Param) -> str:
     return f"<code>{prm.name}</code>" if prm.tunable else repr(prm.value)
 
 
-def _attachment_text(att: Attachment) -> str:
+def _attachment_text(att: Attachment, scene_kind: str = "crank") -> str:
+    """Where a dyad's outer pair sits, in words (`scene_kind`: the driver's kind)."""
     if att.kind == "frame":
         return "the frame" + (f" (guide at {h(_param_text(att.guide))} rad)" if att.guide else "")
     if att.guide is not None:
@@ -163,10 +164,38 @@ def _attachment_text(att: Attachment) -> str:
     if att.kind == "external":
         return "an external link whose motion is an input"
     if att.at is None:
-        return f"the pin of the crank <code>{h(att.link)}</code>"
+        return f"the {_DRIVER_POINT[scene_kind]} <code>{h(att.link)}</code>"
     return (
         f"<code>{h(att.link)}</code> at ({h(_param_text(att.at[0]))}, "
         f"{h(_param_text(att.at[1]))}) m in its frame"
+    )
+
+
+#: where a dyad sits on the driver when its table gives no point
+_DRIVER_POINT = {"crank": "pin of the crank", "ram": "origin R of the ram", "cylinder": "pin B of"}
+
+
+def _driver_text(scene: Scene) -> str:
+    """The driver's paragraph: what it is and what balances it."""
+    driver = scene.crank
+    name = f"<code>{h(driver.name)}</code>"
+    if driver.is_cylinder():
+        return (
+            f"Cylinder <code>{h(driver.actuator)}</code> between the frame pin A and the pin B "
+            f"of {name}, which turns about the frame pivot O; its length is the driver's "
+            "coordinate. Its axial force and the reactions at A, B and O follow from the "
+            "equilibrium of the link, the barrel and the rod once every dyad is solved."
+        )
+    if driver.is_ram():
+        return (
+            f"Ram {name} sliding on a frame guide; its origin R is at its displacement along "
+            "the guide. Its actuator force and the guide's normal force and moment follow "
+            "from its equilibrium once every dyad is solved."
+        )
+    return (
+        f"Crank {name} about the fixed pivot O; its pin A lies at (length, 0) in its frame. "
+        "Its driving torque and the force of the frame at O follow from its equilibrium "
+        "once every dyad is solved."
     )
 
 
@@ -174,17 +203,12 @@ def _scene_sections(scene: Scene) -> dict[str, str]:
     """The parts of a scene's page that depend on its mechanism."""
     loaded = [f"{g} (force)" for g, link in scene.links.items() if link.force]
     loaded += [f"{g} (moment)" for g, link in scene.links.items() if link.moment]
-    crank = ""
-    if scene.crank:
-        crank = (
-            f"\n<p>Crank <code>{h(scene.crank.name)}</code> about the fixed pivot O; its "
-            "pin A lies at (length, 0) in its frame. Its driving torque and the force of "
-            "the frame at O follow from its equilibrium once every dyad is solved.</p>"
-        )
+    crank = f"\n<p>{_driver_text(scene)}</p>" if scene.crank else ""
+    kind = scene.crank.kind if scene.crank else "crank"
     dyads = "".join(
         f"\n<tr><td><code>{h(d.name or '-')}</code></td><td>{d.type}</td>"
         f"<td><code>{h(d.m)}</code></td><td><code>{h(d.n)}</code></td>"
-        f"<td>{_attachment_text(d.k)}</td><td>{_attachment_text(d.p)}</td></tr>"
+        f"<td>{_attachment_text(d.k, kind)}</td><td>{_attachment_text(d.p, kind)}</td></tr>"
         for d in scene.dyads
     )
     baked = [prm for prm in scene.parameters() if not prm.tunable]
@@ -215,9 +239,10 @@ def _takes(table: Table) -> str:
     scene = table.scene
     if not scene.internal():
         return "the links' current kinematics and active loads"
-    motion = [v.name for v in table.of("input") if v.name.startswith(f"{scene.crank.name}.")]
+    prefix = f"{scene.crank.driver_name()}."
+    motion = [v.name for v in table.of("input") if v.name.startswith(prefix)]
     loads = len(table.of("input")) - len(motion)
-    driver = "ram" if scene.crank.is_ram() else "crank"
+    driver = scene.crank.kind
     named = ", ".join(f"<code>{h(name)}</code>" for name in motion)
     rest = {0: "no load", 1: "the active load (1 input)"}.get(
         loads, f"the active loads ({loads} inputs)"

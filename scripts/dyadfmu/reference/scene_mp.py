@@ -439,8 +439,9 @@ def _link_geometry(rd: _Reader, d: DyadSpec, links: dict, translating: set) -> N
 
 def _dyads(rd: _Reader, links: dict, kind: str, names: tuple) -> tuple[list, set]:
     rows = rd.data.get("dyad", [])
-    if not isinstance(rows, list) or not rows:
-        rd.fail("[[dyad]]", "a scene has at least one dyad")
+    # a cylinder and the link it turns are a mechanism of their own
+    if not isinstance(rows, list) or not (rows or kind == "cylinder"):
+        rd.fail("[[dyad]]", "a scene has at least one dyad (or a [cylinder])")
     name, driven = names
     ctx = {"driver": kind, "driver_name": name, "carrier": driven or name}
     ctx.update(done=set(), type="")
