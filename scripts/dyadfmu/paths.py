@@ -47,6 +47,8 @@ def project_dir() -> Path:
 
 #: The scene files, modelDescription/scenes/*.toml.
 SCENES_DIR = project_dir() / "modelDescription" / "scenes"
+#: The build's test scenes, tests/scenes/*.toml (a checkout's; an installed package has none).
+TEST_SCENES_DIR = project_dir() / "tests" / "scenes"
 #: The scene generator, modelDescription/scene.py.
 GENERATOR = project_dir() / "modelDescription" / "scene.py"
 

@@ -125,8 +125,12 @@ def assert_close(got, want, rel, what, floor=0.0):
 def test_names_and_paths():
     assert chains.NAMES == (*NAMES, "four_bar_payload")
     assert chains.RAM_NAMES == ("lift", "lift_loads")
-    for name in chains.NAMES + chains.RAM_NAMES:
+    assert chains.CYLINDER_NAMES == ("tipper", "cylinder_arm", "cylinder_boom")
+    for name in chains.NAMES + chains.RAM_NAMES + ("tipper",):
         assert chains.scene_path(name) == ROOT / "modelDescription" / "scenes" / f"{name}.toml"
+        assert chains.scene_path(name).is_file()
+    for name in ("cylinder_arm", "cylinder_boom"):  # the build's test scenes
+        assert chains.scene_path(name) == ROOT / "tests" / "scenes" / f"{name}.toml"
         assert chains.scene_path(name).is_file()
     with pytest.raises(ValueError, match="shaper"):
         chains.load("pendulum")

@@ -1,6 +1,7 @@
 """The input series and reference outputs of the mechanism FMUs
 (dyadfmu.mechanisms.driven.driver_motion_inputs), for the five built-in mechanisms, the
-crank chains and the ram-driven chains (the lift), with loads where they act among them.
+crank chains, the ram-driven chains (the lift) and the cylinder-driven ones (the tipper
+and the cylinder test scenes), with loads where they act among them.
 
 - the inputs are exactly the driver's motion and the loads the scene lists ([loads] and
   [[load]]), with the motion's values;
@@ -25,13 +26,18 @@ H = 1e-30
 #: the sliding pairs of each type, written out: D_m (mk), E (mn), D_n (np)
 SLIDING = {"RRR": (), "RRT": ("mk",), "RTR": ("mn",), "TRT": ("mk", "np"), "RTT": ("mk", "mn")}
 CASES = [("builtin", n) for n in builtin.NAMES] + [
-    ("chain", n) for n in chains.NAMES + chains.RAM_NAMES
+    ("chain", n) for n in chains.NAMES + chains.RAM_NAMES + chains.CYLINDER_NAMES
 ]
+#: The cylinder scenes that are test scenes, not examples.
+TEST_SCENES = ("cylinder_arm", "cylinder_boom")
 
 
 def scene_of(kind, name):
     stem = driven.SCENE_OF[name] if kind == "builtin" else name
-    with open(ROOT / "modelDescription" / "scenes" / f"{stem}.toml", "rb") as f:
+    folder = (
+        ROOT / "tests" / "scenes" if name in TEST_SCENES else ROOT / "modelDescription" / "scenes"
+    )
+    with open(folder / f"{stem}.toml", "rb") as f:
         return tomllib.load(f)
 
 
@@ -46,6 +52,8 @@ def driver_names(sc):
     if "ram" in sc:
         name = sc["ram"].get("name", "ram")
         return name, ("position", "velocity", "acceleration"), "force"
+    if "cylinder" in sc:
+        return sc["cylinder"]["name"], ("length", "velocity", "acceleration"), "force"
     name = sc["crank"].get("name", "crank")
     return name, ("angle", "omega", "epsilon"), "torque"
 
@@ -71,9 +79,9 @@ def test_inputs(kind, name):
             want.add(f"{placed['name']}.moment")
     assert set(series.inputs) == want
     fns = (
-        (motion.position, motion.velocity, motion.acceleration)
-        if "ram" in sc
-        else (motion.phi, motion.omega, motion.epsilon)
+        (motion.phi, motion.omega, motion.epsilon)
+        if "crank" in sc
+        else (motion.position, motion.velocity, motion.acceleration)
     )
     for what, fn in zip(motion_names, fns, strict=True):
         assert np.array_equal(series.inputs[f"{driver}.{what}"], fn(t))
@@ -89,9 +97,9 @@ def test_output_names(kind, name):
     sc = scene_of(kind, name)
     driver, _, effort = driver_names(sc)
     want = set()
-    for link in sc["link"]:
+    for link in sc.get("link", []):
         want |= {f"{link['name']}.{k}" for k in ("angle", "omega", "epsilon")}
-    for d in sc["dyad"]:
+    for d in sc.get("dyad", []):
         for point in ("D_m", "E", "D_n"):
             want |= {f"{d['name']}.{point}.position.x", f"{d['name']}.{point}.position.y"}
         want.add(f"{d['name']}.conditioning")
@@ -103,6 +111,14 @@ def test_output_names(kind, name):
         for pair in SLIDING[d["type"]]:
             want |= {f"{d['name']}.N_{pair}", f"{d['name']}.M_{pair}"}
     if "ram" in sc:
+        want |= {f"{driver}.N", f"{driver}.M"}
+    elif "cylinder" in sc:  # the link it turns, its axis, its pins, its barrel and rod
+        link = sc["cylinder"]["link"]
+        want |= {f"{g}.{k}" for g in (link, driver) for k in ("angle", "omega", "epsilon")}
+        want |= {f"{driver}.B.position.x", f"{driver}.B.position.y", f"{driver}.conditioning"}
+        want |= {
+            f"{r}.{c}" for r in (f"{link}.R_O", f"{driver}.R_A", f"{driver}.R_B") for c in "xy"
+        }
         want |= {f"{driver}.N", f"{driver}.M"}
     else:
         want |= {f"{driver}.R_O.x", f"{driver}.R_O.y"}
@@ -118,8 +134,8 @@ def test_outputs_are_the_kinematics(kind, name):
     mech, motion, t, series = setup(kind, name)
     sc = scene_of(kind, name)
     kin = mech.kinematics(t, motion)
-    d = sc["dyad"][0]
     if kind == "builtin":
+        d = sc["dyad"][0]
         role = {d["m"]: "m", d["n"]: "n"}
         points = {f"{d['name']}.{p}.position": p for p in ("D_m", "E", "D_n")}
     else:
@@ -127,6 +143,11 @@ def test_outputs_are_the_kinematics(kind, name):
         points = {
             f"{e['name']}.{p}.position": f"{e['name']}.{p}" for e in mech.plan for p in ("D_m", "E")
         }
+    if "cylinder" in sc:
+        cyl, link = sc["cylinder"]["name"], sc["cylinder"]["link"]
+        role.update({link: link, cyl: cyl})
+        points[f"{cyl}.B.position"] = f"{cyl}.B"
+        assert np.array_equal(series.outputs[f"{cyl}.conditioning"], kin[f"{cyl}.conditioning"])
     for link, key in role.items():
         for what in ("angle", "omega", "epsilon"):
             assert np.array_equal(series.outputs[f"{link}.{what}"], kin[f"{key}.{what}"])
@@ -151,6 +172,8 @@ def coordinates(series):
     d = series.driver
     if f"{d}.position" in series.inputs:
         return (series.inputs[f"{d}.{k}"] for k in ("position", "velocity", "acceleration"))
+    if f"{d}.length" in series.inputs:
+        return (series.inputs[f"{d}.{k}"] for k in ("length", "velocity", "acceleration"))
     return (series.inputs[f"{d}.{k}"] for k in ("angle", "omega", "epsilon"))
 
 

@@ -82,10 +82,12 @@ def test_against_central_differences(name):
 
 
 def _driver(name):
-    """The driver's name, effort and motion inputs: a ram where the scene has one."""
-    if getattr(mf.mechanism_of(name), "driver", "crank") == "ram":
-        return "ram", "force", "position", "velocity", "acceleration"
-    return "crank", "torque", "angle", "omega", "epsilon"
+    """The driver's name, effort and motion inputs: a crank's, a ram's or a cylinder's."""
+    mechanism = mf.mechanism_of(name)
+    if getattr(mechanism, "driver", "crank") == "crank":
+        return "crank", "torque", "angle", "omega", "epsilon"
+    q, rate, accel = (k.rpartition(".")[2] for k in mechanism.coordinate_names)
+    return mechanism.driver_name, "force", q, rate, accel
 
 
 # the monitor offers only its bearing loads: no effort, J or link motion to relate

@@ -36,6 +36,10 @@ MECHANISM_FMUS = {
     "lift": ("chain", "lift"),
     "four_bar_payload": ("chain", "four_bar_payload"),
     "lift_loads": ("chain", "lift_loads"),
+    "tipper": ("chain", "tipper"),
+    # test scenes (tests/scenes/), built with the tests
+    "cylinder_arm": ("chain", "cylinder_arm"),
+    "cylinder_boom": ("chain", "cylinder_boom"),
 }
 
 #: The mechanisms that close in two ways: their FMU's tunable branch parameter, and the
@@ -46,6 +50,7 @@ BRANCHES = {
     "slider_crank": ("engine.branch", 1),
     "four_bar": ("linkage.branch", -1),
     "four_bar_payload": ("linkage.branch", -1),
+    "cylinder_arm": ("hoist.branch", 1),
 }
 
 
@@ -110,6 +115,13 @@ def mechanism_of(name: str, branch: int = 1) -> builtin.Mechanism | chains.Chain
     return builtin.load(harness, data)
 
 
+def scene_file(name: str) -> Path:
+    """The scene file of the mechanism FMU ``name``: a chain's (an example scene or a
+    test scene, :func:`.chains.scene_path`), else ``modelDescription/scenes/<name>.toml``."""
+    kind, harness = MECHANISM_FMUS[name]
+    return chains.scene_path(harness) if kind == "chain" else paths.SCENES_DIR / f"{name}.toml"
+
+
 def relative_error(output: str, got: np.ndarray, want: np.ndarray) -> float:
     """max |got - want| / max |want| (wrapped for an angle; absolute where want is 0)."""
     diff = got - want
@@ -137,9 +149,7 @@ def setup(
     drive = mechanism.motion(motion, revolutions)
     t = communication_grid(drive.duration, revolutions, steps)
     kw = {"branch": branch} if name in BRANCHES else {}
-    series = driven.driver_motion_inputs(
-        mechanism, t, drive, scene=paths.SCENES_DIR / f"{name}.toml", **kw
-    )
+    series = driven.driver_motion_inputs(mechanism, t, drive, scene=scene_file(name), **kw)
     start = {}
     if name in BRANCHES:
         parameter, sign = BRANCHES[name]
@@ -217,6 +227,7 @@ __all__ = [
     "mechanism_of",
     "relative_error",
     "run",
+    "scene_file",
     "setup",
     "summary",
 ]

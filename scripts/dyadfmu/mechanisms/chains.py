@@ -25,6 +25,12 @@ payload        Loads where they act: a payload at a coupler point, a drag along 
                resisting torque on the rocker.
 lift_loads     the lift, loads where they act: a follower force and a moment on the ram,
                a payload at the platform's far edge.
+tipper         a hydraulic cylinder between two pins ([cylinder]) tips a dump body about
+               its rear hinge; dyad ``gate`` (RRR): a tailgate on the body opened by a rod
+               from the chassis. A 10 t payload on the body.
+cylinder_arm   (tests/scenes) a cylinder alone raises an arm; a payload at its tip.
+cylinder_boom  (tests/scenes) a cylinder raises a boom; dyad ``hang`` (RRR): a platform
+               from the boom's tip and a tie to the frame. A payload at the boom's tip.
 =============  ============================================================================
 
 The scene file gives the topology, lengths, mass properties, points of attachment on
@@ -43,6 +49,29 @@ guide acts on it with a normal force N (along j_guide) and a moment M (about R),
 ``<ram>.N`` and ``<ram>.M``; its actuator force along the guide at R, ``<ram>.force``,
 takes the place of the crank's driving torque. ``k`` or ``p = "ram"`` attaches a dyad at
 R; ``{ link = "ram", at = [x, y] }`` at another point of the ram.
+
+The driver may also be a hydraulic cylinder between two pins (``[cylinder]``): its
+barrel pinned to the frame at A (``base``), its rod to the link it turns (``link``) at B
+(``pin``, in that link's frame {O; i, j}), the link pivoted on the frame at O (``at``).
+Its length s = |AB| is the driver's coordinate (``<cyl>.length``, ``.velocity``,
+``.acceleration``). B closes the triangle O, A, B: with e the unit vector from O to A,
+d = |OA|, r = |pin|, B - O = x e + y (k x e), x = (d^2 + r^2 - s^2) / (2 d) and
+y = branch sqrt(r^2 - x^2) (``branch`` +1: B to the left of O -> A). The link's angle turns
+``pin`` onto B - O. The cylinder's axis u = (B - A) / s, its angle ``<cyl>.angle`` and
+j_c = k x u. Rates from the closure differentiated: B' = omega k x (B - O) and
+(B - A) . B' = s s' give omega = s' / ((B - O) x u); B' . j_c = s Omega gives the axis's
+rate Omega; along u, B'' . u = s'' - s Omega^2 gives epsilon, across it B'' . j_c =
+s Omega' + 2 s' Omega gives Omega'. The barrel (frame {A; u, j_c}, centre of mass at
+A + com u) and the rod (frame {B; u, j_c}, centre of mass at B - com u) turn with u; the
+rod's point at B slides along the barrel's axis: its acceleration is (s'' - s Omega^2) u
++ (s Omega' + 2 s' Omega) j_c, the last term the Coriolis one. Pair forces: ``<link>.R_O``
+on the link from the frame at O, ``<cyl>.R_A`` on the barrel from the frame at A,
+``<cyl>.R_B`` on the link from the rod at B; the barrel acts on the rod with
+``<cyl>.force`` u (the axial force, positive pushing the pins apart) and ``<cyl>.N`` j_c at
+B and the couple ``<cyl>.M``, the rod on the barrel with the opposites. The link, the
+barrel and the rod are three bodies of the Newton-Euler system, the force its driver's
+unknown; ``<cyl>.conditioning`` is |(B - O) x u| / r. Dyads and [[load]] tables name the
+link.
 
 Loads. A link the scene lists under ``[loads]`` carries a force at its centre of mass
 and a moment, from the model chains.toml gives it. Each ``[[load]]`` table of the scene
@@ -104,18 +133,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..paths import SCENES_DIR
+from ..paths import SCENES_DIR, TEST_SCENES_DIR
 from . import geometry as geo
 from . import motion as motion_
 from .motion import CrankMotion
 
-__all__ = ["NAMES", "RAM_NAMES", "Chain", "load", "scene_path", "default_data"]
+__all__ = ["NAMES", "RAM_NAMES", "CYLINDER_NAMES", "Chain", "load", "scene_path", "default_data"]
 
 #: The chain mechanisms driven by a crank.
 NAMES = ("shaper", "sixbar", "rocker_slider", "four_bar_payload")
 #: The chain mechanisms driven by a ram (a linear actuator on a frame guide).
 RAM_NAMES = ("lift", "lift_loads")
-_ALL_NAMES = NAMES + RAM_NAMES
+#: The chain mechanisms driven by a hydraulic cylinder between two pins.
+CYLINDER_NAMES = ("tipper", "cylinder_arm", "cylinder_boom")
+#: The mechanisms whose scenes are the build's test scenes (tests/scenes/), not examples.
+_TEST_SCENES = ("cylinder_arm", "cylinder_boom")
+_ALL_NAMES = NAMES + RAM_NAMES + CYLINDER_NAMES
 
 #: The attachments that are guides (a translational pair at the dyad's outer pair).
 _GUIDES = ("guide", "link_guide")
@@ -145,12 +178,12 @@ def _solve2(c1: np.ndarray, c2: np.ndarray, rhs: np.ndarray):
 # ---------------------------------------------------------------------------
 def scene_path(name: str) -> Path:
     """The scene file of mechanism ``name``: ``modelDescription/scenes/<name>.toml`` of the
-    project."""
+    project, or for a test scene ``tests/scenes/<name>.toml``."""
     if name not in _ALL_NAMES:
         raise ValueError(
             f"unknown chain mechanism {name!r}; expected one of: {', '.join(_ALL_NAMES)}"
         )
-    return SCENES_DIR / f"{name}.toml"
+    return (TEST_SCENES_DIR if name in _TEST_SCENES else SCENES_DIR) / f"{name}.toml"
 
 
 def default_data() -> dict:
@@ -206,6 +239,25 @@ def _swinging(model: Mapping, placed: Mapping, where: str) -> dict:
     }
 
 
+def _sliding(
+    key: str, first: str, second: str | None, point: str, guide: str, tag: str, prefix: str
+) -> dict:
+    """A driver's translational pair: ``first`` receives N j at ``point`` (j = k x the
+    unit vector at the angle ``guide``) and the couple M, named ``prefix.N``, ``prefix.M``;
+    ``second`` (None: the frame) the opposites."""
+    return {
+        "key": key,
+        "kind": "T",
+        "first": first,
+        "second": second,
+        "point": point,
+        "guide": guide,
+        "tag": tag,
+        "n_name": f"{prefix}.N",
+        "m_name": f"{prefix}.M",
+    }
+
+
 # ---------------------------------------------------------------------------
 # the chains
 # ---------------------------------------------------------------------------
@@ -253,11 +305,14 @@ class Chain:
     Attributes: ``name``; ``scene`` (the parsed scene file); ``data`` (this chain's table
     of ``chains.toml``, after overrides); ``dyads`` (the scene's [[dyad]] tables, in
     order); ``links`` (name -> the scene's [[link]] table, with ``length`` where it is
-    constant); ``crank`` (the scene's [crank] table); ``gravity`` (gx, gy) [m/s2];
+    constant); ``crank`` (the scene's [crank], [ram] or [cylinder] table); ``driver``
+    ("crank", "ram" or "cylinder"); ``crank_name`` (the driver's body: the crank, the ram
+    or the link a cylinder turns); ``cylinder_name`` (a cylinder's); ``gravity`` (gx, gy) [m/s2];
     ``effects`` {"inertia": bool, "gravity": bool}; ``plan`` (the dyads resolved: per
     dyad its name, type, links m and n, the attachments k and p, lengths and branch);
     ``pairs`` (every pair of the mechanism, crank pivot first, as used by
-    :meth:`reference`); ``bodies`` (the moving bodies: the crank, then the dyads' links);
+    :meth:`reference`); ``bodies`` (the moving bodies: the driver's (a cylinder's link,
+    ``<cylinder>.barrel`` and ``<cylinder>.rod``), then the dyads' links);
     ``point_loads`` (name -> the scene's [[load]] read: its link, point ``at``,
     ``follower``, which inputs it has, its model).
     """
@@ -269,7 +324,6 @@ class Chain:
         self.description = str(self.data.get("description", name))
         where = f"scene {name}"
 
-        self._read_driver(where)
         grav = self.scene.get("gravity", {})
         self.gravity = (
             geo.number(grav, "x", f"{where}.gravity"),
@@ -282,10 +336,11 @@ class Chain:
         }
         #: gravity as it enters the dynamics and the potential energy
         self._g = np.array(self.gravity if self.effects["gravity"] else (0.0, 0.0))
+        self._read_driver(where)
 
         self._read_links(where)
         self.dyads = [dict(d) for d in self.scene.get("dyad", [])]
-        if not self.dyads:
+        if not self.dyads and self.driver != "cylinder":  # a cylinder alone turns its link
             raise ValueError(f"{where}: no [[dyad]]")
 
         self._read_motion()
@@ -300,35 +355,87 @@ class Chain:
         self._sweep()
 
     def _read_driver(self, where: str) -> None:
-        """The driver: [crank] (pivot ``at``, default O = (0, 0)) or [ram] (a slider on
-        the frame guide at angle ``guide`` through ``at``, its point R = at + x i_guide)."""
-        crank, ram = self.scene.get("crank"), self.scene.get("ram")
-        if (crank is None) == (ram is None):
-            raise ValueError(f"{where}: expected one table [crank] or [ram]")
-        table = crank if ram is None else ram
+        """The driver: [crank] (pivot ``at``, default O = (0, 0)), [ram] (a slider on
+        the frame guide at angle ``guide`` through ``at``, its point R = at + x i_guide)
+        or [cylinder] (between the frame and a link it turns about O)."""
+        tables = {k: self.scene[k] for k in ("crank", "ram", "cylinder") if k in self.scene}
+        if len(tables) != 1:
+            raise ValueError(f"{where}: expected one table [crank], [ram] or [cylinder]")
+        ((self.driver, table),) = tables.items()
         if not isinstance(table, Mapping):
-            raise ValueError(f"{where}: [crank] / [ram] must be a table")
-        self.driver = "crank" if ram is None else "ram"
+            raise ValueError(f"{where}: [{self.driver}] must be a table")
         self.crank = dict(table)
-        self.crank_name = str(table.get("name", self.driver))
         w = f"{where}.{self.driver}"
-        self._crank_mass = geo.number(table, "mass", w, nonnegative=True)
-        self._crank_com = geo.pair(table, "com", w)
-        self._O = geo.pair(table, "at", w) if "at" in table or ram is not None else (0.0, 0.0)
-        if ram is None:
+        #: the driver's moving bodies: name -> (mass, inertia, centre of mass in its frame)
+        self._parts = {}
+        if self.driver == "cylinder":
+            self._read_cylinder(table, w)
+            return
+        self.crank_name = str(table.get("name", self.driver))
+        mass = geo.number(table, "mass", w, nonnegative=True)
+        com = geo.pair(table, "com", w)
+        self._O = geo.pair(table, "at", w) if "at" in table or self.driver == "ram" else (0.0, 0.0)
+        if self.driver == "crank":
             self._r = geo.number(table, "length", w, positive=True)
-            self._crank_inertia = geo.number(table, "inertia", w, nonnegative=True)
+            inertia = geo.number(table, "inertia", w, nonnegative=True)
             self._pin, self._guide = (self._r, 0.0), 0.0
         else:  # the ram translates: its inertia never enters
-            self._crank_inertia = geo.number(table, "inertia", w, nonnegative=True, default=0.0)
+            inertia = geo.number(table, "inertia", w, nonnegative=True, default=0.0)
             self._guide = geo.number(table, "guide", w)
             self._pin = (0.0, 0.0)
+        self._parts[self.crank_name] = (mass, inertia, com)
+
+    def _read_cylinder(self, table: Mapping, w: str) -> None:
+        """[cylinder]: its name, the link it turns (the driver's body ``crank_name``), the
+        link's pivot O (``at``), the barrel's pin A (``base``), the rod's pin B in the
+        link's frame (``pin``), the branch, the link's mass properties and the optional
+        barrel and rod tables (a part left out is massless)."""
+        self.cylinder_name = str(table.get("name", "cylinder"))
+        link = table.get("link")
+        if not isinstance(link, str) or not link.isidentifier() or link == self.cylinder_name:
+            raise ValueError(f"{w}.link: expected the name of the link the cylinder turns")
+        self.crank_name = link
+        self._O = geo.pair(table, "at", w)
+        self._base = geo.pair(table, "base", w)
+        self._pin = geo.pair(table, "pin", w)
+        self._guide = 0.0
+        if math.hypot(*self._pin) == 0.0:
+            raise ValueError(f"{w}.pin: B must be off the pivot O, got {self._pin!r}")
+        if math.hypot(self._base[0] - self._O[0], self._base[1] - self._O[1]) == 0.0:
+            raise ValueError(f"{w}.base: A must be off the pivot O, got {self._base!r}")
+        self._cylinder_branch = _sign(table, "branch", w)
+        heavy = self.effects["inertia"] or self.effects["gravity"]
+        need = None if heavy else 0.0
+        need_i = None if self.effects["inertia"] else 0.0
+        mass = geo.number(table, "mass", w, nonnegative=True, default=need)
+        inertia = geo.number(table, "inertia", w, nonnegative=True, default=need_i)
+        com = geo.pair(table, "com", w) if "com" in table or heavy else (0.0, 0.0)
+        self._parts[link] = (mass, inertia, com)
+        for part, sign in (("barrel", 1.0), ("rod", -1.0)):
+            spec = table.get(part, {"mass": 0.0, "com": 0.0, "inertia": 0.0})
+            wp = f"{w}.{part}"
+            if not isinstance(spec, Mapping):
+                raise ValueError(f"{wp}: expected a table {{ mass, com, inertia }}")
+            stray = sorted(set(spec) - {"mass", "com", "inertia"})
+            if stray:
+                raise ValueError(f"{wp}.{stray[0]}: not a key of the {part} (mass, com, inertia)")
+            m = geo.number(spec, "mass", wp, nonnegative=True)
+            along = geo.number(spec, "com", wp)
+            i = geo.number(spec, "inertia", wp, nonnegative=True, default=need_i)
+            # the barrel's frame is {A; u, j_c}, the rod's {B; u, j_c}: the rod's centre
+            # of mass lies com back from B towards A
+            self._parts[f"{self.cylinder_name}.{part}"] = (m, i, (sign * along, 0.0))
+
+    @property
+    def _driver_names(self) -> tuple:
+        """The names the driver takes: its body's, and a cylinder's own."""
+        return (self.crank_name, getattr(self, "cylinder_name", self.crank_name))
 
     def _read_links(self, where: str) -> None:
         self.links = {}
         for lt in self.scene.get("link", []):
             lname = str(lt.get("name", ""))
-            if not lname or lname in self.links or lname in (self.crank_name, "frame"):
+            if not lname or lname in self.links or lname in (*self._driver_names, "frame"):
                 raise ValueError(f"{where}: bad or repeated link name {lname!r}")
             wl = f"{where}.link[{lname}]"
             link = dict(lt)
@@ -347,8 +454,9 @@ class Chain:
         if self.driver == "crank":
             self._phi0 = geo.number(md, "phi0", wm, default=0.0)
             self._scale = self._r
-        else:
-            self._x0 = geo.number(md, "x0", wm)
+        else:  # a ram from its position x0, a cylinder from its length s0
+            cylinder = self.driver == "cylinder"
+            self._x0 = geo.number(md, "s0" if cylinder else "x0", wm, positive=cylinder)
             self._stroke = geo.number(md, "stroke", wm, positive=True)
             self._scale = self._stroke
 
@@ -400,7 +508,7 @@ class Chain:
         frame = (self.data.get("frame") or {}).get(dyad, {}).get(pair)
         if spec == "frame":
             return self._frame_pivot(spec, frame, dyad, pair)
-        pin = "A" if self.driver == "crank" else "R"
+        pin = {"crank": "A", "ram": "R", "cylinder": "B"}[self.driver]
         if spec == self.crank_name or (spec == "crank" and self.driver == "crank"):
             return {"kind": "point", "body": self.crank_name, "at": self._pin, "label": pin}
         if isinstance(spec, Mapping):
@@ -437,7 +545,8 @@ class Chain:
         """(name, type, m, n, where) of a [[dyad]] table, checked against the earlier ones."""
         dname = str(d.get("name", ""))
         where = f"scene {self.name}.dyad[{dname}]"
-        if not dname or any(p["name"] == dname for p in self.plan) or dname == self.crank_name:
+        taken = any(p["name"] == dname for p in self.plan) or dname in self._driver_names
+        if not dname or taken:
             raise ValueError(f"{where}: bad or repeated dyad name")
         kind = str(d.get("type", "")).upper()
         if kind not in PAIR_KINDS:
@@ -535,7 +644,7 @@ class Chain:
             if "lm" in entry:
                 self.links[entry["m"]]["length"] = entry["lm"]
             self.links[entry["n"]]["length"] = entry["ln"]
-        self.bodies = [self.crank_name] + [g for e in self.plan for g in (e["m"], e["n"])]
+        self.bodies = list(self._parts) + [g for e in self.plan for g in (e["m"], e["n"])]
 
     def _resolve_loads(self):
         """The load models of chains.toml's [.load]: one per link the scene's [loads]
@@ -613,7 +722,7 @@ class Chain:
         rows = self.scene.get("load", [])
         if not isinstance(rows, list) or not all(isinstance(r, Mapping) for r in rows):
             raise ValueError(f"scene {self.name}: [[load]] must be an array of tables")
-        taken = set(self.links) | {self.crank_name, "frame", "gravity"}
+        taken = set(self.links) | {*self._driver_names, "frame", "gravity"}
         taken |= {e["name"] for e in self.plan}
         out = {}
         for row in rows:
@@ -627,7 +736,7 @@ class Chain:
             link = row.get("link")
             if link != self.crank_name and link not in self.links:
                 raise ValueError(f"{where}.link: unknown link {link!r}")
-            com = self._crank_com if link == self.crank_name else self.links[link]["com"]
+            com = self._parts[link][2] if link == self.crank_name else self.links[link]["com"]
             components = row.get("components", "global")
             if components not in ("global", "link"):
                 raise ValueError(
@@ -653,21 +762,13 @@ class Chain:
         c = self.crank_name
         if self.driver == "crank":
             self.pairs = [{"key": f"{c}.R_O", "kind": "R", "first": c, "point": "O", "tag": "O"}]
-        else:  # the ram on its frame guide: the guide's force N j at R and couple M
-            self.pairs = [
-                {
-                    "key": f"{c}.R_G",
-                    "kind": "T",
-                    "first": c,
-                    "point": "R",
-                    "guide": f"{c}.angle",
-                    "tag": "G",
-                    "n_name": f"{c}.N",
-                    "m_name": f"{c}.M",
-                }
-            ]
+        elif self.driver == "ram":  # the ram on its frame guide: its force N j at R, couple M
+            self.pairs = [_sliding(f"{c}.R_G", c, None, "R", f"{c}.angle", "G", c)]
+        else:
+            self.pairs = self._cylinder_pairs()
         for pr in self.pairs:
-            pr.update(second=None, dyad=None)
+            pr.setdefault("second", None)
+            pr["dyad"] = None
         for e in self.plan:
             kinds = PAIR_KINDS[e["type"]]
             others = {"D_m": e["k"]["body"], "E": e["n"], "D_n": e["p"]["body"]}
@@ -692,6 +793,20 @@ class Chain:
                     }
                 )
 
+    def _cylinder_pairs(self) -> list:
+        """The cylinder's pairs: the link's pivot O and the barrel's pin A on the frame, the
+        rod's pin B on the link (``R_B`` the force on the link), and the sliding pair of
+        the rod in the barrel (the rod receives N j_c at B and the couple M)."""
+        c, cyl = self.crank_name, self.cylinder_name
+        barrel, rod = f"{cyl}.barrel", f"{cyl}.rod"
+        return [
+            {"key": f"{c}.R_O", "kind": "R", "first": c, "point": "O", "tag": "O"},
+            {"key": f"{cyl}.R_A", "kind": "R", "first": barrel, "point": "A", "tag": "A"},
+            {"key": f"{cyl}.R_B", "kind": "R", "first": c, "second": rod, "point": f"{cyl}.B"}
+            | {"tag": "B"},
+            _sliding(f"{cyl}.R_slide", rod, barrel, f"{cyl}.B", f"{cyl}.angle", "slide", cyl),
+        ]
+
     def output_names(self) -> list:
         """The names of the outputs of :meth:`reference`, in the order of the unknowns."""
         names = []
@@ -704,9 +819,28 @@ class Chain:
 
     @property
     def drive_output(self) -> str:
-        """The name of the driver's effort: ``<crank>.torque`` (N m) or ``<ram>.force``
-        (N, along the ram's guide)."""
+        """The name of the driver's effort: ``<crank>.torque`` (N m), ``<ram>.force``
+        (N, along the ram's guide) or ``<cylinder>.force`` (N, the axial force)."""
+        if self.driver == "cylinder":
+            return f"{self.cylinder_name}.force"
         return f"{self.crank_name}.{'torque' if self.driver == 'crank' else 'force'}"
+
+    @property
+    def driver_name(self) -> str:
+        """The prefix of the driver's motion: the crank's, the ram's or the cylinder's name."""
+        return self.cylinder_name if self.driver == "cylinder" else self.crank_name
+
+    @property
+    def coordinate_names(self) -> tuple[str, str, str]:
+        """The kinematics keys (and FMU inputs) of the driver's coordinate, rate and
+        acceleration: ``crank.angle``, ``.omega``, ``.epsilon``; ``ram.position``,
+        ``.velocity``, ``.acceleration``; ``cylinder.length``, ``.velocity``, ``.acceleration``."""
+        names = {
+            "crank": ("angle", "omega", "epsilon"),
+            "ram": ("position", "velocity", "acceleration"),
+            "cylinder": ("length", "velocity", "acceleration"),
+        }[self.driver]
+        return tuple(f"{self.driver_name}.{k}" for k in names)
 
     # ---- motion -----------------------------------------------------------
     def motion(
@@ -714,9 +848,10 @@ class Chain:
     ) -> CrankMotion | motion_.RamMotion:
         """The driver's motion. A crank: ``revolutions`` full turns (counter-clockwise);
         kind "constant": omega = w0; "varying": omega = w0 (1 + a sin(w0 t)), phi exact. A
-        ram: ``revolutions`` strokes out and back (:func:`.motion.stroke`)."""
+        ram or a cylinder: ``revolutions`` strokes out and back (:func:`.motion.stroke`),
+        the ram's position or the cylinder's length."""
         revolutions = motion_.checked_request(kind, revolutions)
-        if self.driver == "ram":
+        if self.driver != "crank":
             return motion_.stroke(
                 kind, self._x0, self._stroke, self._w0, self._variation, revolutions
             )
@@ -743,6 +878,12 @@ class Chain:
         its velocity ``v_P_NAME``;
         ``<dyad>.guide_k.angle`` for a guide on link k; for a guide on a moving link also
         ``<dyad>.slide_k``, ``<dyad>.slide_k_rate``, ``<dyad>.slide_k_accel``.
+        A cylinder CYL turning link L: ``CYL.length``, ``CYL.velocity``,
+        ``CYL.acceleration`` (its motion), ``L.angle``, ``L.omega``, ``L.epsilon`` (the
+        link's), ``CYL.angle``, ``CYL.omega``, ``CYL.epsilon`` (its axis u's, as those of
+        ``CYL.barrel`` and ``CYL.rod``), the points ``O``, ``A``, ``CYL.B`` with ``v_B``,
+        ``a_B``, ``CYL.conditioning``, and ``S_``, ``v_S_``, ``a_S_`` of the link, the
+        barrel and the rod.
         Non-array entries: ``frame`` ({"pivots": {label: (x, y)}, "guides": {label:
         ((x0, y0), (x1, y1))}}, and "link_guides" with guides on moving links, see
         :meth:`_frame`) and ``mechanism`` (the name).
@@ -853,16 +994,20 @@ class Chain:
             kin[f"{name}.moment"] = model["moment"] + model["moment_swing"] * wave
 
     def _driver(self, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple:
-        """The driver's state (as a body) and its kinematics entries, from its coordinate
-        q (crank angle or ram position) and its first two time derivatives."""
+        """The states of the driver's bodies and its kinematics entries, from its
+        coordinate q (crank angle, ram position or cylinder length) and its first two time
+        derivatives."""
         c = self.crank_name
         z2 = np.zeros(q.shape + (2,))
         pivot = z2 + np.asarray(self._O)
-        if self.driver == "crank":
+        if self.driver == "cylinder":
+            states, kin = self._cylinder_states(q, dq, ddq)
+        elif self.driver == "crank":
             state = {"angle": q, "omega": dq, "epsilon": ddq, "D": pivot, "vD": z2, "aD": z2}
             pin = self._material(state, self._pin)
             kin = {f"{c}.angle": q, f"{c}.omega": dq, f"{c}.epsilon": ddq, "O": pivot}
             kin.update(zip(("A", "v_A", "a_A"), pin, strict=True))
+            states = {c: state}
         else:
             i_g = geo.unit(self._guide)
             zero = np.zeros(q.shape)
@@ -872,17 +1017,40 @@ class Chain:
             kin = {f"{c}.position": q, f"{c}.velocity": dq, f"{c}.acceleration": ddq}
             kin.update({f"{c}.angle": state["angle"], f"{c}.omega": zero, f"{c}.epsilon": zero})
             kin.update(R=R, v_R=vR, a_R=aR)
+            states = {c: state}
         kin["t"] = t
-        kin[f"{c}.accel_d"] = state["aD"]
-        return state, kin
+        for b, state in states.items():
+            kin[f"{b}.accel_d"] = state["aD"]
+        return states, kin
+
+    def _cylinder_states(self, s: np.ndarray, ds: np.ndarray, dds: np.ndarray) -> tuple:
+        """The link's, the barrel's and the rod's states and the cylinder's kinematics
+        entries at the lengths s with their rates (:func:`_cylinder`)."""
+        c, cyl = self.crank_name, self.cylinder_name
+        g = _cylinder(self._O, self._base, self._pin, self._cylinder_branch, s, ds, dds, cyl)
+        z2 = np.zeros(np.shape(s) + (2,))
+        pivot, base = z2 + np.asarray(self._O), z2 + np.asarray(self._base)
+        link = _state(g["theta"], g["omega"], g["epsilon"], pivot, z2, z2.copy(), 0.0)
+        axis = (g["psi"], g["Omega"], g["Omega_dot"])
+        barrel = _state(*axis, base, z2.copy(), z2.copy(), 0.0)
+        rod = _state(*(a.copy() for a in axis), g["B"], g["v_slide"], g["a_slide"], 0.0)
+        kin = {f"{cyl}.length": s, f"{cyl}.velocity": ds, f"{cyl}.acceleration": dds}
+        for body, st in ((c, link), (cyl, barrel)):
+            for key in ("angle", "omega", "epsilon"):
+                kin[f"{body}.{key}"] = st[key]
+        kin.update({"O": pivot, "A": base, f"{cyl}.B": g["B"], "v_B": g["v_B"], "a_B": g["a_B"]})
+        kin[f"{cyl}.conditioning"] = g["conditioning"]
+        states = {c: link, f"{cyl}.barrel": barrel, f"{cyl}.rod": rod}
+        for body in (f"{cyl}.barrel", f"{cyl}.rod"):
+            for key in ("angle", "omega", "epsilon"):
+                kin[f"{body}.{key}"] = states[body][key]
+        return states, kin
 
     def _solve(self, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> dict:
         shape = q.shape
         zero = np.zeros(shape, dtype=np.result_type(q, dq, ddq, float))
         z2 = np.zeros(shape + (2,), dtype=zero.dtype)
-        c = self.crank_name
-        driver_state, kin = self._driver(t, q, dq, ddq)
-        states = {c: driver_state}
+        states, kin = self._driver(t, q, dq, ddq)
         for e in self.plan:
             sm, sn, E = self._dyad_states(e, states, shape, kin)
             states[e["m"]], states[e["n"]] = sm, sn
@@ -890,7 +1058,7 @@ class Chain:
             kin[f"{e['name']}.conditioning"] = self._conditioning(e, kin)
         # centres of mass (S = D + rel, rel fixed in the body)
         for b in self.bodies:
-            com = self._crank_com if b == c else self.links[b]["com"]
+            com = self._parts[b][2] if b in self._parts else self.links[b]["com"]
             kin[f"S_{b}"], kin[f"v_S_{b}"], kin[f"a_S_{b}"] = self._material(states[b], com)
         for g in self.links:
             kin[f"{g}.force"], kin[f"{g}.moment"] = self._active_load(g, kin, zero, z2)
@@ -921,7 +1089,7 @@ class Chain:
 
     def sweep_coordinates(self, count: int = 720) -> np.ndarray:
         """The driver's coordinate over its whole range: a full crank turn, or the ram's
-        stroke (both ends included)."""
+        or the cylinder's stroke (both ends included)."""
         if self.driver == "crank":
             return self._phi0 + np.linspace(0.0, 2.0 * math.pi, count, endpoint=False)
         return self._x0 + np.linspace(0.0, self._stroke, count)
@@ -955,6 +1123,8 @@ class Chain:
             pivots, guides, link_guides = {}, {}, {}
             if self.driver == "crank":
                 pivots["O"] = tuple(self._O)
+            elif self.driver == "cylinder":  # the link's pivot and the barrel's pin
+                pivots["O"], pivots["A"] = tuple(self._O), tuple(self._base)
             else:  # the ram's guide over its stroke
                 i = np.array([math.cos(self._guide), math.sin(self._guide)])
                 pad = 0.25 * self._stroke
@@ -996,22 +1166,18 @@ class Chain:
         """Per body: mass, inertia, S (N, 2), a_S (N, 2) from accel_d, omega, epsilon and
         the centre of mass, epsilon, the load of its [loads] model (at S) and the
         [[load]]s on it, (P, F, M) each (:meth:`placed_load`)."""
-        c = self.crank_name
         out = {}
         for b in self.bodies:
-            if b == c:
-                mass, inertia, com = self._crank_mass, self._crank_inertia, self._crank_com
-                a_d = np.asarray(kin[f"{c}.accel_d"], dtype=float)  # 0: O is fixed
-            else:
-                link = self.links[b]
-                mass, inertia, com = link["mass"], link["inertia"], link["com"]
-                a_d = np.asarray(kin[f"{b}.accel_d"], dtype=float)
+            mass, inertia = self._mass(b)
+            com = self._parts[b][2] if b in self._parts else self.links[b]["com"]
+            a_d = np.asarray(kin[f"{b}.accel_d"], dtype=float)
             i = geo.unit(kin[f"{b}.angle"])
             rel = com[0] * i + com[1] * geo.rot90(i)
             w, e = np.asarray(kin[f"{b}.omega"], float), np.asarray(kin[f"{b}.epsilon"], float)
             a_s = a_d + geo.col(e) * geo.rot90(rel) - geo.col(w * w) * rel
-            force = kin[f"{b}.force"] if b != c else np.zeros_like(a_d)
-            moment = kin[f"{b}.moment"] if b != c else np.zeros(len(w))
+            # the driver's bodies carry [[load]]s only
+            force = kin[f"{b}.force"] if b in self.links else np.zeros_like(a_d)
+            moment = kin[f"{b}.moment"] if b in self.links else np.zeros(len(w))
             out[b] = {
                 "mass": mass,
                 "inertia": inertia,
@@ -1106,11 +1272,8 @@ class Chain:
                 put(col, pr["first"], P, f, mu, 1.0)
                 put(col, pr["second"], P, f, mu, -1.0)
                 col += 1
-        if self.driver == "crank":  # the driving torque
-            K[:, row[self.crank_name] + 2, col] = 1.0
-        else:  # the actuator's force along the guide, at R
-            i_g = np.broadcast_to(geo.unit(self._guide), (count, 2))
-            put(col, self.crank_name, np.asarray(kin["R"], dtype=float), i_g, zero, 1.0)
+        for body, point, f, mu, sign in self._drive_actions(kin):
+            put(col, body, point, f, mu, sign)
         col += 1
         assert col == n_eq
         for b, bd in bodies.items():
@@ -1180,17 +1343,33 @@ class Chain:
                     np.maximum(np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))),
                 )
         drive = np.asarray(out[self.drive_output], float)
-        if self.driver == "crank":
-            balance.couple(self.crank_name, drive)
-        else:
-            R = np.asarray(kin["R"], dtype=float)
-            balance.force(self.crank_name, R, geo.col(drive) * geo.unit(self._guide))
+        for body, point, f, mu, sign in self._drive_actions(kin):
+            if self.driver == "crank":
+                balance.couple(body, sign * drive * mu)
+            else:
+                balance.force(body, point, geo.col(sign * drive) * f)
         return balance.worst()
+
+    def _drive_actions(self, kin: dict) -> list:
+        """What the driver's effort does per unit, as (body, point, force, couple, sign):
+        the crank's torque a couple on the crank; the ram's force along its guide at R;
+        the cylinder's axial force along u at B, on the rod (+) and the barrel (-)."""
+        count = len(np.atleast_1d(kin["t"]))
+        zero, z2 = np.zeros(count), np.zeros((count, 2))
+        if self.driver == "crank":
+            return [(self.crank_name, np.asarray(kin["O"], dtype=float), z2, zero + 1.0, 1.0)]
+        if self.driver == "ram":
+            i_g = np.broadcast_to(geo.unit(self._guide), (count, 2))
+            return [(self.crank_name, np.asarray(kin["R"], dtype=float), i_g, zero, 1.0)]
+        cyl = self.cylinder_name
+        u = geo.unit(np.real(kin[f"{cyl}.angle"]))
+        B = np.asarray(np.real(kin[f"{cyl}.B"]), dtype=float)
+        return [(f"{cyl}.rod", B, u, zero, 1.0), (f"{cyl}.barrel", B, u, zero, -1.0)]
 
     # ---- energy -----------------------------------------------------------
     def _mass(self, b: str):
-        if b == self.crank_name:
-            return self._crank_mass, self._crank_inertia
+        if b in self._parts:
+            return self._parts[b][:2]
         return self.links[b]["mass"], self.links[b]["inertia"]
 
     def mass_properties(self, body: str) -> tuple[float, float]:
@@ -1229,6 +1408,13 @@ class Chain:
             total = total + geo.dot(f, geo.inexact(kin[f"v_P_{name}"]))
             total = total + mu * geo.inexact(kin[f"{placed['link']}.omega"])
         return geo.inexact(total)
+
+    def driver_power(self, kin: dict, out: dict) -> np.ndarray:
+        """Power [W] the driver puts in: its effort of ``out`` (:meth:`reference`) times
+        its rate, torque x omega (a crank) or force x velocity (a ram; a cylinder, its
+        axial force times ds/dt)."""
+        rate = np.asarray(kin[self.coordinate_names[1]], dtype=float)
+        return np.asarray(out[self.drive_output], dtype=float) * rate
 
     def __repr__(self):
         return (
@@ -1423,17 +1609,88 @@ def _rtr(
     return sm, sn, P.copy()
 
 
+def _check_closes(y2: np.ndarray, s: np.ndarray, reach: tuple, name: str) -> None:
+    """A ValueError naming the cylinder where its triangle does not close (y2, the square
+    of B's distance from the line O A, not positive) at some length s; ``reach`` the
+    lengths between which it closes."""
+    if np.any(~(np.real(y2) > 0.0)):
+        s = np.real(s)
+        raise ValueError(
+            f"cylinder {name}: the triangle O, A, B does not close at every length "
+            f"(s from {s.min():.4g} to {s.max():.4g} m; it closes for "
+            f"{reach[0]:.4g} < s < {reach[1]:.4g} m)"
+        )
+
+
+def _cylinder(
+    pivot: tuple,
+    base: tuple,
+    pin: tuple,
+    branch: float,
+    s: np.ndarray,
+    ds: np.ndarray,
+    dds: np.ndarray,
+    name: str,
+) -> dict:
+    """The triangle O, A, B of a cylinder of length s = |AB| between the frame's pin A
+    (``base``) and the pin B of a link pivoted at O (``pivot``; ``pin``: B in the link's
+    frame), with the rates
+    s' and s''. Returns the link's angle ``theta`` and its rates ``omega``, ``epsilon``;
+    B with ``v_B``, ``a_B``; the axis u's angle ``psi`` and rates ``Omega``,
+    ``Omega_dot``; the rod's point at B as sliding along the barrel's axis, ``v_slide``
+    and ``a_slide`` (equal to v_B, a_B); the ``conditioning`` |(B - O) x u| / |pin| of the
+    real parts."""
+    O, A = np.asarray(pivot, dtype=float), np.asarray(base, dtype=float)  # noqa: E741
+    d = math.hypot(*(A - O))
+    e = (A - O) / d
+    r = math.hypot(*pin)
+    # B - O = x e + y (k x e): |B - O| = r and |B - A| = s
+    x = (d * d + r * r - s * s) / (2.0 * d)
+    y2 = r * r - x * x
+    _check_closes(y2, s, (abs(r - d), r + d), name)
+    rho = geo.col(x) * e + geo.col(branch * np.sqrt(y2)) * geo.rot90(e)  # B - O
+    B = O + rho
+    cb, sb = pin[0] / r, pin[1] / r  # the link turns pin onto rho
+    theta = _angle(geo.vec(cb * rho[:, 0] + sb * rho[:, 1], cb * rho[:, 1] - sb * rho[:, 0]))
+    u = (B - A) / geo.col(s)
+    j_c = geo.rot90(u)
+    lever = geo.cross(rho, u)  # (B - O) x u: B' . u = omega lever = s'
+    omega = ds / lever
+    v_B = geo.col(omega) * geo.rot90(rho)
+    Omega = geo.dot(v_B, j_c) / s  # B' = s' u + s Omega j_c
+    # B'' = epsilon k x rho - omega^2 rho; along u: s'' - s Omega^2, across: s Omega' + 2 s' Omega
+    epsilon = (dds - s * Omega * Omega + omega * omega * geo.dot(rho, u)) / lever
+    a_B = geo.col(epsilon) * geo.rot90(rho) - geo.col(omega * omega) * rho
+    Omega_dot = (geo.dot(a_B, j_c) - 2.0 * ds * Omega) / s
+    return {
+        "theta": theta,
+        "omega": omega,
+        "epsilon": epsilon,
+        "B": B,
+        "v_B": v_B,
+        "a_B": a_B,
+        "psi": _angle(u),
+        "Omega": Omega,
+        "Omega_dot": Omega_dot,
+        "v_slide": geo.col(ds) * u + geo.col(s * Omega) * j_c,
+        "a_slide": geo.col(dds - s * Omega * Omega) * u
+        + geo.col(s * Omega_dot + 2.0 * ds * Omega) * j_c,
+        "conditioning": np.abs(np.real(lever)) / r,
+    }
+
+
 # ---------------------------------------------------------------------------
 # loading
 # ---------------------------------------------------------------------------
 def load(
     name: str, data: Mapping | None = None, branches: Mapping[str, int] | None = None
 ) -> Chain:
-    """The chain ``name`` (one of :data:`NAMES`): its scene file plus its table of the
+    """The chain ``name`` (one of :data:`NAMES`, :data:`RAM_NAMES`,
+    :data:`CYLINDER_NAMES`): its scene file plus its table of the
     packaged ``chains.toml``. ``data`` overrides that table key by key (nested tables
     merged): a mapping, either the whole document (with a table ``name``) or the
     mechanism's own table, or the path of a TOML file of the same form. ``branches``
-    {dyad: +1 or -1} takes the place of the scene's branch of those dyads."""
+    {dyad or cylinder: +1 or -1} takes the place of the scene's branch of those."""
     if name not in _ALL_NAMES:
         raise ValueError(
             f"unknown chain mechanism {name!r}; expected one of: {', '.join(_ALL_NAMES)}"
@@ -1442,8 +1699,11 @@ def load(
     with open(scene_path(name), "rb") as f:
         scene = tomllib.load(f)
     dyads = {str(d.get("name")): d for d in scene.get("dyad", [])}
+    cylinder = scene.get("cylinder")
+    if isinstance(cylinder, dict):  # the cylinder's triangle closes in two ways too
+        dyads[str(cylinder.get("name", "cylinder"))] = cylinder
     for dyad, branch in (branches or {}).items():
         if dyad not in dyads:
-            raise ValueError(f"branches: {name} has no dyad {dyad!r}")
+            raise ValueError(f"branches: {name} has no dyad or cylinder {dyad!r}")
         dyads[dyad]["branch"] = branch
     return Chain(name, scene, table)

@@ -2,8 +2,9 @@
 driver's motion and the active loads) and the reference values of its outputs.
 
 A mechanism FMU (a scene with ``kinematics = "internal"``) takes only the driver's
-motion, ``crank.angle``, ``crank.omega``, ``crank.epsilon`` or ``ram.position``,
-``ram.velocity``, ``ram.acceleration``, and the loads the scene lists
+motion, ``crank.angle``, ``crank.omega``, ``crank.epsilon``, ``ram.position``,
+``ram.velocity``, ``ram.acceleration`` or ``hoist.length``, ``hoist.velocity``,
+``hoist.acceleration`` (a cylinder), and the loads the scene lists
 (``LINK.force.x/.y``, ``LINK.moment``, and ``NAME.force.x/.y``, ``NAME.moment`` of each
 ``[[load]]``), and solves the kinematics itself. Its outputs:
 ``LINK.angle``, ``LINK.omega``, ``LINK.epsilon``; ``DYAD.D_m.position.x/.y``,
@@ -11,7 +12,11 @@ motion, ``crank.angle``, ``crank.omega``, ``crank.epsilon`` or ``ram.position``,
 ``DYAD.R_mk.x/.y`` ... and
 ``DYAD.N_..``, ``DYAD.M_..`` of the sliding pairs; for a crank ``crank.torque``,
 ``crank.R_O.x/.y``; for a ram ``ram.force`` (along the guide), ``ram.N`` (the guide's
-normal force, along j_guide), ``ram.M`` (the guide's moment about R); and the driver's
+normal force, along j_guide), ``ram.M`` (the guide's moment about R); for a cylinder
+turning link L ``hoist.force`` (axial), ``hoist.R_A``, ``hoist.R_B``, ``L.R_O``,
+``hoist.N``, ``hoist.M``, the motions ``L.angle/.omega/.epsilon`` and
+``hoist.angle/.omega/.epsilon``, ``hoist.B.position.x/.y`` and ``hoist.conditioning``;
+and the driver's
 effective inertia ``J``, its derivative ``dJdq`` and ``torque0`` (``force0``), the
 effort at zero driver acceleration:
 
@@ -58,9 +63,8 @@ SCENE_OF = {
     "trt-slot": "trt_slot",
 }
 
-#: The driver's coordinate, speed and acceleration inputs, and its outputs' suffixes.
+#: A crank's angle, speed and acceleration inputs, and a link's motion outputs' suffixes.
 _CRANK = ("angle", "omega", "epsilon")
-_RAM = ("position", "velocity", "acceleration")
 
 Driven = builtin.Mechanism | chains.Chain
 
@@ -211,11 +215,26 @@ def _builtin_outputs(mech: builtin.Mechanism, kin: dict, scene: Mapping) -> dict
 
 
 def _chain_outputs(chain: chains.Chain, kin: dict) -> dict:
-    """The reference outputs of a chain under its scene's names."""
+    """The reference outputs of a chain under its scene's names: a cylinder's also the
+    motion of the link it turns and of its axis, its pin B and its conditioning."""
     points = {f"{e['name']}.{p}.position": f"{e['name']}.{p}" for e in chain.plan for p in _POINTS}
-    out = _link_and_points(kin, {g: g for g in chain.links}, points)
+    links = {g: g for g in chain.links}
+    if chain.driver == "cylinder":
+        cyl = chain.cylinder_name
+        links.update({chain.crank_name: chain.crank_name, cyl: cyl})
+        points[f"{cyl}.B.position"] = f"{cyl}.B"
+    out = _link_and_points(kin, links, points)
+    if chain.driver == "cylinder":
+        out[f"{cyl}.conditioning"] = np.asarray(kin[f"{cyl}.conditioning"], dtype=float).copy()
     ref = chain.reference(kin)
-    skip = (f"{chain.crank_name}.R_G.x", f"{chain.crank_name}.R_G.y")  # not an FMU output
+    # the vector of a driver's sliding pair (the ram's guide, the rod in the barrel) is
+    # no FMU output: its N and M are
+    skip = {
+        f"{pr['key']}.{c}"
+        for pr in chain.pairs
+        if pr["dyad"] is None and pr["kind"] == "T"
+        for c in "xy"
+    }
     out.update({k: v for k, v in ref.items() if k not in skip})
     return out
 
@@ -247,7 +266,7 @@ def _slide(scene: Mapping, spec: Mapping, out: dict, point: str, kin: dict, key:
 def _dyad_extras(scene: Mapping, kin: dict, out: dict, role: Mapping, conditioning: dict) -> None:
     """The sliding lengths, the slides of sliding outer pairs and each dyad's
     conditioning, under the FMU's names (added to ``out``)."""
-    for dyad in scene["dyad"]:
+    for dyad in scene.get("dyad", []):
         d = dyad.get("name", "")
         pre = f"{d}." if d else ""
         out[f"{pre}conditioning"] = np.asarray(conditioning[d], dtype=float)
@@ -280,21 +299,23 @@ def driver_motion_inputs(
     scene = _scene_of(mechanism, scene)
     if isinstance(mechanism, chains.Chain):
         kin = mechanism.kinematics(t, motion)
-        driver, ram = mechanism.crank_name, mechanism.driver == "ram"
+        driver = mechanism.driver_name
         role = {g: g for g in mechanism.links}
         out = _chain_outputs(mechanism, kin)
         effort = mechanism.drive_output
-        conditioning = {d["name"]: kin[f"{d['name']}.conditioning"] for d in scene["dyad"]}
+        dyads = scene.get("dyad", [])
+        conditioning = {d["name"]: kin[f"{d['name']}.conditioning"] for d in dyads}
+        keys = list(mechanism.coordinate_names)
+        names = [k.rpartition(".")[2] for k in keys]
     else:
         kin = mechanism.kinematics(t, motion, branch)
-        driver, ram = scene.get("crank", {}).get("name", "crank"), False
+        driver = scene.get("crank", {}).get("name", "crank")
         dyad = scene["dyad"][0]
         role = {dyad["m"]: "m", dyad["n"]: "n"}
         out = _builtin_outputs(mechanism, kin, scene)
         effort = f"{driver}.torque"
         conditioning = {dyad.get("name", ""): mechanism.conditioning(kin)}
-    names = _RAM if ram else _CRANK
-    keys = [f"{driver}.{k}" for k in names] if ram else [f"crank.{k}" for k in _CRANK]
+        names, keys = _CRANK, [f"crank.{k}" for k in _CRANK]
     q, _, ddq = (np.asarray(kin[k], dtype=float) for k in keys)
     inputs = {
         f"{driver}.{k}": np.asarray(kin[key], dtype=float)
