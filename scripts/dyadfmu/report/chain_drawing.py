@@ -36,20 +36,9 @@ if TYPE_CHECKING:
 
 __all__ = ["draw", "figure", "reaction_vectors", "chain_size"]
 
-_CRANK_COLOUR = "#dd8452"
-_LINK_COLOURS = ("#4c72b0", "#8c8c3c", "#7f7f7f", "#c49c3c", "#64b5cd", "#8172b3")
-_ARROW_COLOURS = (
-    "tab:red",
-    "tab:green",
-    "tab:purple",
-    "tab:brown",
-    "tab:pink",
-    "tab:cyan",
-    "black",
-    "magenta",
-    "tab:blue",
-    "tab:olive",
-)
+_CRANK_COLOUR = sketch.DRIVER_COLOUR
+_LINK_COLOURS = sketch.LINK_COLOURS
+_ARROW_COLOURS = sketch.ARROW_COLOURS
 _WIDTH = 5.0
 
 
@@ -283,29 +272,7 @@ def _draw_links(c: _Canvas, chain: Chain, kin: dict, frame: dict, pivot: np.ndar
 
 def _label_points(c: _Canvas, names: dict) -> dict:
     """The point labels, coincident points merged; returns the label shown for each key."""
-    keys = list(names)
-    pts = {k: c.at(k) for k in keys}
-    centre = np.mean([pts[k] for k in keys], axis=0)
-    done, shown = set(), {}
-    for a in keys:
-        if a in done:
-            continue
-        group = [names[a]]
-        for b in keys:
-            if b != a and b not in done and np.hypot(*(pts[a] - pts[b])) <= 1e-9 * c.size:
-                done.add(b)
-                if names[b] not in group:
-                    group.append(names[b])
-        done.add(a)
-        named = [g for g in group if "." not in g]  # drop raw keys where a name exists
-        group = named or group
-        for b in keys:
-            if np.hypot(*(pts[a] - pts[b])) <= 1e-9 * c.size:
-                shown[b] = group[0]
-        d = pts[a] - centre
-        d = d / np.hypot(*d) if np.hypot(*d) > 1e-12 else np.array([-1.0, 1.0]) / math.sqrt(2)
-        sketch.label(c.ax, pts[a], " = ".join(group), tuple(11.0 * d), size=9)
-    return shown
+    return sketch.label_points(c.ax, {k: c.at(k) for k in names}, names, c.size)
 
 
 def _draw_reactions(c: _Canvas, vectors: list, scale: float, labels: dict) -> dict:
@@ -313,25 +280,18 @@ def _draw_reactions(c: _Canvas, vectors: list, scale: float, labels: dict) -> di
     u, arrows = c.u, {}
     for k, (name, body, point, f) in enumerate(vectors):
         p = c.at(point)
-        vec = f / scale
-        length = float(np.hypot(*vec))
-        head = min(1.0 * u, 0.5 * length)
         label = f"{name} on {body} at {labels[point]}: {np.hypot(*f):.4g} N"
         # later arrows thinner and on top, so that coincident ones stay visible
         width = 0.2 * u * (1.0 - 0.5 * k / max(len(vectors) - 1, 1))
-        arrows[name] = c.ax.arrow(
-            p[0],
-            p[1],
-            vec[0],
-            vec[1],
+        arrows[name] = sketch.force_arrow(
+            c.ax,
+            p,
+            f / scale,
+            u,
+            _ARROW_COLOURS[k % len(_ARROW_COLOURS)],
+            label,
             width=width,
-            head_width=max(0.6 * u, 2.0 * width),
-            head_length=head,
-            length_includes_head=True,
-            color=_ARROW_COLOURS[k % len(_ARROW_COLOURS)],
-            alpha=0.85,
-            zorder=8 + 0.01 * k,
-            label=label,
+            z=8 + 0.01 * k,
         )
     c.ax.legend(
         handles=list(arrows.values()),

@@ -8,7 +8,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.patches import Circle, Polygon
+from matplotlib.patches import Circle, FancyArrow, Polygon
 
 from ..mechanisms import geometry as geo
 
@@ -19,14 +19,43 @@ if TYPE_CHECKING:
 LINK_WIDTH = 5.0
 #: Colour of the frame: ground, fixed guides, fixed pivots.
 FRAME_COLOUR = "0.35"
+#: Colour of the driver (the crank, or the link a cylinder turns).
+DRIVER_COLOUR = "#dd8452"
+#: Colours of the other links, in turn.
+LINK_COLOURS = ("#4c72b0", "#8c8c3c", "#7f7f7f", "#c49c3c", "#64b5cd", "#8172b3")
+#: Colours of force arrows, in turn.
+ARROW_COLOURS = (
+    "tab:red",
+    "tab:green",
+    "tab:purple",
+    "tab:brown",
+    "tab:pink",
+    "tab:cyan",
+    "black",
+    "magenta",
+    "tab:blue",
+    "tab:olive",
+)
 
 
 def bar(
-    ax: Axes, p0: np.ndarray, p1: np.ndarray, colour: str, width: float = LINK_WIDTH, z: float = 2.0
+    ax: Axes,
+    p0: np.ndarray,
+    p1: np.ndarray,
+    colour: str,
+    width: float = LINK_WIDTH,
+    z: float = 2.0,
+    alpha: float = 1.0,
 ) -> None:
-    """A link as a bar from p0 to p1."""
+    """A link as a bar from p0 to p1 (``alpha`` below 1 fades it)."""
     ax.plot(
-        [p0[0], p1[0]], [p0[1], p1[1]], color=colour, lw=width, solid_capstyle="round", zorder=z
+        [p0[0], p1[0]],
+        [p0[1], p1[1]],
+        color=colour,
+        lw=width,
+        solid_capstyle="round",
+        zorder=z,
+        alpha=alpha,
     )
 
 
@@ -42,9 +71,18 @@ def slot(ax: Axes, p0: np.ndarray, p1: np.ndarray, z: float) -> None:
     )
 
 
-def pin(ax: Axes, p: np.ndarray, u: float, z: float = 6.0) -> None:
-    """A revolute pair: a white pin at p."""
-    ax.add_patch(Circle(tuple(p), 0.42 * u, facecolor="white", edgecolor="black", lw=1.2, zorder=z))
+def pin(ax: Axes, p: np.ndarray, u: float, z: float = 6.0, alpha: float = 1.0) -> None:
+    """A revolute pair: a white pin at p (``alpha`` below 1 fades its outline)."""
+    ax.add_patch(
+        Circle(
+            tuple(p),
+            0.42 * u,
+            facecolor="white",
+            edgecolor=(0.0, 0.0, 0.0, alpha),
+            lw=1.2,
+            zorder=z,
+        )
+    )
 
 
 def block(
@@ -55,6 +93,7 @@ def block(
     width: float,
     colour: str,
     z: float = 4.0,
+    alpha: float = 0.9,
 ) -> None:
     """A rectangle centred at ``centre`` with its long side along ``direction``."""
     i = np.asarray(direction, dtype=float)
@@ -65,7 +104,7 @@ def block(
     corners = [c - a - b, c + a - b, c + a + b, c - a + b]
     ax.add_patch(
         Polygon(
-            corners, closed=True, facecolor=colour, edgecolor="black", lw=1.0, alpha=0.9, zorder=z
+            corners, closed=True, facecolor=colour, edgecolor="black", lw=1.0, alpha=alpha, zorder=z
         )
     )
 
@@ -156,6 +195,88 @@ def away(
     if n < 1e-12:
         d, n = np.asarray(default, dtype=float), float(np.hypot(*default))
     return d / n
+
+
+def label_points(
+    ax: Axes,
+    points: dict,
+    names: dict,
+    size: float,
+    offset: float = 11.0,
+    fontsize: float = 9,
+    drop_dotted: bool = True,
+    avoid: np.ndarray | None = None,
+) -> dict:
+    """Label every point (key -> (2,) point) with its name (key -> text), coincident points
+    (within 1e-9 of ``size``) merged into one label "a = b" away from the points' centre,
+    or, given ``avoid`` (an (N, 2) array of points drawn), on the side of the eight where
+    the nearest of them is farthest; with ``drop_dotted`` a name with a dot is left out
+    where one without names the same point. Returns the label shown for each key."""
+    keys = list(names)
+    pts = {k: np.asarray(points[k], dtype=float) for k in keys}
+    centre = np.mean([pts[k] for k in keys], axis=0)
+    done, shown = set(), {}
+    for a in keys:
+        if a in done:
+            continue
+        same = [b for b in keys if np.hypot(*(pts[a] - pts[b])) <= 1e-9 * size]
+        group = list(dict.fromkeys(names[b] for b in same if b == a or b not in done))
+        done.update(same)
+        if drop_dotted:
+            group = [g for g in group if "." not in g] or group
+        for b in same:
+            shown[b] = group[0]
+        d = away(pts[a], centre, default=(-1.0, 1.0))
+        if avoid is not None:
+            d = clearest_side(pts[a], d, avoid, 0.04 * size)
+        label(ax, pts[a], " = ".join(group), tuple(offset * d), size=fontsize)
+    return shown
+
+
+def clearest_side(
+    p: np.ndarray, preferred: np.ndarray, avoid: np.ndarray, reach: float
+) -> np.ndarray:
+    """Of the eight unit directions from p (and ``preferred``, which wins ties), the one
+    whose point ``reach`` away is farthest from the nearest point of ``avoid`` (points
+    within 1e-9 ``reach`` of p do not count)."""
+    others = np.asarray(avoid, dtype=float).reshape(-1, 2)
+    others = others[np.hypot(*(others - p).T) > 1e-9 * reach]
+    if len(others) == 0:
+        return preferred
+    turns = np.linspace(0.0, 2.0 * math.pi, 8, endpoint=False)
+    sides = [preferred] + [np.array([math.cos(t), math.sin(t)]) for t in turns]
+    clear = [float(np.hypot(*(others - (p + reach * d)).T).min()) for d in sides]
+    return sides[int(np.argmax(clear))]
+
+
+def force_arrow(
+    ax: Axes,
+    p: np.ndarray,
+    vec: np.ndarray,
+    u: float,
+    colour: str,
+    text: str,
+    width: float | None = None,
+    z: float = 8.0,
+) -> FancyArrow:
+    """A force drawn from its point of application p as the arrow vec (m of drawing, the
+    head included), labelled ``text`` for a legend; its head at most half its length."""
+    width = 0.2 * u if width is None else width
+    length = float(np.hypot(*vec))
+    return ax.arrow(
+        p[0],
+        p[1],
+        vec[0],
+        vec[1],
+        width=width,
+        head_width=max(0.6 * u, 2.0 * width),
+        head_length=min(1.0 * u, 0.5 * length),
+        length_includes_head=True,
+        color=colour,
+        alpha=0.85,
+        zorder=z,
+        label=text,
+    )
 
 
 def sample_at(kin: dict, index: int) -> tuple[int, Callable[[str], np.ndarray]]:
