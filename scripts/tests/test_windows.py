@@ -41,13 +41,18 @@ def replays(windows_build, tmp_path_factory):
 
 @pytest.mark.parametrize("fmu", ALL)
 def test_the_windows_binary_gives_the_linux_outputs_bit_for_bit(replays, fmu):
+    """Every output bit for bit, but an angle (an output named *.angle), which comes from
+    the C runtime's atan2 (the MinGW build calls msvcrt's, Wine's own under Wine, glibc's
+    on Linux) and may be one unit in the last place apart; nothing computed from it is."""
     d = replays[fmu]
     assert d.steps >= 100 and d.outputs > 0
     assert d.same_status, f"{fmu}: doStep statuses or integer outputs differ"
-    assert d.identical == d.outputs, (
-        f"{fmu}: {d.outputs - d.identical} outputs differ, worst {d.worst:.3g} of its peak "
-        f"({d.worst_output})"
+    apart = {n: u for n, u in d.ulps.items() if not (n.endswith(".angle") and u <= 1)}
+    assert not apart, (
+        f"{fmu}: {len(apart)} outputs differ, worst {d.worst:.3g} of its peak "
+        f"({d.worst_output}); in units in the last place: {apart}"
     )
+    assert d.identical + len(d.ulps) == d.outputs
 
 
 @pytest.mark.parametrize("fmu", ALL)
@@ -84,3 +89,8 @@ def test_the_comparison_sees_one_ulp_and_a_status():
     d = windows.compare("x", {7: "a", 8: "b"}, linux, other)
     assert d.identical == 1 and d.worst_output == "b" and not d.same_status
     assert d.worst == pytest.approx(np.spacing(2.5) / 3.0, rel=1e-12, abs=0)
+    assert d.ulps == {"b": 1.0}
+    moved[1] = np.nextafter(np.nextafter(moved[1], 0.0), 0.0)
+    assert windows.compare("x", {7: "a", 8: "b"}, linux, other).ulps == {"b": 3.0}
+    moved[1] = 2.5
+    assert windows.compare("x", {7: "a", 8: "b"}, linux, other).ulps == {"b": float("inf")}

@@ -10,11 +10,12 @@ follow from the inputs that are left."""
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Callable
 from pathlib import Path
 
 from dyadgen.emit.scene_c import inputs_read
-from dyadgen.model import Crank, Scene
+from dyadgen.model import Crank, Param, Scene
 from dyadgen.needs import derive_inputs, derive_outputs
 from dyadgen.scenefile import loads as point_loads
 from dyadgen.scenefile import mechanism, sections
@@ -133,11 +134,30 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     return scene
 
 
+def _cylinder_as_crank(scene: Scene) -> None:
+    """A cylinder's link as a crank whose motion is an input (the kinematics outside
+    would give it), its dyads on the pin B where they sit on it without a point."""
+    driver = scene.crank
+    pin = (driver.params["pin.x"], driver.params["pin.y"])
+    for d in scene.dyads:
+        for att in (d.k, d.p):
+            if att.kind == "crank" and att.at is None:
+                att.at = pin
+    length = math.hypot(pin[0].value, pin[1].value)
+    driver.params = {
+        k: v for k, v in driver.params.items() if k in ("com.x", "com.y", "mass", "inertia")
+    }
+    driver.params["length"] = Param(f"{driver.name}.length", length, "m", "|O B|")
+    driver.kind, driver.actuator = "crank", ""
+
+
 def inputs_with_external_kinematics(scene: Scene) -> list[str]:
     """The inputs a mechanism scene's FMU would take if every link's motion were an input
     (kinematics = "external", every output of that kind): what the kinematics inside save
     its user from computing."""
     other = copy.deepcopy(scene)
+    if other.crank is not None and other.crank.is_cylinder():
+        _cylinder_as_crank(other)
     other.kinematics, other.computed, other.loaders = "external", {}, {}
     for d in other.dyads:
         d.internal = False

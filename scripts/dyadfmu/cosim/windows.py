@@ -18,7 +18,7 @@ import shutil
 import struct
 import subprocess
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -146,11 +146,15 @@ class Difference:
     worst: float  # largest |windows - linux| / peak |linux| over the outputs
     worst_output: str
     same_status: bool  # doStep statuses and integer outputs equal
+    #: each output that differs -> its largest distance in units in the last place
+    #: (inf where one is finite and the other not, or their signs differ)
+    ulps: dict = field(default_factory=dict)
 
 
 def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference:
     """``names``: value reference -> output name."""
     identical, worst, worst_output = 0, 0.0, ""
+    ulps: dict = {}
     for vr, a in linux.reals.items():
         b = windows.reals[vr]
         same = np.array_equal(a.view(np.uint64), b.view(np.uint64))
@@ -158,6 +162,7 @@ def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference
         if same:
             continue
         finite = np.isfinite(a) & np.isfinite(b)
+        ulps[names[vr]] = _ulps(a, b)
         if not np.array_equal(np.isfinite(a), np.isfinite(b)):
             worst, worst_output = float("inf"), names[vr]
             continue
@@ -169,8 +174,17 @@ def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference
         np.array_equal(v, windows.integers[vr]) for vr, v in linux.integers.items()
     )
     return Difference(
-        fmu, len(linux.status), len(linux.reals), identical, worst, worst_output, same_status
+        fmu, len(linux.status), len(linux.reals), identical, worst, worst_output, same_status, ulps
     )
+
+
+def _ulps(a: np.ndarray, b: np.ndarray) -> float:
+    """The largest distance between two runs of one output in units in the last place."""
+    if not np.array_equal(np.isfinite(a), np.isfinite(b)) or np.any(np.signbit(a) != np.signbit(b)):
+        return float("inf")
+    finite = np.isfinite(a)
+    ia, ib = np.abs(a[finite]).view(np.int64), np.abs(b[finite]).view(np.int64)
+    return float(np.max(np.abs(ia - ib))) if finite.any() else 0.0
 
 
 def replay_all(workdir: Path, build: Path | None = None, names: list | None = None) -> list:
