@@ -2052,7 +2052,9 @@ static int craft_state(unsigned char* bytes, size_t size, double from, double to
 /* A state whose checksum is good but one of whose values could never have been set,
  * below its variable's lower bound: refused, naming the variable (the FMU solves its
  * values without checking them again). The first parameter or input with a lower
- * bound whose value the state holds once is the one changed. */
+ * bound whose value the state holds once is the one changed. One must be found where
+ * a parameter has a bound: an input may have been set again since the state was taken
+ * (a cylinder's length, the only bound of a scene without tunable numbers). */
 static int check_crafted_state(int version, void* c, const unsigned char* bytes, size_t size,
                                const probe_log_book* book)
 {
@@ -2069,7 +2071,7 @@ static int check_crafted_state(int version, void* c, const unsigned char* bytes,
             (v->causality != PROBE_PARAMETER && v->causality != PROBE_INPUT)) {
             continue;
         }
-        ++tried;
+        tried += v->causality == PROBE_PARAMETER;
         memcpy(crafted, bytes, size);
         if ((version == 2 ? (int)api2.GetReal(c, &vr, 1, &now)
                           : (int)api3.GetFloat64(c, &vr, 1, &now, 1)) != 0 ||
