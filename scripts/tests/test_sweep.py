@@ -19,7 +19,7 @@ import markdown_check
 import numpy as np
 import pytest
 from dyadfmu import paths
-from dyadfmu.sweep import designs, execute, figures, results, runs, sources, study
+from dyadfmu.sweep import designs, execute, figures, results, runs, sources, stroke, study
 from dyadfmu.sweep.studyfile import (
     Counterweight,
     Figure,
@@ -1162,3 +1162,442 @@ def test_a_scene_study_without_cmake_or_a_compiler_is_refused_in_one_line(monkey
     with pytest.raises(scenebuild.BuildError) as info:
         scenebuild.scene_fmu(tmp_path / "x.toml", "x_sweep_0123456789", 2, tmp_path)
     assert str(info.value) == problem
+
+
+# ---- runs over a linear driver's stroke -----------------------------------------------------
+
+CYLINDER_ARM = paths.build_dir() / "fmus" / "cylinder_arm_fmi2.fmu"
+LIFT = paths.build_dir() / "fmus" / "lift_fmi2.fmu"
+
+#: The arm of tests/scenes/cylinder_arm.toml (O = (0, 1), B at |OB| = 1.2166 m) with its
+#: cylinder's frame pin A = (x, 0.2) moved out: the triangle closes for lengths from
+#: ||OA| - |OB|| to |OA| + |OB|, 0.2166 m at x = 0.6, 0.3096 m at x = 1.3 and 0.9375 m at
+#: x = 2.0, where the stroke's first lengths cannot reach. 25 instants put samples at a
+#: quarter and at half of the run: the cycloid's largest acceleration and speed.
+STROKE_STUDY = f"""
+[study]
+description = "the arm's cylinder pinned farther out on the frame"
+fmu = "{CYLINDER_ARM}"
+
+[run]
+kind = "kinetostatic"
+stroke = [0.6, 1.9]
+duration = 2.0
+points = 25
+
+[sampling]
+method = "grid"
+count = 3
+
+[[parameter]]
+name = "hoist.base.x"
+low = 0.6
+high = 2.0
+
+[loads]
+"payload.force.y" = -4000.0
+
+[[figure]]
+name = "force_peak"
+of = "hoist.force"
+stat = "peak"
+
+[[figure]]
+name = "speed_max"
+of = "hoist.velocity"
+stat = "max"
+
+[[figure]]
+name = "acceleration_max"
+of = "hoist.acceleration"
+stat = "max"
+
+[[figure]]
+name = "length_min"
+of = "hoist.length"
+stat = "min"
+
+[[figure]]
+name = "length_max"
+of = "hoist.length"
+stat = "max"
+
+[objective]
+minimize = "force_peak"
+"""
+
+
+def _needs(fmu: Path) -> None:
+    if not fmu.is_file():
+        pytest.skip(f"{fmu} is not built")
+
+
+@pytest.mark.parametrize(
+    "old, new, marker, words",
+    [
+        ("stroke = [0.6, 1.9]", "stroke = [1.9, 0.6]", "stroke =", "stroke must rise"),
+        ("stroke = [0.6, 1.9]", "stroke = [0.6, nan]", "stroke =", "two finite numbers"),
+        ("stroke = [0.6, 1.9]", "stroke = [0.6, inf]", "stroke =", "two finite numbers"),
+        ("stroke = [0.6, 1.9]", "stroke = [0.6]", "stroke =", "stroke must be [low, high]"),
+        ("stroke = [0.6, 1.9]", 'stroke = [0.6, "1.9"]', "stroke =", "must be [low, high]"),
+        ("stroke = [0.6, 1.9]", "stroke = [0.6, 2e4]", "stroke =", "within +-10000"),
+        ("stroke = [0.6, 1.9]", "stroke = [0.6, 0.6]", "stroke =", "stroke must rise"),
+        ("stroke = [0.6, 1.9]", "angle = [0.0, 3.2]", "angle =", "less than pi"),
+        ("stroke = [0.6, 1.9]", "angle = [0.5, 0.1]", "angle =", "angle must rise"),
+        ("stroke = [0.6, 1.9]", "stroke = [0.6, 1.9]\nspeed = 3.0", "speed = 3.0", "one of speed"),
+        ("stroke = [0.6, 1.9]", "", 'kind = "kinetostatic"', "one of speed"),
+        ("duration = 2.0", "duration = 0.0", "duration =", "duration must be a positive"),
+        ("duration = 2.0", "", "[run]", "duration must be a number"),
+        ("points = 25", "points = 3", "points =", "points must be an integer"),
+        (
+            '"payload.force.y" = -4000.0',
+            '"payload.force.y" = { angle = [0.0, 1.0], value = [1.0, 2.0] }',
+            '"payload.force.y"',
+            "a run over a stroke takes constant loads",
+        ),
+        ('stat = "peak"', 'stat = "work_per_revolution"', "work_per", "has no revolution"),
+    ],
+)
+def test_a_bad_stroke_run_is_refused_at_its_line(tmp_path, old, new, marker, words):
+    _needs(CYLINDER_ARM)
+    text = STROKE_STUDY.replace(old, new, 1)
+    assert text != STROKE_STUDY
+    line = max(k for k, t in enumerate(text.splitlines(), start=1) if marker in t)
+    message = _refused(tmp_path, text)
+    assert message.startswith(f"{tmp_path / 'study.toml'}:{line}: "), message
+    assert words in message
+
+
+def test_a_crank_s_run_takes_no_duration(tmp_path):
+    text = BALANCE_STUDY.replace("speed = 100.0", "speed = 100.0\nduration = 1.0")
+    line = next(k for k, t in enumerate(text.splitlines(), start=1) if t.startswith("duration"))
+    message = _refused(tmp_path, text)
+    assert message.startswith(f"{tmp_path / 'study.toml'}:{line}: duration belongs to a run")
+
+
+@pytest.mark.parametrize(
+    "fmu, old, new, marker, words",
+    [
+        (
+            CYLINDER_ARM,
+            "stroke = [0.6, 1.9]\nduration = 2.0\n",
+            "speed = 10.0\n",
+            "speed =",
+            "speed turns a crank (a revolution); cylinder_arm_fmi2.fmu is driven by the "
+            "cylinder hoist: give kind = 'kinetostatic', stroke = [low, high] (m, its length",
+        ),
+        (
+            CYLINDER_ARM,
+            "stroke = [0.6, 1.9]",
+            "angle = [0.0, 1.0]",
+            "angle =",
+            "angle needs the geometry of cylinder hoist among the parameters",
+        ),
+        (
+            CYLINDER_ARM,
+            "stroke = [0.6, 1.9]",
+            "stroke = [0.0, 1.9]",
+            "stroke =",
+            "a cylinder's length is positive: stroke from 0 m",
+        ),
+        (
+            CYLINDER_ARM,
+            '[run]\nkind = "kinetostatic"\nstroke = [0.6, 1.9]\nduration = 2.0\npoints = 25\n',
+            DRIVEN_RUN,
+            'kind = "driven"',
+            "kind turns a crank (by the drive FMU); cylinder_arm_fmi2.fmu is driven by the "
+            "cylinder hoist",
+        ),
+        (
+            LIFT,
+            "stroke = [0.6, 1.9]",
+            "angle = [0.0, 1.0]",
+            "angle =",
+            "angle turns a cylinder's link; lift_fmi2.fmu is driven by the ram ram: give "
+            "stroke = [low, high] (m, its position)",
+        ),
+        (
+            BALANCE,
+            "stroke = [0.6, 1.9]",
+            "stroke = [0.0, 0.1]",
+            "stroke =",
+            "stroke moves a ram or a cylinder over its stroke; balance_fmi2.fmu is driven by "
+            "the crank crank: give speed (rad/s, one revolution)",
+        ),
+        (
+            CYLINDER_ARM,
+            '"payload.force.y" = -4000.0',
+            '"hoist.velocity" = 1.0',
+            '"hoist.velocity" = 1.0',
+            "hoist.velocity is not a load input of cylinder_arm_fmi2.fmu",
+        ),
+    ],
+    ids=["speed-on-cylinder", "angle-without-geometry", "stroke-from-0", "driven-on-cylinder",
+         "angle-on-ram", "stroke-on-crank", "driver-input-as-load"],
+)  # fmt: skip
+def test_a_run_its_driver_cannot_do_is_refused_at_its_line(tmp_path, fmu, old, new, marker, words):
+    _needs(fmu)
+    # the driver is checked first: the names of the cylinder study do not matter here
+    text = STROKE_STUDY.replace(old, new, 1).replace(str(CYLINDER_ARM), str(fmu))
+    assert text != STROKE_STUDY
+    line = max(k for k, t in enumerate(text.splitlines(), start=1) if marker in t)
+    with pytest.raises(StudyError) as info:
+        study.prepare(_write(tmp_path, text), tmp_path)
+    assert str(info.value).startswith(f"{tmp_path / 'study.toml'}:{line}: "), str(info.value)
+    assert words in str(info.value)
+
+
+@pytest.mark.parametrize("use_rows", [True, False], ids=["rows", "fmi"])
+def test_a_stroke_that_the_triangle_cannot_close_over_fails_its_design(tmp_path, use_rows):
+    """The cylinder's pin at x = 2 m cannot reach the stroke's first lengths: that design is
+    cannot_assemble with the FMU's gap and the length where it failed; the others run the
+    cycloid: rest at both ends, 1.3 m/s at half way, 2 pi 1.3 / 2^2 m/s2 at a quarter."""
+    _needs(CYLINDER_ARM)
+    from dataclasses import replace
+
+    s, run, values, _ = study.prepare(_write(tmp_path, STROKE_STUDY), tmp_path)
+    assert isinstance(run, runs.StrokeRun) and run.inputs()[:3] == (
+        "hoist.length", "hoist.velocity", "hoist.acceleration",
+    )  # fmt: skip
+    run = replace(run, use_rows=use_rows)
+    table = results.table_of(s, values, run.chunk(list(enumerate(values))))
+    assert table.status == ["ok", "ok", "cannot_assemble"], table.message
+    assert "cylinder hoist cannot assemble" in table.message[2]
+    assert "|O A| > |O B| + s by 0.3375" in table.message[2]  # 2.1541 - 1.2166 - 0.6
+    assert "at sample 0: hoist.length 0.6" in table.message[2]
+    for k in (0, 1):
+        assert table.column("length_min")[k] == 0.6 and table.column("length_max")[k] == 1.9
+        assert table.column("speed_max")[k] == pytest.approx(1.3, rel=1e-15)
+        assert table.column("acceleration_max")[k] == pytest.approx(
+            2 * math.pi * 1.3 / 4, rel=1e-15
+        )
+    assert results.best_designs(table, s)[0] in (0, 1)
+    other = results.table_of(
+        s, values, replace(run, use_rows=not use_rows).chunk(list(enumerate(values)))
+    )
+    assert np.array_equal(other.figures, table.figures, equal_nan=True)
+    assert other.message == table.message
+
+
+def test_a_ram_s_stroke_run_gives_the_force_the_fmu_gives_at_each_position(tmp_path):
+    """The lift's ram over 0.1 to 0.4 m in 1.5 s: the sweep's peak force against the FMU
+    stepped through the same motion, computed here from the cycloid's definition."""
+    _needs(LIFT)
+    text = (
+        STROKE_STUDY.replace(str(CYLINDER_ARM), str(LIFT))
+        .replace("stroke = [0.6, 1.9]", "stroke = [0.1, 0.4]")
+        .replace("duration = 2.0", "duration = 1.5")
+        .replace('name = "hoist.base.x"', 'name = "gravity.y"')
+        .replace("low = 0.6\nhigh = 2.0", "low = -9.81\nhigh = 0.0")
+        .replace('"payload.force.y" = -4000.0', '"platform.force.y" = -2000.0')
+        .replace("hoist.", "ram.")
+        .replace('"ram.length"', '"ram.position"')
+    )  # fmt: skip
+    s, run, values, _ = study.prepare(_write(tmp_path, text), tmp_path)
+    table = results.table_of(s, values, run.chunk(list(enumerate(values))))
+    assert table.status == ["ok"] * 3, table.message
+    from dyadfmu.fmi.slave import Slave
+
+    lift = Slave(LIFT)
+    tau = np.arange(25) / 24
+    q = 0.1 + 0.3 * (tau - np.sin(2 * math.pi * tau) / (2 * math.pi))
+    v = 0.3 / 1.5 * (1 - np.cos(2 * math.pi * tau))
+    a = 2 * math.pi * 0.3 / 1.5**2 * np.sin(2 * math.pi * tau)
+    for k, (g,) in enumerate(values):
+        lift.reset()
+        lift.initialize({"gravity.y": g})
+        force = []
+        for j in range(25):
+            lift.set(("ram.position", "ram.velocity", "ram.acceleration", "platform.force.y"),
+                     (q[j], v[j], a[j], -2000.0))  # fmt: skip
+            lift.do_step(j * 1.5 / 24, 1.5 / 24)
+            force.append(lift.get("ram.force"))
+        assert table.column("force_peak")[k] == pytest.approx(np.max(np.abs(force)), rel=1e-12)
+    lift.close()
+
+
+def test_the_cycloid_rises_rest_to_rest_and_its_rates_are_its_derivatives():
+    q, v, a = stroke.cycloid(0.5, 2.0, 3.0, 3001)
+    assert (q[0], q[-1], v[0], a[0]) == (0.5, 2.0, 0.0, 0.0)
+    assert abs(v[-1]) < 1e-15 and abs(a[-1]) < 1e-14
+    assert np.all(np.diff(q) > 0)
+    # central differences over dt = 1 ms: second order, within 1e-5 of the rates here
+    assert np.max(np.abs((q[2:] - q[:-2]) / 2e-3 - v[1:-1])) < 1e-5
+    assert np.max(np.abs((v[2:] - v[:-2]) / 2e-3 - a[1:-1])) < 1e-5
+    assert np.max(v) == pytest.approx(2 * 1.5 / 3.0, rel=1e-12)
+
+
+def test_a_cylinder_s_length_and_rates_follow_its_pins():
+    """s, s' and s'' against the pins themselves: B from the link's angle, s = |B - A|,
+    s' = u . v_B and s'' = u . a_B + (|v_B|^2 - s'^2) / s with u = (B - A) / s, v_B and a_B
+    the velocity and acceleration of B turning about O."""
+    o, a, pin = (0.3, -0.2), (2.0, 0.5), (1.1, -0.4)
+    cylinder = stroke.Cylinder("c", "l", o, a, pin, 1.0)
+    theta = np.linspace(-0.3, 1.2, 7)
+    omega, epsilon = np.linspace(0.5, -0.7, 7), np.linspace(-2.0, 3.0, 7)
+    s, rate, acceleration = cylinder.lengths(theta, omega, epsilon)
+    r = np.stack([np.cos(theta) * pin[0] - np.sin(theta) * pin[1],
+                  np.sin(theta) * pin[0] + np.cos(theta) * pin[1]], axis=1)  # fmt: skip
+    d = np.array(o) + r - np.array(a)
+    length = np.hypot(d[:, 0], d[:, 1])
+    u = d / length[:, None]
+    across = np.stack([-r[:, 1], r[:, 0]], axis=1)  # k x r
+    v_b = omega[:, None] * across
+    a_b = epsilon[:, None] * across - (omega**2)[:, None] * r
+    s_rate = np.sum(u * v_b, axis=1)
+    s_acc = np.sum(u * a_b, axis=1) + (np.sum(v_b * v_b, axis=1) - s_rate**2) / length
+    np.testing.assert_allclose(s, length, rtol=1e-14)
+    np.testing.assert_allclose(rate, s_rate, rtol=1e-13, atol=1e-15)
+    np.testing.assert_allclose(acceleration, s_acc, rtol=1e-12, atol=1e-14)
+
+
+def test_a_cylinder_run_through_its_toggle_or_on_its_other_branch_cannot_be_run():
+    # O at the origin, A on +x, B on the link's i: in line with O and A at angle 0 and pi,
+    # to the left of O -> A (branch +1) between them
+    left = stroke.Cylinder("c", "l", (0.0, 0.0), (2.0, 0.0), (1.0, 0.0), 1.0)
+    left.check(0.1, 3.0)
+    for low, high, at in [(-0.1, 0.5, "l.angle 0 rad"), (0.5, math.pi, "l.angle 3.14159 rad")]:
+        with pytest.raises(stroke.Unreachable) as info:
+            left.check(low, high)  # the end of the range at the toggle counts
+        assert info.value.status == "singular"
+        assert f"passes its toggle (O, A and B in line) at {at}" in str(info.value)
+    with pytest.raises(stroke.Unreachable) as info:
+        left.check(-1.0, -0.1)
+    assert info.value.status == "cannot_assemble"
+    assert "B is to the right of the line O -> A, the branch -1, not the cylinder's +1" in str(
+        info.value
+    )
+    # the FMU's reading of a branch: below 0 is -1, anything else +1
+    stroke.Cylinder("c", "l", (0.0, 0.0), (2.0, 0.0), (1.0, 0.0), -1e-300).check(-1.0, -0.1)
+    stroke.Cylinder("c", "l", (0.0, 0.0), (2.0, 0.0), (1.0, 0.0), 0.0).check(0.1, 1.0)
+    # any geometry: at the angle reported, O, A and B are in line
+    tilted = stroke.Cylinder("c", "l", (0.3, 1.7), (5.3, 0.9), (4.3, -0.7), 1.0)
+    with pytest.raises(stroke.Unreachable) as info:
+        tilted.check(0.0, 0.8)
+    at = float(re.search(r"at l.angle ([-0-9.e]+) rad", str(info.value)).group(1))
+    b = (
+        0.3 + math.cos(at) * 4.3 + math.sin(at) * 0.7,
+        1.7 + math.sin(at) * 4.3 - math.cos(at) * 0.7,
+    )
+    cross = (5.3 - 0.3) * (b[1] - 1.7) - (0.9 - 1.7) * (b[0] - 0.3)
+    assert abs(cross) < 1e-5 * 5.1 * 4.36  # |OA| |OB| sin(angle), to the 6 digits shown
+    with pytest.raises(stroke.Unreachable) as info:
+        stroke.Cylinder("c", "l", (1.0, 1.0), (1.0, 1.0), (1.0, 0.0), 1.0).check(0.0, 1.0)
+    assert info.value.status == "invalid_input"
+
+
+#: The arm's cylinder turning the arm from -0.25 to 1.8 rad, its bracket B at 1.2 m along
+#: the arm and y below or above it: O, A and B fall in line at arm.angle 2.379 rad for
+#: y = -0.2, 2.049 for y = 0.2 and 1.750 for y = 0.6, within the run.
+ARM_ANGLE_STUDY = f"""
+[study]
+scene = "{ROOT / "tests" / "scenes" / "cylinder_arm.toml"}"
+
+[run]
+kind = "kinetostatic"
+angle = [-0.25, 1.8]
+duration = 3.0
+points = 41
+
+[sampling]
+method = "grid"
+count = 3
+
+[[parameter]]
+name = "hoist.pin.y"
+low = -0.2
+high = 0.6
+
+[loads]
+"payload.force.y" = -4000.0
+
+[[figure]]
+name = "force_peak"
+of = "hoist.force"
+stat = "peak"
+
+[[figure]]
+name = "arm_omega_max"
+of = "arm.omega"
+stat = "max"
+
+[[figure]]
+name = "arm_epsilon_max"
+of = "arm.epsilon"
+stat = "max"
+
+[objective]
+minimize = "force_peak"
+"""
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="building a study's scene needs CMake")
+def test_an_angle_run_turns_the_link_as_asked_and_refuses_a_design_through_its_toggle(
+    tmp_path, monkeypatch
+):
+    """Over the arm's angle, each design's cylinder lengths from its own pins: the FMU's arm
+    turns at the cycloid's rates (2 x 2.05 / 3 rad/s at half way, 2 pi 2.05 / 3^2 rad/s2 at
+    a quarter); the design whose triangle passes its toggle within the run is singular,
+    before any sample; with the checks of the branch taken away, a design on the other
+    branch is caught by the angle the FMU reports."""
+    from dataclasses import replace
+
+    s, run, values, _ = study.prepare(_write(tmp_path, ARM_ANGLE_STUDY), tmp_path)
+    assert run.link == "arm" and run.inputs()[0] == "hoist.length"
+    for use_rows in (True, False):
+        table = results.table_of(
+            s, values, replace(run, use_rows=use_rows).chunk(list(enumerate(values)))
+        )
+        assert table.status == ["ok", "ok", "singular"], table.message
+        assert "passes its toggle (O, A and B in line) at arm.angle 1.75" in table.message[2]
+        omega, epsilon = table.column("arm_omega_max"), table.column("arm_epsilon_max")
+        assert omega[:2] == pytest.approx([2 * 2.05 / 3] * 2, rel=1e-12)
+        assert epsilon[:2] == pytest.approx([2 * math.pi * 2.05 / 9] * 2, rel=1e-9)
+    unchecked = replace(run, fixed=(("hoist.branch", -1.0),))
+    assert unchecked(tuple(values[0])).status == "cannot_assemble"
+    monkeypatch.setattr(stroke.Cylinder, "check", lambda self, low, high: None)
+    outcome = unchecked(tuple(values[0]))
+    assert outcome.status == "wrong_angle" and "the FMU puts arm at" in outcome.message
+    assert "not the run's -0.25 rad (sample 0)" in outcome.message
+
+
+def _model(inputs: tuple, outputs: tuple, parameters: tuple = ()):
+    from fmpy.model_description import ModelDescription, ScalarVariable
+
+    md = ModelDescription()
+    for causality, names in (("input", inputs), ("output", outputs), ("parameter", parameters)):
+        for name in names:
+            v = ScalarVariable(name=name, valueReference=len(md.modelVariables))
+            v.causality, v.type = causality, "Real"
+            md.modelVariables.append(v)
+    return md
+
+
+def test_the_driver_of_a_mechanism_fmu_is_found_by_its_inputs_and_effort():
+    """A crank needs its rates; a ram or a cylinder without inertia takes its coordinate
+    alone, and a stroke run sets that alone; a cylinder's geometry is known where the FMU
+    has all of it as parameters."""
+    from dyadfmu.sweep.checks import driver_of
+
+    assert driver_of(_model(("crank.angle",), ("crank.torque",))) is None
+    crank = driver_of(_model(("c.angle", "c.omega", "c.epsilon", "f.force.x"), ("c.torque",)))
+    assert (crank.kind, crank.motion, crank.effort) == (
+        "crank", ("c.angle", "c.omega", "c.epsilon"), "c.torque",
+    )  # fmt: skip
+    ram = driver_of(_model(("r.position", "r.velocity", "r.acceleration"), ("r.force",)))
+    assert (ram.kind, ram.motion) == ("ram", ("r.position", "r.velocity", "r.acceleration"))
+    geometry = ("arm.at.x", "arm.at.y", "h.base.x", "h.base.y", "h.pin.x", "h.pin.y", "h.branch")
+    still = driver_of(_model(("h.length", "p.force.y"), ("h.force", "arm.angle"), geometry))
+    assert (still.kind, still.motion, still.link, still.geometry) == (
+        "cylinder", ("h.length",), "arm", geometry,
+    )  # fmt: skip
+    assert driver_of(_model(("h.length",), ("h.force", "arm.angle"), geometry[:-1])).geometry == ()
+    assert driver_of(_model(("h.length",), ("h.angle",))) is None  # no force: no driver
+    run = runs.StrokeRun(
+        "x.fmu", "h", (), (), (), (LoadTable("p.force.y", (0.0,), (-5.0,)),), (),
+        motion=still.motion, effort=still.effort, points=9, low=1.0, high=2.0, duration=4.0,
+    )  # fmt: skip
+    x = run.samples({})
+    assert run.inputs() == ("h.length", "p.force.y") and x.shape == (9, 2)
+    assert x[:, 0].tolist() == pytest.approx(stroke.cycloid(1.0, 2.0, 4.0, 9)[0].tolist())
+    assert set(x[:, 1]) == {-5.0}

@@ -1,7 +1,11 @@
-"""One run of a study per design, of one of two kinds:
+"""One run of a study per design, of one of three kinds:
 
 - :class:`KinetostaticRun`: the mechanism FMU turned through one revolution at constant
   crank speed (the loads from the study's load case at each angle);
+- :class:`StrokeRun`: a ram or a cylinder moved once over its stroke, or a cylinder's
+  link turned over a range of angles, rest to rest (:mod:`dyadfmu.sweep.stroke`), under
+  constant loads; a design whose cylinder cannot turn its link over the range (its toggle
+  within it, or its pin on the other branch) is a failed run before any sample;
 - :class:`DrivenRun`: the drive FMU (motor and rotor) and the mechanism FMU co-simulated
   with the stabilised coupling of :mod:`dyadfmu.cosim.mechanism_drive`: at each
   communication point the mechanism FMU gives its torque at zero crank acceleration
@@ -35,14 +39,16 @@ import numpy as np
 from fmpy.model_description import ModelDescription
 
 from ..fmi.slave import Slave, SlaveError
-from .checks import base_values
+from . import stroke
+from .checks import Driver, base_values, driver_of
 from .figures import UndefinedFigure, figure_value, series_names
-from .rows import rows_entry
-from .studyfile import MIN_DIGITS, Driven, Kinetostatic, Study, recorded_from
+from .rows import RowsEntry, rows_entry
+from .studyfile import MIN_DIGITS, Driven, Kinetostatic, Stroke, Study, recorded_from
 
 __all__ = [
     "Outcome",
     "KinetostaticRun",
+    "StrokeRun",
     "DrivenRun",
     "run_of",
     "run_rows",
@@ -128,7 +134,7 @@ def _assignments(study_parameters: tuple, values: tuple, base: dict) -> dict:
 @dataclass(frozen=True)
 class _Common:
     mechanism: str  # the mechanism FMU's path
-    driver: str  # the crank's name in the mechanism FMU
+    driver: str  # the driver's name in the mechanism FMU (a crank, a ram or a cylinder)
     parameters: tuple
     base: tuple  # ((name, start value), ...) the counterweights read
     fixed: tuple
@@ -136,15 +142,25 @@ class _Common:
     figures: tuple
     amplifications: tuple = ()  # the FMU's amplification outputs (amplification_outputs)
     min_digits: float = MIN_DIGITS
+    motion: tuple = ()  # the driver's motion inputs (Driver.motion); a crank's by default
+    effort: str = ""  # the driver's torque or force output; a crank's torque by default
+
+    def motion_inputs(self) -> tuple:
+        """The driver's coordinate, rate and acceleration inputs (those the FMU has)."""
+        return self.motion or tuple(f"{self.driver}.{q}" for q in ("angle", "omega", "epsilon"))
+
+    def checked(self) -> tuple:
+        """Outputs a sample reads beyond the figures' series, to solve it and check it:
+        the amplifications and the driver's torque or force (an output: reading it
+        solves the sample, so that its status is that of the whole mechanism even where
+        the figures read inputs only)."""
+        return (*self.amplifications, self.effort or f"{self.driver}.torque")
 
     def read(self) -> tuple:
         """The mechanism FMU's variables a sample reads: the figures' series, then the
-        amplifications and the crank's torque (an output: reading it solves the sample,
-        so that its status is that of the whole mechanism even where the figures read
-        inputs only)."""
+        checked outputs."""
         series = series_names(self.figures)
-        more = (*self.amplifications, f"{self.driver}.torque")
-        return series + tuple(n for n in dict.fromkeys(more) if n not in series)
+        return series + tuple(n for n in dict.fromkeys(self.checked()) if n not in series)
 
     def mechanism_parameters(self, values: tuple) -> dict:
         """The mechanism FMU's parameters of a design (drive.* left out)."""
@@ -153,9 +169,8 @@ class _Common:
         return {n: v for n, v in assigned.items() if not n.startswith("drive.")}
 
     def inputs(self) -> tuple:
-        """The mechanism FMU's inputs a point sets: the crank's motion, then the loads."""
-        crank = tuple(f"{self.driver}.{q}" for q in ("angle", "omega", "epsilon"))
-        return crank + tuple(load.name for load in self.loads)
+        """The mechanism FMU's inputs a point sets: the driver's motion, then the loads."""
+        return self.motion_inputs() + tuple(load.name for load in self.loads)
 
     def guarded(self, run: Callable[[], Outcome]) -> Outcome:
         """run(), or the Outcome of its failure (NaN figures and the status)."""
@@ -211,7 +226,7 @@ class _Common:
 
 def _failed_point(mech: Slave, where: str) -> _Failed:
     code = mech.get_status() if "status" in mech.names else 0
-    message = mech.messages[-1] if mech.messages else f"outputs not finite {where}"
+    message = f"{mech.messages[-1]} ({where})" if mech.messages else f"outputs not finite {where}"
     return _Failed(STATUS_NAMES.get(code, f"status {code}") if code else "diverged", message)
 
 
@@ -247,8 +262,21 @@ class KinetostaticRun(_Common):
             rows.append((phi, self.speed, 0.0) + tuple(ld.at(phi) for ld in self.loads))
         return np.array(rows)
 
+    def samples(self, params: dict) -> np.ndarray:
+        """The inputs of every sample of the design whose mechanism parameters are
+        ``params`` (samples x inputs); _Failed where the design cannot be run."""
+        return self._point_inputs
+
+    def where(self, k: int, x: np.ndarray) -> str:
+        """Sample ``k`` (inputs ``x``) as a message names it."""
+        return f"at crank angle {x[0]:.6g} rad"
+
+    def result(self, series: dict, x: np.ndarray) -> Outcome:
+        """The outcome of a design's series, its samples' inputs ``x``."""
+        return self.outcome(series, None)
+
     def chunk(self, rows: list) -> list:
-        """[(index, Outcome)] of the designs [(index, values)]: every angle of every
+        """[(index, Outcome)] of the designs [(index, values)]: every sample of every
         design in one call of the binary's rows entry; a design that fails there runs
         again through FMI, whose calls name the failure."""
         entry = rows_entry(self.mechanism) if self.use_rows else None
@@ -261,32 +289,124 @@ class KinetostaticRun(_Common):
         p_names = tuple(params[0]) if params else ()
         if any(tuple(p) != p_names for p in params):
             return super().chunk(rows)
-        names, n = self.read(), self.points
-        p = np.repeat(np.array([[d[k] for k in p_names] for d in params]), n, axis=0)
-        x = np.tile(self._point_inputs, (len(rows), 1))
+        out, runnable = {}, []
+        for j, (index, _) in enumerate(rows):
+            try:
+                runnable.append((j, self.samples(params[j])))
+            except _Failed as e:  # the design cannot run: its outcome says why
+                out[index] = Outcome((math.nan,) * len(self.figures), e.status, e.message)
         try:
-            y, status = entry.evaluate(p_names, p, self.inputs(), x, names)
+            out.update(self._evaluated(entry, rows, params, p_names, runnable))
         except RuntimeError:  # refused as a whole (an FMU whose GUID is not its binary's)
             return super().chunk(rows)
-        out = []
-        for j, (index, values) in enumerate(rows):
-            block, ok = y[j * n : (j + 1) * n], not status[j * n : (j + 1) * n].any()
+        return [(index, out[index]) for index, _ in rows]
+
+    def _evaluated(
+        self, entry: RowsEntry, rows: list, params: list, p_names: tuple, runnable: list
+    ) -> dict:
+        """{index: Outcome} of the runnable designs [(j, their samples' inputs)] of
+        ``rows``, all their samples in one call of the rows entry."""
+        if not runnable:
+            return {}
+        names, n = self.read(), self.points
+        p = np.repeat(np.array([[params[j][k] for k in p_names] for j, _ in runnable]), n, axis=0)
+        x = np.concatenate([xj for _, xj in runnable])
+        y, status = entry.evaluate(p_names, p, self.inputs(), x, names)
+        out = {}
+        for m, (j, xj) in enumerate(runnable):
+            index, values = rows[j]
+            block, ok = y[m * n : (m + 1) * n], not status[m * n : (m + 1) * n].any()
             if ok and np.all(np.isfinite(block)):
-                out.append((index, self.outcome(dict(zip(names, block.T, strict=True)), None)))
+                out[index] = self.result(dict(zip(names, block.T, strict=True)), xj)
             else:
-                out.append((index, self(tuple(values))))
+                out[index] = self(tuple(values))
         return out
 
     def _run(self, values: tuple) -> Outcome:
-        mech = _fresh(self.mechanism, "mechanism", self.mechanism_parameters(values))
+        params = self.mechanism_parameters(values)
+        x = self.samples(params)
+        mech = _fresh(self.mechanism, "mechanism", params)
         names, inputs = self.read(), self.inputs()
         rows = np.empty((self.points, len(names)))
         for k in range(self.points):
-            phi = 2 * math.pi * k / self.points
-            mech.set(inputs, (phi, self.speed, 0.0) + tuple(ld.at(phi) for ld in self.loads))
+            mech.set(inputs, tuple(x[k]))
             rows[k] = mech.get(names)
-            _check_point(mech, rows[k], f"at crank angle {phi:.6g} rad")
-        return self.outcome(dict(zip(names, rows.T, strict=True)), None)
+            _check_point(mech, rows[k], self.where(k, x[k]))
+        return self.result(dict(zip(names, rows.T, strict=True)), x)
+
+
+@dataclass(frozen=True)
+class StrokeRun(KinetostaticRun):
+    """A ram or a cylinder moved once over its stroke (``over`` "stroke": its coordinate
+    from ``low`` to ``high``, m) or a cylinder's link turned (``over`` "angle": from
+    ``low`` to ``high``, rad), rest to rest in ``duration`` s along the cycloidal rise of
+    :mod:`dyadfmu.sweep.stroke`, at ``points`` instants. An angle run takes the cylinder's
+    geometry (``geometry``: the names of O, A, B and the branch, Driver.geometry) from
+    each design's parameters, refuses a design whose run passes the toggle or lies on the
+    other branch before it runs, and checks at every sample that the FMU puts ``link`` at
+    the run's angle."""
+
+    over: str = "stroke"
+    low: float = 0.0
+    high: float = 1.0
+    duration: float = 1.0
+    link: str = ""
+    geometry: tuple = ()
+
+    @functools.cached_property
+    def _profile(self) -> tuple:
+        return stroke.cycloid(self.low, self.high, self.duration, self.points)
+
+    def _loads(self) -> np.ndarray:
+        """The loads at every instant: constant (points x loads)."""
+        return np.tile(np.array([ld.value[0] for ld in self.loads], dtype=float), (self.points, 1))
+
+    def checked(self) -> tuple:
+        """The amplifications, the driver's force and, for an angle run, the link's angle."""
+        return (*super().checked(), *((f"{self.link}.angle",) if self.over == "angle" else ()))
+
+    def cylinder(self, params: dict) -> stroke.Cylinder:
+        """The cylinder's geometry of a design (its parameters, else the FMU's start values)."""
+        base = dict(self.base)
+        ox, oy, ax, ay, px, py, branch = (params.get(n, base.get(n)) for n in self.geometry)
+        return stroke.Cylinder(self.driver, self.link, (ox, oy), (ax, ay), (px, py), branch)
+
+    def samples(self, params: dict) -> np.ndarray:
+        """The driver's motion at every instant (its coordinate and, where the FMU takes
+        them, its rates), then the loads; _Failed where the link cannot be turned over
+        the run on the cylinder's branch."""
+        q = self._profile
+        if self.over == "angle":
+            cylinder = self.cylinder(params)
+            try:
+                cylinder.check(self.low, self.high)
+            except stroke.Unreachable as e:
+                raise _Failed(e.status, str(e)) from None
+            with np.errstate(all="ignore"):
+                q = cylinder.lengths(*q)
+        motion = np.column_stack(q[: len(self.motion_inputs())])
+        return np.hstack([motion, self._loads()])
+
+    def where(self, k: int, x: np.ndarray) -> str:
+        """Sample ``k`` as a message names it: the driver's coordinate (and the angle)."""
+        at = f"at sample {k}: {self.motion_inputs()[0]} {x[0]:.6g}"
+        return at if self.over != "angle" else f"{at}, {self.link}.angle {self._profile[0][k]:.6g}"
+
+    def result(self, series: dict, x: np.ndarray) -> Outcome:
+        """The outcome; for an angle run ``wrong_angle`` where the FMU's link is not at the
+        run's angle (by more than 1e-6 rad) at some sample: the message names the first."""
+        if self.over == "angle":
+            got = series[f"{self.link}.angle"]
+            off = np.abs(np.remainder(got - self._profile[0] + math.pi, 2 * math.pi) - math.pi)
+            if not np.all(off <= 1e-6):
+                k = int(np.argmax(~(off <= 1e-6)))  # the first sample off the run
+                return Outcome(
+                    (math.nan,) * len(self.figures),
+                    "wrong_angle",
+                    f"the FMU puts {self.link} at {got[k]:.9g} rad, not the run's "
+                    f"{self._profile[0][k]:.9g} rad (sample {k})",
+                )
+        return self.outcome(series, None)
 
 
 @dataclass(frozen=True)
@@ -359,26 +479,31 @@ class DrivenRun(_Common):
         return self.outcome(series, np.unwrap(np.array(phis)))
 
 
-def _crank_of(md: ModelDescription) -> str:
-    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
-    drivers = [n[: -len(".angle")] for n in inputs if n.endswith(".angle")]
-    for d in drivers:
-        if {f"{d}.omega", f"{d}.epsilon", f"{d}.torque"} <= {v.name for v in md.modelVariables}:
-            return d
-    raise ValueError(
-        "the study needs a mechanism FMU driven by a crank (inputs CRANK.angle, .omega, "
-        ".epsilon and output CRANK.torque); this FMU has none"
+def _stroke_run(common: dict, run: Stroke, driver: Driver) -> StrokeRun:
+    return StrokeRun(
+        **common,
+        points=run.points,
+        over=run.over,
+        low=run.low,
+        high=run.high,
+        duration=run.duration,
+        link=driver.link or "",
+        geometry=driver.geometry if run.over == "angle" else (),
     )
 
 
 def run_of(
     study: Study, mechanism: str, drive: str | None, md: ModelDescription
-) -> KinetostaticRun | DrivenRun:
+) -> KinetostaticRun | StrokeRun | DrivenRun:
     """The run of a study on the mechanism FMU at path ``mechanism`` (model description
-    ``md``) and, for a driven study, the drive FMU at ``drive``."""
+    ``md``) and, for a driven study, the drive FMU at ``drive``. ValueError where the FMU
+    has no driver (check_names refuses such a study first)."""
+    driver = driver_of(md)
+    if driver is None:
+        raise ValueError("the mechanism FMU has no crank, ram or cylinder to drive")
     common = dict(
         mechanism=mechanism,
-        driver=_crank_of(md),
+        driver=driver.name,
         parameters=study.parameters,
         base=tuple(base_values(study, md).items()),
         fixed=study.fixed,
@@ -386,7 +511,11 @@ def run_of(
         figures=study.figures,
         amplifications=amplification_outputs(md),
         min_digits=study.min_digits,
+        motion=driver.motion,
+        effort=driver.effort,
     )
+    if isinstance(study.run, Stroke):
+        return _stroke_run(common, study.run, driver)
     if isinstance(study.run, Kinetostatic):
         return KinetostaticRun(**common, speed=study.run.speed, points=study.run.points)
     r: Driven = study.run
@@ -402,6 +531,6 @@ def run_of(
     )
 
 
-def run_rows(run: KinetostaticRun | DrivenRun, rows: list) -> list:
+def run_rows(run: KinetostaticRun | StrokeRun | DrivenRun, rows: list) -> list:
     """[(design index, Outcome)] of the designs [(index, values)], in order."""
     return run.chunk(rows)

@@ -25,7 +25,7 @@ from fmpy.model_description import ModelDescription
 
 from .. import paths
 from .scenebuild import BuildError, generator, scene_fmu
-from .studyfile import Counterweight, Driven, Study, StudyError, line_of
+from .studyfile import Counterweight, Driven, Stroke, Study, StudyError, line_of
 
 __all__ = [
     "toml_text",
@@ -121,13 +121,31 @@ def _copy_of(scene_file: Path, study: Study) -> dict:
     tunable = scene.get("tunable", [])
     if not isinstance(tunable, list) or not all(isinstance(n, str) for n in tunable):
         raise ValueError("[scene] tunable must be a list of parameter names")
-    scene["tunable"] = tunable + [n for n in _varied(study) if n not in tunable]
+    geometry, angle = _cylinder_names(data, study)
+    wanted = _varied(study) + geometry
+    scene["tunable"] = tunable + [n for n in dict.fromkeys(wanted) if n not in tunable]
     outputs = scene.get("outputs")
     if isinstance(outputs, list) and "all" not in outputs:
         # every dyad's amplification: the round-off bound a study checks at each sample
-        scene["outputs"] = outputs + [n for n in _amplifications(data) if n not in outputs]
+        more = _amplifications(data) + angle
+        scene["outputs"] = outputs + [n for n in dict.fromkeys(more) if n not in outputs]
     toml_text(data)  # every value can be written
     return data
+
+
+def _cylinder_names(data: dict, study: Study) -> tuple[list, list]:
+    """(tunable names, outputs) a run over a cylinder's link's angle needs: the geometry
+    the run computes the cylinder's length from (the link's pivot, the pins, the branch)
+    and the link's angle it checks; nothing for another run or a scene without one."""
+    cylinder = data.get("cylinder")
+    if not (isinstance(study.run, Stroke) and study.run.over == "angle"):
+        return [], []
+    if not isinstance(cylinder, dict) or not isinstance(cylinder.get("link"), str):
+        return [], []  # the run is refused against the scene's model description
+    name, link = cylinder.get("name", "cylinder"), cylinder["link"]
+    if not isinstance(name, str):
+        return [], []
+    return [f"{link}.at", f"{name}.base", f"{name}.pin", f"{name}.branch"], [f"{link}.angle"]
 
 
 def _amplifications(data: dict) -> list:

@@ -13,7 +13,7 @@ from . import execute, sources
 from .checks import check_names, units_of
 from .designs import designs
 from .results import Table, best_designs, table_of, write_csv
-from .runs import DrivenRun, KinetostaticRun, run_of
+from .runs import DrivenRun, KinetostaticRun, StrokeRun, run_of
 from .studyfile import Study, StudyError, line_of, read_study
 
 __all__ = ["SweepResult", "run_study", "prepare"]
@@ -32,7 +32,7 @@ class SweepResult:
 
 def prepare(
     path: Path, out: Path, build: Path | None = None
-) -> tuple[Study, KinetostaticRun | DrivenRun, np.ndarray, dict]:
+) -> tuple[Study, KinetostaticRun | StrokeRun | DrivenRun, np.ndarray, dict]:
     """(study, run, designs, units): the study read, its FMUs found or built and its
     names checked against them, its designs drawn, the units of its columns. A scene
     study's names are checked against the model description generated from its scene
@@ -48,7 +48,7 @@ def prepare(
     check_names(study, md, drive_md, mechanism.name)
     try:
         run = run_of(study, str(mechanism), str(drive) if drive else None, md)
-    except ValueError as e:  # no crank to drive
+    except ValueError as e:  # no driver (check_names refuses that first)
         source = "scene" if study.scene is not None else "fmu"
         line = line_of(study.text, "study", key=source)
         raise StudyError(f"{study.path}:{line}: {mechanism.name}: {e}") from None

@@ -27,6 +27,7 @@ __all__ = [
     "Objective",
     "Sampling",
     "Kinetostatic",
+    "Stroke",
     "Driven",
     "Study",
     "read_study",
@@ -50,11 +51,15 @@ MIN_DIGITS = 8.0
 DOUBLE_DIGITS = 52 * math.log10(2)
 #: A driven run's figures are taken from at least this many communication points.
 MIN_RECORDED = 10
-#: The most work a study may ask for: crank positions (kinetostatic: designs x points)
+#: The most work a study may ask for: driver positions (kinetostatic: designs x points)
 #: or communication steps (driven: designs x steps), a few hours on one core here. A
 #: study beyond them is split into several.
 MAX_POSITIONS = 10_000_000_000
 MAX_STEPS = 100_000_000
+#: A stroke run's bounds: the driver's coordinate within +-MAX_STROKE m, a link's angle
+#: within +-MAX_ANGLE rad (the load tables' bound).
+MAX_STROKE = 1e4
+MAX_ANGLE = 100.0
 #: A counterweight's bounds: its mass (kg) and its distance from the link's frame (m).
 MAX_COUNTERWEIGHT_MASS = 1e6
 MAX_COUNTERWEIGHT_AT = 1e3
@@ -221,6 +226,22 @@ class Kinetostatic:
 
 
 @dataclass(frozen=True)
+class Stroke:
+    """Each design: a linear driver (a ram or a cylinder) moved once over its stroke,
+    rest to rest in ``duration`` s (a cycloidal rise, :mod:`dyadfmu.sweep.stroke`), at
+    ``points`` equally spaced instants, both ends included. ``over`` "stroke": the
+    driver's coordinate (a ram's position, a cylinder's length, m) from ``low`` to
+    ``high``; "angle": a cylinder's link turned from ``low`` to ``high`` (rad), the
+    cylinder's length at each angle from the design's geometry."""
+
+    over: str
+    low: float
+    high: float
+    duration: float
+    points: int
+
+
+@dataclass(frozen=True)
 class Driven:
     """Each design: the drive FMU and the mechanism FMU co-simulated (stabilised
     coupling) from ``start_speed`` (rad/s) for ``duration`` s at communication step
@@ -244,7 +265,7 @@ class Study:
     scene: Path | None
     fmu: Path | None
     fmi: int
-    run: Kinetostatic | Driven
+    run: Kinetostatic | Stroke | Driven
     parameters: tuple
     sampling: Sampling
     loads: tuple
@@ -451,19 +472,87 @@ def _sources(r: _Reader, study: dict) -> tuple:
     return (path, None) if key == "scene" else (None, path)
 
 
-def _run(r: _Reader, data: dict) -> Kinetostatic | Driven:
+def _range(r: _Reader, t: dict, key: str, unit: str, bound: float) -> tuple[float, float]:
+    """A run's [low, high]: two finite numbers within +-bound, low below high."""
+    value = t[key]
+    pair = [finite(v) for v in value] if isinstance(value, list) and len(value) == 2 else [None]
+    if not all(v is not None and abs(v) <= bound for v in pair):
+        r.fail(
+            "run",
+            f"{key} must be [low, high] in {unit}, two finite numbers within +-{bound:g} "
+            f"(got {_shown(value)})",
+            key=key,
+        )
+    if not pair[0] < pair[1]:
+        r.fail(
+            "run",
+            f"{key} must rise, low below high (got [{pair[0]:g}, {pair[1]:g}]): the run "
+            "goes from low to high",
+            key=key,
+        )
+    return pair[0], pair[1]
+
+
+def _stroke(r: _Reader, t: dict, key: str) -> Stroke:
+    """A run over a linear driver's stroke (``key`` "stroke") or a cylinder's link's
+    angle (``key`` "angle")."""
+    if key == "stroke":
+        low, high = _range(r, t, key, "metres", MAX_STROKE)
+    else:
+        low, high = _range(r, t, key, "radians", MAX_ANGLE)
+        if not high - low < math.pi:
+            r.fail(
+                "run",
+                f"angle spans {high - low:.6g} rad: a cylinder turns its link by less than "
+                "pi between its toggles (O, A and B in line)",
+                key=key,
+            )
+    return Stroke(
+        over=key,
+        low=low,
+        high=high,
+        duration=r.number(t, "run", "duration", positive=True),
+        points=r.integer(t, "run", "points", 8, 100_000, default=101),
+    )
+
+
+def _kinetostatic(r: _Reader, t: dict) -> Kinetostatic | Stroke:
+    """A crank's revolution at ``speed``, or a linear driver's ``stroke`` or ``angle``."""
+    r.unknown_keys(t, "run", ("kind", "speed", "points", "stroke", "angle", "duration"))
+    given = [k for k in ("speed", "stroke", "angle") if k in t]
+    if len(given) != 1:
+        r.fail(
+            "run",
+            "a kinetostatic run takes one of speed (rad/s: a crank's revolution), stroke = "
+            "[low, high] (m: a ram's position or a cylinder's length) or angle = [low, "
+            "high] (rad: a cylinder's link)",
+            # the second of them in the file, or the table where there is none
+            key=max(given, key=lambda k: line_of(r.text, "run", key=k)) if given else "kind",
+        )
+    if given[0] != "speed":
+        return _stroke(r, t, given[0])
+    if "duration" in t:
+        r.fail(
+            "run",
+            "duration belongs to a run over a stroke or an angle; a crank's run is one "
+            "revolution at constant speed",
+            key="duration",
+        )
+    return Kinetostatic(
+        speed=r.number(t, "run", "speed", positive=True),
+        points=r.integer(t, "run", "points", 8, 100_000, default=360),
+    )
+
+
+def _run(r: _Reader, data: dict) -> Kinetostatic | Stroke | Driven:
     t = r.table(data, "run")
     kind = t.get("kind")
     if kind == "kinetostatic":
-        r.unknown_keys(t, "run", ("kind", "speed", "points"))
         if "drive" in data:
             r.fail(
                 "drive", "[drive] sets the drive FMU's parameters: it needs [run] kind = 'driven'"
             )
-        return Kinetostatic(
-            speed=r.number(t, "run", "speed", positive=True),
-            points=r.integer(t, "run", "points", 8, 100_000, default=360),
-        )
+        return _kinetostatic(r, t)
     if kind == "driven":
         r.unknown_keys(
             t, "run", ("kind", "step", "duration", "settle", "start_speed", "start_angle")
@@ -598,12 +687,19 @@ def _sampling(r: _Reader, data: dict, n_params: int) -> Sampling:
     return Sampling(method, count, seed)
 
 
-def _load(r: _Reader, name: str, value: object) -> LoadTable:
+def _load(r: _Reader, name: str, value: object, stroke: bool) -> LoadTable:
     if isinstance(value, int | float) and not isinstance(value, bool):
         v = r.number({name: value}, "loads", name)
         if abs(v) > MAX_LOAD:
             r.fail("loads", f"{name}: a load beyond +-{MAX_LOAD:g}", key=name)
         return LoadTable(name, (0.0,), (v,))
+    if stroke:
+        r.fail(
+            "loads",
+            f"{name}: a run over a stroke takes constant loads (a number); a table is over "
+            "a crank's angle",
+            key=name,
+        )
     if not isinstance(value, dict) or set(value) != {"angle", "value"}:
         r.fail(
             "loads",
@@ -633,7 +729,7 @@ def _load(r: _Reader, name: str, value: object) -> LoadTable:
     return LoadTable(name, tuple(angle), tuple(val))
 
 
-def _figures(r: _Reader, data: dict, parameters: tuple) -> tuple:
+def _figures(r: _Reader, data: dict, parameters: tuple, stroke: bool) -> tuple:
     items = data.get("figure")
     if not isinstance(items, list) or not items or not all(isinstance(t, dict) for t in items):
         r.fail("figure", "at least one [[figure]] table is required")
@@ -648,6 +744,8 @@ def _figures(r: _Reader, data: dict, parameters: tuple) -> tuple:
         of = tuple(r.name(o, "figure", "of", k) for o in of)
         if t.get("stat") not in STATS:
             r.fail("figure", f"{name}: stat must be one of {', '.join(STATS)}", k, "stat")
+        if stroke and t["stat"] == "work_per_revolution":
+            r.fail("figure", f"{name}: a run over a stroke has no revolution", k, "stat")
         taken = {f.name for f in figures} | {p.name for p in parameters}
         if name in taken or name in RESERVED_COLUMNS:
             r.fail(
@@ -753,6 +851,8 @@ def _check_work(r: _Reader, sampling: Sampling, n_params: int, run: object) -> N
     designs = sampling.count**n_params if sampling.method == "grid" else sampling.count
     if isinstance(run, Kinetostatic):
         work, limit, what = designs * run.points, MAX_POSITIONS, "crank positions"
+    elif isinstance(run, Stroke):
+        work, limit, what = designs * run.points, MAX_POSITIONS, "driver positions"
     else:
         steps = round(run.duration / run.step)
         work, limit, what = designs * steps, MAX_STEPS, "communication steps"
@@ -835,11 +935,12 @@ def read_study(path: Path | str) -> Study:
     run = _run(r, data)
     params = _parameters(r, data, isinstance(run, Driven))
     loads_t = r.table(data, "loads", False)
-    loads = tuple(_load(r, r.name(n, "loads", n), v) for n, v in loads_t.items())
+    stroke = isinstance(run, Stroke)
+    loads = tuple(_load(r, r.name(n, "loads", n), v, stroke) for n, v in loads_t.items())
     fixed_t = r.table(data, "fixed", False)
     fixed = tuple((r.name(n, "fixed", n), _fixed_value(r, fixed_t, n)) for n in fixed_t)
     _check_assigned_once(r, params, fixed, run)
-    figures = _figures(r, data, params)
+    figures = _figures(r, data, params, stroke)
     sampling = _sampling(r, data, len(params))
     _check_work(r, sampling, len(params), run)
     return Study(
