@@ -317,17 +317,20 @@ def driver_rates(scene: Scene) -> tuple[str, str]:
     return f"in->{c}_omega", f"in->{c}_epsilon"
 
 
-def _body_terms(mass: Param | None, inertia: Param | None, com: str, w: str) -> tuple[list, list]:
+def _body_terms(
+    mass: Param | None, inertia: Param | None, com: str, turn: tuple[str, str]
+) -> tuple[list, list]:
     """m V.V + I W^2 and m V.V' + I W W' of one body, from its centre of mass's motion
-    `com` and its angular motion `w` (a prefix of _omega and _epsilon) at unit rate."""
+    `com` and its angular velocity and acceleration `turn` at unit rate (C)."""
     j_terms, dj_terms = [], []
     if mass is not None and not mass.is_zero():
         v, a = f"{com}.velocity", f"{com}.acceleration"
         j_terms.append(f"{mass.c()} * dyad_dot({v}, {v})")
         dj_terms.append(f"{mass.c()} * dyad_dot({v}, {a})")
     if inertia is not None and not inertia.is_zero():
-        j_terms.append(f"{inertia.c()} * {w}_omega * {w}_omega")
-        dj_terms.append(f"{inertia.c()} * {w}_omega * {w}_epsilon")
+        omega, epsilon = turn
+        j_terms.append(f"{inertia.c()} * {omega} * {omega}")
+        dj_terms.append(f"{inertia.c()} * {omega} * {epsilon}")
     return j_terms, dj_terms
 
 
@@ -335,15 +338,14 @@ def _cylinder_inertia_terms(scene: Scene) -> tuple[list[str], list[str]]:
     """The link's, the barrel's and the rod's terms of J and of dJ/dq."""
     params = scene.crank.params
     res = f"unit.{kin_name_of_cylinder(scene)}"
+    link = (f"{res}.link_omega", f"{res}.link_epsilon")
     j_terms, dj_terms = _body_terms(
-        params.get("mass"), params.get("inertia"), f"{res}.link_com", f"{res}.link"
+        params.get("mass"), params.get("inertia"), f"{res}.link_com", link
     )
+    axis = (f"{res}.cylinder_omega", f"{res}.cylinder_epsilon")
     for part in ("barrel", "rod"):
         j, dj = _body_terms(
-            params.get(f"{part}.mass"),
-            params.get(f"{part}.inertia"),
-            f"{res}.{part}_com",
-            f"{res}.cylinder",
+            params.get(f"{part}.mass"), params.get(f"{part}.inertia"), f"{res}.{part}_com", axis
         )
         j_terms += j
         dj_terms += dj
@@ -372,12 +374,12 @@ def inertia_terms(scene: Scene, dyads: list[Dyad]) -> tuple[list[str], list[str]
         for side, g in (("m", d.m), ("n", d.n)):
             res = f"unit.{kin_name(d)}.{side}"
             params = scene.links[g].params
-            m, i = params.get("mass"), params.get("inertia")
-            if m is not None and not m.is_zero():
-                v, a = f"{res}.com.velocity", f"{res}.com.acceleration"
-                j_terms.append(f"{m.c()} * dyad_dot({v}, {v})")
-                dj_terms.append(f"{m.c()} * dyad_dot({v}, {a})")
-            if i is not None and not i.is_zero():
-                j_terms.append(f"{i.c()} * {res}.omega * {res}.omega")
-                dj_terms.append(f"{i.c()} * {res}.omega * {res}.epsilon")
+            j, dj = _body_terms(
+                params.get("mass"),
+                params.get("inertia"),
+                f"{res}.com",
+                (f"{res}.omega", f"{res}.epsilon"),
+            )
+            j_terms += j
+            dj_terms += dj
     return j_terms, dj_terms
