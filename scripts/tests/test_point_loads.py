@@ -6,8 +6,8 @@
 - a load at a point equals the same load at the centre of mass plus its moment r x F;
 - a follower force on the crank turns with it: its torque about O is the same at every
   angle, its share of R_O turns with the crank;
-- the generated directional derivative along every input, the loads' included, against
-  central differences of the FMU's outputs;
+- (the directional derivatives: test_scene_derivatives, which covers every FMU of the
+  harness's registry, this scene's among them);
 - the energy balance over the turn: the driver's and the loads' power equal the rate of
   kinetic and potential energy;
 - the refusals of malformed [[load]] tables, each at its file:line.
@@ -20,10 +20,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 from dyadfmu.reference import scene_mp
-from test_scene_derivatives import DIFFERENCE_LIMIT, _central, _names, _outputs, _slave
 from test_scene_mp import inputs_at, run_fmu, scene_file, unit_errors
 
 NAME = "four_bar_payload"
@@ -240,25 +238,3 @@ def test_energy_balance_over_the_turn():
         peak = max(peak, abs(rate), abs(driver), *(abs(x) for x in loads))
     print("energy balance, worst residual / peak power:", max(residuals) / peak)
     assert max(residuals) < 1e-9 * peak
-
-
-def test_directional_derivative_along_every_input():
-    """Every Real output's exact rate along every input (the loads' and their points'
-    terms included) against fourth-order central differences, at three crank angles."""
-    scene = scene_mp.read_scene(scene_file(NAME))
-    s = _slave(NAME)
-    inputs, outputs = _names(s)
-    worst = 0.0
-    try:
-        for q in (0.7, 2.9, 5.1):
-            values = inputs_at(scene, q)
-            _outputs(s, values, outputs)
-            for known in inputs:
-                exact = np.array(s.directional_derivative(tuple(outputs), (known,), [1.0]))
-                fd = _central(s, values, known, outputs)
-                error = np.max(np.abs(exact - fd)) / max(np.max(np.abs(fd)), 1e-300)
-                worst = max(worst, error)
-                assert error < DIFFERENCE_LIMIT, (known, q, error)
-    finally:
-        s.close()
-    print(f"derivatives: worst difference {worst:.2e} of the largest rate")
