@@ -26,7 +26,7 @@ def scene_core_sources(scene: Scene, derivatives: bool) -> list[str]:
     `derivatives`, <identifier>_scene_tangent.c) calls into, in link order."""
     types = scene_types(scene)
     files = ["dyad_common.c"] + [f"dyad_{t}.c" for t in types]
-    cylinder = bool(scene.crank and scene.crank.is_cylinder())
+    cylinder = any(d.is_cylinder() for d in scene.drivers)
     if scene.internal():
         files += ["dyad_kinematics.c"] + [f"dyad_kin_{t}.c" for t in types]
     if cylinder:

@@ -506,7 +506,7 @@ def is_generic(scene: Scene) -> bool:
     """A scene that is one whole dyad: every variable of its type, every parameter tunable,
     both external links free. It is realised by the generic dyad FMU (the core's validating
     solver with its exact directional derivatives) rather than by generated code."""
-    if len(scene.dyads) != 1 or scene.crank is not None:
+    if len(scene.dyads) != 1 or scene.drivers:
         return False
     d = scene.dyads[0]
     links = [scene.links[d.m], scene.links[d.n]]

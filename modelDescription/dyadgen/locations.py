@@ -25,6 +25,7 @@ C_NAMES_PROBES = (
     INTERFACE_DIR / "c_names_probe_internal.toml",
     INTERFACE_DIR / "c_names_probe_ram.toml",
     INTERFACE_DIR / "c_names_probe_cylinder.toml",
+    INTERFACE_DIR / "c_names_probe_drivers.toml",
 )
 #: Where the headers the generated code includes are found.
 HEADER_DIRS = (ROOT / "src" / "include", ROOT / "src", ROOT / "fmu")

@@ -134,6 +134,7 @@ class Crank:
     params: dict = field(default_factory=dict)
     kind: str = "crank"
     actuator: str = ""
+    index: int = 0  # of its table among the scene's tables of its kind
 
     def is_ram(self) -> bool:
         """Whether the driver is a ram: it translates, and balances with a force."""
@@ -190,6 +191,7 @@ class Scene:
     description: str
     inertia: bool
     gravity: bool
+    #: the driver where the scene has exactly one (else None: see drivers)
     crank: Crank | None
     dyads: list
     links: dict  # name -> Link
@@ -206,12 +208,18 @@ class Scene:
     #: dyad index -> the dyads that load it (see loaders), computed once
     loaders: dict = field(default_factory=dict, repr=False)
     point_loads: list = field(default_factory=list)  # PointLoad, in file order
+    #: every driver: cranks, rams, cylinders, each kind in file order
+    drivers: list = field(default_factory=list)
+
+    def driver_of(self, name: str) -> Crank | None:
+        """The driver whose moving link is `name` (a crank, a ram, a cylinder's link)."""
+        return next((d for d in self.drivers if d.name == name), None)
 
     def parameters(self) -> list:
         """Every Param of the scene in table order."""
         out = []
-        if self.crank:
-            out += self.crank.params.values()
+        for driver in self.drivers:
+            out += driver.params.values()
         for d in self.dyads:
             for g in (d.m, d.n):
                 out += self.links[g].params.values()
@@ -234,8 +242,9 @@ class Scene:
         return self.kinematics == "internal"
 
     def params_of(self, g: str) -> dict:
-        """The numbers of a moving link: the crank's or a dyad link's."""
-        return self.crank.params if self.crank and g == self.crank.name else self.links[g].params
+        """The numbers of a moving link: a driver's or a dyad link's."""
+        driver = self.driver_of(g)
+        return driver.params if driver else self.links[g].params
 
 
 def carriers(scene: Scene) -> dict:
@@ -244,8 +253,8 @@ def carriers(scene: Scene) -> dict:
     for name, link in scene.links.items():
         att = link.attachment()
         out[name] = att.link if att.kind in ("crank", "link") else None
-    if scene.crank:
-        out[scene.crank.name] = None
+    for driver in scene.drivers:
+        out[driver.name] = None
     return out
 
 

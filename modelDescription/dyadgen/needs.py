@@ -11,6 +11,7 @@ import re
 
 from dyadgen.dyadtypes import PAIR_NAMES, PAIRS, pair_label
 from dyadgen.model import (
+    Crank,
     Dyad,
     Input,
     Link,
@@ -171,8 +172,8 @@ def _link_inputs(scene: Scene, link: Link) -> list[Input]:
     return out
 
 
-def _crank_inputs(scene: Scene) -> list[Input]:
-    c = scene.crank.name
+def _crank_inputs(scene: Scene, driver: Crank) -> list[Input]:
+    c = driver.name
     inputs = [
         Input(
             f"{c}.angle",
@@ -228,8 +229,8 @@ def _guide_inputs(d: Dyad) -> list[Input]:
     return inputs
 
 
-def _ram_inputs(scene: Scene) -> list[Input]:
-    r = scene.crank.name
+def _ram_inputs(scene: Scene, driver: Crank) -> list[Input]:
+    r = driver.name
     inputs = [
         Input(
             f"{r}.position",
@@ -248,10 +249,10 @@ def _ram_inputs(scene: Scene) -> list[Input]:
     return inputs
 
 
-def _cylinder_inputs(scene: Scene) -> list[Input]:
+def _cylinder_inputs(scene: Scene, driver: Crank) -> list[Input]:
     """A cylinder's length and, with inertia, its rate and acceleration: the inputs of
     the driver's motion, owned by the link it turns."""
-    c, link = scene.crank.actuator, scene.crank.name
+    c, link = driver.actuator, driver.name
     motion = [("length", "m", "Cylinder length s = |A B| between its pins")]
     if scene.inertia:
         motion += [
@@ -267,10 +268,14 @@ def _cylinder_inputs(scene: Scene) -> list[Input]:
 
 
 def _driver_motion_inputs(scene: Scene) -> list[Input]:
-    """The inputs of the driver's motion."""
-    if scene.crank.is_cylinder():
-        return _cylinder_inputs(scene)
-    return _ram_inputs(scene) if scene.crank.is_ram() else _crank_inputs(scene)
+    """The inputs of the drivers' motion, driver by driver."""
+    inputs = []
+    for driver in scene.drivers:
+        if driver.is_cylinder():
+            inputs += _cylinder_inputs(scene, driver)
+        else:
+            inputs += (_ram_inputs if driver.is_ram() else _crank_inputs)(scene, driver)
+    return inputs
 
 
 def derive_inputs(scene: Scene) -> None:
@@ -285,9 +290,7 @@ def derive_inputs(scene: Scene) -> None:
         scene.inputs = inputs + point_load_inputs(scene)
         scene.computed = computed_motion(scene)
         return
-    inputs = []
-    if scene.crank:
-        inputs = _driver_motion_inputs(scene)
+    inputs = _driver_motion_inputs(scene)
     for d in scene.dyads:
         for g in (d.m, d.n):
             inputs += _link_inputs(scene, scene.links[g])
@@ -317,20 +320,20 @@ def computed_motion(scene: Scene) -> dict[str, str]:
                 out[f"{g}.length"] = f"{res}.length"
         for side in "kp":
             out[f"{d.prefix()}slide_{side}"] = f"kin.{dn}.slide_{side}.s"
-    if scene.crank.is_ram():
-        guide = scene.crank.params["guide"]
-        out[f"{scene.crank.name}.angle"] = unit_vector_c(guide)
-    if scene.crank.is_cylinder():
-        g, cyl = scene.crank.name, f"kin.{kin_name_of_cylinder(scene)}"
-        out[f"{g}.angle"] = f"{cyl}.link_dir"
-        out[f"{g}.omega"] = f"{cyl}.link_omega"
-        out[f"{g}.epsilon"] = f"{cyl}.link_epsilon"
+    for driver in scene.drivers:
+        if driver.is_ram():
+            out[f"{driver.name}.angle"] = unit_vector_c(driver.params["guide"])
+        if driver.is_cylinder():
+            g, cyl = driver.name, f"kin.{kin_name_of_cylinder(driver)}"
+            out[f"{g}.angle"] = f"{cyl}.link_dir"
+            out[f"{g}.omega"] = f"{cyl}.link_omega"
+            out[f"{g}.epsilon"] = f"{cyl}.link_epsilon"
     return out
 
 
-def kin_name_of_cylinder(scene: Scene) -> str:
-    """The member of the generated kinematics block that holds the cylinder's result."""
-    return member(scene.crank.actuator) + "_cylinder"
+def kin_name_of_cylinder(driver: Crank) -> str:
+    """The member of the generated kinematics block that holds a cylinder's result."""
+    return member(driver.actuator) + "_cylinder"
 
 
 # ---------------------------------------------------------------------------
@@ -364,9 +367,13 @@ class _Index:
 
 
 def _driver_inputs(scene: Scene, upto: int) -> list[str]:
-    """The first `upto` inputs of the driver's motion: its position, velocity, acceleration."""
-    motion = [i for i in scene.inputs if i.owner == scene.crank.name]
-    return [i.name for i in motion if i.unit not in ("N", "N.m")][:upto]
+    """The first `upto` inputs of each driver's motion: its position, velocity,
+    acceleration."""
+    names = []
+    for driver in scene.drivers:
+        motion = [i for i in scene.inputs if i.owner == driver.name]
+        names += [i.name for i in motion if i.unit not in ("N", "N.m")][:upto]
+    return names
 
 
 def _dependencies(scene: Scene, d: Dyad, index: _Index) -> tuple[list, list]:
@@ -523,7 +530,11 @@ def _kinematic_outputs(offer: _Offer, scene: Scene, d: Dyad) -> None:
 
 def _driver_inertia_outputs(offer: _Offer, scene: Scene) -> None:
     """Internal kinematics with inertia: the effective inertia at the driver and the
-    balancing torque (force) at zero driver acceleration."""
+    balancing torque (force) at zero driver acceleration; with several drivers the inertia
+    matrix M(q) instead of J and dJ/dq."""
+    if len(scene.drivers) > 1:
+        _inertia_matrix_outputs(offer, scene)
+        return
     c = scene.crank.driver_name()
     ram = scene.crank.balances_with_force()
     unit, rate = ("kg", "m") if ram else ("kg.m2", "rad")
@@ -543,10 +554,52 @@ def _driver_inertia_outputs(offer: _Offer, scene: Scene) -> None:
         _motion_output(offer, f"{c}.{key}", u, text, c_member, depends, source)
 
 
-def _cylinder_motion_outputs(offer: _Offer, scene: Scene) -> None:
+def effort_of(driver: Crank) -> tuple[str, str]:
+    """(name, unit) of a driver's effort: a crank's torque, a ram's or a cylinder's force."""
+    return ("force", "N") if driver.balances_with_force() else ("torque", "N.m")
+
+
+def inertia_entry_unit(row: Crank, column: Crank) -> str:
+    """The unit of M(q)'s entry: effort of `row` per acceleration of `column`."""
+    linear = row.balances_with_force() + column.balances_with_force()
+    return ("kg.m2", "kg.m", "kg")[linear]
+
+
+def inertia_entry_member(row: Crank, column: Crank) -> str:
+    """The C member of M(q)'s entry (row, column)."""
+    return f"inertia_m_{member(row.driver_name())}_{member(column.driver_name())}"
+
+
+def _inertia_matrix_outputs(offer: _Offer, scene: Scene) -> None:
+    """Several drivers: every entry of M(q), efforts = M(q) q'' + h, and each driver's
+    effort at zero acceleration of every driver, h."""
+    position = _driver_inputs(scene, 1)
+    every = [i.name for i in scene.inputs]
+    for row in scene.drivers:
+        a = row.driver_name()
+        for column in scene.drivers:
+            b = column.driver_name()
+            effort = effort_of(row)[0]
+            rate = "acceleration" if column.balances_with_force() else "epsilon"
+            text = f"Inertia matrix M(q), row {a}, column {b}: d {a}.{effort} / d {b}.{rate}"
+            unit = inertia_entry_unit(row, column)
+            c_member = inertia_entry_member(row, column)
+            _motion_output(offer, f"M.{a}.{b}", unit, text, c_member, position, "driver")
+    for driver in scene.drivers:
+        c = driver.driver_name()
+        effort, unit = effort_of(driver)
+        text = (
+            f"{effort.capitalize()} of {c} with every driver's acceleration zero: h in "
+            "efforts = M(q) q'' + h"
+        )
+        c_member = f"{member(c)}_{effort}0"
+        _motion_output(offer, f"{c}.{effort}0", unit, text, c_member, every, "crank")
+
+
+def _cylinder_motion_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None:
     """The motion of the link a cylinder turns and of the cylinder itself, pin B, and the
     triangle's conditioning."""
-    link, c = scene.crank.name, scene.crank.actuator
+    link, c = driver.name, driver.actuator
     rates = _driver_inputs(scene, 3)
     bodies = (
         (link, member(link), f"Direction of {link}: angle of its i, in (-pi, pi]", f"{link}"),
@@ -597,10 +650,10 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene) -> None:
     )
 
 
-def _cylinder_outputs(offer: _Offer, scene: Scene) -> None:
+def _cylinder_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None:
     """A cylinder's axial force, its pins' reactions and the barrel's action on the rod,
     and the frame's force on the link it turns."""
-    link, c = scene.crank.name, scene.crank.actuator
+    link, c = driver.name, driver.actuator
     every = [i.name for i in scene.inputs]
     _motion_output(
         offer,
@@ -638,8 +691,8 @@ def _cylinder_outputs(offer: _Offer, scene: Scene) -> None:
         )
 
 
-def _ram_outputs(offer: _Offer, scene: Scene) -> None:
-    c = scene.crank.name
+def _ram_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None:
+    c = driver.name
     every = [i.name for i in scene.inputs]
     for key, unit, text in (
         ("force", "N", "Actuator force on the ram along its guide i_r"),
@@ -650,8 +703,8 @@ def _ram_outputs(offer: _Offer, scene: Scene) -> None:
         _motion_output(offer, f"{c}.{key}", unit, text, c_member, every, "crank")
 
 
-def _crank_outputs(offer: _Offer, scene: Scene) -> None:
-    c = scene.crank.name
+def _crank_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None:
+    c = driver.name
     every = [i.name for i in scene.inputs]
     torque = Output(
         f"{c}.torque",
@@ -691,18 +744,17 @@ def why_not(scene: Scene, wanted: str) -> str:
                 f"dyad '{d.name}' has no output '{tail}' (it has R_mk, R_np, R_mn, "
                 "conditioning, amplification and N_/M_ of its sliding pairs)"
             )
-    if (
-        scene.crank
-        and scene.crank.is_cylinder()
-        and head in (scene.crank.name, scene.crank.actuator)
-    ):
-        return (
-            f"the cylinder has 'force', 'R_A', 'R_B', 'N', 'M', its motion and 'B.position'; "
-            f"its link '{scene.crank.name}' its motion and 'R_O'"
-        )
-    if scene.crank and head == scene.crank.name:
-        return "the crank has only 'torque' and 'R_O'"
-    names = [d.name for d in scene.dyads] + ([scene.crank.name] if scene.crank else [])
+    for driver in scene.drivers:
+        if driver.is_cylinder() and head in (driver.name, driver.actuator):
+            return (
+                f"the cylinder has 'force', 'R_A', 'R_B', 'N', 'M', its motion and "
+                f"'B.position'; its link '{driver.name}' its motion and 'R_O'"
+            )
+        if head == driver.name and driver.is_ram():
+            return "the ram has only 'force', 'N' and 'M'"
+        if head == driver.name:
+            return "the crank has only 'torque' and 'R_O'"
+    names = [d.name for d in scene.dyads] + [d.driver_name() for d in scene.drivers]
     return f"no dyad or crank is named '{head}' (known: {', '.join(names)})"
 
 
@@ -739,13 +791,14 @@ def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
             _kinematic_outputs(offer, scene, d)
         deps, own_geometry = _dependencies(scene, d, index)
         _dyad_outputs(offer, d, deps, own_geometry, scene.internal())
-    if scene.crank and scene.crank.is_cylinder():
-        _cylinder_motion_outputs(offer, scene)
-        _cylinder_outputs(offer, scene)
-    elif scene.crank and scene.crank.is_ram():
-        _ram_outputs(offer, scene)
-    elif scene.crank:
-        _crank_outputs(offer, scene)
+    for driver in scene.drivers:
+        if driver.is_cylinder():
+            _cylinder_motion_outputs(offer, scene, driver)
+            _cylinder_outputs(offer, scene, driver)
+        elif driver.is_ram():
+            _ram_outputs(offer, scene, driver)
+        else:
+            _crank_outputs(offer, scene, driver)
     if scene.internal() and scene.inertia:
         _driver_inertia_outputs(offer, scene)
     chosen, problems = _choose(offer, scene, wanted)
@@ -764,7 +817,7 @@ def derive_outputs(scene: Scene, wanted: list[str]) -> list[str]:
     status_text = "0 ok, 1 a dyad is singular, 3 a reaction overflows"
     if scene.internal():
         status_text += ", 4 a dyad cannot assemble"
-    if scene.crank and scene.crank.is_cylinder():
+    if any(d.is_cylinder() for d in scene.drivers):
         status_text = (
             "0 ok, 1 a dyad or the cylinder is singular, 3 a reaction overflows, 4 a dyad or "
             "the cylinder cannot assemble"

@@ -95,14 +95,18 @@ def test_the_documentation_says_what_the_fmu_takes(path):
         assert said.group(1) == "the links' current kinematics and active loads"
         return
     assert "current kinematics" not in page
-    driver = scene.crank
-    motion = [f"{driver.driver_name()}.{q}" for q in DRIVER_MOTION[driver.kind]]
+    motion = [
+        f"{driver.driver_name()}.{q}"
+        for driver in scene.drivers
+        for q in DRIVER_MOTION[driver.kind]
+    ]
     loads = [n for n in inputs if n not in motion]
     assert set(motion) <= set(inputs)
     assert all(re.fullmatch(r"\w+\.(force\.[xy]|moment)", n) for n in loads), loads
     named = ", ".join(f"<code>{n}</code>" for n in motion)
     count = "(1 input)" if len(loads) == 1 else f"({len(loads)} inputs)"
-    assert said.group(1).startswith(f"only the {driver.kind}'s motion ({named}) and the active")
+    who = f"its {len(scene.drivers)} drivers'" if len(scene.drivers) > 1 else f"the {scene.crank.kind}'s"
+    assert said.group(1).startswith(f"only {who} motion ({named}) and the active")
     assert count in said.group(1) and "no link's motion is an input" in said.group(1)
 
 

@@ -12,7 +12,7 @@ from string import Template
 from dyadgen import textsafe
 from dyadgen.dyadtypes import MAY_BE_ZERO, PAIRS, TYPE_NOTES
 from dyadgen.emit.xmltext import num, settings_of
-from dyadgen.model import Attachment, Param, Scene
+from dyadgen.model import Attachment, Crank, Param, Scene
 from dyadgen.table import Table, Variable
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
@@ -152,8 +152,8 @@ def _param_text(prm: Param) -> str:
     return f"<code>{prm.name}</code>" if prm.tunable else repr(prm.value)
 
 
-def _attachment_text(att: Attachment, scene_kind: str = "crank") -> str:
-    """Where a dyad's outer pair sits, in words (`scene_kind`: the driver's kind)."""
+def _attachment_text(att: Attachment, kinds: dict | None = None) -> str:
+    """Where a dyad's outer pair sits, in words (`kinds`: each driver's kind by its link)."""
     if att.kind == "frame":
         return "the frame" + (f" (guide at {h(_param_text(att.guide))} rad)" if att.guide else "")
     if att.guide is not None:
@@ -164,7 +164,8 @@ def _attachment_text(att: Attachment, scene_kind: str = "crank") -> str:
     if att.kind == "external":
         return "an external link whose motion is an input"
     if att.at is None:
-        return f"the {_DRIVER_POINT[scene_kind]} <code>{h(att.link)}</code>"
+        kind = (kinds or {}).get(att.link, "crank")
+        return f"the {_DRIVER_POINT[kind]} <code>{h(att.link)}</code>"
     return (
         f"<code>{h(att.link)}</code> at ({h(_param_text(att.at[0]))}, "
         f"{h(_param_text(att.at[1]))}) m in its frame"
@@ -175,9 +176,8 @@ def _attachment_text(att: Attachment, scene_kind: str = "crank") -> str:
 _DRIVER_POINT = {"crank": "pin of the crank", "ram": "origin R of the ram", "cylinder": "pin B of"}
 
 
-def _driver_text(scene: Scene) -> str:
-    """The driver's paragraph: what it is and what balances it."""
-    driver = scene.crank
+def _driver_text(driver: Crank) -> str:
+    """A driver's paragraph: what it is and what balances it."""
     name = f"<code>{h(driver.name)}</code>"
     if driver.is_cylinder():
         return (
@@ -203,12 +203,19 @@ def _scene_sections(scene: Scene) -> dict[str, str]:
     """The parts of a scene's page that depend on its mechanism."""
     loaded = [f"{g} (force)" for g, link in scene.links.items() if link.force]
     loaded += [f"{g} (moment)" for g, link in scene.links.items() if link.moment]
-    crank = f"\n<p>{_driver_text(scene)}</p>" if scene.crank else ""
-    kind = scene.crank.kind if scene.crank else "crank"
+    crank = "".join(f"\n<p>{_driver_text(driver)}</p>" for driver in scene.drivers)
+    if len(scene.drivers) > 1:
+        crank += (
+            "\n<p>With several drivers, the efforts (torques and forces) are M(q) q'' + h: "
+            "<code>M.a.b</code> is the inertia matrix (the effort of a per acceleration of b), "
+            "each driver's <code>torque0</code> or <code>force0</code> its effort h at zero "
+            "acceleration of every driver.</p>"
+        )
+    kinds = {driver.name: driver.kind for driver in scene.drivers}
     dyads = "".join(
         f"\n<tr><td><code>{h(d.name or '-')}</code></td><td>{d.type}</td>"
         f"<td><code>{h(d.m)}</code></td><td><code>{h(d.n)}</code></td>"
-        f"<td>{_attachment_text(d.k, kind)}</td><td>{_attachment_text(d.p, kind)}</td></tr>"
+        f"<td>{_attachment_text(d.k, kinds)}</td><td>{_attachment_text(d.p, kinds)}</td></tr>"
         for d in scene.dyads
     )
     baked = [prm for prm in scene.parameters() if not prm.tunable]
@@ -239,10 +246,20 @@ def _takes(table: Table) -> str:
     scene = table.scene
     if not scene.internal():
         return "the links' current kinematics and active loads"
-    prefix = f"{scene.crank.driver_name()}."
-    motion = [v.name for v in table.of("input") if v.name.startswith(prefix)]
+    prefixes = tuple(f"{d.driver_name()}." for d in scene.drivers)
+    motion = [v.name for v in table.of("input") if v.name.startswith(prefixes)]
     loads = len(table.of("input")) - len(motion)
-    driver = scene.crank.kind
+    driver = scene.crank.kind if scene.crank else "drivers"
+    if not scene.crank:
+        named = ", ".join(f"<code>{h(name)}</code>" for name in motion)
+        rest = {0: "no load", 1: "the active load (1 input)"}.get(
+            loads, f"the active loads ({loads} inputs)"
+        )
+        return (
+            f"only its {len(scene.drivers)} drivers' motion ({named}) and {rest}, solves the "
+            "links' motion from the drivers' itself (the kinematics are inside: no link's "
+            "motion is an input),"
+        )
     named = ", ".join(f"<code>{h(name)}</code>" for name in motion)
     rest = {0: "no load", 1: "the active load (1 input)"}.get(
         loads, f"the active loads ({loads} inputs)"

@@ -14,11 +14,20 @@ from __future__ import annotations
 import math
 
 from dyadgen import textsafe
-from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, member
+from dyadgen.model import Attachment, Crank, Dyad, Param, Scene, c_num, member
 from dyadgen.needs import kin_name, kin_name_of_cylinder
 
 #: the core's failure statuses and the scene status each one reports
 FAILURE_TEXT = "0 ok, 1 singular, 3 out of range, 4 cannot assemble"
+
+
+def rate_names(scene: Scene, driver: Crank) -> tuple[str, str]:
+    """The names of a driver's rate and acceleration among the arguments of the generated
+    `kinematics`: `rate` and `accel` where the scene has one driver."""
+    if len(scene.drivers) == 1:
+        return "rate", "accel"
+    c = member(driver.driver_name())
+    return f"rate_{c}", f"accel_{c}"
 
 
 def _vec(x: str, y: str) -> str:
@@ -52,22 +61,21 @@ class _Mounts:
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
         self.owner = {g: (d, side) for d in scene.dyads for side, g in (("m", d.m), ("n", d.n))}
-        self.driver = scene.crank.name
 
     def carrier(self, link: str) -> tuple[str, str, str, str]:
         """(origin motion, direction, omega, epsilon) of a moving link, in C."""
-        if link == self.driver and self.scene.crank.is_cylinder():
-            res = f"kin->{kin_name_of_cylinder(self.scene)}"
+        driver = self.scene.driver_of(link)
+        if driver is not None and driver.is_cylinder():
+            res = f"kin->{kin_name_of_cylinder(driver)}"
             return (
                 f"&{member(link)}_o",
                 f"{res}.link_dir",
                 f"{res}.link_omega",
                 f"{res}.link_epsilon",
             )
-        if link == self.driver:
+        if driver is not None:
             c = member(link)
-            rate = "0.0" if self.scene.crank.is_ram() else "rate"
-            accel = "0.0" if self.scene.crank.is_ram() else "accel"
+            rate, accel = ("0.0", "0.0") if driver.is_ram() else rate_names(self.scene, driver)
             return f"&{c}_o", f"{c}_i", rate, accel
         d, side = self.owner[link]
         res = f"kin->{kin_name(d)}.{side}"
@@ -102,20 +110,25 @@ class _Mounts:
                 if owner not in owners:
                     owners.append(owner)
         terms = [f"kin->{kin_name(o)}.amplification" for o in owners]
-        if self.scene.crank.is_cylinder() and any(att.kind == "crank" for att in (d.k, d.p)):
-            # the link the cylinder turns carries the triangle's round-off
-            terms.append(f"kin->{kin_name_of_cylinder(self.scene)}.kin_amplification")
+        cylinders = []
+        for att in (d.k, d.p):
+            driver = self.scene.driver_of(att.link) if att.kind == "crank" else None
+            if driver is not None and driver.is_cylinder() and driver not in cylinders:
+                cylinders.append(driver)
+        # the link a cylinder turns carries the triangle's round-off
+        terms += [f"kin->{kin_name_of_cylinder(c)}.kin_amplification" for c in cylinders]
         return " + ".join(terms) if terms else None
 
     def offset(self, att: Attachment) -> str:
         """The pair's point (a guide's point) in its carrier's frame."""
         if att.at is not None:
             return _point(att.at)
-        if att.kind == "crank" and self.scene.crank.is_cylinder():
-            params = self.scene.crank.params  # the rod's pin B
+        driver = self.scene.driver_of(att.link) if att.kind == "crank" else None
+        if driver is not None and driver.is_cylinder():
+            params = driver.params  # the rod's pin B
             return _vec(params["pin.x"].c(), params["pin.y"].c())
-        if att.kind == "crank" and not self.scene.crank.is_ram():
-            return _vec(self.scene.crank.params["length"].c(), "0.0")
+        if driver is not None and not driver.is_ram():
+            return _vec(driver.params["length"].c(), "0.0")
         return _vec("0.0", "0.0")
 
 
@@ -193,13 +206,12 @@ def _cylinder_part_lines(params: dict, target: str) -> list[str]:
 
 
 def cylinder_input_lines(
-    scene: Scene, target: str, rates: tuple[str, str], pivot: str
+    scene: Scene, driver: Crank, target: str, rates: tuple[str, str], pivot: str
 ) -> list[str]:
     """The assignments of a dyad_cylinder_input `target`: the frame pins (O's motion
     `pivot`), the pin B, the length and its `rates`, the branch and, for the kinematics
     alone (`target` "cin"), the centres of mass, or for the forces every mass of the
     barrel and the rod (the link's resultant is the scene's, at O)."""
-    driver = scene.crank
     params = driver.params
     branch = params["branch"]
     rate, accel = rates
@@ -221,36 +233,43 @@ def cylinder_input_lines(
     return out + _cylinder_part_lines(params, target)
 
 
-def _cylinder_lines(scene: Scene) -> list[str]:
-    """The cylinder's motion and that of the link it turns, first."""
-    c = member(scene.crank.name)
-    at = _vec(scene.crank.params["at.x"].c(), scene.crank.params["at.y"].c())
-    result = f"kin->{kin_name_of_cylinder(scene)}"
-    out = [f"const dyad_point_motion {c}_o = fixed_point({at});", "dyad_cylinder_input cin;"]
-    out += cylinder_input_lines(scene, "cin", ("rate", "accel"), f"{c}_o")
+def _cylinder_lines(scene: Scene, driver: Crank) -> list[str]:
+    """A cylinder's motion and that of the link it turns."""
+    c = member(driver.name)
+    at = _vec(driver.params["at.x"].c(), driver.params["at.y"].c())
+    result = f"kin->{kin_name_of_cylinder(driver)}"
+    cin = "cin" if len(scene.drivers) == 1 else f"cin_{member(driver.actuator)}"
+    out = [f"const dyad_point_motion {c}_o = fixed_point({at});", f"dyad_cylinder_input {cin};"]
+    out += cylinder_input_lines(scene, driver, cin, rate_names(scene, driver), f"{c}_o")
+    failed = len(scene.dyads) + cylinders(scene).index(driver)
     out += [
-        f"if (dyad_cylinder(&cin, &{result}) != DYAD_STATUS_OK) {{",
-        f"    *failed = {len(scene.dyads)};",
+        f"if (dyad_cylinder(&{cin}, &{result}) != DYAD_STATUS_OK) {{",
+        f"    *failed = {failed};",
         f"    return cylinder_failure(&{result}, &kin->cylinder_failure);",
         "}",
     ]
     return out
 
 
-def _driver_lines(scene: Scene) -> list[str]:
-    """The driver's frame and the motion of its origin (O or R)."""
-    driver = scene.crank
+def cylinders(scene: Scene) -> list[Crank]:
+    """The scene's cylinders, in the order of their failures' indices after the dyads'."""
+    return [d for d in scene.drivers if d.is_cylinder()]
+
+
+def _driver_lines(scene: Scene, driver: Crank) -> list[str]:
+    """A driver's frame and the motion of its origin (O or R)."""
     if driver.is_cylinder():
-        return _cylinder_lines(scene)
+        return _cylinder_lines(scene, driver)
     c = member(driver.name)
     at = _vec(driver.params["at.x"].c(), driver.params["at.y"].c())
     if driver.is_ram():
+        rate, accel = rate_names(scene, driver)
         return [
             f"const dyad_vec2 {c}_i = {_unit(driver.params['guide'])};",
             f"dyad_point_motion {c}_o;",
             f"{c}_o.position = dyad_add({at}, dyad_scale(in->{c}_position, {c}_i));",
-            f"{c}_o.velocity = dyad_scale(rate, {c}_i);",
-            f"{c}_o.acceleration = dyad_scale(accel, {c}_i);",
+            f"{c}_o.velocity = dyad_scale({rate}, {c}_i);",
+            f"{c}_o.acceleration = dyad_scale({accel}, {c}_i);",
         ]
     return [
         f"const dyad_vec2 {c}_i = in->{c}_dir;",
@@ -261,7 +280,8 @@ def _driver_lines(scene: Scene) -> list[str]:
 def kinematics_body(scene: Scene, dyads: list[Dyad]) -> list[str]:
     """The statements of the function `kinematics`."""
     mounts = _Mounts(scene)
-    body = _driver_lines(scene) + (["dyad_kin_input k;"] if dyads else [])
+    body = [line for driver in scene.drivers for line in _driver_lines(scene, driver)]
+    body += ["dyad_kin_input k;"] if dyads else []
     for d in dyads:
         body += _dyad_lines(scene, mounts, d)
     body.append("return NULL;")
@@ -272,8 +292,9 @@ def kinematics_type(scene: Scene) -> str:
     """The kinematics block type: one dyad_kin_result per dyad."""
     ident = scene.identifier
     members = [f"    dyad_kin_result {kin_name(d)};" for d in scene.dyads]
-    if scene.crank and scene.crank.is_cylinder():
-        members.append(f"    dyad_cylinder_result {kin_name_of_cylinder(scene)};")
+    for driver in cylinders(scene):
+        members.append(f"    dyad_cylinder_result {kin_name_of_cylinder(driver)};")
+    if cylinders(scene):
         members.append("    dyad_kin_result cylinder_failure; /* its failure, as a dyad's */")
     return "\n".join([f"typedef struct {ident}_kinematics {{", *members, f"}} {ident}_kinematics;"])
 
@@ -283,16 +304,31 @@ def kinematics_function(scene: Scene, dyads: list[Dyad]) -> str:
     ident = scene.identifier
     body = kinematics_body(scene, dyads)
     lines = [kinematics_type(scene), ""]
-    lines += [
-        "/* The chain's kinematics from the driver outwards, the driver at its position in",
-        " * `in` moving at `rate` with `accel` (rad/s and rad/s2, or m/s and m/s2 for a ram).",
-        " * Returns NULL, or the result of the first dyad that does not solve (its index",
-        " * in `failed`). */",
-        f"static const dyad_kin_result* kinematics(const {ident}_input* in, double rate,",
-        f"                                         double accel, {ident}_kinematics* kin,",
-        "                                         int* failed)",
-        "{",
-    ]
+    if len(scene.drivers) == 1:
+        lines += [
+            "/* The chain's kinematics from the driver outwards, the driver at its position in",
+            " * `in` moving at `rate` with `accel` (rad/s and rad/s2, or m/s and m/s2 for a ram).",
+            " * Returns NULL, or the result of the first dyad that does not solve (its index",
+            " * in `failed`). */",
+            f"static const dyad_kin_result* kinematics(const {ident}_input* in, double rate,",
+            f"                                         double accel, {ident}_kinematics* kin,",
+            "                                         int* failed)",
+            "{",
+        ]
+    else:
+        rates = ", ".join(
+            f"double {rate}, double {accel}"
+            for rate, accel in (rate_names(scene, d) for d in scene.drivers)
+        )
+        lines += [
+            "/* The chain's kinematics from the drivers outwards, each driver at its position",
+            " * in `in` moving at its rate with its acceleration (rad/s and rad/s2, or m/s and",
+            " * m/s2 for a ram or a cylinder). Returns NULL, or the result of the first dyad",
+            " * or cylinder that does not solve (its index in `failed`). */",
+            f"static const dyad_kin_result* kinematics(const {ident}_input* in, {rates},",
+            f"                                         {ident}_kinematics* kin, int* failed)",
+            "{",
+        ]
     lines += [f"    {line}" for line in body]
     lines.append("}")
     return "\n".join(lines)
@@ -302,17 +338,16 @@ def failure_names(scene: Scene) -> str:
     """The dyads' names by index (the cylinder's last), for the log, as a C array
     initialiser."""
     names = [f"dyad {d.name or d.type}" for d in scene.dyads]
-    if scene.crank and scene.crank.is_cylinder():
-        names.append(f"cylinder {scene.crank.actuator}")
+    names += [f"cylinder {c.actuator}" for c in cylinders(scene)]
     return ", ".join(textsafe.c_string(n) for n in names)
 
 
-def driver_rates(scene: Scene) -> tuple[str, str]:
-    """The C expressions of the driver's rate and acceleration (0 without inertia)."""
-    c = member(scene.crank.driver_name())
+def driver_rates(scene: Scene, driver: Crank) -> tuple[str, str]:
+    """The C expressions of a driver's rate and acceleration (0 without inertia)."""
+    c = member(driver.driver_name())
     if not scene.inertia:
         return "0.0", "0.0"
-    if scene.crank.balances_with_force():
+    if driver.balances_with_force():
         return f"in->{c}_velocity", f"in->{c}_acceleration"
     return f"in->{c}_omega", f"in->{c}_epsilon"
 
@@ -334,10 +369,10 @@ def _body_terms(
     return j_terms, dj_terms
 
 
-def _cylinder_inertia_terms(scene: Scene) -> tuple[list[str], list[str]]:
+def _cylinder_inertia_terms(driver: Crank, unit: str) -> tuple[list[str], list[str]]:
     """The link's, the barrel's and the rod's terms of J and of dJ/dq."""
-    params = scene.crank.params
-    res = f"unit.{kin_name_of_cylinder(scene)}"
+    params = driver.params
+    res = f"{unit}.{kin_name_of_cylinder(driver)}"
     link = (f"{res}.link_omega", f"{res}.link_epsilon")
     j_terms, dj_terms = _body_terms(
         params.get("mass"), params.get("inertia"), f"{res}.link_com", link
@@ -352,24 +387,29 @@ def _cylinder_inertia_terms(scene: Scene) -> tuple[list[str], list[str]]:
     return j_terms, dj_terms
 
 
+def _driver_inertia_terms(driver: Crank, unit: str) -> tuple[list[str], list[str]]:
+    """A driver's own body's terms of J and dJ/dq at unit rate `unit`."""
+    if driver.is_cylinder():
+        return _cylinder_inertia_terms(driver, unit)
+    mass = driver.params.get("mass")
+    j_terms: list[str] = []
+    if driver.is_ram():
+        if mass is not None and not mass.is_zero():
+            j_terms.append(mass.c())
+        return j_terms, []
+    com = _vec(driver.params["com.x"].c(), driver.params["com.y"].c())
+    if mass is not None and not mass.is_zero():
+        j_terms.append(f"{mass.c()} * dyad_dot({com}, {com})")
+    inertia = driver.params.get("inertia")
+    if inertia is not None and not inertia.is_zero():
+        j_terms.append(inertia.c())
+    return j_terms, []
+
+
 def inertia_terms(scene: Scene, dyads: list[Dyad]) -> tuple[list[str], list[str]]:
     """The terms of J and of dJ/dq in C, from the kinematics at unit rate `unit`: each
     moving body's m V.V + I W^2 and 2 (m V.V' + I W W')."""
-    driver = scene.crank
-    mass = driver.params.get("mass")
-    j_terms, dj_terms = [], []
-    if driver.is_cylinder():
-        j_terms, dj_terms = _cylinder_inertia_terms(scene)
-    elif driver.is_ram():
-        if mass is not None and not mass.is_zero():
-            j_terms.append(mass.c())
-    else:
-        com = _vec(driver.params["com.x"].c(), driver.params["com.y"].c())
-        if mass is not None and not mass.is_zero():
-            j_terms.append(f"{mass.c()} * dyad_dot({com}, {com})")
-        inertia = driver.params.get("inertia")
-        if inertia is not None and not inertia.is_zero():
-            j_terms.append(inertia.c())
+    j_terms, dj_terms = _driver_inertia_terms(scene.crank, "unit")
     for d in dyads:
         for side, g in (("m", d.m), ("n", d.n)):
             res = f"unit.{kin_name(d)}.{side}"
@@ -383,3 +423,61 @@ def inertia_terms(scene: Scene, dyads: list[Dyad]) -> tuple[list[str], list[str]
             j_terms += j
             dj_terms += dj
     return j_terms, dj_terms
+
+
+def _cross_terms(mass: Param | None, inertia: Param | None, com: tuple, turn: tuple) -> list:
+    """m V_a.V_b + I W_a W_b of one body from its centre of mass's velocity and its
+    angular velocity per unit rate of drivers a and b (C: `com` and `turn` pairs)."""
+    terms = []
+    if mass is not None and not mass.is_zero():
+        terms.append(f"{mass.c()} * dyad_dot({com[0]}.velocity, {com[1]}.velocity)")
+    if inertia is not None and not inertia.is_zero():
+        terms.append(f"{inertia.c()} * {turn[0]} * {turn[1]}")
+    return terms
+
+
+def _own_body_cross(driver: Crank, units: tuple[str, str], same: bool) -> list[str]:
+    """A driver's own bodies' terms of M(q)'s entry (a, b): only where a = b, each body
+    moving with its driver alone, except a cylinder's, whose link and axis turn with it."""
+    if not same:
+        return []
+    if not driver.is_cylinder():
+        return _driver_inertia_terms(driver, units[0])[0]
+    params = driver.params
+    res = tuple(f"{u}.{kin_name_of_cylinder(driver)}" for u in units)
+    terms = _cross_terms(
+        params.get("mass"),
+        params.get("inertia"),
+        (f"{res[0]}.link_com", f"{res[1]}.link_com"),
+        (f"{res[0]}.link_omega", f"{res[1]}.link_omega"),
+    )
+    for part in ("barrel", "rod"):
+        terms += _cross_terms(
+            params.get(f"{part}.mass"),
+            params.get(f"{part}.inertia"),
+            (f"{res[0]}.{part}_com", f"{res[1]}.{part}_com"),
+            (f"{res[0]}.cylinder_omega", f"{res[1]}.cylinder_omega"),
+        )
+    return terms
+
+
+def inertia_matrix_terms(scene: Scene, dyads: list[Dyad], a: Crank, b: Crank) -> list[str]:
+    """The terms of M(q)'s entry (a, b) in C, from the kinematics at unit rate of driver a
+    alone, `unit_<a>`, and of b alone: sum over the moving bodies of m V_a.V_b + I W_a W_b.
+    A driver's own body moves with its driver only."""
+    units = (f"unit_{member(a.driver_name())}", f"unit_{member(b.driver_name())}")
+    terms = []
+    for driver in scene.drivers:
+        if driver is a:
+            terms += _own_body_cross(driver, units, a is b)
+    for d in dyads:
+        for side, g in (("m", d.m), ("n", d.n)):
+            res = tuple(f"{u}.{kin_name(d)}.{side}" for u in units)
+            params = scene.links[g].params
+            terms += _cross_terms(
+                params.get("mass"),
+                params.get("inertia"),
+                (f"{res[0]}.com", f"{res[1]}.com"),
+                (f"{res[0]}.omega", f"{res[1]}.omega"),
+            )
+    return terms

@@ -25,8 +25,8 @@ from string import Template
 
 from dyadgen import textsafe
 from dyadgen.emit import kinematics_c, tangent_c
-from dyadgen.model import Attachment, Dyad, Param, Scene, c_num, loaders, member
-from dyadgen.needs import kin_name_of_cylinder
+from dyadgen.model import Attachment, Crank, Dyad, Param, Scene, c_num, loaders, member
+from dyadgen.needs import effort_of, inertia_entry_member, kin_name_of_cylinder
 from dyadgen.table import Table
 
 TEMPLATE = Path(__file__).resolve().parent / "templates" / "scene.c.in"
@@ -86,8 +86,9 @@ class Plan:
 
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
-        self.crank = scene.crank
+        self.drivers = scene.drivers
         self.names = {i.name: i for i in scene.inputs}
+        #: every driver's balance is wanted (one output of one of them asks for them all)
         self.crank_needed = any(o.source == "crank" for o in scene.outputs)
         needed = {int(o.source) for o in scene.outputs if o.source.isdigit()}
         if self.crank_needed:
@@ -96,7 +97,7 @@ class Plan:
             if d.index in needed:
                 needed |= {other.index for other in loaders(scene, d)}
         self.solved = [d for d in scene.dyads if d.index in needed]
-        crank = [self.crank.name] if self.crank else []
+        crank = [driver.name for driver in self.drivers]
         self.everything = crank + [g for d in scene.dyads for g in (d.m, d.n)]
         self.moving = (crank if self.crank_needed else []) + [
             g for d in self.solved for g in (d.m, d.n)
@@ -112,7 +113,7 @@ class Plan:
             else []
         )
         #: the kinematics function runs: for the dyads' motion, or a cylinder's
-        self.runs_kinematics = bool(self.kinematic) or bool(self.crank and self.crank.is_cylinder())
+        self.runs_kinematics = bool(self.kinematic) or bool(kinematics_c.cylinders(scene))
         self.accel: dict[str, str | None] = {}  # link -> C name of a_D or None for zero
         self.accel_size: dict[str, str] = {}  # link -> C expression of the size of a_D's terms
 
@@ -153,13 +154,14 @@ class Plan:
 
     def attachment_point(self, att: Attachment) -> str | None:
         """The pair's point (for a sliding pair: the guide's point) from the carrier's D."""
-        if att.kind == "crank" and att.at is None and self.crank.is_ram():
+        driver = self.scene.driver_of(att.link) if att.kind == "crank" else None
+        if driver is not None and att.at is None and driver.is_ram():
             return None  # the ram's origin R
-        if att.kind == "crank" and att.at is None and self.crank.is_cylinder():
-            params = self.crank.params  # the rod's pin B
+        if driver is not None and att.at is None and driver.is_cylinder():
+            params = driver.params  # the rod's pin B
             return self.point(att.link, (params["pin.x"], params["pin.y"]))
-        if att.kind == "crank" and att.at is None:
-            length = self.crank.params["length"]
+        if driver is not None and att.at is None:
+            length = driver.params["length"]
             return self.point(att.link, (length, Param("", 0.0, "m", "")))
         return self.point(att.link, att.at)
 
@@ -178,13 +180,16 @@ def _kinematics(plan: Plan, code: _Code) -> None:
     if not plan.runs_kinematics:
         return
     scene = plan.scene
-    rate, accel = kinematics_c.driver_rates(scene)
+    rates = ", ".join(
+        f"{rate}, {accel}"
+        for rate, accel in (kinematics_c.driver_rates(scene, d) for d in scene.drivers)
+    )
     code("/* The kinematics from the driver outwards; a dyad that cannot close (or is at a")
     code(" * dead centre) stops here with every output NaN. */")
     code(f"{scene.identifier}_kinematics kin;")
     code("{")
     code("    int failed = 0;")
-    code(f"    const dyad_kin_result* bad = kinematics(in, {rate}, {accel}, &kin, &failed);")
+    code(f"    const dyad_kin_result* bad = kinematics(in, {rates}, &kin, &failed);")
     code("    if (bad != NULL) {")
     code(f"        fail_kinematics(out, bad, failed, {scene.threshold.c()}, evaluation);")
     code("        return;")
@@ -243,13 +248,13 @@ def _accelerations(plan: Plan, code: _Code) -> None:
     code()
     code("/* Accelerations of the pairs D: 0 on a fixed pivot, an input on a guide or an")
     code(" * external link, and from the carrying link's motion on a moving link. */")
-    if plan.crank:
-        plan.accel[plan.crank.name] = None
-    if plan.crank and plan.crank.is_ram() and plan.crank_needed:
-        c = member(plan.crank.name)
-        code(f"const dyad_vec2 {c}_a_d = dyad_scale(in->{c}_acceleration, {c}_i);")
-        plan.accel[plan.crank.name] = f"{c}_a_d"
-        plan.accel_size[plan.crank.name] = f"fabs(in->{c}_acceleration)"
+    for driver in plan.drivers:
+        plan.accel[driver.name] = None
+        if driver.is_ram() and plan.crank_needed:
+            c = member(driver.name)
+            code(f"const dyad_vec2 {c}_a_d = dyad_scale(in->{c}_acceleration, {c}_i);")
+            plan.accel[driver.name] = f"{c}_a_d"
+            plan.accel_size[driver.name] = f"fabs(in->{c}_acceleration)"
     for d in plan.solved:
         for g, att in ((d.m, d.k), (d.n, d.p)):
             c = member(g)
@@ -495,11 +500,11 @@ def mechanism_amplification(plan: Plan) -> str:
     its motion's (the accelerations and the effective inertia square the rates)."""
     solved = {d.index for d in plan.solved}
     terms = ["1.0"] + [f"{member(d.name or 'dyad')}_bound" for d in plan.solved]
-    if plan.crank and plan.crank.is_cylinder():
-        kin = f"kin.{kin_name_of_cylinder(plan.scene)}"
+    for driver in kinematics_c.cylinders(plan.scene):
+        kin = f"kin.{kin_name_of_cylinder(driver)}"
         terms.append(f"3.0 * {kin}.kin_amplification")
         if plan.crank_needed:
-            terms.append(f"{member(plan.crank.actuator)}_bound")
+            terms.append(f"{member(driver.actuator)}_bound")
     terms += [
         f"3.0 * kin.{kinematics_c.kin_name(d)}.amplification"
         for d in plan.kinematic
@@ -531,9 +536,9 @@ def _chain(plan: Plan, code: _Code) -> None:
         _bound(plan, code, d)
 
 
-def _crank_outputs(plan: Plan) -> tuple[bool, bool]:
+def _crank_outputs(plan: Plan, driver: Crank) -> tuple[bool, bool]:
     """Whether the crank's torque and its R_O are wanted."""
-    c = member(plan.crank.name)
+    c = member(driver.name)
     outputs = plan.scene.outputs
     return (
         any(o.member == f"{c}_torque" for o in outputs),
@@ -541,16 +546,16 @@ def _crank_outputs(plan: Plan) -> tuple[bool, bool]:
     )
 
 
-def _wanted(plan: Plan, key: str) -> bool:
+def _wanted(plan: Plan, driver: Crank, key: str) -> bool:
     """Whether the driver's output `key` (its member's suffix) is wanted."""
-    c = member(plan.crank.driver_name())
+    c = member(driver.driver_name())
     return any(o.member == f"{c}_{key}" for o in plan.scene.outputs)
 
 
-def _ram(plan: Plan, code: _Code) -> None:
+def _ram(code: _Code, driver: Crank) -> None:
     """The ram: the actuator force balances the forces along the guide, the guide's
     normal force those across it and its reactive moment the moments about R."""
-    c = member(plan.crank.name)
+    c = member(driver.name)
     code()
     code("/* The ram: the actuator force balances the forces along its guide, the guide's")
     code(" * normal force those across it, its reactive moment the moments about R. */")
@@ -559,13 +564,13 @@ def _ram(plan: Plan, code: _Code) -> None:
     code(f"{c}_guide_m = -{c}_m_d;")
 
 
-def _cylinder_bound(plan: Plan) -> str:
+def _cylinder_bound(driver: Crank) -> str:
     """The bound of the cylinder's forces: the core's (its own terms) and the round-off
     of the loads on the link, which reach it summed (their sizes over the largest force,
     the sum of the forces' norms standing for the largest within a factor 4), both
     carrying the triangle's."""
-    c, link = member(plan.crank.actuator), member(plan.crank.name)
-    params = plan.crank.params
+    c, link = member(driver.actuator), member(driver.name)
+    params = driver.params
     pin = f"dyad_norm1({kinematics_c._vec(params['pin.x'].c(), params['pin.y'].c())})"
     forces = " + ".join(
         [f"fabs({c}_cyl.axial_force)"] + [f"dyad_norm1({c}_cyl.r_{p})" for p in "abo"]
@@ -577,22 +582,23 @@ def _cylinder_bound(plan: Plan) -> str:
     )
 
 
-def _cylinder(plan: Plan, code: _Code) -> None:
+def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
     """The cylinder: the loads on its link (its resultant about O, every dyad's reaction
     on it included) and the barrel's and the rod's own, balanced by the axial force and
     the pins' reactions (dyadfmu/cylinder.h)."""
     scene = plan.scene
-    c, link = member(plan.crank.actuator), member(plan.crank.name)
-    rate, accel = kinematics_c.driver_rates(scene)
+    c, link = member(driver.actuator), member(driver.name)
+    rate, accel = kinematics_c.driver_rates(scene, driver)
     code()
     code("/* The cylinder: its link's resultant (at O, with its moment about O) and the")
     code(" * barrel's and the rod's weight and inertia balanced by the axial force and the")
     code(" * pins' reactions. */")
     code("{")
     code("    dyad_cylinder_input cyl_in;")
-    params = plan.crank.params
+    params = driver.params
     pivot = f"fixed_point({_vec(params['at.x'].c(), params['at.y'].c())})"
-    for line in kinematics_c.cylinder_input_lines(scene, "cyl_in", (rate, accel), pivot):
+    lines = kinematics_c.cylinder_input_lines(scene, driver, "cyl_in", (rate, accel), pivot)
+    for line in lines:
         code("    " + line)
     code(f"    cyl_in.link.force = {link}_f;")
     code(f"    cyl_in.link.moment = {link}_m_d;")
@@ -600,29 +606,33 @@ def _cylinder(plan: Plan, code: _Code) -> None:
         gx, gy = scene.gravity_params
         code(f"    cyl_in.gravity = {_vec(gx.c(), gy.c())};")
     code(f"    if (dyad_cylinder(&cyl_in, &{c}_cyl) != DYAD_STATUS_OK) {{")
-    name = textsafe.c_string(plan.crank.actuator)
+    name = textsafe.c_string(driver.actuator)
     code(f"        fail_cylinder(out, &{c}_cyl, {name}, evaluation);")
     code("        return;")
     code("    }")
     code("}")
     code(f"{c}_force = {c}_cyl.axial_force;")
-    code(f"const double {c}_bound = {_cylinder_bound(plan)};")
+    code(f"const double {c}_bound = {_cylinder_bound(driver)};")
 
 
 def _crank(plan: Plan, code: _Code) -> None:
     if not plan.crank_needed:
         return
-    if plan.crank.is_cylinder():
-        _cylinder(plan, code)
-        return
-    if plan.crank.is_ram():
-        _ram(plan, code)
-        return
-    c = member(plan.crank.name)
-    torque, r_o = _crank_outputs(plan)
+    for driver in plan.drivers:
+        if driver.is_cylinder():
+            _cylinder(plan, code, driver)
+        elif driver.is_ram():
+            _ram(code, driver)
+        else:
+            _crank_balance(plan, code, driver)
+
+
+def _crank_balance(plan: Plan, code: _Code, driver: Crank) -> None:
+    c = member(driver.name)
+    torque, r_o = _crank_outputs(plan, driver)
     code()
     code("/* The crank: the driving torque balances the moments about O, R_O the forces. */")
-    if torque or _wanted(plan, "torque0"):
+    if torque or _wanted(plan, driver, "torque0"):
         code(f"{c}_torque = -{c}_m_d;")
     if r_o:
         code(f"{c}_r_o = dyad_neg({c}_f);")
@@ -630,8 +640,12 @@ def _crank(plan: Plan, code: _Code) -> None:
 
 
 def _driver_inertia(plan: Plan, code: _Code) -> None:
-    """J(q), dJ/dq and the balance at zero driver acceleration (internal kinematics)."""
+    """J(q), dJ/dq and the balance at zero driver acceleration (internal kinematics);
+    with several drivers M(q) and the balances at zero acceleration of every driver."""
     if not plan.inertia_needed:
+        return
+    if len(plan.drivers) > 1:
+        _inertia_matrix(plan, code)
         return
     scene = plan.scene
     c = member(scene.crank.driver_name())
@@ -642,20 +656,61 @@ def _driver_inertia(plan: Plan, code: _Code) -> None:
     code(" * derivative along the driver V', each link's W and W': J = sum m V.V + I W^2,")
     code(" * dJ/dq = 2 sum (m V.V' + I W W'). */")
     code(f"{scene.identifier}_kinematics unit;")
+    _unit_kinematics(plan, code, "unit", "1.0, 0.0")
+    code(f"const double {c}_reduced_j = {' + '.join(j_terms) or '0.0'};")
+    code(f"const double {c}_reduced_djdq = 2.0 * ({' + '.join(dj_terms) or '0.0'});")
+    _, accel = kinematics_c.driver_rates(scene, scene.crank)
+    balance = "force" if scene.crank.balances_with_force() else "torque"
+    if _wanted(plan, scene.crank, f"{balance}0"):
+        code(f"const double {c}_{balance}0 = {c}_{balance} - {c}_reduced_j * {accel};")
+
+
+def _unit_kinematics(plan: Plan, code: _Code, target: str, rates: str) -> None:
+    """The kinematics at the rates `rates` (C arguments) and zero accelerations."""
+    scene = plan.scene
     code("{")
     code("    int failed = 0;")
-    code("    const dyad_kin_result* bad = kinematics(in, 1.0, 0.0, &unit, &failed);")
+    code(f"    const dyad_kin_result* bad = kinematics(in, {rates}, &{target}, &failed);")
     code("    if (bad != NULL) {")
     code(f"        fail_kinematics(out, bad, failed, {scene.threshold.c()}, evaluation);")
     code("        return;")
     code("    }")
     code("}")
-    code(f"const double {c}_reduced_j = {' + '.join(j_terms) or '0.0'};")
-    code(f"const double {c}_reduced_djdq = 2.0 * ({' + '.join(dj_terms) or '0.0'});")
-    _, accel = kinematics_c.driver_rates(scene)
-    balance = "force" if scene.crank.balances_with_force() else "torque"
-    if _wanted(plan, f"{balance}0"):
-        code(f"const double {c}_{balance}0 = {c}_{balance} - {c}_reduced_j * {accel};")
+
+
+def _inertia_matrix(plan: Plan, code: _Code) -> None:
+    """M(q) from the kinematics at unit rate of each driver alone, and each driver's
+    effort at zero acceleration of every driver, h = effort - M q''."""
+    scene = plan.scene
+    drivers = plan.drivers
+    code()
+    code("/* The inertia matrix: at unit rate of driver a alone (the others at rest, no")
+    code(" * acceleration) the kinematics give each centre of mass's velocity V_a and each")
+    code(" * link's angular velocity W_a per unit rate of a: M_ab = sum m V_a.V_b + I W_a W_b,")
+    code(" * symmetric; efforts = M(q) q'' + h. */")
+    for driver in drivers:
+        unit = f"unit_{member(driver.driver_name())}"
+        rates = ", ".join(
+            "1.0, 0.0" if other is driver else "0.0, 0.0" for other in drivers
+        )
+        code(f"{scene.identifier}_kinematics {unit};")
+        _unit_kinematics(plan, code, unit, rates)
+    for i, a in enumerate(drivers):
+        for b in drivers[i:]:
+            terms = kinematics_c.inertia_matrix_terms(scene, plan.kinematic, a, b)
+            code(f"const double {inertia_entry_member(a, b)} = {' + '.join(terms) or '0.0'};")
+        for b in drivers[:i]:
+            code(f"const double {inertia_entry_member(a, b)} = {inertia_entry_member(b, a)};")
+    for a in drivers:
+        effort = effort_of(a)[0]
+        if not _wanted(plan, a, f"{effort}0"):
+            continue
+        c = member(a.driver_name())
+        terms = [
+            f"{inertia_entry_member(a, b)} * {kinematics_c.driver_rates(scene, b)[1]}"
+            for b in drivers
+        ]
+        code(f"const double {c}_{effort}0 = {c}_{effort} - ({' + '.join(terms)});")
 
 
 def _kinematic_exprs(scene: Scene) -> dict[str, str]:
@@ -675,18 +730,21 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
                 exprs[f"{pre}{pair}_position_{x}"] = f"{kin}.{point}.position.{x}"
         for side in "kp":
             exprs[f"{pre}slide_{side}"] = f"{kin}.slide_{side}.s"
-    c = member(scene.crank.driver_name())
-    for key in ("torque0", "force0", "reduced_j", "reduced_djdq"):
-        exprs[f"{c}_{key}"] = f"{c}_{key}"
-    if scene.crank.is_cylinder():
-        exprs.update(_cylinder_exprs(scene))
+    for driver in scene.drivers:
+        c = member(driver.driver_name())
+        for key in ("torque0", "force0", "reduced_j", "reduced_djdq"):
+            exprs[f"{c}_{key}"] = f"{c}_{key}"
+        for other in scene.drivers:
+            exprs[inertia_entry_member(driver, other)] = inertia_entry_member(driver, other)
+        if driver.is_cylinder():
+            exprs.update(_cylinder_exprs(driver))
     return exprs
 
 
-def _cylinder_exprs(scene: Scene) -> dict[str, str]:
+def _cylinder_exprs(driver: Crank) -> dict[str, str]:
     """The C expressions of a cylinder's outputs and of its link's."""
-    c, link = member(scene.crank.actuator), member(scene.crank.name)
-    kin = f"kin.{kin_name_of_cylinder(scene)}"
+    c, link = member(driver.actuator), member(driver.name)
+    kin = f"kin.{kin_name_of_cylinder(driver)}"
     exprs = {}
     for key in ("angle", "omega", "epsilon"):
         exprs[f"{link}_{key}"] = f"{kin}.link_{key}"
@@ -706,8 +764,8 @@ def _cylinder_exprs(scene: Scene) -> dict[str, str]:
 def _output_exprs(scene: Scene) -> dict[str, str]:
     """The C expression of every output's value, by output member."""
     exprs = {}
-    if scene.crank:
-        c = member(scene.crank.name)
+    for driver in scene.drivers:
+        c = member(driver.name)
         exprs[f"{c}_torque"] = f"{c}_torque"
         exprs[f"{c}_r_o_x"] = f"{c}_r_o.x"
         exprs[f"{c}_r_o_y"] = f"{c}_r_o.y"
@@ -786,19 +844,20 @@ PASSES = (
 def _declarations(plan: Plan) -> tuple[list[str], list[str]]:
     dyads = [f"    dyad_result {member(d.name or 'dyad')};" for d in plan.solved]
     crank = []
-    if plan.crank_needed and plan.crank.is_cylinder():
-        c = member(plan.crank.actuator)
-        crank += [f"    dyad_cylinder_result {c}_cyl;", f"    double {c}_force;"]
-    elif plan.crank_needed and plan.crank.is_ram():
-        c = member(plan.crank.name)
-        crank += [f"    double {c}_{key};" for key in ("force", "guide_n", "guide_m")]
-    elif plan.crank_needed:
-        c = member(plan.crank.name)
-        torque, r_o = _crank_outputs(plan)
-        if torque or _wanted(plan, "torque0"):
-            crank.append(f"    double {c}_torque;")
-        if r_o:
-            crank.append(f"    dyad_vec2 {c}_r_o;")
+    for driver in plan.drivers if plan.crank_needed else []:
+        if driver.is_cylinder():
+            c = member(driver.actuator)
+            crank += [f"    dyad_cylinder_result {c}_cyl;", f"    double {c}_force;"]
+        elif driver.is_ram():
+            c = member(driver.name)
+            crank += [f"    double {c}_{key};" for key in ("force", "guide_n", "guide_m")]
+        else:
+            c = member(driver.name)
+            torque, r_o = _crank_outputs(plan, driver)
+            if torque or _wanted(plan, driver, "torque0"):
+                crank.append(f"    double {c}_torque;")
+            if r_o:
+                crank.append(f"    dyad_vec2 {c}_r_o;")
     return dyads, crank
 
 
@@ -825,7 +884,7 @@ def _kinematics_code(plan: Plan, tangent: bool = False, later: str = "") -> str:
         kinematics_function=function,
         names=kinematics_c.failure_names(scene),
         cylinder_failure=_template(CYLINDER_FAILURE_TEMPLATE).template
-        if scene.crank.is_cylinder()
+        if kinematics_c.cylinders(scene)
         else "",
         failure_text=_failure_text(scene),
     )
@@ -838,9 +897,9 @@ def _failure_text(scene: Scene) -> str:
         "static const char* failure_text(const dyad_kin_result* dyad, int index)",
         "{",
     ]
-    if scene.crank.is_cylinder():
+    if kinematics_c.cylinders(scene):
         lines += [
-            f"    if (index == {len(scene.dyads)}) {{",
+            f"    if (index >= {len(scene.dyads)}) {{",
             "        return dyad->failure == DYAD_KIN_TOO_FAR",
             '                   ? "the cylinder is too short to reach, |O A| > |O B| + s"',
             '                   : "the triangle of its pins does not close, |O A| < ||O B| - s|";',
@@ -866,7 +925,7 @@ def _helpers(plan: Plan, tangent: bool = False, later: str = "") -> str:
         else "",
         kinematics_code=_kinematics_code(plan, tangent, later),
         fail_cylinder=_template(FAIL_CYLINDER_TEMPLATE).substitute(ident=plan.scene.identifier)
-        if plan.crank_needed and plan.crank.is_cylinder()
+        if plan.crank_needed and kinematics_c.cylinders(plan.scene)
         else "",
         check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
     )
@@ -897,7 +956,7 @@ def _file_fields(plan: Plan) -> dict[str, str]:
         "ident": scene.identifier,
         "scene_file": textsafe.c_comment(scene.path.name),
         "kinematics_include": (KINEMATICS_INCLUDE if plan.runs_kinematics else "")
-        + (CYLINDER_INCLUDE if scene.crank and scene.crank.is_cylinder() else ""),
+        + (CYLINDER_INCLUDE if kinematics_c.cylinders(scene) else ""),
     }
 
 

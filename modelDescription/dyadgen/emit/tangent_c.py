@@ -431,8 +431,8 @@ _CYLINDER_CALL = re.compile(
     r"^if \(dyad_cylinder\(&(?P<a>[^,]+), &(?P<b>[^)]+)\) != DYAD_STATUS_OK\) \{$"
 )
 _DRIVER_CALL = re.compile(
-    r"^const dyad_kin_result\* bad = kinematics\(in, (?P<rate>[^,]+), (?P<accel>[^,]+), "
-    r"&(?P<kin>[a-z_]+), &failed\);$"
+    r"^const dyad_kin_result\* bad = kinematics\(in, (?P<rates>(?:[^,&]+, )+)"
+    r"&(?P<kin>[a-z_][a-z0-9_]*), &failed\);$"
 )
 #: statements whose values the derivative needs as they are
 _VERBATIM = re.compile(
@@ -501,11 +501,12 @@ class Differentiation:
         return [f"if (dyad_cylinder_tangent({args}) != DYAD_STATUS_OK) {{"]
 
     def _driver_call(self, m: re.Match) -> list[str]:
-        rate = dual(parse(m["rate"]), self.names).lifted()
-        accel = dual(parse(m["accel"]), self.names).lifted()
+        rates = [
+            dual(parse(arg), self.names).lifted() for arg in m["rates"].removesuffix(", ").split(", ")
+        ]
         kin = m["kin"]
         return [
-            f"const dyad_kin_result* bad = kinematics_tangent(in, seed, {rate}, {accel}, "
+            f"const dyad_kin_result* bad = kinematics_tangent(in, seed, {', '.join(rates)}, "
             f"&{kin}, &d_{kin}, &failed);"
         ]
 
@@ -621,7 +622,9 @@ def _inputs(scene: Scene) -> dict[str, str]:
 
 
 def _kinematics_tangent(scene: Scene, dyads: list[Dyad], evaluate_text: str) -> str:
-    names = Names(_inputs(scene), duals={"rate": REAL, "accel": REAL}, structs={"kin"})
+    rates = [kinematics_c.rate_names(scene, d) for d in scene.drivers]
+    duals = {name: REAL for pair in rates for name in pair}
+    names = Names(_inputs(scene), duals=duals, structs={"kin"})
     body = Differentiation(scene.identifier, names).lines(
         kinematics_c.kinematics_body(scene, dyads)
     )
@@ -629,8 +632,13 @@ def _kinematics_tangent(scene: Scene, dyads: list[Dyad], evaluate_text: str) -> 
     wanted = [h for h in _POINT_HELPERS if f"{h}(" in used]
     if "dual_point_const" in wanted and "dual_point" not in wanted:
         wanted.insert(0, "dual_point")
+    indent = " " * len("static const dyad_kin_result* kinematics_tangent(")
+    arguments = [f"dyad_dual {name}" for pair in rates for name in pair]
+    if len(rates) == 1:  # two to a line, as they always were
+        arguments = [", ".join(arguments)]
     return _template("scene_kinematics_tangent.c.in").substitute(
         ident=scene.identifier,
+        rates=f",\n{indent}".join(arguments),
         point_helpers="\n".join(_POINT_HELPERS[h] for h in wanted),
         body=_indented(body),
     )

@@ -49,9 +49,11 @@ def _learn_from(path: object, reserved: set, patterns: dict) -> None:
         "model.c": model_c(table),
     }
     # a cylinder's name and its link's are the driver's, as a crank's
-    kind_of = {probe.identifier: "identifier", probe.crank.name: "crank"}
-    if probe.crank.actuator:
-        kind_of[probe.crank.actuator] = "crank"
+    kind_of = {probe.identifier: "identifier"}
+    for driver in probe.drivers:
+        kind_of[driver.name] = "crank"
+        if driver.actuator:
+            kind_of[driver.actuator] = "crank"
     kind_of.update({d.name: "dyad" for d in probe.dyads})
     kind_of.update({g: "link" for g in probe.links})
     reserved |= cnames.headers_names(

@@ -19,10 +19,13 @@ MAX_AT = 1.0e4
 RESERVED = {"gravity", "singular_threshold", "amplification", "status"}
 
 
-def _raw_com(data: dict, crank: Crank | None, link: str) -> tuple[float, float] | None:
+def _raw_com(data: dict, drivers: list[Crank], link: str) -> tuple[float, float] | None:
     """The centre of mass a link's table gives (m, its frame), where it is valid."""
-    if crank is not None and link == crank.name:
-        table = data.get(crank.kind, {})
+    driver = next((d for d in drivers if d.name == link), None)
+    if driver is not None:
+        table = data.get(driver.kind, {})
+        if isinstance(table, list):  # [[crank]]: one of several
+            table = table[driver.index]
     else:
         rows = data.get("link", [])
         found = [r for r in rows if isinstance(r, dict) and r.get("name") == link]
@@ -36,8 +39,8 @@ def _raw_com(data: dict, crank: Crank | None, link: str) -> tuple[float, float] 
 class _Reading:
     """The parse of the [[load]] tables, one by one."""
 
-    def __init__(self, p: Problems, data: dict, crank: Crank | None, names: set) -> None:
-        self.p, self.data, self.crank = p, data, crank
+    def __init__(self, p: Problems, data: dict, drivers: list[Crank], names: set) -> None:
+        self.p, self.data, self.drivers = p, data, drivers
         self.taken = set(names) | RESERVED  # the scene's other names
         self.seen: dict[str, int] = {}  # load name -> its table
 
@@ -65,12 +68,12 @@ class _Reading:
         return name
 
     def link(self, i: int, row: dict, name: str, links: dict) -> str | None:
-        """The loaded link: a dyad's link or the driver."""
+        """The loaded link: a dyad's link or a driver's."""
         link = row.get("link")
-        driver = self.crank.name if self.crank else None
-        if link == driver and driver is not None or link in links:
+        driven = [d.name for d in self.drivers]
+        if link in driven or link in links:
             return link
-        known = ([driver] if driver else []) + list(links)
+        known = driven + list(links)
         self.p.add(
             f"load '{name}': on unknown link {shown(link)} (links: {', '.join(known) or 'none'})",
             "load",
@@ -82,7 +85,7 @@ class _Reading:
     def at(self, i: int, row: dict, name: str, link: str) -> tuple[float, float] | None:
         """The point it acts at, in the link's frame (m); default the centre of mass."""
         if "at" not in row:
-            com = _raw_com(self.data, self.crank, link)
+            com = _raw_com(self.data, self.drivers, link)
             if com is None:
                 self.p.add(
                     f"load '{name}': '{link}' has no centre of mass to default to: "
@@ -153,7 +156,7 @@ class _Reading:
 
 
 def point_loads(
-    p: Problems, data: dict, crank: Crank | None, links: dict, names: set
+    p: Problems, data: dict, drivers: list[Crank], links: dict, names: set
 ) -> list[PointLoad]:
     """The [[load]] tables, checked; `names` are the scene's other names (links, dyads,
     driver, identifier), which a load's name may not take."""
@@ -161,7 +164,7 @@ def point_loads(
     if not isinstance(rows, list):
         p.add("[[load]] must be an array of tables", "load", 0)
         return []
-    reading = _Reading(p, data, crank, names)
+    reading = _Reading(p, data, drivers, names)
     found = []
     for i, row in enumerate(rows):
         if not isinstance(row, dict):

@@ -22,8 +22,15 @@ ATTACHMENT_KEYS = ("link", "at", "guide")
 MAX_CHAIN = 200
 
 
+def driver_text(driver: Crank) -> str:
+    """A driver's moving link in words: "the crank", "ram 'r'", "the link of cylinder 'c'"."""
+    if driver.is_cylinder():
+        return f"the link of cylinder '{driver.actuator}'"
+    return "the crank" if driver.kind == "crank" else f"{driver.kind} '{driver.name}'"
+
+
 def link_tables(
-    p: Problems, data: dict, crank: Crank | None, refused: dict[str, int]
+    p: Problems, data: dict, drivers: list[Crank], refused: dict[str, int]
 ) -> dict[str, tuple[dict, int]]:
     """The [[link]] tables by name (tables first, so that dyads can refer to them); the
     index of each table whose name is refused goes to `refused`, by that name, so that
@@ -47,8 +54,9 @@ def link_tables(
         elif name in tables:
             also = p.loc.line("link", tables[name][1])
             p.add(f"link '{name}' is described twice (also line {also})", "link", i, "name")
-        elif crank and name == crank.name:
-            p.add(f"link '{name}' has the crank's name", "link", i, "name")
+        elif any(name == d.name for d in drivers):
+            driver = next(d for d in drivers if d.name == name)
+            p.add(f"link '{name}' has the name of {driver_text(driver)}", "link", i, "name")
         else:
             tables[name] = (row, i)
     return tables
@@ -58,7 +66,7 @@ class _Attaching:
     """The parse of one outer pair's attachment (k at D_m, or p at D_n) of a dyad."""
 
     def __init__(
-        self, p: Problems, dyad: Dyad, side: str, label: str, crank: Crank | None, internal: bool
+        self, p: Problems, dyad: Dyad, side: str, label: str, drivers: list[Crank], internal: bool
     ) -> None:
         self.p = p
         self.internal = internal
@@ -68,7 +76,7 @@ class _Attaching:
         self.label = label
         self.index = dyad.index
         self.prefix = dyad.prefix()
-        self.crank = crank
+        self.drivers = {d.name: d for d in drivers}
 
     def problem(self, message: str, key: bool = True) -> None:
         if key:
@@ -102,8 +110,7 @@ class _Attaching:
         if not isinstance(target, str):
             self.problem(f"'{self.side}' needs link = <name>")
             return None
-        crank = self.crank
-        moving = (crank is not None and target == crank.name) or target in links
+        moving = target in self.drivers or target in links
         if target not in ("frame", "external") and not moving:
             later = (
                 " (a link of a later dyad or of this one: dyads are listed from the crank outwards)"
@@ -112,7 +119,7 @@ class _Attaching:
             )
             self.problem(
                 f"'{self.side}' names unknown link {target!r}{later}; expected 'frame', "
-                f"'external'{', the crank' if crank else ''} or a link of an earlier dyad"
+                f"'external'{', a driver' if self.drivers else ''} or a link of an earlier dyad"
             )
             return None
         return target
@@ -144,10 +151,7 @@ class _Attaching:
             return Attachment("external")
         if target == "frame" and not self.sliding:
             return Attachment("frame")
-        crank = self.crank
-        kind = (
-            "frame" if target == "frame" else "crank" if crank and target == crank.name else "link"
-        )
+        kind = "frame" if target == "frame" else "crank" if target in self.drivers else "link"
         guide = None
         if self.sliding:
             guide = self.guide(spec, target, kind)
@@ -229,7 +233,7 @@ class _Attaching:
             if self.sliding:
                 at = [0.0, 0.0]  # the guide passes through the carrier's D (O)
             elif kind == "crank":
-                return Attachment("crank", self.crank.name)  # the crank's pin
+                return Attachment("crank", target)  # the crank's pin, a ram's R, a cylinder's B
             else:
                 self.problem(
                     f"'{self.side}' on link '{target}' needs at = [x, y], the pair's point "
@@ -252,13 +256,13 @@ class Mechanism:
     def __init__(
         self,
         p: Problems,
-        crank: Crank | None,
+        drivers: list[Crank],
         tables: dict,
         internal: bool,
         refused: dict[str, int] | None = None,
     ) -> None:
         self.p = p
-        self.crank = crank
+        self.drivers = drivers
         self.internal = internal
         self.tables = tables
         self.refused = refused or {}  # link name -> its table, whose name was refused
@@ -273,7 +277,7 @@ class Mechanism:
     def parse(self, data: dict) -> None:
         """Every [[dyad]] table."""
         rows = data.get("dyad", [])
-        cylinder = self.crank is not None and self.crank.is_cylinder()
+        cylinder = any(d.is_cylinder() for d in self.drivers)
         if not isinstance(rows, list) or not (rows or cylinder):
             # a cylinder and the link it turns are a mechanism of their own (a tipper body)
             self.p.add(
@@ -323,10 +327,17 @@ class Mechanism:
         if not all([self.link(dyad, row, side, label) for side in ("m", "n")]):
             return
         for side in ("k", "p"):
-            attaching = _Attaching(self.p, dyad, side, label, self.crank, self.internal)
+            attaching = _Attaching(self.p, dyad, side, label, self.drivers, self.internal)
             setattr(dyad, side, attaching.parse(row.get(side, None), self.links))
         if dyad.k is None or dyad.p is None:
             return
+        if self.internal and dyad.k.kind == dyad.p.kind == "frame":
+            self.p.add(
+                f"{label}: both its outer pairs are on the frame, so that no driver moves its "
+                "links; attach k or p to a driver or to a link of an earlier dyad",
+                "dyad",
+                dyad.index,
+            )
         dyad.branch = self.branch(dyad, row, label)
         d_m, e, d_n = PAIRS[dtype]
         for side, outer, attached in (("m", d_m, dyad.k), ("n", d_n, dyad.p)):
@@ -433,9 +444,13 @@ class Mechanism:
                 side,
             )
             return False
-        if self.crank and lname == self.crank.name:
+        driver = next((d for d in self.drivers if d.name == lname), None)
+        if driver is not None:
             p.add(
-                f"{label}: link '{lname}' is the crank, which no dyad may contain", "dyad", i, side
+                f"{label}: link '{lname}' is {driver_text(driver)}, which no dyad may contain",
+                "dyad",
+                i,
+                side,
             )
             return False
         if lname in self.refused:  # its table's name was refused there

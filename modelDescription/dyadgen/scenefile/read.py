@@ -24,7 +24,7 @@ from dyadgen.scenefile.names import CNames, c_name_clashes, identifier_problem
 from dyadgen.scenefile.problems import Problems, SceneError
 
 
-def _named_objects(identifier: str, found: mechanism.Mechanism, crank: Crank | None) -> list:
+def _named_objects(identifier: str, found: mechanism.Mechanism, drivers: list[Crank]) -> list:
     """(kind, name, label, where) of every name of the scene, in file order."""
     objects = []
     if not identifier_problem(identifier):
@@ -36,14 +36,16 @@ def _named_objects(identifier: str, found: mechanism.Mechanism, crank: Crank | N
                 ("scene", 0, "identifier"),
             )
         )
-    if crank is not None and crank.is_cylinder():
-        where = ("cylinder", 0, "name")
-        label = f"cylinder '{crank.actuator}'"
-        objects.append(("crank", crank.actuator, label, where))
-        objects.append(("crank", crank.name, f"link '{crank.name}'", ("cylinder", 0, "link")))
-    elif crank is not None:
-        where = (crank.kind, 0, "name")
-        objects.append(("crank", crank.name, f"{crank.kind} '{crank.name}'", where))
+    for crank in drivers:
+        i = crank.index
+        if crank.is_cylinder():
+            label = f"cylinder '{crank.actuator}'"
+            objects.append(("crank", crank.actuator, label, ("cylinder", i, "name")))
+            link_label = f"link '{crank.name}'"
+            objects.append(("crank", crank.name, link_label, ("cylinder", i, "link")))
+        else:
+            where = (crank.kind, i, "name")
+            objects.append(("crank", crank.name, f"{crank.kind} '{crank.name}'", where))
     objects += [
         ("dyad", d.name, f"dyad '{d.name}'", ("dyad", d.index, "name"))
         for d in found.dyads
@@ -94,31 +96,26 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     threshold = sections.threshold(p, scene_t)
     kinematics = sections.kinematics(p, scene_t, any(d in data for d in sections.DRIVERS))
     internal = kinematics == "internal"
-    if "crank" in data and "cylinder" in data:
-        p.add("[cylinder]: a scene has one driver, a [crank] or a [cylinder], not both", "cylinder")
-    crank = (
-        sections.crank(p, data, inertia, needs_mass, internal)
-        or sections.ram(p, data, needs_mass, internal)
-        or sections.cylinder(p, data, inertia, needs_mass, internal)
-    )
+    drivers = sections.drivers(p, data, inertia, needs_mass, internal)
     refused: dict[str, int] = {}
-    tables = mechanism.link_tables(p, data, crank, refused)
-    found = mechanism.Mechanism(p, crank, tables, internal, refused)
+    tables = mechanism.link_tables(p, data, drivers, refused)
+    found = mechanism.Mechanism(p, drivers, tables, internal, refused)
     found.parse(data)
     found.link_numbers(inertia, needs_mass)
     if c_names is not None:
-        objects = _named_objects(identifier, found, crank)
+        objects = _named_objects(identifier, found, drivers)
         c_name_clashes(p, objects, c_names())
     sections.loads(p, data, found.links, found.known())
-    names = {o[1] for o in _named_objects(identifier, found, crank)}
-    placed = point_loads.point_loads(p, data, crank, found.links, names | found.known())
+    names = {o[1] for o in _named_objects(identifier, found, drivers)}
+    placed = point_loads.point_loads(p, data, drivers, found.links, names | found.known())
     scene = Scene(
         path=path,
         identifier=identifier,
         description=description,
         inertia=inertia,
         gravity=gravity,
-        crank=crank,
+        crank=drivers[0] if len(drivers) == 1 else None,
+        drivers=drivers,
         dyads=found.dyads,
         links=found.links,
         gravity_params=gravity_params,

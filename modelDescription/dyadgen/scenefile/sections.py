@@ -179,7 +179,7 @@ def kinematics(p: Problems, scene_t: dict, driven: bool) -> str:
 
 def _pivot(p: Problems, driver: Crank, table: dict, section: str, text: str) -> None:
     """The driver's point on the frame, `at` (m, global; default the origin)."""
-    at = pair_of_numbers(p, table, "at", f"[{section}]", section, 0, required=False)
+    at = pair_of_numbers(p, table, "at", f"[{section}]", section, driver.index, required=False)
     x, y = at if at is not None else (0.0, 0.0)
     name = driver.name
     driver.params["at.x"] = Param(f"{name}.at.x", x, "m", f"{text}, global x")
@@ -191,7 +191,7 @@ def _crank_params(
 ) -> None:
     cname = crank.name
     where = f"crank '{cname}'"
-    length = number(p, crank_t, "length", where, "crank", 0, positive=True)
+    length = number(p, crank_t, "length", where, "crank", crank.index, positive=True)
     if length is not None:
         crank.params["length"] = Param(
             f"{cname}.length",
@@ -212,7 +212,8 @@ def _crank_mass(
     label = "Crank" if section == "crank" else f"Link {name}"
     frame = "crank frame {O; i_c, j_c}" if section == "crank" else f"frame of {name} {{O; i, j}}"
     where = f"{section} '{driver.driver_name()}'"
-    com = pair_of_numbers(p, table, "com", where, section, 0, required=needs_mass)
+    i = driver.index
+    com = pair_of_numbers(p, table, "com", where, section, i, required=needs_mass)
     if com is not None and needs_mass:
         driver.params["com.x"] = Param(
             f"{name}.com.x", com[0], "m", f"{label}'s centre of mass, x in the {frame}"
@@ -223,10 +224,10 @@ def _crank_mass(
             "m",
             f"{label}'s centre of mass, y in the {frame.split(' {')[0]}",
         )
-    mass = number(p, table, "mass", where, section, 0, nonnegative=True, required=needs_mass)
+    mass = number(p, table, "mass", where, section, i, nonnegative=True, required=needs_mass)
     if mass is not None and needs_mass:
         driver.params["mass"] = Param(f"{name}.mass", mass, "kg", f"{label}'s mass", {"min": 0.0})
-    inert = number(p, table, "inertia", where, section, 0, nonnegative=True, required=inertia)
+    inert = number(p, table, "inertia", where, section, i, nonnegative=True, required=inertia)
     if inert is not None and inertia:
         driver.params["inertia"] = Param(
             f"{name}.inertia",
@@ -237,31 +238,37 @@ def _crank_mass(
         )
 
 
-def _driver_table(p: Problems, data: dict, section: str, keys: set) -> tuple[dict, str] | None:
-    """A driver's table ([crank] or [ram]), its keys checked, and its name (the section's
-    name where it is left out or invalid); None where there is none."""
-    table = data.get(section)
-    if table is None:
-        return None
-    if not isinstance(table, dict):
-        p.add(f"[{section}] must be a table", section, 0)
-        return None
-    unknown_keys(p, table, keys, f"[{section}]", section, 0)
-    name = table.get("name", section)
-    problem = name_problem(name)
-    if problem:
-        p.add(f"[{section}]: name {problem}", section, 0, "name")
-        name = section
-    return table, name
+def _driver_tables(
+    p: Problems, data: dict, section: str, keys: set
+) -> list[tuple[dict, str, int]]:
+    """The driver tables of a section ([crank], or [[crank]] for several), their keys
+    checked: (table, name, index), the name the section's where it is left out or
+    invalid."""
+    found = data.get(section)
+    if found is None:
+        return []
+    rows = found if isinstance(found, list) else [found]
+    out = []
+    for i, table in enumerate(rows):
+        if not isinstance(table, dict):
+            p.add(f"[{section}] must be a table", section, i)
+            continue
+        unknown_keys(p, table, keys, f"[{section}]", section, i)
+        name = table.get("name", section)
+        problem = name_problem(name)
+        if problem:
+            p.add(f"[{section}]: name {problem}", section, i, "name")
+            name = section if len(rows) == 1 else f"{section}{i + 1}"
+        out.append((table, name, i))
+    return out
 
 
-def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool) -> Crank | None:
-    """[crank], if any: its name and numbers (and its pivot, for internal kinematics)."""
-    found_table = _driver_table(p, data, "crank", CRANK_KEYS)
-    if found_table is None:
-        return None
-    crank_t, cname = found_table
-    found = Crank(cname, p.loc.line("crank"))
+def crank(
+    p: Problems, row: tuple[dict, str, int], inertia: bool, needs_mass: bool, internal: bool
+) -> Crank:
+    """A crank: its name and numbers (and its pivot, for internal kinematics)."""
+    crank_t, cname, index = row
+    found = Crank(cname, p.loc.line("crank", index), index=index)
     if internal:
         _pivot(p, found, crank_t, "crank", "The crank's pivot O on the frame")
     elif "at" in crank_t:
@@ -269,7 +276,7 @@ def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bo
             "[crank]: 'at' places the crank for internal kinematics; with kinematics = "
             "'external' nothing reads it",
             "crank",
-            0,
+            index,
             "at",
         )
     _crank_params(p, found, crank_t, inertia, needs_mass)
@@ -277,9 +284,9 @@ def crank(p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bo
 
 
 def _ram_params(p: Problems, ram_t: dict, found: Crank, needs_mass: bool) -> None:
-    name = found.name
+    name, i = found.name, found.index
     where = f"ram '{name}'"
-    angle = number(p, ram_t, "guide", where, "ram", 0)
+    angle = number(p, ram_t, "guide", where, "ram", i)
     if angle is not None:
         found.params["guide"] = Param(
             f"{name}.guide",
@@ -288,7 +295,7 @@ def _ram_params(p: Problems, ram_t: dict, found: Crank, needs_mass: bool) -> Non
             "Direction of the ram's frame guide (angle of i_r from x)",
         )
     _pivot(p, found, ram_t, "ram", "The ram's origin R at zero displacement")
-    com = pair_of_numbers(p, ram_t, "com", where, "ram", 0, required=needs_mass)
+    com = pair_of_numbers(p, ram_t, "com", where, "ram", i, required=needs_mass)
     if com is not None and needs_mass:
         found.params["com.x"] = Param(
             f"{name}.com.x", com[0], "m", "Ram's centre of mass, x in the ram frame {R; i_r, j_r}"
@@ -296,43 +303,38 @@ def _ram_params(p: Problems, ram_t: dict, found: Crank, needs_mass: bool) -> Non
         found.params["com.y"] = Param(
             f"{name}.com.y", com[1], "m", "Ram's centre of mass, y in the ram frame"
         )
-    mass = number(p, ram_t, "mass", where, "ram", 0, nonnegative=True, required=needs_mass)
+    mass = number(p, ram_t, "mass", where, "ram", i, nonnegative=True, required=needs_mass)
     if mass is not None and needs_mass:
         found.params["mass"] = Param(f"{name}.mass", mass, "kg", "Ram's mass", {"min": 0.0})
-    number(p, ram_t, "inertia", where, "ram", 0, nonnegative=True, required=False)
+    number(p, ram_t, "inertia", where, "ram", i, nonnegative=True, required=False)
 
 
-def ram(p: Problems, data: dict, needs_mass: bool, internal: bool) -> Crank | None:
-    """[ram], if any: a linear actuator sliding on a frame guide, the driver."""
-    found_table = _driver_table(p, data, "ram", RAM_KEYS)
-    if found_table is None:
-        return None
-    ram_t, name = found_table
-    if "crank" in data:
-        p.add("[ram]: a scene has one driver, a [crank] or a [ram], not both", "ram", 0)
-        return None
-    if "cylinder" in data:
-        p.add("[ram]: a scene has one driver, a [ram] or a [cylinder], not both", "ram", 0)
-        return None
+def ram(p: Problems, row: tuple[dict, str, int], needs_mass: bool, internal: bool) -> Crank | None:
+    """A ram: a linear actuator sliding on a frame guide."""
+    ram_t, name, index = row
     if not internal:
-        p.add("[ram]: a ram drives the chain only with kinematics = 'internal'", "ram", 0)
+        p.add("[ram]: a ram drives the chain only with kinematics = 'internal'", "ram", index)
         return None
-    found = Crank(name, p.loc.line("ram"), kind="ram")
+    found = Crank(name, p.loc.line("ram", index), kind="ram", index=index)
     _ram_params(p, ram_t, found, needs_mass)
     return found
 
 
-def _part_number(p: Problems, part_t: dict, key: str, part: str, required: bool) -> float | None:
+def _part_number(
+    p: Problems, part_t: dict, key: str, part: str, required: bool, index: int
+) -> float | None:
     """A number of the cylinder's barrel or rod table (located at that table's line)."""
     where = f"[cylinder] {part}"
     if key not in part_t:
         if required:
-            p.add(f"{where}: missing '{key}'", "cylinder", 0, part)
+            p.add(f"{where}: missing '{key}'", "cylinder", index, part)
         return None
     value = real(part_t[key])
     if value is None or (key != "com" and not value >= 0):
         what = "a finite number" if key == "com" else "a finite number, not negative"
-        p.add(f"{where}: '{key}' must be {what}, not {shown(part_t[key])}", "cylinder", 0, part)
+        p.add(
+            f"{where}: '{key}' must be {what}, not {shown(part_t[key])}", "cylinder", index, part
+        )
         return None
     return value
 
@@ -353,7 +355,7 @@ def _cylinder_part(p: Problems, table: dict, found: Crank, part: str, inertia: b
         p.add(
             f"[cylinder]: '{part}' must be a table {{ mass = ..., com = ..., inertia = ... }}",
             "cylinder",
-            0,
+            found.index,
             part,
         )
         return
@@ -363,14 +365,14 @@ def _cylinder_part(p: Problems, table: dict, found: Crank, part: str, inertia: b
             f"[cylinder] {part}: unknown key '{textsafe.plain(str(unknown[0]))}' (known: "
             f"{', '.join(sorted(CYLINDER_PART_KEYS))})",
             "cylinder",
-            0,
+            found.index,
             part,
         )
     label, along = _PART_TEXT[part]
     name = f"{found.actuator}.{part}"
-    mass = _part_number(p, part_t, "mass", part, required=True)
-    com = _part_number(p, part_t, "com", part, required=True)
-    inert = _part_number(p, part_t, "inertia", part, required=inertia)
+    mass = _part_number(p, part_t, "mass", part, True, found.index)
+    com = _part_number(p, part_t, "com", part, True, found.index)
+    inert = _part_number(p, part_t, "inertia", part, inertia, found.index)
     if mass is not None:
         found.params[f"{part}.mass"] = Param(
             f"{name}.mass", mass, "kg", f"{label}'s mass", {"min": 0.0}
@@ -391,7 +393,7 @@ def _cylinder_part(p: Problems, table: dict, found: Crank, part: str, inertia: b
 
 def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
     """The frame pins O and A, the pin B in the link's frame and the branch."""
-    name, link = found.actuator, found.name
+    name, link, i = found.actuator, found.name, found.index
     _pivot(p, found, table, "cylinder", f"The pivot O of {link} on the frame")
     where = f"cylinder '{name}'"
     texts = (
@@ -399,11 +401,11 @@ def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
         ("pin", f"{name}.pin", f"The rod's pin B on {link}", f"in {link}'s frame"),
     )
     for key, prefix, text, frame in texts:
-        point = pair_of_numbers(p, table, key, where, "cylinder", 0)
+        point = pair_of_numbers(p, table, key, where, "cylinder", i)
         if point is None:
             continue
         if key == "pin" and point == (0.0, 0.0):
-            p.add(f"{where}: 'pin' must not be O itself, [0, 0]", "cylinder", 0, key)
+            p.add(f"{where}: 'pin' must not be O itself, [0, 0]", "cylinder", i, key)
             continue
         for axis, value in zip("xy", point, strict=True):
             found.params[f"{key}.{axis}"] = Param(
@@ -415,7 +417,7 @@ def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
             f"{where}: 'branch' must be 1 (B to the left of the line from O to A) or -1 "
             f"(to its right), not {shown(branch)}",
             "cylinder",
-            0,
+            i,
             "branch" if "branch" in table else None,
         )
         branch = 1
@@ -429,19 +431,16 @@ def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
 
 
 def cylinder(
-    p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool
+    p: Problems, row: tuple[dict, str, int], inertia: bool, needs_mass: bool, internal: bool
 ) -> Crank | None:
-    """[cylinder], if any: a hydraulic cylinder between the frame pin A and the pin B of
-    a link that it turns about the frame pivot O, the driver."""
-    found_table = _driver_table(p, data, "cylinder", CYLINDER_KEYS)
-    if found_table is None:
-        return None
-    table, name = found_table
+    """A hydraulic cylinder between the frame pin A and the pin B of a link that it turns
+    about the frame pivot O."""
+    table, name, index = row
     if not internal:
         p.add(
             "[cylinder]: a cylinder drives the chain only with kinematics = 'internal'",
             "cylinder",
-            0,
+            index,
         )
         return None
     link = table.get("link")
@@ -449,21 +448,72 @@ def cylinder(
     if link is None:
         problem = "is missing: the name of the link the cylinder turns"
     if problem:
-        p.add(f"[cylinder]: link {problem}", "cylinder", 0, "link" if link is not None else None)
+        key = "link" if link is not None else None
+        p.add(f"[cylinder]: link {problem}", "cylinder", index, key)
         link = f"{name}_link"
     if link == name:
         p.add(
             f"[cylinder]: the link and the cylinder need names of their own, not both '{name}'",
             "cylinder",
-            0,
+            index,
             "link",
         )
-    found = Crank(link, p.loc.line("cylinder"), kind="cylinder", actuator=name)
+    found = Crank(
+        link, p.loc.line("cylinder", index), kind="cylinder", actuator=name, index=index
+    )
     _cylinder_geometry(p, table, found)
     _crank_mass(p, found, table, "cylinder", inertia, needs_mass)
     for part in ("barrel", "rod"):
         _cylinder_part(p, table, found, part, inertia)
     return found
+
+
+def drivers(
+    p: Problems, data: dict, inertia: bool, needs_mass: bool, internal: bool
+) -> list[Crank]:
+    """Every driver of the scene: its cranks, rams and cylinders, each kind in file order.
+    Several drivers solve their chain's kinematics inside (kinematics = 'internal')."""
+    rows = {
+        "crank": _driver_tables(p, data, "crank", CRANK_KEYS),
+        "ram": _driver_tables(p, data, "ram", RAM_KEYS),
+        "cylinder": _driver_tables(p, data, "cylinder", CYLINDER_KEYS),
+    }
+    if sum(len(found) for found in rows.values()) > 1 and not internal:
+        p.add(
+            "[scene]: several drivers move the chain only with kinematics = 'internal'",
+            "scene",
+            0,
+            "kinematics",
+        )
+        internal = True  # read on as they are meant, so that nothing else is told
+    found = [crank(p, row, inertia, needs_mass, internal) for row in rows["crank"]]
+    found += [ram(p, row, needs_mass, internal) for row in rows["ram"]]
+    found += [cylinder(p, row, inertia, needs_mass, internal) for row in rows["cylinder"]]
+    return _distinct([d for d in found if d is not None], p)
+
+
+def _distinct(found: list[Crank], p: Problems) -> list[Crank]:
+    """The drivers whose names (a cylinder's and its link's) no earlier driver has: two
+    drivers of one link would over-determine its motion."""
+    seen: dict[str, Crank] = {}
+    kept = []
+    for driver in found:
+        names = [driver.name] + ([driver.actuator] if driver.actuator else [])
+        clash = next((n for n in names if n in seen), None)
+        if clash is None:
+            seen.update((n, driver) for n in names)
+            kept.append(driver)
+            continue
+        other = seen[clash]
+        what = "is driven twice" if driver.is_cylinder() or other.is_cylinder() else "is named twice"
+        p.add(
+            f"{driver.kind} '{driver.driver_name()}': '{clash}' {what}: {other.kind} "
+            f"'{other.driver_name()}' (line {other.line}) has that name too",
+            driver.kind,
+            driver.index,
+            "link" if driver.is_cylinder() and clash == driver.name else "name",
+        )
+    return kept
 
 
 def loads(p: Problems, data: dict, links: dict, known: set) -> None:
@@ -502,8 +552,8 @@ def _told(p: Problems, entry: str, tables_of: dict, scene: Scene) -> bool:
     had a problem (a value refused there: [gravity] y = nan, a link refused)."""
     head = entry.split(".")[0]
     tables = dict(tables_of, gravity=("gravity", 0))
-    if scene.crank is not None:
-        tables[scene.crank.name] = (scene.crank.kind, 0)
+    for driver in scene.drivers:
+        tables[driver.name] = (driver.kind, driver.index)
     return head in tables and tables[head] in p.troubled
 
 
