@@ -392,6 +392,30 @@ class MultiChain(chains.Chain):
             m.names, m.mid, m.rate, m.swing, m.omega, m.phase, revolutions * m.duration
         )
 
+    def working_points(self, count: int, seed: int = 0) -> dict:
+        """``count`` random points of the working ranges: the kinematics (:meth:`state`)
+        at coordinates uniform over each driver's range, rates and accelerations uniform
+        within the peaks of chains.toml's motion (|rate| + swing omega, swing omega^2 +
+        1), loads uniform within their models' mean +- twice the swing."""
+        rng = np.random.default_rng(seed)
+        m, n = self._motion, len(self.drivers)
+        low, high = np.array([self.ranges[d] for d in self.driver_names]).T
+        q = rng.uniform(low, high, (count, n))
+        dq = rng.uniform(-1.0, 1.0, (count, n)) * (np.abs(m.rate) + np.abs(m.swing * m.omega))
+        ddq = rng.uniform(-1.0, 1.0, (count, n)) * (np.abs(m.swing) * m.omega**2 + 1.0)
+        loads = {}
+        for name, placed in self.point_loads.items():
+            model = placed["model"]
+            parts = [
+                (f"{name}.force.{c}", model["force"][k], model["force_swing"][k])
+                for k, c in enumerate("xy")
+            ]
+            parts.append((f"{name}.moment", model["moment"], model["moment_swing"]))
+            for key, mean, swing in parts:
+                if key in self.load_inputs():
+                    loads[key] = mean + (2.0 * abs(swing) + 1.0) * rng.uniform(-1.0, 1.0, count)
+        return self.state(q, dq, ddq, loads)
+
     def kinematics(self, t: np.ndarray, motion: DriverMotion) -> dict:
         """The kinematics along ``motion`` at the times t (complex t: a complex step)."""
         kin = self._solve(*motion.sampled(t))
