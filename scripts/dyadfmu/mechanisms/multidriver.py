@@ -27,7 +27,9 @@ derived from the efforts' formula: its column b is the efforts at q, every rate 
 no gravity and no loads, driver b's acceleration 1 and the others' 0; the efforts at
 zero accelerations (rates, gravity and loads kept) are h (``<crank>.torque0``,
 ``<ram>.force0``, ``<cyl>.force0``), so that efforts = M q'' + h.
-:func:`inertia_from_energy` gives M from the kinetic energy alone, T = q'^T M q' / 2.
+:func:`inertia_from_energy` gives M from the kinetic energy alone, T = q'^T M q' / 2;
+:func:`energy_balance` checks the efforts' power against the rate of T + V along a
+motion of every driver (chains.toml's ``drivers`` table).
 
 Example::
 
@@ -51,7 +53,16 @@ from ..paths import SCENES_DIR, TEST_SCENES_DIR
 from . import chains
 from . import geometry as geo
 
-__all__ = ["NAMES", "Driver", "DriverMotion", "MultiChain", "load", "scene_path"]
+__all__ = [
+    "NAMES",
+    "Driver",
+    "DriverMotion",
+    "MultiChain",
+    "energy_balance",
+    "inertia_from_energy",
+    "load",
+    "scene_path",
+]
 
 #: The mechanisms with several drivers.
 NAMES = ("leg", "three_drivers")
@@ -572,6 +583,34 @@ def inertia_from_energy(chain: MultiChain, q: np.ndarray) -> np.ndarray:
         for b in range(a + 1, n):
             M[:, a, b] = M[:, b, a] = energy(a, b) - single[a] - single[b]
     return M
+
+
+def energy_balance(chain: MultiChain, count: int = 150, revolutions: float = 1.0) -> dict:
+    """The energy balance along chains.toml's motion of every driver at once, at ``count``
+    times: the drivers' power sum effort x rate (``drivers``), the loads' (``loads``) and
+    d(T + V)/dt (``rate``), a five-point central difference in time of the reference's
+    own kinetic and potential energies; ``residual`` = max |drivers + loads - rate| /
+    max |drivers|."""
+    motion = chain.motion("varying", revolutions)
+    t = (np.arange(count) + 0.37) * motion.duration / count
+    kin = chain.kinematics(t, motion)
+    out = chain.reference(kin)
+    step = 2e-4 * motion.duration / revolutions
+
+    def energy(at: np.ndarray) -> np.ndarray:
+        k = chain.kinematics(at, motion)
+        return chain.kinetic_energy(k) + chain.potential_energy(k)
+
+    e = [energy(t + k * step) for k in (-2, -1, 1, 2)]
+    rate = (e[0] - 8.0 * e[1] + 8.0 * e[2] - e[3]) / (12.0 * step)
+    drivers, loads = chain.driver_power(kin, out), chain.load_power(kin)
+    peak = float(np.max(np.abs(drivers)))
+    residual = float(np.max(np.abs(drivers + loads - rate))) / peak
+    return {"t": t, "kin": kin, "out": out, "drivers": drivers, "loads": loads} | {
+        "rate": rate,
+        "peak": peak,
+        "residual": residual,
+    }
 
 
 def scene_path(name: str) -> Path:
