@@ -365,17 +365,22 @@ class Chain:
         if not isinstance(table, Mapping):
             raise ValueError(f"{where}: [{self.driver}] must be a table")
         self.crank = dict(table)
-        w = f"{where}.{self.driver}"
         #: the driver's moving bodies: name -> (mass, inertia, centre of mass in its frame)
         self._parts = {}
-        if self.driver == "cylinder":
+        self._read_one_driver(self.driver, table, f"{where}.{self.driver}")
+
+    def _read_one_driver(self, kind: str, table: Mapping, w: str) -> None:
+        """One driver's table of ``kind``: its names, pivot, pin and guide into
+        ``crank_name``, ``_O``, ``_pin``, ``_guide`` (a crank's length ``_r``, a cylinder's
+        own attributes), its bodies added to ``_parts``."""
+        if kind == "cylinder":
             self._read_cylinder(table, w)
             return
-        self.crank_name = str(table.get("name", self.driver))
+        self.crank_name = str(table.get("name", kind))
         mass = geo.number(table, "mass", w, nonnegative=True)
         com = geo.pair(table, "com", w)
-        self._O = geo.pair(table, "at", w) if "at" in table or self.driver == "ram" else (0.0, 0.0)
-        if self.driver == "crank":
+        self._O = geo.pair(table, "at", w) if "at" in table or kind == "ram" else (0.0, 0.0)
+        if kind == "crank":
             self._r = geo.number(table, "length", w, positive=True)
             inertia = geo.number(table, "inertia", w, nonnegative=True)
             self._pin, self._guide = (self._r, 0.0), 0.0
@@ -430,6 +435,24 @@ class Chain:
     def _driver_names(self) -> tuple:
         """The names the driver takes: its body's, and a cylinder's own."""
         return (self.crank_name, getattr(self, "cylinder_name", self.crank_name))
+
+    @property
+    def _driver_links(self) -> tuple:
+        """The driver's links that dyads and [[load]]s may name: the crank, the ram or the
+        link a cylinder turns."""
+        return (self.crank_name,)
+
+    def _driver_alias(self, name: object) -> object:
+        """The driver link's name for ``name``: "crank" stands for a crank of another name."""
+        return self.crank_name if name == "crank" and self.driver == "crank" else name
+
+    def _driver_pin(self, spec: object) -> dict | None:
+        """The attachment at a driver link's pin when ``spec`` names that link (a crank's
+        pin A, a ram's point R, a cylinder's pin B), else None."""
+        if not isinstance(spec, str) or self._driver_alias(spec) != self.crank_name:
+            return None
+        pin = {"crank": "A", "ram": "R", "cylinder": "B"}[self.driver]
+        return {"kind": "point", "body": self.crank_name, "at": self._pin, "label": pin}
 
     def _read_links(self, where: str) -> None:
         self.links = {}
@@ -508,18 +531,17 @@ class Chain:
         frame = (self.data.get("frame") or {}).get(dyad, {}).get(pair)
         if spec == "frame":
             return self._frame_pivot(spec, frame, dyad, pair)
-        pin = {"crank": "A", "ram": "R", "cylinder": "B"}[self.driver]
-        if spec == self.crank_name or (spec == "crank" and self.driver == "crank"):
-            return {"kind": "point", "body": self.crank_name, "at": self._pin, "label": pin}
+        pinned = self._driver_pin(spec)
+        if pinned is not None:
+            return pinned
         if isinstance(spec, Mapping):
             body = spec.get("link")
             if body == "frame" and "guide" in spec:
                 return self._frame_guide(spec, frame, dyad, pair, where)
             if body == "frame":
                 return self._frame_pivot(spec, frame, dyad, pair)
-            if body == "crank" and self.driver == "crank":
-                body = self.crank_name
-            if body != self.crank_name and body not in done:
+            body = self._driver_alias(body)
+            if body not in self._driver_links and body not in done:
                 raise ValueError(
                     f"{where}: link {body!r} is not the crank nor a link of an earlier dyad"
                 )
@@ -734,9 +756,9 @@ class Chain:
                     "driver or other load"
                 )
             link = row.get("link")
-            if link != self.crank_name and link not in self.links:
+            if link not in self._driver_links and link not in self.links:
                 raise ValueError(f"{where}.link: unknown link {link!r}")
-            com = self._parts[link][2] if link == self.crank_name else self.links[link]["com"]
+            com = self._parts[link][2] if link in self._driver_links else self.links[link]["com"]
             components = row.get("components", "global")
             if components not in ("global", "link"):
                 raise ValueError(
@@ -759,13 +781,7 @@ class Chain:
         """Every pair: output key, kind, the body named first (it receives +R), the other
         body (None: the frame), kin key of its point, and for a translational pair the
         kin key of its guide's angle."""
-        c = self.crank_name
-        if self.driver == "crank":
-            self.pairs = [{"key": f"{c}.R_O", "kind": "R", "first": c, "point": "O", "tag": "O"}]
-        elif self.driver == "ram":  # the ram on its frame guide: its force N j at R, couple M
-            self.pairs = [_sliding(f"{c}.R_G", c, None, "R", f"{c}.angle", "G", c)]
-        else:
-            self.pairs = self._cylinder_pairs()
+        self.pairs = self._driver_pairs()
         for pr in self.pairs:
             pr.setdefault("second", None)
             pr["dyad"] = None
@@ -793,6 +809,15 @@ class Chain:
                     }
                 )
 
+    def _driver_pairs(self) -> list:
+        """The pairs of the driver's bodies with the frame (and with each other)."""
+        c = self.crank_name
+        if self.driver == "crank":
+            return [{"key": f"{c}.R_O", "kind": "R", "first": c, "point": "O", "tag": "O"}]
+        if self.driver == "ram":  # the ram on its frame guide: its force N j at R, couple M
+            return [_sliding(f"{c}.R_G", c, None, "R", f"{c}.angle", "G", c)]
+        return self._cylinder_pairs()
+
     def _cylinder_pairs(self) -> list:
         """The cylinder's pairs: the link's pivot O and the barrel's pin A on the frame, the
         rod's pin B on the link (``R_B`` the force on the link), and the sliding pair of
@@ -814,8 +839,12 @@ class Chain:
             names += [f"{pr['key']}.x", f"{pr['key']}.y"]
             if pr["kind"] == "T":
                 names += [pr["n_name"], pr["m_name"]]
-        names.append(self.drive_output)
-        return names
+        return names + self.effort_names
+
+    @property
+    def effort_names(self) -> list:
+        """The names of the drivers' efforts, in the order of their unknowns."""
+        return [self.drive_output]
 
     @property
     def drive_output(self) -> str:
@@ -1047,10 +1076,14 @@ class Chain:
         return states, kin
 
     def _solve(self, t: np.ndarray, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> dict:
-        shape = q.shape
-        zero = np.zeros(shape, dtype=np.result_type(q, dq, ddq, float))
-        z2 = np.zeros(shape + (2,), dtype=zero.dtype)
         states, kin = self._driver(t, q, dq, ddq)
+        return self._completed(states, kin, q.shape, np.result_type(q, dq, ddq, float))
+
+    def _completed(self, states: dict, kin: dict, shape: tuple, dtype: np.dtype) -> dict:
+        """The kinematics from the driver's states on: the dyads, the centres of mass and
+        the loads (``kin`` completed and returned)."""
+        zero = np.zeros(shape, dtype=dtype)
+        z2 = np.zeros(shape + (2,), dtype=zero.dtype)
         for e in self.plan:
             sm, sn, E = self._dyad_states(e, states, shape, kin)
             states[e["m"]], states[e["n"]] = sm, sn
@@ -1272,9 +1305,10 @@ class Chain:
                 put(col, pr["first"], P, f, mu, 1.0)
                 put(col, pr["second"], P, f, mu, -1.0)
                 col += 1
-        for body, point, f, mu, sign in self._drive_actions(kin):
-            put(col, body, point, f, mu, sign)
-        col += 1
+        for actions in self._effort_actions(kin).values():
+            for body, point, f, mu, sign in actions:
+                put(col, body, point, f, mu, sign)
+            col += 1
         assert col == n_eq
         for b, bd in bodies.items():
             forces, moments = self._known(bd)
@@ -1301,7 +1335,9 @@ class Chain:
                 out[f"{pr['key']}.x"], out[f"{pr['key']}.y"] = N * j[:, 0], N * j[:, 1]
                 out[pr["n_name"]], out[pr["m_name"]] = N, M
             col += 2
-        out[self.drive_output] = x[:, col].copy()
+        for name in self.effort_names:
+            out[name] = x[:, col].copy()
+            col += 1
         return out
 
     def residuals(self, kin: dict, out: dict) -> np.ndarray:
@@ -1342,13 +1378,16 @@ class Chain:
                     balance.tangential,
                     np.maximum(np.abs(geo.dot(R, i)), np.abs(N - geo.dot(R, geo.rot90(i)))),
                 )
-        drive = np.asarray(out[self.drive_output], float)
-        for body, point, f, mu, sign in self._drive_actions(kin):
-            if self.driver == "crank":
-                balance.couple(body, sign * drive * mu)
-            else:
+        for name, actions in self._effort_actions(kin).items():
+            drive = np.asarray(out[name], float)
+            for body, point, f, mu, sign in actions:
                 balance.force(body, point, geo.col(sign * drive) * f)
+                balance.couple(body, sign * drive * mu)
         return balance.worst()
+
+    def _effort_actions(self, kin: dict) -> dict:
+        """Effort name -> what that effort does per unit (:meth:`_drive_actions`)."""
+        return {self.drive_output: self._drive_actions(kin)}
 
     def _drive_actions(self, kin: dict) -> list:
         """What the driver's effort does per unit, as (body, point, force, couple, sign):
