@@ -126,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
     kind = table.kind
     if args.cmake_info:
         types = sorted({d.type.lower() for d in scene.dyads})
-        if scene.crank and scene.crank.is_cylinder():
+        if any(d.is_cylinder() for d in scene.drivers):
             types.append("cylinder")  # its closed forms link as a type's do
         print(";".join([scene.identifier, kind.realisation] + types))
         return 0

@@ -192,12 +192,12 @@ def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad) -> list[str]:
     return out
 
 
-def _cylinder_part_lines(params: dict, target: str) -> list[str]:
-    """The barrel's and the rod's centres of mass (and with `target` "cin", where the
-    kinematics alone are wanted, nothing more; else their masses and inertias too)."""
+def _cylinder_part_lines(params: dict, target: str, motion_only: bool) -> list[str]:
+    """The barrel's and the rod's centres of mass (and where the kinematics alone are
+    wanted, `motion_only`, nothing more; else their masses and inertias too)."""
     out = []
     for part in ("barrel", "rod"):
-        keys = ("com",) if target == "cin" else ("mass", "com", "inertia")
+        keys = ("com",) if motion_only else ("mass", "com", "inertia")
         for key in keys:
             value = params.get(f"{part}.{key}")
             if value is not None and not value.is_zero():
@@ -206,11 +206,16 @@ def _cylinder_part_lines(params: dict, target: str) -> list[str]:
 
 
 def cylinder_input_lines(
-    scene: Scene, driver: Crank, target: str, rates: tuple[str, str], pivot: str
+    scene: Scene,
+    driver: Crank,
+    target: str,
+    rates: tuple[str, str],
+    pivot: str,
+    motion_only: bool = False,
 ) -> list[str]:
     """The assignments of a dyad_cylinder_input `target`: the frame pins (O's motion
     `pivot`), the pin B, the length and its `rates`, the branch and, for the kinematics
-    alone (`target` "cin"), the centres of mass, or for the forces every mass of the
+    alone (`motion_only`), the centres of mass, or for the forces every mass of the
     barrel and the rod (the link's resultant is the scene's, at O)."""
     params = driver.params
     branch = params["branch"]
@@ -228,9 +233,9 @@ def cylinder_input_lines(
         else f"{target}.branch = {int(branch.value)};",
         f"{target}.singular_threshold = {scene.threshold.c()};",
     ]
-    if "com.x" in params and target == "cin":
+    if "com.x" in params and motion_only:
         out.append(f"{target}.link.com = {_vec(params['com.x'].c(), params['com.y'].c())};")
-    return out + _cylinder_part_lines(params, target)
+    return out + _cylinder_part_lines(params, target, motion_only)
 
 
 def _cylinder_lines(scene: Scene, driver: Crank) -> list[str]:
@@ -240,7 +245,7 @@ def _cylinder_lines(scene: Scene, driver: Crank) -> list[str]:
     result = f"kin->{kin_name_of_cylinder(driver)}"
     cin = "cin" if len(scene.drivers) == 1 else f"cin_{member(driver.actuator)}"
     out = [f"const dyad_point_motion {c}_o = fixed_point({at});", f"dyad_cylinder_input {cin};"]
-    out += cylinder_input_lines(scene, driver, cin, rate_names(scene, driver), f"{c}_o")
+    out += cylinder_input_lines(scene, driver, cin, rate_names(scene, driver), f"{c}_o", True)
     failed = len(scene.dyads) + cylinders(scene).index(driver)
     out += [
         f"if (dyad_cylinder(&{cin}, &{result}) != DYAD_STATUS_OK) {{",

@@ -131,14 +131,13 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     return scene
 
 
-def _cylinder_as_crank(scene: Scene) -> None:
+def _cylinder_as_crank(scene: Scene, driver: Crank) -> None:
     """A cylinder's link as a crank whose motion is an input (the kinematics outside
     would give it), its dyads on the pin B where they sit on it without a point."""
-    driver = scene.crank
     pin = (driver.params["pin.x"], driver.params["pin.y"])
     for d in scene.dyads:
         for att in (d.k, d.p):
-            if att.kind == "crank" and att.at is None:
+            if att.kind == "crank" and att.link == driver.name and att.at is None:
                 att.at = pin
     length = math.hypot(pin[0].value, pin[1].value)
     driver.params = {
@@ -153,8 +152,9 @@ def inputs_with_external_kinematics(scene: Scene) -> list[str]:
     (kinematics = "external", every output of that kind): what the kinematics inside save
     its user from computing."""
     other = copy.deepcopy(scene)
-    if other.crank is not None and other.crank.is_cylinder():
-        _cylinder_as_crank(other)
+    for driver in other.drivers:
+        if driver.is_cylinder():
+            _cylinder_as_crank(other, driver)
     other.kinematics, other.computed, other.loaders = "external", {}, {}
     for d in other.dyads:
         d.internal = False
