@@ -1,8 +1,10 @@
 """The mpmath reference of a whole mechanism FMU (dyadfmu.reference.scene_mp).
 
 - every Real output of every mechanism FMU of modelDescription/scenes/ (built, run through
-  fmpy) against the reference at a few driver positions, both branches where a branch is tunable,
-  within 1e-12 of the largest output of its unit;
+  fmpy) against the reference at a few driver positions, both branches where a branch is
+  tunable,
+  within 1e-12 of the largest output of its unit; the scenes with several drivers (leg,
+  three_drivers) likewise, skipped while their FMUs are not built;
 - the lift bisected with the reference's own status to within 1e-15 m of the ram
   position where its lever dyad stops closing: there, 50 and 80 digits agree to 30;
 - the statuses: a dyad exactly at its dead point (singular), just inside it (ok, both
@@ -49,6 +51,13 @@ SCENES["lift_loads"] = SCENES["lift"]
 SCENES["tipper"] = (1.4, 3.0, 4.6)  # cylinder lengths (m) over its stroke
 SCENES["cylinder_arm"] = (0.4, 1.2, 2.0)
 SCENES["cylinder_boom"] = (0.95, 1.2, 1.45)
+#: scenes with several drivers: each driver's coordinate, in the scene's driver order
+#: (cranks, rams, cylinders), over their working ranges
+SCENES["leg"] = ((-1.05, -2.09), (-1.66, -1.48), (-0.44, -2.71))  # front, rear (rad)
+SCENES["three_drivers"] = ((0.5, 1.0, 1.95), (2.5, 0.65, 1.86), (4.0, 1.35, 2.01))  # wheel,
+# slide (m), jack (m)
+#: scenes whose FMUs the generator may not build yet: skipped while they are missing
+AWAITED = ("leg", "three_drivers")
 #: the scenes with a tunable branch
 BRANCHES = {
     "slider_crank": "engine.branch",
@@ -70,13 +79,19 @@ def scene_file(name):
 
 
 def inputs_at(scene, q):
-    """The FMU's inputs: the driver at q with RATES, every load at LOADS."""
+    """The FMU's inputs: the driver at q (several drivers: each at its entry of the tuple
+    q) with RATES, every load at LOADS."""
+    if isinstance(q, tuple):
+        coordinates = dict(zip((d.motion(True)[0] for d in scene.drivers), q, strict=True))
+    else:
+        coordinates = {scene.motion_inputs[0]: q}
+    drivers = {d.name for d in scene.drivers}
     values = {}
     for name in scene.inputs:
         head, _, tail = name.partition(".")
-        if name == scene.motion_inputs[0]:
-            values[name] = q
-        elif head == scene.driver_name:
+        if name in coordinates:
+            values[name] = coordinates[name]
+        elif head in drivers:
             values[name] = RATES[tail]
         else:
             values[name] = LOADS[tail]
@@ -124,6 +139,11 @@ def unit_errors(got, ref, units):
 def test_every_output_of_every_mechanism_fmu(name):
     """The FMU's every Real output (but its amplification) within 1e-12 of the largest
     reference output of its unit, status 0, at each position and branch."""
+    if name in AWAITED:
+        try:
+            paths.built_fmu(name, 2, None)
+        except FileNotFoundError as missing:
+            pytest.skip(f"{name}'s FMU is not built yet: {missing}")
     scene = scene_mp.read_scene(scene_file(name))
     branch = BRANCHES.get(name)
     params = [{branch: b} for b in (1.0, -1.0)] if branch else [{}]

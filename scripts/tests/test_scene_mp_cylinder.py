@@ -483,8 +483,11 @@ def _edit(path: str, value: object) -> dict:
     return data
 
 
+CRANK = {"length": 0.1, "inertia": 1.0, "com": [0.0, 0.0], "mass": 1.0}
 REFUSED = [
-    ("crank", {"length": 0.1}, r"\[crank\]/\[ram\]/\[cylinder\]: a mechanism FMU has exactly"),
+    ("crank", {"length": 0.1}, r"\[crank\]: missing 'inertia'"),
+    ("crank", {"name": "body", **CRANK}, r"\[cylinder\]: two drivers or links named 'body'"),
+    ("crank", {"name": "hoist", **CRANK}, r"\[cylinder\]: two drivers or links named 'hoist'"),
     ("cylinder.stroke", 3.5, r"\[cylinder\]: unknown key 'stroke'"),
     ("cylinder.branch", 0, r"\[cylinder\].branch: must be 1 or -1, not 0"),
     ("cylinder.branch", True, r"\[cylinder\].branch: must be 1 or -1"),

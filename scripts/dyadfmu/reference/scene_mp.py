@@ -1,20 +1,22 @@
 """Independent high-precision reference of a whole mechanism FMU (mpmath).
 
-From a scene file with internal kinematics (``modelDescription/scenes/*.toml`` with a
-``[crank]``, a ``[ram]`` or a ``[cylinder]``; schema in modelDescription/scenes/README.md)
-and the FMU's input values, :func:`evaluate` gives every Real output of the scene's
-mechanism FMU as an mpf at a chosen precision, and the status. It is built from the two
-independent references of this package and the cylinder's equations below, not from the
-C code or the generated code:
+From a scene file with internal kinematics (``modelDescription/scenes/*.toml`` with one
+or several drivers, ``[crank]``/``[[crank]]``, ``[ram]``/``[[ram]]``,
+``[cylinder]``/``[[cylinder]]``, each on the frame; schema in
+modelDescription/scenes/README.md) and the FMU's input values, :func:`evaluate` gives
+every Real output of the scene's mechanism FMU as an mpf at a chosen precision, and the
+status. It is built from the two independent references of this package and the
+cylinder's equations below, not from the C code or the generated code:
 
 * a cylinder's triangle: pin B on the circle of radius |pin| about the link's pivot O
   and on the circle of radius s about the barrel's pin A, on the branch's side of the
   directed line O -> A; the link's angle turns ``pin`` (B in the link's frame) onto
   B - O; the rates by implicit differentiation of the closure O + B(theta) - A - s u(psi)
   = 0 (two 2 x 2 linear solves, ``mpmath.lu_solve``);
-* kinematics, from the driver outwards: each dyad by :func:`.dyad_kinematics.solve`
-  (the closure solved by findroot, rates by implicit differentiation), its mounts being
-  points and guides of the driver or of the links of earlier dyads, moved as rigid
+* kinematics, from the drivers outwards: each driver's body from its own motion inputs,
+  then each dyad by :func:`.dyad_kinematics.solve` (the closure solved by findroot,
+  rates by implicit differentiation), its mounts being points and guides of any
+  driver's body or of the links of earlier dyads, moved as rigid
   bodies (v = v_D + w perp(r), a = a_D + e perp(r) - w^2 r) from that dyad's mpf
   results, never rounded to float;
 * kinetostatics, from the last dyad back: each dyad's Newton-Euler equations (the system
@@ -23,7 +25,7 @@ C code or the generated code:
   sliding pair's reactive moment too); each ``[[load]]`` of the scene as a force at its
   point of its link (the driver included) and a couple, its force global or turned by
   the link's angle (a follower force);
-* the driver's balance: a crank's torque about O and the frame's force R_O on it; a ram's
+* each driver's balance: a crank's torque about O and the frame's force R_O on it; a ram's
   actuator force along its guide i_r, the guide's normal force N along j_r and reactive
   moment M about R; a cylinder's three bodies, the barrel (pinned at A, its centre of
   mass at A + com u), the rod (pinned to the link at B, at B - com u; both turn with the
@@ -36,7 +38,16 @@ C code or the generated code:
   velocity and the angular velocity per unit driver rate, V', W' their derivatives in the
   driver's coordinate q: the kinematics evaluated again at unit driver rate and zero
   driver acceleration; torque0 = torque - J q'' (a ram's and a cylinder's force0
-  likewise; a cylinder's J counts the link, the barrel, the rod and every dyad link).
+  likewise; a cylinder's J counts the link, the barrel, the rod and every dyad link);
+* with inertia and N >= 2 drivers (no J, dJdq), by the same route as J: the inertia
+  matrix M.<a>.<b> = sum m V_a.V_b + I W_a W_b over every moving body (every driver's
+  body, a cylinder's barrel and rod, every dyad link), V_a and W_a per unit rate of driver
+  a, the kinematics evaluated once per driver at its unit rate, the other drivers' rates
+  and every acceleration zero (the kinetic energy is q'.M q' / 2; M is symmetric by
+  construction); each driver's torque0 / force0 (h_a) is its effort from the
+  kinetostatics run again with every driver's acceleration zero, velocities, gravity
+  and loads kept. The efforts are then M q'' + h, which the Newton-Euler balance
+  checks rather than assumes.
 
 A cylinder's link carries dyads and [[load]] tables as a crank does: a dyad names it
 ``{ link = "body", at = [x, y] }`` (a point of its frame {O; i, j}) or ``"body"`` alone,
@@ -54,12 +65,17 @@ Every input is taken as the exact binary value of its float; every number of the
 evaluated exactly. The arithmetic runs at ``dps + 20`` digits and the outputs are rounded
 to ``dps``.
 
+Several drivers: each has its own motion inputs and the outputs a single one of its kind
+has (but J and dJdq); dyads and [[load]] tables name any driver's body; ``"crank"`` alone
+names a scene's only crank. Driver order: cranks, rams, cylinders, each in file order.
+
 Units: m, s, rad, kg, N, N m. Driver coordinate q: the crank's angle (rad), the ram's
 position or the cylinder's length s (m); J in kg m2 (crank) or kg (ram, cylinder); dJdq
-in kg m2/rad or kg/m.
+in kg m2/rad or kg/m; M.<a>.<b> in kg m2 (angle-angle), kg m (angle-length) or kg
+(length-length).
 
 Status (:class:`Result`): ``"ok"``; ``"cannot assemble"`` (the first dyad, from the
-driver, whose closure has no real solution on its branch; or the cylinder, named by its
+drivers, whose closure has no real solution on its branch; or the cylinder, named by its
 name, whose triangle does not close: s <= 0 or outside [| |OA| - |OB| |, |OA| + |OB|]);
 ``"singular"`` (a dyad at a dead point: its closure's Jacobian vanishes to the working
 precision, which for the float inputs of an FMU means conditioning exactly 0, or TRT /
@@ -98,6 +114,7 @@ __all__ = [
     "OK",
     "SINGULAR",
     "Attachment",
+    "Driver",
     "DyadSpec",
     "MechanismScene",
     "Result",
@@ -167,20 +184,40 @@ class DyadSpec:
 
 
 @dataclass(frozen=True)
+class Driver:
+    """A driver: ``kind`` ``"crank"``, ``"ram"`` or ``"cylinder"``, ``name`` its name in the
+    FMU's variables, ``link`` the moving body dyads and [[load]] tables may name (the
+    crank, the ram, or the link a cylinder turns)."""
+
+    kind: str
+    name: str
+    link: str
+
+    @property
+    def effort(self) -> str:
+        """Its effort's output name: ``torque`` (N m) or ``force`` (N)."""
+        return "torque" if self.kind == "crank" else "force"
+
+    def motion(self, inertia: bool) -> tuple[str, ...]:
+        """Its coordinate, rate and acceleration inputs (the rates with inertia)."""
+        names = {"ram": _RAM_MOTION, "cylinder": _CYLINDER_MOTION}.get(self.kind, _CRANK_MOTION)
+        return tuple(f"{self.name}.{k}" for k in names[: 3 if inertia else 1])
+
+
+@dataclass(frozen=True)
 class MechanismScene:
     """A scene read for :func:`evaluate`.
 
-    ``driver`` is ``"crank"``, ``"ram"`` or ``"cylinder"``, ``driver_name`` its name in
-    the FMU's variables; ``driven`` the link a cylinder turns ("" for a crank or a ram);
-    ``inputs`` the FMU's inputs with their start values (the driver's motion: rad, rad/s,
+    ``drivers``: the scene's drivers, cranks, rams, cylinders, each kind in file order;
+    ``inputs`` the FMU's inputs with their start values (the drivers' motion: rad, rad/s,
     rad/s2 or m, m/s, m/s2; the loads: N, N m); ``parameters`` every parameter of the
     scene under the FMU's names (tunable or baked) with its value; ``translating``: the
-    links that slide on a frame guide (no angle output).
+    links that slide on a frame guide (no angle output). ``driver``, ``driver_name``,
+    ``driven`` and ``carrier`` describe a scene's only driver (SceneError with several).
     """
 
     label: str
-    driver: str
-    driver_name: str
+    drivers: tuple[Driver, ...]
     inertia: bool
     gravity: bool
     dyads: tuple[DyadSpec, ...]
@@ -191,19 +228,45 @@ class MechanismScene:
     parameters: dict[str, float]
     #: the [[load]] tables: (name, link, components, force?, moment?) each
     point_loads: tuple = ()
-    driven: str = ""
+
+    @property
+    def only_driver(self) -> Driver:
+        """The scene's only driver (SceneError when it has several)."""
+        if len(self.drivers) != 1:
+            names = ", ".join(d.name for d in self.drivers)
+            raise SceneError(f"{self.label}: {len(self.drivers)} drivers ({names}), not one")
+        return self.drivers[0]
+
+    @property
+    def driver(self) -> str:
+        """The only driver's kind: ``"crank"``, ``"ram"`` or ``"cylinder"``."""
+        return self.only_driver.kind
+
+    @property
+    def driver_name(self) -> str:
+        """The only driver's name."""
+        return self.only_driver.name
+
+    @property
+    def driven(self) -> str:
+        """The link the only driver, a cylinder, turns ("" for a crank or a ram)."""
+        d = self.only_driver
+        return d.link if d.kind == "cylinder" else ""
 
     @property
     def carrier(self) -> str:
-        """The moving body the first dyads and [[load]] tables may name: the crank, the
-        ram, or the link a cylinder turns."""
-        return self.driven or self.driver_name
+        """The moving body of the only driver that dyads and [[load]] tables may name."""
+        return self.only_driver.link
 
     @property
     def motion_inputs(self) -> tuple[str, ...]:
-        """The driver's coordinate, rate and acceleration inputs (the rates with inertia)."""
-        names = {"ram": _RAM_MOTION, "cylinder": _CYLINDER_MOTION}.get(self.driver, _CRANK_MOTION)
-        return tuple(f"{self.driver_name}.{k}" for k in names[: 3 if self.inertia else 1])
+        """Every driver's coordinate, rate and acceleration inputs (the rates with
+        inertia), driver after driver."""
+        return tuple(n for d in self.drivers for n in d.motion(self.inertia))
+
+    def driver_on(self, link: str) -> Driver | None:
+        """The driver whose moving body is ``link``, or None."""
+        return next((d for d in self.drivers if d.link == link), None)
 
     def split(self, values: Mapping[str, float]) -> tuple[dict, dict]:
         """(inputs, parameters): the start values and scene values with ``values`` over
@@ -284,34 +347,54 @@ class _Reader:
             self.param("gravity.y", self.number(g, "y", "[gravity]"))
         return inertia, gravity
 
-    def driver(self, needs_mass: bool, inertia: bool) -> tuple[str, str, str]:
-        """(kind, name, the link a cylinder turns or ""), the driver's parameters and
-        motion inputs recorded."""
-        kinds = [k for k in _DRIVERS if k in self.data]
-        if len(kinds) != 1:
-            self.fail("[crank]/[ram]/[cylinder]", "a mechanism FMU has exactly one driver")
-        kind = kinds[0]
+    def entries(self, kind: str) -> list[dict]:
+        """A driver kind's tables: ``[kind]`` (one) or ``[[kind]]`` (an array of them)."""
+        value = self.data.get(kind)
+        if value is None:
+            return []
+        rows = [value] if isinstance(value, Mapping) else value
+        if not isinstance(rows, list) or not all(isinstance(r, Mapping) for r in rows):
+            self.fail(f"[{kind}]", "must be a table or an array of tables")
+        return [dict(r) for r in rows]
+
+    def drivers(self, needs_mass: bool, inertia: bool) -> list[Driver]:
+        """Every driver, cranks, rams, cylinders, each kind in file order, its parameters
+        and motion inputs recorded; names (a cylinder's and its link's) unique."""
+        found = []
+        for kind in _DRIVERS:
+            rows = self.entries(kind)
+            for index, t in enumerate(rows):
+                where = f"[{kind}]" if len(rows) == 1 else f"[[{kind}]] #{index + 1}"
+                found.append(self.driver(kind, t, where, (needs_mass, inertia)))
+        if not found:
+            self.fail("[crank]/[ram]/[cylinder]", "a mechanism FMU has at least one driver")
+        names = [d.name for d in found] + [d.link for d in found if d.kind == "cylinder"]
+        for name in names:
+            if names.count(name) > 1:
+                self.fail("[crank]/[ram]/[cylinder]", f"two drivers or links named {name!r}")
+        return found
+
+    def driver(self, kind: str, t: dict, where: str, needs: tuple) -> Driver:
+        """One driver of ``kind`` from its table ``t``."""
+        needs_mass, inertia = needs
         if kind == "cylinder":
-            name, link = _cylinder(self, needs_mass, inertia)
-            for key in _CYLINDER_MOTION[: 3 if inertia else 1]:
-                self.inputs[f"{name}.{key}"] = 0.0
-            return kind, name, link
-        t = self.table(kind, required=True)
-        name = str(t.get("name", kind))
-        where = f"[{kind}]"
-        self.param_pair(f"{name}.at", self.pair(t, "at", where, (0.0, 0.0)))
-        if kind == "crank":
-            self.param(f"{name}.length", self.number(t, "length", where))
-            self.param(f"{name}.inertia", self.number(t, "inertia", where) if inertia else 0.0)
+            name, link = _cylinder(self, t, where, needs)
+            driver = Driver(kind, name, link)
         else:
-            self.param(f"{name}.guide", self.number(t, "guide", where))
-        com = self.pair(t, "com", where) if needs_mass else (0.0, 0.0)
-        self.param_pair(f"{name}.com", com)
-        self.param(f"{name}.mass", self.number(t, "mass", where) if needs_mass else 0.0)
-        motion = _RAM_MOTION if kind == "ram" else _CRANK_MOTION
-        for key in motion[: 3 if inertia else 1]:
-            self.inputs[f"{name}.{key}"] = 0.0
-        return kind, name, ""
+            name = str(t.get("name", kind))
+            driver = Driver(kind, name, name)
+            self.param_pair(f"{name}.at", self.pair(t, "at", where, (0.0, 0.0)))
+            if kind == "crank":
+                self.param(f"{name}.length", self.number(t, "length", where))
+                self.param(f"{name}.inertia", self.number(t, "inertia", where) if inertia else 0.0)
+            else:
+                self.param(f"{name}.guide", self.number(t, "guide", where))
+            com = self.pair(t, "com", where) if needs_mass else (0.0, 0.0)
+            self.param_pair(f"{name}.com", com)
+            self.param(f"{name}.mass", self.number(t, "mass", where) if needs_mass else 0.0)
+        for key in driver.motion(inertia):
+            self.inputs[key] = 0.0
+        return driver
 
     def links(self, needs_mass: bool, inertia: bool) -> dict[str, dict]:
         rows = self.data.get("link", [])
@@ -335,10 +418,9 @@ _CYLINDER_KEYS = frozenset(
 )
 
 
-def _cylinder(rd: _Reader, needs_mass: bool, inertia: bool) -> tuple[str, str]:
+def _cylinder(rd: _Reader, t: dict, where: str, needs: tuple) -> tuple[str, str]:
     """(the cylinder's name, the link it turns): a [cylinder]'s geometry, the link's mass
     and the barrel's and the rod's, as parameters under the FMU's names."""
-    t, where = rd.table("cylinder", required=True), "[cylinder]"
     unknown = sorted(set(t) - _CYLINDER_KEYS)
     if unknown:
         rd.fail(where, f"unknown key {unknown[0]!r} (keys: {', '.join(sorted(_CYLINDER_KEYS))})")
@@ -360,15 +442,15 @@ def _cylinder(rd: _Reader, needs_mass: bool, inertia: bool) -> tuple[str, str]:
     if branch not in (1, -1) or isinstance(branch, bool):
         rd.fail(f"{where}.branch", f"must be 1 or -1, not {branch!r}")
     rd.param(f"{name}.branch", float(branch))
-    _cylinder_masses(rd, t, name, link, (needs_mass, inertia))
+    _cylinder_masses(rd, t, (name, link, where), needs)
     return name, link
 
 
-def _cylinder_masses(rd: _Reader, t: dict, name: str, link: str, needs: tuple) -> None:
+def _cylinder_masses(rd: _Reader, t: dict, names: tuple, needs: tuple) -> None:
     """The link's centre of mass, mass and inertia and the barrel's and the rod's (zero
     where the scene has no inertia or gravity, or no barrel or rod)."""
     needs_mass, inertia = needs
-    where = "[cylinder]"
+    name, link, where = names
     rd.param_pair(f"{link}.com", rd.pair(t, "com", where) if needs_mass else (0.0, 0.0))
     rd.param(f"{link}.mass", rd.number(t, "mass", where) if needs_mass else 0.0)
     rd.param(f"{link}.inertia", rd.number(t, "inertia", where) if inertia else 0.0)
@@ -393,11 +475,11 @@ def _attachment(rd: _Reader, spec: object, side: str, dyad: str, ctx: dict) -> A
     if not isinstance(spec, Mapping) or not isinstance(spec.get("link"), str):
         rd.fail(where, "expected 'frame', the driver's name or { link = ..., at = [x, y] }")
     body = spec["link"]
-    if body == "crank" and ctx["driver"] == "crank":
-        body = ctx["driver_name"]
-    if ctx["driver"] == "cylinder" and body == ctx["driver_name"]:
-        rd.fail(where, f"a dyad hangs on the link the cylinder turns, {ctx['carrier']!r}")
-    if body != "frame" and body != ctx["carrier"] and body not in ctx["done"]:
+    if body == "crank" and ctx["crank"]:
+        body = ctx["crank"]
+    if body in ctx["cylinders"]:
+        rd.fail(where, f"a dyad hangs on the link the cylinder turns, {ctx['cylinders'][body]!r}")
+    if body != "frame" and body not in ctx["carriers"] and body not in ctx["done"]:
         rd.fail(where, f"{body!r} is not the frame, the driver nor a link of an earlier dyad")
     pair = "D_m" if side == "k" else "D_n"
     if slides:
@@ -437,14 +519,16 @@ def _link_geometry(rd: _Reader, d: DyadSpec, links: dict, translating: set) -> N
             rd.param(f"{g}.turn", rd.number(row, "turn", where, 0.0))
 
 
-def _dyads(rd: _Reader, links: dict, kind: str, names: tuple) -> tuple[list, set]:
+def _dyads(rd: _Reader, links: dict, drivers: list[Driver]) -> tuple[list, set]:
     rows = rd.data.get("dyad", [])
+    cylinders = {d.name: d.link for d in drivers if d.kind == "cylinder"}
     # a cylinder and the link it turns are a mechanism of their own
-    if not isinstance(rows, list) or not (rows or kind == "cylinder"):
+    if not isinstance(rows, list) or not (rows or cylinders):
         rd.fail("[[dyad]]", "a scene has at least one dyad (or a [cylinder])")
-    name, driven = names
-    ctx = {"driver": kind, "driver_name": name, "carrier": driven or name}
-    ctx.update(done=set(), type="")
+    cranks = [d.name for d in drivers if d.kind == "crank"]
+    # "crank" names a scene's only crank, whatever its name
+    ctx = {"crank": cranks[0] if len(cranks) == 1 else None, "cylinders": cylinders}
+    ctx.update(carriers={d.link for d in drivers}, done=set(), type="")
     dyads, translating = [], set()
     for row in rows:
         dname = str(row.get("name", "")) if isinstance(row, Mapping) else ""
@@ -483,7 +567,7 @@ def _loads(rd: _Reader, links: dict) -> tuple[tuple, tuple]:
     return out[0], out[1]
 
 
-def _point_loads(rd: _Reader, links: dict, driver: str) -> tuple:
+def _point_loads(rd: _Reader, links: dict, carriers: set) -> tuple:
     """The [[load]] tables: each load's inputs (N, N m) and its point (m, the link's frame;
     default the link's centre of mass) as parameters NAME.at.x, NAME.at.y."""
     rows = rd.data.get("load", [])
@@ -493,7 +577,7 @@ def _point_loads(rd: _Reader, links: dict, driver: str) -> tuple:
     for row in rows:
         name, link = row.get("name"), row.get("link")
         where = f"load {name!r}"
-        if not isinstance(name, str) or (link not in links and link != driver):
+        if not isinstance(name, str) or (link not in links and link not in carriers):
             rd.fail(where, "needs a name and the link it acts on (a dyad's link or the driver)")
         com = (rd.params[f"{link}.com.x"], rd.params[f"{link}.com.y"])
         rd.param_pair(f"{name}.at", rd.pair(row, "at", where, com))
@@ -518,22 +602,21 @@ def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
             raise SceneError(f"{label}: cannot read the scene: {exc}") from None
     rd = _Reader(data, label)
     inertia, gravity = rd.effects()
-    kind, name, driven = rd.driver(inertia or gravity, inertia)
+    drivers = rd.drivers(inertia or gravity, inertia)
     links = rd.links(inertia or gravity, inertia)
-    for taken in (name, driven):
+    for taken in [d.name for d in drivers] + [d.link for d in drivers]:
         if taken in links:
             rd.fail(f"link '{taken}'", "a [[link]] named like the driver or the link it turns")
-    dyads, translating = _dyads(rd, links, kind, (name, driven))
+    dyads, translating = _dyads(rd, links, drivers)
     forces, moments = _loads(rd, links)
-    placed = _point_loads(rd, links, driven or name)
+    placed = _point_loads(rd, links, {d.link for d in drivers})
     start = rd.table("start")
     for key, value in start.items():
         if key in rd.inputs:
             rd.inputs[key] = _finite(value, f"[start].{key}", label)
     return MechanismScene(
         label=label,
-        driver=kind,
-        driver_name=name,
+        drivers=tuple(drivers),
         inertia=inertia,
         gravity=gravity,
         dyads=tuple(dyads),
@@ -543,7 +626,6 @@ def read_scene(scene: Mapping | str | os.PathLike) -> MechanismScene:
         inputs=dict(rd.inputs),
         parameters=dict(rd.params),
         point_loads=placed,
-        driven=driven,
     )
 
 
@@ -653,7 +735,7 @@ class _Chain:
     bodies: dict
     results: dict
     guides: dict
-    axis: _Axis | None = None  # a cylinder's
+    axes: dict  # each cylinder's _Axis, by the cylinder's name
 
 
 class _Failure(Exception):
@@ -675,27 +757,28 @@ class _Evaluation:
         return (self.par[f"{name}.x"], self.par[f"{name}.y"])
 
     # ---- kinematics ---------------------------------------------------------------------
-    def driver_body(self, q: mpf, rate: mpf, accel: mpf) -> tuple[_Body, _Axis | None]:
-        """The body the first dyads hang on (the crank, the ram or the link a cylinder
-        turns) with the driver at coordinate q moving at ``rate`` with ``accel``, and a
-        cylinder's axis (None for a crank or a ram)."""
-        if self.s.driver == "cylinder":
-            return self.cylinder(q, rate, accel)
-        c = self.s.driver_name
+    def driver_body(self, drv: Driver, motion: tuple) -> tuple[_Body, _Axis | None]:
+        """The body dyads hang on (the crank, the ram or the link a cylinder turns) with
+        driver ``drv`` at coordinate q moving at rate q' with q'' (``motion`` = (q, q',
+        q'')), and a cylinder's axis (None for a crank or a ram)."""
+        q, rate, accel = motion
+        if drv.kind == "cylinder":
+            return self.cylinder(drv, q, rate, accel)
+        c = drv.name
         at = self.vec(f"{c}.at")
         zero = mpf(0)
-        if self.s.driver == "crank":
+        if drv.kind == "crank":
             i = (mpmath.cos(q), mpmath.sin(q))
             return _Body(at, (zero, zero), (zero, zero), i, rate, accel), None
         i = (mpmath.cos(self.par[f"{c}.guide"]), mpmath.sin(self.par[f"{c}.guide"]))
         body = _Body(_add(at, _scale(q, i)), _scale(rate, i), _scale(accel, i), i, zero, zero)
         return body, None
 
-    def triangle(self, s: mpf) -> tuple[Vec, Vec, mpf]:
+    def triangle(self, drv: Driver, s: mpf) -> tuple[Vec, Vec, mpf]:
         """(A - O, B - O, |sin| of the angle between OB and AB) of the cylinder at length s:
         B on the circle of radius |pin| about O and of radius s about A, on the branch's
         side of the directed line O -> A; _Failure where they do not meet or touch."""
-        c, g = self.s.driver_name, self.s.driven
+        c, g = drv.name, drv.link
         pin, o, a = self.vec(f"{c}.pin"), self.vec(f"{g}.at"), self.vec(f"{c}.base")
         with mpmath.extraprec(mpmath.mp.prec + 64):  # exact on the inputs' digits: 0 is 0
             d = (a[0] - o[0], a[1] - o[1])
@@ -717,13 +800,13 @@ class _Evaluation:
             raise _Failure(SINGULAR, c, "O, A and B are in line (the toggle)")
         return d, b, sine
 
-    def cylinder(self, s: mpf, rate: mpf, accel: mpf) -> tuple[_Body, _Axis]:
+    def cylinder(self, drv: Driver, s: mpf, rate: mpf, accel: mpf) -> tuple[_Body, _Axis]:
         """The link a cylinder turns and the cylinder's axis at length s, s', s'': the
         closure O + B(theta) - A - s u(psi) = 0 differentiated once and twice in time,
         J (omega, psi')' = s' u and J (epsilon, psi'')' = s'' u + 2 s' psi' perp(u)
         - s psi'^2 u + omega^2 (B - O), J = [perp(B - O), -s perp(u)]."""
-        c, g = self.s.driver_name, self.s.driven
-        d, b, sine = self.triangle(s)
+        c, g = drv.name, drv.link
+        d, b, sine = self.triangle(drv, s)
         pin = self.vec(f"{c}.pin")
         rr = _dot(pin, pin)
         u = ((b[0] - d[0]) / s, (b[1] - d[1]) / s)
@@ -744,13 +827,13 @@ class _Evaluation:
         if att.body is None:  # the frame: a fixed pivot, or a point of a fixed guide
             angle = self.par[att.guide] if att.guide else mpf(0)
             return dk.Mount(self.vec(att.at), direction=angle)
-        body = bodies[att.body]
+        body, drv = bodies[att.body], self.s.driver_on(att.body)
         if att.at is not None:
             local = self.vec(att.at)
-        elif att.body == self.s.driver_name and self.s.driver == "crank":
+        elif drv.kind == "crank":
             local = (self.par[f"{att.body}.length"], mpf(0))  # the crank's pin A
-        elif att.body == self.s.driven:
-            local = self.vec(f"{self.s.driver_name}.pin")  # the cylinder's pin B
+        elif drv.kind == "cylinder":
+            local = self.vec(f"{drv.name}.pin")  # the cylinder's pin B
         else:
             local = (mpf(0), mpf(0))  # the ram's R
         pos, vel, acc = body.point(local)
@@ -783,11 +866,15 @@ class _Evaluation:
             branch=branch,
         )
 
-    def kinematics(self, q: mpf, rate: mpf, accel: mpf) -> _Chain:
-        """The chain's motion, from the driver outwards; _Failure where a dyad does not
-        close."""
-        body, axis = self.driver_body(q, rate, accel)
-        chain = _Chain({self.s.carrier: body}, {}, {}, axis)
+    def kinematics(self, motions: list[tuple]) -> _Chain:
+        """The chain's motion, from the drivers outwards, each driver at its (q, q', q'')
+        of ``motions``; _Failure where a cylinder or a dyad does not close."""
+        chain = _Chain({}, {}, {}, {})
+        for drv, motion in zip(self.s.drivers, motions, strict=True):
+            body, axis = self.driver_body(drv, motion)
+            chain.bodies[drv.link] = body
+            if axis is not None:
+                chain.axes[drv.name] = axis
         for d in self.s.dyads:
             inputs = self.dyad_inputs(d, chain.bodies)
             if _parallel(inputs):
@@ -812,63 +899,98 @@ class _Evaluation:
                 )
         return chain
 
-    def motion(self) -> tuple[mpf, mpf, mpf]:
-        """The driver's coordinate, rate and acceleration inputs (rates 0 without inertia)."""
-        names = self.s.motion_inputs
-        values = [self.inp[n] for n in names] + [mpf(0)] * (3 - len(names))
-        return values[0], values[1], values[2]
+    def motion(self) -> list[tuple[mpf, mpf, mpf]]:
+        """Each driver's coordinate, rate and acceleration inputs (rates 0 without inertia)."""
+        motions = []
+        for drv in self.s.drivers:
+            names = drv.motion(self.s.inertia)
+            values = [self.inp[n] for n in names] + [mpf(0)] * (3 - len(names))
+            motions.append((values[0], values[1], values[2]))
+        return motions
 
-    def effective_inertia(self, unit: _Chain) -> tuple[mpf, mpf]:
-        """(J, dJ/dq) from the chain moved at unit driver rate and zero driver acceleration,
-        where a centre of mass's velocity and acceleration are V and V' and a body's omega
-        and epsilon W and W'."""
-        c = self.s.carrier
-        _, v, a = unit.bodies[c].point(self.vec(f"{c}.com"))
-        inertia = self.par.get(f"{c}.inertia", mpf(0))
-        w = unit.bodies[c].omega
-        terms = [(self.par[f"{c}.mass"], inertia, v, a, w, unit.bodies[c].epsilon)]
-        axis, h = unit.axis, self.s.driver_name
-        for part, on_rod in (("barrel", False), ("rod", True)) if axis else ():
-            com = self.par[f"{h}.{part}.com"]
-            _, v, a = axis.point(axis.length - com if on_rod else com, on_rod)
-            mass, inertia = self.par[f"{h}.{part}.mass"], self.par[f"{h}.{part}.inertia"]
-            terms.append((mass, inertia, v, a, axis.omega, axis.epsilon))
+    def mass_terms(self, unit: _Chain) -> list[tuple]:
+        """(m, I, V, V', W, W') of every moving body from a chain moved at a unit rate of
+        one driver, zero rates of the others and zero accelerations: V and V' its centre
+        of mass's velocity and acceleration, W and W' its omega and epsilon."""
+        terms = []
+        for drv in self.s.drivers:
+            c, body = drv.link, unit.bodies[drv.link]
+            _, v, a = body.point(self.vec(f"{c}.com"))
+            inertia = self.par.get(f"{c}.inertia", mpf(0))
+            terms.append((self.par[f"{c}.mass"], inertia, v, a, body.omega, body.epsilon))
+            axis, h = unit.axes.get(drv.name), drv.name
+            for part, on_rod in (("barrel", False), ("rod", True)) if axis else ():
+                com = self.par[f"{h}.{part}.com"]
+                _, v, a = axis.point(axis.length - com if on_rod else com, on_rod)
+                mass, inertia = self.par[f"{h}.{part}.mass"], self.par[f"{h}.{part}.inertia"]
+                terms.append((mass, inertia, v, a, axis.omega, axis.epsilon))
         for d in self.s.dyads:
             r = unit.results[d.name]
             for g, tag in ((d.m, "m"), (d.n, "n")):
                 v, a = r[f"{tag}.s.velocity"], r[f"{tag}.s.acceleration"]
                 w, e = r[f"omega_{tag}"], r[f"epsilon_{tag}"]
                 terms.append((self.par[f"{g}.mass"], self.par[f"{g}.inertia"], v, a, w, e))
+        return terms
+
+    def effective_inertia(self, unit: _Chain) -> tuple[mpf, mpf]:
+        """(J, dJ/dq) of a scene's only driver from the chain moved at unit driver rate
+        and zero driver acceleration (:meth:`mass_terms`)."""
+        terms = self.mass_terms(unit)
         j = sum((m * _dot(v, v) + i * w * w for m, i, v, _, w, _ in terms), mpf(0))
         dj = 2 * sum((m * _dot(v, a) + i * w * e for m, i, v, a, w, e in terms), mpf(0))
         return j, dj
 
+    def inertia_matrix(self, motions: list[tuple]) -> dict[str, mpf]:
+        """M.<a>.<b> = sum m V_a.V_b + I W_a W_b over every moving body, V_a and W_a its
+        centre of mass's velocity and its angular velocity per unit rate of driver a
+        (the kinetic energy is q'.M q' / 2)."""
+        per_driver = []
+        for a in range(len(self.s.drivers)):
+            unit = [(q, mpf(1 if b == a else 0), mpf(0)) for b, (q, _, _) in enumerate(motions)]
+            per_driver.append(self.mass_terms(self.kinematics(unit)))
+        out = {}
+        for da, ta in zip(self.s.drivers, per_driver, strict=True):
+            for db, tb in zip(self.s.drivers, per_driver, strict=True):
+                pairs = zip(ta, tb, strict=True)
+                terms = (x[0] * _dot(x[2], y[2]) + x[1] * x[4] * y[4] for x, y in pairs)
+                out[f"M.{da.name}.{db.name}"] = sum(terms, mpf(0))
+        return out
+
     def outputs(self) -> dict[str, mpf]:
         """Every output, in the FMU's order; _Failure where a dyad does not close."""
-        q, rate, accel = self.motion()
-        chain = self.kinematics(q, rate, accel)
+        motions = self.motion()
+        chain = self.kinematics(motions)
         reactions = _Kinetostatics(self, chain).run()
         out = {}
         for d in self.s.dyads:
             out.update(_motion_outputs(self.s, d, chain.results[d.name]))
             out.update(reactions[d.name])
             out[f"{d.prefix}conditioning"] = _conditioning(d, chain.results[d.name], chain)
-        c = self.s.driver_name
-        if chain.axis is not None:
-            out.update(self.cylinder_outputs(chain))
+        for drv in self.s.drivers:
+            if drv.kind == "cylinder":
+                out.update(self.cylinder_outputs(drv, chain))
         out.update(reactions[None])
-        if self.s.inertia:
-            j, dj = self.effective_inertia(self.kinematics(q, mpf(1), mpf(0)))
-            effort = "torque" if self.s.driver == "crank" else "force"
-            out[f"{c}.J"], out[f"{c}.dJdq"] = j, dj
-            out[f"{c}.{effort}0"] = out[f"{c}.{effort}"] - j * accel
+        if not self.s.inertia:
+            return out
+        if len(self.s.drivers) == 1:
+            drv, (q, _, accel) = self.s.drivers[0], motions[0]
+            j, dj = self.effective_inertia(self.kinematics([(q, mpf(1), mpf(0))]))
+            out[f"{drv.name}.J"], out[f"{drv.name}.dJdq"] = j, dj
+            out[f"{drv.name}.{drv.effort}0"] = out[f"{drv.name}.{drv.effort}"] - j * accel
+            return out
+        out.update(self.inertia_matrix(motions))
+        # h: the balance again with every driver's acceleration zero
+        still = [(q, rate, mpf(0)) for q, rate, _ in motions]
+        balance = _Kinetostatics(self, self.kinematics(still)).run()[None]
+        for drv in self.s.drivers:
+            out[f"{drv.name}.{drv.effort}0"] = balance[f"{drv.name}.{drv.effort}"]
         return out
 
-    def cylinder_outputs(self, chain: _Chain) -> dict[str, mpf]:
+    def cylinder_outputs(self, drv: Driver, chain: _Chain) -> dict[str, mpf]:
         """The link's and the cylinder's angles (rad) and, with inertia, their rates (rad/s,
         rad/s2); pin B (m); the triangle's conditioning."""
-        c, g = self.s.driver_name, self.s.driven
-        body, axis = chain.bodies[g], chain.axis
+        c, g = drv.name, drv.link
+        body, axis = chain.bodies[g], chain.axes[c]
         out = {}
         for name, i, w, e in (
             (g, body.i, body.omega, body.epsilon),
@@ -919,7 +1041,7 @@ class _Kinetostatics:
 
     def __init__(self, ev: _Evaluation, chain: _Chain) -> None:
         self.ev, self.bodies, self.results = ev, chain.bodies, chain.results
-        self.guides, self.axis = chain.guides, chain.axis
+        self.guides, self.axes = chain.guides, chain.axes
         self.loads = _Loads()
         self.out: dict[str | None, dict[str, mpf]] = {}  # by dyad name; None: the driver
 
@@ -978,13 +1100,13 @@ class _Kinetostatics:
         self.loads.add(d.k.body, r["m.d.position"], minus(rx["r_mk"]), -rx["m_mk"])
         self.loads.add(d.p.body, r["n.d.position"], minus(rx["r_np"]), -rx["m_np"])
 
-    def driver(self) -> None:
-        """The driver's balance: a crank's torque and R_O, a ram's force, N and M."""
+    def driver(self, drv: Driver) -> None:
+        """A driver's balance: a crank's torque and R_O, a ram's force, N and M."""
         ev = self.ev
-        if ev.s.driver == "cylinder":
-            self.cylinder()
+        if drv.kind == "cylinder":
+            self.cylinder(drv)
             return
-        c, body = ev.s.driver_name, self.bodies[ev.s.driver_name]
+        c, body = drv.name, self.bodies[drv.name]
         mass = ev.par[f"{c}.mass"]
         arm = body.arm(ev.vec(f"{c}.com"))
         _, _, a_s = body.point(ev.vec(f"{c}.com"))
@@ -995,7 +1117,7 @@ class _Kinetostatics:
         force = _add(force, known)
         moment += _cross(arm, known)
         out = self.out.setdefault(None, {})
-        if ev.s.driver == "crank":
+        if drv.kind == "crank":
             if ev.s.inertia:
                 moment -= ev.par[f"{c}.inertia"] * body.epsilon
             out[f"{c}.torque"] = -moment
@@ -1005,12 +1127,12 @@ class _Kinetostatics:
         out[f"{c}.N"] = -_dot(force, _perp(body.i))
         out[f"{c}.M"] = -moment
 
-    def cylinder(self) -> None:
+    def cylinder(self, drv: Driver) -> None:
         """The balance of the barrel (pinned at A, moments about A), the rod (pinned to the
         link at B, moments about B) and the link (about O, moments about O): 9 equations
         in x = (R_A, R_B, R_O, the axial force, N, M), solved by mpmath.lu_solve."""
-        ev, axis = self.ev, self.axis
-        h, g = ev.s.driver_name, ev.s.driven
+        axis = self.axes[drv.name]
+        h, g = drv.name, drv.link
         link, zero = self.bodies[g], mpf(0)
         u, n = axis.u, _perp(axis.u)
         a_pin, b_pin, o_pin = axis.base, axis.point(axis.length, True)[0], link.position
@@ -1024,8 +1146,8 @@ class _Kinetostatics:
         rod += [(7, n, b_pin, 0), (8, none, b_pin, 1)]
         body = [(2, ex, b_pin, 0), (3, ey, b_pin, 0), (4, ex, o_pin, 0), (5, ey, o_pin, 0)]
         parts = [
-            (a_pin, barrel, self.part_known(f"{h}.barrel", a_pin, False)),
-            (b_pin, rod, self.part_known(f"{h}.rod", b_pin, True)),
+            (a_pin, barrel, self.part_known(axis, f"{h}.barrel", a_pin, False)),
+            (b_pin, rod, self.part_known(axis, f"{h}.rod", b_pin, True)),
             (o_pin, body, self.link_known(g)),
         ]
         rows, rhs = [], []
@@ -1042,10 +1164,10 @@ class _Kinetostatics:
         for name, k in ((f"{h}.R_A", 0), (f"{h}.R_B", 2), (f"{g}.R_O", 4)):
             out[f"{name}.x"], out[f"{name}.y"] = x[k], x[k + 1]
 
-    def part_known(self, prefix: str, centre: Vec, on_rod: bool) -> tuple[tuple, mpf]:
+    def part_known(self, axis: _Axis, prefix: str, centre: Vec, on_rod: bool) -> tuple:
         """The barrel's or the rod's weight and d'Alembert force and moment: (force, moment
         about ``centre``)."""
-        ev, axis = self.ev, self.axis
+        ev = self.ev
         mass, com = ev.par[f"{prefix}.mass"], ev.par[f"{prefix}.com"]
         point, _, acc = axis.point(axis.length - com if on_rod else com, on_rod)
         return self.known(mass, ev.par[f"{prefix}.inertia"], point, acc, axis.epsilon, centre)
@@ -1086,11 +1208,12 @@ class _Kinetostatics:
             self.loads.add(link, point, force, couple)
 
     def run(self) -> dict:
-        """The outputs: by dyad name, the driver's under None."""
+        """The outputs: by dyad name, the drivers' under None."""
         self.place()
         for d in reversed(self.ev.s.dyads):
             self.dyad(d)
-        self.driver()
+        for drv in self.ev.s.drivers:
+            self.driver(drv)
         return self.out
 
 
@@ -1152,7 +1275,7 @@ def _run(
         ev = _Evaluation(ms, inputs, params, work)
         try:
             if what == "status":
-                ev.kinematics(ev.motion()[0], mpf(0), mpf(0))
+                ev.kinematics([(q, mpf(0), mpf(0)) for q, _, _ in ev.motion()])
                 outputs = {}
             else:
                 outputs = ev.outputs()
