@@ -2,7 +2,8 @@
 
 From a scene file with internal kinematics (``modelDescription/scenes/*.toml`` with one
 or several drivers, ``[crank]``/``[[crank]]``, ``[ram]``/``[[ram]]``,
-``[cylinder]``/``[[cylinder]]``, each on the frame; schema in
+``[cylinder]``/``[[cylinder]]``, cranks and rams on the frame, a cylinder's pivot O and
+barrel's pin A each on the frame or on the link of an earlier driver; schema in
 modelDescription/scenes/README.md) and the FMU's input values, :func:`evaluate` gives
 every Real output of the scene's mechanism FMU as an mpf at a chosen precision, and the
 status. It is built from the two independent references of this package and the
@@ -12,7 +13,8 @@ cylinder's equations below, not from the C code or the generated code:
   and on the circle of radius s about the barrel's pin A, on the branch's side of the
   directed line O -> A; the link's angle turns ``pin`` (B in the link's frame) onto
   B - O; the rates by implicit differentiation of the closure O + B(theta) - A - s u(psi)
-  = 0 (two 2 x 2 linear solves, ``mpmath.lu_solve``);
+  = 0 (two 2 x 2 linear solves, ``mpmath.lu_solve``), O and A moving with their
+  carriers (the frame, or an earlier driver's link, whose motion is solved first);
 * kinematics, from the drivers outwards: each driver's body from its own motion inputs,
   then each dyad by :func:`.dyad_kinematics.solve` (the closure solved by findroot,
   rates by implicit differentiation), its mounts being points and guides of any
@@ -32,7 +34,8 @@ cylinder's equations below, not from the C code or the generated code:
   axis u, the rod slides along it) and the link (about O), each with its weight and
   d'Alembert force and couple, the link with its [[load]] tables and the reactions of the
   dyads on it: 9 equations in R_A, R_B, R_O, the axial force, N and M, solved by
-  ``mpmath.lu_solve``;
+  ``mpmath.lu_solve``; the drivers from the last back, so that a carrier (an earlier
+  driver's link) bears minus R_A at A and minus R_O at O of each cylinder it carries;
 * with inertia, the effective inertia J = sum m V.V + I W^2 over every moving body (the
   driver included) and dJ/dq = 2 sum (m V.V' + I W W'), V, W the centre of mass's
   velocity and the angular velocity per unit driver rate, V', W' their derivatives in the
@@ -68,6 +71,12 @@ to ``dps``.
 Several drivers: each has its own motion inputs and the outputs a single one of its kind
 has (but J and dJdq); dyads and [[load]] tables name any driver's body; ``"crank"`` alone
 names a scene's only crank. Driver order: cranks, rams, cylinders, each in file order.
+A cylinder's ``at`` (O) or ``base`` (A) given as ``{ link = "boom", at = [x, y] }`` is a
+point of the link of an earlier driver (in that link's frame; parameters ``body.at.x``,
+``hoist.base.x`` ... as on the frame); its link's angle and omega and the axis's stay
+absolute (global); ``hoist.R_A`` is the force on the barrel from A's carrier and
+``body.R_O`` the force on the link from O's carrier. Refused (SceneError): a carrier
+that is neither the frame nor an earlier driver's link, or the link the cylinder turns.
 
 Units: m, s, rad, kg, N, N m. Driver coordinate q: the crank's angle (rad), the ram's
 position or the cylinder's length s (m); J in kg m2 (crank) or kg (ram, cylinder); dJdq
@@ -187,11 +196,15 @@ class DyadSpec:
 class Driver:
     """A driver: ``kind`` ``"crank"``, ``"ram"`` or ``"cylinder"``, ``name`` its name in the
     FMU's variables, ``link`` the moving body dyads and [[load]] tables may name (the
-    crank, the ram, or the link a cylinder turns)."""
+    crank, the ram, or the link a cylinder turns). A cylinder's ``pivot_on`` and
+    ``base_on``: the link of an earlier driver that carries its pivot O and its barrel's
+    pin A (None: the frame)."""
 
     kind: str
     name: str
     link: str
+    pivot_on: str | None = None
+    base_on: str | None = None
 
     @property
     def effort(self) -> str:
@@ -360,12 +373,12 @@ class _Reader:
     def drivers(self, needs_mass: bool, inertia: bool) -> list[Driver]:
         """Every driver, cranks, rams, cylinders, each kind in file order, its parameters
         and motion inputs recorded; names (a cylinder's and its link's) unique."""
-        found = []
+        found: list[Driver] = []
         for kind in _DRIVERS:
             rows = self.entries(kind)
             for index, t in enumerate(rows):
                 where = f"[{kind}]" if len(rows) == 1 else f"[[{kind}]] #{index + 1}"
-                found.append(self.driver(kind, t, where, (needs_mass, inertia)))
+                found.append(self.driver(kind, t, where, (needs_mass, inertia), found))
         if not found:
             self.fail("[crank]/[ram]/[cylinder]", "a mechanism FMU has at least one driver")
         names = [d.name for d in found] + [d.link for d in found if d.kind == "cylinder"]
@@ -374,12 +387,11 @@ class _Reader:
                 self.fail("[crank]/[ram]/[cylinder]", f"two drivers or links named {name!r}")
         return found
 
-    def driver(self, kind: str, t: dict, where: str, needs: tuple) -> Driver:
-        """One driver of ``kind`` from its table ``t``."""
+    def driver(self, kind: str, t: dict, where: str, needs: tuple, earlier: list) -> Driver:
+        """One driver of ``kind`` from its table ``t``, after the drivers ``earlier``."""
         needs_mass, inertia = needs
         if kind == "cylinder":
-            name, link = _cylinder(self, t, where, needs)
-            driver = Driver(kind, name, link)
+            driver = _cylinder(self, t, where, needs, [d.link for d in earlier])
         else:
             name = str(t.get("name", kind))
             driver = Driver(kind, name, name)
@@ -418,9 +430,10 @@ _CYLINDER_KEYS = frozenset(
 )
 
 
-def _cylinder(rd: _Reader, t: dict, where: str, needs: tuple) -> tuple[str, str]:
-    """(the cylinder's name, the link it turns): a [cylinder]'s geometry, the link's mass
-    and the barrel's and the rod's, as parameters under the FMU's names."""
+def _cylinder(rd: _Reader, t: dict, where: str, needs: tuple, carriers: list) -> Driver:
+    """A [cylinder]: its geometry, the link's mass and the barrel's and the rod's, as
+    parameters under the FMU's names; ``carriers``, the links of the drivers before it,
+    may carry its O and A."""
     unknown = sorted(set(t) - _CYLINDER_KEYS)
     if unknown:
         rd.fail(where, f"unknown key {unknown[0]!r} (keys: {', '.join(sorted(_CYLINDER_KEYS))})")
@@ -430,11 +443,13 @@ def _cylinder(rd: _Reader, t: dict, where: str, needs: tuple) -> tuple[str, str]
             rd.fail(f"{where}.{key}", f"must be a lower-case name, not {value!r}")
     if name == link:
         rd.fail(where, f"the cylinder and the link it turns are both named {name!r}")
-    rd.param_pair(f"{link}.at", rd.pair(t, "at", where))
-    base, pin = rd.pair(t, "base", where), rd.pair(t, "pin", where)
+    pivot_on, pivot = _cylinder_point(rd, t, "at", where, (link, carriers))
+    rd.param_pair(f"{link}.at", pivot)
+    base_on, base = _cylinder_point(rd, t, "base", where, (link, carriers))
+    pin = rd.pair(t, "pin", where)
     if pin == (0.0, 0.0):
         rd.fail(f"{where}.pin", "must not be [0, 0]: B must be off the pivot O (|pin| > 0)")
-    if base == (rd.params[f"{link}.at.x"], rd.params[f"{link}.at.y"]):
+    if base_on == pivot_on and base == pivot:
         rd.fail(f"{where}.base", "A must differ from the link's pivot O ('at')")
     rd.param_pair(f"{name}.base", base)
     rd.param_pair(f"{name}.pin", pin)
@@ -443,7 +458,31 @@ def _cylinder(rd: _Reader, t: dict, where: str, needs: tuple) -> tuple[str, str]
         rd.fail(f"{where}.branch", f"must be 1 or -1, not {branch!r}")
     rd.param(f"{name}.branch", float(branch))
     _cylinder_masses(rd, t, (name, link, where), needs)
-    return name, link
+    return Driver("cylinder", name, link, pivot_on, base_on)
+
+
+def _cylinder_point(rd: _Reader, t: dict, key: str, where: str, links: tuple) -> tuple:
+    """(carrier, (x, y)) of a cylinder's ``at`` (O) or ``base`` (A): ``[x, y]`` on the
+    frame (carrier None, global) or ``{ link = NAME, at = [x, y] }`` on the link of an
+    earlier driver (in that link's frame). ``links``: (the link the cylinder turns, the
+    links of the drivers before it)."""
+    own, carriers = links
+    spec, here = t.get(key), f"{where}.{key}"
+    if not isinstance(spec, Mapping):
+        return None, rd.pair(t, key, where)
+    carrier = spec.get("link")
+    if set(spec) != {"link", "at"} or not isinstance(carrier, str):
+        rd.fail(here, "must be [x, y] (m, the frame) or { link = NAME, at = [x, y] }")
+    if carrier == own:
+        rd.fail(here, f"on {own!r}, the link the cylinder turns: a cylinder cannot carry itself")
+    if carrier != "frame" and carrier not in carriers:
+        known = ", ".join(repr(c) for c in carriers) or "none"
+        rd.fail(
+            here,
+            f"{carrier!r} is not the frame nor the link of a driver listed before this "
+            f"cylinder (cranks, rams, then cylinders in file order; before it: {known})",
+        )
+    return (None if carrier == "frame" else carrier), rd.pair(spec, "at", here)
 
 
 def _cylinder_masses(rd: _Reader, t: dict, names: tuple, needs: tuple) -> None:
@@ -698,16 +737,20 @@ class _Axis:
     omega: mpf
     epsilon: mpf
     conditioning: mpf
+    #: A's velocity and acceleration (zero on the frame)
+    base_motion: tuple = ((0, 0), (0, 0))
 
     def point(self, x: mpf, on_rod: bool) -> tuple:
         """(position, velocity, acceleration) of the point at x (m) from A along u: fixed
-        on the barrel, or on the rod, where x = s - c grows at s' and s''."""
+        on the barrel, or on the rod, where x = s - c grows at s' and s''; A's own motion
+        added."""
         x1, x2 = (self.rate, self.accel) if on_rod else (mpf(0), mpf(0))
         w, e, u, n = self.omega, self.epsilon, self.u, _perp(self.u)
+        v_a, a_a = self.base_motion
         return (
             _add(self.base, _scale(x, u)),
-            _add(_scale(x1, u), _scale(x * w, n)),
-            _add(_scale(x2 - x * w * w, u), _scale(2 * x1 * w + x * e, n)),
+            _add(_scale(x1, u), _scale(x * w, n), v_a),
+            _add(_scale(x2 - x * w * w, u), _scale(2 * x1 * w + x * e, n), a_a),
         )
 
 
@@ -757,13 +800,14 @@ class _Evaluation:
         return (self.par[f"{name}.x"], self.par[f"{name}.y"])
 
     # ---- kinematics ---------------------------------------------------------------------
-    def driver_body(self, drv: Driver, motion: tuple) -> tuple[_Body, _Axis | None]:
+    def driver_body(self, drv: Driver, motion: tuple, bodies: dict) -> tuple[_Body, _Axis | None]:
         """The body dyads hang on (the crank, the ram or the link a cylinder turns) with
         driver ``drv`` at coordinate q moving at rate q' with q'' (``motion`` = (q, q',
-        q'')), and a cylinder's axis (None for a crank or a ram)."""
+        q'')), and a cylinder's axis (None for a crank or a ram); ``bodies``: the earlier
+        drivers' bodies, which may carry a cylinder's O and A."""
         q, rate, accel = motion
         if drv.kind == "cylinder":
-            return self.cylinder(drv, q, rate, accel)
+            return self.cylinder(drv, (q, rate, accel), bodies)
         c = drv.name
         at = self.vec(f"{c}.at")
         zero = mpf(0)
@@ -774,17 +818,29 @@ class _Evaluation:
         body = _Body(_add(at, _scale(q, i)), _scale(rate, i), _scale(accel, i), i, zero, zero)
         return body, None
 
-    def triangle(self, drv: Driver, s: mpf) -> tuple[Vec, Vec, mpf]:
-        """(A - O, B - O, |sin| of the angle between OB and AB) of the cylinder at length s:
-        B on the circle of radius |pin| about O and of radius s about A, on the branch's
-        side of the directed line O -> A; _Failure where they do not meet or touch."""
-        c, g = drv.name, drv.link
-        pin, o, a = self.vec(f"{c}.pin"), self.vec(f"{g}.at"), self.vec(f"{c}.base")
+    def carried(self, carrier: str | None, name: str, bodies: dict) -> tuple:
+        """(position, velocity, acceleration) of the point ``name`` (parameters
+        ``name.x``, ``name.y``): global on the frame (carrier None), else of the carrier's
+        frame, moving with it."""
+        if carrier is None:
+            zero = (mpf(0), mpf(0))
+            return self.vec(name), zero, zero
+        return bodies[carrier].point(self.vec(name))
+
+    def triangle(self, drv: Driver, s: mpf, o: Vec, a: Vec) -> tuple[Vec, Vec, mpf]:
+        """(A - O, B - O, |sin| of the angle between OB and AB) of the cylinder at length s
+        with its pivot at ``o`` and A at ``a``: B on the circle of radius |pin| about O and
+        of radius s about A, on the branch's side of the directed line O -> A; _Failure
+        where they do not meet or touch."""
+        c = drv.name
+        pin = self.vec(f"{c}.pin")
         with mpmath.extraprec(mpmath.mp.prec + 64):  # exact on the inputs' digits: 0 is 0
             d = (a[0] - o[0], a[1] - o[1])
             dd, rr = _dot(d, d), _dot(pin, pin)
             along = (dd + rr - s * s) / 2  # (B - O).(A - O)
             disc = rr * dd - along * along  # ((A - O) x (B - O))^2
+        if dd == 0 and drv.pivot_on != drv.base_on:  # carried apart, met by the motion
+            raise _Failure(SINGULAR, c, "its pivot O and its barrel's pin A coincide")
         for value, name in ((rr, f"{c}.pin"), (dd, f"{c}.base")):
             if value == 0:
                 raise SceneError(f"{self.s.label}: {name}: O, A and B must be distinct points")
@@ -800,27 +856,30 @@ class _Evaluation:
             raise _Failure(SINGULAR, c, "O, A and B are in line (the toggle)")
         return d, b, sine
 
-    def cylinder(self, drv: Driver, s: mpf, rate: mpf, accel: mpf) -> tuple[_Body, _Axis]:
-        """The link a cylinder turns and the cylinder's axis at length s, s', s'': the
-        closure O + B(theta) - A - s u(psi) = 0 differentiated once and twice in time,
-        J (omega, psi')' = s' u and J (epsilon, psi'')' = s'' u + 2 s' psi' perp(u)
-        - s psi'^2 u + omega^2 (B - O), J = [perp(B - O), -s perp(u)]."""
+    def cylinder(self, drv: Driver, motion: tuple, bodies: dict) -> tuple[_Body, _Axis]:
+        """The link a cylinder turns and the cylinder's axis at length s, s', s''
+        (``motion``), O and A moving with their carriers (of ``bodies``): the closure
+        O + B(theta) - A - s u(psi) = 0 differentiated once and twice in time with
+        d = A - O, J (omega, psi')' = s' u + d' and J (epsilon, psi'')' = s'' u + 2 s' psi'
+        perp(u) - s psi'^2 u + omega^2 (B - O) + d'', J = [perp(B - O), -s perp(u)]."""
         c, g = drv.name, drv.link
-        d, b, sine = self.triangle(drv, s)
+        s, rate, accel = motion
+        o, v_o, a_o = self.carried(drv.pivot_on, f"{g}.at", bodies)
+        a, v_a, a_a = self.carried(drv.base_on, f"{c}.base", bodies)
+        d, b, sine = self.triangle(drv, s, o, a)
         pin = self.vec(f"{c}.pin")
         rr = _dot(pin, pin)
         u = ((b[0] - d[0]) / s, (b[1] - d[1]) / s)
         n, nb = _perp(u), _perp(b)
         jac = mpmath.matrix([[nb[0], -s * n[0]], [nb[1], -s * n[1]]])
-        omega, psi1 = mpmath.lu_solve(jac, mpmath.matrix([rate * u[0], rate * u[1]]))
+        rhs = _add(_scale(rate, u), (v_a[0] - v_o[0], v_a[1] - v_o[1]))
+        omega, psi1 = mpmath.lu_solve(jac, mpmath.matrix(list(rhs)))
         rhs = _add(_scale(accel - s * psi1 * psi1, u), _scale(2 * rate * psi1, n))
-        rhs = _add(rhs, _scale(omega * omega, b))
+        rhs = _add(rhs, _scale(omega * omega, b), (a_a[0] - a_o[0], a_a[1] - a_o[1]))
         eps, psi2 = mpmath.lu_solve(jac, mpmath.matrix(list(rhs)))
         i = (_dot(pin, b) / rr, _cross(pin, b) / rr)  # R(theta) pin = B - O
-        zero = (mpf(0), mpf(0))
-        body = _Body(self.vec(f"{g}.at"), zero, zero, i, omega, eps)
-        a = self.vec(f"{c}.base")
-        return body, _Axis(a, u, s, rate, accel, psi1, psi2, sine)
+        body = _Body(o, v_o, a_o, i, omega, eps)
+        return body, _Axis(a, u, s, rate, accel, psi1, psi2, sine, (v_a, a_a))
 
     def mount(self, att: Attachment, bodies: dict) -> dk.Mount:
         """The motion of an outer pair's external link where the dyad meets it."""
@@ -871,7 +930,7 @@ class _Evaluation:
         of ``motions``; _Failure where a cylinder or a dyad does not close."""
         chain = _Chain({}, {}, {}, {})
         for drv, motion in zip(self.s.drivers, motions, strict=True):
-            body, axis = self.driver_body(drv, motion)
+            body, axis = self.driver_body(drv, motion, chain.bodies)
             chain.bodies[drv.link] = body
             if axis is not None:
                 chain.axes[drv.name] = axis
@@ -1163,6 +1222,9 @@ class _Kinetostatics:
         out[f"{h}.force"], out[f"{h}.N"], out[f"{h}.M"] = x[6], x[7], x[8]
         for name, k in ((f"{h}.R_A", 0), (f"{h}.R_B", 2), (f"{g}.R_O", 4)):
             out[f"{name}.x"], out[f"{name}.y"] = x[k], x[k + 1]
+        # the carriers bear the opposites: of R_A at A (the barrel's pin), of R_O at O
+        self.loads.add(drv.base_on, a_pin, (-x[0], -x[1]), zero)
+        self.loads.add(drv.pivot_on, o_pin, (-x[4], -x[5]), zero)
 
     def part_known(self, axis: _Axis, prefix: str, centre: Vec, on_rod: bool) -> tuple:
         """The barrel's or the rod's weight and d'Alembert force and moment: (force, moment
@@ -1208,12 +1270,18 @@ class _Kinetostatics:
             self.loads.add(link, point, force, couple)
 
     def run(self) -> dict:
-        """The outputs: by dyad name, the drivers' under None."""
+        """The outputs: by dyad name, the drivers' under None (in the drivers' order)."""
         self.place()
         for d in reversed(self.ev.s.dyads):
             self.dyad(d)
-        for drv in self.ev.s.drivers:
+        # from the last driver back: a cylinder's reactions load the earlier driver's link
+        # that carries it before that driver's balance
+        per_driver = {}
+        for drv in reversed(self.ev.s.drivers):
+            self.out[None] = {}
             self.driver(drv)
+            per_driver[drv.name] = self.out[None]
+        self.out[None] = {k: v for d in self.ev.s.drivers for k, v in per_driver[d.name].items()}
         return self.out
 
 
