@@ -1,16 +1,27 @@
 """Scenes with several drivers: the whole-mechanism Newton-Euler reference of
-:mod:`.chains` for any mix of cranks, rams and cylinders on the frame.
+:mod:`.chains` for any mix of cranks, rams and cylinders, a cylinder on the frame or on an
+earlier driver's link.
 
-=============  ============================================================================
-name           mechanism (scene file)
-=============  ============================================================================
-leg            ``modelDescription/scenes/leg.toml``: two hip cranks ``front`` and ``rear``
-               and dyad ``knees`` (RRR), the shanks meeting at the foot; a ground force
-               at the foot.
-three_drivers  ``tests/scenes/three_drivers.toml``: crank ``wheel``, cylinder ``jack``
-               (turning link ``arm``), ram ``slide``; dyads ``tie`` and ``hang`` (RRR); a
-               follower force and moment ``tool`` on the hanger.
-=============  ============================================================================
+=================  ========================================================================
+name               mechanism (scene file)
+=================  ========================================================================
+leg                ``modelDescription/scenes/leg.toml``: two hip cranks ``front`` and
+                   ``rear`` and dyad ``knees`` (RRR), the shanks meeting at the foot; a
+                   ground force at the foot.
+three_drivers      ``tests/scenes/three_drivers.toml``: crank ``wheel``, cylinder ``jack``
+                   (turning link ``arm``), ram ``slide``; dyads ``tie`` and ``hang`` (RRR);
+                   a follower force and moment ``tool`` on the hanger.
+carried_cylinders  ``tests/scenes/carried_cylinders.toml``: cylinder ``lift`` raises a
+                   boom; cylinder ``reach``, pinned to the boom at both ends, turns an arm;
+                   a payload at the arm's tip.
+excavator          ``modelDescription/scenes/excavator.toml``: cylinders ``boom_cyl``,
+                   ``stick_cyl`` (on the boom) and ``bucket_cyl`` (on the stick, turning
+                   the rocker); dyad ``linkage`` (RRR) turns the bucket; a digging force
+                   ``dig`` at the bucket's tip.
+=================  ========================================================================
+
+A cylinder's O and A may ride on an earlier driver's link (``{ link = NAME, at = [x,
+y] }``): they move with it, and it receives minus the cylinder's R_O and R_A there.
 
 Each driver is read as :class:`.chains.Chain` reads a single one (``[crank]`` or
 ``[[crank]]`` and so on), in the order cranks, rams, cylinders, each in file order. Its
@@ -65,7 +76,7 @@ __all__ = [
 ]
 
 #: The mechanisms with several drivers.
-NAMES = ("leg", "three_drivers", "carried_cylinders")
+NAMES = ("leg", "three_drivers", "carried_cylinders", "excavator")
 _TEST_SCENES = ("three_drivers", "carried_cylinders")
 
 #: Driver kinds in their order, with the names of their coordinate, rate and acceleration.
