@@ -2,8 +2,10 @@
 (scripts/dyadfmu/mechanisms/multidriver.py): the two-motor leg
 (modelDescription/scenes/leg.toml, two cranks), tests/scenes/three_drivers.toml (a
 crank, a cylinder and a ram), tests/scenes/carried_cylinders.toml (a cylinder pinned
-at both ends to the boom another one raises) and modelDescription/scenes/excavator.toml
-(boom, stick and bucket cylinders, each carried by the link the one before turns).
+at both ends to the boom another one raises), modelDescription/scenes/excavator.toml
+(boom, stick and bucket cylinders, each carried by the link the one before turns) and
+modelDescription/scenes/loader.toml (a wheel loader's Z-bar: the tilt cylinder's barrel
+on the frame, its bellcrank on the lift arm).
 
 - at random points of the working ranges (rates, accelerations and loads random too):
   every body balances to 1e-12, and a reaction or an effort moved by 1e-6 of the
@@ -61,14 +63,15 @@ def _largest(values: dict, unit_of) -> dict:
 def test_the_points_cover_the_working_ranges():
     """The leg's hips over -100..-20 and -160..-80 deg; the wheel all round, the jack
     over 1.85..2.02 m, the slide over 0.6..1.4 m; the lift over 1.1..1.4 m, the reach
-    over 1.3..1.7 m; the excavator's cylinders over the ranges of its header; rates of
-    both signs."""
+    over 1.3..1.7 m; the excavator's and the loader's cylinders over the ranges of
+    their headers; rates of both signs."""
     want = {
         "leg": {"front": (-100, -20), "rear": (-160, -80)},
         "three_drivers": {"wheel": (0, 360), "jack": (1.85, 2.02), "slide": (0.6, 1.4)},
         "carried_cylinders": {"lift": (1.1, 1.4), "reach": (1.3, 1.7)},
         "excavator": {"boom_cyl": (1.95, 3.35), "stick_cyl": (2.5, 3.8)}
         | {"bucket_cyl": (1.85, 2.85)},
+        "loader": {"lift_cyl": (1.2, 2.45), "tilt_cyl": (1.2, 2.0)},
     }
     for name, ranges in want.items():
         chain = md.load(name)
@@ -374,6 +377,9 @@ SPEC_OUTPUTS = {
     + _cylinder_outputs("stick_cyl", "stick")
     + _cylinder_outputs("bucket_cyl", "rocker")
     + _inertia_outputs("boom_cyl", "stick_cyl", "bucket_cyl"),
+    "loader": _cylinder_outputs("lift_cyl", "lift_arm")
+    + _cylinder_outputs("tilt_cyl", "bellcrank")
+    + _inertia_outputs("lift_cyl", "tilt_cyl"),
 }
 
 

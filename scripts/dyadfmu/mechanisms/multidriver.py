@@ -18,6 +18,10 @@ excavator          ``modelDescription/scenes/excavator.toml``: cylinders ``boom_
                    ``stick_cyl`` (on the boom) and ``bucket_cyl`` (on the stick, turning
                    the rocker); dyad ``linkage`` (RRR) turns the bucket; a digging force
                    ``dig`` at the bucket's tip.
+loader             ``modelDescription/scenes/loader.toml``: cylinder ``lift_cyl`` raises
+                   the lift arm; cylinder ``tilt_cyl`` (barrel on the frame) turns the
+                   ``bellcrank`` about its pivot on the arm; dyad ``zbar`` (RRR) turns the
+                   bucket; a ``payload`` in the bucket.
 =================  ========================================================================
 
 A cylinder's O and A may ride on an earlier driver's link (``{ link = NAME, at = [x,
@@ -76,7 +80,7 @@ __all__ = [
 ]
 
 #: The mechanisms with several drivers.
-NAMES = ("leg", "three_drivers", "carried_cylinders", "excavator")
+NAMES = ("leg", "three_drivers", "carried_cylinders", "excavator", "loader")
 _TEST_SCENES = ("three_drivers", "carried_cylinders")
 
 #: Driver kinds in their order, with the names of their coordinate, rate and acceleration.
