@@ -135,6 +135,14 @@ class Crank:
     kind: str = "crank"
     actuator: str = ""
     index: int = 0  # of its table among the scene's tables of its kind
+    #: a cylinder's carriers: the driver link its pivot O (its pin A) is a point of, in
+    #: that link's frame; None for the frame (a global point)
+    pivot_on: str | None = None
+    base_on: str | None = None
+
+    def carriers(self) -> list[str]:
+        """The moving links a cylinder's pins O and A sit on (none for the frame)."""
+        return [c for c in (self.pivot_on, self.base_on) if c is not None]
 
     def is_ram(self) -> bool:
         """Whether the driver is a ram: it translates, and balances with a force."""

@@ -1,7 +1,11 @@
 """Scenes with several drivers in the harness's NumPy reference
 (scripts/dyadfmu/mechanisms/multidriver.py): the two-motor leg
-(modelDescription/scenes/leg.toml, two cranks) and tests/scenes/three_drivers.toml (a
-crank, a cylinder and a ram).
+(modelDescription/scenes/leg.toml, two cranks), tests/scenes/three_drivers.toml (a
+crank, a cylinder and a ram), tests/scenes/carried_cylinders.toml (a cylinder pinned
+at both ends to the boom another one raises), modelDescription/scenes/excavator.toml
+(boom, stick and bucket cylinders, each carried by the link the one before turns) and
+modelDescription/scenes/loader.toml (a wheel loader's Z-bar: the tilt cylinder's barrel
+on the frame, its bellcrank on the lift arm).
 
 - at random points of the working ranges (rates, accelerations and loads random too):
   every body balances to 1e-12, and a reaction or an effort moved by 1e-6 of the
@@ -13,8 +17,12 @@ crank, a cylinder and a ram).
 - the energy balance along a smooth motion of all drivers: sum of effort x rate + the
   loads' power = d(T + V)/dt, the rate a five-point finite difference in time of the
   reference's own energies, to 1e-9 of the peak power;
+- the kinematics' rates are the complex-step derivatives in time of its positions
+  (every driver's body: angles, centres of mass and their velocities);
 - the leg with its rear hip held still is a single-driver chain (chains.Chain, the
-  rear knee a frame pivot): the front torque and the knees' reactions agree;
+  rear knee a frame pivot): the front torque and the knees' reactions agree; likewise a
+  carried cylinder with its carrier held still is a cylinder on the frame;
+- a cylinder's O or A on the link it turns, or on no earlier driver's link, is refused;
 - the scene's FMU, where built, against the reference at the same points
   (:mod:`dyadfmu.cosim.multidriver_fmus`).
 """
@@ -54,10 +62,16 @@ def _largest(values: dict, unit_of) -> dict:
 # ---------------------------------------------------------------------------
 def test_the_points_cover_the_working_ranges():
     """The leg's hips over -100..-20 and -160..-80 deg; the wheel all round, the jack
-    over 1.85..2.02 m, the slide over 0.6..1.4 m; rates of both signs."""
+    over 1.85..2.02 m, the slide over 0.6..1.4 m; the lift over 1.1..1.4 m, the reach
+    over 1.3..1.7 m; the excavator's and the loader's cylinders over the ranges of
+    their headers; rates of both signs."""
     want = {
         "leg": {"front": (-100, -20), "rear": (-160, -80)},
         "three_drivers": {"wheel": (0, 360), "jack": (1.85, 2.02), "slide": (0.6, 1.4)},
+        "carried_cylinders": {"lift": (1.1, 1.4), "reach": (1.3, 1.7)},
+        "excavator": {"boom_cyl": (1.95, 3.35), "stick_cyl": (2.5, 3.8)}
+        | {"bucket_cyl": (1.85, 2.85)},
+        "loader": {"lift_cyl": (1.2, 2.45), "tilt_cyl": (1.2, 2.0)},
     }
     for name, ranges in want.items():
         chain = md.load(name)
@@ -179,6 +193,32 @@ def test_energy_balance_over_a_motion_of_all_drivers(name):
 
 
 # ---------------------------------------------------------------------------
+# the kinematics
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("name", NAMES)
+def test_the_rates_are_the_derivatives_of_the_positions(name):
+    """A complex step in time of the positions along chains.toml's motion gives the
+    velocities, of the velocities the accelerations, to 1e-12 of each one's peak: every
+    body's angle and centre of mass (a carried cylinder's link, barrel and rod move with
+    their carrier)."""
+    chain = md.load(name)
+    motion = chain.motion()
+    t = (np.arange(48) + 0.3) * motion.duration / 48
+    h = 1e-20 * motion.duration
+    kin, step = chain.kinematics(t, motion), chain.kinematics(t + 1j * h, motion)
+    pairs = []
+    for b in chain.bodies:
+        pairs += [(f"S_{b}", f"v_S_{b}"), (f"v_S_{b}", f"a_S_{b}")]
+        if b not in [d.link for d in chain.drivers if d.kind == "ram"]:  # a ram never turns
+            pairs += [(f"{b}.angle", f"{b}.omega"), (f"{b}.omega", f"{b}.epsilon")]
+    for position, rate in pairs:
+        got, want = np.imag(step[position]) / h, np.real(kin[rate])
+        peak = np.max(np.abs(want))
+        assert peak > 0, rate
+        assert np.max(np.abs(got - want)) < 1e-12 * peak, (name, rate)
+
+
+# ---------------------------------------------------------------------------
 # the single-driver reference
 # ---------------------------------------------------------------------------
 def _leg_with_rear_held(angle: float) -> chains.Chain:
@@ -220,6 +260,74 @@ def test_the_leg_with_one_hip_held_is_a_single_driver_chain():
         assert np.max(np.abs(got[f"knees.R_np.{c}"] - ref[f"knees.R_np.{c}"])) < 1e-12 * scale
 
 
+def _reach_on_a_held_boom(carried: md.MultiChain, length: float) -> chains.Chain:
+    """carried_cylinders' reach cylinder as a single-driver chain: its O and A fixed on
+    the frame where the boom held at the lift's ``length`` puts them."""
+    kin = carried.state({"lift": length, "reach": 1.5})
+    scene = copy.deepcopy(carried.scene)
+    reach = next(c for c in scene["cylinder"] if c["name"] == "reach")
+    reach["at"] = np.real(kin["arm.O"][0]).tolist()
+    reach["base"] = np.real(kin["reach.A"][0]).tolist()
+    scene["cylinder"] = reach
+    table = copy.deepcopy(carried.data)
+    del table["drivers"]
+    table["motion"] = {"s0": 1.35, "stroke": 0.3, "omega": 1.0, "variation": 0.0}
+    return chains.Chain("carried_cylinders", scene, table)
+
+
+def test_a_carried_cylinder_on_a_held_carrier_is_a_cylinder_on_the_frame():
+    """Boom held (the lift's rate and acceleration 0): the reach cylinder's force, its
+    reactions at A, B and O, N and M equal those of chains.Chain's frame cylinder to
+    1e-12; and the boom receives minus R_O and minus R_A: the lift's force changes with
+    the payload."""
+    carried = md.load("carried_cylinders")
+    length = 1.25
+    single = _reach_on_a_held_boom(carried, length)
+    rng = np.random.default_rng(11)
+    s, ds, dds = rng.uniform(1.3, 1.7, 40), rng.uniform(-0.4, 0.4, 40), rng.uniform(-1, 1, 40)
+    payload = {"payload.force.x": rng.uniform(-500, 500, 40)}
+    payload["payload.force.y"] = rng.uniform(-3000, 0, 40)
+    kin = carried.state({"lift": length + 0 * s, "reach": s}, {"reach": ds}, {"reach": dds})
+    kin.update(payload)
+    want = single._solve(np.zeros(40), s, ds, dds)
+    want.update(payload)
+    ref, got = single.reference(want), carried.reference(kin)
+    forces = [f"{k}.{c}" for k in ("reach.R_A", "reach.R_B", "arm.R_O") for c in "xy"]
+    forces += ["reach.force", "reach.N"]
+    scale = max(np.max(np.abs(ref[k])) for k in forces)
+    for key in forces:
+        assert np.max(np.abs(got[key] - ref[key])) < 1e-12 * scale, key
+    assert np.max(np.abs(got["reach.M"] - ref["reach.M"])) < 1e-12 * np.max(np.abs(ref["reach.M"]))
+    heavier = dict(kin, **{"payload.force.y": kin["payload.force.y"] - 1000.0})
+    assert np.all(carried.reference(heavier)["lift.force"] > got["lift.force"] + 100.0)
+
+
+@pytest.mark.parametrize(
+    ("key", "spec", "match"),
+    [
+        ("at", {"link": "arm", "at": [0.0, 0.0]}, "not on the link it turns"),
+        ("base", {"link": "arm", "at": [0.5, 0.0]}, "not on the link it turns"),
+        ("base", {"link": "mast", "at": [0.5, 0.0]}, "neither the frame nor an earlier"),
+        ("at", {"link": "boom", "at": [3.0, 0.0], "guide": 0.0}, "not a key"),
+    ],
+)
+def test_a_cylinder_on_its_own_or_no_earlier_link_is_refused(key, spec, match):
+    carried = md.load("carried_cylinders")
+    scene = copy.deepcopy(carried.scene)
+    scene["cylinder"][1][key] = spec
+    with pytest.raises(ValueError, match=match):
+        md.MultiChain("carried_cylinders", scene, carried.data)
+
+
+def test_a_cylinder_on_a_later_cylinders_link_is_refused():
+    """The lift's base on the arm, which the reach cylinder (listed after it) turns."""
+    carried = md.load("carried_cylinders")
+    scene = copy.deepcopy(carried.scene)
+    scene["cylinder"][0]["base"] = {"link": "arm", "at": [0.5, 0.0]}
+    with pytest.raises(ValueError, match="neither the frame nor an earlier driver's link"):
+        md.MultiChain("carried_cylinders", scene, carried.data)
+
+
 def test_repeated_driver_names_are_refused():
     leg = md.load("leg")
     scene = copy.deepcopy(leg.scene)
@@ -239,6 +347,18 @@ def test_one_driver_is_no_scene_of_several():
 # ---------------------------------------------------------------------------
 # the FMUs
 # ---------------------------------------------------------------------------
+def _cylinder_outputs(cyl: str, link: str) -> list:
+    """A cylinder's outputs of the spec."""
+    names = [f"{cyl}.force", f"{cyl}.force0", f"{cyl}.N", f"{cyl}.M", f"{cyl}.conditioning"]
+    names += [f"{k}.{c}" for k in (f"{cyl}.R_A", f"{cyl}.R_B", f"{link}.R_O") for c in "xy"]
+    names += [f"{g}.{k}" for g in (link, cyl) for k in ("angle", "omega", "epsilon")]
+    return names + [f"{cyl}.B.position.x", f"{cyl}.B.position.y"]
+
+
+def _inertia_outputs(*drivers: str) -> list:
+    return [f"M.{a}.{b}" for a in drivers for b in drivers]
+
+
 SPEC_OUTPUTS = {
     "leg": ["front.torque", "front.R_O.x", "front.R_O.y", "front.torque0"]
     + ["rear.torque", "rear.R_O.x", "rear.R_O.y", "rear.torque0"]
@@ -250,6 +370,16 @@ SPEC_OUTPUTS = {
     + [f"{g}.{k}" for g in ("arm", "jack") for k in ("angle", "omega", "epsilon")]
     + ["jack.B.position.x", "jack.B.position.y"]
     + [f"M.{a}.{b}" for a in ("wheel", "slide", "jack") for b in ("wheel", "slide", "jack")],
+    "carried_cylinders": _cylinder_outputs("lift", "boom")
+    + _cylinder_outputs("reach", "arm")
+    + _inertia_outputs("lift", "reach"),
+    "excavator": _cylinder_outputs("boom_cyl", "boom")
+    + _cylinder_outputs("stick_cyl", "stick")
+    + _cylinder_outputs("bucket_cyl", "rocker")
+    + _inertia_outputs("boom_cyl", "stick_cyl", "bucket_cyl"),
+    "loader": _cylinder_outputs("lift_cyl", "lift_arm")
+    + _cylinder_outputs("tilt_cyl", "bellcrank")
+    + _inertia_outputs("lift_cyl", "tilt_cyl"),
 }
 
 

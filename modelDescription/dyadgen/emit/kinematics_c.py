@@ -210,20 +210,21 @@ def cylinder_input_lines(
     driver: Crank,
     target: str,
     rates: tuple[str, str],
-    pivot: str,
+    pins: tuple[str, str],
     motion_only: bool = False,
 ) -> list[str]:
     """The assignments of a dyad_cylinder_input `target`: the frame pins (O's motion
     `pivot`), the pin B, the length and its `rates`, the branch and, for the kinematics
     alone (`motion_only`), the centres of mass, or for the forces every mass of the
-    barrel and the rod (the link's resultant is the scene's, at O)."""
+    barrel and the rod (the link's resultant is the scene's, at O). `pins`: the motion
+    of A and of O, in C."""
     params = driver.params
     branch = params["branch"]
     rate, accel = rates
     out = [
         f"{target} = dyad_cylinder_input_default();",
-        f"{target}.a = fixed_point({_vec(params['base.x'].c(), params['base.y'].c())});",
-        f"{target}.o = {pivot};",
+        f"{target}.a = {pins[0]};",
+        f"{target}.o = {pins[1]};",
         f"{target}.pin_b = {_vec(params['pin.x'].c(), params['pin.y'].c())};",
         f"{target}.length = in->{member(driver.actuator)}_length;",
         f"{target}.rate = {rate};",
@@ -238,14 +239,55 @@ def cylinder_input_lines(
     return out + _cylinder_part_lines(params, target, motion_only)
 
 
-def _cylinder_lines(scene: Scene, driver: Crank) -> list[str]:
+def fixed_pin(driver: Crank, key: str) -> str:
+    """A cylinder's pin on the frame, `at` (O) or `base` (A), as a point's motion in C."""
+    params = driver.params
+    return f"fixed_point({_vec(params[f'{key}.x'].c(), params[f'{key}.y'].c())})"
+
+
+def is_carried(driver: Crank) -> bool:
+    """Whether a cylinder's pin O or A sits on a moving link."""
+    return bool(driver.carriers())
+
+
+def mount_names(driver: Crank) -> tuple[str, str]:
+    """The kinematics block's members holding a carried cylinder's pins A and O."""
+    c = member(driver.actuator)
+    return f"{c}_mount_a", f"{c}_mount_o"
+
+
+def _pin_motion(mounts: _Mounts, driver: Crank, key: str) -> str:
+    """The motion of a cylinder's pin O (`at`) or A (`base`) in C: on the frame, or a
+    point of the driver's link carrying it."""
+    carrier = driver.pivot_on if key == "at" else driver.base_on
+    if carrier is None:
+        return fixed_pin(driver, key)
+    origin, direction, omega, epsilon = mounts.carrier(carrier)
+    point = _vec(driver.params[f"{key}.x"].c(), driver.params[f"{key}.y"].c())
+    return f"dyad_point_on_link({origin}, {direction}, {omega}, {epsilon}, {point})"
+
+
+def _cylinder_lines(scene: Scene, mounts: _Mounts, driver: Crank) -> list[str]:
     """A cylinder's motion and that of the link it turns."""
     c = member(driver.name)
-    at = _vec(driver.params["at.x"].c(), driver.params["at.y"].c())
     result = f"kin->{kin_name_of_cylinder(driver)}"
     cin = "cin" if len(scene.drivers) == 1 else f"cin_{member(driver.actuator)}"
-    out = [f"const dyad_point_motion {c}_o = fixed_point({at});", f"dyad_cylinder_input {cin};"]
-    out += cylinder_input_lines(scene, driver, cin, rate_names(scene, driver), f"{c}_o", True)
+    out = [f"const dyad_point_motion {c}_o = {_pin_motion(mounts, driver, 'at')};"]
+    base = _pin_motion(mounts, driver, "base")
+    if is_carried(driver):
+        mount_a, mount_o = mount_names(driver)
+        out += [f"kin->{mount_a} = {base};", f"kin->{mount_o} = {c}_o;"]
+        base = f"kin->{mount_a}"
+    out.append(f"dyad_cylinder_input {cin};")
+    rates = rate_names(scene, driver)
+    out += cylinder_input_lines(scene, driver, cin, rates, (base, f"{c}_o"), True)
+    carried = [
+        f"kin->{kin_name_of_cylinder(d)}.kin_amplification"
+        for d in scene.drivers
+        if d.is_cylinder() and d.name in driver.carriers()
+    ]
+    if carried:
+        out.append(f"{cin}.mount_amplification = {' + '.join(carried)};")
     failed = len(scene.dyads) + cylinders(scene).index(driver)
     out += [
         f"if (dyad_cylinder(&{cin}, &{result}) != DYAD_STATUS_OK) {{",
@@ -261,10 +303,10 @@ def cylinders(scene: Scene) -> list[Crank]:
     return [d for d in scene.drivers if d.is_cylinder()]
 
 
-def _driver_lines(scene: Scene, driver: Crank) -> list[str]:
+def _driver_lines(scene: Scene, mounts: _Mounts, driver: Crank) -> list[str]:
     """A driver's frame and the motion of its origin (O or R)."""
     if driver.is_cylinder():
-        return _cylinder_lines(scene, driver)
+        return _cylinder_lines(scene, mounts, driver)
     c = member(driver.name)
     at = _vec(driver.params["at.x"].c(), driver.params["at.y"].c())
     if driver.is_ram():
@@ -285,7 +327,7 @@ def _driver_lines(scene: Scene, driver: Crank) -> list[str]:
 def kinematics_body(scene: Scene, dyads: list[Dyad]) -> list[str]:
     """The statements of the function `kinematics`."""
     mounts = _Mounts(scene)
-    body = [line for driver in scene.drivers for line in _driver_lines(scene, driver)]
+    body = [line for driver in scene.drivers for line in _driver_lines(scene, mounts, driver)]
     body += ["dyad_kin_input k;"] if dyads else []
     for d in dyads:
         body += _dyad_lines(scene, mounts, d)
@@ -299,6 +341,9 @@ def kinematics_type(scene: Scene) -> str:
     members = [f"    dyad_kin_result {kin_name(d)};" for d in scene.dyads]
     for driver in cylinders(scene):
         members.append(f"    dyad_cylinder_result {kin_name_of_cylinder(driver)};")
+        if is_carried(driver):
+            mount_a, mount_o = mount_names(driver)
+            members.append(f"    dyad_point_motion {mount_a}, {mount_o}; /* its pins A and O */")
     if cylinders(scene):
         members.append("    dyad_kin_result cylinder_failure; /* its failure, as a dyad's */")
     return "\n".join([f"typedef struct {ident}_kinematics {{", *members, f"}} {ident}_kinematics;"])
@@ -442,12 +487,11 @@ def _cross_terms(mass: Param | None, inertia: Param | None, com: tuple, turn: tu
 
 
 def _own_body_cross(driver: Crank, units: tuple[str, str], same: bool) -> list[str]:
-    """A driver's own bodies' terms of M(q)'s entry (a, b): only where a = b, each body
-    moving with its driver alone, except a cylinder's, whose link and axis turn with it."""
-    if not same:
-        return []
+    """A driver's own bodies' terms of M(q)'s entry (a, b): a crank or a ram (turning or
+    sliding on the frame) moves with its own driver alone, where a = b = the driver; a
+    cylinder's link, barrel and rod with whatever moves its pins too."""
     if not driver.is_cylinder():
-        return _driver_inertia_terms(driver, units[0])[0]
+        return _driver_inertia_terms(driver, units[0])[0] if same else []
     params = driver.params
     res = tuple(f"{u}.{kin_name_of_cylinder(driver)}" for u in units)
     terms = _cross_terms(
@@ -473,7 +517,9 @@ def inertia_matrix_terms(scene: Scene, dyads: list[Dyad], a: Crank, b: Crank) ->
     units = (f"unit_{member(a.driver_name())}", f"unit_{member(b.driver_name())}")
     terms = []
     for driver in scene.drivers:
-        if driver is a:
+        if driver.is_cylinder() and (driver is a or is_carried(driver)):
+            terms += _own_body_cross(driver, units, a is b)
+        elif driver is a:
             terms += _own_body_cross(driver, units, a is b)
     for d in dyads:
         for side, g in (("m", d.m), ("n", d.n)):

@@ -250,6 +250,10 @@ def _accelerations(plan: Plan, code: _Code) -> None:
     code(" * external link, and from the carrying link's motion on a moving link. */")
     for driver in plan.drivers:
         plan.accel[driver.name] = None
+        if driver.pivot_on is not None and driver.name in plan.moving:
+            # the pivot O moves with the link carrying it
+            at = (driver.params["at.x"], driver.params["at.y"])
+            _carried_accel(plan, code, driver.name, Attachment("crank", driver.pivot_on, at))
         if driver.is_ram() and plan.crank_needed:
             c = member(driver.name)
             code(f"const dyad_vec2 {c}_a_d = dyad_scale(in->{c}_acceleration, {c}_i);")
@@ -595,9 +599,11 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
     code(" * pins' reactions. */")
     code("{")
     code("    dyad_cylinder_input cyl_in;")
-    params = driver.params
-    pivot = f"fixed_point({_vec(params['at.x'].c(), params['at.y'].c())})"
-    lines = kinematics_c.cylinder_input_lines(scene, driver, "cyl_in", (rate, accel), pivot)
+    if kinematics_c.is_carried(driver):
+        pins = tuple(f"kin.{name}" for name in kinematics_c.mount_names(driver))
+    else:
+        pins = (kinematics_c.fixed_pin(driver, "base"), kinematics_c.fixed_pin(driver, "at"))
+    lines = kinematics_c.cylinder_input_lines(scene, driver, "cyl_in", (rate, accel), pins)
     for line in lines:
         code("    " + line)
     code(f"    cyl_in.link.force = {link}_f;")
@@ -618,13 +624,43 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
 def _crank(plan: Plan, code: _Code) -> None:
     if not plan.crank_needed:
         return
-    for driver in plan.drivers:
+    # from the last driver back: a cylinder's reactions load the earlier driver's link
+    # that carries its pins before that driver's balance
+    for driver in reversed(plan.drivers):
         if driver.is_cylinder():
             _cylinder(plan, code, driver)
+            _cylinder_feedback(plan, code, driver)
         elif driver.is_ram():
             _ram(code, driver)
         else:
             _crank_balance(plan, code, driver)
+
+
+def _cylinder_feedback(plan: Plan, code: _Code, driver: Crank) -> None:
+    """A carried cylinder's reactions on the links carrying its pins: -R_A at A, -R_O at
+    O, with their sizes."""
+    c = member(driver.actuator)
+    for key, carrier, force in (
+        ("base", driver.base_on, f"{c}_cyl.r_a"),
+        ("at", driver.pivot_on, f"{c}_cyl.r_o"),
+    ):
+        if carrier is None:
+            continue
+        g = member(carrier)
+        pin = "A" if key == "base" else "O"
+        r = plan.point(carrier, (driver.params[f"{key}.x"], driver.params[f"{key}.y"]))
+        code(f"/* on {carrier}: the reaction of cylinder {driver.actuator} at {pin} */")
+        code(f"{g}_f = dyad_sub({g}_f, {force});")
+        code(f"{g}_f_size += dyad_norm1({force});")
+        if r is None:
+            continue
+        code(f"{{ const dyad_real moment = -dyad_cross({r}, {force});")
+        code(f"  {g}_m_d += moment;")
+        code(f"  {g}_m_d_size += dyad_norm1({r}) * dyad_norm1({force});")
+        if plan.has_com(carrier):
+            code(f"  {g}_m += moment + dyad_cross({g}_r, {force}); }}")
+        else:
+            code(f"  {g}_m += moment; }}")
 
 
 def _crank_balance(plan: Plan, code: _Code, driver: Crank) -> None:

@@ -297,12 +297,19 @@ class Dual:
         return f"{_LIFT[self.type]}({self.text})"
 
 
+#: the kinematics block's members that hold a carried cylinder's pins A and O (points'
+#: motion), by their names' ending
+_MOUNT_SUFFIXES = ("_mount_a", "_mount_o")
+
+
 def _field_type(steps: tuple) -> str:
     last = steps[-1][1]
     two = ".".join(name for _, name in steps[-2:])
     for key in (two, last):
         if key in _CYLINDER_FIELDS:
             return _CYLINDER_FIELDS[key]
+    if last.endswith(_MOUNT_SUFFIXES):
+        return POINT
     if last in _INT_FIELDS:
         return INT
     return VEC if last in _VEC_FIELDS else POINT if last in _POINT_FIELDS else REAL

@@ -391,26 +391,62 @@ def _cylinder_part(p: Problems, table: dict, found: Crank, part: str, inertia: b
         )
 
 
+def _cylinder_point(
+    p: Problems, table: dict, key: str, found: Crank
+) -> tuple[tuple[float, float], str | None] | None:
+    """A cylinder's pin O (`at`) or A (`base`): [x, y] on the frame (global), or
+    { link = NAME, at = [x, y] } on a driver's link (in its frame); (point, carrier)."""
+    where, i = f"cylinder '{found.actuator}'", found.index
+    value = table.get(key, [0.0, 0.0] if key == "at" else None)
+    if not isinstance(value, dict):
+        point = pair_of_numbers(p, {key: value} if value is not None else {}, key, where, "cylinder", i)
+        return None if point is None else (point, None)
+    carrier = value.get("link")
+    extra = sorted(set(value) - {"link", "at"})
+    if extra or not isinstance(carrier, str) or name_problem(carrier):
+        p.add(
+            f"{where}: '{key}' must be [x, y] (m, on the frame) or "
+            f'{{ link = "NAME", at = [x, y] }} (m, a point of a driver\'s link in its frame)'
+            + (f", not with '{textsafe.plain(str(extra[0]))}'" if extra else ""),
+            "cylinder",
+            i,
+            key,
+        )
+        return None
+    if carrier == "frame":
+        point = pair_of_numbers(p, value, "at", f"{where} {key}", "cylinder", i)
+        return None if point is None else (point, None)
+    point = pair_of_numbers(p, value, "at", f"{where} {key}", "cylinder", i)
+    return None if point is None else (point, carrier)
+
+
 def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
-    """The frame pins O and A, the pin B in the link's frame and the branch."""
+    """The pins O and A (on the frame or a driver's link), the pin B in the link's frame
+    and the branch."""
     name, link, i = found.actuator, found.name, found.index
-    _pivot(p, found, table, "cylinder", f"The pivot O of {link} on the frame")
     where = f"cylinder '{name}'"
-    texts = (
-        ("base", f"{name}.base", "The barrel's pin A on the frame", "global"),
-        ("pin", f"{name}.pin", f"The rod's pin B on {link}", f"in {link}'s frame"),
-    )
-    for key, prefix, text, frame in texts:
-        point = pair_of_numbers(p, table, key, where, "cylinder", i)
-        if point is None:
+    for key, prefix, text in (
+        ("at", f"{link}.at", f"The pivot O of {link} on"),
+        ("base", f"{name}.base", "The barrel's pin A on"),
+    ):
+        placed = _cylinder_point(p, table, key, found)
+        if placed is None:
             continue
-        if key == "pin" and point == (0.0, 0.0):
-            p.add(f"{where}: 'pin' must not be O itself, [0, 0]", "cylinder", i, key)
-            continue
+        point, carrier = placed
+        if key == "at":
+            found.pivot_on = carrier
+        else:
+            found.base_on = carrier
+        on = "the frame, global" if carrier is None else f"{carrier}, in its frame"
         for axis, value in zip("xy", point, strict=True):
-            found.params[f"{key}.{axis}"] = Param(
-                f"{prefix}.{axis}", value, "m", f"{text}, {frame} {axis}"
-            )
+            found.params[f"{key}.{axis}"] = Param(f"{prefix}.{axis}", value, "m", f"{text} {on} {axis}")
+    pin = pair_of_numbers(p, table, "pin", where, "cylinder", i)
+    if pin is not None and pin == (0.0, 0.0):
+        p.add(f"{where}: 'pin' must not be O itself, [0, 0]", "cylinder", i, "pin")
+    elif pin is not None:
+        for axis, value in zip("xy", pin, strict=True):
+            text = f"The rod's pin B on {link}, in {link}'s frame {axis}"
+            found.params[f"pin.{axis}"] = Param(f"{name}.pin.{axis}", value, "m", text)
     branch = table.get("branch")
     if branch not in (1, -1) or isinstance(branch, bool):
         p.add(
@@ -489,7 +525,30 @@ def drivers(
     found = [crank(p, row, inertia, needs_mass, internal) for row in rows["crank"]]
     found += [ram(p, row, needs_mass, internal) for row in rows["ram"]]
     found += [cylinder(p, row, inertia, needs_mass, internal) for row in rows["cylinder"]]
-    return _distinct([d for d in found if d is not None], p)
+    kept = _distinct([d for d in found if d is not None], p)
+    _carriers_checked(p, kept)
+    return kept
+
+
+def _carriers_checked(p: Problems, drivers: list[Crank]) -> None:
+    """A cylinder's pins sit on the frame or on an earlier driver's link (whose motion is
+    known before its own), never on the link it turns."""
+    earlier: set[str] = set()
+    for driver in drivers:
+        for key, carrier in (("at", driver.pivot_on), ("base", driver.base_on)):
+            if carrier is None or carrier in earlier:
+                continue
+            where = f"cylinder '{driver.actuator}'"
+            if carrier == driver.name:
+                why = f"is on '{carrier}', the link the cylinder turns: a cylinder pinned to it at both ends cannot turn it"
+            else:
+                known = ", ".join(sorted(earlier)) or "none"
+                why = (
+                    f"names '{carrier}', which is no earlier driver's link (the frame or a "
+                    f"crank's, a ram's or an earlier cylinder's link: {known})"
+                )
+            p.add(f"{where}: '{key}' {why}", "cylinder", driver.index, key)
+        earlier.add(driver.name)
 
 
 def _distinct(found: list[Crank], p: Problems) -> list[Crank]:

@@ -1,4 +1,4 @@
-"""The FMU of a scene with several drivers (``leg``, ``three_drivers``) evaluated at random
+"""The FMU of a scene with several drivers (one of :data:`.multidriver.NAMES`) evaluated at random
 points of its working ranges and compared output by output with the NumPy reference of
 :mod:`dyadfmu.mechanisms.multidriver`.
 

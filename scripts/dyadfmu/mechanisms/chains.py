@@ -340,7 +340,7 @@ class Chain:
 
         self._read_links(where)
         self.dyads = [dict(d) for d in self.scene.get("dyad", [])]
-        if not self.dyads and self.driver != "cylinder":  # a cylinder alone turns its link
+        if not self.dyads and not self._moves_alone:
             raise ValueError(f"{where}: no [[dyad]]")
 
         self._read_motion()
@@ -430,6 +430,11 @@ class Chain:
             # the barrel's frame is {A; u, j_c}, the rod's {B; u, j_c}: the rod's centre
             # of mass lies com back from B towards A
             self._parts[f"{self.cylinder_name}.{part}"] = (m, i, (sign * along, 0.0))
+
+    @property
+    def _moves_alone(self) -> bool:
+        """Whether the driver is a mechanism without dyads: a cylinder turns its link."""
+        return self.driver == "cylinder"
 
     @property
     def _driver_names(self) -> tuple:

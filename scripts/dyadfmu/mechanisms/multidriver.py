@@ -1,16 +1,31 @@
 """Scenes with several drivers: the whole-mechanism Newton-Euler reference of
-:mod:`.chains` for any mix of cranks, rams and cylinders on the frame.
+:mod:`.chains` for any mix of cranks, rams and cylinders, a cylinder on the frame or on an
+earlier driver's link.
 
-=============  ============================================================================
-name           mechanism (scene file)
-=============  ============================================================================
-leg            ``modelDescription/scenes/leg.toml``: two hip cranks ``front`` and ``rear``
-               and dyad ``knees`` (RRR), the shanks meeting at the foot; a ground force
-               at the foot.
-three_drivers  ``tests/scenes/three_drivers.toml``: crank ``wheel``, cylinder ``jack``
-               (turning link ``arm``), ram ``slide``; dyads ``tie`` and ``hang`` (RRR); a
-               follower force and moment ``tool`` on the hanger.
-=============  ============================================================================
+=================  ========================================================================
+name               mechanism (scene file)
+=================  ========================================================================
+leg                ``modelDescription/scenes/leg.toml``: two hip cranks ``front`` and
+                   ``rear`` and dyad ``knees`` (RRR), the shanks meeting at the foot; a
+                   ground force at the foot.
+three_drivers      ``tests/scenes/three_drivers.toml``: crank ``wheel``, cylinder ``jack``
+                   (turning link ``arm``), ram ``slide``; dyads ``tie`` and ``hang`` (RRR);
+                   a follower force and moment ``tool`` on the hanger.
+carried_cylinders  ``tests/scenes/carried_cylinders.toml``: cylinder ``lift`` raises a
+                   boom; cylinder ``reach``, pinned to the boom at both ends, turns an arm;
+                   a payload at the arm's tip.
+excavator          ``modelDescription/scenes/excavator.toml``: cylinders ``boom_cyl``,
+                   ``stick_cyl`` (on the boom) and ``bucket_cyl`` (on the stick, turning
+                   the rocker); dyad ``linkage`` (RRR) turns the bucket; a digging force
+                   ``dig`` at the bucket's tip.
+loader             ``modelDescription/scenes/loader.toml``: cylinder ``lift_cyl`` raises
+                   the lift arm; cylinder ``tilt_cyl`` (barrel on the frame) turns the
+                   ``bellcrank`` about its pivot on the arm; dyad ``zbar`` (RRR) turns the
+                   bucket; a ``payload`` in the bucket.
+=================  ========================================================================
+
+A cylinder's O and A may ride on an earlier driver's link (``{ link = NAME, at = [x,
+y] }``): they move with it, and it receives minus the cylinder's R_O and R_A there.
 
 Each driver is read as :class:`.chains.Chain` reads a single one (``[crank]`` or
 ``[[crank]]`` and so on), in the order cranks, rams, cylinders, each in file order. Its
@@ -65,8 +80,8 @@ __all__ = [
 ]
 
 #: The mechanisms with several drivers.
-NAMES = ("leg", "three_drivers")
-_TEST_SCENES = ("three_drivers",)
+NAMES = ("leg", "three_drivers", "carried_cylinders", "excavator", "loader")
+_TEST_SCENES = ("three_drivers", "carried_cylinders")
 
 #: Driver kinds in their order, with the names of their coordinate, rate and acceleration.
 COORDINATES = {
@@ -82,7 +97,9 @@ class Driver:
     ``link`` (the body dyads attach to: the crank, the ram, a cylinder's link);
     ``pivot`` (a crank's or a cylinder's link's O, a ram's point at q = 0); ``pin`` (in
     the link's frame: a crank's A, a ram's R = (0, 0), a cylinder's B); ``guide`` (a ram's
-    angle); ``base`` (a cylinder's A) and ``branch`` (its triangle's)."""
+    angle); ``base`` (a cylinder's A) and ``branch`` (its triangle's); ``pivot_on`` and
+    ``base_on``: the earlier driver's link that carries a cylinder's O or A (None: the
+    frame), ``pivot`` and ``base`` then in that link's frame."""
 
     kind: str
     name: str
@@ -92,6 +109,8 @@ class Driver:
     guide: float = 0.0
     base: tuple | None = None
     branch: float = 1.0
+    pivot_on: str | None = None
+    base_on: str | None = None
 
     @property
     def coordinates(self) -> tuple[str, str, str]:
@@ -173,12 +192,57 @@ class MultiChain(chains.Chain):
 
     def _harvested(self, kind: str) -> Driver:
         """The driver :meth:`_read_one_driver` has just read, from what it set."""
-        if kind == "cylinder":
-            name, base, branch = self.cylinder_name, self._base, self._cylinder_branch
-            del self.cylinder_name
-        else:
-            name, base, branch = self.crank_name, None, 1.0
-        return Driver(kind, name, self.crank_name, self._O, self._pin, self._guide, base, branch)
+        if kind != "cylinder":
+            return Driver(kind, self.crank_name, self.crank_name, self._O, self._pin, self._guide)
+        name, base, branch = self.cylinder_name, self._base, self._cylinder_branch
+        del self.cylinder_name
+        carriers = self._carriers
+        return Driver(kind, name, self.crank_name, self._O, self._pin, 0.0, base, branch, *carriers)
+
+    def _read_cylinder(self, table: Mapping, w: str) -> None:
+        """As :meth:`.chains.Chain._read_cylinder`, with O (``at``) and A (``base``) each a
+        point of the frame, [x, y], or of an earlier driver's link, { link = NAME, at =
+        [x, y] } in that link's frame (spec part 2); the carriers in ``_carriers``."""
+        local, carriers = dict(table), []
+        for key in ("at", "base"):
+            carrier, point = self._carried(table, key, w)
+            carriers.append(carrier)
+            local[key] = list(point)
+        if carriers[0] != carriers[1]:
+            # O and A in different frames: their coordinates are not comparable, so the
+            # check that A is off O has no meaning here (the triangle's closure checks it)
+            local["base"] = [local["at"][0] + 1.0, local["at"][1]]
+        super()._read_cylinder(local, w)
+        self._base = tuple(self._carried(table, "base", w)[1])
+        self._carriers = tuple(carriers)
+
+    def _carried(self, table: Mapping, key: str, w: str) -> tuple:
+        """(carrier, point) of a cylinder's ``at`` or ``base``: (None, global point) on
+        the frame, else (the earlier driver's link, the point in its frame)."""
+        spec = table.get(key)
+        if not isinstance(spec, Mapping):
+            return None, geo.pair(table, key, w)
+        where = f"{w}.{key}"
+        stray = sorted(set(spec) - {"link", "at"})
+        if stray:
+            raise ValueError(f"{where}.{stray[0]}: not a key of a carried point (link, at)")
+        carrier = spec.get("link")
+        if carrier == "frame":
+            return None, geo.pair(spec, "at", where)
+        if carrier == table.get("link"):
+            raise ValueError(f"{where}.link: a cylinder's {key!r} is not on the link it turns")
+        earlier = [d.link for d in self.drivers]
+        if carrier not in earlier:
+            raise ValueError(
+                f"{where}.link: {carrier!r} is neither the frame nor an earlier driver's "
+                f"link ({', '.join(earlier) or 'none'})"
+            )
+        return carrier, geo.pair(spec, "at", where)
+
+    @property
+    def _moves_alone(self) -> bool:
+        """Several drivers are a mechanism without dyads too (e.g. a cylinder on a boom)."""
+        return True
 
     @property
     def _driver_names(self) -> tuple:
@@ -258,9 +322,12 @@ class MultiChain(chains.Chain):
             else:
                 cyl = d.name
                 barrel, rod = f"{cyl}.barrel", f"{cyl}.rod"
+                # O's and A's carriers (None: the frame) receive minus R_O and minus R_A
                 pairs += [
-                    {"key": f"{c}.R_O", "kind": "R", "first": c, "point": f"{c}.O"},
-                    {"key": f"{cyl}.R_A", "kind": "R", "first": barrel, "point": f"{cyl}.A"},
+                    {"key": f"{c}.R_O", "kind": "R", "first": c, "second": d.pivot_on}
+                    | {"point": f"{c}.O"},
+                    {"key": f"{cyl}.R_A", "kind": "R", "first": barrel, "second": d.base_on}
+                    | {"point": f"{cyl}.A"},
                     {"key": f"{cyl}.R_B", "kind": "R", "first": c, "second": rod}
                     | {"point": f"{cyl}.B"},
                     chains._sliding(
@@ -294,15 +361,18 @@ class MultiChain(chains.Chain):
         """The kinematics at q, q', q'' (N, drivers)."""
         states, kin = {}, {"t": t}
         for i, d in enumerate(self.drivers):
-            st, entries = self._driver_state(d, q[:, i], dq[:, i], ddq[:, i])
+            st, entries = self._driver_state(d, q[:, i], dq[:, i], ddq[:, i], states)
             states.update(st)
             kin.update(entries)
         for b, state in states.items():
             kin[f"{b}.accel_d"] = state["aD"]
         return self._completed(states, kin, q.shape[:1], np.result_type(q, dq, ddq, float))
 
-    def _driver_state(self, d: Driver, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray) -> tuple:
-        """The states of one driver's bodies and its kinematics entries."""
+    def _driver_state(
+        self, d: Driver, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray, states: dict
+    ) -> tuple:
+        """The states of one driver's bodies and its kinematics entries (``states``:
+        those of the earlier drivers' bodies, a cylinder's carriers among them)."""
         c = d.link
         z2 = np.zeros(q.shape + (2,), dtype=np.result_type(q, float))
         pivot = z2 + np.asarray(d.pivot)
@@ -320,23 +390,31 @@ class MultiChain(chains.Chain):
             kin.update({f"{c}.angle": state["angle"], f"{c}.omega": zero, f"{c}.epsilon": zero})
             kin[f"{c}.R"] = R
             return {c: state}, kin
-        return self._cylinder_state(d, q, dq, ddq, kin)
+        return self._cylinder_state(d, q, dq, ddq, kin, states)
+
+    def _carried_point(self, carrier: str | None, at: tuple, states: dict, shape: tuple):
+        """Position, velocity and acceleration of a cylinder's O or A: fixed on the frame
+        (carrier None) or moving with an earlier driver's link."""
+        if carrier is None:
+            z2 = np.zeros(shape + (2,))
+            return z2 + np.asarray(at), z2.copy(), z2.copy()
+        return self._material(states[carrier], at)
 
     def _cylinder_state(
-        self, d: Driver, s: np.ndarray, ds: np.ndarray, dds: np.ndarray, kin: dict
+        self, d: Driver, s: np.ndarray, ds: np.ndarray, dds: np.ndarray, kin: dict, done: dict
     ) -> tuple:
-        """A cylinder's link, barrel and rod (the closure of :func:`.chains._cylinder`)."""
+        """A cylinder's link, barrel and rod (:func:`cylinder_triangle`), O and A moving
+        with their carriers (``done``: the earlier drivers' states)."""
         c, cyl = d.link, d.name
-        g = chains._cylinder(d.pivot, d.base, d.pin, d.branch, s, ds, dds, cyl)
-        z2 = np.zeros(np.shape(s) + (2,))
-        pivot, base = z2 + np.asarray(d.pivot), z2 + np.asarray(d.base)
+        O = self._carried_point(d.pivot_on, d.pivot, done, np.shape(s))  # noqa: E741
+        A = self._carried_point(d.base_on, d.base, done, np.shape(s))
+        g = cylinder_triangle(O, A, d.pin, d.branch, s, ds, dds, cyl)
         axis = (g["psi"], g["Omega"], g["Omega_dot"])
+        pivot, base = O[0], A[0]
         states = {
-            c: chains._state(g["theta"], g["omega"], g["epsilon"], pivot, z2, z2.copy(), 0.0),
-            f"{cyl}.barrel": chains._state(*axis, base, z2.copy(), z2.copy(), 0.0),
-            f"{cyl}.rod": chains._state(
-                *(a.copy() for a in axis), g["B"], g["v_slide"], g["a_slide"], 0.0
-            ),
+            c: chains._state(g["theta"], g["omega"], g["epsilon"], *O, 0.0),
+            f"{cyl}.barrel": chains._state(*axis, *A, 0.0),
+            f"{cyl}.rod": chains._state(*(a.copy() for a in axis), g["B"], g["v_B"], g["a_B"], 0.0),
         }
         for body in (c, cyl, f"{cyl}.barrel", f"{cyl}.rod"):
             st = states[f"{cyl}.barrel" if body == cyl else body]
@@ -454,9 +532,9 @@ class MultiChain(chains.Chain):
                 i = geo.unit(d.guide)
                 ends = [np.asarray(d.pivot) + x * i for x in self.ranges[d.name]]
                 guides[d.link] = tuple(tuple(map(float, p)) for p in ends)
-            else:
+            elif d.kind == "crank" or d.pivot_on is None:  # a carried O or A moves
                 pivots[f"{d.link}.O"] = tuple(d.pivot)
-            if d.kind == "cylinder":
+            if d.kind == "cylinder" and d.base_on is None:
                 pivots[f"{d.name}.A"] = tuple(d.base)
         for e in self.plan:
             for att in (e["k"], e["p"]):
@@ -563,6 +641,63 @@ class MultiChain(chains.Chain):
         }
         out.update({k: v for k, v in self.outputs(kin).items() if k not in skip})
         return out
+
+
+def cylinder_triangle(
+    pivot: tuple,
+    base: tuple,
+    pin: tuple,
+    branch: float,
+    s: np.ndarray,
+    ds: np.ndarray,
+    dds: np.ndarray,
+    name: str,
+) -> dict:
+    """The triangle O, A, B of a cylinder of length s = |AB| whose link's pivot O and
+    barrel's pin A move: ``pivot`` (O) and ``base`` (A) each (position, velocity,
+    acceleration), (N, 2) arrays; ``pin``: B in the link's frame; s' = ``ds``, s'' =
+    ``dds``. Returns the link's angle ``theta``, ``omega``, ``epsilon``; B, ``v_B``,
+    ``a_B``; the axis u's angle ``psi`` and rates ``Omega``, ``Omega_dot``; the
+    ``conditioning`` |(B - O) x u| / |pin|.
+
+    B - O = rho = x e + y (k x e), e from O to A, |rho| = |pin|, |B - A| = s. The rates
+    follow from B = O + rho turning with the link, differentiated: u . (B' - A') = s'
+    gives omega; (B - A) . (B'' - A'') = s s'' + s'^2 - |B' - A'|^2 gives epsilon."""
+    (pO, vO, aO), (pA, vA, aA) = pivot, base
+    d = geo.norm(pA - pO)
+    e = (pA - pO) / geo.col(d)
+    r = math.hypot(*pin)
+    x = (d * d + r * r - s * s) / (2.0 * d)
+    y2 = r * r - x * x
+    reach = (float(np.max(np.abs(np.real(r - d)))), float(np.min(np.real(r + d))))
+    chains._check_closes(y2, s, reach, name)
+    rho = geo.col(x) * e + geo.col(branch * np.sqrt(y2)) * geo.rot90(e)
+    B = pO + rho
+    cb, sb = pin[0] / r, pin[1] / r  # the link turns pin onto rho
+    theta = geo.angle(geo.vec(cb * rho[:, 0] + sb * rho[:, 1], cb * rho[:, 1] - sb * rho[:, 0]))
+    u = (B - pA) / geo.col(s)
+    j_c = geo.rot90(u)
+    lever = geo.cross(rho, u)  # u . (k x rho)
+    omega = (ds - geo.dot(u, vO - vA)) / lever
+    v_B = vO + geo.col(omega) * geo.rot90(rho)
+    v_rel = v_B - vA  # = s' u + s Omega j_c
+    Omega = geo.dot(v_rel, j_c) / s
+    along = (s * dds + ds * ds - geo.dot(v_rel, v_rel)) / s  # u . (B'' - A'')
+    epsilon = (along - geo.dot(u, aO - aA - geo.col(omega * omega) * rho)) / lever
+    a_B = aO + geo.col(epsilon) * geo.rot90(rho) - geo.col(omega * omega) * rho
+    Omega_dot = (geo.dot(a_B - aA, j_c) - 2.0 * ds * Omega) / s
+    return {
+        "theta": theta,
+        "omega": omega,
+        "epsilon": epsilon,
+        "B": B,
+        "v_B": v_B,
+        "a_B": a_B,
+        "psi": geo.angle(u),
+        "Omega": Omega,
+        "Omega_dot": Omega_dot,
+        "conditioning": np.abs(np.real(lever)) / r,
+    }
 
 
 def inertia_from_energy(chain: MultiChain, q: np.ndarray) -> np.ndarray:
