@@ -1,9 +1,11 @@
 """The mpmath reference with cylinders pinned to moving links (dyadfmu.reference.scene_mp,
 spec part 2), on tests/scenes/carried_cylinders.toml (cylinder lift raises a boom;
-cylinder reach, pinned at both ends to the boom, turns an arm with a payload) and, once
-they exist, modelDescription/scenes/excavator.toml and loader.toml (skipped while
-missing), at points of their working ranges with nonzero rates, accelerations and loads,
-at 50 digits:
+cylinder reach, pinned at both ends to the boom, turns an arm with a payload),
+modelDescription/scenes/excavator.toml (three cylinders, each carried by the previous
+one's link, and an RRR four-bar) and loader.toml (a tilt cylinder with A on the frame
+and O on the lift arm, and an RRR Z-bar), each skipped while its file is missing, at
+points of their working ranges with nonzero rates, accelerations and loads, at 50
+digits:
 
 - every body in equilibrium with its weight, its d'Alembert force and couple and the
   reactions the reference outputs, a carrier bearing minus R_A at A and minus R_O at O of
@@ -39,10 +41,12 @@ DPS = 50
 TOL = mpf(10) ** -25
 #: driver coordinates (lift.length, reach.length in m) over carried_cylinders' range
 CARRIED_POINTS = [(1.1, 1.3), (1.25, 1.5), (1.4, 1.7), (1.15, 1.65), (1.38, 1.35)]
-#: scenes written on another branch: points from their [start] values, skipped if missing
-LATER = ("excavator", "loader")
+#: boom_cyl, stick_cyl, bucket_cyl (m) over the excavator's working range, its corners too
+EXCAVATOR_POINTS = [(2.65, 3.15, 2.35), (1.98, 3.75, 1.9), (3.3, 2.55, 2.8), (2.2, 2.6, 2.0)]
+#: lift_cyl, tilt_cyl (m) over the loader's working range
+LOADER_POINTS = [(1.825, 1.6), (1.25, 1.95), (2.4, 1.25), (2.0, 1.9)]
 CASES = [("carried_cylinders", p) for p in CARRIED_POINTS]
-CASES += [(name, k) for name in LATER for k in (0, 1)]
+CASES += [("excavator", p) for p in EXCAVATOR_POINTS] + [("loader", p) for p in LOADER_POINTS]
 #: frame-pinned scenes, one point each: the rebuilding of cranks and rams checked too
 OTHERS = [("leg", (-1.05, -2.09)), ("three_drivers", (0.5, 1.0, 1.95))]
 #: each driver's rate and acceleration, by kind, the k-th driver's scaled by (-1)^k
@@ -65,15 +69,6 @@ def read(name: str) -> scene_mp.MechanismScene:
     return scene_mp.read_scene(path)
 
 
-def coordinates(scene, point) -> tuple:
-    """The drivers' coordinates: ``point`` itself, or for a scene of LATER its [start]
-    values (point 0) or those turned 1 % (point 1: up, down, up... driver by driver)."""
-    if isinstance(point, tuple):
-        return point
-    start = [scene.inputs[d.motion(True)[0]] for d in scene.drivers]
-    return tuple(q * (1 + 0.01 * point * (-1) ** k) for k, q in enumerate(start))
-
-
 def values_at(scene, point) -> dict:
     """The inputs: the coordinates, each driver's RATES, every load at LOADS."""
     values = {}
@@ -81,7 +76,7 @@ def values_at(scene, point) -> dict:
         names = drv.motion(True)
         rate, accel = RATES[drv.kind]
         sign = (-1) ** k
-        values |= {names[0]: coordinates(scene, point)[k], names[1]: sign * rate}
+        values |= {names[0]: point[k], names[1]: sign * rate}
         values[names[2]] = sign * accel
     for name in scene.inputs:
         if name not in values:
