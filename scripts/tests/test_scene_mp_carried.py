@@ -63,10 +63,7 @@ def _precision():
 
 
 def read(name: str) -> scene_mp.MechanismScene:
-    path = scene_file(name)
-    if not path.is_file():
-        pytest.skip(f"{name}.toml is not written yet")
-    return scene_mp.read_scene(path)
+    return scene_mp.read_scene(scene_file(name))
 
 
 def values_at(scene, point) -> dict:

@@ -105,7 +105,8 @@ def test_the_documentation_says_what_the_fmu_takes(path):
     assert all(re.fullmatch(r"\w+\.(force\.[xy]|moment)", n) for n in loads), loads
     named = ", ".join(f"<code>{n}</code>" for n in motion)
     count = "(1 input)" if len(loads) == 1 else f"({len(loads)} inputs)"
-    who = f"its {len(scene.drivers)} drivers'" if len(scene.drivers) > 1 else f"the {scene.crank.kind}'s"
+    several = len(scene.drivers) > 1
+    who = f"its {len(scene.drivers)} drivers'" if several else f"the {scene.crank.kind}'s"
     assert said.group(1).startswith(f"only {who} motion ({named}) and the active")
     assert count in said.group(1) and "no link's motion is an input" in said.group(1)
 

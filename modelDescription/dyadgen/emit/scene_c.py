@@ -726,9 +726,7 @@ def _inertia_matrix(plan: Plan, code: _Code) -> None:
     code(" * symmetric; efforts = M(q) q'' + h. */")
     for driver in drivers:
         unit = f"unit_{member(driver.driver_name())}"
-        rates = ", ".join(
-            "1.0, 0.0" if other is driver else "0.0, 0.0" for other in drivers
-        )
+        rates = ", ".join("1.0, 0.0" if other is driver else "0.0, 0.0" for other in drivers)
         code(f"{scene.identifier}_kinematics {unit};")
         _unit_kinematics(plan, code, unit, rates)
     for i, a in enumerate(drivers):

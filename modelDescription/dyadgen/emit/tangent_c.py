@@ -509,7 +509,8 @@ class Differentiation:
 
     def _driver_call(self, m: re.Match) -> list[str]:
         rates = [
-            dual(parse(arg), self.names).lifted() for arg in m["rates"].removesuffix(", ").split(", ")
+            dual(parse(arg), self.names).lifted()
+            for arg in m["rates"].removesuffix(", ").split(", ")
         ]
         kin = m["kin"]
         return [

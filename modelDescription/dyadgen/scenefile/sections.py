@@ -238,9 +238,7 @@ def _crank_mass(
         )
 
 
-def _driver_tables(
-    p: Problems, data: dict, section: str, keys: set
-) -> list[tuple[dict, str, int]]:
+def _driver_tables(p: Problems, data: dict, section: str, keys: set) -> list[tuple[dict, str, int]]:
     """The driver tables of a section ([crank], or [[crank]] for several), their keys
     checked: (table, name, index), the name the section's where it is left out or
     invalid."""
@@ -332,9 +330,7 @@ def _part_number(
     value = real(part_t[key])
     if value is None or (key != "com" and not value >= 0):
         what = "a finite number" if key == "com" else "a finite number, not negative"
-        p.add(
-            f"{where}: '{key}' must be {what}, not {shown(part_t[key])}", "cylinder", index, part
-        )
+        p.add(f"{where}: '{key}' must be {what}, not {shown(part_t[key])}", "cylinder", index, part)
         return None
     return value
 
@@ -399,7 +395,9 @@ def _cylinder_point(
     where, i = f"cylinder '{found.actuator}'", found.index
     value = table.get(key, [0.0, 0.0] if key == "at" else None)
     if not isinstance(value, dict):
-        point = pair_of_numbers(p, {key: value} if value is not None else {}, key, where, "cylinder", i)
+        point = pair_of_numbers(
+            p, {key: value} if value is not None else {}, key, where, "cylinder", i
+        )
         return None if point is None else (point, None)
     carrier = value.get("link")
     extra = sorted(set(value) - {"link", "at"})
@@ -439,7 +437,9 @@ def _cylinder_geometry(p: Problems, table: dict, found: Crank) -> None:
             found.base_on = carrier
         on = "the frame, global" if carrier is None else f"{carrier}, in its frame"
         for axis, value in zip("xy", point, strict=True):
-            found.params[f"{key}.{axis}"] = Param(f"{prefix}.{axis}", value, "m", f"{text} {on} {axis}")
+            found.params[f"{key}.{axis}"] = Param(
+                f"{prefix}.{axis}", value, "m", f"{text} {on} {axis}"
+            )
     pin = pair_of_numbers(p, table, "pin", where, "cylinder", i)
     if pin is not None and pin == (0.0, 0.0):
         p.add(f"{where}: 'pin' must not be O itself, [0, 0]", "cylinder", i, "pin")
@@ -494,9 +494,7 @@ def cylinder(
             index,
             "link",
         )
-    found = Crank(
-        link, p.loc.line("cylinder", index), kind="cylinder", actuator=name, index=index
-    )
+    found = Crank(link, p.loc.line("cylinder", index), kind="cylinder", actuator=name, index=index)
     _cylinder_geometry(p, table, found)
     _crank_mass(p, found, table, "cylinder", inertia, needs_mass)
     for part in ("barrel", "rod"):
@@ -540,7 +538,10 @@ def _carriers_checked(p: Problems, drivers: list[Crank]) -> None:
                 continue
             where = f"cylinder '{driver.actuator}'"
             if carrier == driver.name:
-                why = f"is on '{carrier}', the link the cylinder turns: a cylinder pinned to it at both ends cannot turn it"
+                why = (
+                    f"is on '{carrier}', the link the cylinder turns: a cylinder pinned to "
+                    "it cannot turn it"
+                )
             else:
                 known = ", ".join(sorted(earlier)) or "none"
                 why = (
@@ -564,7 +565,9 @@ def _distinct(found: list[Crank], p: Problems) -> list[Crank]:
             kept.append(driver)
             continue
         other = seen[clash]
-        what = "is driven twice" if driver.is_cylinder() or other.is_cylinder() else "is named twice"
+        what = (
+            "is driven twice" if driver.is_cylinder() or other.is_cylinder() else "is named twice"
+        )
         p.add(
             f"{driver.kind} '{driver.driver_name()}': '{clash}' {what}: {other.kind} "
             f"'{other.driver_name()}' (line {other.line}) has that name too",
