@@ -565,9 +565,10 @@ def inertia_entry_unit(row: Crank, column: Crank) -> str:
     return ("kg.m2", "kg.m", "kg")[linear]
 
 
-def inertia_entry_member(row: Crank, column: Crank) -> str:
-    """The C member of M(q)'s entry (row, column)."""
-    return f"inertia_m_{member(row.driver_name())}_{member(column.driver_name())}"
+def inertia_entry_member(scene: Scene, row: Crank, column: Crank) -> str:
+    """The C member of M(q)'s entry (row, column), by the drivers' places in the scene (two
+    names joined could read as two other names joined)."""
+    return f"inertia_m_{scene.drivers.index(row)}_{scene.drivers.index(column)}"
 
 
 def _inertia_matrix_outputs(offer: _Offer, scene: Scene) -> None:
@@ -583,7 +584,7 @@ def _inertia_matrix_outputs(offer: _Offer, scene: Scene) -> None:
             rate = "acceleration" if column.balances_with_force() else "epsilon"
             text = f"Inertia matrix M(q), row {a}, column {b}: d {a}.{effort} / d {b}.{rate}"
             unit = inertia_entry_unit(row, column)
-            c_member = inertia_entry_member(row, column)
+            c_member = inertia_entry_member(scene, row, column)
             _motion_output(offer, f"M.{a}.{b}", unit, text, c_member, position, "driver")
     for driver in scene.drivers:
         c = driver.driver_name()

@@ -729,21 +729,19 @@ def _inertia_matrix(plan: Plan, code: _Code) -> None:
         rates = ", ".join("1.0, 0.0" if other is driver else "0.0, 0.0" for other in drivers)
         code(f"{scene.identifier}_kinematics {unit};")
         _unit_kinematics(plan, code, unit, rates)
+    entry = functools.partial(inertia_entry_member, scene)
     for i, a in enumerate(drivers):
         for b in drivers[i:]:
             terms = kinematics_c.inertia_matrix_terms(scene, plan.kinematic, a, b)
-            code(f"const double {inertia_entry_member(a, b)} = {' + '.join(terms) or '0.0'};")
+            code(f"const double {entry(a, b)} = {' + '.join(terms) or '0.0'};")
         for b in drivers[:i]:
-            code(f"const double {inertia_entry_member(a, b)} = {inertia_entry_member(b, a)};")
+            code(f"const double {entry(a, b)} = {entry(b, a)};")
     for a in drivers:
         effort = effort_of(a)[0]
         if not _wanted(plan, a, f"{effort}0"):
             continue
         c = member(a.driver_name())
-        terms = [
-            f"{inertia_entry_member(a, b)} * {kinematics_c.driver_rates(scene, b)[1]}"
-            for b in drivers
-        ]
+        terms = [f"{entry(a, b)} * {kinematics_c.driver_rates(scene, b)[1]}" for b in drivers]
         code(f"const double {c}_{effort}0 = {c}_{effort} - ({' + '.join(terms)});")
 
 
@@ -769,7 +767,8 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
         for key in ("torque0", "force0", "reduced_j", "reduced_djdq"):
             exprs[f"{c}_{key}"] = f"{c}_{key}"
         for other in scene.drivers:
-            exprs[inertia_entry_member(driver, other)] = inertia_entry_member(driver, other)
+            entry = inertia_entry_member(scene, driver, other)
+            exprs[entry] = entry
         if driver.is_cylinder():
             exprs.update(_cylinder_exprs(driver))
     return exprs
