@@ -148,3 +148,25 @@ def test_engine_torque_meets_lagrange_from_the_fmu_alone(tmp_path):
     lagrange = J * qdd + 0.5 * dJ * qd**2 + dV - force * dx
     power = np.max(np.abs(torque * qd))
     assert np.max(np.abs((torque - lagrange) * qd)) < 1e-9 * power
+
+
+def test_the_scenes_report_has_a_row_per_scene_with_several_drivers(monkeypatch):
+    """dyadfmu scenes' mechanism table (report/mechanisms.rows): a row per FMU of a scene
+    with several drivers, its inputs with external kinematics and its own (every driver's
+    motion and the loads), its worst errors at random working points within 1e-12. The
+    single-driver rows and the callgrind counts are left out here (their own tests)."""
+    from dyadfmu.cosim import multidriver_fmus as mdf
+    from dyadfmu.report import mechanisms
+
+    monkeypatch.setattr(mechanisms.mf, "MECHANISM_FMUS", {})
+    monkeypatch.setattr(mechanisms, "instructions", lambda *a, **k: (math.nan, math.nan))
+    table = mechanisms.rows(paths.build_dir(), quick=True, log=lambda text: None)
+    assert table[0] == list(mechanisms.HEADER)
+    assert [r[0] for r in table[1:]] == list(mdf.NAMES)
+    for r in table[1:]:
+        s = fmi_slave.Slave(paths.built_fmu(r[0], 2), instance_name=r[0])
+        own = sum(v.causality == "input" for v in s.md.modelVariables)
+        s.close()
+        assert int(r[2]) > int(r[3]) == own, r
+        for cell in r[4:6]:
+            assert float(cell.split()[0]) < 1e-12, r
