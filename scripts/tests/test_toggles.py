@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from dyadfmu import paths
 from dyadfmu.fmi.slave import Slave
+from dyadfmu.mechanisms import multidriver
 from dyadfmu.reference import scene_mp
 
 EPS = float(np.finfo(float).eps)
@@ -50,24 +51,20 @@ MOTION["toggles"] = np.linspace(-0.9, 0.85, 8)  # rad, between its two limits
 MOTION["tipper"] = np.linspace(1.25, 4.75, 8)  # m, the cylinder's stroke
 MOTION["cylinder_arm"] = np.linspace(0.25, 2.18, 8)  # m, close to both toggles
 MOTION["cylinder_boom"] = np.linspace(0.95, 1.45, 6)  # m, where its platform hangs
-#: scenes with several drivers: each driver's coordinate in the scene's driver order
-#: (cranks, rams, cylinders), over their working ranges
-MOTION["leg"] = [  # front, rear (rad)
-    (-1.74, -2.79),
-    (-1.05, -2.09),
-    (-0.35, -1.40),
-    (-1.66, -1.48),
-    (-0.44, -2.71),
-    (-1.20, -2.40),
-]
-MOTION["three_drivers"] = [  # wheel (rad), slide (m), jack (m)
-    (0.5, 1.0, 1.95),
-    (1.7, 0.6, 1.85),
-    (2.5, 0.65, 1.86),
-    (4.0, 1.35, 2.01),
-    (5.2, 1.4, 2.02),
-    (-0.8, 0.9, 1.9),
-]
+
+
+def _working_points(name: str, count: int = 6, seed: int = 35) -> list[tuple]:
+    """``count`` random points of the working ranges of a scene with several drivers
+    (chains.toml's, :attr:`.multidriver.MultiChain.ranges`): each a tuple of the drivers'
+    coordinates in the scene's driver order (cranks, rams, cylinders)."""
+    chain = multidriver.load(name)
+    low, high = np.array([chain.ranges[d] for d in chain.driver_names]).T
+    points = np.random.default_rng(seed).uniform(low, high, (count, len(low)))
+    return [tuple(float(x) for x in q) for q in points]
+
+
+#: scenes with several drivers: at points of their working ranges
+MOTION.update({name: _working_points(name) for name in multidriver.NAMES})
 #: the driver's rates and the loads: arbitrary, nonzero
 RATES = {"omega": 9.5, "epsilon": -23.0, "velocity": 0.35, "acceleration": -1.7}
 LOADS = {"force.x": -850.0, "force.y": 420.0, "moment": -3.5}
