@@ -22,6 +22,7 @@ from collections import defaultdict
 import numpy as np
 import pytest
 from dyadfmu import paths
+from dyadfmu.cosim import multidriver_fmus as mdf
 from dyadfmu.fmi.slave import Slave
 from dyadfmu.mechanisms import multidriver
 from dyadfmu.reference import scene_mp
@@ -185,6 +186,8 @@ def dyad_reactions(m: Mechanism) -> dict:
 def test_over_the_motion_every_output_is_within_its_amplification(name):
     """Every output with status 0 within 10 eps x amplification of the peak of its unit
     over the motion; the amplification at least 1 and finite."""
+    if name in multidriver.NAMES and mdf.fmu_path(name, 2) is None:
+        pytest.skip(f"{name}'s FMU is not built yet")
     m = Mechanism(name)
     try:
         samples = []
