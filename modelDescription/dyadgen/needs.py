@@ -601,7 +601,9 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None
     """The motion of the link a cylinder turns and of the cylinder itself, pin B, and the
     triangle's conditioning."""
     link, c = driver.name, driver.actuator
-    rates = _driver_inputs(scene, 3)
+    # every driver's motion, as a dyad's links list it: with several drivers the cylinder
+    # is not the first one (nor, carried, moved by its own alone)
+    position = _driver_inputs(scene, 1)
     bodies = (
         (link, member(link), f"Direction of {link}: angle of its i, in (-pi, pi]", f"{link}"),
         (
@@ -612,7 +614,7 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None
         ),
     )
     for name, cm, text, label in bodies:
-        _motion_output(offer, f"{name}.angle", "rad", text, f"{cm}_angle", rates[:1], "crank")
+        _motion_output(offer, f"{name}.angle", "rad", text, f"{cm}_angle", position, "crank")
         if scene.inertia:
             for key, unit, what, upto in (
                 ("omega", "rad/s", "Angular velocity", 2),
@@ -624,7 +626,7 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None
                     unit,
                     f"{what} of {label}",
                     f"{cm}_{key}",
-                    rates[:upto],
+                    _driver_inputs(scene, upto),
                     "crank",
                 )
     group = [
@@ -633,7 +635,7 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None
             "m",
             f"Position of the rod's pin B of cylinder {c}, global {x}",
             f"{member(c)}_b_position_{x}",
-            depends=rates[:1],
+            depends=position,
             source="crank",
         )
         for x in "xy"
@@ -646,7 +648,7 @@ def _cylinder_motion_outputs(offer: _Offer, scene: Scene, driver: Crank) -> None
         f"Conditioning of cylinder {c} in [0, 1]: |sin| of the angle between O B and A B, 0 "
         "where O, A and B fall in line (the toggle, where the cylinder cannot turn the link)",
         f"{member(c)}_conditioning",
-        rates[:1],
+        position,
         "crank",
     )
 

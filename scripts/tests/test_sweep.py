@@ -1601,3 +1601,33 @@ def test_the_driver_of_a_mechanism_fmu_is_found_by_its_inputs_and_effort():
     assert run.inputs() == ("h.length", "p.force.y") and x.shape == (9, 2)
     assert x[:, 0].tolist() == pytest.approx(stroke.cycloid(1.0, 2.0, 4.0, 9)[0].tolist())
     assert set(x[:, 1]) == {-5.0}
+
+
+def test_every_driver_of_a_mechanism_fmu_is_found():
+    """A scene with several drivers: each, cranks, rams, cylinders, by its own inputs
+    and effort."""
+    from dyadfmu.sweep.checks import drivers_of
+
+    inputs = ("w.angle", "w.omega", "w.epsilon", "s.position", "s.velocity", "s.acceleration")
+    inputs += ("j.length", "j.velocity", "j.acceleration", "t.moment")
+    found = drivers_of(_model(inputs, ("w.torque", "j.force", "s.force", "arm.angle")))
+    assert [(d.kind, d.name, d.effort) for d in found] == [
+        ("crank", "w", "w.torque"), ("ram", "s", "s.force"), ("cylinder", "j", "j.force"),
+    ]  # fmt: skip
+
+
+LEG = paths.build_dir() / "fmus" / "leg_fmi2.fmu"
+
+
+def test_a_mechanism_fmu_with_several_drivers_is_refused_naming_them(tmp_path):
+    """A study moves one driver: the leg's FMU (two hip cranks) is refused at the study's
+    fmu line, naming both drivers."""
+    _needs(LEG)
+    text = BALANCE_STUDY.replace(str(BALANCE), str(LEG))
+    line = next(k for k, t in enumerate(text.splitlines(), start=1) if t.startswith("fmu ="))
+    with pytest.raises(StudyError) as info:
+        study.prepare(_write(tmp_path, text), tmp_path)
+    assert str(info.value) == (
+        f"{tmp_path / 'study.toml'}:{line}: leg_fmi2.fmu has 2 drivers (the crank front, the "
+        "crank rear): a study moves one driver; give a mechanism FMU with one"
+    )

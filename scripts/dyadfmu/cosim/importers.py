@@ -29,7 +29,7 @@ from lxml import etree
 from .. import paths
 from ..fmi.simulate import CoSimSetup, setup_for, simulate
 from ..report import markdown
-from . import harness, mechanism_fmus, scenes
+from . import harness, mechanism_fmus, multidriver_fmus, scenes
 
 DYADS = ("rrr", "rrt", "rtr", "trt", "rtt")
 #: The generic dyad FMUs run over the harness mechanism of their type.
@@ -99,6 +99,7 @@ def _quiet_env() -> dict:
 def fmu_names() -> list[str]:
     """Every FMU the build makes, without the _fmi<v> suffix."""
     mechanisms = [n for n in mechanism_fmus.MECHANISM_FMUS if n not in scenes.NAMES]
+    mechanisms += list(multidriver_fmus.NAMES)
     return (
         [f"dyad_{d}" for d in DYADS] + list(scenes.NAMES) + mechanisms + list(TAILORED) + ["drive"]
     )
@@ -124,7 +125,8 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
     """The harness's co-simulation of the FMU `name` (one crank revolution at `steps`
     communication steps): a generic dyad over the mechanism of its type, a tailored scene
     over its scene's kinematics, a tailored test FMU over the generic dyad's mechanism
-    with its own baked parameters, the drive under a varying load."""
+    with its own baked parameters, a scene with several drivers over one period of its
+    drivers' motion, the drive under a varying load."""
     if name == "drive":
         return drive_setup(version, build)
     if name.startswith("dyad_"):
@@ -137,6 +139,8 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
         )[0]
         path = (build or paths.build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
         return setup_for(path, generic.time, generic.inputs)
+    if name in multidriver_fmus.NAMES:
+        return multidriver_fmus.setup(name, version, 1.0, steps, build)
     if name not in scenes.NAMES:  # a mechanism FMU of a built-in mechanism or a chain
         return mechanism_fmus.setup(name, version, revolutions=1.0, steps=steps, build=build)[0]
     return scenes.setup(name, version, 1.0, steps, build=build)[0]

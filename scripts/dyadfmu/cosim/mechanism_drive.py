@@ -40,7 +40,9 @@ __all__ = ["MACHINES", "DriveRun", "Machine", "machine_of", "run", "reference", 
 
 #: The mechanism FMUs of the study: the harness's motor for the mechanism (the shaper a
 #: 100 N m motor of 7.5 rad/s no-load speed, as the quick-return's), the start speed
-#: [rad/s] and the simulated time [s].
+#: [rad/s] and the simulated time [s]. One drive FMU turns one crank through its J: the
+#: scenes with several drivers (leg, three_drivers) are not among them, their drivers
+#: coupled through M(q) would need a drive each and M's off-diagonal entries between them.
 MACHINES = {
     "slider_crank": ("slider-crank", 314.16, 0.1),
     "four_bar": ("four-bar", 31.4, 0.25),

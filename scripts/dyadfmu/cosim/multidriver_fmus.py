@@ -8,6 +8,9 @@ over the points; a kinematic one (:func:`.mechanism_fmus.is_kinematic`, angles w
 is measured against its own peak, any other against the largest peak of the outputs of
 its unit (N, N.m, kg, kg.m, kg.m2, ...), the accuracy contract of the mechanism FMUs.
 
+:func:`setup` gives the co-simulation of such an FMU along chains.toml's motion of every
+driver at once (the importers' and the Windows binaries' comparisons run it).
+
 Example::
 
     result = compare("leg", 2)
@@ -20,13 +23,28 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from fmpy import read_model_description
 
 from .. import paths
+from ..fmi.simulate import CoSimSetup, setup_for
 from ..fmi.slave import Slave
 from ..mechanisms import multidriver
+from .compare import communication_grid
 from .mechanism_fmus import is_kinematic
 
-__all__ = ["Comparison", "compare", "evaluate", "fmu_path", "summary"]
+__all__ = [
+    "NAMES",
+    "Comparison",
+    "compare",
+    "evaluate",
+    "fmu_path",
+    "setup",
+    "summary",
+    "working_inputs",
+]
+
+#: The scenes with several drivers whose FMUs the build makes and the reference knows.
+NAMES = multidriver.NAMES
 
 
 @dataclass
@@ -60,6 +78,52 @@ def fmu_path(name: str, version: int, build: Path | None = None) -> Path | None:
         return paths.built_fmu(name, version, build, how="scripts/run-tests")
     except FileNotFoundError:
         return None
+
+
+def _inputs_of(chain: multidriver.MultiChain, kin: dict) -> dict:
+    """The FMU's inputs at kin: every driver's coordinate, rate and acceleration, and the
+    [[load]] inputs."""
+    inputs = {n: np.real(kin[n]) for d in chain.drivers for n in d.coordinates}
+    inputs.update({n: np.real(kin[n]) for n in chain.load_inputs()})
+    return inputs
+
+
+def _checked(path: Path, inputs: dict, wanted: set) -> None:
+    """ValueError unless the reference gives exactly the FMU's inputs (one left at its
+    start value would go untested)."""
+    if set(inputs) != wanted:
+        raise ValueError(
+            f"{path.name}: the reference gives {sorted(set(inputs) - wanted)}, no inputs of "
+            f"the FMU, and nothing for its inputs {sorted(wanted - set(inputs))}"
+        )
+
+
+def working_inputs(name: str, count: int, seed: int = 0) -> dict:
+    """The FMU's inputs (name -> (count,)) at ``count`` random points of the working
+    ranges of scene ``name`` (:meth:`.multidriver.MultiChain.working_points`)."""
+    chain = multidriver.load(name)
+    return _inputs_of(chain, chain.working_points(count, seed))
+
+
+def setup(
+    name: str,
+    version: int = 2,
+    revolutions: float = 1.0,
+    steps: int = 120,
+    build: Path | None = None,
+) -> CoSimSetup:
+    """The co-simulation of the FMU of scene ``name`` along chains.toml's motion of every
+    driver at once (:meth:`.multidriver.MultiChain.motion`): ``revolutions`` periods of
+    the loads' swing at ``steps`` communication steps each; each driver's coordinate,
+    rate and acceleration and the [[load]] inputs at the grid's times."""
+    chain = multidriver.load(name)
+    motion = chain.motion("varying", revolutions)
+    t = communication_grid(motion.duration, revolutions, steps)
+    inputs = _inputs_of(chain, chain.kinematics(t, motion))
+    path = paths.built_fmu(name, version, build, how="scripts/run-tests")
+    variables = read_model_description(str(path)).modelVariables
+    _checked(path, inputs, {v.name for v in variables if v.causality == "input"})
+    return setup_for(path, t, inputs)
 
 
 def evaluate(path: Path, inputs: dict, outputs: list) -> dict:
@@ -101,8 +165,7 @@ def compare(
     chain = multidriver.load(name)
     kin = chain.working_points(count, seed)
     want = chain.fmu_outputs(kin)
-    inputs = {n: np.real(kin[n]) for d in chain.drivers for n in d.coordinates}
-    inputs.update({n: np.real(kin[n]) for n in chain.load_inputs()})
+    inputs = _inputs_of(chain, kin)
     variables = Slave(path, instance_name="listing")
     md = variables.md
     variables.close()
@@ -111,12 +174,7 @@ def compare(
         for v in md.modelVariables
         if v.causality == "output" and v.type in ("Real", "Float64")
     }
-    wanted = {v.name for v in md.modelVariables if v.causality == "input"}
-    if set(inputs) != wanted:
-        raise ValueError(
-            f"{path.name}: the reference gives {sorted(set(inputs) - wanted)}, no inputs of "
-            f"the FMU, and nothing for its inputs {sorted(wanted - set(inputs))}"
-        )
+    _checked(path, inputs, {v.name for v in md.modelVariables if v.causality == "input"})
     compared = [o for o in want if o in reals]
     got = evaluate(path, inputs, compared)
     peaks: dict = {}

@@ -26,6 +26,8 @@ from fmpy import read_model_description
 
 from .. import paths
 from ..cosim import mechanism_fmus as mf
+from ..cosim import multidriver_fmus as mdf
+from ..mechanisms import multidriver
 from ..study import bench
 
 GENERATOR = paths.GENERATOR
@@ -33,11 +35,12 @@ GENERATOR = paths.GENERATOR
 
 def inputs_before(name: str) -> list[str]:
     """The inputs the scene's FMU would take with every link's motion an input."""
+    scene = multidriver.scene_path(name) if name in mdf.NAMES else mf.scene_file(name)
     done = subprocess.run(
         [
             sys.executable,
             str(GENERATOR),
-            str(mf.scene_file(name)),
+            str(scene),
             "--external-inputs",
         ],
         capture_output=True,
@@ -76,14 +79,18 @@ def _callgrind(args: list[str], work: Path) -> tuple[int, int]:
 
 
 def instructions(name: str, build: Path, work: Path, rows: int = 200) -> tuple[float, float]:
-    """(instructions per doStep, of them the kinematics) of the FMI 2 mechanism FMU."""
+    """(instructions per doStep, of them the kinematics) of the FMI 2 mechanism FMU, over
+    one driver cycle (several drivers: one period of their motion)."""
     if shutil.which("valgrind") is None or shutil.which("callgrind_annotate") is None:
         return math.nan, math.nan
-    co, series, _ = mf.setup(name, 2, revolutions=1.0, steps=rows, build=build)
+    if name in mdf.NAMES:
+        co = mdf.setup(name, 2, revolutions=1.0, steps=rows, build=build)
+    else:
+        co = mf.setup(name, 2, revolutions=1.0, steps=rows, build=build)[0]
     md = read_model_description(str(co.path))
     inputs = [v for v in md.modelVariables if v.causality == "input"]
     outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
-    data = np.stack([series.inputs[v.name] for v in inputs], axis=1)
+    data = np.stack([co.inputs[v.name] for v in inputs], axis=1)
     file = work / f"{name}.bin"
     data.astype("<f8").tofile(file)
     binary = paths.stage_binary(build, name, 2)
@@ -158,7 +165,25 @@ def rows(build: Path, quick: bool = False, log: Callable = print) -> list:
                 kin = run.worst_of(True) if any(map(mf.is_kinematic, run.errors)) else ("-", 0.0)
                 inputs = (before, len(run.inputs))
                 table.append(row(name, branch, inputs, kin, run.worst_of(False), work))
+        for name in mdf.NAMES:
+            log(f"mechanism FMU {name} (several drivers)")
+            before = _count_before(name, log)
+            work = instructions(name, build, Path(tmp))
+            result = mdf.compare(name, 2, count=40 if quick else 200, build=build)
+            inputs = (before, len(mdf.working_inputs(name, 1)))
+            table.append(row(name, 1, inputs, *_worst_split(result.errors), work))
     return table
+
+
+def _worst_split(errors: dict) -> tuple[tuple[str, float], tuple[str, float]]:
+    """The worst kinematic error and the worst other one, each (output, error); ("-", 0)
+    where there is none."""
+    split = []
+    for kinematic in (True, False):
+        chosen = {k: v for k, v in errors.items() if mf.is_kinematic(k) == kinematic}
+        name = max(chosen, key=chosen.get) if chosen else "-"
+        split.append((name, chosen.get(name, 0.0)))
+    return split[0], split[1]
 
 
 REPORT_TEXT = (
@@ -169,7 +194,11 @@ REPORT_TEXT = (
     "relative to their own peak, the others to the largest peak of their unit), on each "
     "assembly branch, and callgrind's instructions per doStep (FMI 2, set the inputs, "
     "doStep, get the real outputs): in all, in the generated kinematics (both passes: the "
-    "motion, and the unit-rate pass behind J and dJ/dq) and without them:"
+    "motion, and the unit-rate pass behind J and dJ/dq) and without them. The scenes with "
+    "several drivers (no J: their inertia matrix M(q) instead) are "
+    "compared at random points of their working ranges (every driver's coordinate, rate "
+    "and acceleration and the loads drawn at once), their instructions over one period "
+    "of their drivers' motion:"
 )
 
 __all__ = ["HEADER", "REPORT_TEXT", "inputs_before", "instructions", "row", "rows"]

@@ -12,7 +12,15 @@ from fmpy.model_description import ModelDescription
 
 from .studyfile import Counterweight, Driven, Kinetostatic, Stroke, Study, StudyError, line_of
 
-__all__ = ["check_names", "base_values", "units_of", "Driver", "driver_of", "DRIVERS"]
+__all__ = [
+    "check_names",
+    "base_values",
+    "units_of",
+    "Driver",
+    "driver_of",
+    "drivers_of",
+    "DRIVERS",
+]
 
 #: Each kind of driver: its coordinate, rate and acceleration inputs, and its effort
 #: output (the torque or force that drives it), as DRIVER.<suffix>.
@@ -77,12 +85,14 @@ def _cylinder_geometry(name: str, md: ModelDescription) -> tuple[str | None, tup
     return (link, geometry) if set(geometry) <= params else (None, ())
 
 
-def driver_of(md: ModelDescription) -> Driver | None:
-    """The mechanism FMU's driver: a crank (inputs CRANK.angle, .omega, .epsilon, output
-    CRANK.torque), a ram (RAM.position, output RAM.force) or a cylinder (NAME.length,
-    output NAME.force), their rates where the FMU takes them; None where it has none."""
+def drivers_of(md: ModelDescription) -> list[Driver]:
+    """The mechanism FMU's drivers, cranks, rams, cylinders: a crank (inputs
+    CRANK.angle, .omega, .epsilon, output CRANK.torque), a ram (RAM.position, output
+    RAM.force) or a cylinder (NAME.length, output NAME.force), their rates where the FMU
+    takes them."""
     inputs = _names(md, ("input",))
     outputs = set(_names(md, ("output",)))
+    found = []
     for kind, (q, rate, acceleration, effort) in DRIVERS.items():
         for n in inputs:
             name = n[: -len(q) - 1]
@@ -92,15 +102,32 @@ def driver_of(md: ModelDescription) -> Driver | None:
             if kind == "crank" and len(rates) != 2:
                 continue
             link, geometry = _cylinder_geometry(name, md) if kind == "cylinder" else (None, ())
-            return Driver(kind, name, (n, *rates), f"{name}.{effort}", link, geometry)
-    return None
+            found.append(Driver(kind, name, (n, *rates), f"{name}.{effort}", link, geometry))
+    return found
+
+
+def driver_of(md: ModelDescription) -> Driver | None:
+    """The mechanism FMU's first driver (:func:`drivers_of`); None where it has none."""
+    return next(iter(drivers_of(md)), None)
 
 
 def _check_driver(study: Study, md: ModelDescription, what: str) -> Driver:
     """The FMU's driver, refused at the run's line where the run is not one it can do."""
-    d, run = driver_of(md), study.run
+    drivers, run = drivers_of(md), study.run
+    source = "scene" if study.scene is not None else "fmu"
+    if len(drivers) > 1:
+        # a run moves one driver: the others' motion inputs would stay at their start values
+        names = ", ".join(f"the {d.kind} {d.name}" for d in drivers)
+        _fail(
+            study,
+            "study",
+            None,
+            source,
+            f"{what} has {len(drivers)} drivers ({names}): a study moves one driver; "
+            "give a mechanism FMU with one",
+        )
+    d = drivers[0] if drivers else None
     if d is None:
-        source = "scene" if study.scene is not None else "fmu"
         _fail(
             study,
             "study",
