@@ -151,7 +151,9 @@ def core_counts(build: Path, dyad: str, rows: np.ndarray, work: Path) -> tuple[f
 
 def step_rows(md: ModelDescription, count: int, seed: int) -> tuple[list, list, np.ndarray]:
     """An FMU's inputs, Real outputs and `count` rows of inputs swinging smoothly about
-    their start values (an angle by 0.3 rad, a length by 30 %, others by 20 %)."""
+    their start values (an angle by 0.3 rad, a length by 10 %, others by 20 %): within
+    the working range of the scenes' cylinders, whose chains close over a stroke of a
+    few tens of percent of their length (an excavator's three)."""
     inputs = [v for v in md.modelVariables if v.causality == "input"]
     outputs = [
         v for v in md.modelVariables if v.causality == "output" and v.type in ("Real", "Float64")
@@ -164,7 +166,7 @@ def step_rows(md: ModelDescription, count: int, seed: int) -> tuple[list, list, 
         if v.unit == "rad":
             swing = 0.3
         elif v.unit == "m":
-            swing = 0.3 * start
+            swing = 0.1 * start
         else:
             swing = 0.2 * (abs(start) + 1.0)
         rows[:, k] = start + swing * np.sin(t + rng.uniform(0, 2 * math.pi))
