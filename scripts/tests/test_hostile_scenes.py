@@ -208,10 +208,10 @@ def test_a_c_keyword_is_refused_as_a_link_name(keyword, tmp_path):
 
 def _scene_objects(sc) -> list[tuple[str, str]]:
     objects = [("identifier", sc.identifier)]
-    if sc.crank:
-        objects.append(("crank", sc.crank.name))
-    if sc.crank and sc.crank.actuator:  # a cylinder's name is the driver's too
-        objects.append(("crank", sc.crank.actuator))
+    for driver in sc.drivers:
+        objects.append(("crank", driver.name))
+        if driver.actuator:  # a cylinder's name is the driver's too
+            objects.append(("crank", driver.actuator))
     # an unnamed dyad is "dyad" in the generated C (its result, and d_dyad its rate)
     objects += [("dyad", d.name or "dyad") for d in sc.dyads]
     objects += [("link", g) for g in sc.links]
