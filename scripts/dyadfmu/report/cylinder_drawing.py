@@ -142,7 +142,7 @@ def read_scene(path: Path | str) -> CylinderScene:
     )
 
 
-def _prefix(scene: CylinderScene, dyad: dict) -> str:
+def _prefix(dyad: dict) -> str:
     """The prefix of a dyad's variables ("" for the one unnamed dyad of a scene)."""
     return f"{dyad['name']}." if "name" in dyad else ""
 
@@ -158,25 +158,23 @@ def _carrier(attachment: object) -> tuple[str, bool]:
 # ---------------------------------------------------------------------------
 # the FMU
 # ---------------------------------------------------------------------------
-class Machine:
-    """The scene's mechanism FMU, stepped at cylinder lengths: ``at`` gives its outputs;
-    the frame's pins and the loads' points are read once (the FMU's tunable parameters,
-    else the scene's numbers)."""
+class Instance:
+    """A scene's mechanism FMU, opened with tunable parameters: its inputs (start values),
+    its Real outputs, its parameters read as points, one step per set of inputs. Subclasses
+    give ``_start`` (what they read once) and ``_need`` (the outputs they draw)."""
 
-    def __init__(
-        self, scene: CylinderScene, fmu: Path | str, parameters: dict | None = None
-    ) -> None:
+    def __init__(self, scene: object, fmu: Path | str, parameters: dict | None = None) -> None:
         self.scene, self.path = scene, Path(fmu)
         self.slave = Slave(self.path, instance_name=scene.identifier)
         try:
-            self._start(parameters or {})
+            self._open(parameters or {})
+            self._start()
         except Exception:
             self.slave.close()
             raise
 
-    def _start(self, parameters: dict) -> None:
-        """The names checked, the FMU initialised, the frame's pins and loads' points read."""
-        scene = self.scene
+    def _open(self, parameters: dict) -> None:
+        """The parameters' names checked, the outputs' names checked, the FMU initialised."""
         variables = self.slave.md.modelVariables
         self.inputs = {v.name: float(v.start or 0.0) for v in variables if v.causality == "input"}
         tunable = {v.name for v in variables if v.causality == "parameter" and v.type == "Real"}
@@ -192,16 +190,13 @@ class Machine:
         self._require()
         self.slave.initialize(parameters)
         self.time = 0.0
-        n = scene.name
-        self.pivot = self._point(f"{scene.link}.at", scene.pivot)
-        self.base = self._point(f"{n}.base", scene.base)
-        self.pin = self._point(f"{n}.pin", scene.pin)
-        self.load_at = {}
-        for load in scene.loads:
-            default = scene.com if load["link"] == scene.link else scene.link_coms[load["link"]]
-            self.load_at[load["name"]] = self._point(f"{load['name']}.at", load.get("at", default))
-        self.driver = f"{n}.length"
-        self.rated = f"{n}.velocity" in self.inputs
+
+    def _start(self) -> None:
+        """What is read once after initialisation (nothing here)."""
+
+    def _need(self) -> list:
+        """The outputs drawn (none here)."""
+        return []
 
     def _point(self, prefix: str, default: Sequence) -> np.ndarray:
         """The point of the parameters prefix.x and prefix.y, each the FMU's where it has
@@ -216,45 +211,38 @@ class Machine:
 
     def _require(self) -> None:
         """A DrawingError naming the first output the drawing needs that the FMU lacks."""
-        s = self.scene
-        need = [f"{s.name}.B.position.x", f"{s.name}.angle", f"{s.name}.force", f"{s.link}.angle"]
-        for dyad in s.dyads:
-            p = _prefix(s, dyad)
-            need += [f"{p}{pair}.position.x" for pair in ("D_m", "E", "D_n")]
-        need += [f"{load['link']}.angle" for load in s.loads if load["link"] != s.link]
-        for name in need:
+        for name in self._need():
             if name not in self.reals:
                 raise DrawingError(
                     f"{self.path.name}: no output {name}: the drawing needs it (the scene's "
                     'outputs = ["all"] has it)'
                 )
 
+    def motion_inputs(self) -> set:
+        """The inputs of the drivers' motion (none here)."""
+        return set()
+
     def load_inputs(self) -> tuple:
-        """The FMU's inputs but the cylinder's motion: the loads."""
-        motion = {f"{self.scene.name}.{k}" for k in ("length", "velocity", "acceleration")}
+        """The FMU's inputs but the drivers' motion: the loads."""
+        motion = self.motion_inputs()
         return tuple(n for n in self.inputs if n not in motion)
 
-    def at(self, length: float, loads: dict, rate: float = 0.0) -> dict:
-        """Every Real output with the inputs set: the cylinder at ``length`` (m), extending
-        at ``rate`` (m/s) without acceleration, the loads (input -> value) and the other
-        loads 0. A DrawingError where the FMU has no answer there."""
-        values = dict.fromkeys(self.load_inputs(), 0.0)
-        values.update(loads)
-        values[self.driver] = float(length)
-        if self.rated:
-            values[f"{self.scene.name}.velocity"] = float(rate)
-            values[f"{self.scene.name}.acceleration"] = 0.0
+    def step(self, values: dict, where: str) -> dict:
+        """Every Real output and the inputs after one step with the inputs ``values`` (the
+        loads not given 0); a DrawingError starting with ``where`` where the FMU has no
+        answer there."""
+        values = {**dict.fromkeys(self.load_inputs(), 0.0), **values}
         names = tuple(values)
         try:
             self.slave.set(names, [values[n] for n in names])
             self.slave.do_step(self.time, STEP)
         except SlaveError as e:
-            raise DrawingError(f"{self.driver} = {length:.6g} m: {e}") from None
+            raise DrawingError(f"{where}: {e}") from None
         self.time += STEP
         status = self.slave.get_status()
         if status != 0:
             said = self.slave.messages[-1] if self.slave.messages else ""
-            raise DrawingError(f"{self.driver} = {length:.6g} m: status {status} {said}".strip())
+            raise DrawingError(f"{where}: status {status} {said}".strip())
         out = dict(zip(self.reals, self.slave.get(self.reals), strict=True))
         out.update(values)
         return out
@@ -264,18 +252,60 @@ class Machine:
         self.slave.close()
 
 
+class Machine(Instance):
+    """The scene's mechanism FMU, stepped at cylinder lengths: ``at`` gives its outputs;
+    the frame's pins and the loads' points are read once (the FMU's tunable parameters,
+    else the scene's numbers)."""
+
+    def _start(self) -> None:
+        """The frame's pins and loads' points read."""
+        scene = self.scene
+        n = scene.name
+        self.pivot = self._point(f"{scene.link}.at", scene.pivot)
+        self.base = self._point(f"{n}.base", scene.base)
+        self.pin = self._point(f"{n}.pin", scene.pin)
+        self.load_at = {}
+        for load in scene.loads:
+            default = scene.com if load["link"] == scene.link else scene.link_coms[load["link"]]
+            self.load_at[load["name"]] = self._point(f"{load['name']}.at", load.get("at", default))
+        self.driver = f"{n}.length"
+        self.rated = f"{n}.velocity" in self.inputs
+
+    def _need(self) -> list:
+        """The outputs drawn: B, the angles, the force, the dyads' pairs."""
+        s = self.scene
+        need = [f"{s.name}.B.position.x", f"{s.name}.angle", f"{s.name}.force", f"{s.link}.angle"]
+        for dyad in s.dyads:
+            p = _prefix(dyad)
+            need += [f"{p}{pair}.position.x" for pair in ("D_m", "E", "D_n")]
+        need += [f"{load['link']}.angle" for load in s.loads if load["link"] != s.link]
+        return need
+
+    def motion_inputs(self) -> set:
+        """The cylinder's motion inputs."""
+        return {f"{self.scene.name}.{k}" for k in ("length", "velocity", "acceleration")}
+
+    def at(self, length: float, loads: dict, rate: float = 0.0) -> dict:
+        """Every Real output with the inputs set: the cylinder at ``length`` (m), extending
+        at ``rate`` (m/s) without acceleration, the loads (input -> value) and the other
+        loads 0. A DrawingError where the FMU has no answer there."""
+        values = {**loads, self.driver: float(length)}
+        if self.rated:
+            values[f"{self.scene.name}.velocity"] = float(rate)
+            values[f"{self.scene.name}.acceleration"] = 0.0
+        return self.step(values, f"{self.driver} = {length:.6g} m")
+
+
 # ---------------------------------------------------------------------------
 # one length: the points, bodies and forces drawn
 # ---------------------------------------------------------------------------
-@dataclass
-class Pose:
-    """One cylinder length as drawn: every point (key -> (2,) m), the moving bodies (body ->
-    keys of its points, in the order drawn), the pins and sliding pairs, the fixed pivots,
-    the barrel and the rod, the forces (output or load name, body, key of its point, force
-    (2,) N, whether applied) and the FMU's outputs it comes from."""
+@dataclass(kw_only=True)
+class Drawn:
+    """A mechanism as drawn at one position: every point (key -> (2,) m), the moving bodies
+    (body -> keys of its points, in the order drawn), the pins and sliding pairs, the fixed
+    pivots, the forces (output or load name, body, key of its point, force (2,) N, whether
+    applied) and the FMU's outputs it comes from; subclasses give its cylinders."""
 
-    length: float
-    angle: float
     outputs: dict
     points: dict = field(default_factory=dict)
     bodies: dict = field(default_factory=dict)
@@ -283,19 +313,40 @@ class Pose:
     sliders: list = field(default_factory=list)
     pivots: list = field(default_factory=list)
     guides: list = field(default_factory=list)
-    barrel: tuple = ()
-    rod: tuple = ()
     forces: list = field(default_factory=list)
 
+    def cylinders(self) -> dict:
+        """Each cylinder drawn: {name: (barrel (A, mouth), rod (mouth, B))}."""
+        return {}
+
     def segments(self) -> dict:
-        """Every straight piece drawn (name -> (p0, p1)): the barrel, the rod, and each body's
-        bars (two points) or polygon edges."""
-        out = {"barrel": self.barrel, "rod": self.rod}
+        """Every straight piece drawn (name -> (p0, p1)): each cylinder's barrel and rod
+        ("barrel", "rod" of the cylinder named "", else "NAME.barrel", "NAME.rod"), and each
+        body's bars (two points) or polygon edges."""
+        out = {}
+        for name, (barrel, rod) in self.cylinders().items():
+            dot = f"{name}." if name else ""
+            out[f"{dot}barrel"], out[f"{dot}rod"] = barrel, rod
         for body, keys in self.bodies.items():
             closing = keys[:1] if len(keys) > 2 else []  # a polygon closes, a bar does not
             for a, b in zip(keys, keys[1:] + closing, strict=False):
                 out[f"{body}: {a}-{b}"] = (self.points[a], self.points[b])
         return out
+
+
+@dataclass(kw_only=True)
+class Pose(Drawn):
+    """One cylinder length as drawn: :class:`Drawn` with the length, the link's angle, the
+    barrel and the rod."""
+
+    length: float
+    angle: float
+    barrel: tuple = ()
+    rod: tuple = ()
+
+    def cylinders(self) -> dict:
+        """The one cylinder, named ""."""
+        return {"": (self.barrel, self.rod)}
 
 
 def _vector(out: dict, name: str) -> np.ndarray:
@@ -308,11 +359,11 @@ def _turned(angle: float, local: np.ndarray) -> np.ndarray:
     return local[0] * i + local[1] * geo.rot90(i)
 
 
-def _add_dyads(pose: Pose, scene: CylinderScene) -> None:
+def _add_dyads(pose: Pose, dyads: Sequence[dict]) -> None:
     """Each dyad's pair points (outputs), its links' points, pins, sliders and frame pairs."""
     out = pose.outputs
-    for dyad in scene.dyads:
-        p = _prefix(scene, dyad)
+    for dyad in dyads:
+        p = _prefix(dyad)
         for pair in ("D_m", "E", "D_n"):
             pose.points[p + pair] = _vector(out, f"{p}{pair}.position")
         for side, pair, letter in (("k", "D_m", 0), ("p", "D_n", 2)):
@@ -339,31 +390,48 @@ def _add_loads(pose: Pose, machine: Machine) -> None:
             origin = pose.points["O"]
         else:
             dyad, side = next((d, s) for d in scene.dyads for s in ("m", "n") if d[s] == link)
-            origin = pose.points[_prefix(scene, dyad) + ("D_m" if side == "m" else "D_n")]
-        angle = out[f"{link}.angle"]
-        pose.points[name] = origin + _turned(angle, machine.load_at[name])
-        pose.bodies.setdefault(link, []).append(name)
-        if load.get("force", True):
-            force = np.array([out.get(f"{name}.force.x", 0.0), out.get(f"{name}.force.y", 0.0)])
-            if load.get("components", "global") == "link":
-                force = _turned(angle, force)
-            pose.forces.append((name, link, name, force, True))
+            origin = pose.points[_prefix(dyad) + ("D_m" if side == "m" else "D_n")]
+        add_load(pose, load, origin, out[f"{link}.angle"], machine.load_at[name])
+
+
+def add_load(pose: Drawn, load: dict, origin: np.ndarray, angle: float, at: np.ndarray) -> None:
+    """A [[load]]'s point (``at`` in its link's frame, the link's origin and angle given)
+    on its link, and its applied force (its inputs, in the link's components or global)."""
+    name, link, out = load["name"], load["link"], pose.outputs
+    pose.points[name] = origin + _turned(angle, at)
+    pose.bodies.setdefault(link, []).append(name)
+    if load.get("force", True):
+        force = np.array([out.get(f"{name}.force.x", 0.0), out.get(f"{name}.force.y", 0.0)])
+        if load.get("components", "global") == "link":
+            force = _turned(angle, force)
+        pose.forces.append((name, link, name, force, True))
 
 
 def _add_reactions(pose: Pose, scene: CylinderScene) -> None:
     """The pair reactions the FMU has as outputs, each at its point."""
-    n, link, out = scene.name, scene.link, pose.outputs
+    n, link = scene.name, scene.link
     found = [(f"{link}.R_O", link, "O"), (f"{n}.R_A", "barrel", "A"), (f"{n}.R_B", link, "B")]
-    for dyad in scene.dyads:
-        p = _prefix(scene, dyad)
+    add_reactions(pose, found + dyad_reactions(scene.dyads))
+
+
+def dyad_reactions(dyads: Sequence[dict]) -> list:
+    """Each dyad's pair reactions: (output, the body it acts on, the key of its point)."""
+    found = []
+    for dyad in dyads:
+        p = _prefix(dyad)
         found += [
             (f"{p}R_mk", dyad["m"], f"{p}D_m"),
             (f"{p}R_mn", dyad["m"], f"{p}E"),
             (f"{p}R_np", dyad["n"], f"{p}D_n"),
         ]
+    return found
+
+
+def add_reactions(pose: Pose, found: list) -> None:
+    """The reactions of ``found`` (output, body, key) the FMU has as outputs, as forces."""
     for name, body, key in found:
-        if f"{name}.x" in out:
-            pose.forces.append((name, body, key, _vector(out, name), False))
+        if f"{name}.x" in pose.outputs:
+            pose.forces.append((name, body, key, _vector(pose.outputs, name), False))
 
 
 def _ordered(points: dict, keys: list, size: float) -> list:
@@ -396,7 +464,7 @@ def pose(machine: Machine, out: dict, barrel: float) -> Pose:
     found.bodies[scene.link] = ["O", "B"]
     found.pivots += ["O", "A"]
     found.pins += ["O", "A", "B"]
-    _add_dyads(found, scene)
+    _add_dyads(found, scene.dyads)
     _add_loads(found, machine)
     _add_reactions(found, scene)
     size = max(np.ptp(np.array(list(found.points.values())), axis=0).max(), 1e-3)
@@ -439,10 +507,11 @@ def _nice(value: float) -> float:
     return next(m * power for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * power >= value * (1 - 1e-12))
 
 
-def force_scale(forces: list, size: float) -> float:
-    """The force scale (kN per m of arrow): a round number that makes the largest force's
-    arrow at most ``ARROW_SHARE`` of ``size`` (1 where there is no force)."""
-    largest = max((float(np.hypot(*f)) for *_, f, _ in forces), default=0.0) / 1e3
+def force_scale(forces: list, size: float, unit: float = 1e3) -> float:
+    """The force scale (``unit`` N, by default kN, per m of arrow): a round number that
+    makes the largest force's arrow at most ``ARROW_SHARE`` of ``size`` (1 where there is
+    no force)."""
+    largest = max((float(np.hypot(*f)) for *_, f, _ in forces), default=0.0) / unit
     return _nice(largest / (ARROW_SHARE * size)) if largest > 0 else 1.0
 
 
@@ -475,9 +544,9 @@ def _draw_pose(ax: Axes, pose_: Pose, colours: dict, u: float, look: tuple, z: f
     """One length: the cylinder, the bodies, the pins and sliders; ``look`` is (opacity,
     share of the full line widths)."""
     alpha, weight = look
-    (a, mouth), (_, b) = pose_.barrel, pose_.rod
-    sketch.bar(ax, mouth, b, ROD_COLOUR, width=weight * ROD_WIDTH, z=z + 0.2, alpha=alpha)
-    sketch.bar(ax, a, mouth, BARREL_COLOUR, width=weight * BARREL_WIDTH, z=z + 0.3, alpha=alpha)
+    for (a, mouth), (_, b) in pose_.cylinders().values():
+        sketch.bar(ax, mouth, b, ROD_COLOUR, width=weight * ROD_WIDTH, z=z + 0.2, alpha=alpha)
+        sketch.bar(ax, a, mouth, BARREL_COLOUR, width=weight * BARREL_WIDTH, z=z + 0.3, alpha=alpha)
     for body in pose_.bodies:
         _draw_body(ax, pose_, body, colours.get(body, "0.5"), look, z)
     for key in pose_.sliders:
@@ -515,14 +584,15 @@ def _names(pose_: Pose, scene: CylinderScene) -> dict:
     """The label of every point drawn: O, A, B, the dyads' pairs and the loads' names."""
     names = {"O": "O", "A": "A", "B": "B"}
     for dyad in scene.dyads:
-        p = _prefix(scene, dyad)
+        p = _prefix(dyad)
         names.update({p + k: f"{p}{k}" for k in ("D_m", "E", "D_n")})
     names.update({load["name"]: load["name"] for load in scene.loads})
     return {k: v for k, v in names.items() if k in pose_.points}
 
 
-def _label_bodies(ax: Axes, pose_: Pose, scene: CylinderScene, colours: dict, u: float) -> None:
-    """The names of the bodies and of the cylinder, beside them."""
+def _label_bodies(ax: Axes, pose_: Pose, names: dict, colours: dict, u: float) -> None:
+    """The names of the bodies and of the cylinders (``names``: the key of
+    :meth:`Pose.cylinders` -> its name), beside them."""
     for body, keys in pose_.bodies.items():
         xy = np.array([pose_.points[k] for k in keys])
         far = max(range(len(keys)), key=lambda i: float(np.hypot(*(xy[i] - xy[0]))))
@@ -531,16 +601,9 @@ def _label_bodies(ax: Axes, pose_: Pose, scene: CylinderScene, colours: dict, u:
             where = xy.mean(axis=0)
         colour = colours.get(body, "black")
         sketch.label(ax, where, body, (0.0, 0.0), colour=colour, size=10, weight="bold", box=False)
-    a, mouth = pose_.barrel
-    sketch.label(
-        ax,
-        sketch.beside(a, mouth, u, up=False),
-        scene.name,
-        (0.0, 0.0),
-        size=10,
-        weight="bold",
-        box=False,
-    )
+    for key, ((a, mouth), _) in pose_.cylinders().items():
+        where = sketch.beside(a, mouth, u, up=False)
+        sketch.label(ax, where, names[key], (0.0, 0.0), size=10, weight="bold", box=False)
 
 
 def _degrees(angle: float) -> str:
@@ -550,12 +613,17 @@ def _degrees(angle: float) -> str:
 
 def _tag(ax: Axes, pose_: Pose, scene: CylinderScene, alpha: float) -> None:
     """The length and the link's angle, just inside the link's point farthest from O."""
-    keys = pose_.bodies[scene.link]
-    o = pose_.points["O"]
+    text = f"{pose_.length:.3g} m, {_degrees(pose_.angle)}"
+    tag(ax, pose_, pose_.bodies[scene.link], "O", text, alpha)
+
+
+def tag(ax: Axes, pose_: Pose, keys: Sequence[str], origin: str, text: str, alpha: float) -> None:
+    """``text`` just inside the point of ``keys`` farthest from the point ``origin``."""
+    o = pose_.points[origin]
     far = max(keys, key=lambda k: float(np.hypot(*(pose_.points[k] - o))))
     inward = sketch.away(np.mean([pose_.points[k] for k in keys], axis=0), pose_.points[far])
     ax.annotate(
-        f"{pose_.length:.3g} m, {_degrees(pose_.angle)}",
+        text,
         xy=tuple(pose_.points[far]),
         xytext=tuple(36.0 * inward),
         textcoords="offset points",
@@ -594,12 +662,15 @@ def _label_moved(
         )
 
 
-def _arrows(ax: Axes, pose_: Pose, scale: float, u: float, labels: dict) -> dict:
-    """Every force of the pose as an arrow from its point, |F| / scale long (applied loads
-    black, reactions in colours), each labelled for the legend."""
+def _arrows(
+    ax: Axes, pose_: Pose, scale: float, u: float, labels: dict, unit: tuple = ("kN", 1e3)
+) -> dict:
+    """Every force of the pose as an arrow from its point, |F| / scale long (scale in
+    ``unit`` (name, N) per m; applied loads black, reactions in colours), each labelled
+    for the legend."""
     arrows, reaction = {}, 0
     for k, (name, body, key, force, applied) in enumerate(pose_.forces):
-        magnitude = float(np.hypot(*force)) / 1e3
+        magnitude = float(np.hypot(*force)) / unit[1]
         if magnitude == 0.0:
             continue
         if applied:
@@ -612,10 +683,10 @@ def _arrows(ax: Axes, pose_: Pose, scale: float, u: float, labels: dict) -> dict
         arrows[name] = sketch.force_arrow(
             ax,
             pose_.points[key],
-            force / 1e3 / scale,
+            force / unit[1] / scale,
             u,
             colour,
-            f"{text}: {magnitude:.3g} kN",
+            f"{text}: {magnitude:.3g} {unit[0]}",
             width=width,
             z=8 + 0.01 * k,
         )
@@ -642,7 +713,7 @@ def draw(
     names = _names(poses[0], scene)
     drawn = _drawn_points(poses)
     sketch.label_points(ax, poses[0].points, names, size, drop_dotted=False, avoid=drawn)
-    _label_bodies(ax, poses[0], scene, colours, u)
+    _label_bodies(ax, poses[0], {"": scene.name}, colours, u)
     if poses[reactions_at] is not poses[0]:
         _label_moved(ax, poses[0], poses[reactions_at], names, size, drawn)
     loaded = poses[reactions_at]
@@ -899,6 +970,24 @@ def _parser() -> argparse.ArgumentParser:
 
 def _loads_and_sources(p: argparse.ArgumentParser) -> None:
     """The options of the loads, the force figure and the FMU."""
+    load_options(p)
+    p.add_argument(
+        "--rate",
+        type=argtypes.real(-100.0, 100.0),
+        default=0.1,
+        help="the constant extension rate of the force figure's second curves (m/s; default 0.1)",
+    )
+    p.add_argument(
+        "--samples",
+        type=argtypes.whole(2, 10_000),
+        default=101,
+        help="lengths over the stroke in the force figure (default 101)",
+    )
+    source_options(p, "cylinder")
+
+
+def load_options(p: argparse.ArgumentParser) -> None:
+    """The options --load and --set."""
     p.add_argument(
         "--load",
         type=_assignment,
@@ -916,18 +1005,10 @@ def _loads_and_sources(p: argparse.ArgumentParser) -> None:
         metavar="PARAMETER=VALUE",
         help="a tunable parameter of the FMU and its value (SI units), repeatable",
     )
-    p.add_argument(
-        "--rate",
-        type=argtypes.real(-100.0, 100.0),
-        default=0.1,
-        help="the constant extension rate of the force figure's second curves (m/s; default 0.1)",
-    )
-    p.add_argument(
-        "--samples",
-        type=argtypes.whole(2, 10_000),
-        default=101,
-        help="lengths over the stroke in the force figure (default 101)",
-    )
+
+
+def source_options(p: argparse.ArgumentParser, out: str) -> None:
+    """The options --fmi, --build and --out (default out/``out``)."""
     p.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (default 2)")
     p.add_argument(
         "--build",
@@ -938,12 +1019,12 @@ def _loads_and_sources(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--out",
         type=Path,
-        default=paths.ROOT / "out" / "cylinder",
-        help="output folder (default out/cylinder)",
+        default=paths.ROOT / "out" / out,
+        help=f"output folder (default out/{out})",
     )
 
 
-def _loads(machine: Machine, given: list | None) -> dict:
+def loads_given(machine: Instance, given: list | None) -> dict:
     """The load inputs: those given (each checked to be one), else the FMU's start values."""
     names = machine.load_inputs()
     if given is None:
@@ -963,7 +1044,7 @@ def _run(args: argparse.Namespace, say: Callable[[str], None]) -> list:
     fmu = paths.built_fmu(scene.identifier, args.fmi, args.build, how="cmake --build build")
     machine = Machine(scene, fmu, dict(args.set))
     try:
-        loads = _loads(machine, args.load)
+        loads = loads_given(machine, args.load)
         stroke = sorted(args.stroke)
         if stroke[0] == stroke[1]:
             raise DrawingError(f"--stroke {stroke[0]:g} {stroke[1]:g}: the ends must differ")
@@ -986,7 +1067,17 @@ def _run(args: argparse.Namespace, say: Callable[[str], None]) -> list:
 
 def main(argv: list[str] | None = None) -> int:
     """The command: draw the scene's mechanism and its cylinder's force; prints the files."""
-    parser = _parser()
+    return run_command(_parser(), argv, _run)
+
+
+def run_command(
+    parser: argparse.ArgumentParser,
+    argv: list[str] | None,
+    run: Callable[[argparse.Namespace, Callable[[str], None]], list],
+) -> int:
+    """Parse (the scene a file, --out a folder, --build one given), then ``run`` with a
+    function that prints a line with the seconds since the start; a DrawingError as one
+    line and exit status 2; prints the files written."""
     args = paths.parse_checked(
         parser, argv, (("scene", "scene", paths.FILE), ("--out", "out", paths.OUT))
     )
@@ -999,7 +1090,7 @@ def main(argv: list[str] | None = None) -> int:
 
     say(f"checking {args.scene}")
     try:
-        written = _run(args, say)
+        written = run(args, say)
     except (DrawingError, FileNotFoundError) as e:
         parser.exit(2, f"{parser.prog}: error: {e}\n")
     for path in written:
