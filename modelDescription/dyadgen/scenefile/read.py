@@ -145,6 +145,9 @@ def _cylinder_as_crank(scene: Scene, driver: Crank) -> None:
     }
     driver.params["length"] = Param(f"{driver.name}.length", length, "m", "|O B|")
     driver.kind, driver.actuator = "crank", ""
+    # counted as a crank on the frame: a carried pivot's acceleration, which a user would
+    # give as well, is left out of the count
+    driver.pivot_on = driver.base_on = None
 
 
 def inputs_with_external_kinematics(scene: Scene) -> list[str]:
