@@ -1,0 +1,171 @@
+"""The forward dynamics of a mechanism with several drivers as one ODE: the efforts in,
+the motion out, from the whole-mechanism Newton-Euler reference of
+:mod:`dyadfmu.mechanisms.multidriver` alone.
+
+Its inverse dynamics give each driver's effort for a motion, efforts = M(q) q'' + h, with
+M(q) and h(t, q, q') each solved for from the Newton-Euler system of every moving body
+(:meth:`~.multidriver.MultiChain.inertia_matrix`, :meth:`~.multidriver.MultiChain.bias`;
+never from a formula of the generated code). Given the efforts u(t, q, q') the
+accelerations follow as
+
+    q'' = M(q)^-1 (u - h(t, q, q')),
+
+and the state y = (q, q', W) obeys y' = (q', q'', u . q' + P_loads): W is the work the
+drivers and the loads have done since the start, integrated with the motion so that the
+energy balance T + V - W = constant can be checked along it at the solver's own
+accuracy (T, V from the reference's kinetic and potential energies, P_loads the loads'
+power at the state). ``scipy.integrate.solve_ivp`` integrates it (DOP853 by default:
+the mechanism without a motor is not stiff).
+
+Example::
+
+    leg = multidriver.load("leg")
+    run = integrate(leg, holding(leg, {"front": -1.0, "rear": -2.0}), ...)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..mechanisms.multidriver import MultiChain
+
+__all__ = ["Trajectory", "accelerations", "energy", "holding", "integrate"]
+
+#: u(t, q, q') -> efforts (drivers,): the drivers' torques [N m] and forces [N]
+EffortLaw = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A forward run at the times ``t`` (T,): the drivers' coordinates ``q``, rates
+    ``dq``, accelerations ``ddq`` and efforts ``u`` (T, drivers) in the chain's driver
+    order, and ``work`` (T,), the drivers' and loads' work since the start [J]."""
+
+    t: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+    u: np.ndarray
+    work: np.ndarray
+    evaluations: int
+
+
+def _state(
+    chain: MultiChain, t: float, q: np.ndarray, dq: np.ndarray, loads: Mapping | None = None
+) -> dict:
+    """The reference's kinematics at one state, every acceleration zero; the [[load]]
+    inputs ``loads`` or, left out, their models' values at t."""
+    return chain.state(
+        np.asarray(q, float)[None, :], np.asarray(dq, float)[None, :], loads=loads, t=t
+    )
+
+
+def accelerations(
+    chain: MultiChain,
+    t: float,
+    q: np.ndarray,
+    dq: np.ndarray,
+    u: np.ndarray,
+    loads: Mapping | None = None,
+) -> np.ndarray:
+    """q'' (drivers,) at (t, q, q') under the efforts u: M(q) q'' = u - h(t, q, q'), the
+    [[load]] inputs ``loads`` or their models' values at t."""
+    kin = _state(chain, t, q, dq, loads)
+    M, h = chain.inertia_matrix(kin)[0], chain.bias(kin)[0]
+    return np.linalg.solve(M, np.asarray(u, dtype=float) - h)
+
+
+def energy(chain: MultiChain, t: float, q: np.ndarray, dq: np.ndarray) -> float:
+    """T + V [J] at (t, q, q'): the reference's kinetic and potential energies."""
+    kin = _state(chain, t, q, dq)
+    return float(chain.kinetic_energy(kin)[0] + chain.potential_energy(kin)[0])
+
+
+def _load_power(chain: MultiChain, kin: dict) -> float:
+    return float(np.real(chain.load_power(kin))[0])
+
+
+def integrate(
+    chain: MultiChain,
+    law: EffortLaw,
+    q0: Mapping | np.ndarray,
+    dq0: Mapping | np.ndarray,
+    times: np.ndarray,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+    method: str = "DOP853",
+) -> Trajectory:
+    """The motion from (q0, dq0) at ``times[0]`` under the efforts ``law``, reported at
+    ``times`` (increasing); q0, dq0 as arrays in the driver order or {driver: value}.
+    Raises RuntimeError where the solver fails (a chain that stops assembling)."""
+    from scipy.integrate import solve_ivp
+
+    n = len(chain.drivers)
+    y0 = np.concatenate([_vector(chain, q0, "q0"), _vector(chain, dq0, "dq0"), [0.0]])
+    times = np.asarray(times, dtype=float)
+    if times.ndim != 1 or times.size < 2 or np.any(np.diff(times) <= 0):
+        raise ValueError("times: expected an increasing array of at least two instants [s]")
+    count = [0]
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        count[0] += 1
+        q, dq = y[:n], y[n : 2 * n]
+        u = np.asarray(law(t, q, dq), dtype=float)
+        kin = _state(chain, t, q, dq)
+        M, h = chain.inertia_matrix(kin)[0], chain.bias(kin)[0]
+        ddq = np.linalg.solve(M, u - h)
+        if not np.all(np.isfinite(ddq)):
+            raise RuntimeError(
+                f"{chain.name}: no motion at t = {t:.6g} s, q = {q} (a chain "
+                "that does not assemble there, or efforts not finite)"
+            )
+        return np.concatenate([dq, ddq, [u @ dq + _load_power(chain, kin)]])
+
+    sol = solve_ivp(rhs, (times[0], times[-1]), y0, method, times, rtol=rtol, atol=atol)
+    if not sol.success:
+        raise RuntimeError(
+            f"{chain.name}: the forward run failed at t = {sol.t[-1]:.6g} s: {sol.message}"
+        )
+    q, dq, work = sol.y[:n].T, sol.y[n : 2 * n].T, sol.y[-1]
+    u = np.array([law(t, a, b) for t, a, b in zip(sol.t, q, dq, strict=True)], dtype=float)
+    ddq = np.array(
+        [accelerations(chain, t, a, b, f) for t, a, b, f in zip(sol.t, q, dq, u, strict=True)]
+    )
+    return Trajectory(sol.t, q, dq, ddq, u, work, count[0])
+
+
+def _vector(chain: MultiChain, value: Mapping | np.ndarray, what: str) -> np.ndarray:
+    names = chain.driver_names
+    if isinstance(value, Mapping):
+        unknown = sorted(set(value) - set(names))
+        if unknown or len(value) != len(names):
+            raise ValueError(f"{what}: expected a value for each of {', '.join(names)}")
+        value = [value[n] for n in names]
+    v = np.asarray(value, dtype=float)
+    if v.shape != (len(names),) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{what}: expected {len(names)} finite values ({', '.join(names)})")
+    return v
+
+
+def holding(
+    chain: MultiChain, target: Mapping, stiffness: float = 50.0, damping: float = 0.0
+) -> EffortLaw:
+    """A servo about ``target`` ({driver: coordinate}): u = h(t, target, 0) at rest plus
+    M(target) (stiffness^2 (target - q) - damping q'), so that the motion is a lightly
+    coupled oscillation about the target (damping 0 keeps it going)."""
+    if not (math.isfinite(stiffness) and math.isfinite(damping)):
+        raise ValueError("stiffness, damping: expected finite rates [1/s]")
+    goal = _vector(chain, target, "target")
+    kin = _state(chain, 0.0, goal, 0.0 * goal)
+    M, rest = chain.inertia_matrix(kin)[0], chain.bias(kin)[0]
+    gain = stiffness**2 * M
+    damp = damping * M
+
+    def law(t: float, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+        return rest + gain @ (goal - q) - damp @ dq
+
+    return law
