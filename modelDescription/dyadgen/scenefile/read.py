@@ -145,8 +145,8 @@ def _cylinder_as_crank(scene: Scene, driver: Crank) -> None:
     }
     driver.params["length"] = Param(f"{driver.name}.length", length, "m", "|O B|")
     driver.kind, driver.actuator = "crank", ""
-    # counted as a crank on the frame: a carried pivot's acceleration, which a user would
-    # give as well, is left out of the count
+    # a carried pivot moves with its carrier, whose angle, rate and acceleration are inputs
+    # already: its motion follows from them as a dyad's pair on a link does, no input more
     driver.pivot_on = driver.base_on = None
 
 
