@@ -260,7 +260,7 @@ static int test_linear_exact(void)
         }
         REPORT("rtol %.0e: max error %.2e, %ld steps, %ld f\n", rtols[r], worst,
                s.counters.accepted_steps, s.counters.rhs_evaluations);
-        CHECK(worst < 10 * rtols[r], "rtol %g: error %g", rtols[r], worst);
+        CHECK(worst < rtols[r], "rtol %g: error %g", rtols[r], worst);
         CHECK(worst > 1e-3 * rtols[r], "rtol %g: error %g suspiciously small", rtols[r], worst);
     }
     return fails;
@@ -516,7 +516,7 @@ static int test_gsl_motor(void)
                grid_error(3, MOTOR_STEPS, ref, ref2, unit));
         fails += motor_accuracy(&m, ref, errors[c], evaluations[c]);
         for (r = 0; r < 5; ++r) {
-            CHECK(errors[c][r] < 10 * pow(10, -6 - r), "case %d rtol 1e-%d: %g", c, r + 6,
+            CHECK(errors[c][r] < 2 * pow(10, -6 - r), "case %d rtol 1e-%d: %g", c, r + 6,
                   errors[c][r]);
             CHECK(r == 0 || errors[c][r] < errors[c][r - 1], "case %d: no fall at 1e-%d", c, r + 6);
         }
@@ -695,6 +695,8 @@ static int test_step_underflow(void)
            s.counters.accepted_steps);
     CHECK(st == DYAD_ODE_STEP_UNDERFLOW, "status %s", dyad_ode_status_name(st));
     CHECK(fabs(s.t - 0.5) < 1e-9, "stopped at %.17g", s.t);
+    /* It gives up at 16 eps |t|, not at the last bit of t. */
+    CHECK(s.h_next > 1e-16 && s.h_next < 16 * 2.3e-16 * s.t, "gave up at h %g", s.h_next);
     return fails;
 }
 
