@@ -1,0 +1,602 @@
+/* dyadfmu: the integrator of dyadfmu/ode.h, the Rosenbrock method RODASP.
+ *
+ * The problem. A mechanism's equation of motion M(q) q'' = effort - h(q, q')
+ * is smooth and mildly stiff at most; with a DC motor in the same system the
+ * armature current i obeys L i' = V - R i - k_e w, an eigenvalue near -R/L,
+ * down to -1e6 1/s for L/R = 1e-6 s, while the motion it drives changes over
+ * milliseconds. An explicit method must keep h |lambda| inside its stability
+ * region, h < ~3e-6 s there: a thousand steps per millisecond of motion, no
+ * matter the tolerance. The method must therefore be A-stable, and L-stable
+ * (its amplification R(z) -> 0 as z -> -inf), so that the fast mode is
+ * damped out in one step instead of ringing with |R| near 1 (the trapezoidal
+ * rule, ROS3P's |R(inf)| = 0.73).
+ *
+ * Why a Rosenbrock method. An implicit Runge-Kutta or BDF method solves a
+ * nonlinear system per step by Newton's iteration, whose convergence test,
+ * Jacobian reuse and restarts make the cost irregular and the code large. A
+ * Rosenbrock method builds the Newton step into the method: with
+ * J = df/dy (t0, y0), f_t = df/dt (t0, y0), gamma fixed and
+ *      (I / (h gamma) - J) u_i = f(t0 + c_i h, y0 + sum_{j<i} a_ij u_j)
+ *                                 + sum_{j<i} (C_ij / h) u_j + h d_i f_t,
+ * for i = 1..s, each stage is one linear solve with the same matrix: one LU
+ * factorisation per step, s evaluations of f, no iteration, so the cost of a
+ * step is fixed and its result a fixed sequence of operations (bit-for-bit
+ * reproducible). The price is that the order conditions assume the exact J,
+ * which the FMU has (the generated code's directional derivatives); a
+ * forward-difference J is the fallback here, at n evaluations of f.
+ *
+ * Why RODASP. Of the Rosenbrock methods with an embedded estimate, the RODAS
+ * family (E. Hairer, G. Wanner, Solving Ordinary Differential Equations II,
+ * 2nd ed., Springer 1996, section IV.7, and their code rodas.f) is order 4
+ * with an order-3 embedded solution, L-stable, and stiffly accurate (the last
+ * stage's argument is the solution, c_5 = c_6 = 1), so it keeps its order on
+ * very stiff problems and index-1 DAEs. Order 4 matters at the project's
+ * tolerances (rtol 1e-8 and below): the step grows as rtol^(1/4), against
+ * rtol^(1/3) for the order-3 ROS34PW2 or ROS3P, a factor rtol^(-1/12) = 4.6
+ * fewer steps at 1e-8 (the constants aside) for two more stages than
+ * ROS34PW2's four. Six stages, the last one the estimate:
+ *      y1 = y0 + sum_{j<5} a_5j u_j + u_5 + u_6,   error = u_6,
+ * the difference between the order-4 solution and the order-3 one (the
+ * argument of stage 6).
+ * The motor's current is the case that decides between the members: with
+ * L/R small, L i' = V(t) - R i - k w(t) is a Prothero-Robinson equation,
+ * i - g(t) = O(L/R) pulled onto a slowly moving g, on which Hairer's RODAS4
+ * (rodas.f METH = 1) loses order for h >> L/R (its stages do not satisfy
+ * the extra conditions). Measured here on the motor of dyad_ode_tests.c at
+ * rtol 1e-10: RODAS4 took 32209 steps for L/R = 1e-6 s against 4315 for
+ * L/R = 1e-3 s. RODASP (G. Steinebach, Order-reduction of ROW-methods for
+ * DAEs and method of lines applications, Preprint 1741, TH Darmstadt 1995;
+ * rodas.f METH = 2; also called Rodas4P) satisfies them: order 4 on the
+ * Prothero-Robinson problem for any stiffness, and with it the two motors
+ * take 3223 and 3197 steps. The coefficients below are rodas.f's (METH = 2)
+ * to 16 digits. Its continuous extension (rodas.f, CONTRO) is the cubic
+ *      y(t0 + s h) = (1 - s) y0 + s (y1 + (1 - s)(D1 + s D2)),
+ *      D1 = sum_{j<=5} h_1j u_j,  D2 = sum_{j<=5} h_2j u_j,
+ * of order 3, free: the stages are already there. The tests measure the
+ * order 4 (the error of fixed steps falls 16 times per halving) and the
+ * continuous output against exact solutions.
+ *
+ * The error control (rodas.f's): the error of a step is the root mean square
+ * of u_6,i / (atol + rtol max(|y0_i|, |y1_i|)); accepted at <= 1; the next
+ * step is h / fac, fac = err^(1/4) / 0.9 limited to [1/6, 5], with
+ * Gustafsson's predictive factor (from the last accepted step's h and error,
+ * kept in the state) after an accepted step, and no growth right after a
+ * rejection. A singular iteration matrix halves the step.
+ *
+ * Determinism. Nothing but the arguments and the state is read; the loops run
+ * in fixed order; no FMA is asked for (C99 with GCC's -std=c99 contracts
+ * nothing), so two runs of the same calls agree to the bit.
+ */
+#include "dyadfmu/ode.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#define ODE_STAGES 6
+#define ODE_SAFETY ((dyad_real)0.9)
+/** fac = h / h_new is kept in [1 / DYAD_ODE_MAX_GROWTH, 1 / ODE_MIN_SHRINK]. */
+#define ODE_MIN_SHRINK ((dyad_real)0.2)
+
+/* RODASP (Rodas4P), G. Steinebach 1995, as in rodas.f (METH = 2). gamma, and
+ * c_5 = c_6 = 1, d_5 = d_6 = 0 (stiffly accurate). */
+static const dyad_real rodas_gamma = 0.25;
+static const dyad_real rodas_c[ODE_STAGES] = {0.0, 0.75, 0.21, 0.63, 1.0, 1.0};
+static const dyad_real rodas_d[ODE_STAGES] = {0.25, -0.5, -0.023504, -0.0362, 0.0, 0.0};
+/* a[i][j], j < i: the arguments of f; stage 6 is stage 5's plus u_5. */
+static const dyad_real rodas_a[5][4] = {
+    {0.0, 0.0, 0.0, 0.0},
+    {3.0, 0.0, 0.0, 0.0},
+    {1.831036793486759, 0.4955183967433795, 0.0, 0.0},
+    {2.304376582692669, -0.05249275245743001, -1.176798761832782, 0.0},
+    {-7.170454962423024, -4.741636671481785, -16.31002631330971, -1.062004044111401}};
+/* C[i][j], j < i: the stages' coupling, divided by h. */
+static const dyad_real rodas_cc[ODE_STAGES][5] = {
+    {0.0, 0.0, 0.0, 0.0, 0.0},
+    {-12.0, 0.0, 0.0, 0.0, 0.0},
+    {-8.791795173947035, -2.207865586973518, 0.0, 0.0, 0.0},
+    {10.81793056857153, 6.780270611428266, 19.53485944642410, 0.0, 0.0},
+    {34.19095006749676, 15.49671153725963, 54.74760875964130, 14.16005392148534, 0.0},
+    {34.62605830930532, 15.30084976114473, 56.99955578662667, 18.40807009793095,
+     -5.714285714285717}};
+/* The continuous output's D1 and D2 from u_1..u_5. */
+static const dyad_real rodas_h[2][5] = {
+    {25.09876703708589, 11.62013104361867, 28.49148307714626, -5.664021568594133, 0.0},
+    {1.638054557396973, -0.7373619806678748, 8.477918219238990, 15.99253148779520,
+     -1.882352941176471}};
+
+/* What one point (t0, y0) needs for all attempts at a step from it, and the
+ * attempts' scratch. On the stack of dyad_ode_advance(): nothing persists. */
+typedef struct ode_work {
+    dyad_real f0[DYAD_ODE_MAX_DIM];
+    dyad_real ft[DYAD_ODE_MAX_DIM];
+    dyad_real jac[DYAD_ODE_MAX_DIM * DYAD_ODE_MAX_DIM];
+    dyad_real lu[DYAD_ODE_MAX_DIM * DYAD_ODE_MAX_DIM];
+    int pivot[DYAD_ODE_MAX_DIM];
+    dyad_real u[ODE_STAGES][DYAD_ODE_MAX_DIM];
+    dyad_real arg[DYAD_ODE_MAX_DIM];  /* the argument of f at a stage */
+    dyad_real ynew[DYAD_ODE_MAX_DIM]; /* the step's solution */
+} ode_work;
+
+/* ---- options and arguments ------------------------------------------------------------------ */
+
+dyad_ode_options dyad_ode_options_default(void)
+{
+    dyad_ode_options o;
+    o.rtol = (dyad_real)1e-8;
+    o.atol = (dyad_real)1e-10;
+    o.h_max = (dyad_real)INFINITY;
+    o.h_initial = 0;
+    o.max_steps = 100000;
+    return o;
+}
+
+static int ode_finite_vector(int n, const dyad_real* v)
+{
+    int i;
+    for (i = 0; i < n; ++i) {
+        if (!isfinite(v[i])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static int ode_options_valid(const dyad_ode_options* o)
+{
+    return isfinite(o->rtol) && o->rtol > 0 && isfinite(o->atol) && o->atol > 0 && o->h_max > 0 &&
+           isfinite(o->h_initial) && o->h_initial >= 0 && o->max_steps > 0;
+}
+
+dyad_ode_status dyad_ode_init(dyad_ode_state* state, int n, dyad_real t0, const dyad_real* y0,
+                              const dyad_ode_options* options)
+{
+    int i;
+    dyad_ode_state s;
+    if (state == NULL) {
+        return DYAD_ODE_INVALID_ARGUMENT;
+    }
+    for (i = 0; i < DYAD_ODE_MAX_DIM; ++i) {
+        s.y[i] = s.y_last[i] = s.d1[i] = s.d2[i] = 0;
+    }
+    s.n = n;
+    s.t = s.t_failed = t0;
+    s.options = options != NULL ? *options : dyad_ode_options_default();
+    s.counters.rhs_evaluations = s.counters.jacobian_evaluations = s.counters.decompositions = 0;
+    s.counters.accepted_steps = s.counters.rejected_steps = 0;
+    s.h_next = s.h_accepted = s.error_accepted = s.h_last = 0;
+    s.rhs_code = 0;
+    s.status = DYAD_ODE_OK;
+    if (n < 1 || n > DYAD_ODE_MAX_DIM || y0 == NULL || !isfinite(t0) || !ode_finite_vector(n, y0) ||
+        !ode_options_valid(&s.options)) {
+        s.status = DYAD_ODE_INVALID_ARGUMENT;
+    } else {
+        for (i = 0; i < n; ++i) {
+            s.y[i] = y0[i];
+        }
+    }
+    *state = s;
+    return s.status;
+}
+
+const char* dyad_ode_status_name(dyad_ode_status status)
+{
+    switch (status) {
+    case DYAD_ODE_OK: return "ok";
+    case DYAD_ODE_INVALID_ARGUMENT: return "invalid argument";
+    case DYAD_ODE_RHS_FAILED: return "right-hand side failed";
+    case DYAD_ODE_RHS_NONFINITE: return "right-hand side not finite";
+    case DYAD_ODE_JACOBIAN_FAILED: return "Jacobian failed";
+    case DYAD_ODE_SINGULAR: return "singular iteration matrix";
+    case DYAD_ODE_STEP_UNDERFLOW: return "step size underflow";
+    case DYAD_ODE_TOO_MANY_STEPS: return "too many steps";
+    }
+    return "unknown status";
+}
+
+/* ---- linear algebra: LU with partial pivoting, n x n, row-major, in place ------------------- */
+
+/* Returns 0, or 1 where a pivot is zero or not finite (the matrix is singular
+ * to working precision or overflowed). */
+static int ode_lu_factor(int n, dyad_real* a, int* pivot)
+{
+    int i, j, k;
+    for (k = 0; k < n; ++k) {
+        int p = k;
+        for (i = k + 1; i < n; ++i) {
+            if (fabs(a[i * n + k]) > fabs(a[p * n + k])) {
+                p = i;
+            }
+        }
+        pivot[k] = p;
+        if (!(a[p * n + k] != 0) || !isfinite(a[p * n + k])) {
+            return 1;
+        }
+        if (p != k) {
+            for (j = 0; j < n; ++j) {
+                dyad_real swap = a[k * n + j];
+                a[k * n + j] = a[p * n + j];
+                a[p * n + j] = swap;
+            }
+        }
+        for (i = k + 1; i < n; ++i) {
+            dyad_real l = a[i * n + k] /= a[k * n + k];
+            for (j = k + 1; j < n; ++j) {
+                a[i * n + j] -= l * a[k * n + j];
+            }
+        }
+    }
+    return 0;
+}
+
+static void ode_lu_solve(int n, const dyad_real* lu, const int* pivot, dyad_real* b)
+{
+    int i, j;
+    for (i = 0; i < n; ++i) {
+        dyad_real swap = b[pivot[i]];
+        b[pivot[i]] = b[i];
+        b[i] = swap;
+        for (j = 0; j < i; ++j) {
+            b[i] -= lu[i * n + j] * b[j];
+        }
+    }
+    for (i = n - 1; i >= 0; --i) {
+        for (j = i + 1; j < n; ++j) {
+            b[i] -= lu[i * n + j] * b[j];
+        }
+        b[i] /= lu[i * n + i];
+    }
+}
+
+/* ---- evaluations ---------------------------------------------------------------------------- */
+
+/* f(t, y) into dydt, counted; a failure is recorded in the state with t. */
+static dyad_ode_status ode_rhs(dyad_ode_state* s, const dyad_ode_system* sys, dyad_real t,
+                               const dyad_real* y, dyad_real* dydt)
+{
+    int code = sys->rhs(sys->user, t, y, dydt);
+    ++s->counters.rhs_evaluations;
+    if (code != 0 || !ode_finite_vector(s->n, dydt)) {
+        s->rhs_code = code;
+        s->t_failed = t;
+        return code != 0 ? DYAD_ODE_RHS_FAILED : DYAD_ODE_RHS_NONFINITE;
+    }
+    return DYAD_ODE_OK;
+}
+
+/* Forward differences (rodas.f's increments): column j of J from a step of
+ * y_j by sqrt(eps max(1e-5, |y_j|)), df/dt likewise in t. */
+static dyad_ode_status ode_difference_jacobian(dyad_ode_state* s, const dyad_ode_system* sys,
+                                               ode_work* w)
+{
+    int i, j, n = s->n;
+    dyad_real fj[DYAD_ODE_MAX_DIM];
+    dyad_ode_status status;
+    for (j = 0; j < n; ++j) {
+        w->arg[j] = s->y[j];
+    }
+    for (j = 0; j < n; ++j) {
+        dyad_real delta = sqrt(DYAD_REAL_EPSILON * fmax((dyad_real)1e-5, fabs(s->y[j])));
+        w->arg[j] = s->y[j] + delta;
+        delta = w->arg[j] - s->y[j]; /* the step as represented */
+        status = ode_rhs(s, sys, s->t, w->arg, fj);
+        w->arg[j] = s->y[j];
+        if (status != DYAD_ODE_OK) {
+            return status;
+        }
+        for (i = 0; i < n; ++i) {
+            w->jac[i * n + j] = (fj[i] - w->f0[i]) / delta;
+        }
+    }
+    for (i = 0; i < n; ++i) {
+        w->ft[i] = 0;
+    }
+    if (!sys->autonomous) {
+        dyad_real delta = sqrt(DYAD_REAL_EPSILON * fmax((dyad_real)1e-5, fabs(s->t)));
+        delta = (s->t + delta) - s->t;
+        status = ode_rhs(s, sys, s->t + delta, s->y, fj);
+        if (status != DYAD_ODE_OK) {
+            return status;
+        }
+        for (i = 0; i < n; ++i) {
+            w->ft[i] = (fj[i] - w->f0[i]) / delta;
+        }
+    }
+    return DYAD_ODE_OK;
+}
+
+/* f, J and df/dt at the state's (t, y), into the work. */
+static dyad_ode_status ode_linearise(dyad_ode_state* s, const dyad_ode_system* sys, ode_work* w)
+{
+    int n = s->n, code;
+    dyad_ode_status status = ode_rhs(s, sys, s->t, s->y, w->f0);
+    if (status != DYAD_ODE_OK) {
+        return status;
+    }
+    ++s->counters.jacobian_evaluations;
+    if (sys->jacobian == NULL) {
+        return ode_difference_jacobian(s, sys, w);
+    }
+    code = sys->jacobian(sys->user, s->t, s->y, w->f0, w->jac, w->ft);
+    if (code != 0 || !ode_finite_vector(n * n, w->jac) || !ode_finite_vector(n, w->ft)) {
+        s->rhs_code = code;
+        s->t_failed = s->t;
+        return DYAD_ODE_JACOBIAN_FAILED;
+    }
+    return DYAD_ODE_OK;
+}
+
+/* ---- one step ------------------------------------------------------------------------------- */
+
+/* LU of I / (h gamma) - J into w->lu; 1 where singular. */
+static int ode_iteration_matrix(dyad_ode_state* s, ode_work* w, dyad_real h)
+{
+    int i, n = s->n;
+    dyad_real diagonal = 1 / (h * rodas_gamma);
+    for (i = 0; i < n * n; ++i) {
+        w->lu[i] = -w->jac[i];
+    }
+    for (i = 0; i < n; ++i) {
+        w->lu[i * n + i] += diagonal;
+    }
+    ++s->counters.decompositions;
+    return ode_lu_factor(n, w->lu, w->pivot);
+}
+
+/* Stage k (0-based): the argument y0 + sum a_kj u_j (stage 5 adds u_4 to
+ * stage 4's), f there, the right-hand side and the solve, into w->u[k]. */
+static dyad_ode_status ode_stage(dyad_ode_state* s, const dyad_ode_system* sys, ode_work* w,
+                                 dyad_real h, int k)
+{
+    int i, j, n = s->n;
+    dyad_ode_status status = DYAD_ODE_OK;
+    if (k == 0) {
+        for (i = 0; i < n; ++i) {
+            w->u[0][i] = w->f0[i];
+        }
+    } else {
+        for (i = 0; i < n; ++i) {
+            dyad_real arg = s->y[i];
+            for (j = 0; j < k && j < 4; ++j) {
+                arg += rodas_a[k < 5 ? k : 4][j] * w->u[j][i];
+            }
+            w->arg[i] = k == 5 ? arg + w->u[4][i] : arg;
+        }
+        status = ode_rhs(s, sys, s->t + rodas_c[k] * h, w->arg, w->u[k]);
+    }
+    for (i = 0; i < n; ++i) {
+        dyad_real coupling = 0;
+        for (j = 0; j < k; ++j) {
+            coupling += rodas_cc[k][j] * w->u[j][i];
+        }
+        w->u[k][i] += coupling / h + h * rodas_d[k] * w->ft[i];
+    }
+    ode_lu_solve(n, w->lu, w->pivot, w->u[k]);
+    return status;
+}
+
+/* All stages of a step of size h; the solution into w->ynew and the error
+ * norm into *error. */
+static dyad_ode_status ode_attempt(dyad_ode_state* s, const dyad_ode_system* sys, ode_work* w,
+                                   dyad_real h, dyad_real* error)
+{
+    int i, k, n = s->n;
+    dyad_real sum = 0;
+    for (k = 0; k < ODE_STAGES; ++k) {
+        dyad_ode_status status = ode_stage(s, sys, w, h, k);
+        if (status != DYAD_ODE_OK) {
+            return status;
+        }
+    }
+    for (i = 0; i < n; ++i) {
+        dyad_real scale, ratio;
+        w->ynew[i] = w->arg[i] + w->u[5][i];
+        scale = s->options.atol + s->options.rtol * fmax(fabs(s->y[i]), fabs(w->ynew[i]));
+        ratio = w->u[5][i] / scale;
+        sum += ratio * ratio;
+    }
+    *error = sqrt(sum / n);
+    return DYAD_ODE_OK;
+}
+
+/* h / h_new from the error: err^(1/4) / safety, limited. */
+static dyad_real ode_shrink(dyad_real error)
+{
+    dyad_real fac = isfinite(error) ? pow(error, (dyad_real)0.25) / ODE_SAFETY : 1 / ODE_MIN_SHRINK;
+    return fmax(1 / (dyad_real)DYAD_ODE_MAX_GROWTH, fmin(1 / ODE_MIN_SHRINK, fac));
+}
+
+/* The accepted step's next size, with Gustafsson's predictive factor. */
+static dyad_real ode_next_step(dyad_ode_state* s, dyad_real h, dyad_real error)
+{
+    dyad_real fac = ode_shrink(error);
+    if (s->h_accepted > 0) {
+        dyad_real gus = (s->h_accepted / h) *
+                        pow(error * error / s->error_accepted, (dyad_real)0.25) / ODE_SAFETY;
+        gus = fmax(1 / (dyad_real)DYAD_ODE_MAX_GROWTH, fmin(1 / ODE_MIN_SHRINK, gus));
+        fac = fmax(fac, gus);
+    }
+    s->h_accepted = h;
+    s->error_accepted = fmax((dyad_real)1e-2, error);
+    return fmin(h / fac, s->options.h_max);
+}
+
+/* Moves the state to the accepted step's end t_new and keeps its dense output. */
+static void ode_accept(dyad_ode_state* s, const ode_work* w, dyad_real h, dyad_real t_new)
+{
+    int i, j, n = s->n;
+    for (i = 0; i < n; ++i) {
+        dyad_real d1 = 0, d2 = 0;
+        for (j = 0; j < 5; ++j) {
+            d1 += rodas_h[0][j] * w->u[j][i];
+            d2 += rodas_h[1][j] * w->u[j][i];
+        }
+        s->d1[i] = d1;
+        s->d2[i] = d2;
+        s->y_last[i] = s->y[i];
+        s->y[i] = w->ynew[i];
+    }
+    s->h_last = h;
+    s->t = t_new;
+    ++s->counters.accepted_steps;
+}
+
+/* ---- the call ------------------------------------------------------------------------------- */
+
+/* A first step from the sizes of y and f (Hairer, Norsett, Wanner I, II.4):
+ * 1e-2 |y| / |f| in the error's norm, 1e-6 where either is too small. */
+static dyad_real ode_initial_step(const dyad_ode_state* s, const ode_work* w)
+{
+    int i;
+    dyad_real ny = 0, nf = 0;
+    if (s->options.h_initial > 0) {
+        return s->options.h_initial;
+    }
+    for (i = 0; i < s->n; ++i) {
+        dyad_real scale = s->options.atol + s->options.rtol * fabs(s->y[i]);
+        ny += (s->y[i] / scale) * (s->y[i] / scale);
+        nf += (w->f0[i] / scale) * (w->f0[i] / scale);
+    }
+    ny = sqrt(ny / s->n);
+    nf = sqrt(nf / s->n);
+    return ny < 1e-5 || nf < 1e-5 ? (dyad_real)1e-6 : (dyad_real)1e-2 * ny / nf;
+}
+
+/* The fewest steps the controller could cover `span` in from step size h
+ * (growth at most DYAD_ODE_MAX_GROWTH per step, at most h_max), counted up to
+ * `limit` + 1. */
+static long ode_fewest_steps(dyad_real h, dyad_real h_max, dyad_real span, long limit)
+{
+    long count = 0;
+    dyad_real covered = 0;
+    while (covered < span && count <= limit) {
+        h = fmin(h, h_max);
+        covered += h;
+        h *= DYAD_ODE_MAX_GROWTH;
+        ++count;
+    }
+    return count;
+}
+
+/* The step the next call starts with, +inf before the first if not set. */
+static dyad_real ode_planned_step(const dyad_ode_state* s)
+{
+    if (s->h_next > 0) {
+        return s->h_next;
+    }
+    return s->options.h_initial > 0 ? s->options.h_initial : (dyad_real)INFINITY;
+}
+
+static int ode_step_too_small(const dyad_ode_state* s, dyad_real h)
+{
+    return !(h >= 16 * DYAD_REAL_EPSILON * fabs(s->t)) || !(s->t + h != s->t);
+}
+
+/* One accepted step from the state's point toward t_end, with the attempts
+ * it takes; *h is the step to try and becomes the next one's. *attempts
+ * counts against max_steps. */
+static dyad_ode_status ode_step(dyad_ode_state* s, const dyad_ode_system* sys, ode_work* w,
+                                dyad_real t_end, dyad_real* h, long* attempts)
+{
+    int singular = 0, rejected = 0;
+    for (;;) {
+        dyad_real error, try_h = *h, left = t_end - s->t;
+        int last = try_h >= left;
+        dyad_ode_status status;
+        if (*attempts >= s->options.max_steps) {
+            s->t_failed = s->t;
+            return DYAD_ODE_TOO_MANY_STEPS;
+        }
+        if (last) {
+            try_h = left;
+        } else if (ode_step_too_small(s, try_h)) {
+            s->t_failed = s->t;
+            return DYAD_ODE_STEP_UNDERFLOW;
+        }
+        ++*attempts;
+        if (ode_iteration_matrix(s, w, try_h)) {
+            if (++singular > DYAD_ODE_SINGULAR_RETRIES) {
+                s->t_failed = s->t;
+                return DYAD_ODE_SINGULAR;
+            }
+            *h = try_h / 2;
+            continue;
+        }
+        status = ode_attempt(s, sys, w, try_h, &error);
+        if (status != DYAD_ODE_OK) {
+            return status;
+        }
+        if (error <= 1) {
+            dyad_real next = ode_next_step(s, try_h, error);
+            next = rejected ? fmin(next, try_h) : next;
+            /* A step shortened to end on t_end keeps the size proposed before. */
+            *h = last && try_h < *h ? fmax(*h, next) : next;
+            ode_accept(s, w, try_h, last ? t_end : s->t + try_h);
+            return DYAD_ODE_OK;
+        }
+        ++s->counters.rejected_steps;
+        rejected = 1;
+        *h = s->counters.accepted_steps == 0 ? try_h / 10 : try_h / ode_shrink(error);
+    }
+}
+
+static dyad_ode_status ode_finish(dyad_ode_state* s, dyad_ode_status status)
+{
+    s->status = status;
+    return status;
+}
+
+dyad_ode_status dyad_ode_advance(dyad_ode_state* state, const dyad_ode_system* system,
+                                 dyad_real t_end)
+{
+    ode_work w;
+    long attempts = 0;
+    dyad_ode_status status = DYAD_ODE_OK;
+    if (state == NULL) {
+        return DYAD_ODE_INVALID_ARGUMENT;
+    }
+    if (system == NULL || system->rhs == NULL || system->n != state->n || state->n < 1 ||
+        state->n > DYAD_ODE_MAX_DIM || !ode_options_valid(&state->options) ||
+        !(t_end >= state->t) || !isfinite(t_end)) {
+        return ode_finish(state, DYAD_ODE_INVALID_ARGUMENT);
+    }
+    if (ode_fewest_steps(ode_planned_step(state), state->options.h_max, t_end - state->t,
+                         state->options.max_steps) > state->options.max_steps) {
+        state->t_failed = state->t;
+        return ode_finish(state, DYAD_ODE_TOO_MANY_STEPS);
+    }
+    while (status == DYAD_ODE_OK && state->t < t_end) {
+        status = ode_linearise(state, system, &w);
+        if (status == DYAD_ODE_OK) {
+            dyad_real h = state->h_next > 0 ? state->h_next : ode_initial_step(state, &w);
+            h = fmin(h, state->options.h_max);
+            status = ode_step(state, system, &w, t_end, &h, &attempts);
+            state->h_next = h;
+        }
+    }
+    return ode_finish(state, status);
+}
+
+dyad_ode_status dyad_ode_dense(const dyad_ode_state* state, dyad_real t, dyad_real* y,
+                               dyad_real* dydt)
+{
+    int i;
+    dyad_real t0, s;
+    if (state == NULL || !(state->h_last > 0)) {
+        return DYAD_ODE_INVALID_ARGUMENT;
+    }
+    t0 = state->t - state->h_last;
+    if (!(t >= t0 && t <= state->t)) {
+        return DYAD_ODE_INVALID_ARGUMENT;
+    }
+    s = (t - t0) / state->h_last;
+    for (i = 0; i < state->n; ++i) {
+        dyad_real y0 = state->y_last[i], y1 = state->y[i], d1 = state->d1[i], d2 = state->d2[i];
+        if (y != NULL) {
+            y[i] = (1 - s) * y0 + s * (y1 + (1 - s) * (d1 + s * d2));
+        }
+        if (dydt != NULL) {
+            dydt[i] = (y1 - y0 + (1 - 2 * s) * d1 + s * (2 - 3 * s) * d2) / state->h_last;
+        }
+    }
+    return DYAD_ODE_OK;
+}
