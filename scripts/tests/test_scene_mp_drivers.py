@@ -1,23 +1,39 @@
-"""The mpmath reference of a scene with several drivers (dyadfmu.reference.scene_mp), on
-modelDescription/scenes/leg.toml (two cranks, an RRR dyad, a foot load) and
+"""The mpmath reference of scenes with several drivers (dyadfmu.reference.scene_mp):
+modelDescription/scenes/leg.toml (two cranks, an RRR dyad, a foot load),
 tests/scenes/three_drivers.toml (a crank, a ram and a cylinder, two RRR dyads, a
-follower force and moment), at points of their working ranges with nonzero rates,
-accelerations and loads, at 50 digits:
+follower force and moment), and with cylinders pinned to moving links (spec part 2):
+tests/scenes/carried_cylinders.toml (cylinder lift raises a boom; cylinder reach, pinned
+at both ends to the boom, turns an arm with a payload), modelDescription/scenes/
+excavator.toml (three cylinders, each carried by the previous one's link, and an RRR
+four-bar) and loader.toml (a tilt cylinder with A on the frame and O on the lift arm,
+and an RRR Z-bar); at points of their working ranges with nonzero rates, accelerations
+and loads, at 50 digits:
 
 - every body in equilibrium with its weight, its d'Alembert force and couple and the
-  reactions the reference outputs: each driver's body, the cylinder's barrel and rod,
-  every dyad link; the accelerations rebuilt here from the output angles, rates and pair
-  points by rigid-body kinematics from the drivers' motion, to 1e-25 of the largest term;
-- M (from the kinetic energy) symmetric and positive definite, and equal to the efforts'
+  reactions the reference outputs (each driver's body, a cylinder's barrel and rod,
+  every dyad link), a carrier bearing minus R_A at A and minus R_O at O of each cylinder
+  it carries; the accelerations rebuilt here by rigid-body kinematics from the drivers'
+  motion and the output angles, rates and pair points, carrier after carrier, to 1e-25
+  of the largest term;
+- each carried cylinder's triangle closed in position, velocity and acceleration: pin B
+  moved with the link (its pivot O with O's carrier) and with the rod (A with A's
+  carrier, s', s'' along the axis) alike, to 1e-25;
+- M (from the kinetic energy) symmetric, positive definite, and equal to the efforts'
   response to unit accelerations with velocities, gravity and loads off (a Newton-Euler
-  route, symmetric only when the balances are right) to 1e-25;
+  route, symmetric only when the balances are right), to 1e-25;
 - every effort = M q'' + h, h the torque0 / force0 outputs, to 1e-25;
-- the outputs named as the spec says: M.<a>.<b> for every ordered pair, no J nor dJdq.
+- the outputs named as the spec says: M.<a>.<b> for every ordered pair, no J nor dJdq;
+- the refusals: a cylinder pinned to the link it turns, a carrier that is not the frame
+  nor an earlier driver's link (a later cylinder's link, a cylinder's own name, an
+  unknown name, a dyad's link), each with a message naming the field.
 """
 
 from __future__ import annotations
 
+import copy
 import math
+import re
+import tomllib
 
 import mpmath
 import pytest
@@ -33,19 +49,22 @@ LEG_POINTS = [(-60 * DEG, -120 * DEG), (-95 * DEG, -85 * DEG), (-25 * DEG, -155 
 LEG_POINTS.append((-40 * DEG, -100 * DEG))
 #: (wheel.angle rad, slide.position m, jack.length m) over three_drivers' working range
 THREE_POINTS = [(0.5, 1.0, 1.95), (2.5, 0.65, 1.86), (4.0, 1.35, 2.01), (-1.2, 0.8, 1.9)]
-#: the rates, accelerations and loads, arbitrary and nonzero
-LEG_MOTION = {"front.omega": 3.0, "front.epsilon": 10.0, "rear.omega": -2.0}
-LEG_MOTION |= {"rear.epsilon": 5.0, "foot.force.x": 5.0, "foot.force.y": 30.0}
-THREE_MOTION = {"wheel.omega": 2.0, "wheel.epsilon": -3.0, "slide.velocity": -0.3}
-THREE_MOTION |= {"slide.acceleration": 0.5, "jack.velocity": 0.08, "jack.acceleration": -0.2}
-THREE_MOTION |= {"tool.force.x": 10.0, "tool.force.y": -20.0, "tool.moment": 3.0}
+#: driver coordinates (lift.length, reach.length in m) over carried_cylinders' range
+CARRIED_POINTS = [(1.1, 1.3), (1.25, 1.5), (1.4, 1.7), (1.15, 1.65), (1.38, 1.35)]
+#: boom_cyl, stick_cyl, bucket_cyl (m) over the excavator's working range, its corners too
+EXCAVATOR_POINTS = [(2.65, 3.15, 2.35), (1.98, 3.75, 1.9), (3.3, 2.55, 2.8), (2.2, 2.6, 2.0)]
+#: lift_cyl, tilt_cyl (m) over the loader's working range
+LOADER_POINTS = [(1.825, 1.6), (1.25, 1.95), (2.4, 1.25), (2.0, 1.9)]
+#: the scenes with a cylinder pinned to a moving link
+CARRIED = [("carried_cylinders", p) for p in CARRIED_POINTS]
+CARRIED += [("excavator", p) for p in EXCAVATOR_POINTS] + [("loader", p) for p in LOADER_POINTS]
+#: every scene: the frame-pinned ones check the rebuilding of cranks and rams too
 CASES = [("leg", p) for p in LEG_POINTS] + [("three_drivers", p) for p in THREE_POINTS]
-#: what turns every velocity, weight and load off
-STILL = {
-    "leg": {"gravity.y": 0.0, "foot.force.y": 0.0, "foot.force.x": 0.0},
-    "three_drivers": {"gravity.y": 0.0, "tool.force.x": 0.0, "tool.force.y": 0.0},
-}
-STILL["three_drivers"]["tool.moment"] = 0.0
+CASES += CARRIED
+#: each driver's rate and acceleration, by kind, the k-th driver's scaled by (-1)^k
+RATES = {"crank": (2.0, -3.0), "ram": (-0.3, 0.5), "cylinder": (0.08, -0.35)}
+#: every load's inputs (N, N m), arbitrary and nonzero
+LOADS = {"force.x": 150.0, "force.y": -900.0, "moment": 40.0}
 
 
 @pytest.fixture(autouse=True)
@@ -59,33 +78,40 @@ def read(name: str) -> scene_mp.MechanismScene:
     return scene_mp.read_scene(scene_file(name))
 
 
-def values_at(name: str, point: tuple) -> dict:
-    """The inputs: the drivers' coordinates at ``point``, rates, accelerations and loads."""
-    scene = read(name)
-    coords = [d.motion(True)[0] for d in scene.drivers]
-    motion = LEG_MOTION if name == "leg" else THREE_MOTION
-    return {**dict(zip(coords, point, strict=True)), **motion}
+def values_at(scene, point) -> dict:
+    """The inputs: the coordinates, each driver's RATES, every load at LOADS."""
+    values = {}
+    for k, drv in enumerate(scene.drivers):
+        names = drv.motion(True)
+        rate, accel = RATES[drv.kind]
+        sign = (-1) ** k
+        values |= {names[0]: point[k], names[1]: sign * rate}
+        values[names[2]] = sign * accel
+    for name in scene.inputs:
+        if name not in values:
+            values[name] = LOADS[name.split(".", 1)[1]]
+    return values
 
 
-def evaluate(name: str, values: dict) -> dict:
-    r = scene_mp.evaluate(read(name), values, dps=DPS)
-    assert r.status == scene_mp.OK, (name, values, r.reason)
+def evaluate(scene, values) -> dict:
+    r = scene_mp.evaluate(scene, values, dps=DPS)
+    assert r.status == scene_mp.OK, (scene.label, values, r.reason)
     return r.outputs
 
 
 # ---------------------------------------------------------------------------
-# rigid-body kinematics from the outputs
+# plane vectors as (x, y) pairs of mpf
 # ---------------------------------------------------------------------------
-def vec(out: dict, name: str) -> tuple:
-    return (mpf(out[f"{name}.x"]), mpf(out[f"{name}.y"]))
-
-
 def add(*vs):
     return (sum(v[0] for v in vs), sum(v[1] for v in vs))
 
 
 def scale(s, v):
     return (s * v[0], s * v[1])
+
+
+def minus(v):
+    return (-v[0], -v[1])
 
 
 def perp(v):
@@ -96,36 +122,114 @@ def cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
 
 
-class Body:
-    """A body's origin (position, acceleration) and its angle, omega, epsilon."""
+# ---------------------------------------------------------------------------
+# the bodies' motion rebuilt from the outputs, carrier after carrier
+# ---------------------------------------------------------------------------
+class Moving:
+    """A body: its origin's position, velocity and acceleration, angle, omega, epsilon."""
 
-    def __init__(self, origin, accel, angle, omega, epsilon):
-        self.origin, self.accel = origin, accel
+    def __init__(self, origin, angle, omega, epsilon):
+        self.origin = origin  # (position, velocity, acceleration)
         self.i = (mpmath.cos(angle), mpmath.sin(angle))
         self.omega, self.epsilon = mpf(omega), mpf(epsilon)
 
-    def arm(self, local):
-        return add(scale(local[0], self.i), scale(local[1], perp(self.i)))
-
-    def at(self, local):
-        """(position, acceleration) of the body's point ``local``."""
-        r = self.arm(local)
-        acc = add(self.accel, scale(self.epsilon, perp(r)), scale(-(self.omega**2), r))
-        return add(self.origin, r), acc
+    def at(self, local) -> tuple:
+        """(position, velocity, acceleration) of the body's point ``local``."""
+        r = add(scale(local[0], self.i), scale(local[1], perp(self.i)))
+        p, v, a = self.origin
+        w, e = self.omega, self.epsilon
+        return add(p, r), add(v, scale(w, perp(r))), add(a, scale(e, perp(r)), scale(-w * w, r))
 
 
-def link(out: dict, g: str, origin: tuple, accel: tuple) -> Body:
-    """A dyad link from its output angle and rates, its origin D and D's acceleration."""
-    return Body(origin, accel, out[f"{g}.angle"], out[f"{g}.omega"], out[f"{g}.epsilon"])
+ZERO = (mpf(0), mpf(0))
+FRAME = Moving((ZERO, ZERO, ZERO), 0, 0, 0)
 
 
-def crank(scene, values, c: str) -> Body:
+def local(scene, name: str) -> tuple:
     p = scene.parameters
-    at = (mpf(p[f"{c}.at.x"]), mpf(p[f"{c}.at.y"]))
-    motion = (values[f"{c}.{k}"] for k in ("angle", "omega", "epsilon"))
-    return Body(at, (mpf(0), mpf(0)), *motion)
+    return (mpf(p[f"{name}.x"]), mpf(p[f"{name}.y"]))
 
 
+def vec(out, name: str) -> tuple:
+    return (mpf(out[f"{name}.x"]), mpf(out[f"{name}.y"]))
+
+
+class Rebuilt:
+    """Every moving body of a scene (cranks, rams, cylinders' links, RRR dyads' links)
+    and each cylinder's axis, from the inputs and the outputs."""
+
+    def __init__(self, scene, values, out) -> None:
+        self.scene, self.values, self.out = scene, values, out
+        self.bodies: dict[str, Moving] = {}
+        self.axes: dict[str, tuple] = {}
+        for drv in scene.drivers:
+            self.bodies[drv.link] = getattr(self, drv.kind)(drv)
+        for d in scene.dyads:
+            assert d.type == "RRR", "only RRR dyads are rebuilt here"
+            for g, pair, att in ((d.m, "D_m", d.k), (d.n, "D_n", d.p)):
+                _, v, a = self.mount(att)
+                origin = (vec(out, f"{d.prefix}{pair}.position"), v, a)
+                self.bodies[g] = self.link(g, origin)
+
+    def link(self, g: str, origin: tuple) -> Moving:
+        out = self.out
+        return Moving(origin, out[f"{g}.angle"], out[f"{g}.omega"], out[f"{g}.epsilon"])
+
+    def crank(self, drv) -> Moving:
+        motion = (self.values[n] for n in drv.motion(True))
+        return Moving((local(self.scene, f"{drv.name}.at"), ZERO, ZERO), *motion)
+
+    def ram(self, drv) -> Moving:
+        x, v, a = (mpf(self.values[n]) for n in drv.motion(True))
+        guide = mpf(self.scene.parameters[f"{drv.name}.guide"])
+        i = (mpmath.cos(guide), mpmath.sin(guide))
+        at = local(self.scene, f"{drv.name}.at")
+        return Moving((add(at, scale(x, i)), scale(v, i), scale(a, i)), guide, 0, 0)
+
+    def carried(self, carrier, name: str) -> tuple:
+        """A point of the frame (global) or of its carrier's frame, and its motion."""
+        return (FRAME if carrier is None else self.bodies[carrier]).at(local(self.scene, name))
+
+    def cylinder(self, drv) -> Moving:
+        c, g, out = drv.name, drv.link, self.out
+        self.axes[c] = (
+            self.carried(drv.base_on, f"{c}.base"),
+            (mpmath.cos(out[f"{c}.angle"]), mpmath.sin(out[f"{c}.angle"])),
+            mpf(out[f"{c}.omega"]),
+            mpf(out[f"{c}.epsilon"]),
+        )
+        return self.link(g, self.carried(drv.pivot_on, f"{g}.at"))
+
+    def along(self, c: str, x, x1, x2) -> tuple:
+        """(position, velocity, acceleration) of the point x from A along the axis, x
+        growing at x1, x2 (the rod's points at s', s'', the barrel's fixed)."""
+        (a_p, a_v, a_a), u, w, e = self.axes[c]
+        n = perp(u)
+        return (
+            add(a_p, scale(x, u)),
+            add(a_v, scale(x1, u), scale(x * w, n)),
+            add(a_a, scale(x2 - x * w * w, u), scale(2 * x1 * w + x * e, n)),
+        )
+
+    def mount(self, att) -> tuple:
+        """Where a dyad meets its outer link: (position, velocity, acceleration)."""
+        if att.body is None:
+            return self.carried(None, att.at)
+        drv = self.scene.driver_on(att.body)
+        if att.at is not None:
+            point = local(self.scene, att.at)
+        elif drv.kind == "crank":
+            point = (mpf(self.scene.parameters[f"{drv.name}.length"]), 0)
+        elif drv.kind == "cylinder":
+            point = local(self.scene, f"{drv.name}.pin")
+        else:
+            point = ZERO
+        return self.bodies[att.body].at(point)
+
+
+# ---------------------------------------------------------------------------
+# every body's balance
+# ---------------------------------------------------------------------------
 class Balance:
     """The forces at points and couples on one body; the residual of its equilibrium."""
 
@@ -155,143 +259,98 @@ class Balance:
         return max(sums) / max(terms)
 
 
-def minus(v):
-    return (-v[0], -v[1])
+class Balances:
+    """The forces and couples on every body, from the outputs."""
 
+    def __init__(self, scene, values, out) -> None:
+        self.scene, self.values, self.out = scene, values, out
+        self.rb = Rebuilt(scene, values, out)
+        p = scene.parameters
+        self.gravity = (mpf(p.get("gravity.x", 0)), mpf(p.get("gravity.y", 0)))
+        self.of: dict[str, Balance] = {}
 
-def leg_balances(scene, values, out) -> dict:
-    g = (mpf(0), mpf(-9.81))
-    cranks = {c: crank(scene, values, c) for c in ("front", "rear")}
-    pins = {c: b.at((mpf(scene.parameters[f"{c}.length"]), mpf(0))) for c, b in cranks.items()}
-    shank_m = link(out, "front_shank", vec(out, "knees.D_m.position"), pins["front"][1])
-    shank_n = link(out, "rear_shank", vec(out, "knees.D_n.position"), pins["rear"][1])
-    e = vec(out, "knees.E.position")
-    bal = {}
-    for c, body in cranks.items():
-        b = bal[c] = Balance()
-        b.force(body.origin, vec(out, f"{c}.R_O"))
-        pair = "R_mk" if c == "front" else "R_np"
-        b.force(pins[c][0], minus(vec(out, f"knees.{pair}")))
-        b.couple(out[f"{c}.torque"])
-        b.mass(scene, c, body.at(_com(scene, c)), body.epsilon, g)
-    b = bal["front_shank"] = Balance()
-    b.force(shank_m.origin, vec(out, "knees.R_mk"))
-    b.force(e, vec(out, "knees.R_mn"))
-    b.force(
-        shank_m.at(_local(scene, "foot.at"))[0], (values["foot.force.x"], values["foot.force.y"])
-    )
-    b.mass(scene, "front_shank", shank_m.at(_com(scene, "front_shank")), shank_m.epsilon, g)
-    b = bal["rear_shank"] = Balance()
-    b.force(shank_n.origin, vec(out, "knees.R_np"))
-    b.force(e, minus(vec(out, "knees.R_mn")))
-    b.mass(scene, "rear_shank", shank_n.at(_com(scene, "rear_shank")), shank_n.epsilon, g)
-    return bal
+    def on(self, body) -> Balance | None:
+        """The balance of ``body`` (None: the frame, which is not checked)."""
+        return None if body is None else self.of.setdefault(body, Balance())
 
+    def weigh(self, body: str, name: str, point: tuple, epsilon) -> None:
+        """Weight and d'Alembert force at the centre of mass ``point``, the d'Alembert couple."""
+        self.on(body).mass(self.scene, name, (point[0], point[2]), epsilon, self.gravity)
 
-def _local(scene, name: str) -> tuple:
-    p = scene.parameters
-    return (mpf(p[f"{name}.x"]), mpf(p[f"{name}.y"]))
+    def all(self) -> dict[str, Balance]:
+        for drv in self.scene.drivers:
+            getattr(self, drv.kind)(drv)
+        for d in self.scene.dyads:
+            self.dyad(d)
+        for name, link, components, has_force, has_moment in self.scene.point_loads:
+            self.load(name, link, components, has_force, has_moment)
+        return self.of
 
+    def crank(self, drv) -> None:
+        c, body, out = drv.name, self.rb.bodies[drv.link], self.out
+        self.on(c).force(body.origin[0], vec(out, f"{c}.R_O"))
+        self.on(c).couple(out[f"{c}.torque"])
+        self.weigh(c, c, body.at(local(self.scene, f"{c}.com")), body.epsilon)
 
-def _com(scene, name: str) -> tuple:
-    return _local(scene, f"{name}.com")
+    def ram(self, drv) -> None:
+        c, body, out = drv.name, self.rb.bodies[drv.link], self.out
+        push = add(scale(out[f"{c}.force"], body.i), scale(out[f"{c}.N"], perp(body.i)))
+        self.on(c).force(body.origin[0], push)
+        self.on(c).couple(out[f"{c}.M"])
+        self.weigh(c, c, body.at(local(self.scene, f"{c}.com")), 0)
 
+    def cylinder(self, drv) -> None:
+        c, g, out, rb = drv.name, drv.link, self.out, self.rb
+        p = self.scene.parameters
+        (a_pin, _, _), u, _, e = rb.axes[c]
+        b_pin, o_pin = vec(out, f"{c}.B.position"), rb.bodies[g].origin[0]
+        on_rod = add(scale(out[f"{c}.force"], u), scale(out[f"{c}.N"], perp(u)))
+        barrel, rod = self.on(f"{c}.barrel"), self.on(f"{c}.rod")
+        barrel.force(a_pin, vec(out, f"{c}.R_A"))
+        barrel.force(b_pin, minus(on_rod))
+        barrel.couple(-out[f"{c}.M"])
+        self.weigh(f"{c}.barrel", f"{c}.barrel", rb.along(c, mpf(p[f"{c}.barrel.com"]), 0, 0), e)
+        rod.force(b_pin, on_rod)
+        rod.couple(out[f"{c}.M"])
+        rod.force(b_pin, minus(vec(out, f"{c}.R_B")))
+        s, v, a = (mpf(self.values[n]) for n in drv.motion(True))
+        self.weigh(f"{c}.rod", f"{c}.rod", rb.along(c, s - mpf(p[f"{c}.rod.com"]), v, a), e)
+        link = self.on(g)
+        link.force(o_pin, vec(out, f"{g}.R_O"))
+        link.force(b_pin, vec(out, f"{c}.R_B"))
+        body = rb.bodies[g]
+        self.weigh(g, g, body.at(local(self.scene, f"{g}.com")), body.epsilon)
+        # the carriers: the barrel's pin and the link's pivot act back on them
+        if self.on(drv.base_on):
+            self.on(drv.base_on).force(a_pin, minus(vec(out, f"{c}.R_A")))
+        if self.on(drv.pivot_on):
+            self.on(drv.pivot_on).force(o_pin, minus(vec(out, f"{g}.R_O")))
 
-def three_bodies(scene, values, out) -> dict:
-    """Every moving body of three_drivers, its acceleration chained from the drivers."""
-    p = scene.parameters
-    zero = (mpf(0), mpf(0))
-    wheel = crank(scene, values, "wheel")
-    x, xdd = mpf(values["slide.position"]), mpf(values["slide.acceleration"])
-    slide = Body(add(_local(scene, "slide.at"), (x, mpf(0))), (xdd, mpf(0)), 0, 0, 0)
-    arm = link(out, "arm", _local(scene, "arm.at"), zero)
-    coupler = link(
-        out, "coupler", vec(out, "tie.D_m.position"), wheel.at((mpf(p["wheel.length"]), 0))[1]
-    )
-    rocker = link(out, "rocker", vec(out, "tie.D_n.position"), arm.at(_local(scene, "tie.D_n"))[1])
-    hanger = link(
-        out, "hanger", vec(out, "hang.D_m.position"), coupler.at(_local(scene, "hang.D_m"))[1]
-    )
-    strut = link(out, "strut", vec(out, "hang.D_n.position"), slide.accel)
-    return dict(
-        wheel=wheel,
-        slide=slide,
-        arm=arm,
-        coupler=coupler,
-        rocker=rocker,
-        hanger=hanger,
-        strut=strut,
-    )
+    def dyad(self, d) -> None:
+        out, pre = self.out, d.prefix
+        e = vec(out, f"{pre}E.position")
+        d_m, d_n = vec(out, f"{pre}D_m.position"), vec(out, f"{pre}D_n.position")
+        self.on(d.m).force(d_m, vec(out, f"{pre}R_mk"))
+        self.on(d.m).force(e, vec(out, f"{pre}R_mn"))
+        self.on(d.n).force(d_n, vec(out, f"{pre}R_np"))
+        self.on(d.n).force(e, minus(vec(out, f"{pre}R_mn")))
+        for g in (d.m, d.n):
+            body = self.rb.bodies[g]
+            self.weigh(g, g, body.at(local(self.scene, f"{g}.com")), body.epsilon)
+        if self.on(d.k.body):
+            self.on(d.k.body).force(d_m, minus(vec(out, f"{pre}R_mk")))
+        if self.on(d.p.body):
+            self.on(d.p.body).force(d_n, minus(vec(out, f"{pre}R_np")))
 
-
-def cylinder_parts(scene, values, out) -> dict:
-    """The barrel and the rod as (centre of mass, its acceleration), the axis u, its
-    epsilon: the rod's point at x = s - c from A slides at s', s''."""
-    p = scene.parameters
-    s, v, a = (mpf(values[f"jack.{k}"]) for k in ("length", "velocity", "acceleration"))
-    w, e = mpf(out["jack.omega"]), mpf(out["jack.epsilon"])
-    u = (mpmath.cos(out["jack.angle"]), mpmath.sin(out["jack.angle"]))
-    base = _local(scene, "jack.base")
-
-    def point(x, x1, x2):
-        acc = add(scale(x2 - x * w * w, u), scale(2 * x1 * w + x * e, perp(u)))
-        return add(base, scale(x, u)), acc
-
-    barrel = point(mpf(p["jack.barrel.com"]), 0, 0)
-    rod = point(s - mpf(p["jack.rod.com"]), v, a)
-    return {"barrel": barrel, "rod": rod, "u": u, "epsilon": e}
-
-
-def three_balances(scene, values, out) -> dict:
-    g = (mpf(0), mpf(-9.81))
-    b_ = three_bodies(scene, values, out)
-    cyl = cylinder_parts(scene, values, out)
-    bal = {name: Balance() for name in ("wheel", "slide", "arm", "barrel", "rod")}
-    bal.update({name: Balance() for name in ("coupler", "rocker", "hanger", "strut")})
-    # the crank
-    wheel = b_["wheel"]
-    bal["wheel"].force(wheel.origin, vec(out, "wheel.R_O"))
-    bal["wheel"].force(vec(out, "tie.D_m.position"), minus(vec(out, "tie.R_mk")))
-    bal["wheel"].couple(out["wheel.torque"])
-    bal["wheel"].mass(scene, "wheel", wheel.at(_com(scene, "wheel")), wheel.epsilon, g)
-    # the ram: the actuator's force along i, the guide's N along j and M about R
-    slide = bal["slide"]
-    slide.force(b_["slide"].origin, (out["slide.force"], out["slide.N"]))
-    slide.couple(out["slide.M"])
-    slide.force(vec(out, "hang.D_n.position"), minus(vec(out, "hang.R_np")))
-    slide.mass(scene, "slide", b_["slide"].at(_com(scene, "slide")), 0, g)
-    # the cylinder: barrel, rod, arm
-    u, b_pin = cyl["u"], vec(out, "jack.B.position")
-    along = add(scale(out["jack.force"], u), scale(out["jack.N"], perp(u)))  # on the rod
-    bal["barrel"].force(_local(scene, "jack.base"), vec(out, "jack.R_A"))
-    bal["barrel"].force(b_pin, minus(along))
-    bal["barrel"].couple(-out["jack.M"])
-    bal["barrel"].mass(scene, "jack.barrel", cyl["barrel"], cyl["epsilon"], g)
-    bal["rod"].force(b_pin, along)
-    bal["rod"].couple(out["jack.M"])
-    bal["rod"].force(b_pin, minus(vec(out, "jack.R_B")))
-    bal["rod"].mass(scene, "jack.rod", cyl["rod"], cyl["epsilon"], g)
-    arm = b_["arm"]
-    bal["arm"].force(arm.origin, vec(out, "arm.R_O"))
-    bal["arm"].force(b_pin, vec(out, "jack.R_B"))
-    bal["arm"].force(vec(out, "tie.D_n.position"), minus(vec(out, "tie.R_np")))
-    bal["arm"].mass(scene, "arm", arm.at(_com(scene, "arm")), arm.epsilon, g)
-    # the dyads' links
-    for dyad, m, n in (("tie", "coupler", "rocker"), ("hang", "hanger", "strut")):
-        e = vec(out, f"{dyad}.E.position")
-        bal[m].force(vec(out, f"{dyad}.D_m.position"), vec(out, f"{dyad}.R_mk"))
-        bal[m].force(e, vec(out, f"{dyad}.R_mn"))
-        bal[n].force(vec(out, f"{dyad}.D_n.position"), vec(out, f"{dyad}.R_np"))
-        bal[n].force(e, minus(vec(out, f"{dyad}.R_mn")))
-        for g_ in (m, n):
-            body = b_[g_]
-            bal[g_].mass(scene, g_, body.at(_com(scene, g_)), body.epsilon, g)
-    bal["coupler"].force(vec(out, "hang.D_m.position"), minus(vec(out, "hang.R_mk")))
-    hanger = b_["hanger"]
-    tool = hanger.arm((mpf(values["tool.force.x"]), mpf(values["tool.force.y"])))  # follower
-    bal["hanger"].force(hanger.at(_local(scene, "tool.at"))[0], tool)
-    bal["hanger"].couple(values["tool.moment"])
-    return bal
+    def load(self, name, link, components, has_force, has_moment) -> None:
+        body = self.rb.bodies[link]
+        if has_force:
+            f = (mpf(self.values[f"{name}.force.x"]), mpf(self.values[f"{name}.force.y"]))
+            if components == "link":
+                f = add(scale(f[0], body.i), scale(f[1], perp(body.i)))
+            self.on(link).force(body.at(local(self.scene, f"{name}.at"))[0], f)
+        if has_moment:
+            self.on(link).couple(self.values[f"{name}.moment"])
 
 
 # ---------------------------------------------------------------------------
@@ -300,12 +359,39 @@ def three_balances(scene, values, out) -> dict:
 @pytest.mark.parametrize(("name", "point"), CASES)
 def test_every_body_is_in_equilibrium(name, point):
     """Each body's forces and moments, d'Alembert's included, sum to zero to 1e-25 of
-    their largest term."""
-    scene, values = read(name), values_at(name, point)
-    out = evaluate(name, values)
-    balances = (leg_balances if name == "leg" else three_balances)(scene, values, out)
+    their largest term; every carrier checked with the cylinders it carries."""
+    scene = read(name)
+    values = values_at(scene, point)
+    balances = Balances(scene, values, evaluate(scene, values)).all()
+    bodies = {d.link for d in scene.drivers} | {g for d in scene.dyads for g in (d.m, d.n)}
+    assert bodies <= set(balances)
     worst = max((b.residual(), body) for body, b in balances.items())
     assert worst[0] < TOL, (name, point, worst)
+
+
+def relative(a: tuple, b: tuple) -> mpf:
+    return max(abs(a[k] - b[k]) for k in (0, 1)) / max(abs(c) for c in a + b)
+
+
+@pytest.mark.parametrize(("name", "point"), CARRIED)
+def test_every_cylinder_closes_in_position_velocity_and_acceleration(name, point):
+    """Pin B moved with the link (O with its carrier) and with the rod (A with its
+    carrier, sliding at s', s'') alike, and at the output B, to 1e-25."""
+    scene = read(name)
+    values = values_at(scene, point)
+    out = evaluate(scene, values)
+    rb = Rebuilt(scene, values, out)
+    carried = 0
+    for drv in (d for d in scene.drivers if d.kind == "cylinder"):
+        by_link = rb.bodies[drv.link].at(local(scene, f"{drv.name}.pin"))
+        s, v, a = (mpf(values[n]) for n in drv.motion(True))
+        by_rod = rb.along(drv.name, s, v, a)
+        for k in range(3):
+            assert relative(by_link[k], by_rod[k]) < TOL, (name, point, drv.name, k)
+        assert relative(by_link[0], vec(out, f"{drv.name}.B.position")) < TOL
+        assert max(abs(c) for c in by_link[1] + by_link[2]) > 1e-3  # it does move
+        carried += drv.pivot_on is not None or drv.base_on is not None
+    assert carried  # the scene has a carried cylinder
 
 
 def matrix_of(scene, out) -> mpmath.matrix:
@@ -313,16 +399,15 @@ def matrix_of(scene, out) -> mpmath.matrix:
     return mpmath.matrix([[out[f"M.{a}.{b}"] for b in names] for a in names])
 
 
-def response_matrix(name: str, values: dict) -> mpmath.matrix:
+def response_matrix(scene, values: dict) -> mpmath.matrix:
     """Column b: the efforts at zero velocities, gravity and loads with driver b's
     acceleration 1 and the others' 0."""
-    scene = read(name)
-    still = dict(values, **STILL[name])
-    rates = [n for d in scene.drivers for n in d.motion(True)[1:]]
-    still.update(dict.fromkeys(rates, 0.0))
+    kept = {d.motion(True)[0] for d in scene.drivers}  # the coordinates
+    still = {k: (v if k in kept else 0.0) for k, v in values.items()}  # rates, loads: 0
+    still |= {k: 0.0 for k in scene.parameters if k.startswith("gravity.")}
     columns = []
     for d in scene.drivers:
-        out = evaluate(name, {**still, d.motion(True)[2]: 1.0})
+        out = evaluate(scene, {**still, d.motion(True)[2]: 1.0})
         columns.append([out[f"{e.name}.{e.effort}"] for e in scene.drivers])
     n = len(columns)
     return mpmath.matrix([[columns[b][a] for b in range(n)] for a in range(n)])
@@ -334,11 +419,12 @@ def largest(m: mpmath.matrix) -> mpf:
 
 @pytest.mark.parametrize(("name", "point"), CASES)
 def test_inertia_matrix_is_symmetric_positive_definite_and_the_efforts_response(name, point):
-    """M symmetric, positive definite (Cholesky), and equal to the efforts' response to
-    unit accelerations (itself symmetric) to 1e-25 of its largest entry."""
-    scene, values = read(name), values_at(name, point)
-    m = matrix_of(scene, evaluate(name, values))
-    k = response_matrix(name, values)
+    """M symmetric, positive definite, and equal to the efforts' response to unit
+    accelerations (itself symmetric) to 1e-25 of its largest entry."""
+    scene = read(name)
+    values = values_at(scene, point)
+    m = matrix_of(scene, evaluate(scene, values))
+    k = response_matrix(scene, values)
     size = largest(m)
     assert largest(m - m.T) / size < TOL
     assert largest(k - k.T) / size < TOL, (name, point, largest(k - k.T) / size)
@@ -347,13 +433,15 @@ def test_inertia_matrix_is_symmetric_positive_definite_and_the_efforts_response(
     assert min(lower[i, i] for i in range(m.rows)) > 0
     eigen = mpmath.eigsy(m)[0]
     assert min(eigen) > size * mpf(10) ** -6, (name, point, eigen)
+    assert min(abs(m[i, j]) for i in range(m.rows) for j in range(m.cols)) > 0  # coupled
 
 
 @pytest.mark.parametrize(("name", "point"), CASES)
 def test_efforts_are_inertia_times_accelerations_plus_h(name, point):
     """Every effort = sum_b M_ab q''_b + effort0_a to 1e-25 of the largest term."""
-    scene, values = read(name), values_at(name, point)
-    out = evaluate(name, values)
+    scene = read(name)
+    values = values_at(scene, point)
+    out = evaluate(scene, values)
     qdd = [mpf(values[d.motion(True)[2]]) for d in scene.drivers]
     for a in scene.drivers:
         terms = [out[f"M.{a.name}.{b.name}"] * x for b, x in zip(scene.drivers, qdd, strict=True)]
@@ -363,10 +451,12 @@ def test_efforts_are_inertia_times_accelerations_plus_h(name, point):
         assert abs(h - effort) > size * mpf(10) ** -6  # the accelerations do count
 
 
-@pytest.mark.parametrize("name", ["leg", "three_drivers"])
-def test_outputs_are_named_as_the_spec_says(name):
+@pytest.mark.parametrize(
+    ("name", "point"), [("leg", LEG_POINTS[0]), ("three_drivers", THREE_POINTS[0])]
+)
+def test_outputs_are_named_as_the_spec_says(name, point):
     scene = read(name)
-    out = evaluate(name, values_at(name, (LEG_POINTS if name == "leg" else THREE_POINTS)[0]))
+    out = evaluate(scene, values_at(scene, point))
     names = [d.name for d in scene.drivers]
     assert {k for k in out if k.startswith("M.")} == {f"M.{a}.{b}" for a in names for b in names}
     assert not [k for k in out if k.endswith((".J", ".dJdq"))]
@@ -375,3 +465,86 @@ def test_outputs_are_named_as_the_spec_says(name):
         assert set(d.motion(True)) <= set(scene.inputs)
     kinds = {"leg": ["crank", "crank"], "three_drivers": ["crank", "ram", "cylinder"]}
     assert [d.kind for d in scene.drivers] == kinds[name]
+
+
+def carried_data() -> dict:
+    with open(scene_file("carried_cylinders"), "rb") as f:
+        return tomllib.load(f)
+
+
+def refusal(change) -> str:
+    """The message of the SceneError read_scene raises on carried_cylinders changed by
+    ``change`` (a function of its parsed table)."""
+    data = copy.deepcopy(carried_data())
+    change(data)
+    with pytest.raises(scene_mp.SceneError) as caught:
+        scene_mp.read_scene(data)
+    return str(caught.value)
+
+
+def _reach(key, value):
+    def change(data):
+        data["cylinder"][1][key] = value
+
+    return change
+
+
+def _lift_on_arm(data):
+    data["cylinder"][0]["base"] = {"link": "arm", "at": [0.5, 0.0]}
+
+
+def _on_dyad_link(data):
+    """A third cylinder whose A is on a dyad's link."""
+    data["link"] = [{"name": "tie", "length": 1.0, "com": [0.5, 0.0], "mass": 1.0}]
+    data["link"].append({"name": "post", "length": 1.0, "com": [0.5, 0.0], "mass": 1.0})
+    data["link"][0]["inertia"] = data["link"][1]["inertia"] = 0.1
+    data["dyad"] = [{"name": "pair", "type": "RRR", "m": "tie", "n": "post", "branch": 1}]
+    data["dyad"][0] |= {"k": {"link": "arm", "at": [1.0, 0.0]}, "p": {"link": "frame"}}
+    data["dyad"][0]["p"]["at"] = [4.0, 0.0]
+    third = dict(data["cylinder"][1], name="tip", link="claw")
+    third["base"] = {"link": "tie", "at": [0.5, 0.0]}
+    data["cylinder"].append(third)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (_reach("at", {"link": "arm", "at": [0.0, 0.0]}), r"#2\.at: on 'arm', the link the"),
+        (_reach("base", {"link": "arm", "at": [1.5, 0.3]}), r"#2\.base: on 'arm', the link"),
+        (_lift_on_arm, r"#1\.base: 'arm' is not the frame nor the link of a driver listed bef"),
+        (_reach("base", {"link": "lift", "at": [1.5, 0.3]}), r"#2\.base: 'lift' is not the fr"),
+        (_reach("at", {"link": "jib", "at": [3.0, 0.0]}), r"#2\.at: 'jib' is not the frame"),
+        (_on_dyad_link, r"#3\.base: 'tie' is not the frame nor the link of a driver listed"),
+        (_reach("at", {"link": "boom"}), r"#2\.at: must be \[x, y\] \(m, the frame\) or \{"),
+        (_reach("base", {"link": "boom", "at": [3.0, 0.0]}), r"#2\.base: A must differ"),
+    ],
+)
+def test_refused_carriers(change, message):
+    """A cylinder pinned to the link it turns, or to a body that is neither the frame nor
+    an earlier driver's link, refused with a message naming the field."""
+    said = refusal(change)
+    assert said.startswith("scene: [[cylinder]] "), said
+    assert re.search(message, said), said
+
+
+def test_a_frame_point_given_as_a_link_is_the_frame():
+    """``{ link = "frame", at = [x, y] }`` is the frame's point [x, y]: the same outputs."""
+    data = carried_data()
+    scene = scene_mp.read_scene(data)
+    values = values_at(scene, CARRIED_POINTS[1])
+    changed = copy.deepcopy(data)
+    changed["cylinder"][0]["base"] = {"link": "frame", "at": data["cylinder"][0]["base"]}
+    assert scene_mp.read_scene(changed).drivers == scene.drivers
+    a = scene_mp.evaluate(data, values, dps=30).outputs
+    assert a == scene_mp.evaluate(changed, values, dps=30).outputs
+
+
+def test_o_and_a_with_equal_coordinates_on_different_bodies_are_accepted():
+    """A on the frame at [3, 0] and O at [3, 0] of the boom are distinct points: read
+    and evaluated (the check of A against O holds on one body only)."""
+    data = copy.deepcopy(carried_data())
+    data["cylinder"][1]["base"] = [3.0, 0.0]
+    scene = scene_mp.read_scene(data)
+    assert (scene.drivers[1].pivot_on, scene.drivers[1].base_on) == ("boom", None)
+    r = scene_mp.assembly_status(scene, values_at(scene, CARRIED_POINTS[1]), dps=30)
+    assert r.status in (scene_mp.OK, scene_mp.CANNOT_ASSEMBLE), r

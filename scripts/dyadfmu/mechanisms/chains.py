@@ -1059,15 +1059,19 @@ class Chain:
 
     def _cylinder_states(self, s: np.ndarray, ds: np.ndarray, dds: np.ndarray) -> tuple:
         """The link's, the barrel's and the rod's states and the cylinder's kinematics
-        entries at the lengths s with their rates (:func:`_cylinder`)."""
+        entries at the lengths s with their rates (:func:`cylinder_triangle`, O and A
+        at rest on the frame)."""
         c, cyl = self.crank_name, self.cylinder_name
-        g = _cylinder(self._O, self._base, self._pin, self._cylinder_branch, s, ds, dds, cyl)
         z2 = np.zeros(np.shape(s) + (2,))
         pivot, base = z2 + np.asarray(self._O), z2 + np.asarray(self._base)
+        at_rest = (z2, z2)
+        g = cylinder_triangle(
+            (pivot, *at_rest), (base, *at_rest), self._pin, self._cylinder_branch, s, ds, dds, cyl
+        )
         link = _state(g["theta"], g["omega"], g["epsilon"], pivot, z2, z2.copy(), 0.0)
         axis = (g["psi"], g["Omega"], g["Omega_dot"])
         barrel = _state(*axis, base, z2.copy(), z2.copy(), 0.0)
-        rod = _state(*(a.copy() for a in axis), g["B"], g["v_slide"], g["a_slide"], 0.0)
+        rod = _state(*(a.copy() for a in axis), g["B"], g["v_B"], g["a_B"], 0.0)
         kin = {f"{cyl}.length": s, f"{cyl}.velocity": ds, f"{cyl}.acceleration": dds}
         for body, st in ((c, link), (cyl, barrel)):
             for key in ("angle", "omega", "epsilon"):
@@ -1666,7 +1670,7 @@ def _check_closes(y2: np.ndarray, s: np.ndarray, reach: tuple, name: str) -> Non
         )
 
 
-def _cylinder(
+def cylinder_triangle(
     pivot: tuple,
     base: tuple,
     pin: tuple,
@@ -1676,36 +1680,40 @@ def _cylinder(
     dds: np.ndarray,
     name: str,
 ) -> dict:
-    """The triangle O, A, B of a cylinder of length s = |AB| between the frame's pin A
-    (``base``) and the pin B of a link pivoted at O (``pivot``; ``pin``: B in the link's
-    frame), with the rates
-    s' and s''. Returns the link's angle ``theta`` and its rates ``omega``, ``epsilon``;
-    B with ``v_B``, ``a_B``; the axis u's angle ``psi`` and rates ``Omega``,
-    ``Omega_dot``; the rod's point at B as sliding along the barrel's axis, ``v_slide``
-    and ``a_slide`` (equal to v_B, a_B); the ``conditioning`` |(B - O) x u| / |pin| of the
-    real parts."""
-    O, A = np.asarray(pivot, dtype=float), np.asarray(base, dtype=float)  # noqa: E741
-    d = math.hypot(*(A - O))
-    e = (A - O) / d
+    """The triangle O, A, B of a cylinder of length s = |AB| whose link's pivot O and
+    barrel's pin A may move (carried by other links; on the frame, at rest): ``pivot``
+    (O) and ``base`` (A) each (position, velocity, acceleration), (N, 2) arrays;
+    ``pin``: B in the link's frame; s' = ``ds``, s'' = ``dds``. Returns the link's angle
+    ``theta``, ``omega``, ``epsilon``; B, ``v_B``, ``a_B`` (also the rod's point at B);
+    the axis u's angle ``psi`` and rates ``Omega``, ``Omega_dot``; the ``conditioning``
+    |(B - O) x u| / |pin| of the real parts.
+
+    B - O = rho = x e + y (k x e), e from O to A, |rho| = |pin|, |B - A| = s. The rates
+    follow from B = O + rho turning with the link, differentiated: u . (B' - A') = s'
+    gives omega; (B - A) . (B'' - A'') = s s'' + s'^2 - |B' - A'|^2 gives epsilon."""
+    (pO, vO, aO), (pA, vA, aA) = pivot, base
+    d = geo.norm(pA - pO)
+    e = (pA - pO) / geo.col(d)
     r = math.hypot(*pin)
-    # B - O = x e + y (k x e): |B - O| = r and |B - A| = s
     x = (d * d + r * r - s * s) / (2.0 * d)
     y2 = r * r - x * x
-    _check_closes(y2, s, (abs(r - d), r + d), name)
-    rho = geo.col(x) * e + geo.col(branch * np.sqrt(y2)) * geo.rot90(e)  # B - O
-    B = O + rho
+    reach = (float(np.max(np.abs(np.real(r - d)))), float(np.min(np.real(r + d))))
+    _check_closes(y2, s, reach, name)
+    rho = geo.col(x) * e + geo.col(branch * np.sqrt(y2)) * geo.rot90(e)
+    B = pO + rho
     cb, sb = pin[0] / r, pin[1] / r  # the link turns pin onto rho
-    theta = _angle(geo.vec(cb * rho[:, 0] + sb * rho[:, 1], cb * rho[:, 1] - sb * rho[:, 0]))
-    u = (B - A) / geo.col(s)
+    theta = geo.angle(geo.vec(cb * rho[:, 0] + sb * rho[:, 1], cb * rho[:, 1] - sb * rho[:, 0]))
+    u = (B - pA) / geo.col(s)
     j_c = geo.rot90(u)
-    lever = geo.cross(rho, u)  # (B - O) x u: B' . u = omega lever = s'
-    omega = ds / lever
-    v_B = geo.col(omega) * geo.rot90(rho)
-    Omega = geo.dot(v_B, j_c) / s  # B' = s' u + s Omega j_c
-    # B'' = epsilon k x rho - omega^2 rho; along u: s'' - s Omega^2, across: s Omega' + 2 s' Omega
-    epsilon = (dds - s * Omega * Omega + omega * omega * geo.dot(rho, u)) / lever
-    a_B = geo.col(epsilon) * geo.rot90(rho) - geo.col(omega * omega) * rho
-    Omega_dot = (geo.dot(a_B, j_c) - 2.0 * ds * Omega) / s
+    lever = geo.cross(rho, u)  # u . (k x rho)
+    omega = (ds - geo.dot(u, vO - vA)) / lever
+    v_B = vO + geo.col(omega) * geo.rot90(rho)
+    v_rel = v_B - vA  # = s' u + s Omega j_c
+    Omega = geo.dot(v_rel, j_c) / s
+    along = (s * dds + ds * ds - geo.dot(v_rel, v_rel)) / s  # u . (B'' - A'')
+    epsilon = (along - geo.dot(u, aO - aA - geo.col(omega * omega) * rho)) / lever
+    a_B = aO + geo.col(epsilon) * geo.rot90(rho) - geo.col(omega * omega) * rho
+    Omega_dot = (geo.dot(a_B - aA, j_c) - 2.0 * ds * Omega) / s
     return {
         "theta": theta,
         "omega": omega,
@@ -1713,12 +1721,9 @@ def _cylinder(
         "B": B,
         "v_B": v_B,
         "a_B": a_B,
-        "psi": _angle(u),
+        "psi": geo.angle(u),
         "Omega": Omega,
         "Omega_dot": Omega_dot,
-        "v_slide": geo.col(ds) * u + geo.col(s * Omega) * j_c,
-        "a_slide": geo.col(dds - s * Omega * Omega) * u
-        + geo.col(s * Omega_dot + 2.0 * ds * Omega) * j_c,
         "conditioning": np.abs(np.real(lever)) / r,
     }
 

@@ -403,12 +403,12 @@ class MultiChain(chains.Chain):
     def _cylinder_state(
         self, d: Driver, s: np.ndarray, ds: np.ndarray, dds: np.ndarray, kin: dict, done: dict
     ) -> tuple:
-        """A cylinder's link, barrel and rod (:func:`cylinder_triangle`), O and A moving
+        """A cylinder's link, barrel and rod (:func:`.chains.cylinder_triangle`), O and A moving
         with their carriers (``done``: the earlier drivers' states)."""
         c, cyl = d.link, d.name
         O = self._carried_point(d.pivot_on, d.pivot, done, np.shape(s))  # noqa: E741
         A = self._carried_point(d.base_on, d.base, done, np.shape(s))
-        g = cylinder_triangle(O, A, d.pin, d.branch, s, ds, dds, cyl)
+        g = chains.cylinder_triangle(O, A, d.pin, d.branch, s, ds, dds, cyl)
         axis = (g["psi"], g["Omega"], g["Omega_dot"])
         pivot, base = O[0], A[0]
         states = {
@@ -641,63 +641,6 @@ class MultiChain(chains.Chain):
         }
         out.update({k: v for k, v in self.outputs(kin).items() if k not in skip})
         return out
-
-
-def cylinder_triangle(
-    pivot: tuple,
-    base: tuple,
-    pin: tuple,
-    branch: float,
-    s: np.ndarray,
-    ds: np.ndarray,
-    dds: np.ndarray,
-    name: str,
-) -> dict:
-    """The triangle O, A, B of a cylinder of length s = |AB| whose link's pivot O and
-    barrel's pin A move: ``pivot`` (O) and ``base`` (A) each (position, velocity,
-    acceleration), (N, 2) arrays; ``pin``: B in the link's frame; s' = ``ds``, s'' =
-    ``dds``. Returns the link's angle ``theta``, ``omega``, ``epsilon``; B, ``v_B``,
-    ``a_B``; the axis u's angle ``psi`` and rates ``Omega``, ``Omega_dot``; the
-    ``conditioning`` |(B - O) x u| / |pin|.
-
-    B - O = rho = x e + y (k x e), e from O to A, |rho| = |pin|, |B - A| = s. The rates
-    follow from B = O + rho turning with the link, differentiated: u . (B' - A') = s'
-    gives omega; (B - A) . (B'' - A'') = s s'' + s'^2 - |B' - A'|^2 gives epsilon."""
-    (pO, vO, aO), (pA, vA, aA) = pivot, base
-    d = geo.norm(pA - pO)
-    e = (pA - pO) / geo.col(d)
-    r = math.hypot(*pin)
-    x = (d * d + r * r - s * s) / (2.0 * d)
-    y2 = r * r - x * x
-    reach = (float(np.max(np.abs(np.real(r - d)))), float(np.min(np.real(r + d))))
-    chains._check_closes(y2, s, reach, name)
-    rho = geo.col(x) * e + geo.col(branch * np.sqrt(y2)) * geo.rot90(e)
-    B = pO + rho
-    cb, sb = pin[0] / r, pin[1] / r  # the link turns pin onto rho
-    theta = geo.angle(geo.vec(cb * rho[:, 0] + sb * rho[:, 1], cb * rho[:, 1] - sb * rho[:, 0]))
-    u = (B - pA) / geo.col(s)
-    j_c = geo.rot90(u)
-    lever = geo.cross(rho, u)  # u . (k x rho)
-    omega = (ds - geo.dot(u, vO - vA)) / lever
-    v_B = vO + geo.col(omega) * geo.rot90(rho)
-    v_rel = v_B - vA  # = s' u + s Omega j_c
-    Omega = geo.dot(v_rel, j_c) / s
-    along = (s * dds + ds * ds - geo.dot(v_rel, v_rel)) / s  # u . (B'' - A'')
-    epsilon = (along - geo.dot(u, aO - aA - geo.col(omega * omega) * rho)) / lever
-    a_B = aO + geo.col(epsilon) * geo.rot90(rho) - geo.col(omega * omega) * rho
-    Omega_dot = (geo.dot(a_B - aA, j_c) - 2.0 * ds * Omega) / s
-    return {
-        "theta": theta,
-        "omega": omega,
-        "epsilon": epsilon,
-        "B": B,
-        "v_B": v_B,
-        "a_B": a_B,
-        "psi": geo.angle(u),
-        "Omega": Omega,
-        "Omega_dot": Omega_dot,
-        "conditioning": np.abs(np.real(lever)) / r,
-    }
 
 
 def inertia_from_energy(chain: MultiChain, q: np.ndarray) -> np.ndarray:
