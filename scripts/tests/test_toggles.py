@@ -6,8 +6,14 @@ assembly limits.
   drivers, points of their working ranges): every output with status 0 within
   10 eps x amplification (the FMU's own output) of the peak of its unit over the motion.
 - Bisected to each assembly limit (the lift's ram where its arm and strut stretch out;
-  tests/scenes/toggles.toml's crank where its RRT rod and its RTR slot stop reaching) and
-  to the TRT slot's dead centre (slot and guide parallel):
+  tests/scenes/toggles.toml's crank where its RRT rod and its RTR slot stop reaching;
+  cylinder_arm's cylinder where its triangle stretches out and folds) and to the TRT
+  slot's dead centre (slot and guide parallel); with several drivers, one driver moved
+  and the others held at the middle of their working ranges (rates and accelerations
+  nonzero), to the stroke limits of the cylinders carried by a driven link (their
+  triangles stretched out and folded: carried_cylinders' reach, the excavator's stick
+  cylinder at both ends and its bucket cylinder short, the loader's tilt cylinder at
+  both ends) and to the excavator's bucket four-bar folded (its bucket cylinder long):
   going in, the status goes 0, then 1 (singular), and only past the last position that
   closes 4 (cannot assemble), never back; every output with status 0 within
   10 eps x amplification of the peak of its unit; at the last status 0 every output
