@@ -659,7 +659,7 @@ def _run(r: _Reader, data: dict) -> Kinetostatic | Stroke | MultiStroke | Driven
                 "run",
                 "[[run.driver]] moves drivers over given ranges: it needs kind = "
                 "'kinetostatic'; a driven run turns one crank by the drive FMU",
-                key="driver",
+                key="kind",
             )
         return _driven(r, data, t)
     r.fail("run", f"kind must be 'kinetostatic' or 'driven' (got {kind!r})", key="kind")
