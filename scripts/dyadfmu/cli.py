@@ -148,8 +148,10 @@ def _sweep_command(sub: argparse._SubParsersAction) -> None:
         description="Read a study file, draw its designs (grid, random or Latin hypercube), "
         "run each on the mechanism FMU (and the drive FMU for a driven study) on a local Dask "
         "cluster or an existing one, and write the table (results.csv), the best designs "
-        "(report.md) and a plot (designs.png) to OUT/<study>/. A failed run is a row with "
-        "its status.",
+        "(report.md) and a plot (designs.png) to OUT/<study>/. A run turns a crank through a "
+        "revolution, moves a ram or a cylinder over its stroke or its link's angle, or, with "
+        "[[run.driver]] tables, moves every driver of a mechanism with several at once, each "
+        "over its own range. A failed run is a row with its status.",
     )
     sweep.add_argument("study", type=Path, metavar="STUDY.toml", help="the study file")
     sweep.add_argument(

@@ -1619,15 +1619,18 @@ def test_every_driver_of_a_mechanism_fmu_is_found():
 LEG = paths.build_dir() / "fmus" / "leg_fmi2.fmu"
 
 
-def test_a_mechanism_fmu_with_several_drivers_is_refused_naming_them(tmp_path):
-    """A study moves one driver: the leg's FMU (two hip cranks) is refused at the study's
-    fmu line, naming both drivers."""
+def test_a_one_driver_run_of_a_mechanism_fmu_with_several_drivers_is_refused_naming_them(
+    tmp_path,
+):
+    """A [run] over one driver would leave the others at their start values: the leg's FMU
+    (two hip cranks) is refused at the run's speed, naming both drivers and the way out."""
     _needs(LEG)
     text = BALANCE_STUDY.replace(str(BALANCE), str(LEG))
-    line = next(k for k, t in enumerate(text.splitlines(), start=1) if t.startswith("fmu ="))
+    line = next(k for k, t in enumerate(text.splitlines(), start=1) if t.startswith("speed ="))
     with pytest.raises(StudyError) as info:
         study.prepare(_write(tmp_path, text), tmp_path)
     assert str(info.value) == (
         f"{tmp_path / 'study.toml'}:{line}: leg_fmi2.fmu has 2 drivers (the crank front, the "
-        "crank rear): a study moves one driver; give a mechanism FMU with one"
+        "crank rear): a run over one driver would leave the others at their start values; "
+        "give each driver its range in a [[run.driver]] table (name, and angle or stroke)"
     )

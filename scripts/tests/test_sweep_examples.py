@@ -178,3 +178,27 @@ def test_the_tipper_cylinder_study_agrees_with_the_fmu_stepped_through_the_tip(t
     )
     assert len(original) == 1 and table.status[original[0]] == "ok"
     assert table.column("force_peak")[best] < 0.9 * table.column("force_peak")[original[0]]
+
+
+def test_the_excavator_pins_study_moves_all_three_cylinders_and_beats_the_original(tmp_path):
+    """Every design of the excavator's pass runs (the boom's pins never bring its triangle
+    to a toggle over it); the original pins are one of them, feasible, and the best design
+    lowers the peak boom cylinder force by more than 15 % within the cylinder's lengths.
+    The stick's and the bucket's cylinders, whose pins the study does not move, pull the
+    same over every design: their motion is each design's same pass."""
+    result = study.run_study(STUDIES / "excavator_pins.toml", tmp_path, workers=2, plots=False)
+    table, s = result.table, result.study
+    assert set(table.status) == {"ok"}, set(table.message)
+    original = np.flatnonzero(
+        np.all(np.isclose(table.values, [1.2, 0.7, 2.35, 0.75], rtol=0, atol=1e-12), axis=1)
+    )
+    assert len(original) == 1
+    feasible = results.feasible(table, s)
+    assert feasible[original[0]]
+    best = result.best[0]
+    force = table.column("boom_force_peak")
+    assert force[best] < 0.85 * force[original[0]]
+    assert table.column("boom_length_closed")[best] >= 2.0
+    assert table.column("boom_length_extended")[best] <= 3.2
+    stick = table.column("stick_force_peak")
+    assert np.max(np.abs(stick / stick[original[0]] - 1)) < 1e-12

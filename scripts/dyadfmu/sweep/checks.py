@@ -6,11 +6,22 @@ a load an input, a figure's series an output or input. A name that is not is ref
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 from fmpy.model_description import ModelDescription
 
-from .studyfile import Counterweight, Driven, Kinetostatic, Stroke, Study, StudyError, line_of
+from .studyfile import (
+    Counterweight,
+    Driven,
+    DriverRange,
+    Kinetostatic,
+    MultiStroke,
+    Stroke,
+    Study,
+    StudyError,
+    line_of,
+)
 
 __all__ = [
     "check_names",
@@ -20,6 +31,7 @@ __all__ = [
     "driver_of",
     "drivers_of",
     "DRIVERS",
+    "angle_runs",
 ]
 
 #: Each kind of driver: its coordinate, rate and acceleration inputs, and its effort
@@ -40,7 +52,8 @@ class Driver:
     FMU has inertia), its ``effort`` output and, for a cylinder whose geometry is among
     the FMU's parameters, the ``geometry`` parameters: its link's pivot O (x, y), its
     barrel's pin A (x, y), its rod's pin B in the link's frame (x, y), its branch; and
-    its ``link`` (None otherwise)."""
+    its ``link`` (None otherwise); and the ``carriers`` of O and A (None for the frame, else
+    the driver's link they move with)."""
 
     kind: str
     name: str
@@ -48,6 +61,7 @@ class Driver:
     effort: str
     link: str | None = None
     geometry: tuple = ()
+    carriers: tuple = (None, None)  # the links O and A are points of; None: the frame
 
 
 def _fail(study: Study, table: str, index: int | None, key: str, why: str) -> None:
@@ -68,21 +82,56 @@ def _short_list(names: list) -> str:
     return shown + (f", ... ({len(names)} in all)" if len(names) > 12 else "") if names else "none"
 
 
-def _cylinder_geometry(name: str, md: ModelDescription) -> tuple[str | None, tuple]:
-    """(link, geometry parameters) of cylinder ``name`` where the FMU has them all as Real
-    parameters: the link is the one with a pivot ``LINK.at`` and an angle output."""
-    params = set(_names(md, ("parameter",), reals=True))
-    outputs = set(_names(md, ("output",), reals=True))
+#: The generator's descriptions of a cylinder's geometry parameters
+#: (modelDescription/dyadgen/scenefile/sections.py): the link B is a pin of, and the
+#: carriers of O and A, "the frame" or a driver's link.
+_PIN_ON = re.compile(r"^The rod's pin B on ([A-Za-z_][A-Za-z0-9_]*), in \1's frame x$")
+_CARRIED = re.compile(
+    r"^The (?:pivot O of \S+|barrel's pin A) on (?:the frame, global|(\S+), in its frame) x$"
+)
+
+
+def _description(md: ModelDescription, name: str) -> str:
+    return next((v.description or "" for v in md.modelVariables if v.name == name), "")
+
+
+def _cylinder_link(name: str, md: ModelDescription, params: set, outputs: set) -> str | None:
+    """The link cylinder ``name`` turns: the one its pin B's description names, else the
+    only link with a pivot ``LINK.at`` among the parameters and an angle output."""
+    named = _PIN_ON.match(_description(md, f"{name}.pin.x"))
+    if named:
+        return named.group(1)
     links = {n[: -len(".at.x")] for n in params if n.endswith(".at.x")}
     links = sorted(k for k in links if f"{k}.at.y" in params and f"{k}.angle" in outputs)
-    if len(links) != 1:
-        return None, ()
-    link = links[0]
+    return links[0] if len(links) == 1 else None
+
+
+def _carriers(md: ModelDescription, link: str, name: str) -> tuple:
+    """(O's carrier, A's carrier): None for the frame, else the driver's link they are
+    points of, as the parameters' descriptions say (the frame where they say nothing:
+    an FMU with one driver has no other link to carry them)."""
+    found = []
+    for which in (f"{link}.at.x", f"{name}.base.x"):
+        said = _CARRIED.match(_description(md, which))
+        found.append(said.group(1) if said else None)
+    return tuple(found)
+
+
+def _cylinder_geometry(name: str, md: ModelDescription) -> tuple[str | None, tuple, tuple]:
+    """(link, geometry parameters, carriers) of cylinder ``name`` where the FMU has its
+    geometry all as Real parameters and its link's angle as an output."""
+    params = set(_names(md, ("parameter",), reals=True))
+    outputs = set(_names(md, ("output",), reals=True))
+    link = _cylinder_link(name, md, params, outputs)
+    if link is None or f"{link}.angle" not in outputs:
+        return None, (), (None, None)
     geometry = (
         f"{link}.at.x", f"{link}.at.y", f"{name}.base.x", f"{name}.base.y",
         f"{name}.pin.x", f"{name}.pin.y", f"{name}.branch",
     )  # fmt: skip
-    return (link, geometry) if set(geometry) <= params else (None, ())
+    if not set(geometry) <= params:
+        return None, (), (None, None)
+    return link, geometry, _carriers(md, link, name)
 
 
 def drivers_of(md: ModelDescription) -> list[Driver]:
@@ -101,8 +150,11 @@ def drivers_of(md: ModelDescription) -> list[Driver]:
             rates = tuple(f"{name}.{r}" for r in (rate, acceleration) if f"{name}.{r}" in inputs)
             if kind == "crank" and len(rates) != 2:
                 continue
-            link, geometry = _cylinder_geometry(name, md) if kind == "cylinder" else (None, ())
-            found.append(Driver(kind, name, (n, *rates), f"{name}.{effort}", link, geometry))
+            link, geometry, carriers = (
+                _cylinder_geometry(name, md) if kind == "cylinder" else (None, (), (None, None))
+            )
+            motion = (n, *rates)
+            found.append(Driver(kind, name, motion, f"{name}.{effort}", link, geometry, carriers))
     return found
 
 
@@ -115,18 +167,22 @@ def _check_driver(study: Study, md: ModelDescription, what: str) -> Driver:
     """The FMU's driver, refused at the run's line where the run is not one it can do."""
     drivers, run = drivers_of(md), study.run
     source = "scene" if study.scene is not None else "fmu"
+    d = drivers[0] if drivers else None
+    if d is not None and isinstance(run, MultiStroke):
+        _check_multi(study, md, drivers, what)
+        return d
     if len(drivers) > 1:
-        # a run moves one driver: the others' motion inputs would stay at their start values
-        names = ", ".join(f"the {d.kind} {d.name}" for d in drivers)
+        # a run over one driver would leave the others' motion inputs at their start values
+        key = "kind" if isinstance(run, Driven) else getattr(run, "over", "speed")
         _fail(
             study,
-            "study",
+            "run",
             None,
-            source,
-            f"{what} has {len(drivers)} drivers ({names}): a study moves one driver; "
-            "give a mechanism FMU with one",
+            key,
+            f"{what} has {len(drivers)} drivers ({_listed(drivers)}): a run over one driver "
+            "would leave the others at their start values; give each driver its range in a "
+            "[[run.driver]] table (name, and angle or stroke)",
         )
-    d = drivers[0] if drivers else None
     if d is None:
         _fail(
             study,
@@ -153,6 +209,101 @@ def _check_driver(study: Study, md: ModelDescription, what: str) -> Driver:
     if isinstance(run, Stroke):
         _check_stroke(study, d, driven_by, what)
     return d
+
+
+def _listed(drivers: list) -> str:
+    return ", ".join(f"the {d.kind} {d.name}" for d in drivers)
+
+
+def _check_multi(study: Study, md: ModelDescription, drivers: list, what: str) -> None:
+    """A run moving several drivers: each [[run.driver]] names a driver of the FMU with a
+    range it can take, and every driver of the FMU is named (one left out would stay at
+    its start value, its rates at zero)."""
+    by_name = {d.name: d for d in drivers}
+    for k, entry in enumerate(study.run.drivers):
+        d = by_name.get(entry.name)
+        if d is None:
+            _fail(
+                study,
+                "run.driver",
+                k,
+                "name",
+                f"{entry.name} is no driver of {what}; its drivers: {_listed(drivers)}",
+            )
+        _check_range(study, md, k, entry, d, by_name)
+    named = {e.name for e in study.run.drivers}
+    left = [d for d in drivers if d.name not in named]
+    if left:
+        _fail(
+            study,
+            "run",
+            None,
+            None,
+            f"the run moves no range of {_listed(left)} of {what}: give every driver a "
+            "[[run.driver]] table (one left out would stay at its start value)",
+        )
+
+
+def _check_range(
+    study: Study, md: ModelDescription, k: int, entry: DriverRange, d: Driver, by_name: dict
+) -> None:
+    """One [[run.driver]]'s range against its driver."""
+    it = f"{d.name} is a {d.kind}"
+    if entry.over == "angle" and d.kind == "ram":
+        _fail(study, "run.driver", k, "angle",
+              f"angle turns a crank or a cylinder's link; {it}: give stroke = [low, high] "
+              "(m, its position)")  # fmt: skip
+    if entry.over == "stroke" and d.kind == "crank":
+        _fail(study, "run.driver", k, "stroke",
+              f"stroke moves a ram or a cylinder; {it}: give angle = [low, high] (rad, its "
+              "angle)")  # fmt: skip
+    if d.kind == "cylinder" and entry.over == "stroke" and not min(entry.start, entry.end) > 0:
+        _fail(study, "run.driver", k, "stroke",
+              f"a cylinder's length is positive: stroke = [{entry.start:g}, {entry.end:g}] m; "
+              f"{it}")  # fmt: skip
+    if d.kind == "cylinder" and entry.over == "angle":
+        _check_cylinder_angle(study, md, k, entry, d, by_name)
+
+
+def _check_cylinder_angle(
+    study: Study, md: ModelDescription, k: int, entry: DriverRange, d: Driver, by_name: dict
+) -> None:
+    """A cylinder's link turned over an angle: its geometry among the FMU's parameters,
+    O and A on one body (the frame, or a rotating driver's link whose angle the FMU
+    gives), less than pi between the toggles."""
+
+    def fail(why: str) -> None:
+        _fail(study, "run.driver", k, "angle", f"cylinder {d.name}: {why}")
+
+    if not d.geometry:
+        fail(
+            "angle needs its geometry among the FMU's parameters (LINK.at, "
+            f"{d.name}.base, {d.name}.pin and {d.name}.branch tunable, and LINK.angle an "
+            "output; a scene study makes them so): give stroke = [low, high] (m, its "
+            "length) instead"
+        )
+    o_on, a_on = d.carriers
+    if o_on != a_on:
+        fail(
+            f"its pivot O is on {o_on or 'the frame'} and its barrel's pin A on "
+            f"{a_on or 'the frame'}: its length depends on the angles of {d.link} and of "
+            f"{o_on or a_on}, not on one angle; give stroke = [low, high] (m, its length)"
+        )
+    # the carrier turns with its angle: a crank's (an input) or a cylinder's link's (an
+    # output); a ram's slides and has none
+    rams = {d.name for d in by_name.values() if d.kind == "ram"}
+    readable = set(_names(md, ("output", "input"), reals=True))
+    if o_on is not None and (o_on in rams or f"{o_on}.angle" not in readable):
+        fail(
+            f"its pins O and A are on {o_on}, which has no angle in the FMU (a ram, or "
+            f"{o_on}.angle not an output): give stroke = [low, high] (m, its length)"
+        )
+    if not abs(entry.end - entry.start) < math.pi:
+        relative = f" relative to {o_on}" if o_on else ""
+        fail(
+            f"angle spans {abs(entry.end - entry.start):.6g} rad: a cylinder turns its link"
+            f"{relative} by less than pi between its toggles (O, A and B in line)"
+        )
 
 
 def _check_stroke(study: Study, d: Driver, driven_by: str, what: str) -> None:
@@ -268,8 +419,7 @@ def _claim(study: Study, owner: dict, variables: dict, name: str, where: tuple) 
 
 
 def _check_loads(study: Study, md: ModelDescription, what: str) -> None:
-    d = driver_of(md)
-    motion = d.motion if d is not None else ()
+    motion = {n for d in drivers_of(md) for n in d.motion}
     inputs = [
         n
         for n in _names(md, ("input",))
@@ -338,8 +488,7 @@ def base_values(study: Study, md: ModelDescription) -> dict:
         if isinstance(p, Counterweight)
         for name in p.needs()
     ]
-    d = driver_of(md) if isinstance(study.run, Stroke) and study.run.over == "angle" else None
-    wanted += [(name, ("run", None, "angle"), "angle") for name in d.geometry] if d else []
+    wanted += [(name, where, "angle") for where, d in angle_runs(study, md) for name in d.geometry]
     base = {}
     for name, where, who in wanted:
         value, given = _start(md, name)
@@ -351,6 +500,23 @@ def base_values(study: Study, md: ModelDescription) -> dict:
             )
         base[name] = value
     return base
+
+
+def angle_runs(study: Study, md: ModelDescription) -> list:
+    """[(where in the study file, Driver)] of the cylinders the run turns over their
+    links' angles (their lengths then come from their geometry)."""
+    run = study.run
+    if isinstance(run, Stroke) and run.over == "angle":
+        d = driver_of(md)
+        return [(("run", None, "angle"), d)] if d is not None else []
+    if not isinstance(run, MultiStroke):
+        return []
+    by_name = {d.name: d for d in drivers_of(md)}
+    return [
+        (("run.driver", k, "angle"), by_name[e.name])
+        for k, e in enumerate(run.drivers)
+        if e.over == "angle" and e.name in by_name and by_name[e.name].kind == "cylinder"
+    ]
 
 
 def _unit(md: ModelDescription | None, name: str) -> str:

@@ -6,6 +6,8 @@
   link turned over a range of angles, rest to rest (:mod:`dyadfmu.sweep.stroke`), under
   constant loads; a design whose cylinder cannot turn its link over the range (its toggle
   within it, or its pin on the other branch) is a failed run before any sample;
+- :class:`MultiStrokeRun`: every driver of a mechanism with several moved at once, each
+  over its own range (an angle or a stroke), in one duration, under constant loads;
 - :class:`DrivenRun`: the drive FMU (motor and rotor) and the mechanism FMU co-simulated
   with the stabilised coupling of :mod:`dyadfmu.cosim.mechanism_drive`: at each
   communication point the mechanism FMU gives its torque at zero crank acceleration
@@ -40,15 +42,25 @@ from fmpy.model_description import ModelDescription
 
 from ..fmi.slave import Slave, SlaveError
 from . import stroke
-from .checks import Driver, base_values, driver_of
+from .checks import Driver, base_values, driver_of, drivers_of
 from .figures import UndefinedFigure, figure_value, series_names
 from .rows import RowsEntry, rows_entry
-from .studyfile import MIN_DIGITS, Driven, Kinetostatic, Stroke, Study, recorded_from
+from .studyfile import (
+    MIN_DIGITS,
+    Driven,
+    Kinetostatic,
+    MultiStroke,
+    Stroke,
+    Study,
+    recorded_from,
+)
 
 __all__ = [
     "Outcome",
     "KinetostaticRun",
     "StrokeRun",
+    "Axis",
+    "MultiStrokeRun",
     "DrivenRun",
     "run_of",
     "run_rows",
@@ -359,7 +371,7 @@ class StrokeRun(KinetostaticRun):
 
     def _loads(self) -> np.ndarray:
         """The loads at every instant: constant (points x loads)."""
-        return np.tile(np.array([ld.value[0] for ld in self.loads], dtype=float), (self.points, 1))
+        return _constant_loads(self.loads, self.points)
 
     def checked(self) -> tuple:
         """The amplifications, the driver's force and, for an angle run, the link's angle."""
@@ -367,9 +379,7 @@ class StrokeRun(KinetostaticRun):
 
     def cylinder(self, params: dict) -> stroke.Cylinder:
         """The cylinder's geometry of a design (its parameters, else the FMU's start values)."""
-        base = dict(self.base)
-        ox, oy, ax, ay, px, py, branch = (params.get(n, base.get(n)) for n in self.geometry)
-        return stroke.Cylinder(self.driver, self.link, (ox, oy), (ax, ay), (px, py), branch)
+        return _cylinder(self.driver, self.link, None, self.geometry, params, dict(self.base))
 
     def samples(self, params: dict) -> np.ndarray:
         """The driver's motion at every instant (its coordinate and, where the FMU takes
@@ -377,13 +387,7 @@ class StrokeRun(KinetostaticRun):
         the run on the cylinder's branch."""
         q = self._profile
         if self.over == "angle":
-            cylinder = self.cylinder(params)
-            try:
-                cylinder.check(self.low, self.high)
-            except stroke.Unreachable as e:
-                raise _Failed(e.status, str(e)) from None
-            with np.errstate(all="ignore"):
-                q = cylinder.lengths(*q)
+            q = _turned(self.cylinder(params), self.low, self.high, q)
         motion = np.column_stack(q[: len(self.motion_inputs())])
         return np.hstack([motion, self._loads()])
 
@@ -397,14 +401,138 @@ class StrokeRun(KinetostaticRun):
         run's angle (by more than 1e-6 rad) at some sample: the message names the first."""
         if self.over == "angle":
             got = series[f"{self.link}.angle"]
-            off = np.abs(np.remainder(got - self._profile[0] + math.pi, 2 * math.pi) - math.pi)
-            if not np.all(off <= 1e-6):
-                k = int(np.argmax(~(off <= 1e-6)))  # the first sample off the run
+            k = _off_run(got, self._profile[0])
+            if k is not None:
                 return Outcome(
                     (math.nan,) * len(self.figures),
                     "wrong_angle",
                     f"the FMU puts {self.link} at {got[k]:.9g} rad, not the run's "
                     f"{self._profile[0][k]:.9g} rad (sample {k})",
+                )
+        return self.outcome(series, None)
+
+
+def _constant_loads(loads: tuple, points: int) -> np.ndarray:
+    """A run over time's loads at every instant: constant (points x loads)."""
+    return np.tile(np.array([ld.value[0] for ld in loads], dtype=float), (points, 1))
+
+
+def _cylinder(
+    name: str, link: str, carrier: str | None, geometry: tuple, params: dict, base: dict
+) -> stroke.Cylinder:
+    """Cylinder ``name``'s geometry of a design: the names ``geometry`` (O, A, B, the
+    branch: Driver.geometry) read from its parameters, else the FMU's start values."""
+    ox, oy, ax, ay, px, py, branch = (params.get(n, base.get(n)) for n in geometry)
+    return stroke.Cylinder(name, link, (ox, oy), (ax, ay), (px, py), branch, carrier)
+
+
+def _turned(cylinder: stroke.Cylinder, low: float, high: float, q: tuple) -> tuple:
+    """(s, s', s'') of a cylinder whose link runs the angles ``q`` (angle, rate,
+    acceleration) from ``low`` to ``high``; _Failed where it cannot."""
+    try:
+        cylinder.check(low, high)
+    except stroke.Unreachable as e:
+        raise _Failed(e.status, str(e)) from None
+    with np.errstate(all="ignore"):
+        return cylinder.lengths(*q)
+
+
+def _off_run(got: np.ndarray, wanted: np.ndarray) -> int | None:
+    """The first sample where an angle the FMU gives is more than 1e-6 rad from the
+    run's (modulo 2 pi); None where none is."""
+    off = np.abs(np.remainder(got - wanted + math.pi, 2 * math.pi) - math.pi)
+    return None if np.all(off <= 1e-6) else int(np.argmax(~(off <= 1e-6)))
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One driver of a :class:`MultiStrokeRun`: ``name``, moved from ``start`` to ``end``
+    over ``over`` ("angle": a crank's angle or a cylinder's link's, rad; "stroke": a
+    ram's position or a cylinder's length, m), its ``motion`` inputs and ``effort``
+    output (Driver.motion, Driver.effort); a cylinder turned over its link's angle has
+    its ``link``, the ``carrier`` of its pins O and A ("" for the frame; the angle is
+    then relative to the carrier's) and its ``geometry`` (Driver.geometry)."""
+
+    name: str
+    over: str
+    start: float
+    end: float
+    motion: tuple
+    effort: str
+    link: str = ""
+    carrier: str = ""
+    geometry: tuple = ()
+
+    def angles(self) -> tuple:
+        """The FMU's angles a turned cylinder's link is checked by: its own and its
+        carrier's (the run's angle is their difference); () for another driver."""
+        if not self.geometry:
+            return ()
+        return (f"{self.link}.angle",) + ((f"{self.carrier}.angle",) if self.carrier else ())
+
+
+@dataclass(frozen=True)
+class MultiStrokeRun(KinetostaticRun):
+    """Every driver of the mechanism moved at once, each over its own range (``axes``,
+    :class:`Axis`), all rest to rest in ``duration`` s along the cycloidal rise of
+    :mod:`dyadfmu.sweep.stroke`, at ``points`` instants. A cylinder turned over its link's
+    angle takes its lengths from each design's geometry (relative to its pins' carrier),
+    as :class:`StrokeRun` does for one; its design fails before any sample where the run
+    passes its toggle or lies on its other branch, and ``wrong_angle`` where the FMU puts
+    the link elsewhere than the run's angle."""
+
+    duration: float = 1.0
+    axes: tuple = ()
+
+    @functools.cached_property
+    def _profiles(self) -> tuple:
+        """(q, q', q'') of every axis's cycloid."""
+        return tuple(stroke.cycloid(a.start, a.end, self.duration, self.points) for a in self.axes)
+
+    def motion_inputs(self) -> tuple:
+        """Every driver's coordinate, rate and acceleration inputs, driver after driver."""
+        return tuple(n for a in self.axes for n in a.motion)
+
+    def checked(self) -> tuple:
+        """The amplifications, every driver's effort and the turned links' angles."""
+        angles = tuple(n for a in self.axes for n in a.angles())
+        return (*self.amplifications, *(a.effort for a in self.axes), *angles)
+
+    def samples(self, params: dict) -> np.ndarray:
+        """Every driver's motion at every instant, then the loads; _Failed where a
+        cylinder cannot turn its link over its range."""
+        columns, base = [], dict(self.base)
+        for a, q in zip(self.axes, self._profiles, strict=True):
+            if a.geometry:
+                cylinder = _cylinder(a.name, a.link, a.carrier or None, a.geometry, params, base)
+                q = _turned(cylinder, min(a.start, a.end), max(a.start, a.end), q)
+            columns += list(q[: len(a.motion)])
+        return np.hstack([np.column_stack(columns), _constant_loads(self.loads, self.points)])
+
+    def where(self, k: int, x: np.ndarray) -> str:
+        """Sample ``k`` as a message names it: every driver's coordinate."""
+        at, column = [], 0
+        for a in self.axes:
+            at.append(f"{a.motion[0]} {x[column]:.6g}")
+            column += len(a.motion)
+        return f"at sample {k}: {', '.join(at)}"
+
+    def result(self, series: dict, x: np.ndarray) -> Outcome:
+        """The outcome; ``wrong_angle`` where the FMU puts a turned link elsewhere than the
+        run's angle (by more than 1e-6 rad) at some sample: the message names the first."""
+        for a, q in zip(self.axes, self._profiles, strict=True):
+            if not a.geometry:
+                continue
+            got = series[f"{a.link}.angle"]
+            got = got - series[f"{a.carrier}.angle"] if a.carrier else got
+            k = _off_run(got, q[0])
+            if k is not None:
+                return Outcome(
+                    (math.nan,) * len(self.figures),
+                    "wrong_angle",
+                    f"the FMU puts {a.link} at {got[k]:.9g} rad"
+                    f"{f' from {a.carrier}' if a.carrier else ''}, not the run's "
+                    f"{q[0][k]:.9g} rad (sample {k})",
                 )
         return self.outcome(series, None)
 
@@ -492,9 +620,31 @@ def _stroke_run(common: dict, run: Stroke, driver: Driver) -> StrokeRun:
     )
 
 
+def _multi_stroke_run(common: dict, run: MultiStroke, md: ModelDescription) -> MultiStrokeRun:
+    by_name = {d.name: d for d in drivers_of(md)}
+    axes = []
+    for entry in run.drivers:
+        d = by_name[entry.name]  # check_names refuses a name that is no driver first
+        turned = d.kind == "cylinder" and entry.over == "angle"
+        axes.append(
+            Axis(
+                entry.name,
+                entry.over,
+                entry.start,
+                entry.end,
+                d.motion,
+                d.effort,
+                link=(d.link or "") if turned else "",
+                carrier=(d.carriers[0] or "") if turned else "",
+                geometry=d.geometry if turned else (),
+            )  # fmt: skip
+        )
+    return MultiStrokeRun(**common, points=run.points, duration=run.duration, axes=tuple(axes))
+
+
 def run_of(
     study: Study, mechanism: str, drive: str | None, md: ModelDescription
-) -> KinetostaticRun | StrokeRun | DrivenRun:
+) -> KinetostaticRun | StrokeRun | MultiStrokeRun | DrivenRun:
     """The run of a study on the mechanism FMU at path ``mechanism`` (model description
     ``md``) and, for a driven study, the drive FMU at ``drive``. ValueError where the FMU
     has no driver (check_names refuses such a study first)."""
@@ -514,6 +664,8 @@ def run_of(
         motion=driver.motion,
         effort=driver.effort,
     )
+    if isinstance(study.run, MultiStroke):
+        return _multi_stroke_run(common, study.run, md)
     if isinstance(study.run, Stroke):
         return _stroke_run(common, study.run, driver)
     if isinstance(study.run, Kinetostatic):
@@ -531,6 +683,6 @@ def run_of(
     )
 
 
-def run_rows(run: KinetostaticRun | StrokeRun | DrivenRun, rows: list) -> list:
+def run_rows(run: KinetostaticRun | StrokeRun | MultiStrokeRun | DrivenRun, rows: list) -> list:
     """[(design index, Outcome)] of the designs [(index, values)], in order."""
     return run.chunk(rows)

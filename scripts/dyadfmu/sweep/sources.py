@@ -25,7 +25,7 @@ from fmpy.model_description import ModelDescription
 
 from .. import paths
 from .scenebuild import BuildError, generator, scene_fmu
-from .studyfile import Counterweight, Driven, Stroke, Study, StudyError, line_of
+from .studyfile import Counterweight, Driven, MultiStroke, Stroke, Study, StudyError, line_of
 
 __all__ = [
     "toml_text",
@@ -133,19 +133,39 @@ def _copy_of(scene_file: Path, study: Study) -> dict:
     return data
 
 
+def _turned_cylinders(study: Study) -> list:
+    """The names of the cylinders the study's run turns over their links' angles (None
+    for the scene's only driver, as a [run] over an angle names none)."""
+    run = study.run
+    if isinstance(run, Stroke) and run.over == "angle":
+        return [None]
+    if isinstance(run, MultiStroke):
+        return [e.name for e in run.drivers if e.over == "angle"]
+    return []
+
+
 def _cylinder_names(data: dict, study: Study) -> tuple[list, list]:
-    """(tunable names, outputs) a run over a cylinder's link's angle needs: the geometry
-    the run computes the cylinder's length from (the link's pivot, the pins, the branch)
-    and the link's angle it checks; nothing for another run or a scene without one."""
-    cylinder = data.get("cylinder")
-    if not (isinstance(study.run, Stroke) and study.run.over == "angle"):
-        return [], []
-    if not isinstance(cylinder, dict) or not isinstance(cylinder.get("link"), str):
-        return [], []  # the run is refused against the scene's model description
-    name, link = cylinder.get("name", "cylinder"), cylinder["link"]
-    if not isinstance(name, str):
-        return [], []
-    return [f"{link}.at", f"{name}.base", f"{name}.pin", f"{name}.branch"], [f"{link}.angle"]
+    """(tunable names, outputs) a run over cylinders' links' angles needs: the geometry
+    the run computes each cylinder's length from (the link's pivot, the pins, the branch)
+    and the angles it checks, the link's and its pins' carrier's; nothing for another run
+    or a scene without such a cylinder (the run is refused against the scene's model
+    description)."""
+    tables = data.get("cylinder")
+    tables = [tables] if isinstance(tables, dict) else tables if isinstance(tables, list) else []
+    tables = [t for t in tables if isinstance(t, dict) and isinstance(t.get("link"), str)]
+    by_name = {t.get("name", "cylinder"): t for t in tables}
+    links = {t["link"] for t in tables}
+    tunable, outputs = [], []
+    for wanted in _turned_cylinders(study):
+        table = tables[0] if wanted is None and len(tables) == 1 else by_name.get(wanted)
+        if table is None or not isinstance(table.get("name", "cylinder"), str):
+            continue
+        name, link = table.get("name", "cylinder"), table["link"]
+        tunable += [f"{link}.at", f"{name}.base", f"{name}.pin", f"{name}.branch"]
+        outputs.append(f"{link}.angle")
+        carrier = table.get("at", {}).get("link") if isinstance(table.get("at"), dict) else None
+        outputs += [f"{carrier}.angle"] if carrier in links else []
+    return tunable, outputs
 
 
 def _amplifications(data: dict) -> list:

@@ -32,6 +32,16 @@ cylinder cannot turn the link and the link's angle passes from one branch to the
 A run over [low, high] is possible on the cylinder's branch only where sin(psi) keeps the
 branch's sign over the whole interval: psi is linear in theta, so the check is exact, not
 sampled.
+
+A cylinder's pins O and A may both sit on a moving link, the carrier C (the stick
+cylinder of an excavator, pinned to the boom at both ends; modelDescription/scenes/
+README.md, "Several drivers"). The triangle O, A, B is then one of C's frame: O and A are
+fixed in it and B turns about O with the link's angle relative to C, theta - theta_C.
+The formulas above hold in C's frame with that relative angle and its rates, whatever C
+itself does: the length depends on the relative angle only, so a run over it gives each
+design's lengths and rates in closed form and its toggle check stays exact. Where O and
+A sit on different bodies (one on the frame, one on a link), the length depends on two
+angles: such a cylinder is run over its length, not an angle (the study refuses it).
 """
 
 from __future__ import annotations
@@ -68,8 +78,10 @@ class Unreachable(ValueError):
 
 @dataclass(frozen=True)
 class Cylinder:
-    """A cylinder's geometry: the link's pivot O and the barrel's pin A (m, global), the
-    rod's pin B (m, in the link's frame), the branch (its sign)."""
+    """A cylinder's geometry: the link's pivot O and the barrel's pin A (m, global, or in
+    the frame of the link ``carrier`` that carries both), the rod's pin B (m, in the
+    link's frame), the branch (its sign). Its angles are the link's, relative to the
+    carrier's where it has one."""
 
     name: str
     link: str
@@ -77,6 +89,13 @@ class Cylinder:
     a: tuple
     pin: tuple
     branch: float
+    carrier: str | None = None
+
+    @property
+    def angle_name(self) -> str:
+        """The angle the triangle sees, as messages name it."""
+        own = f"{self.link}.angle"
+        return own if self.carrier is None else f"{own} - {self.carrier}.angle"
 
     def _triangle(self) -> tuple[float, float, float]:
         """(|OA|, |OB|, beta - alpha)."""
@@ -104,14 +123,14 @@ class Cylinder:
             raise Unreachable(
                 "singular",
                 f"cylinder {self.name} passes its toggle (O, A and B in line) at "
-                f"{self.link}.angle {at:.6g} rad ({math.degrees(at):.4g} deg): no length "
+                f"{self.angle_name} {at:.6g} rad ({math.degrees(at):.4g} deg): no length "
                 f"of it turns {self.link} from {low:.6g} to {high:.6g} rad",
             )
         side = 1 if math.sin(0.5 * (psi0 + psi1)) > 0 else -1
         if side != (-1 if self.branch < 0 else 1):
             raise Unreachable(
                 "cannot_assemble",
-                f"cylinder {self.name}: from {self.link}.angle {low:.6g} to {high:.6g} rad "
+                f"cylinder {self.name}: from {self.angle_name} {low:.6g} to {high:.6g} rad "
                 f"B is to the {'left' if side > 0 else 'right'} of the line O -> A, the "
                 f"branch {side:+d}, not the cylinder's {-side:+d}",
             )

@@ -28,6 +28,8 @@ __all__ = [
     "Sampling",
     "Kinetostatic",
     "Stroke",
+    "DriverRange",
+    "MultiStroke",
     "Driven",
     "Study",
     "read_study",
@@ -60,6 +62,8 @@ MAX_STEPS = 100_000_000
 #: within +-MAX_ANGLE rad (the load tables' bound).
 MAX_STROKE = 1e4
 MAX_ANGLE = 100.0
+#: The most drivers a run moves at once ([[run.driver]] tables).
+MAX_RUN_DRIVERS = 32
 #: A counterweight's bounds: its mass (kg) and its distance from the link's frame (m).
 MAX_COUNTERWEIGHT_MASS = 1e6
 MAX_COUNTERWEIGHT_AT = 1e3
@@ -242,6 +246,36 @@ class Stroke:
 
 
 @dataclass(frozen=True)
+class DriverRange:
+    """One driver of a :class:`MultiStroke` run: ``name`` (a crank, a ram or a cylinder of
+    the FMU) moved from ``start`` to ``end`` (either way; held still where they are
+    equal): ``over`` "angle" (rad: a crank's angle, or a cylinder's link's angle, relative
+    to the link carrying the cylinder's pins where they sit on a moving link) or "stroke"
+    (m: a ram's position, a cylinder's length)."""
+
+    name: str
+    over: str
+    start: float
+    end: float
+
+
+@dataclass(frozen=True)
+class MultiStroke:
+    """Each design: every driver of the FMU moved at once, each over its own range
+    (``drivers``, :class:`DriverRange`, in the file's order), all rest to rest along the
+    cycloidal rise of :mod:`dyadfmu.sweep.stroke` in one ``duration`` s, at ``points``
+    equally spaced instants, both ends included."""
+
+    duration: float
+    points: int
+    drivers: tuple
+
+
+#: The runs over time under constant loads (no crank revolution, no load tables).
+OVER_TIME = (Stroke, MultiStroke)
+
+
+@dataclass(frozen=True)
 class Driven:
     """Each design: the drive FMU and the mechanism FMU co-simulated (stabilised
     coupling) from ``start_speed`` (rad/s) for ``duration`` s at communication step
@@ -265,7 +299,7 @@ class Study:
     scene: Path | None
     fmu: Path | None
     fmi: int
-    run: Kinetostatic | Stroke | Driven
+    run: Kinetostatic | Stroke | MultiStroke | Driven
     parameters: tuple
     sampling: Sampling
     loads: tuple
@@ -472,23 +506,35 @@ def _sources(r: _Reader, study: dict) -> tuple:
     return (path, None) if key == "scene" else (None, path)
 
 
-def _range(r: _Reader, t: dict, key: str, unit: str, bound: float) -> tuple[float, float]:
-    """A run's [low, high]: two finite numbers within +-bound, low below high."""
+def _range(
+    r: _Reader,
+    t: dict,
+    key: str,
+    unit: str,
+    bound: float,
+    table: str = "run",
+    index: int | None = None,
+    rise: bool = True,
+) -> tuple[float, float]:
+    """A run's [low, high]: two finite numbers within +-bound, low below high where it
+    must ``rise`` (else a driver's [start, end], either way)."""
     value = t[key]
     pair = [finite(v) for v in value] if isinstance(value, list) and len(value) == 2 else [None]
     if not all(v is not None and abs(v) <= bound for v in pair):
         r.fail(
-            "run",
+            table,
             f"{key} must be [low, high] in {unit}, two finite numbers within +-{bound:g} "
             f"(got {_shown(value)})",
-            key=key,
+            index,
+            key,
         )
-    if not pair[0] < pair[1]:
+    if rise and not pair[0] < pair[1]:
         r.fail(
-            "run",
+            table,
             f"{key} must rise, low below high (got [{pair[0]:g}, {pair[1]:g}]): the run "
             "goes from low to high",
-            key=key,
+            index,
+            key,
         )
     return pair[0], pair[1]
 
@@ -513,6 +559,60 @@ def _stroke(r: _Reader, t: dict, key: str) -> Stroke:
         high=high,
         duration=r.number(t, "run", "duration", positive=True),
         points=r.integer(t, "run", "points", 8, 100_000, default=101),
+    )
+
+
+def _driver_range(r: _Reader, t: object, k: int, taken: set) -> DriverRange:
+    """One [[run.driver]] table: a driver's name and its angle or stroke."""
+    where = "run.driver"
+    if not isinstance(t, dict):
+        r.fail("run", "driver must be an array of tables: [[run.driver]]", key="driver")
+    r.unknown_keys(t, where, ("name", "angle", "stroke"), k)
+    name = r.name(t.get("name"), where, "name", k)
+    if name in taken:
+        r.fail(where, f"driver {name} is given twice: one [[run.driver]] per driver", k, "name")
+    taken.add(name)
+    given = [key for key in ("angle", "stroke") if key in t]
+    if len(given) != 1:
+        r.fail(
+            where,
+            f"driver {name}: give one of angle = [low, high] (rad: a crank's angle or a "
+            "cylinder's link's) or stroke = [low, high] (m: a ram's position or a cylinder's "
+            "length)",
+            k,
+            given[-1] if given else "name",
+        )
+    over = given[0]
+    start, end = _range(
+        r, t, over, "radians" if over == "angle" else "metres",
+        MAX_ANGLE if over == "angle" else MAX_STROKE, where, k, rise=False,
+    )  # fmt: skip
+    return DriverRange(name, over, start, end)
+
+
+def _multi_stroke(r: _Reader, t: dict) -> MultiStroke:
+    """A run moving several drivers at once: [run] holds the duration and the points,
+    each [[run.driver]] a driver's range."""
+    for key in ("speed", "stroke", "angle"):
+        if key in t:
+            r.fail(
+                "run",
+                f"{key} moves a mechanism's only driver; with [[run.driver]] tables each "
+                "driver's range is given in its own table (name and angle or stroke)",
+                key=key,
+            )
+    r.unknown_keys(t, "run", ("kind", "duration", "points", "driver"))
+    items = t["driver"]
+    if not isinstance(items, list) or not items:
+        r.fail("run", "driver must be an array of tables: [[run.driver]]", key="driver")
+    if len(items) > MAX_RUN_DRIVERS:
+        r.fail("run.driver", f"at most {MAX_RUN_DRIVERS} drivers", MAX_RUN_DRIVERS, "name")
+    taken: set = set()
+    drivers = tuple(_driver_range(r, d, k, taken) for k, d in enumerate(items))
+    return MultiStroke(
+        duration=r.number(t, "run", "duration", positive=True),
+        points=r.integer(t, "run", "points", 8, 100_000, default=101),
+        drivers=drivers,
     )
 
 
@@ -544,7 +644,7 @@ def _kinetostatic(r: _Reader, t: dict) -> Kinetostatic | Stroke:
     )
 
 
-def _run(r: _Reader, data: dict) -> Kinetostatic | Stroke | Driven:
+def _run(r: _Reader, data: dict) -> Kinetostatic | Stroke | MultiStroke | Driven:
     t = r.table(data, "run")
     kind = t.get("kind")
     if kind == "kinetostatic":
@@ -552,52 +652,61 @@ def _run(r: _Reader, data: dict) -> Kinetostatic | Stroke | Driven:
             r.fail(
                 "drive", "[drive] sets the drive FMU's parameters: it needs [run] kind = 'driven'"
             )
-        return _kinetostatic(r, t)
+        return _multi_stroke(r, t) if "driver" in t else _kinetostatic(r, t)
     if kind == "driven":
-        r.unknown_keys(
-            t, "run", ("kind", "step", "duration", "settle", "start_speed", "start_angle")
-        )
-        step = r.number(t, "run", "step", positive=True)
-        duration = r.number(t, "run", "duration", positive=True)
-        settle = r.number(t, "run", "settle", default=0.0)
-        if not 0 <= settle < duration:
-            r.fail("run", "settle must be at least 0 and below duration", key="settle")
-        if not 2 <= duration / step <= 10_000_000:
-            r.fail("run", "duration / step must be from 2 to 1e7 steps", key="step")
-        steps = round(duration / step)
-        if abs(duration / step - steps) > 1e-9 * steps:
+        if "driver" in t:
             r.fail(
                 "run",
-                "duration must be a whole number of steps "
-                f"(duration / step = {duration / step:.6g})",
-                key="duration",
+                "[[run.driver]] moves drivers over given ranges: it needs kind = "
+                "'kinetostatic'; a driven run turns one crank by the drive FMU",
+                key="kind",
             )
-        if steps + 1 - recorded_from(settle, step) < MIN_RECORDED:
-            r.fail(
-                "run",
-                f"settle leaves fewer than {MIN_RECORDED} communication points to take the "
-                f"figures from: (duration - settle) / step must be at least {MIN_RECORDED - 1}",
-                key="settle",
-            )
-        drive = r.table(data, "drive", required=False)
-        for name in drive:
-            if name not in DRIVE_PARAMETERS:
-                r.fail(
-                    "drive",
-                    f"unknown drive parameter {name!r}; expected one of "
-                    f"{', '.join(DRIVE_PARAMETERS)} (a name with a dot is written in quotes: "
-                    '"motor.stall_torque" = 200)',
-                    key=name,
-                )
-        return Driven(
-            step=step,
-            duration=duration,
-            settle=settle,
-            start_speed=r.number(t, "run", "start_speed"),
-            start_angle=r.number(t, "run", "start_angle", default=0.0),
-            drive=tuple((n, r.number(drive, "drive", n, positive=True)) for n in drive),
-        )
+        return _driven(r, data, t)
     r.fail("run", f"kind must be 'kinetostatic' or 'driven' (got {kind!r})", key="kind")
+
+
+def _driven(r: _Reader, data: dict, t: dict) -> Driven:
+    """A run of the drive FMU and the mechanism FMU co-simulated, and its [drive]."""
+    r.unknown_keys(t, "run", ("kind", "step", "duration", "settle", "start_speed", "start_angle"))
+    step = r.number(t, "run", "step", positive=True)
+    duration = r.number(t, "run", "duration", positive=True)
+    settle = r.number(t, "run", "settle", default=0.0)
+    if not 0 <= settle < duration:
+        r.fail("run", "settle must be at least 0 and below duration", key="settle")
+    if not 2 <= duration / step <= 10_000_000:
+        r.fail("run", "duration / step must be from 2 to 1e7 steps", key="step")
+    steps = round(duration / step)
+    if abs(duration / step - steps) > 1e-9 * steps:
+        r.fail(
+            "run",
+            f"duration must be a whole number of steps (duration / step = {duration / step:.6g})",
+            key="duration",
+        )
+    if steps + 1 - recorded_from(settle, step) < MIN_RECORDED:
+        r.fail(
+            "run",
+            f"settle leaves fewer than {MIN_RECORDED} communication points to take the "
+            f"figures from: (duration - settle) / step must be at least {MIN_RECORDED - 1}",
+            key="settle",
+        )
+    drive = r.table(data, "drive", required=False)
+    for name in drive:
+        if name not in DRIVE_PARAMETERS:
+            r.fail(
+                "drive",
+                f"unknown drive parameter {name!r}; expected one of "
+                f"{', '.join(DRIVE_PARAMETERS)} (a name with a dot is written in quotes: "
+                '"motor.stall_torque" = 200)',
+                key=name,
+            )
+    return Driven(
+        step=step,
+        duration=duration,
+        settle=settle,
+        start_speed=r.number(t, "run", "start_speed"),
+        start_angle=r.number(t, "run", "start_angle", default=0.0),
+        drive=tuple((n, r.number(drive, "drive", n, positive=True)) for n in drive),
+    )
 
 
 def recorded_from(settle: float, step: float) -> int:
@@ -851,7 +960,7 @@ def _check_work(r: _Reader, sampling: Sampling, n_params: int, run: object) -> N
     designs = sampling.count**n_params if sampling.method == "grid" else sampling.count
     if isinstance(run, Kinetostatic):
         work, limit, what = designs * run.points, MAX_POSITIONS, "crank positions"
-    elif isinstance(run, Stroke):
+    elif isinstance(run, OVER_TIME):
         work, limit, what = designs * run.points, MAX_POSITIONS, "driver positions"
     else:
         steps = round(run.duration / run.step)
@@ -935,7 +1044,7 @@ def read_study(path: Path | str) -> Study:
     run = _run(r, data)
     params = _parameters(r, data, isinstance(run, Driven))
     loads_t = r.table(data, "loads", False)
-    stroke = isinstance(run, Stroke)
+    stroke = isinstance(run, OVER_TIME)
     loads = tuple(_load(r, r.name(n, "loads", n), v, stroke) for n, v in loads_t.items())
     fixed_t = r.table(data, "fixed", False)
     fixed = tuple((r.name(n, "fixed", n), _fixed_value(r, fixed_t, n)) for n in fixed_t)
