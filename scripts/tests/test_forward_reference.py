@@ -67,3 +67,36 @@ def test_the_arguments_are_checked_by_name():
         forward.integrate(chain, lambda t, q, dq: 0 * q, [-1, -2], [0, 0], [1, 0])
     with pytest.raises(ValueError, match="stiffness, damping"):
         forward.holding(chain, {"front": -1.0, "rear": -2.0}, stiffness=np.inf)
+
+
+@pytest.mark.parametrize("inductance", (1e-3, 1e-6))
+def test_with_motors_the_energy_supplied_is_stored_or_dissipated(inductance):
+    """Both hips of the leg driven by DC motors at a voltage law: the supplies' work
+    equals the mechanism's and rotors' kinetic and potential energy, the inductances'
+    L i^2 / 2 and what the resistance and friction dissipate, with a small inductance
+    (stiff) as with a large one."""
+    chain = multidriver.load("leg")
+    low, high = np.array([chain.ranges[d] for d in chain.driver_names]).T
+    middle = 0.5 * (low + high)
+    motor = forward.DCMotor(1.0, inductance, 0.5, rotor_inertia=1e-4, friction=1e-4, ratio=20.0)
+    holding = chain.bias(chain.state(middle[None, :]))[0] / (motor.ratio * motor.torque_constant)
+
+    def voltage(t, q, dq):
+        return motor.resistance * holding + 40.0 * (middle - q)
+
+    start = middle + 0.05 * (high - low)
+    current = dict(zip(chain.driver_names, holding, strict=True))
+    motors = {"front": motor, "rear": motor}
+    times = np.linspace(0.0, 0.05, 3)
+    run = forward.integrate_with_motors(
+        chain, motors, voltage, start, 0.0 * start, current, times, rtol=1e-9, atol=1e-12
+    )
+    balance = run.stored + run.dissipated - run.supplied
+    drift, scale = np.ptp(balance), np.max(np.abs(run.supplied))
+    moved = np.max(np.abs(run.run.q - start))
+    print(
+        f"L = {inductance:g} H: drift {drift:.1e} J of {scale:.3g} J supplied, "
+        f"{run.run.evaluations} evaluations, the hips moved {moved:.3g} rad"
+    )
+    assert moved > 1e-3
+    assert drift < 1e-9 * scale

@@ -33,7 +33,16 @@ import numpy as np
 
 from ..mechanisms.multidriver import MultiChain
 
-__all__ = ["Trajectory", "accelerations", "energy", "holding", "integrate"]
+__all__ = [
+    "DCMotor",
+    "MotorRun",
+    "Trajectory",
+    "accelerations",
+    "energy",
+    "holding",
+    "integrate",
+    "integrate_with_motors",
+]
 
 #: u(t, q, q') -> efforts (drivers,): the drivers' torques [N m] and forces [N]
 EffortLaw = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
@@ -169,3 +178,176 @@ def holding(
         return rest + gain @ (goal - q) - damp @ dq
 
     return law
+
+
+@dataclass(frozen=True)
+class DCMotor:
+    """A DC motor geared to a crank: armature resistance [ohm], inductance [H], torque
+    constant [N m/A] (in SI also the back-EMF constant [V s/rad]), rotor inertia
+    [kg m2], viscous friction at the rotor [N m s/rad] and the gear ratio (rotor turns
+    per crank turn). With the rotor at omega_m = ratio q' and the armature current i:
+
+        inductance i' = V - resistance i - torque_constant omega_m,
+        the crank's torque = ratio (torque_constant i - friction omega_m)
+                             - ratio^2 rotor_inertia q''.
+    """
+
+    resistance: float
+    inductance: float
+    torque_constant: float
+    rotor_inertia: float = 0.0
+    friction: float = 0.0
+    ratio: float = 1.0
+
+    def __post_init__(self):
+        for name in (
+            "resistance",
+            "inductance",
+            "torque_constant",
+            "rotor_inertia",
+            "friction",
+            "ratio",
+        ):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value)):
+                raise ValueError(f"DCMotor.{name}: expected a finite number, got {value!r}")
+        for name in ("resistance", "inductance", "torque_constant", "ratio"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"DCMotor.{name}: expected > 0, got {getattr(self, name)!r}")
+        for name in ("rotor_inertia", "friction"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"DCMotor.{name}: expected >= 0, got {getattr(self, name)!r}")
+
+
+@dataclass(frozen=True)
+class MotorRun:
+    """A run with motors: the :class:`Trajectory` (its ``u`` the drivers' efforts on
+    the mechanism, a motor's torque at its crank), the armature currents ``current``
+    (T, motors) [A] in the order of ``motors``, and the energy accounts [J] since the
+    start: ``supplied`` (the supplies' V i, the other drivers' and the loads' work),
+    ``dissipated`` (armature resistance and rotor friction), ``stored`` at each time
+    (kinetic energy of mechanism and rotors, potential energy, the inductances'
+    L i^2 / 2)."""
+
+    run: Trajectory
+    motors: tuple
+    current: np.ndarray
+    supplied: np.ndarray
+    dissipated: np.ndarray
+    stored: np.ndarray
+
+
+def integrate_with_motors(
+    chain: MultiChain,
+    motors: Mapping[str, DCMotor],
+    law: EffortLaw,
+    q0: Mapping | np.ndarray,
+    dq0: Mapping | np.ndarray,
+    current0: Mapping[str, float],
+    times: np.ndarray,
+    rtol: float = 1e-11,
+    atol: float = 1e-12,
+) -> MotorRun:
+    """The motion from (q0, dq0, current0) at ``times[0]`` with a DC motor at each crank
+    named in ``motors``; ``law`` gives, per driver in the chain's order, the supply
+    voltage [V] of a driver with a motor and the effort of any other. SciPy's Radau
+    integrates it (a small inductance makes it stiff)."""
+    from scipy.integrate import solve_ivp
+
+    names, n = chain.driver_names, len(chain.drivers)
+    geared = _motor_drivers(chain, motors)
+    k = len(geared)
+    i0 = np.array([float(current0[names[a]]) for a in geared]) if k else np.zeros(0)
+    y0 = np.concatenate([_vector(chain, q0, "q0"), _vector(chain, dq0, "dq0"), i0, [0, 0]])
+    times = np.asarray(times, dtype=float)
+    count = [0]
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        count[0] += 1
+        q, dq, i = y[:n], y[n : 2 * n], y[2 * n : 2 * n + k]
+        ddq, di, u, supplied, lost = _motor_step(chain, motors, geared, law, t, q, dq, i)
+        return np.concatenate([dq, ddq, di, [supplied, lost]])
+
+    sol = solve_ivp(rhs, (times[0], times[-1]), y0, "Radau", times, rtol=rtol, atol=atol)
+    if not sol.success:
+        raise RuntimeError(
+            f"{chain.name}: the forward run failed at t = {sol.t[-1]:.6g} s: {sol.message}"
+        )
+    q, dq, i = sol.y[:n].T, sol.y[n : 2 * n].T, sol.y[2 * n : 2 * n + k].T
+    steps = [
+        _motor_step(chain, motors, geared, law, t, a, b, c)
+        for t, a, b, c in zip(sol.t, q, dq, i, strict=True)
+    ]
+    ddq = np.array([s[0] for s in steps])
+    u = np.array([s[2] for s in steps])
+    stored = np.array(
+        [
+            energy(chain, t, a, b) + _motor_energy(chain, motors, geared, b, c)
+            for t, a, b, c in zip(sol.t, q, dq, i, strict=True)
+        ]
+    )
+    run = Trajectory(sol.t, q, dq, ddq, u, sol.y[-2], count[0])
+    return MotorRun(run, tuple(names[a] for a in geared), i, sol.y[-2], sol.y[-1], stored)
+
+
+def _motor_drivers(chain: MultiChain, motors: Mapping[str, DCMotor]) -> list[int]:
+    names = chain.driver_names
+    for name in motors:
+        if name not in names:
+            raise ValueError(f"motors: {name!r} is no driver of {chain.name} ({', '.join(names)})")
+        if chain.drivers[names.index(name)].kind != "crank":
+            raise ValueError(f"motors: {name!r} is no crank; a DC motor turns a crank")
+    return [a for a, name in enumerate(names) if name in motors]
+
+
+def _motor_step(
+    chain: MultiChain,
+    motors: Mapping[str, DCMotor],
+    geared: list[int],
+    law: EffortLaw,
+    t: float,
+    q: np.ndarray,
+    dq: np.ndarray,
+    i: np.ndarray,
+) -> tuple:
+    """q'', i', the efforts on the mechanism, the power supplied and the power lost."""
+    names = chain.driver_names
+    command = np.asarray(law(t, q, dq), dtype=float)
+    kin = _state(chain, t, q, dq)
+    M, h = chain.inertia_matrix(kin)[0].copy(), chain.bias(kin)[0]
+    drive, di = command.copy(), np.zeros(len(geared))
+    supplied, lost = 0.0, 0.0
+    for j, a in enumerate(geared):
+        m = motors[names[a]]
+        speed = m.ratio * dq[a]
+        M[a, a] += m.ratio**2 * m.rotor_inertia
+        drive[a] = m.ratio * (m.torque_constant * i[j] - m.friction * speed)
+        di[j] = (command[a] - m.resistance * i[j] - m.torque_constant * speed) / m.inductance
+        supplied += command[a] * i[j]
+        lost += m.resistance * i[j] ** 2 + m.friction * speed**2
+    ddq = np.linalg.solve(M, drive - h)
+    if not np.all(np.isfinite(ddq)):
+        raise RuntimeError(f"{chain.name}: no motion at t = {t:.6g} s, q = {q}")
+    others = [a for a in range(len(names)) if a not in geared]
+    supplied += sum(command[a] * dq[a] for a in others) + _load_power(chain, kin)
+    u = drive.copy()
+    for a in geared:
+        m = motors[names[a]]
+        u[a] -= m.ratio**2 * m.rotor_inertia * ddq[a]
+    return ddq, di, u, supplied, lost
+
+
+def _motor_energy(
+    chain: MultiChain,
+    motors: Mapping[str, DCMotor],
+    geared: list[int],
+    dq: np.ndarray,
+    i: np.ndarray,
+) -> float:
+    """The rotors' kinetic energy and the inductances' L i^2 / 2 [J]."""
+    names = chain.driver_names
+    total = 0.0
+    for j, a in enumerate(geared):
+        m = motors[names[a]]
+        total += 0.5 * m.rotor_inertia * (m.ratio * dq[a]) ** 2 + 0.5 * m.inductance * i[j] ** 2
+    return total
