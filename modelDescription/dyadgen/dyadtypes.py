@@ -72,6 +72,14 @@ UNITS = {
     "kg.m2": {"kg": 1, "m": 2},
     "kg.m2/rad": {"kg": 1, "m": 2, "rad": -1},
     "kg/m": {"kg": 1, "m": -1},
+    # a motor's (forward scenes' [motor])
+    "s": {"s": 1},
+    "A": {"A": 1},
+    "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
+    "Ohm": {"kg": 1, "m": 2, "s": -3, "A": -2},
+    "H": {"kg": 1, "m": 2, "s": -2, "A": -2},
+    "N.m/A": {"kg": 1, "m": 2, "s": -2, "A": -1},
+    "N.m.s/rad": {"kg": 1, "m": 2, "s": -1, "rad": -1},
 }
 BASE_UNIT_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 #: The unit a simulator shows a variable in by default, and its factor: shown = factor *

@@ -14,6 +14,7 @@ and documentation:
 
 from __future__ import annotations
 
+from dyadgen import forward
 from dyadgen.catalogue import (
     Entry,
     drive_absence_reason,
@@ -26,8 +27,9 @@ from dyadgen.corefiles import dyad_core_sources, scene_core_sources
 from dyadgen.dyadtypes import PAIRS
 from dyadgen.emit import documentation, fmi2, fmi3
 from dyadgen.emit.c_table import model_c
+from dyadgen.emit.forward_c import forward_behaviour
 from dyadgen.emit.scene_c import scene_c, scene_header, scene_tangent_c
-from dyadgen.model import Input, Param, Scene
+from dyadgen.model import Input, Param, Scene, member
 from dyadgen.scenefile.problems import SceneError
 from dyadgen.settings import ON_SINGULAR
 from dyadgen.structs import (
@@ -323,6 +325,9 @@ class SceneKind(Kind):
         inputs = {i.member: "dir" if i.angle else "real" for i in scene.inputs}
         inputs.update((prm.member, "real") for prm in scene.parameters() if prm.tunable)
         outputs = {o.member: "status" if o.integer else "real" for o in scene.outputs}
+        if scene.forward():
+            inputs.update(forward.input_members(scene))
+            outputs.update(forward.output_members(scene))
         super().__init__(
             "scene",
             f"{ident}_input",
@@ -337,18 +342,36 @@ class SceneKind(Kind):
             # a mechanism FMU: the kinematics are solved inside, from the driver's motion
             self.realisation = "mechanism"
             self.label = "mechanism"
+        if scene.forward():
+            # a plant: the motion integrated inside, the efforts in
+            self.realisation = "forward"
+            self.label = "forward mechanism"
+            self.directional_derivatives = "false"
+            self.model_includes = (
+                "<math.h>",
+                "<stddef.h>",
+                "<stdio.h>",
+                "<string.h>",
+                '"dyadfmu/ode.h"',
+                '"fmu_model.h"',
+            )
 
     def source_files(self, table: Table, version: int) -> list[str]:
         """The closed forms of the scene's dyad types with their tangents, and its
         generated code."""
-        return scene_core_sources(table.scene, derivatives=True) + [
-            f"{table.identifier}_scene.c",
-            f"{table.identifier}_scene_tangent.c",
-            "fmu_instance.c",
-            "fmu_state.c",
-            *SHIM_FILES[version],
-            f"{table.identifier}_model.c",
-        ]
+        plant = ["dyad_ode.c"] if table.scene.forward() else []
+        return (
+            scene_core_sources(table.scene, derivatives=True)
+            + plant
+            + [
+                f"{table.identifier}_scene.c",
+                f"{table.identifier}_scene_tangent.c",
+                "fmu_instance.c",
+                "fmu_state.c",
+                *SHIM_FILES[version],
+                f"{table.identifier}_model.c",
+            ]
+        )
 
     def subject(self, table: Table) -> str:
         """The scene."""
@@ -369,6 +392,8 @@ class SceneKind(Kind):
     def model_data(self, table: Table) -> tuple[list[str], str]:
         """The scene's behaviour: its functions (<identifier>_scene.h) on the FMU
         layer's untyped blocks."""
+        if table.scene.forward():
+            return forward_behaviour(table.scene), "NULL"
         return scene_behaviour(table.identifier), "NULL"
 
     def documentation(self, table: Table) -> str:
@@ -479,16 +504,30 @@ def _settable_row(
     _bounds(raw, settable.domain)
 
 
-def _scene_rows(scene: Scene) -> list[dict]:
-    """The rows of a tailored scene's table: its inputs, tunable parameters, outputs."""
+def _forward_rows(scene: Scene) -> list[dict]:
+    """The rows of a forward scene's table: the efforts and loads, the tunable and start
+    parameters and tolerances, the drivers' motion and the scene's outputs."""
     rows: list[dict] = []
-    for i in scene.inputs:
-        _settable_row(rows, i, "input", i.start, f"input.{i.member}{'@angle' if i.angle else ''}")
+    for i in forward.public_inputs(scene):
+        _settable_row(rows, i, "input", i.start, f"input.{i.member}")
     for prm in scene.parameters():
         if prm.tunable:
             _settable_row(rows, prm, "parameter", prm.value, f"input.{prm.member}")
+    for i, start in forward.start_parameters(scene):
+        _settable_row(rows, i, "parameter", start, f"input.{i.member}")
+    for name, start, text in forward.tolerance_parameters():
+        raw = _row(rows, name, "parameter", None, type="Real", start=start, description=text)
+        raw.update(lives=f"input.{member(name).replace('solver_', 'plant_')}", min=0.0)
+        raw.update(min_exclusive=True, max=1.0, max_exclusive=True)
+        if name == "solver.rtol":
+            raw.update(min=forward.RTOL_MIN, min_exclusive=False)
     rows.append(entry_row(setting_entry(ON_SINGULAR), len(rows) + 1, ON_SINGULAR.start))
-    for o in scene.outputs:
+    _output_rows(rows, forward.public_outputs(scene))
+    return rows
+
+
+def _output_rows(rows: list[dict], outputs: list) -> None:
+    for o in outputs:
         _row(
             rows,
             o.name,
@@ -499,6 +538,20 @@ def _scene_rows(scene: Scene) -> list[dict]:
             lives=f"result.{o.member}",
             depends=list(o.depends),
         )
+
+
+def _scene_rows(scene: Scene) -> list[dict]:
+    """The rows of a tailored scene's table: its inputs, tunable parameters, outputs."""
+    if scene.forward():
+        return _forward_rows(scene)
+    rows: list[dict] = []
+    for i in scene.inputs:
+        _settable_row(rows, i, "input", i.start, f"input.{i.member}{'@angle' if i.angle else ''}")
+    for prm in scene.parameters():
+        if prm.tunable:
+            _settable_row(rows, prm, "parameter", prm.value, f"input.{prm.member}")
+    rows.append(entry_row(setting_entry(ON_SINGULAR), len(rows) + 1, ON_SINGULAR.start))
+    _output_rows(rows, scene.outputs)
     return rows
 
 

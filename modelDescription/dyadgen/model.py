@@ -162,6 +162,36 @@ class Crank:
         return self.actuator or self.name
 
 
+@dataclass
+class Motor:
+    """A DC motor geared to a crank of a forward scene ([[motor]]): with the rotor at
+    ratio q' and the armature current i, inductance i' = V - resistance i -
+    torque_constant ratio q', and the crank's torque ratio (torque_constant i - friction
+    ratio q') - ratio^2 rotor_inertia q''. Its numbers are the FMU's parameters."""
+
+    driver: str  # the crank's name
+    line: int | None
+    numbers: dict  # key -> value, every key of MOTOR_NUMBERS
+
+
+#: A motor's numbers: key -> (unit, what, default or None where required, least, strict)
+MOTOR_NUMBERS = {
+    "resistance": ("Ohm", "Armature resistance", None, 0.0, True),
+    "inductance": ("H", "Armature inductance", None, 0.0, True),
+    "torque_constant": (
+        "N.m/A",
+        "Torque constant, in SI also the back-EMF constant (V.s/rad)",
+        None,
+        0.0,
+        True,
+    ),
+    "rotor_inertia": ("kg.m2", "Rotor inertia about its axis", 0.0, 0.0, False),
+    "friction": ("N.m.s/rad", "Viscous friction at the rotor", 0.0, 0.0, False),
+    "ratio": ("", "Gear ratio: rotor turns per crank turn", 1.0, 0.0, True),
+    "current": ("A", "Armature current at the start", 0.0, None, False),
+}
+
+
 @dataclass(eq=False)
 class Output:
     """An output the scene offers: its name, C member and dependencies."""
@@ -208,6 +238,9 @@ class Scene:
     #: "internal": the kinematics are solved in the generated code from the driver's
     #: motion; "external": every link's motion is an input
     kinematics: str = "external"
+    #: "inverse": the drivers' motion in, their efforts out; "forward": the efforts in,
+    #: the motion integrated inside (dyadgen/forward.py)
+    dynamics: str = "inverse"
     #: internal kinematics: the name of a link's motion (as an input would be named,
     #: "rod.angle") -> the C expression that computes it
     computed: dict = field(default_factory=dict)
@@ -218,6 +251,8 @@ class Scene:
     point_loads: list = field(default_factory=list)  # PointLoad, in file order
     #: every driver: cranks, rams, cylinders, each kind in file order
     drivers: list = field(default_factory=list)
+    #: a forward scene's DC motors, one per crank at most, in file order
+    motors: list = field(default_factory=list)
 
     def driver_of(self, name: str) -> Crank | None:
         """The driver whose moving link is `name` (a crank, a ram, a cylinder's link)."""
@@ -248,6 +283,10 @@ class Scene:
     def internal(self) -> bool:
         """Whether the generated code solves the kinematics from the driver's motion."""
         return self.kinematics == "internal"
+
+    def forward(self) -> bool:
+        """Whether the scene is a plant: its drivers' efforts in, its motion integrated."""
+        return self.dynamics == "forward"
 
     def params_of(self, g: str) -> dict:
         """The numbers of a moving link: a driver's or a dyad link's."""

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from dyadgen.emit.scene_c import inputs_read
+from dyadgen.forward import required_outputs
 from dyadgen.model import Crank, Param, Scene
 from dyadgen.needs import derive_inputs, derive_outputs
 from dyadgen.scenefile import loads as point_loads
@@ -70,6 +71,9 @@ def _derive(p: Problems, scene: Scene, scene_t: dict, data: dict) -> None:
     wanted = sections.outputs(p, scene_t)
     if wanted is None:
         return
+    if scene.forward() and "all" not in wanted:
+        # the equation of motion reads M(q) and h
+        wanted = wanted + [n for n in required_outputs(scene) if n not in wanted]
     for problem in derive_outputs(scene, wanted):
         p.add(f"[scene]: {problem}", "scene", 0, "outputs")
     if p.items:
@@ -96,6 +100,7 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
     threshold = sections.threshold(p, scene_t)
     kinematics = sections.kinematics(p, scene_t, any(d in data for d in sections.DRIVERS))
     internal = kinematics == "internal"
+    dynamics = sections.dynamics(p, scene_t, internal, inertia)
     drivers = sections.drivers(p, data, inertia, needs_mass, internal)
     refused: dict[str, int] = {}
     tables = mechanism.link_tables(p, data, drivers, refused)
@@ -121,8 +126,10 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
         gravity_params=gravity_params,
         threshold=threshold,
         kinematics=kinematics,
+        dynamics=dynamics,
         point_loads=placed,
     )
+    scene.motors = sections.motors(p, data, drivers, scene.forward())
     sections.tunable(p, scene_t, scene, found.tables_of_names(data.get("dyad", [])))
     if not p.items:
         _derive(p, scene, scene_t, data)

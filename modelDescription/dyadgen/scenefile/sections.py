@@ -7,7 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from dyadgen import textsafe
-from dyadgen.model import Crank, Param, Scene, member
+from dyadgen.forward import DYNAMICS
+from dyadgen.model import MOTOR_NUMBERS, Crank, Motor, Param, Scene, member
 from dyadgen.scenefile.builtins import builtin_identifiers, is_builtin
 from dyadgen.scenefile.names import (
     identifier_problem,
@@ -32,6 +33,7 @@ SCENE_KEYS = {
     "tunable",
     "singular_threshold",
     "kinematics",
+    "dynamics",
 }
 EFFECT_KEYS = {"inertia", "gravity"}
 CRANK_KEYS = {"name", "length", "com", "mass", "inertia", "at"}
@@ -41,7 +43,9 @@ CYLINDER_KEYS |= {"barrel", "rod"}
 CYLINDER_PART_KEYS = {"mass", "com", "inertia"}
 DRIVERS = ("crank", "ram", "cylinder")
 LOAD_KEYS = {"force", "moment"}
-TOP_KEYS = {"scene", "effects", "gravity", "dyad", "link", "loads", "load", "start", *DRIVERS}
+TOP_KEYS = {"scene", "effects", "gravity", "dyad", "link", "loads", "load", "start", "motor"}
+TOP_KEYS |= set(DRIVERS)
+MOTOR_KEYS = {"driver", *MOTOR_NUMBERS}
 KINEMATICS = ("internal", "external")
 #: sqrt(DBL_EPSILON), where round-off still leaves half of the digits.
 DEFAULT_THRESHOLD = 1.4901161193847656e-8
@@ -174,6 +178,31 @@ def kinematics(p: Problems, scene_t: dict, driven: bool) -> str:
             "kinematics",
         )
         return "external"
+    return value
+
+
+def dynamics(p: Problems, scene_t: dict, internal: bool, inertia: bool) -> str:
+    """[scene] dynamics: "inverse" (the default: the drivers' motion in) or "forward"
+    (their efforts in, the motion integrated), which needs the kinematics inside and
+    the inertia."""
+    value = scene_t.get("dynamics", "inverse")
+    if value not in DYNAMICS:
+        p.add(
+            f"[scene]: dynamics must be 'inverse' or 'forward', not {shown(value)}",
+            "scene",
+            0,
+            "dynamics",
+        )
+        return "inverse"
+    if value == "forward" and not (internal and inertia):
+        p.add(
+            "[scene]: dynamics = 'forward' integrates the drivers' motion from their efforts: "
+            "it needs kinematics = 'internal' (a driver) and [effects] inertia = true",
+            "scene",
+            0,
+            "dynamics",
+        )
+        return "inverse"
     return value
 
 
@@ -694,3 +723,53 @@ def starts(p: Problems, scene: Scene, starts_t: object, candidates: set) -> None
             p.add(f"[start]: '{name}' must be positive, not {shown(value)}", "start", 0, name)
             continue
         target.start = found
+
+
+def motors(p: Problems, data: dict, drivers: list[Crank], forward: bool) -> list[Motor]:
+    """[motor] or [[motor]]: a DC motor at a crank of a forward scene, each crank one at
+    most."""
+    tables = data.get("motor")
+    if tables is None:
+        return []
+    rows = tables if isinstance(tables, list) else [tables]
+    if not forward:
+        p.add("[motor]: a motor drives a plant: it needs [scene] dynamics = 'forward'", "motor", 0)
+        return []
+    cranks = [d.name for d in drivers if d.kind == "crank"]
+    found: list[Motor] = []
+    for i, table in enumerate(rows):
+        if not isinstance(table, dict):
+            p.add("[motor] must be a table", "motor", i)
+            continue
+        unknown_keys(p, table, MOTOR_KEYS, "[motor]", "motor", i)
+        driver = table.get("driver", cranks[0] if len(cranks) == 1 else None)
+        if driver not in cranks:
+            p.add(
+                f"[motor]: 'driver' must name a crank of the scene ({', '.join(cranks) or 'none'}),"
+                f" not {shown(driver)}",
+                "motor",
+                i,
+                "driver" if "driver" in table else None,
+            )
+            continue
+        if any(m.driver == driver for m in found):
+            p.add(f"[motor]: crank '{driver}' has a motor already", "motor", i, "driver")
+            continue
+        numbers = {}
+        for key, (_, _, default, least, strict) in MOTOR_NUMBERS.items():
+            if key not in table and default is not None:
+                numbers[key] = default
+                continue
+            value = number(
+                p,
+                table,
+                key,
+                f"motor of '{driver}'",
+                "motor",
+                i,
+                positive=least == 0.0 and strict,
+                nonnegative=least == 0.0 and not strict,
+            )
+            numbers[key] = value if value is not None else 1.0
+        found.append(Motor(driver, p.loc.line("motor", i), numbers))
+    return found

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mechanisms.chains import Chain
 from ..mechanisms.multidriver import MultiChain
 
 __all__ = [
@@ -38,6 +39,8 @@ __all__ = [
     "MotorRun",
     "Trajectory",
     "accelerations",
+    "chain_terms",
+    "integrate_chain",
     "energy",
     "holding",
     "integrate",
@@ -147,6 +150,47 @@ def integrate(
     return Trajectory(sol.t, q, dq, ddq, u, work, count[0])
 
 
+def chain_terms(chain: Chain, t: float, q: float, dq: float) -> tuple[float, float]:
+    """J(q) and h(t, q, q') of a chain with one driver, effort = J q'' + h: its
+    Newton-Euler effort at zero and at unit acceleration (the effort is affine in q''),
+    with the chain's load models at the state."""
+    pair = np.array([0.0, 1.0])
+    kin = chain._solve(np.full(2, float(t)), np.full(2, float(q)), np.full(2, float(dq)), pair)
+    effort = chain.reference(kin)[chain.drive_output]
+    return float(effort[1] - effort[0]), float(effort[0])
+
+
+def integrate_chain(
+    chain: Chain,
+    effort: float,
+    q0: float,
+    dq0: float,
+    times: np.ndarray,
+    rtol: float = 1e-12,
+    atol: float = 1e-12,
+) -> Trajectory:
+    """The motion of a chain with one driver under a constant ``effort`` [N m or N] from
+    (q0, dq0) at ``times[0]``, reported at ``times``, by DOP853: q'' = (effort - h) / J.
+    Raises RuntimeError where the solver fails."""
+    from scipy.integrate import solve_ivp
+
+    count = [0]
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        count[0] += 1
+        J, h = chain_terms(chain, t, y[0], y[1])
+        return np.array([y[1], (effort - h) / J])
+
+    times = np.asarray(times, dtype=float)
+    sol = solve_ivp(rhs, (times[0], times[-1]), [q0, dq0], "DOP853", times, rtol=rtol, atol=atol)
+    if not sol.success:
+        raise RuntimeError(f"{chain.name}: the forward run failed at t = {sol.t[-1]:.6g} s")
+    q, dq = sol.y[0][:, None], sol.y[1][:, None]
+    ddq = np.array([rhs(t, [a[0], b[0]])[1] for t, a, b in zip(sol.t, q, dq, strict=True)])
+    u = np.full_like(q, float(effort))
+    return Trajectory(sol.t, q, dq, ddq[:, None], u, np.zeros_like(sol.t), count[0])
+
+
 def _vector(chain: MultiChain, value: Mapping | np.ndarray, what: str) -> np.ndarray:
     names = chain.driver_names
     if isinstance(value, Mapping):
@@ -247,11 +291,14 @@ def integrate_with_motors(
     times: np.ndarray,
     rtol: float = 1e-11,
     atol: float = 1e-12,
+    method: str = "Radau",
 ) -> MotorRun:
     """The motion from (q0, dq0, current0) at ``times[0]`` with a DC motor at each crank
     named in ``motors``; ``law`` gives, per driver in the chain's order, the supply
     voltage [V] of a driver with a motor and the effort of any other. SciPy's Radau
-    integrates it (a small inductance makes it stiff)."""
+    integrates it (a small inductance makes it stiff); ``method`` names another of
+    ``solve_ivp``'s (DOP853 is faster where the circuit's time constant L / R is not far
+    below the steps the accuracy asks for)."""
     from scipy.integrate import solve_ivp
 
     names, n = chain.driver_names, len(chain.drivers)
@@ -268,7 +315,7 @@ def integrate_with_motors(
         ddq, di, u, supplied, lost = _motor_step(chain, motors, geared, law, t, q, dq, i)
         return np.concatenate([dq, ddq, di, [supplied, lost]])
 
-    sol = solve_ivp(rhs, (times[0], times[-1]), y0, "Radau", times, rtol=rtol, atol=atol)
+    sol = solve_ivp(rhs, (times[0], times[-1]), y0, method, times, rtol=rtol, atol=atol)
     if not sol.success:
         raise RuntimeError(
             f"{chain.name}: the forward run failed at t = {sol.t[-1]:.6g} s: {sol.message}"

@@ -1,0 +1,31 @@
+"""The C of a forward scene's behaviour (dyadgen/forward.py): the parts generated for
+the scene's drivers around templates/forward_behaviour.c.in."""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+from string import Template
+
+from dyadgen.forward import MAX_STEPS, behaviour_parts
+from dyadgen.model import Scene
+
+TEMPLATE = Path(__file__).parent / "templates" / "forward_behaviour.c.in"
+
+
+@functools.cache
+def _template() -> Template:
+    return Template(TEMPLATE.read_text(encoding="utf-8"))
+
+
+def forward_behaviour(scene: Scene) -> list[str]:
+    """The behaviour's C lines: its constants, the parts of the scene's drivers, the
+    template."""
+    drivers, size, states, parts = behaviour_parts(scene)
+    ident = scene.identifier
+    head = [
+        f"enum {{ PLANT_DRIVERS = {drivers}, PLANT_SIZE = {size}, PLANT_STATES = {states}, "
+        f"PLANT_MAX_STEPS = {MAX_STEPS} }};",
+        "",
+    ]
+    return head + parts + _template().substitute(ident=ident).splitlines() + [""]

@@ -1,0 +1,426 @@
+"""Forward dynamics of a mechanism scene ([scene] dynamics = "forward"): the drivers'
+efforts in, their motion integrated inside the FMU, the scene's outputs at the state
+reached.
+
+The scene's own code (emit/scene_c.py) stays what it is: the inverse dynamics, the
+drivers' motion in and their efforts out. With every driver's acceleration zero it
+gives h(q, q', loads) (torque0, or each driver's effort0) and M(q) (J, or the inertia
+matrix), so the equation of motion efforts = M(q) q'' + h reads
+
+    q'' = M(q)^-1 (efforts - h(q, q', loads)),
+
+one evaluation and an N x N solve. The behaviour generated here integrates y = (q, q')
+with the core's Rosenbrock integrator (dyadfmu/ode.h) over each communication step and
+evaluates the scene once more at the end with the acceleration found, so that every
+reaction is the exact one of the motion integrated. The states live in the input block
+(doubles the FMU state keeps): each driver's position and rate, and the step-size
+controller's memory, so that a restored state continues bit for bit."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from dyadgen.model import MOTOR_NUMBERS, Crank, Input, Motor, Output, Scene, member
+from dyadgen.needs import effort_of, inertia_entry_member
+from dyadgen.textsafe import c_string
+
+#: The [scene] dynamics values.
+DYNAMICS = ("inverse", "forward")
+#: The most internal steps one communication step may take.
+MAX_STEPS = 20000
+#: The tolerances' defaults: about 1e-8 relative in the driver's motion.
+RTOL_DEFAULT = 1e-10
+ATOL_DEFAULT = 1e-10
+
+
+@dataclass
+class ForwardDriver:
+    """A driver of a forward scene: its motion's inputs of the inverse scene (now set
+    inside from the states) and the C members of its effort, start values and states."""
+
+    driver: Crank
+    index: int
+    position: Input
+    rate: Input
+    acceleration: Input
+    motor: Motor | None = None
+    #: the place of its motor's current in the state y, if it has a motor
+    current: int = -1
+
+    @property
+    def name(self) -> str:
+        """The name of the driver's motion and effort (a cylinder's, not its link's)."""
+        return self.driver.driver_name()
+
+    def effort(self) -> tuple[str, str]:
+        """(FMU name, unit) of the effort the driver is driven by."""
+        effort, unit = effort_of(self.driver)
+        return f"{self.name}.{effort}", unit
+
+    def c(self, what: str) -> str:
+        """The C member of one of the plant's own values of this driver."""
+        return f"plant_{member(self.name)}_{what}"
+
+
+def forward_drivers(scene: Scene) -> list[ForwardDriver]:
+    """The drivers of a forward scene with their motion's inputs, in the scene's order."""
+    found = []
+    motors = {m.driver: m for m in scene.motors}
+    geared = [d.name for d in scene.drivers if d.name in motors]
+    for k, driver in enumerate(scene.drivers):
+        motion = [i for i in scene.inputs if i.owner == driver.name and i.unit not in ("N", "N.m")]
+        f = ForwardDriver(driver, k, *motion[:3])
+        if driver.name in motors:
+            f.motor = motors[driver.name]
+            f.current = 2 * len(scene.drivers) + geared.index(driver.name)
+        found.append(f)
+    return found
+
+
+def state_size(scene: Scene) -> int:
+    """The dimension of y: each driver's position and rate, each motor's current."""
+    return 2 * len(scene.drivers) + len(scene.motors)
+
+
+def required_outputs(scene: Scene) -> list[str]:
+    """The outputs the equation of motion reads: M(q) and h."""
+    if len(scene.drivers) == 1:
+        c = scene.drivers[0].driver_name()
+        return [f"{c}.J", f"{c}.{effort_of(scene.drivers[0])[0]}0"]
+    names = [f"M.{a.driver_name()}.{b.driver_name()}" for a in scene.drivers for b in scene.drivers]
+    return names + [f"{d.driver_name()}.{effort_of(d)[0]}0" for d in scene.drivers]
+
+
+def motion_inputs(scene: Scene) -> set[str]:
+    """The inverse scene's inputs that are states (or their derivative) here."""
+    return {i.name for f in forward_drivers(scene) for i in (f.position, f.rate, f.acceleration)}
+
+
+def efforts(scene: Scene) -> set[str]:
+    """The FMU names of the efforts that are inputs here (a driver's without a motor),
+    outputs of the inverse scene."""
+    return {f.effort()[0] for f in forward_drivers(scene) if f.motor is None}
+
+
+def input_members(scene: Scene) -> dict[str, str]:
+    """The plant's own members of the input block: efforts, start values, tolerances,
+    states."""
+    members: dict[str, str] = {}
+    for f in forward_drivers(scene):
+        for what in ("effort", "position_start", "rate_start", "position", "rate"):
+            members[f.c(what)] = "real"
+        if f.motor is not None:
+            for key in (*MOTOR_NUMBERS, "voltage"):
+                members[f.c(f"motor_{key}")] = "real"
+            members[f.c("current")] = "real"
+    for name in ("rtol", "atol", "h_next", "h_accepted", "error_accepted", "steps", "evaluations"):
+        members[f"plant_{name}"] = "real"
+    return members
+
+
+def output_members(scene: Scene) -> dict[str, str]:
+    """The plant's own outputs: each driver's position, rate and acceleration."""
+    members = {
+        f.c(what): "real"
+        for f in forward_drivers(scene)
+        for what in ("position", "rate", "acceleration")
+    }
+    members.update((f.c("current"), "real") for f in forward_drivers(scene) if f.motor)
+    return members | {"plant_steps": "real", "plant_evaluations": "real"}
+
+
+def public_inputs(scene: Scene) -> list[Input]:
+    """The forward FMU's inputs: the efforts, then the scene's loads."""
+    moved = motion_inputs(scene)
+    found = []
+    for f in forward_drivers(scene):
+        if f.motor is not None:
+            text = f"Supply voltage of the motor of {f.name}"
+            found.append(Input(f"{f.name}.motor.voltage", "V", text, f.c("motor_voltage")))
+            continue
+        name, unit = f.effort()
+        text = f"Driving {'force' if unit == 'N' else 'torque'} of {f.name}, the plant's input"
+        found.append(Input(name, unit, text, f.c("effort")))
+    return found + [i for i in scene.inputs if i.name not in moved]
+
+
+def start_parameters(scene: Scene) -> list[tuple[Input, float]]:
+    """The start values of the states as parameters, with their defaults (the inverse
+    scene's start values of the driver's motion)."""
+    found = []
+    for f in forward_drivers(scene):
+        for motion, what in ((f.position, "position"), (f.rate, "rate")):
+            text = f"{motion.description} at the start"
+            start = 0.0 if motion.angle else motion.start
+            found.append(
+                (Input(f"{motion.name}_start", motion.unit, text, f.c(f"{what}_start")), start)
+            )
+        if f.motor is not None:
+            found += _motor_parameters(f)
+    return found
+
+
+def _motor_parameters(f: ForwardDriver) -> list[tuple[Input, float]]:
+    """A motor's numbers as parameters, with their bounds."""
+    found = []
+    for key, (unit, text, _, least, strict) in MOTOR_NUMBERS.items():
+        name = f"{f.name}.motor.{key}" + ("_start" if key == "current" else "")
+        domain = {} if least is None else {"min": least, "min_exclusive": strict}
+        parameter = Input(name, unit or None, text, f.c(f"motor_{key}"), domain=domain)
+        found.append((parameter, f.motor.numbers[key]))
+    return found
+
+
+#: The tightest relative tolerance: a few units of round-off.
+RTOL_MIN = 1e-14
+
+
+def tolerance_parameters() -> list[tuple[str, float, str]]:
+    """(name, default, description) of the integrator's tolerances."""
+    return [
+        (
+            "solver.rtol",
+            RTOL_DEFAULT,
+            "Relative tolerance of the integrator's error per internal step",
+        ),
+        (
+            "solver.atol",
+            ATOL_DEFAULT,
+            "Absolute tolerance of the integrator's error per internal step (in the "
+            "drivers' units: rad, m, rad/s, m/s)",
+        ),
+    ]
+
+
+def motion_outputs(scene: Scene) -> list[Output]:
+    """Each driver's position, rate and acceleration at the end of the step."""
+    inputs = [i.name for i in public_inputs(scene)]
+    found = []
+    for f in forward_drivers(scene):
+        for motion, what in ((f.position, "position"), (f.rate, "rate")):
+            found.append(Output(motion.name, motion.unit, motion.description, f.c(what)))
+        a = f.acceleration
+        found.append(Output(a.name, a.unit, a.description, f.c("acceleration"), depends=inputs))
+        if f.motor is not None:
+            text = f"Armature current of the motor of {f.name}"
+            found.append(Output(f"{f.name}.motor.current", "A", text, f.c("current")))
+    return found + [
+        Output(
+            "solver.steps",
+            None,
+            "Internal steps the integrator took since the start (accepted and rejected)",
+            "plant_steps",
+        ),
+        Output(
+            "solver.evaluations",
+            None,
+            "Evaluations of the equation of motion since the "
+            "start, those of the integrator's difference Jacobians included",
+            "plant_evaluations",
+        ),
+    ]
+
+
+def public_outputs(scene: Scene) -> list[Output]:
+    """The forward FMU's outputs: each driver's motion, then the scene's own (the
+    efforts, now inputs, left out), their dependencies on the motion replaced by the
+    inputs that set the acceleration."""
+    inputs = [i.name for i in public_inputs(scene)]
+    moved, given = motion_inputs(scene), efforts(scene)
+    accelerations = {f.acceleration.name for f in forward_drivers(scene)}
+    found = motion_outputs(scene)
+    for o in scene.outputs:
+        if o.name in given:
+            continue
+        depends = [d for d in o.depends if d not in moved]
+        if any(d in accelerations for d in o.depends):
+            depends = inputs
+        found.append(Output(o.name, o.unit, o.description, o.member, o.integer, depends, o.source))
+    return found
+
+
+def _state_names(scene: Scene) -> list[tuple[str, str, str]]:
+    """(name, unit, C member) of every model state, as an FMU state keeps it."""
+    states = []
+    for f in forward_drivers(scene):
+        states.append((f.position.name, f.position.unit or "", f.c("position")))
+        states.append((f.rate.name, f.rate.unit or "", f.c("rate")))
+    states += [(f"{f.name}.motor.current", "A", f.c("current")) for f in _geared(scene)]
+    states += [
+        ("solver.h_next", "s", "plant_h_next"),
+        ("solver.h_accepted", "s", "plant_h_accepted"),
+        ("solver.error_accepted", "", "plant_error_accepted"),
+        ("solver.steps", "", "plant_steps"),
+        ("solver.evaluations", "", "plant_evaluations"),
+    ]
+    return states
+
+
+def _geared(scene: Scene) -> list[ForwardDriver]:
+    """The drivers with a motor, in the order of their currents in y."""
+    return sorted((f for f in forward_drivers(scene) if f.motor), key=lambda f: f.current)
+
+
+def _motion_into(ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """put_motion(): the drivers' motion into the inverse scene's inputs."""
+    lines = [
+        "/* The drivers' motion as the inverse scene takes it. */",
+        f"static void put_motion({ident}_input* at, const double* q, const double* v,",
+        "                       const double* a)",
+        "{",
+    ]
+    for f in drivers:
+        k = f.index
+        if f.position.angle:
+            lines.append(
+                f"    at->{f.position.member} = dyad_vec2_make((dyad_real)cos(q[{k}]), "
+                f"(dyad_real)sin(q[{k}]));"
+            )
+        else:
+            lines.append(f"    at->{f.position.member} = q[{k}];")
+        lines.append(f"    at->{f.rate.member} = v[{k}];")
+        lines.append(f"    at->{f.acceleration.member} = a[{k}];")
+    return lines + ["}", ""]
+
+
+def _equation_of_motion(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """mass_and_bias(): M(q) and efforts - h from an evaluation at zero acceleration."""
+    n = len(drivers)
+    lines = [
+        "/* M(q) (row-major) and the efforts less h(q, q', loads), from the scene's outputs",
+        " * at zero acceleration of every driver. */",
+        f"static void mass_and_bias(const {ident}_input* in, const {ident}_output* out, "
+        "const double* y,",
+        "                          double* m, double* r)",
+        "{",
+    ]
+    if n == 1:
+        lines.append(f"    m[0] = out->{member(drivers[0].name)}_reduced_j;")
+    else:
+        for a in drivers:
+            for b in drivers:
+                entry = inertia_entry_member(scene, a.driver, b.driver)
+                lines.append(f"    m[{a.index * n + b.index}] = out->{entry};")
+    if not scene.motors:
+        lines.append("    (void)y;")
+    for f in drivers:
+        h = f"out->{member(f.name)}_{effort_of(f.driver)[0]}0"
+        if f.motor is None:
+            lines.append(f"    r[{f.index}] = in->{f.c('effort')} - {h};")
+            continue
+        ratio, k = f"in->{f.c('motor_ratio')}", f.index
+        lines += [
+            "    /* the motor's torque at the crank, its rotor's inertia on M's diagonal */",
+            f"    m[{k * n + k}] += {ratio} * {ratio} * in->{f.c('motor_rotor_inertia')};",
+            f"    r[{k}] = {ratio} * (in->{f.c('motor_torque_constant')} * y[{f.current}] -",
+            f"            in->{f.c('motor_friction')} * {ratio} * y[{n + k}]) - {h};",
+        ]
+    return lines + ["}", ""]
+
+
+def _currents(ident: str, drivers: list[ForwardDriver], n: int) -> list[str]:
+    """currents_rate(): the armature circuits, L i' = V - R i - k ratio q'."""
+    lines = [
+        "/* The motors' armature currents' rates. */",
+        f"static void currents_rate(const {ident}_input* in, const dyad_real* y, dyad_real* dydt)",
+        "{",
+    ]
+    geared = [f for f in drivers if f.motor is not None]
+    if not geared:
+        lines += ["    (void)in;", "    (void)y;", "    (void)dydt;"]
+    for f in geared:
+        c = f.c
+        lines += [
+            f"    dydt[{f.current}] = (dyad_real)((in->{c('motor_voltage')} - "
+            f"in->{c('motor_resistance')} * (double)y[{f.current}] -",
+            f"        in->{c('motor_torque_constant')} * in->{c('motor_ratio')} * "
+            f"(double)y[{n + f.index}]) / in->{c('motor_inductance')});",
+        ]
+    return lines + ["}", ""]
+
+
+def _state_io(drivers: list[ForwardDriver], ident: str) -> list[str]:
+    """get_state() and put_state(): y = (q, q') from and into the input block."""
+    get = [
+        f"static void get_state(const {ident}_input* in, double* y)",
+        "{",
+    ]
+    put = [f"static void put_state({ident}_input* in, const dyad_real* y)", "{"]
+    n = len(drivers)
+    for f in drivers:
+        get.append(f"    y[{f.index}] = in->{f.c('position')};")
+        get.append(f"    y[{n + f.index}] = in->{f.c('rate')};")
+        put.append(f"    in->{f.c('position')} = (double)y[{f.index}];")
+        put.append(f"    in->{f.c('rate')} = (double)y[{n + f.index}];")
+        if f.motor is not None:
+            get.append(f"    y[{f.current}] = in->{f.c('current')};")
+            put.append(f"    in->{f.c('current')} = (double)y[{f.current}];")
+    return [*get, "}", "", *put, "}", ""]
+
+
+def _start(drivers: list[ForwardDriver], ident: str) -> list[str]:
+    lines = [
+        "/* The states from their start parameters; the controller has taken no step. */",
+        "static void start(const fmu_model* model, void* input)",
+        "{",
+        f"    {ident}_input* in = ({ident}_input*)input;",
+        "    (void)model;",
+    ]
+    for f in drivers:
+        lines.append(f"    in->{f.c('position')} = in->{f.c('position_start')};")
+        lines.append(f"    in->{f.c('rate')} = in->{f.c('rate_start')};")
+        if f.motor is not None:
+            lines.append(f"    in->{f.c('current')} = in->{f.c('motor_current')};")
+    lines += [
+        "    in->plant_h_next = 0.0;",
+        "    in->plant_h_accepted = 0.0;",
+        "    in->plant_error_accepted = 0.0;",
+        "    in->plant_steps = 0.0;",
+        "    in->plant_evaluations = 0.0;",
+        "}",
+        "",
+    ]
+    return lines
+
+
+def _outputs(drivers: list[ForwardDriver], ident: str) -> list[str]:
+    lines = [
+        "/* The drivers' own outputs. */",
+        f"static void put_outputs({ident}_output* out, const double* y, const double* a)",
+        "{",
+    ]
+    n = len(drivers)
+    for f in drivers:
+        lines.append(f"    out->{f.c('position')} = y[{f.index}];")
+        lines.append(f"    out->{f.c('rate')} = y[{n + f.index}];")
+        lines.append(f"    out->{f.c('acceleration')} = a[{f.index}];")
+        if f.motor is not None:
+            lines.append(f"    out->{f.c('current')} = y[{f.current}];")
+    return lines + ["}", ""]
+
+
+def _state_table(scene: Scene, ident: str) -> list[str]:
+    lines = [
+        "/* What an FMU state keeps of the plant beyond its parameters and inputs. */",
+        "static const fmu_model_state plant_states[] = {",
+    ]
+    for name, unit, c in _state_names(scene):
+        lines.append(f"    {{{c_string(name)}, {c_string(unit)}, offsetof({ident}_input, {c})}},")
+    return lines + ["};", ""]
+
+
+def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
+    """The counts of drivers, of y's values and of the FMU state's model states, and the
+    C generated for the scene's drivers."""
+    ident = scene.identifier
+    drivers = forward_drivers(scene)
+    parts = (
+        _motion_into(ident, drivers)
+        + _equation_of_motion(scene, ident, drivers)
+        + _currents(ident, drivers, len(drivers))
+        + _state_io(drivers, ident)
+        + _start(drivers, ident)
+        + _outputs(drivers, ident)
+        + _state_table(scene, ident)
+    )
+    return len(drivers), state_size(scene), len(_state_names(scene)), parts

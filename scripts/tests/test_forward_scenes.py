@@ -1,0 +1,295 @@
+"""Forward scenes ([scene] dynamics = "forward"): the drivers' efforts in, their motion
+integrated inside the FMU, against the Newton-Euler reference's own forward dynamics
+(dyadfmu.reference.forward, SciPy's DOP853 at rtol 1e-12, M(q) and h from the
+reference's equations of every body, nothing of the generated C).
+
+- The motion: driver position within 1e-8 of the distance travelled, rate within 1e-8
+  of its peak, at communication steps from 1e-1 to 1e-4 s with the default tolerances;
+  tighter tolerances give a smaller error.
+- The reactions at the FMU's own states (position, rate and the acceleration it
+  outputs) against the reference evaluated there: within 1e-12 of each unit's peak.
+- The same calls give the same bits, and a restored FMU state continues bit for bit.
+- A forward scene is its base scene with [scene] changed: its tables are the base's.
+"""
+
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pytest
+from dyadfmu import paths
+from dyadfmu.mechanisms import chains, multidriver
+from dyadfmu.reference import forward
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave
+
+#: (scene, the base scene's file, where the forward one is)
+SCENES = {
+    "slider_crank_forward": paths.SCENES_DIR / "slider_crank.toml",
+    "shaper_forward": paths.SCENES_DIR / "shaper.toml",
+    "lift_forward": paths.SCENES_DIR / "lift.toml",
+    "leg_forward": paths.SCENES_DIR / "leg.toml",
+    "slider_crank_motor": paths.SCENES_DIR / "slider_crank.toml",
+    "leg_motor": paths.SCENES_DIR / "leg.toml",
+}
+#: A constant cutting force on the shaper's ram [N] (the reference's load model made
+#: constant, as the FMU's input holds it)
+SHAPER_LOAD = {"slider": {"model": "payload", "force": [-30.0, 0.0]}}
+#: Each chain's effort [N m or N] and how long it drives [s]
+RUNS = {"shaper": (20.0, 0.2), "lift": (None, 0.3)}
+
+
+def _fmu(identifier: str, version: int = 2) -> str:
+    try:
+        return str(paths.built_fmu(identifier, version))
+    except FileNotFoundError as missing:
+        pytest.skip(str(missing))
+
+
+def _forward_file(identifier: str):
+    here = paths.SCENES_DIR / f"{identifier}.toml"
+    return here if here.is_file() else paths.TEST_SCENES_DIR / f"{identifier}.toml"
+
+
+@pytest.mark.parametrize("identifier", sorted(SCENES))
+def test_a_forward_scene_is_its_base_with_the_efforts_in(identifier):
+    """Every table but [scene] is the base scene's; the FMU's inputs are the efforts
+    and the loads, and the drivers' motion is output."""
+    with open(_forward_file(identifier), "rb") as f:
+        mine = tomllib.load(f)
+    with open(SCENES[identifier], "rb") as f:
+        base = tomllib.load(f)
+    assert mine.pop("scene")["dynamics"] == "forward"
+    base.pop("scene")
+    motor = mine.pop("motor", None)
+    assert mine == base
+    assert (motor is not None) == identifier.endswith("_motor")
+    md = read_model_description(_fmu(identifier))
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    outputs = {v.name for v in md.modelVariables if v.causality == "output"}
+    efforts = [n for n in inputs if n.endswith((".torque", ".force", ".motor.voltage"))]
+    assert efforts and all(n not in outputs for n in efforts)
+    assert not md.coSimulation.providesDirectionalDerivative
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+
+
+def _chain(name: str) -> chains.Chain:
+    return chains.load(name, data={"load": SHAPER_LOAD} if name == "shaper" else None)
+
+
+def _start(chain: chains.Chain) -> tuple[float, float]:
+    """(start position, the effort that drives it): the chain's own starting point, and
+    for a ram the force that holds it at rest plus what accelerates it gently."""
+    q0 = chain._phi0 if chain.driver == "crank" else chain._x0
+    effort = RUNS[chain.name][0]
+    if effort is None:
+        J, h = forward.chain_terms(chain, 0.0, q0, 0.0)
+        effort = h + 2.0 * J
+    return q0, effort
+
+
+def _run(identifier: str, chain: chains.Chain, step: float, stop: float, **more) -> np.ndarray:
+    pos, rate, acc = chain.coordinate_names
+    q0, effort = _start(chain)
+    start = {f"{pos}_start": q0, chain.drive_output: effort, **more}
+    for link, model in chain._loads.items():
+        # the reference's constant loads as the FMU's inputs
+        assert model["model"] == "payload"
+        start.update({f"{link}.force.x": model["force"][0], f"{link}.force.y": model["force"][1]})
+    return simulate_fmu(_fmu(identifier), stop_time=stop, output_interval=step, start_values=start)
+
+
+@pytest.fixture(scope="module", params=sorted(RUNS))
+def reference(request):
+    chain = _chain(request.param)
+    q0, effort = _start(chain)
+    stop = RUNS[chain.name][1]
+    times = np.linspace(0.0, stop, int(round(stop / 0.01)) + 1)
+    return chain, forward.integrate_chain(chain, effort, q0, 0.0, times)
+
+
+def _on_grid(rows: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """The rows at `times` (every one of them recorded)."""
+    at = [int(np.argmin(np.abs(rows["time"] - t))) for t in times]
+    assert np.allclose(rows["time"][at], times, rtol=0, atol=1e-9)
+    return rows[at]
+
+
+@pytest.mark.parametrize("step", (1e-1, 1e-2, 1e-4))
+def test_the_motion_follows_the_reference_at_any_step(reference, step):
+    chain, ref = reference
+    pos, rate, _ = chain.coordinate_names
+    rows = _run(f"{chain.name}_forward", chain, step, ref.t[-1])
+    times = ref.t[:: max(1, int(round(step / (ref.t[1] - ref.t[0]))))]
+    rows = _on_grid(rows, times)
+    every = slice(None, None, max(1, int(round(step / (ref.t[1] - ref.t[0])))))
+    travel = np.ptp(ref.q[:, 0])
+    q_error = np.max(np.abs(rows[pos] - ref.q[every, 0])) / travel
+    v_error = np.max(np.abs(rows[rate] - ref.dq[every, 0])) / np.max(np.abs(ref.dq))
+    print(f"{chain.name} at {step:g} s: position {q_error:.1e} of the travel, rate {v_error:.1e}")
+    assert travel > 0.05
+    assert q_error < 1e-8 and v_error < 1e-8
+    assert np.all(rows["status"] == 0)
+
+
+def _tolerances(tol: float) -> dict:
+    return {"solver.rtol": tol, "solver.atol": tol}
+
+
+def test_tighter_tolerances_give_a_smaller_error(reference):
+    chain, ref = reference
+    pos = chain.coordinate_names[0]
+    errors = []
+    for tol in (1e-6, 1e-11):
+        rows = _on_grid(
+            _run(f"{chain.name}_forward", chain, 1e-2, ref.t[-1], **_tolerances(tol)),
+            ref.t,
+        )
+        errors.append(np.max(np.abs(rows[pos] - ref.q[:, 0])) / np.ptp(ref.q[:, 0]))
+    print(f"{chain.name}: error {errors[0]:.1e} at rtol 1e-6, {errors[1]:.1e} at 1e-11")
+    assert errors[1] < 1e-3 * errors[0]
+
+
+def _reference_outputs(chain: chains.Chain, rows: np.ndarray) -> dict:
+    pos, rate, acc = chain.coordinate_names
+    t = rows["time"]
+    kin = chain._solve(t, rows[pos], rows[rate], rows[acc])
+    return chain.reference(kin)
+
+
+def test_the_reactions_are_those_of_the_motion_integrated(reference):
+    """At the FMU's states, with the acceleration it outputs, the Newton-Euler
+    reference's reactions and effort equal the FMU's."""
+    chain, ref = reference
+    rows = _run(f"{chain.name}_forward", chain, 1e-2, ref.t[-1])
+    want = _reference_outputs(chain, rows)
+    md = read_model_description(_fmu(f"{chain.name}_forward"))
+    units = {v.name: v.unit for v in md.modelVariables}
+    peaks: dict = {}
+    for name, values in want.items():
+        if name in rows.dtype.names:
+            peaks[units[name]] = max(peaks.get(units[name], 0.0), np.max(np.abs(values)))
+    worst, compared = 0.0, 0
+    for name, values in want.items():
+        if name in rows.dtype.names:
+            compared += 1
+            worst = max(worst, np.max(np.abs(rows[name] - values)) / peaks[units[name]])
+    effort = np.full(len(rows), _start(chain)[1])
+    effort_error = np.max(np.abs(want[chain.drive_output] - effort)) / abs(effort[0])
+    print(
+        f"{chain.name}: {compared} reactions within {worst:.1e} of their unit's peak; the "
+        f"effort they balance within {effort_error:.1e} of the input"
+    )
+    assert compared >= 6
+    assert worst < 1e-12 and effort_error < 1e-11
+
+
+def test_the_leg_follows_the_reference():
+    """Two hip torques held: both hips' motion against the reference's forward dynamics."""
+    data = {"load": {"foot": {"force": [0.0, 30.0], "force_swing": [0.0, 0.0]}}}
+    chain = multidriver.load("leg", data)
+    low, high = np.array([chain.ranges[d] for d in chain.driver_names]).T
+    q0 = 0.5 * (low + high)
+    kin = forward._state(chain, 0.0, q0, 0.0 * q0)
+    u = chain.bias(kin)[0] + chain.inertia_matrix(kin)[0] @ np.array([1.0, -0.5])
+    times = np.linspace(0.0, 0.2, 11)
+    ref = forward.integrate(chain, lambda t, q, dq: u, q0, 0.0 * q0, times)
+    names = chain.driver_names
+    start = {f"{n}.angle_start": q for n, q in zip(names, q0, strict=True)}
+    start.update({f"{n}.torque": e for n, e in zip(names, u, strict=True)})
+    start.update({"foot.force.x": 0.0, "foot.force.y": 30.0})
+    rows = _on_grid(
+        simulate_fmu(_fmu("leg_forward"), stop_time=0.2, output_interval=0.02, start_values=start),
+        times,
+    )
+    for k, n in enumerate(names):
+        travel = np.ptp(ref.q[:, k])
+        error = np.max(np.abs(rows[f"{n}.angle"] - ref.q[:, k])) / travel
+        print(f"leg: {n} within {error:.1e} of its travel {travel:.3g} rad")
+        assert travel > 0.005 and error < 1e-8
+
+
+#: The leg's front motor as the reference takes it (leg_motor.toml's [motor])
+LEG_MOTOR = forward.DCMotor(1.2, 1.0e-3, 0.05, rotor_inertia=1.0e-5, friction=2.0e-6, ratio=20.0)
+
+
+def test_a_motor_inside_follows_the_reference():
+    """The leg's front hip on its DC motor at 12 V, the rear held by a torque: both
+    hips' motion and the armature current against the reference's motors."""
+    data = {"load": {"foot": {"force": [0.0, 30.0], "force_swing": [0.0, 0.0]}}}
+    chain = multidriver.load("leg", data)
+    low, high = np.array([chain.ranges[d] for d in chain.driver_names]).T
+    q0 = 0.5 * (low + high)
+    kin = forward._state(chain, 0.0, q0, 0.0 * q0)
+    rear = float(chain.bias(kin)[0][1])
+    times = np.linspace(0.0, 0.1, 11)
+    run = forward.integrate_with_motors(
+        chain,
+        {"front": LEG_MOTOR},
+        lambda t, q, dq: np.array([12.0, rear]),
+        q0,
+        0.0 * q0,
+        {"front": 0.0},
+        times,
+        rtol=1e-12,
+        atol=1e-13,
+        method="DOP853",
+    )
+    start = {"front.angle_start": q0[0], "rear.angle_start": q0[1], "rear.torque": rear}
+    start.update({"front.motor.voltage": 12.0, "foot.force.x": 0.0, "foot.force.y": 30.0})
+    rows = _on_grid(
+        simulate_fmu(_fmu("leg_motor"), stop_time=0.1, output_interval=0.01, start_values=start),
+        times,
+    )
+    ref = run.run
+    for k, n in enumerate(chain.driver_names):
+        travel = np.ptp(ref.q[:, k])
+        error = np.max(np.abs(rows[f"{n}.angle"] - ref.q[:, k])) / travel
+        print(f"leg_motor: {n} within {error:.1e} of its travel {travel:.3g} rad")
+        assert travel > 0.005 and error < 1e-8
+    current = np.max(np.abs(rows["front.motor.current"] - run.current[:, 0]))
+    print(f"leg_motor: current within {current / np.max(np.abs(run.current)):.1e} of its peak")
+    assert current < 1e-8 * np.max(np.abs(run.current))
+    evaluations = rows["solver.evaluations"][-1] / (1e3 * times[-1])
+    print(f"leg_motor: {evaluations:.1f} evaluations per ms of motion")
+
+
+def _stepped(fmu: str, steps: int, h: float, restore_after: int | None = None) -> list:
+    """The crank's angle and speed after each of `steps` steps; with restore_after, the
+    state saved after that step is serialized, restored after the last, and the rest of
+    the steps taken again."""
+    md = read_model_description(fmu)
+    vrs = {v.name: v.valueReference for v in md.modelVariables}
+    unzipped = extract(fmu)
+    slave = FMU2Slave(
+        guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier
+    )
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.setReal([vrs["crank.torque"]], [2.0])
+    slave.exitInitializationMode()
+    seen, saved = [], None
+    for k in range(steps):
+        slave.doStep(k * h, h)
+        seen.append(tuple(slave.getReal([vrs["crank.angle"], vrs["crank.omega"]])))
+        if k + 1 == restore_after:
+            saved = slave.serializeFMUstate(slave.getFMUstate())
+    if saved is not None:
+        slave.setFMUstate(slave.deSerializeFMUstate(saved))
+        for k in range(restore_after, steps):
+            slave.doStep(k * h, h)
+            seen.append(tuple(slave.getReal([vrs["crank.angle"], vrs["crank.omega"]])))
+    slave.terminate()
+    slave.freeInstance()
+    return seen
+
+
+def test_the_same_calls_give_the_same_bits_and_a_restored_state_continues():
+    fmu = _fmu("slider_crank_forward")
+    once = _stepped(fmu, 40, 2.5e-3)
+    again = _stepped(fmu, 40, 2.5e-3, restore_after=15)
+    assert once == again[:40]
+    assert again[40:] == once[15:]
+    assert once[-1][1] > 1.0  # it moved
