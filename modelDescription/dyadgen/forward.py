@@ -318,6 +318,82 @@ def _equation_of_motion(scene: Scene, ident: str, drivers: list[ForwardDriver]) 
     return lines + ["}", ""]
 
 
+def _inertia_and_bias_members(scene: Scene, drivers: list[ForwardDriver]) -> tuple[list, list]:
+    """The output members of M(q) (row-major) and of h, as the scene names them."""
+    n = len(drivers)
+    if n == 1:
+        masses = [f"{member(drivers[0].name)}_reduced_j"]
+    else:
+        masses = [inertia_entry_member(scene, a.driver, b.driver) for a in drivers for b in drivers]
+    biases = [f"{member(f.name)}_{effort_of(f.driver)[0]}0" for f in drivers]
+    return masses, biases
+
+
+def _jacobian_parts(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """put_seed(), the rates of M and h along it, and the motors' partial derivatives:
+    what the exact Jacobian (templates/forward_behaviour.c.in) is assembled from."""
+    n = len(drivers)
+    lines = [
+        "/* The seed of the inverse scene's directional derivative along y's value j (a",
+        " * driver's position, j < PLANT_DRIVERS, or its rate). */",
+        f"static void put_seed(const {ident}_input* at, {ident}_input* seed, int j)",
+        "{",
+        "    memset(seed, 0, sizeof *seed);",
+    ]
+    if not any(f.position.angle for f in drivers):
+        lines.append("    (void)at;")
+    lines.append("    switch (j) {")
+    for f in drivers:
+        k = f.index
+        if f.position.angle:
+            m = f.position.member
+            lines.append(f"    case {k}: seed->{m} = dyad_perp(at->{m}); break;")
+        else:
+            lines.append(f"    case {k}: seed->{f.position.member} = 1.0; break;")
+        lines.append(f"    case {n + k}: seed->{f.rate.member} = 1.0; break;")
+    lines += ["    default: break;", "    }", "}", ""]
+    masses, biases = _inertia_and_bias_members(scene, drivers)
+    lines += [
+        "/* M's and h's rates along a seed. */",
+        f"static void mass_and_bias_rate(const {ident}_output* rate, double* dm, double* dh)",
+        "{",
+    ]
+    lines += [f"    dm[{k}] = rate->{m};" for k, m in enumerate(masses)]
+    lines += [f"    dh[{k}] = rate->{b};" for k, b in enumerate(biases)]
+    lines += ["}", "", *_motor_partials(ident, drivers, n)]
+    return lines
+
+
+def _motor_partials(ident: str, drivers: list[ForwardDriver], n: int) -> list[str]:
+    """motor_partials(): d r / d y of the motors' torques (r = efforts - h, row-major N x
+    PLANT_SIZE) and d i' / d y of their currents (row-major motors x PLANT_SIZE), the rest
+    zero: both are linear in y."""
+    lines = [
+        "/* The motors' part of d(efforts - h)/dy and the currents' d i'/dy. */",
+        f"static void motor_partials(const {ident}_input* in, double* dr, double* di)",
+        "{",
+        "    memset(dr, 0, sizeof(double) * PLANT_DRIVERS * PLANT_SIZE);",
+    ]
+    geared = [f for f in drivers if f.motor is not None]
+    if geared:
+        lines.append("    memset(di, 0, sizeof(double) * (PLANT_SIZE - 2 * PLANT_DRIVERS) * PLANT_SIZE);")
+    else:
+        lines += ["    (void)in;", "    (void)di;"]
+    size = 2 * n + len(geared)
+    for f in geared:
+        c, k, row = f.c, f.index, f.current - 2 * n
+        ratio = f"in->{c('motor_ratio')}"
+        lines += [
+            f"    dr[{k * size + n + k}] = -{ratio} * {ratio} * in->{c('motor_friction')};",
+            f"    dr[{k * size + f.current}] = {ratio} * in->{c('motor_torque_constant')};",
+            f"    di[{row * size + n + k}] = -in->{c('motor_torque_constant')} * {ratio} / "
+            f"in->{c('motor_inductance')};",
+            f"    di[{row * size + f.current}] = -in->{c('motor_resistance')} / "
+            f"in->{c('motor_inductance')};",
+        ]
+    return lines + ["}", ""]
+
+
 def _currents(ident: str, drivers: list[ForwardDriver], n: int) -> list[str]:
     """currents_rate(): the armature circuits, L i' = V - R i - k ratio q'."""
     lines = [
@@ -418,6 +494,7 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         _motion_into(ident, drivers)
         + _equation_of_motion(scene, ident, drivers)
         + _currents(ident, drivers, len(drivers))
+        + _jacobian_parts(scene, ident, drivers)
         + _state_io(drivers, ident)
         + _start(drivers, ident)
         + _outputs(drivers, ident)

@@ -14,6 +14,7 @@ reference's equations of every body, nothing of the generated C).
 
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 
 import numpy as np
@@ -214,34 +215,45 @@ def test_the_leg_follows_the_reference():
 LEG_MOTOR = forward.DCMotor(1.2, 1.0e-3, 0.05, rotor_inertia=1.0e-5, friction=2.0e-6, ratio=20.0)
 
 
-def test_a_motor_inside_follows_the_reference():
-    """The leg's front hip on its DC motor at 12 V, the rear held by a torque: both
-    hips' motion and the armature current against the reference's motors."""
+def _leg_with_motor(stop: float, inductance: float) -> tuple:
+    """The leg's front hip on its DC motor at 12 V, the rear held by a torque: the
+    reference's run (DOP853, or Radau where the circuit is stiff) and the FMU's rows. The
+    current starts where the circuit would settle at rest, so that no transient of the
+    circuit's own time scale starts the run."""
     data = {"load": {"foot": {"force": [0.0, 30.0], "force_swing": [0.0, 0.0]}}}
     chain = multidriver.load("leg", data)
     low, high = np.array([chain.ranges[d] for d in chain.driver_names]).T
     q0 = 0.5 * (low + high)
     kin = forward._state(chain, 0.0, q0, 0.0 * q0)
     rear = float(chain.bias(kin)[0][1])
-    times = np.linspace(0.0, 0.1, 11)
+    times = np.linspace(0.0, stop, 11)
+    stiff = inductance < 1e-4
     run = forward.integrate_with_motors(
         chain,
-        {"front": LEG_MOTOR},
+        {"front": dataclasses.replace(LEG_MOTOR, inductance=inductance)},
         lambda t, q, dq: np.array([12.0, rear]),
         q0,
         0.0 * q0,
-        {"front": 0.0},
+        {"front": 12.0 / LEG_MOTOR.resistance},
         times,
-        rtol=1e-12,
+        rtol=1e-11 if stiff else 1e-12,
         atol=1e-13,
-        method="DOP853",
+        method="Radau" if stiff else "DOP853",
     )
     start = {"front.angle_start": q0[0], "rear.angle_start": q0[1], "rear.torque": rear}
     start.update({"front.motor.voltage": 12.0, "foot.force.x": 0.0, "foot.force.y": 30.0})
-    rows = _on_grid(
-        simulate_fmu(_fmu("leg_motor"), stop_time=0.1, output_interval=0.01, start_values=start),
-        times,
+    start["front.motor.inductance"] = inductance
+    start["front.motor.current_start"] = 12.0 / LEG_MOTOR.resistance
+    rows = simulate_fmu(
+        _fmu("leg_motor"), stop_time=stop, output_interval=stop / 10, start_values=start
     )
+    return chain, run, _on_grid(rows, times)
+
+
+def test_a_motor_inside_follows_the_reference():
+    """Both hips' motion and the armature current against the reference's motors."""
+    chain, run, rows = _leg_with_motor(0.1, LEG_MOTOR.inductance)
+    times = run.run.t
     ref = run.run
     for k, n in enumerate(chain.driver_names):
         travel = np.ptp(ref.q[:, k])
@@ -253,6 +265,22 @@ def test_a_motor_inside_follows_the_reference():
     assert current < 1e-8 * np.max(np.abs(run.current))
     evaluations = rows["solver.evaluations"][-1] / (1e3 * times[-1])
     print(f"leg_motor: {evaluations:.1f} evaluations per ms of motion")
+
+
+def test_a_stiff_motor_costs_no_more_and_agrees():
+    """L / R = 0.83 us: the exact Jacobian keeps the Rosenbrock steps at what the
+    motion's accuracy needs, no more than with L / R = 0.83 ms; the motion agrees with
+    the reference (Radau)."""
+    chain, run, rows = _leg_with_motor(0.02, 1e-6)
+    _, _, slow = _leg_with_motor(0.02, LEG_MOTOR.inductance)
+    for k, n in enumerate(chain.driver_names):
+        travel = np.ptp(run.run.q[:, k])
+        error = np.max(np.abs(rows[f"{n}.angle"] - run.run.q[:, k])) / travel
+        print(f"stiff leg_motor: {n} within {error:.1e} of its travel {travel:.3g} rad")
+        assert error < 1e-8
+    steps, slow_steps = rows["solver.steps"][-1], slow["solver.steps"][-1]
+    print(f"steps over 20 ms: {steps:g} with L / R = 0.83 us, {slow_steps:g} with 0.83 ms")
+    assert steps <= 1.2 * slow_steps
 
 
 def _stepped(fmu: str, steps: int, h: float, restore_after: int | None = None) -> list:
