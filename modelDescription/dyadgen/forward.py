@@ -376,7 +376,8 @@ def _motor_partials(ident: str, drivers: list[ForwardDriver], n: int) -> list[st
     ]
     geared = [f for f in drivers if f.motor is not None]
     if geared:
-        lines.append("    memset(di, 0, sizeof(double) * (PLANT_SIZE - 2 * PLANT_DRIVERS) * PLANT_SIZE);")
+        rows = "(PLANT_SIZE - 2 * PLANT_DRIVERS)"
+        lines.append(f"    memset(di, 0, sizeof(double) * {rows} * PLANT_SIZE);")
     else:
         lines += ["    (void)in;", "    (void)di;"]
     size = 2 * n + len(geared)
