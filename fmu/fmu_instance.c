@@ -660,7 +660,8 @@ static fmu_status advance_states(fmu_instance* instance, double current_time, do
     fmu_status status = solve(instance, FMU_DISCARD, function, 1);
     if (status == FMU_OK) {
         fmu_evaluation* e = &instance->evaluation;
-        instance->model->behaviour->advance(instance->model, instance->input, step_size, e);
+        const double reached =
+            instance->model->behaviour->advance(instance->model, instance->input, step_size, e);
         instance->dirty = 1;
         if (e->status == FMU_ERROR) {
             /* A step the model refuses (it left its states as they were). */
@@ -668,9 +669,11 @@ static fmu_status advance_states(fmu_instance* instance, double current_time, do
             return FMU_ERROR;
         }
         if (e->status != FMU_OK) {
+            /* A step that failed: the states where it stopped, the outputs there */
             fmu_log(instance, FMU_DISCARD, "%s: at t = %g s: %s", function, current_time,
                     e->reason);
-            instance->last_successful_time = current_time;
+            instance->time = reached > 0 ? current_time + reached : current_time;
+            instance->last_successful_time = instance->time;
             instance->terminate_requested = 1;
             return FMU_DISCARD;
         }

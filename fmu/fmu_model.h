@@ -116,12 +116,14 @@ typedef struct fmu_behaviour {
                      fmu_evaluation* evaluation);
     /* A model with states: sets them from their start parameters when
      * initialization ends, and advances them over a communication step of h
-     * seconds with the inputs held; FMU_ERROR refuses the step and FMU_DISCARD
-     * reports one that failed, both with the states left as they were. NULL for
-     * an algebraic model. */
+     * seconds with the inputs held, returning how far they got: h. FMU_ERROR
+     * refuses the step (the states left as they were, 0 returned); FMU_DISCARD
+     * reports one that failed, the states left at the last point it could
+     * reach, that many seconds into the step (0: where they were). NULL for an
+     * algebraic model. */
     void (*start)(const struct fmu_model* model, void* input);
-    void (*advance)(const struct fmu_model* model, void* input, double h,
-                    fmu_evaluation* evaluation);
+    double (*advance)(const struct fmu_model* model, void* input, double h,
+                      fmu_evaluation* evaluation);
     /* Exact directional derivative of the outputs along `seed` (an input block of
      * rates; an angle's rate as the derivative of its (cos, sin)). NULL: none. */
     void (*derivative)(const struct fmu_model* model, const void* input, const void* seed,

@@ -398,10 +398,18 @@ static dyad_ode_status ode_attempt(dyad_ode_state* s, const dyad_ode_system* sys
     return DYAD_ODE_OK;
 }
 
+/* x^(1/4) by two square roots, which IEEE 754 rounds correctly on every platform (pow is
+ * the C library's own, and differs between them in its last bit): the same steps, so the
+ * same bits, under Windows and Linux. */
+static dyad_real ode_fourth_root(dyad_real x)
+{
+    return (dyad_real)sqrt(sqrt((double)x));
+}
+
 /* h / h_new from the error: err^(1/4) / safety, limited. */
 static dyad_real ode_shrink(dyad_real error)
 {
-    dyad_real fac = isfinite(error) ? pow(error, (dyad_real)0.25) / ODE_SAFETY : 1 / ODE_MIN_SHRINK;
+    dyad_real fac = isfinite(error) ? ode_fourth_root(error) / ODE_SAFETY : 1 / ODE_MIN_SHRINK;
     return fmax(1 / (dyad_real)DYAD_ODE_MAX_GROWTH, fmin(1 / ODE_MIN_SHRINK, fac));
 }
 
@@ -411,7 +419,7 @@ static dyad_real ode_next_step(dyad_ode_state* s, dyad_real h, dyad_real error)
     dyad_real fac = ode_shrink(error);
     if (s->h_accepted > 0) {
         dyad_real gus = (s->h_accepted / h) *
-                        pow(error * error / s->error_accepted, (dyad_real)0.25) / ODE_SAFETY;
+                        ode_fourth_root(error * error / s->error_accepted) / ODE_SAFETY;
         gus = fmax(1 / (dyad_real)DYAD_ODE_MAX_GROWTH, fmin(1 / ODE_MIN_SHRINK, gus));
         fac = fmax(fac, gus);
     }

@@ -158,7 +158,8 @@ static void integrate(const fmu_drive_input* in, double dt, long substeps, doubl
     *speed = w;
 }
 
-static void advance(const fmu_model* model, void* input, double h, fmu_evaluation* evaluation)
+static double advance(const fmu_model* model, void* input, double h,
+                      fmu_evaluation* evaluation)
 {
     fmu_drive_input* in = (fmu_drive_input*)input;
     const double time_constant = total_inertia(in) * in->no_load_speed / in->stall_torque;
@@ -170,7 +171,7 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
     evaluation->bad_variable = -1;
     evaluation->reason[0] = '\0';
     if (!check(model, in, evaluation)) {
-        return;
+        return 0;
     }
     if (!(limit > 0) || limit > h) {
         limit = h;
@@ -182,7 +183,7 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
                  "communicationStepSize = %g s needs %.3g substeps of %.3g s (speed %.3g "
                  "rad/s, time constant %.3g s), over the %g allowed: take shorter steps",
                  h, needed, limit, speed, time_constant, FMU_DRIVE_MAX_SUBSTEPS);
-        return;
+        return 0;
     }
     integrate(in, h / needed, (long)needed, &angle, &speed);
     if (!isfinite(angle) || !isfinite(speed)) {
@@ -190,7 +191,7 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
         snprintf(evaluation->reason, sizeof evaluation->reason,
                  "the crank's state is no longer finite (angle %g rad, speed %g rad/s)", angle,
                  speed);
-        return;
+        return 0;
     }
     /* A step is taken only if the outputs at its end are finite: one that ends
      * where the motor torque or the acceleration overflows is discarded with
@@ -201,10 +202,11 @@ static void advance(const fmu_model* model, void* input, double h, fmu_evaluatio
                  "the step would end where the motor torque (%g N.m) or the crank's "
                  "acceleration (%g rad/s2) overflows double (angle %g rad, speed %g rad/s)",
                  motor_torque(in, speed), acceleration(in, angle, speed), angle, speed);
-        return;
+        return 0;
     }
     in->angle = angle;
     in->speed = speed;
+    return h;
 }
 
 /* The crank's angle and speed: what an FMU state keeps of the drive beyond its

@@ -30,7 +30,7 @@ DYNAMICS = ("inverse", "forward")
 MAX_STEPS = 20000
 #: The tolerances' defaults: about 1e-8 relative in the driver's motion.
 RTOL_DEFAULT = 1e-10
-ATOL_DEFAULT = 1e-10
+ATOL_DEFAULT = 1e-9
 
 
 @dataclass
@@ -151,7 +151,7 @@ def start_parameters(scene: Scene) -> list[tuple[Input, float]]:
     for f in forward_drivers(scene):
         for motion, what in ((f.position, "position"), (f.rate, "rate")):
             text = f"{motion.description} at the start"
-            start = 0.0 if motion.angle else motion.start
+            start = motion.start
             found.append(
                 (Input(f"{motion.name}_start", motion.unit, text, f.c(f"{what}_start")), start)
             )
@@ -272,10 +272,15 @@ def _motion_into(ident: str, drivers: list[ForwardDriver]) -> list[str]:
     for f in drivers:
         k = f.index
         if f.position.angle:
-            lines.append(
-                f"    at->{f.position.member} = dyad_vec2_make((dyad_real)cos(q[{k}]), "
-                f"(dyad_real)sin(q[{k}]));"
-            )
+            # the FMU layer's own cos and sin (dyadfmu/angle.h): the same bits on every
+            # platform, as an angle input's unit vector has
+            lines += [
+                "    {",
+                "        double c, s;",
+                f"        dyad_cos_sin(q[{k}], &c, &s);",
+                f"        at->{f.position.member} = dyad_vec2_make((dyad_real)c, (dyad_real)s);",
+                "    }",
+            ]
         else:
             lines.append(f"    at->{f.position.member} = q[{k}];")
         lines.append(f"    at->{f.rate.member} = v[{k}];")

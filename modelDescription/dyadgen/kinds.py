@@ -349,9 +349,9 @@ class SceneKind(Kind):
             self.directional_derivatives = "false"
             self.model_includes = (
                 "<math.h>",
-                "<stddef.h>",
                 "<stdio.h>",
                 "<string.h>",
+                '"dyadfmu/angle.h"',
                 '"dyadfmu/ode.h"',
                 '"fmu_model.h"',
             )
@@ -521,7 +521,7 @@ def _forward_rows(scene: Scene) -> list[dict]:
         raw.update(min_exclusive=True, max=1.0, max_exclusive=True)
         if name == "solver.rtol":
             raw.update(min=forward.RTOL_MIN, min_exclusive=False)
-    rows.append(entry_row(setting_entry(ON_SINGULAR), len(rows) + 1, ON_SINGULAR.start))
+    # no on_singular: a plant's step without an answer cannot go on (its states stop)
     _output_rows(rows, forward.public_outputs(scene))
     return rows
 

@@ -321,3 +321,67 @@ def test_the_same_calls_give_the_same_bits_and_a_restored_state_continues():
     assert once == again[:40]
     assert again[40:] == once[15:]
     assert once[-1][1] > 1.0  # it moved
+
+
+def _instance(fmu: str) -> tuple[FMU2Slave, dict]:
+    md = read_model_description(fmu)
+    slave = FMU2Slave(
+        guid=md.guid,
+        unzipDirectory=extract(fmu),
+        modelIdentifier=md.coSimulation.modelIdentifier,
+    )
+    slave.instantiate()
+    return slave, {v.name: v.valueReference for v in md.modelVariables}
+
+
+def test_a_ram_pushed_into_a_toggle_stops_at_the_last_good_point():
+    """The lift's ram driven out by a force until the arm reaches its toggle, where the
+    effective inertia J grows without bound: doStep returns Discard, and the last
+    successful time is the last point with an answer, where the FMU's state is the
+    reference's motion at that time, J (the FMU's and the reference's) is 1e5 times
+    the start's and the status still 0; a state saved before continues from there."""
+    chain = _chain("lift")
+    q0, _ = _start(chain)
+    J, h = forward.chain_terms(chain, 0.0, q0, 0.0)
+    force = h + 20.0 * J
+    slave, vrs = _instance(_fmu("lift_forward"))
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.setReal([vrs["ram.position_start"], vrs["ram.force"]], [q0, force])
+    slave.setReal([vrs["platform.force.x"], vrs["platform.force.y"]], [0.0, -2000.0])
+    slave.exitInitializationMode()
+    step, t, saved, discarded = 0.05, 0.0, None, False
+    for _ in range(40):
+        if t >= 0.1 and saved is None:
+            saved = (t, slave.getFMUstate())
+        try:
+            slave.doStep(t, step)
+        except Exception:  # fmpy raises on Discard
+            discarded = True
+            break
+        t += step
+    assert discarded
+    stop = slave.getRealStatus(2)  # fmi2LastSuccessfulTime
+    x, v = slave.getReal([vrs["ram.position"], vrs["ram.velocity"]])
+    assert t < stop < t + step
+    ref = forward.integrate_chain(chain, force, q0, 0.0, np.array([0.0, stop]))
+    travel = ref.q[-1, 0] - q0
+    print(
+        f"lift: stopped at {stop:.12g} s, x = {x:.12g} m ({abs(x - ref.q[-1, 0]):.1e} m "
+        f"from the reference there), v = {v:.4g} m/s"
+    )
+    assert abs(x - ref.q[-1, 0]) < 1e-8 * travel
+    J_stop, _ = forward.chain_terms(chain, stop, x, v)
+    status, fmu_J = slave.getInteger([vrs["status"]])[0], slave.getReal([vrs["ram.J"]])[0]
+    print(
+        f"lift: J = {J_stop:.3g} kg there ({J_stop / J:.2g} times the start's), the FMU's "
+        f"{fmu_J:.3g} kg, status {status}"
+    )
+    assert J_stop > 1e5 * J  # a toggle: the force moves the ram no further
+    assert status == 0 and abs(fmu_J - J_stop) < 1e-6 * J_stop
+    # a state saved before the stop continues from there
+    slave.setFMUstate(saved[1])
+    slave.doStep(saved[0], step)
+    assert slave.getReal([vrs["ram.position"]])[0] < x
+    slave.terminate()
+    slave.freeInstance()

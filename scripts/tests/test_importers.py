@@ -85,6 +85,12 @@ def fmutool() -> str:
 #: FMUs of tests/scenes/ that other tests run: the study's balance, the toggles of the
 #: mechanism FMUs' status at their assembly limits (test_toggles.py)
 STUDY_TEST_FMUS = {"balance_fmi2", "balance_fmi3", "toggles_fmi2", "toggles_fmi3"}
+#: and the plants of tests/scenes/ that test_forward_scenes.py runs against the reference
+STUDY_TEST_FMUS |= {
+    f"{name}_fmi{version}"
+    for name in ("shaper_forward", "lift_forward", "leg_forward", "leg_motor")
+    for version in (2, 3)
+}
 
 
 def test_the_comparison_covers_every_fmu_the_build_makes():

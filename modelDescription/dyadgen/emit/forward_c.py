@@ -26,6 +26,8 @@ def forward_behaviour(scene: Scene) -> list[str]:
     head = [
         f"enum {{ PLANT_DRIVERS = {drivers}, PLANT_SIZE = {size}, PLANT_STATES = {states}, "
         f"PLANT_MAX_STEPS = {MAX_STEPS} }};",
+        "/* How closely a step that fails is located, in parts of the communication step. */",
+        "#define PLANT_LOCATE_TOLERANCE 1e-10",
         "",
     ]
     return head + parts + _template().substitute(ident=ident).splitlines() + [""]

@@ -101,8 +101,37 @@ def fmu_names() -> list[str]:
     mechanisms = [n for n in mechanism_fmus.MECHANISM_FMUS if n not in scenes.NAMES]
     mechanisms += list(multidriver_fmus.NAMES)
     return (
-        [f"dyad_{d}" for d in DYADS] + list(scenes.NAMES) + mechanisms + list(TAILORED) + ["drive"]
+        [f"dyad_{d}" for d in DYADS]
+        + list(scenes.NAMES)
+        + mechanisms
+        + list(TAILORED)
+        + ["drive"]
+        + list(PLANTS)
     )
+
+
+#: The plants (dynamics = "forward") of modelDescription/scenes/, each with its inputs
+#: over time t: (name -> array), their motion integrated inside the FMU.
+PLANTS = {
+    "slider_crank_forward": lambda t, wave: {
+        "crank.torque": 2.0 + 1.5 * wave,
+        "piston.force.x": -40.0 + 20.0 * wave,
+        "piston.force.y": 0.0 * t,
+    },
+    "slider_crank_motor": lambda t, wave: {
+        "crank.motor.voltage": 290.0 * (1.0 + 0.2 * wave),
+        "piston.force.x": -400.0 + 200.0 * wave,
+        "piston.force.y": 0.0 * t,
+    },
+}
+
+
+def plant_setup(name: str, version: int, build: Path | None = None) -> CoSimSetup:
+    """A plant driven by inputs that swing over 0.5 s, at steps of 2^-8 s (a binary
+    fraction, as for the drive: both importers pass the same step to doStep)."""
+    path = (build or paths.build_dir()) / "fmus" / f"{name}_fmi{version}.fmu"
+    t = np.linspace(0.0, 0.5, 129)
+    return setup_for(path, t, PLANTS[name](t, np.sin(2 * math.pi * t / 0.125)))
 
 
 def drive_setup(version: int, build: Path | None = None) -> CoSimSetup:
@@ -129,6 +158,8 @@ def setup_of(name: str, version: int, build: Path | None = None, steps: int = 12
     drivers' motion, the drive under a varying load."""
     if name == "drive":
         return drive_setup(version, build)
+    if name in PLANTS:
+        return plant_setup(name, version, build)
     if name.startswith("dyad_"):
         return harness.mechanism_setup(
             MECHANISM_OF[name.removeprefix("dyad_")], version, 1.0, steps, build=build
@@ -171,6 +202,9 @@ def _without_float64_units(xml: bytes) -> bytes:
     for variable in root.iter("Float64"):
         variable.attrib.pop("unit", None)
         variable.attrib.pop("displayUnit", None)
+    # nor does it know the ampere among the base units (a motor's units)
+    for definitions in root.iter("UnitDefinitions"):
+        definitions.getparent().remove(definitions)
     return etree.tostring(root, xml_declaration=True, encoding="UTF-8")
 
 
