@@ -418,8 +418,8 @@ static dyad_real ode_next_step(dyad_ode_state* s, dyad_real h, dyad_real error)
 {
     dyad_real fac = ode_shrink(error);
     if (s->h_accepted > 0) {
-        dyad_real gus = (s->h_accepted / h) *
-                        ode_fourth_root(error * error / s->error_accepted) / ODE_SAFETY;
+        dyad_real gus =
+            (s->h_accepted / h) * ode_fourth_root(error * error / s->error_accepted) / ODE_SAFETY;
         gus = fmax(1 / (dyad_real)DYAD_ODE_MAX_GROWTH, fmin(1 / ODE_MIN_SHRINK, gus));
         fac = fmax(fac, gus);
     }

@@ -158,8 +158,7 @@ static void integrate(const fmu_drive_input* in, double dt, long substeps, doubl
     *speed = w;
 }
 
-static double advance(const fmu_model* model, void* input, double h,
-                      fmu_evaluation* evaluation)
+static double advance(const fmu_model* model, void* input, double h, fmu_evaluation* evaluation)
 {
     fmu_drive_input* in = (fmu_drive_input*)input;
     const double time_constant = total_inertia(in) * in->no_load_speed / in->stall_torque;
