@@ -30,7 +30,7 @@ DYNAMICS = ("inverse", "forward")
 MAX_STEPS = 20000
 #: The tolerances' defaults: about 1e-8 relative in the driver's motion.
 RTOL_DEFAULT = 1e-10
-ATOL_DEFAULT = 1e-9
+ATOL_DEFAULT = 1e-10
 
 
 @dataclass
