@@ -95,6 +95,13 @@ def test_the_documentation_says_what_the_fmu_takes(path):
         assert said.group(1) == "the links' current kinematics and active loads"
         return
     assert "current kinematics" not in page
+    if scene.forward():
+        # a plant takes what drives it: no motion is an input
+        driving = [n for n in inputs if n.endswith((".torque", ".force", ".motor.voltage"))]
+        assert driving and said.group(1).startswith("only what drives it (")
+        assert all(f"<code>{n}</code>" in said.group(1) for n in driving)
+        assert "no motion is an input" in said.group(1)
+        return
     motion = [
         f"{driver.driver_name()}.{q}"
         for driver in scene.drivers

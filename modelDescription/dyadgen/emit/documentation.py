@@ -239,6 +239,24 @@ def _scene_sections(scene: Scene) -> dict[str, str]:
     }
 
 
+def _plant_takes(table: Table) -> str:
+    """What a plant (dynamics = "forward") takes: its drivers' efforts or motors'
+    voltages and its loads; it integrates the motion itself."""
+    scene = table.scene
+    prefixes = tuple(f"{d.driver_name()}." for d in scene.drivers)
+    driving = [v.name for v in table.of("input") if v.name.startswith(prefixes)]
+    loads = len(table.of("input")) - len(driving)
+    named = ", ".join(f"<code>{h(name)}</code>" for name in driving)
+    rest = {0: "no load", 1: "the active load (1 input)"}.get(
+        loads, f"the active loads ({loads} inputs)"
+    )
+    return (
+        f"only what drives it ({named}) and {rest}, integrates its drivers' motion inside "
+        "each step to the tolerances solver.rtol and solver.atol (a plant: no motion is an "
+        "input), and gives that motion"
+    )
+
+
 def _takes(table: Table) -> str:
     """What the FMU takes at every communication point: a mechanism FMU (internal
     kinematics) its driver's motion and its loads alone, solving the links' motion itself;
@@ -246,6 +264,8 @@ def _takes(table: Table) -> str:
     scene = table.scene
     if not scene.internal():
         return "the links' current kinematics and active loads"
+    if scene.forward():
+        return _plant_takes(table)
     prefixes = tuple(f"{d.driver_name()}." for d in scene.drivers)
     motion = [v.name for v in table.of("input") if v.name.startswith(prefixes)]
     loads = len(table.of("input")) - len(motion)
