@@ -7,7 +7,7 @@ reference's equations of every body, nothing of the generated C).
   of its peak, at communication steps from 1e-1 to 1e-4 s with the default tolerances;
   tighter tolerances give a smaller error.
 - The reactions at the FMU's own states (position, rate and the acceleration it
-  outputs) against the reference evaluated there: within 1e-12 of each unit's peak.
+  outputs) against the reference evaluated there: within 1e-13 of each unit's peak.
 - The same calls give the same bits, and a restored FMU state continues bit for bit.
 - A forward scene is its base scene with [scene] changed: its tables are the base's.
 """
@@ -183,7 +183,7 @@ def test_the_reactions_are_those_of_the_motion_integrated(reference):
         f"effort they balance within {effort_error:.1e} of the input"
     )
     assert compared >= 6
-    assert worst < 1e-12 and effort_error < 1e-11
+    assert worst < 1e-13 and effort_error < 1e-13
 
 
 def test_the_leg_follows_the_reference():
