@@ -184,7 +184,8 @@ def readable_copy(fmu: Path, dest: Path) -> Path:
     """A copy of the FMU that fmi-sim 0.7.0 reads. Its FMI 3 parser (fmi-schema 0.8)
     refuses the `unit` and `displayUnit` attributes on <Float64>, which the FMI 3 schema
     allows and our model descriptions carry; the copy goes without those attributes (a
-    unit changes nothing an importer computes). An FMI 2 FMU is copied unchanged."""
+    unit changes nothing an importer computes), and without the unit definitions where
+    they have the ampere (a motor's). An FMI 2 FMU is copied unchanged."""
     dest.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(dest, "w", zipfile.ZIP_DEFLATED) as out:
         for item in src.infolist():
@@ -202,9 +203,11 @@ def _without_float64_units(xml: bytes) -> bytes:
     for variable in root.iter("Float64"):
         variable.attrib.pop("unit", None)
         variable.attrib.pop("displayUnit", None)
-    # nor does it know the ampere among the base units (a motor's units)
-    for definitions in root.iter("UnitDefinitions"):
-        definitions.getparent().remove(definitions)
+    # nor does it know the ampere among the base units (a motor's units): a model with a
+    # motor goes without its unit definitions
+    for definitions in list(root.iter("UnitDefinitions")):
+        if any(base.get("A") for base in definitions.iter("BaseUnit")):
+            definitions.getparent().remove(definitions)
     return etree.tostring(root, xml_declaration=True, encoding="UTF-8")
 
 
