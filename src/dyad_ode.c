@@ -126,6 +126,7 @@ dyad_ode_options dyad_ode_options_default(void)
     o.atol = (dyad_real)1e-10;
     o.h_max = (dyad_real)INFINITY;
     o.h_initial = 0;
+    o.h_min = 0;
     o.max_steps = 100000;
     return o;
 }
@@ -144,7 +145,8 @@ static int ode_finite_vector(int n, const dyad_real* v)
 static int ode_options_valid(const dyad_ode_options* o)
 {
     return isfinite(o->rtol) && o->rtol > 0 && isfinite(o->atol) && o->atol > 0 && o->h_max > 0 &&
-           isfinite(o->h_initial) && o->h_initial >= 0 && o->max_steps > 0;
+           isfinite(o->h_initial) && o->h_initial >= 0 && isfinite(o->h_min) && o->h_min >= 0 &&
+           o->max_steps > 0;
 }
 
 dyad_ode_status dyad_ode_init(dyad_ode_state* state, int n, dyad_real t0, const dyad_real* y0,
@@ -471,16 +473,20 @@ static dyad_real ode_initial_step(const dyad_ode_state* s, const ode_work* w)
 
 /* The fewest steps the controller could cover `span` in from step size h
  * (growth at most DYAD_ODE_MAX_GROWTH per step, at most h_max), counted up to
- * `limit` + 1. */
+ * `limit` + 1: the growing steps one by one (a few dozen at most), those at
+ * h_max at once. */
 static long ode_fewest_steps(dyad_real h, dyad_real h_max, dyad_real span, long limit)
 {
     long count = 0;
     dyad_real covered = 0;
-    while (covered < span && count <= limit) {
-        h = fmin(h, h_max);
+    while (covered < span && count <= limit && h < h_max) {
         covered += h;
         h *= DYAD_ODE_MAX_GROWTH;
         ++count;
+    }
+    if (covered < span && count <= limit) {
+        const double rest = ceil((double)((span - covered) / h_max));
+        count = rest > (double)(limit - count) ? limit + 1 : count + (long)rest;
     }
     return count;
 }
@@ -496,7 +502,8 @@ static dyad_real ode_planned_step(const dyad_ode_state* s)
 
 static int ode_step_too_small(const dyad_ode_state* s, dyad_real h)
 {
-    return !(h >= 16 * DYAD_REAL_EPSILON * fabs(s->t)) || !(s->t + h != s->t);
+    return !(h >= 16 * DYAD_REAL_EPSILON * fabs(s->t)) || !(s->t + h != s->t) ||
+           h < s->options.h_min;
 }
 
 /* One accepted step from the state's point toward t_end, with the attempts
@@ -576,7 +583,14 @@ dyad_ode_status dyad_ode_advance(dyad_ode_state* state, const dyad_ode_system* s
         status = ode_linearise(state, system, &w);
         if (status == DYAD_ODE_OK) {
             dyad_real h = state->h_next > 0 ? state->h_next : ode_initial_step(state, &w);
+            const long left = state->options.max_steps - attempts;
             h = fmin(h, state->options.h_max);
+            if (ode_fewest_steps(h, state->options.h_max, t_end - state->t, left) > left) {
+                /* the controller's limits already prove that the cap is too low */
+                state->t_failed = state->t;
+                status = DYAD_ODE_TOO_MANY_STEPS;
+                break;
+            }
             status = ode_step(state, system, &w, t_end, &h, &attempts);
             state->h_next = h;
         }

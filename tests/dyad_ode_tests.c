@@ -658,16 +658,20 @@ static int test_step_cap(void)
     CHECK(st == DYAD_ODE_TOO_MANY_STEPS, "status %s", dyad_ode_status_name(st));
     CHECK(s.counters.rhs_evaluations == 0 && s.t == 0 && s.y[0] == before.y[0], "work done");
     /* Within the cap's reach at the controller's limits, but the error
-     * control needs more: stops at the last accepted point. */
+     * control needs more: stops at the last accepted point as soon as the
+     * steps left cannot reach the end even growing as fast as they may, before
+     * the cap itself. */
     o.h_max = INFINITY;
-    o.max_steps = 5;
+    o.max_steps = 60;
     o.rtol = 1e-12;
     o.atol = 1e-14;
     dyad_ode_init(&s, 1, 0, &y0, &o);
-    st = dyad_ode_advance(&s, &sys, 10.0);
+    st = dyad_ode_advance(&s, &sys, 1000.0);
     CHECK(st == DYAD_ODE_TOO_MANY_STEPS, "status %s", dyad_ode_status_name(st));
-    CHECK(s.t > 0 && s.t < 10 && s.counters.accepted_steps + s.counters.rejected_steps == 5,
+    CHECK(s.t > 0 && s.t < 1000 && s.counters.accepted_steps + s.counters.rejected_steps < 60,
           "t %g after %ld + %ld", s.t, s.counters.accepted_steps, s.counters.rejected_steps);
+    printf("    step cap: stopped at t = %g s after %ld + %ld steps of 60\n", s.t,
+           s.counters.accepted_steps, s.counters.rejected_steps);
     CHECK(fabs(s.y[0] - forced_exact(1, 1, s.t)) < 1e-10, "y at the last accepted point");
     return fails;
 }
@@ -697,6 +701,13 @@ static int test_step_underflow(void)
     CHECK(fabs(s.t - 0.5) < 1e-9, "stopped at %.17g", s.t);
     /* It gives up at 16 eps |t|, not at the last bit of t. */
     CHECK(s.h_next > 1e-16 && s.h_next < 16 * 2.3e-16 * s.t, "gave up at h %g", s.h_next);
+    /* or at the shortest step it is given, sooner */
+    o.h_min = 1e-6;
+    dyad_ode_init(&s, 1, 0, &y0, &o);
+    st = dyad_ode_advance(&s, &sys, 1.0);
+    CHECK(st == DYAD_ODE_STEP_UNDERFLOW && fabs(s.t - 0.5) < 1e-5 && s.h_next < 1e-6 &&
+              s.h_next > 1e-8,
+          "h_min 1e-6: %s at t %.17g, gave up at h %g", dyad_ode_status_name(st), s.t, s.h_next);
     return fails;
 }
 

@@ -16,11 +16,15 @@
  *     descriptions keep defined (a dyad's conditioning and amplification; the
  *     drive's motor.torque, NaN only where it overflows itself), and doStep is
  *     not OK unless on_singular (set too, FMI 2 as Integer, FMI 3 as Int64) is 2,
- *     continue; the drive's crank.angle and crank.omega are its states and are
- *     finite whatever the status;
+ *     continue; a model's states (the drive's crank.angle and crank.omega, a
+ *     plant's outputs X with a parameter X_start) and a plant's solver counts
+ *     are finite whatever the status;
  *   - an OK doStep had finite t, h > 0 and t + h, reports t + h as the last
  *     successful time, and moved a model's state if the step should have;
  *     an algebraic model's outputs do not depend on the step;
+ *   - a discarded doStep reports t as the last successful time and changed
+ *     nothing, or, for a model with states, a last successful time in [t, t + h)
+ *     where its states stopped, the next step starting there;
  *   - the episode replayed on a fresh instance gives the same trace, bit for
  *     bit (every status, value, and logged message).
  *
@@ -53,7 +57,7 @@ typedef enum fuzz_rule {
     FUZZ_NAN_WHEN_FAILED = 0, /* NaN unless status 0 (the reactions, crank.epsilon) */
     FUZZ_ANY_WHEN_FAILED,     /* explains the failure: a dyad's conditioning, amplification */
     FUZZ_FINITE_OR_NAN,       /* NaN only where it overflows itself: the drive's motor.torque */
-    FUZZ_ALWAYS_FINITE        /* a state, kept whatever the status: crank.angle, crank.omega */
+    FUZZ_ALWAYS_FINITE        /* a state, kept whatever the status, and a solver's counts */
 } fuzz_rule;
 
 typedef struct fuzz_named_rule {
@@ -64,8 +68,8 @@ typedef struct fuzz_named_rule {
 static const fuzz_named_rule fuzz_rules[] = {{"conditioning", FUZZ_ANY_WHEN_FAILED},
                                              {"amplification", FUZZ_ANY_WHEN_FAILED},
                                              {"motor.torque", FUZZ_FINITE_OR_NAN},
-                                             {"crank.angle", FUZZ_ALWAYS_FINITE},
-                                             {"crank.omega", FUZZ_ALWAYS_FINITE}};
+                                             {"solver.steps", FUZZ_ALWAYS_FINITE},
+                                             {"solver.evaluations", FUZZ_ALWAYS_FINITE}};
 
 typedef struct fuzz_fmu {
     probe_model model;
@@ -82,9 +86,43 @@ typedef struct fuzz_fmu {
     size_t settable_count;
     int status_index;          /* the Integer output `status`, -1 if none */
     int on_singular;           /* the Enumeration parameter on_singular, -1 if none */
-    int angle, omega, epsilon; /* a state: outputs crank.angle, .omega, .epsilon; -1 if none */
+    int angle, omega, epsilon; /* the drive's crank.angle, .omega, .epsilon; -1 if none */
+    int has_states;            /* a step carries states from where the last one ended */
+    int first_state;           /* the first state output, -1 if none */
+    int* rate_of;              /* per state output: the state that is its rate, -1 if none */
     fuzz_rule* rule;           /* per variable: what an output may be when status is not 0 */
 } fuzz_fmu;
+
+/* The length of a state's name up to its last '.': the driver it belongs to. */
+static size_t owner_length(const char* name)
+{
+    const char* dot = strrchr(name, '.');
+    return dot != NULL ? (size_t)(dot - name) : 0;
+}
+
+/* Pairs each state output with the next one of the same driver (a position with its
+ * rate: crank.angle, crank.omega; ram.position, ram.velocity). */
+static void pair_states(fuzz_fmu* f)
+{
+    size_t k, j, n = f->model.variable_count;
+    for (k = 0; k < n; ++k) {
+        const probe_variable* v = &f->model.variables[k];
+        f->rate_of[k] = -1;
+        if (probe_state_start(&f->model, v) == NULL) {
+            continue;
+        }
+        for (j = k + 1; j < n; ++j) {
+            const probe_variable* w = &f->model.variables[j];
+            if (probe_state_start(&f->model, w) != NULL) {
+                if (owner_length(w->name) == owner_length(v->name) &&
+                    strncmp(w->name, v->name, owner_length(v->name)) == 0) {
+                    f->rate_of[k] = (int)j;
+                }
+                break;
+            }
+        }
+    }
+}
 
 static int fuzz_prepare(fuzz_fmu* f, const char* directory)
 {
@@ -107,8 +145,9 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
     f->integer_vrs = (unsigned*)calloc(n + 1, sizeof *f->integer_vrs);
     f->settable = (size_t*)calloc(n + 1, sizeof *f->settable);
     f->rule = (fuzz_rule*)calloc(n + 1, sizeof *f->rule);
+    f->rate_of = (int*)calloc(n + 1, sizeof *f->rate_of);
     if (f->reals == NULL || f->real_vrs == NULL || f->integers == NULL || f->integer_vrs == NULL ||
-        f->settable == NULL || f->rule == NULL) {
+        f->settable == NULL || f->rule == NULL || f->rate_of == NULL) {
         printf("out of memory\n");
         return 0;
     }
@@ -148,11 +187,17 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
                     f->rule[k] = fuzz_rules[j].rule;
                 }
             }
+            if (probe_state_start(&f->model, v) != NULL) {
+                f->rule[k] = FUZZ_ALWAYS_FINITE;
+                f->first_state = f->has_states ? f->first_state : (int)k;
+                f->has_states = 1;
+            }
         }
     }
     if (f->angle < 0 || f->omega < 0 || f->epsilon < 0) {
         f->angle = f->omega = f->epsilon = -1;
     }
+    pair_states(f);
     return 1;
 }
 
@@ -165,12 +210,13 @@ static void fuzz_release(fuzz_fmu* f)
     free(f->integer_vrs);
     free(f->settable);
     free(f->rule);
+    free(f->rate_of);
     probe_free_model(&f->model);
 }
 
 static int has_state(const fuzz_fmu* f)
 {
-    return f->angle >= 0;
+    return f->has_states;
 }
 
 /* ---- an episode ----------------------------------------------------------------------------- */
@@ -922,15 +968,31 @@ static double before_named(const fuzz_episode* e, const char* name)
     return v != NULL ? snapshot_real(e, &e->before, (int)(v - e->fmu->model.variables)) : NAN;
 }
 
+/* Whether a step of h s must move some position from `before` by more than a
+ * billionth of its size (and beyond underflow): its rate times h does. */
+static int position_must_move(const fuzz_episode* e, double h)
+{
+    size_t k;
+    for (k = 0; k < e->fmu->model.variable_count; ++k) {
+        if (e->fmu->rate_of[k] >= 0) {
+            const double position = snapshot_real(e, &e->before, (int)k);
+            const double turn = fabs(h * snapshot_real(e, &e->before, e->fmu->rate_of[k]));
+            if (turn > 1e-250 && turn > 1e-9 * fabs(position)) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
 /* Whether a step of h s from the state in `before` must move it, by more than
- * a billionth of its size (and beyond underflow): in angle, if the crank
- * turns; in speed, if its acceleration is more than the round-off of the
+ * a billionth of its size (and beyond underflow): in position, if it moves; the
+ * drive's speed too, if its acceleration is more than the round-off of the
  * torque balance it comes from (1e-9 of the torques summed: at a standstill
  * held by gravity the acceleration is that round-off, and the state rightly
  * stays). A subnormal step is too short to resolve either. */
 static int state_must_move(const fuzz_episode* e, double h)
 {
-    const double angle = snapshot_real(e, &e->before, e->fmu->angle);
     const double omega = snapshot_real(e, &e->before, e->fmu->omega);
     const double epsilon = snapshot_real(e, &e->before, e->fmu->epsilon);
     const double inertia = before_named(e, "inertia") + before_named(e, "load.inertia");
@@ -939,12 +1001,27 @@ static int state_must_move(const fuzz_episode* e, double h)
                            hypot(before_named(e, "gravity.x"), before_named(e, "gravity.y"));
     const double torques = fabs(before_named(e, "motor.torque")) +
                            fabs(before_named(e, "load.torque")) + gravity; /* N.m */
-    const double turn = fabs(h * omega), spin = fabs(h * epsilon);
+    const double spin = fabs(h * epsilon);
     if (!(h >= DBL_MIN)) {
         return 0;
     }
-    return (turn > 1e-250 && turn > 1e-9 * fabs(angle)) ||
-           (spin > 1e-250 && spin > 1e-9 * fabs(omega) && fabs(epsilon) * inertia > 1e-9 * torques);
+    return position_must_move(e, h) ||
+           (e->fmu->angle >= 0 && spin > 1e-250 && spin > 1e-9 * fabs(omega) &&
+            fabs(epsilon) * inertia > 1e-9 * torques);
+}
+
+/* Whether some state output differs between `before` and `after`. */
+static int states_moved(const fuzz_episode* e)
+{
+    size_t k;
+    for (k = 0; k < e->fmu->real_count; ++k) {
+        if (e->fmu->rule[e->fmu->reals[k]] == FUZZ_ALWAYS_FINITE &&
+            probe_state_start(&e->fmu->model, &e->fmu->model.variables[e->fmu->reals[k]]) != NULL &&
+            probe_bits(e->after.reals[k]) != probe_bits(e->before.reals[k])) {
+            return 1;
+        }
+    }
+    return 0;
 }
 
 static void check_step_ok(fuzz_episode* e, double t, double h, double last, int terminate)
@@ -993,18 +1070,31 @@ static void check_step_ok(fuzz_episode* e, double t, double h, double last, int 
     if (!has_state(e->fmu)) {
         /* an algebraic model: the step size does not change the answer */
         compare_with_before(e, "an OK doStep of an algebraic model");
-    } else if (state_must_move(e, h) &&
-               probe_bits(snapshot_real(e, &e->after, e->fmu->angle)) ==
-                   probe_bits(snapshot_real(e, &e->before, e->fmu->angle)) &&
-               probe_bits(snapshot_real(e, &e->after, e->fmu->omega)) ==
-                   probe_bits(snapshot_real(e, &e->before, e->fmu->omega))) {
-        violation(e,
-                  "doStep(%.17g, %.17g) OK but the state (angle %.17g, speed %.17g, "
-                  "acceleration %.17g) did not move",
-                  t, h, snapshot_real(e, &e->before, e->fmu->angle),
-                  snapshot_real(e, &e->before, e->fmu->omega),
-                  snapshot_real(e, &e->before, e->fmu->epsilon));
+    } else if (state_must_move(e, h) && !states_moved(e)) {
+        violation(e, "doStep(%.17g, %.17g) OK but no state moved (the first, %s, is %.17g)", t, h,
+                  name_of(e, (size_t)e->fmu->first_state),
+                  snapshot_real(e, &e->before, e->fmu->first_state));
     }
+}
+
+/* A discarded step of a model with states stopped at `last`, where the motion last
+ * had an answer: its outputs are there (the states finite, as snapshot checks), FMI 3's
+ * time reads `last`, and the next step starts there. */
+static void check_step_stopped(fuzz_episode* e, double last)
+{
+    snapshot(e, &e->after);
+    if (!fmi2(e) && !stopped(e)) {
+        const unsigned time_vr = 0;
+        double time = NAN;
+        const int status = (int)e->fmu->f3.GetFloat64(e->instance, &time_vr, 1, &time, 1);
+        trace_double(e, time);
+        if (status != 0 || probe_bits(time) != probe_bits(last)) {
+            violation(e, "after a discarded doStep stopped at %.17g s, time reads %.17g (%d)", last,
+                      time, status);
+        }
+    }
+    swap_snapshots(e);
+    e->time = last;
 }
 
 static void op_do_step(fuzz_episode* e)
@@ -1046,6 +1136,10 @@ static void op_do_step(fuzz_episode* e)
     }
     if (status == 2) {
         ++e->counts->steps_discard;
+        if (has_state(e->fmu) && last >= t && last < t + h && terminate) {
+            check_step_stopped(e, last);
+            return;
+        }
         if ((probe_bits(last) != probe_bits(t) || !terminate) && !stopped(e)) {
             violation(e, "doStep(%.17g, %.17g) discarded: last successful time %.17g, terminate %d",
                       t, h, last, terminate);

@@ -564,6 +564,37 @@ const probe_variable* probe_variable_named(const probe_model* model, const char*
     return NULL;
 }
 
+const probe_variable* probe_state_start(const probe_model* model, const probe_variable* v)
+{
+    static const char* const drive[][2] = {{"crank.angle", "start.angle"},
+                                           {"crank.omega", "start.speed"}};
+    char name[256];
+    const probe_variable* start;
+    size_t k;
+    if (v->causality != PROBE_OUTPUT || strlen(v->name) + sizeof "_start" > sizeof name) {
+        return NULL;
+    }
+    snprintf(name, sizeof name, "%s_start", v->name);
+    start = probe_variable_named(model, name);
+    for (k = 0; start == NULL && k < sizeof drive / sizeof drive[0]; ++k) {
+        if (strcmp(v->name, drive[k][0]) == 0) {
+            start = probe_variable_named(model, drive[k][1]);
+        }
+    }
+    return start != NULL && start->causality == PROBE_PARAMETER ? start : NULL;
+}
+
+int probe_has_states(const probe_model* model)
+{
+    size_t k;
+    for (k = 0; k < model->variable_count; ++k) {
+        if (probe_state_start(model, &model->variables[k]) != NULL) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
 const probe_variable* probe_variable_of_vr(const probe_model* model, unsigned vr)
 {
     size_t k;

@@ -86,6 +86,11 @@ int probe_settable_before_initialization(const probe_variable* v); /* Instantiat
 int probe_settable_in_step_mode(const probe_variable* v);
 /* A value reference that no variable of the model has. */
 unsigned probe_unused_vr(const probe_model* model);
+/* The parameter that starts the state output v (a plant's `X_start` for its output X,
+ * the drive's start.angle and start.speed), or NULL if v is not a state. */
+const probe_variable* probe_state_start(const probe_model* model, const probe_variable* v);
+/* Whether the model has states: a step carries them from where the last one ended. */
+int probe_has_states(const probe_model* model);
 
 /* ---- the entry points --------------------------------------------------------- */
 

@@ -9,9 +9,11 @@
  * and then NaN, infinite, -0 or the smallest double), doStep with small step sizes, and every
  * variable read after each step; each thread instantiates, runs it, and frees
  * its instance, twice. Each step starts where the instance's last accepted step
- * ended, as an importer steps on (a model with states, the drive, refuses a step
- * that does not start at its time): a step refused with Error fails the test, so
- * that every step is one the model computes.
+ * ended, as an importer steps on (a model with states, the drive or a plant, refuses
+ * a step that does not start at its time): a step refused with Error fails the test,
+ * so that every step is one the model computes. A model with states that discards a
+ * step stopped where its motion has no answer (a plant at a dead centre); the instance
+ * is then reset and initialised again, and steps on from the start.
  *
  * Usage: fmu_threads [--threads N] [--steps N] [--seed S] FMU_DIR
  */
@@ -144,18 +146,36 @@ static int make_program(thread_program* p, long steps, uint64_t seed)
 }
 
 /* One doStep from `t`; the hash of what it returned (FMI 3: with its last
- * successful time and whether it terminated) goes into *h. */
-static int step_once(const thread_program* p, void* c, double t, double size, uint64_t* h)
+ * successful time and whether it terminated) goes into *h, and the last successful
+ * time into *last. */
+static int step_once(const thread_program* p, void* c, double t, double size, uint64_t* h,
+                     double* last)
 {
     fmi3Boolean event, terminate, early;
-    fmi3Float64 last;
     int status;
     if (p->model.fmi_version == 2) {
-        return (int)p->f2.DoStep(c, t, size, fmi2True);
+        status = (int)p->f2.DoStep(c, t, size, fmi2True);
+        if (status == fmi2Discard && p->f2.GetRealStatus(c, fmi2LastSuccessfulTime, last) != 0) {
+            *last = NAN;
+        }
+        *h = probe_hash_double(*h, *last);
+        return status;
     }
-    status = (int)p->f3.DoStep(c, t, size, fmi3True, &event, &terminate, &early, &last);
-    *h = probe_hash_double(probe_hash_u64(*h, (uint64_t)terminate), last);
+    status = (int)p->f3.DoStep(c, t, size, fmi3True, &event, &terminate, &early, last);
+    *h = probe_hash_double(probe_hash_u64(*h, (uint64_t)terminate), *last);
     return status;
+}
+
+/* Resets the instance and initialises it again from t = 0: the sum of the statuses. */
+static int restart(const thread_program* p, void* c)
+{
+    if (p->model.fmi_version == 2) {
+        return (int)p->f2.Reset(c) + (int)p->f2.SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0) +
+               (int)p->f2.EnterInitializationMode(c) + (int)p->f2.ExitInitializationMode(c);
+    }
+    return (int)p->f3.Reset(c) +
+           (int)p->f3.EnterInitializationMode(c, fmi3False, 0, 0, fmi3False, 0) +
+           (int)p->f3.ExitInitializationMode(c);
 }
 
 /* Runs the program on a fresh instance; trace[k] is the hash of what call k
@@ -164,8 +184,9 @@ static int step_once(const thread_program* p, void* c, double t, double size, ui
  * returned. */
 static int run_program(const thread_program* p, int index, uint64_t* trace, step_counts* counts)
 {
-    double now = 0;
+    double now = 0, last = 0;
     const int fmi2 = p->model.fmi_version == 2;
+    const int has_states = probe_has_states(&p->model);
     probe_log_book book;
     char name[32];
     double* reals = (double*)calloc(p->n_reals + 1, sizeof *reals);
@@ -212,9 +233,14 @@ static int run_program(const thread_program* p, int index, uint64_t* trace, step
                 fmi2 ? (int)p->f2.ExitInitializationMode(c) : (int)p->f3.ExitInitializationMode(c);
             break;
         case OP_STEP:
-            status = step_once(p, c, now, op->h, &h);
+            last = now;
+            status = step_once(p, c, now, op->h, &h, &last);
             if (status <= 1) {
                 now += op->h;
+            }
+            if (has_states && status == 2) {
+                status = 16 * restart(p, c) + 2;
+                now = 0;
             }
             if (counts != NULL) {
                 counts->ok += status <= 1;

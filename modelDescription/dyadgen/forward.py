@@ -113,7 +113,7 @@ def input_members(scene: Scene) -> dict[str, str]:
             for key in (*MOTOR_NUMBERS, "voltage"):
                 members[f.c(f"motor_{key}")] = "real"
             members[f.c("current")] = "real"
-    for name in ("rtol", "atol", "h_next", "h_accepted", "error_accepted", "steps", "evaluations"):
+    for name in ("rtol", "atol", "step_start", "h_next", "steps", "evaluations"):
         members[f"plant_{name}"] = "real"
     return members
 
@@ -126,7 +126,7 @@ def output_members(scene: Scene) -> dict[str, str]:
         for what in ("position", "rate", "acceleration")
     }
     members.update((f.c("current"), "real") for f in forward_drivers(scene) if f.motor)
-    return members | {"plant_steps": "real", "plant_evaluations": "real"}
+    return members | {"plant_h_next": "real", "plant_steps": "real", "plant_evaluations": "real"}
 
 
 def public_inputs(scene: Scene) -> list[Input]:
@@ -192,6 +192,16 @@ def tolerance_parameters() -> list[tuple[str, float, str]]:
     ]
 
 
+def step_start_parameter() -> tuple[str, float, str]:
+    """(name, default, description) of the integrator's first internal step."""
+    return (
+        "solver.step_start",
+        0.0,
+        "The integrator's first internal step (0: it chooses one from the motion's "
+        "derivatives); solver.step continues it",
+    )
+
+
 def motion_outputs(scene: Scene) -> list[Output]:
     """Each driver's position, rate and acceleration at the end of the step."""
     inputs = [i.name for i in public_inputs(scene)]
@@ -205,6 +215,13 @@ def motion_outputs(scene: Scene) -> list[Output]:
             text = f"Armature current of the motor of {f.name}"
             found.append(Output(f"{f.name}.motor.current", "A", text, f.c("current")))
     return found + [
+        Output(
+            "solver.step",
+            "s",
+            "The internal step the integrator takes first in the next communication step "
+            "(what it kept of its step control; 0: it chooses one)",
+            "plant_h_next",
+        ),
         Output(
             "solver.steps",
             None,
@@ -247,9 +264,7 @@ def _state_names(scene: Scene) -> list[tuple[str, str, str]]:
         states.append((f.rate.name, f.rate.unit or "", f.c("rate")))
     states += [(f"{f.name}.motor.current", "A", f.c("current")) for f in _geared(scene)]
     states += [
-        ("solver.h_next", "s", "plant_h_next"),
-        ("solver.h_accepted", "s", "plant_h_accepted"),
-        ("solver.error_accepted", "", "plant_error_accepted"),
+        ("solver.step", "s", "plant_h_next"),
         ("solver.steps", "", "plant_steps"),
         ("solver.evaluations", "", "plant_evaluations"),
     ]
@@ -454,9 +469,7 @@ def _start(drivers: list[ForwardDriver], ident: str) -> list[str]:
         if f.motor is not None:
             lines.append(f"    in->{f.c('current')} = in->{f.c('motor_current')};")
     lines += [
-        "    in->plant_h_next = 0.0;",
-        "    in->plant_h_accepted = 0.0;",
-        "    in->plant_error_accepted = 0.0;",
+        "    in->plant_h_next = in->plant_step_start;",
         "    in->plant_steps = 0.0;",
         "    in->plant_evaluations = 0.0;",
         "}",

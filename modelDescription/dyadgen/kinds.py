@@ -521,6 +521,9 @@ def _forward_rows(scene: Scene) -> list[dict]:
         raw.update(min_exclusive=True, max=1.0, max_exclusive=True)
         if name == "solver.rtol":
             raw.update(min=forward.RTOL_MIN, min_exclusive=False)
+    name, start, text = forward.step_start_parameter()
+    raw = _row(rows, name, "parameter", "s", type="Real", start=start, description=text)
+    raw.update(lives="input.plant_step_start", min=0.0, min_exclusive=False)
     # no on_singular: a plant's step without an answer cannot go on (its states stop)
     _output_rows(rows, forward.public_outputs(scene))
     return rows

@@ -53,11 +53,11 @@ typedef enum dyad_ode_status {
     /** The error control asked for a step below 16 eps |t|: the solution is
      *  not smooth there (a discontinuity of f, a blow-up). */
     DYAD_ODE_STEP_UNDERFLOW,
-    /** The call would need more than max_steps internal steps. Refused before
-     *  any step where the limits of the controller (the present step size,
+    /** The call would need more than max_steps internal steps. Checked before
+     *  each step: where the limits of the controller (the present step size,
      *  its growth by at most DYAD_ODE_MAX_GROWTH per step, h_max) already
-     *  prove it (then nothing was done); otherwise the state stops at the
-     *  last accepted point after max_steps steps. */
+     *  prove it, the state stops at the last accepted point (before the first
+     *  step: nothing was done); it stops there too after max_steps steps. */
     DYAD_ODE_TOO_MANY_STEPS
 } dyad_ode_status;
 
@@ -100,6 +100,10 @@ typedef struct dyad_ode_options {
     dyad_real h_max;
     /** The first step (0: chosen from the tolerances and f). */
     dyad_real h_initial;
+    /** The shortest step the error control may ask for (default 0) before the
+     *  call gives up with DYAD_ODE_STEP_UNDERFLOW, as it does below 16 eps |t|:
+     *  a caller that integrates from t = 0 states its own time's resolution. */
+    dyad_real h_min;
     /** The most internal steps (accepted or not) one call may take (> 0). */
     long max_steps;
 } dyad_ode_options;
@@ -138,7 +142,7 @@ typedef struct dyad_ode_state {
     dyad_real t_failed; /**< where f or the step failed (t itself if before any step) */
 } dyad_ode_state;
 
-/** Defaults: rtol 1e-8, atol 1e-10, h_max +inf, h_initial 0, max_steps 100000. */
+/** Defaults: rtol 1e-8, atol 1e-10, h_max +inf, h_initial 0, h_min 0, max_steps 100000. */
 dyad_ode_options dyad_ode_options_default(void);
 
 /** Starts the integrator at (t0, y0) of dimension n with the given options
