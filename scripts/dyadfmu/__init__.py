@@ -2,5 +2,6 @@
 fmpy, co-simulations, studies and reports."""
 
 from .batch import Reactions, solve
+from .plant import Trajectory, forward
 
-__all__ = ["Reactions", "solve"]
+__all__ = ["Reactions", "Trajectory", "forward", "solve"]

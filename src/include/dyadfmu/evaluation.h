@@ -22,7 +22,7 @@ typedef enum fmu_status {
 typedef struct fmu_evaluation {
     fmu_status status;
     int bad_variable; /* index of the variable to blame, or -1 */
-    char reason[200];
+    char reason[320];
 } fmu_evaluation;
 
 #endif /* DYADFMU_EVALUATION_H */
