@@ -494,6 +494,14 @@ def _outputs(drivers: list[ForwardDriver], ident: str) -> list[str]:
     return lines + ["}", ""]
 
 
+def _no_outputs(scene: Scene, ident: str) -> list[str]:
+    """plant_set_nan: every Real output NaN (no acceleration, so no scene at it)."""
+    members = [o.member for o in scene.outputs if not o.integer] + list(output_members(scene))
+    lines = [f"static void plant_set_nan({ident}_output* out)", "{"]
+    lines += [f"    out->{m} = (double)NAN;" for m in dict.fromkeys(members)]
+    return lines + ["}", ""]
+
+
 def _state_table(scene: Scene, ident: str) -> list[str]:
     lines = [
         "/* What an FMU state keeps of the plant beyond its parameters and inputs. */",
@@ -517,6 +525,7 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         + _state_io(drivers, ident)
         + _start(drivers, ident)
         + _outputs(drivers, ident)
+        + _no_outputs(scene, ident)
         + _state_table(scene, ident)
     )
     return len(drivers), state_size(scene), len(_state_names(scene)), parts
