@@ -239,17 +239,22 @@ def _scene_sections(scene: Scene) -> dict[str, str]:
     }
 
 
-def _plant_takes(table: Table) -> str:
-    """What a plant (dynamics = "forward") takes: its drivers' efforts or motors'
-    voltages and its loads; it integrates the motion itself."""
-    scene = table.scene
-    prefixes = tuple(f"{d.driver_name()}." for d in scene.drivers)
+def _driving_inputs(table: Table) -> tuple[str, str]:
+    """The inputs that belong to the drivers, named in HTML, and the loads counted."""
+    prefixes = tuple(f"{d.driver_name()}." for d in table.scene.drivers)
     driving = [v.name for v in table.of("input") if v.name.startswith(prefixes)]
     loads = len(table.of("input")) - len(driving)
     named = ", ".join(f"<code>{h(name)}</code>" for name in driving)
     rest = {0: "no load", 1: "the active load (1 input)"}.get(
         loads, f"the active loads ({loads} inputs)"
     )
+    return named, rest
+
+
+def _plant_takes(table: Table) -> str:
+    """What a plant (dynamics = "forward") takes: its drivers' efforts or motors'
+    voltages and its loads; it integrates the motion itself."""
+    named, rest = _driving_inputs(table)
     return (
         f"only what drives it ({named}) and {rest}, integrates its drivers' motion inside "
         "each step to the tolerances solver.rtol and solver.atol (a plant: no motion is an "
@@ -266,24 +271,14 @@ def _takes(table: Table) -> str:
         return "the links' current kinematics and active loads"
     if scene.forward():
         return _plant_takes(table)
-    prefixes = tuple(f"{d.driver_name()}." for d in scene.drivers)
-    motion = [v.name for v in table.of("input") if v.name.startswith(prefixes)]
-    loads = len(table.of("input")) - len(motion)
-    driver = scene.crank.kind if scene.crank else "drivers"
+    named, rest = _driving_inputs(table)
     if not scene.crank:
-        named = ", ".join(f"<code>{h(name)}</code>" for name in motion)
-        rest = {0: "no load", 1: "the active load (1 input)"}.get(
-            loads, f"the active loads ({loads} inputs)"
-        )
         return (
             f"only its {len(scene.drivers)} drivers' motion ({named}) and {rest}, solves the "
             "links' motion from the drivers' itself (the kinematics are inside: no link's "
             "motion is an input),"
         )
-    named = ", ".join(f"<code>{h(name)}</code>" for name in motion)
-    rest = {0: "no load", 1: "the active load (1 input)"}.get(
-        loads, f"the active loads ({loads} inputs)"
-    )
+    driver = scene.crank.kind
     return (
         f"only the {driver}'s motion ({named}) and {rest}, solves the links' motion from the "
         f"{driver}'s itself (the kinematics are inside: no link's motion is an input),"
