@@ -224,23 +224,15 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[])
 {
-    (void)vr;
-    (void)nvr;
-    (void)order;
-    (void)value;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2SetRealInputDerivatives",
-                                   "canInterpolateInputs is false"));
+    return to_fmi2(fmu_set_input_rates((fmu_instance*)c, vr, nvr, order, value,
+                                       "fmi2SetRealInputDerivatives"));
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[])
 {
-    (void)vr;
-    (void)nvr;
-    (void)order;
-    (void)value;
-    return to_fmi2(fmu_unsupported((fmu_instance*)c, "fmi2GetRealOutputDerivatives",
-                                   "maxOutputDerivativeOrder is 0"));
+    return to_fmi2(fmu_get_output_rates((fmu_instance*)c, vr, nvr, order, value,
+                                        "fmi2GetRealOutputDerivatives"));
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,

@@ -441,6 +441,19 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueRe
                                               sensitivity, "fmi3GetDirectionalDerivative"));
 }
 
+fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance,
+                                    const fmi3ValueReference valueReferences[],
+                                    size_t nValueReferences, const fmi3Int32 orders[],
+                                    fmi3Float64 values[], size_t nValues)
+{
+    fmu_instance* fmu = (fmu_instance*)instance;
+    if (!scalar_counts(fmu, nValueReferences, nValues, "fmi3GetOutputDerivatives")) {
+        return fmi3Error;
+    }
+    return to_fmi3(fmu_get_output_rates(fmu, valueReferences, nValueReferences, orders, values,
+                                        "fmi3GetOutputDerivatives"));
+}
+
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint,
                       fmi3Float64 communicationStepSize,
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint,

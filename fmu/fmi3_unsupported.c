@@ -272,20 +272,6 @@ fmi3Status fmi3EnterStepMode(fmi3Instance instance)
         fmu_unsupported((fmu_instance*)instance, "fmi3EnterStepMode", "hasEventMode is false"));
 }
 
-fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance,
-                                    const fmi3ValueReference valueReferences[],
-                                    size_t nValueReferences, const fmi3Int32 orders[],
-                                    fmi3Float64 values[], size_t nValues)
-{
-    (void)valueReferences;
-    (void)nValueReferences;
-    (void)orders;
-    (void)values;
-    (void)nValues;
-    return to_fmi3(fmu_unsupported((fmu_instance*)instance, "fmi3GetOutputDerivatives",
-                                   "maxOutputDerivativeOrder is 0"));
-}
-
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
                                       fmi3Float64 activationTime)
 {

@@ -1521,6 +1521,130 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
     return FMU_OK;
 }
 
+/* ---- inputs interpolated and outputs differentiated (canInterpolateInputs) ------------------- */
+
+/* The model's interpolation, or NULL with "not supported" logged. */
+static const fmu_interpolation* interpolation_of(fmu_instance* instance, const char* function,
+                                                 const char* why)
+{
+    const fmu_interpolation* i = instance->model->behaviour->interpolation;
+    if (i == NULL) {
+        fmu_unsupported(instance, function, why);
+    }
+    return i;
+}
+
+/* Where the model keeps the first derivative of the input v, or NULL: it does not
+ * interpolate v. */
+static double* input_rate_of(fmu_instance* instance, const fmu_interpolation* interpolation,
+                             const fmu_variable* v)
+{
+    size_t k;
+    for (k = 0; k < interpolation->input_count; ++k) {
+        if (v->target == FMU_TARGET_INPUT_REAL &&
+            interpolation->inputs[k].value_offset == v->offset) {
+            return (double*)(void*)((char*)instance->input + interpolation->inputs[k].rate_offset);
+        }
+    }
+    return NULL;
+}
+
+/* FMU_ERROR, logged, unless every order is 1: the model's derivatives are first ones. */
+static fmu_status check_orders(fmu_instance* instance, const unsigned int vr[], const int order[],
+                               size_t count, const char* function)
+{
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        if (order[k] != 1) {
+            fmu_log(instance, FMU_ERROR,
+                    "%s: order %d asked of value reference %u: this FMU's derivatives are "
+                    "first derivatives only (order 1)",
+                    function, order[k], vr[k]);
+            return FMU_ERROR;
+        }
+    }
+    return FMU_OK;
+}
+
+/* The rate of each input before any is stored, so that a refused call changes nothing. */
+static fmu_status check_input_rates(fmu_instance* instance, const fmu_interpolation* interpolation,
+                                    const unsigned int vr[], const double values[], size_t count,
+                                    const char* function)
+{
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = lookup(instance, vr[k], reals.types, function);
+        if (v == NULL) {
+            return FMU_ERROR;
+        }
+        if (v->causality != FMU_INPUT || input_rate_of(instance, interpolation, v) == NULL) {
+            fmu_log(instance, FMU_ERROR,
+                    "%s: %s is not an input this FMU interpolates; its inputs are its "
+                    "continuous Real inputs",
+                    function, v->name);
+            return FMU_ERROR;
+        }
+        if (!isfinite(values[k])) {
+            fmu_log(instance, FMU_ERROR, "%s: the derivative of %s = %g (%s/s) is not finite",
+                    function, v->name, values[k], v->unit);
+            return FMU_ERROR;
+        }
+    }
+    return FMU_OK;
+}
+
+fmu_status fmu_set_input_rates(fmu_instance* instance, const unsigned int vr[], size_t count,
+                               const int order[], const double values[], const char* function)
+{
+    const fmu_interpolation* interpolation;
+    size_t k;
+    if (fmu_check_call(instance, FMU_OP_SET, function) != FMU_OK ||
+        check_arrays(instance, vr, count, values, function) != FMU_OK ||
+        check_arrays(instance, order, count, values, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    interpolation = interpolation_of(instance, function, "canInterpolateInputs is false");
+    if (interpolation == NULL || check_orders(instance, vr, order, count, function) != FMU_OK ||
+        check_input_rates(instance, interpolation, vr, values, count, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = &instance->model->variables[instance->model->index_of_vr[vr[k]]];
+        *input_rate_of(instance, interpolation, v) = values[k];
+    }
+    return FMU_OK;
+}
+
+fmu_status fmu_get_output_rates(fmu_instance* instance, const unsigned int vr[], size_t count,
+                                const int order[], double values[], const char* function)
+{
+    const fmu_interpolation* interpolation;
+    fmu_evaluation evaluation;
+    size_t k;
+    if (fmu_check_call(instance, FMU_OP_GET, function) != FMU_OK ||
+        check_arrays(instance, vr, count, values, function) != FMU_OK ||
+        check_arrays(instance, order, count, values, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    interpolation = interpolation_of(instance, function, "maxOutputDerivativeOrder is 0");
+    if (interpolation == NULL || check_orders(instance, vr, order, count, function) != FMU_OK ||
+        check_unknowns(instance, vr, count, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    sync_angles(instance);
+    interpolation->output_rates(instance->model, instance->input, instance->rate, &evaluation);
+    for (k = 0; k < count; ++k) {
+        const fmu_variable* v = &instance->model->variables[instance->model->index_of_vr[vr[k]]];
+        values[k] = *(const double*)(const void*)((const char*)instance->rate + v->offset);
+    }
+    if (evaluation.status != FMU_OK) {
+        fmu_log(instance, FMU_DISCARD, "%s: at t = %g s the outputs have no derivatives: %s",
+                function, instance->time, evaluation.reason);
+        return FMU_DISCARD;
+    }
+    return FMU_OK;
+}
+
 fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,
                                     const unsigned int vr[], size_t count, const char* function)
 {

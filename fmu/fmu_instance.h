@@ -216,6 +216,16 @@ fmu_status fmu_directional_derivative(fmu_instance* instance, const unsigned int
                                       size_t n_knowns, const double seed[], double derivative[],
                                       const char* function);
 
+/* First derivatives of Real inputs (order[k] 1 each) that a model with states follows
+ * over its next steps as straight lines, kept until set again (fmi2SetRealInputDerivatives);
+ * and the first derivatives of Real outputs at the current point
+ * (fmi2GetRealOutputDerivatives, fmi3GetOutputDerivatives). Error, "not supported", for a
+ * model without fmu_behaviour.interpolation. */
+fmu_status fmu_set_input_rates(fmu_instance* instance, const unsigned int vr[], size_t count,
+                               const int order[], const double values[], const char* function);
+fmu_status fmu_get_output_rates(fmu_instance* instance, const unsigned int vr[], size_t count,
+                                const int order[], double values[], const char* function);
+
 /* For variable types the model has none of: accepts an empty list, rejects
  * any value reference by number. */
 fmu_status fmu_no_variables_of_type(fmu_instance* instance, fmu_operation operation,

@@ -105,6 +105,26 @@ typedef struct fmu_states {
     int (*refused)(const struct fmu_model* model, const void* input);
 } fmu_states;
 
+/* A Real input that a model with states follows over a step as a straight line from
+ * its value at the step's start (canInterpolateInputs): the input's value and its first
+ * time derivative as set, both doubles of the input block. */
+typedef struct fmu_input_rate {
+    size_t value_offset; /* the input's value (the variable's offset) */
+    size_t rate_offset;  /* its first time derivative (unit/s) */
+} fmu_input_rate;
+
+/* What a model with states offers an importer that couples at higher order: the inputs
+ * it interpolates and the first time derivatives of its outputs. */
+typedef struct fmu_interpolation {
+    const fmu_input_rate* inputs;
+    size_t input_count;
+    /* The first time derivative of every Real output at the current point, into the
+     * output block `rate` (each output's at its own offset); NaN where it has none,
+     * with the evaluation saying why. */
+    void (*output_rates)(const struct fmu_model* model, const void* input, void* rate,
+                         fmu_evaluation* evaluation);
+} fmu_interpolation;
+
 /* What a kind of model computes, on its own input and output blocks. */
 typedef struct fmu_behaviour {
     size_t input_size;  /* bytes of the input block */
@@ -131,6 +151,9 @@ typedef struct fmu_behaviour {
     /* A model with states: what they are, for an FMU state (fmu_state.c). NULL for an
      * algebraic model. */
     const fmu_states* states;
+    /* A model with states that interpolates its inputs and differentiates its outputs
+     * (canInterpolateInputs, maxOutputDerivativeOrder 1). NULL: it does neither. */
+    const fmu_interpolation* interpolation;
 } fmu_behaviour;
 
 /* The calls an importer makes every step, set every Real input and get every Real

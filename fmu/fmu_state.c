@@ -15,16 +15,16 @@
  * and the payload is 8-byte fields: the state machine's state (int64), the time and
  * the last successful time (double, s), the terminate flag (int64), one double per
  * parameter, input and setting in the order of the variable table, one per model
- * state. The fingerprint is of the model (its instantiation token), of this format's
- * version and of the counts of the fields, so that a state of another FMU, of another
- * build or of an older format is refused; the checksum (FNV-1a over the payload)
- * refuses a damaged one: it guards against accidents, not against a crafted state.
- * That is what the checks of every field are for, each as a setter or a step would
- * check it, so that a state holds only what calls could have left: a value a setter
- * would accept, times that are finite and ordered as steps leave them, one of the four
- * states of the machine, model states a start or step could leave. A refused state
- * names its field. The saved states of an instance are kept in a list and freed with
- * it. */
+ * state, one per first derivative of an input the model interpolates (canInterpolateInputs:
+ * a rate, like a value, holds until set again). The fingerprint is of the model (its instantiation
+ * token), of this format's version and of the counts of the fields, so that a state of another FMU,
+ * of another build or of an older format is refused; the checksum (FNV-1a over the payload) refuses
+ * a damaged one: it guards against accidents, not against a crafted state. That is what the checks
+ * of every field are for, each as a setter or a step would check it, so that a state holds only
+ * what calls could have left: a value a setter would accept, times that are finite and ordered as
+ * steps leave them, one of the four states of the machine, model states a start or step could
+ * leave. A refused state names its field. The saved states of an instance are kept in a list and
+ * freed with it. */
 #include <inttypes.h>
 #include <math.h>
 #include <stdint.h>
@@ -44,7 +44,7 @@ enum { HEADER_SIZE = 32, FIELD_SIZE = 8 };
 /* The fields of the payload before the values, in order. */
 enum { AT_MACHINE = 0, AT_TIME, AT_LAST_TIME, AT_TERMINATE, AT_VALUES };
 /* The format of the payload; a state of another format is refused by its fingerprint. */
-enum { FORMAT_VERSION = 2 };
+enum { FORMAT_VERSION = 3 };
 /* The machine's states before initialization ends: the model's states follow their
  * start values, and no step was taken. */
 enum { BEFORE_STEPS = FMU_STATE_INSTANTIATED | FMU_STATE_INITIALIZATION };
@@ -75,17 +75,24 @@ static size_t model_state_count(const fmu_model* m)
     return m->behaviour->states != NULL ? m->behaviour->states->count : 0;
 }
 
+/* The inputs whose first derivatives the model keeps (fmu_behaviour.interpolation). */
+static size_t input_rate_count(const fmu_model* m)
+{
+    return m->behaviour->interpolation != NULL ? m->behaviour->interpolation->input_count : 0;
+}
+
 static uint64_t fingerprint(const fmu_model* m)
 {
-    const uint64_t counts[4] = {FORMAT_VERSION, m->variable_count, kept_count(m),
-                                model_state_count(m)};
+    const uint64_t counts[5] = {FORMAT_VERSION, m->variable_count, kept_count(m),
+                                model_state_count(m), input_rate_count(m)};
     uint64_t h = fnv1a(0xcbf29ce484222325ULL, m->token, strlen(m->token));
     return fnv1a(h, counts, sizeof counts);
 }
 
 static size_t state_size(const fmu_model* m)
 {
-    return HEADER_SIZE + FIELD_SIZE * (AT_VALUES + kept_count(m) + model_state_count(m));
+    return HEADER_SIZE +
+           FIELD_SIZE * (AT_VALUES + kept_count(m) + model_state_count(m) + input_rate_count(m));
 }
 
 /* The fields of a payload, which need not be aligned. */
@@ -139,6 +146,10 @@ static void write_state(fmu_instance* instance, unsigned char* bytes)
     }
     for (k = 0; k < model_state_count(m); ++k) {
         put_real(payload, field++, *block_real(instance->input, states->states[k].offset));
+    }
+    for (k = 0; k < input_rate_count(m); ++k) {
+        const size_t at = m->behaviour->interpolation->inputs[k].rate_offset;
+        put_real(payload, field++, *block_real(instance->input, at));
     }
     check = fnv1a(0xcbf29ce484222325ULL, payload, (size_t)size - HEADER_SIZE);
     memcpy(bytes, magic, 8);
@@ -286,6 +297,35 @@ static int model_states_refused(const fmu_model* m, const unsigned char* payload
     return bad >= 0;
 }
 
+/* Why an input's first derivative is not one its setter would accept (finite), naming
+ * the input; 0 if none. FMI 3 (the time at value reference 0) sets no input derivatives:
+ * there they are 0. */
+static int input_rates_refused(const fmu_model* m, const unsigned char* payload, int fmi3,
+                               char* why, size_t size)
+{
+    const size_t first = AT_VALUES + kept_count(m) + model_state_count(m);
+    size_t k, j;
+    for (k = 0; k < input_rate_count(m); ++k) {
+        const double rate = real_at(payload, first + k);
+        const size_t at = m->behaviour->interpolation->inputs[k].value_offset;
+        if (isfinite(rate) && (rate == 0 || !fmi3)) {
+            continue;
+        }
+        for (j = 0; j < m->variable_count; ++j) {
+            const fmu_variable* v = &m->variables[j];
+            if (v->causality == FMU_INPUT && v->target == FMU_TARGET_INPUT_REAL &&
+                v->offset == at) {
+                snprintf(why, size, "the derivative of %s = %g %s/s is %s", v->name, rate, v->unit,
+                         isfinite(rate) ? "not 0 (FMI 3 sets no input derivatives)" : "not finite");
+                return 1;
+            }
+        }
+        snprintf(why, size, "the derivative of input %zu = %g cannot be set", k, rate);
+        return 1;
+    }
+    return 0;
+}
+
 /* Why `bytes` is not a state this instance's FMU could be in, naming the field, into
  * `why`; 0 if it is one. */
 static int state_refused(fmu_instance* instance, const unsigned char* bytes, size_t size, char* why,
@@ -301,7 +341,8 @@ static int state_refused(fmu_instance* instance, const unsigned char* bytes, siz
     /* the scratch of directional derivatives, which set it before each use */
     return machine_refused(integer_at(payload, AT_MACHINE), why, why_size) ||
            times_refused(payload, why, why_size) || values_refused(m, payload, why, why_size) ||
-           model_states_refused(m, payload, instance->seed, why, why_size);
+           model_states_refused(m, payload, instance->seed, why, why_size) ||
+           input_rates_refused(m, payload, instance->time_at_vr_0, why, why_size);
 }
 
 /* The state's bytes (checked by state_refused) into the instance: the input block
@@ -321,6 +362,10 @@ static void read_state(fmu_instance* instance, const unsigned char* bytes)
     }
     for (k = 0; k < model_state_count(m); ++k) {
         *block_real(instance->input, states->states[k].offset) = real_at(payload, field++);
+    }
+    for (k = 0; k < input_rate_count(m); ++k) {
+        const size_t at = m->behaviour->interpolation->inputs[k].rate_offset;
+        *block_real(instance->input, at) = real_at(payload, field++);
     }
     instance->time = real_at(payload, AT_TIME);
     instance->last_successful_time = real_at(payload, AT_LAST_TIME);

@@ -246,6 +246,7 @@ typedef struct fuzz_episode {
     probe_log_book book;
     fuzz_state state;
     double* shadow; /* per variable: the value the last accepted set stored */
+    double* rates;  /* per variable: the first derivative the last accepted set gave it */
     double time;    /* the communication point an importer would use next */
     uint64_t trace;
     fuzz_snapshot before, after;
@@ -947,6 +948,63 @@ static void op_get_outputs(fuzz_episode* e)
     free(at);
 }
 
+/* Input derivatives (FMI 2) and output derivatives, either version. A model that does not
+ * interpolate refuses both with a message. One that does takes a finite first derivative
+ * of an input and refuses anything else with a message; the outputs' derivatives are
+ * finite with OK, or Discard with a message where the point has none. */
+static void op_rates(fuzz_episode* e)
+{
+    const fuzz_fmu* f = e->fmu;
+    const int interpolates = f->model.interpolates;
+    const unsigned vr = random_vr(e, PROBE_REAL);
+    const probe_variable* v = probe_variable_of_vr(&f->model, vr);
+    const double rate =
+        probe_rng_below(&e->rng, 4) == 0 ? special_value(&e->rng) : log_uniform(&e->rng);
+    int order = probe_rng_below(&e->rng, 8) == 0 ? 2 : 1, status;
+    long before = e->book.count;
+    size_t k, n = 0;
+    unsigned vrs[64];
+    int orders[64];
+    double values[64];
+    if (fmi2(e)) {
+        const int takes = interpolates && order == 1 && v != NULL && v->causality == PROBE_INPUT &&
+                          v->type == PROBE_REAL && is_finite(rate);
+        status = (int)f->f2.SetRealInputDerivatives(e->instance, &vr, 1, &order, &rate);
+        note(e, "setRealInputDerivatives vr %u order %d = %.17g -> %d", vr, order, rate, status);
+        expect_message(e, status, before, "setRealInputDerivatives");
+        if (status == 0 && takes) {
+            e->rates[v - f->model.variables] = rate;
+        }
+        if ((status == 0) != takes) {
+            violation(e, "setRealInputDerivatives vr %u order %d = %.17g: status %d", vr, order,
+                      rate, status);
+        }
+    }
+    for (k = 0; k < f->real_count && n < 64; ++k) {
+        if (f->model.variables[f->reals[k]].causality == PROBE_OUTPUT) {
+            vrs[n] = f->real_vrs[k];
+            orders[n++] = 1;
+        }
+    }
+    before = e->book.count;
+    status = fmi2(e) ? (int)f->f2.GetRealOutputDerivatives(e->instance, vrs, n, orders, values)
+                     : (int)f->f3.GetOutputDerivatives(e->instance, vrs, n, orders, values, n);
+    note(e, "getOutputDerivatives (%zu) -> %d", n, status);
+    expect_message(e, status, before, "getOutputDerivatives");
+    if (!interpolates && status != 3) {
+        violation(e, "getOutputDerivatives of a model without them: status %d", status);
+    }
+    if (interpolates && status == 2 && e->book.count == before) {
+        violation(e, "getOutputDerivatives discarded without a message");
+    }
+    for (k = 0; k < n && interpolates && status == 0; ++k) {
+        if (!is_finite(values[k])) {
+            violation(e, "getOutputDerivatives: vr %u = %.17g with status 0", vrs[k], values[k]);
+            break;
+        }
+    }
+}
+
 /* FMI 2: the last successful time and the terminate flag, from the status getters. */
 static void fmi2_step_status(fuzz_episode* e, double* last, int* terminate)
 {
@@ -1097,6 +1155,40 @@ static void check_step_stopped(fuzz_episode* e, double last)
     e->time = last;
 }
 
+/* A step of h seconds carried each input with a first derivative along it, as the FMU
+ * computes it: value + h rate. */
+static void move_inputs(fuzz_episode* e, double h)
+{
+    size_t k;
+    for (k = 0; k < e->fmu->model.variable_count; ++k) {
+        if (e->rates[k] != 0) {
+            e->shadow[k] += h * e->rates[k];
+        }
+    }
+}
+
+/* A step that stopped within h seconds left each input with a first derivative between
+ * its value at the start and h seconds on: read, checked and kept. */
+static void inputs_moved_within(fuzz_episode* e, double h)
+{
+    size_t k;
+    for (k = 0; k < e->fmu->model.variable_count; ++k) {
+        const unsigned vr = e->fmu->model.variables[k].vr;
+        const double from = e->shadow[k], to = from + h * e->rates[k];
+        double now = NAN;
+        if (e->rates[k] == 0) {
+            continue;
+        }
+        if (call_get_real(e, &vr, 1, &now) != 0 || !(now >= fmin(from, to)) ||
+            !(now <= fmax(from, to))) {
+            violation(e, "%s reads %.17g after a step that stopped, not within [%.17g, %.17g]",
+                      name_of(e, k), now, from, to);
+            return;
+        }
+        e->shadow[k] = now;
+    }
+}
+
 static void op_do_step(fuzz_episode* e)
 {
     const double t = nasty_time(&e->rng, e->time);
@@ -1129,6 +1221,7 @@ static void op_do_step(fuzz_episode* e)
     expect_message(e, status, log_count, "doStep");
     if (status == 0) {
         ++e->counts->steps_ok;
+        move_inputs(e, h);
         check_step_ok(e, t, h, last, terminate);
         swap_snapshots(e);
         e->time = t + h;
@@ -1137,6 +1230,7 @@ static void op_do_step(fuzz_episode* e)
     if (status == 2) {
         ++e->counts->steps_discard;
         if (has_state(e->fmu) && last >= t && last < t + h && terminate) {
+            inputs_moved_within(e, h);
             check_step_stopped(e, last);
             return;
         }
@@ -1260,6 +1354,7 @@ static void load_start_values(fuzz_episode* e)
     for (k = 0; k < e->fmu->model.variable_count; ++k) {
         const probe_variable* v = &e->fmu->model.variables[k];
         e->shadow[k] = v->has_start ? v->start : 0.0;
+        e->rates[k] = 0.0;
     }
     e->state = S_INSTANTIATED;
     e->before.valid = 0;
@@ -1389,8 +1484,10 @@ static void one_call(fuzz_episode* e)
             op_set_plausible(e);
         } else if (pick < 46) {
             op_set_inputs(e);
-        } else if (pick < 50) {
+        } else if (pick < 48) {
             op_get_outputs(e);
+        } else if (pick < 50) {
+            op_rates(e);
         } else if (pick < 84) {
             op_do_step(e);
         } else if (pick < 90) {
@@ -1589,6 +1686,7 @@ int main(int argc, char** argv)
     e.fmu = &fmu;
     e.counts = &counts;
     e.shadow = (double*)calloc(fmu.model.variable_count + 1, sizeof *e.shadow);
+    e.rates = (double*)calloc(fmu.model.variable_count + 1, sizeof *e.rates);
     if (e.shadow == NULL || !alloc_snapshot(&e.before, &fmu) || !alloc_snapshot(&e.after, &fmu)) {
         printf("out of memory\n");
         return 1;
@@ -1617,6 +1715,7 @@ int main(int argc, char** argv)
            (double)(ended.tv_sec - started.tv_sec) +
                1e-9 * (double)(ended.tv_nsec - started.tv_nsec));
     free(e.shadow);
+    free(e.rates);
     free(e.before.reals);
     free(e.before.integers);
     free(e.after.reals);

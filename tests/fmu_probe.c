@@ -461,6 +461,8 @@ static int read_variables(const char* text, probe_model* model, char* error, siz
             model->identifier = copy_string(id);
             model->provides_directional_derivatives =
                 derivatives != NULL && strcmp(derivatives, "true") == 0;
+            model->interpolates = tag_attribute(&tag, "maxOutputDerivativeOrder") != NULL &&
+                                  atoi(tag_attribute(&tag, "maxOutputDerivativeOrder")) >= 1;
         } else if (strcmp(tag.name, "ModelVariables") == 0) {
             in_variables = !tag.closing && !tag.self_closing;
         } else if (in_variables && model->fmi_version == 2 &&

@@ -68,6 +68,7 @@ typedef struct probe_model {
     char* identifier; /* modelIdentifier of <CoSimulation> */
     char* token;      /* guid (FMI 2) or instantiationToken (FMI 3) */
     int provides_directional_derivatives;
+    int interpolates; /* maxOutputDerivativeOrder >= 1 (FMI 2: and canInterpolateInputs) */
     probe_variable* variables;
     size_t variable_count;
     char* directory;   /* the extracted FMU */

@@ -368,8 +368,12 @@ static double input_value(const probe_variable* v, int step)
 /* A state the fuzz starts from: on_singular = continue (2) where the model has it, the
  * inputs off their start values, in Initialization at 0.25 s (`steps` 0) or after
  * `steps` steps of 0.01 s from there. */
+static int set_rates(instance* in, const double rates[]);
+
+/* The state after `steps` steps (a plant of FMI 2 with its inputs ramping at 1 unit/s). */
 static unsigned char* base_state(const fmu* f, int steps, size_t* size)
 {
+    double ones[MAX_VALUES];
     instance in;
     unsigned char* bytes = NULL;
     void* state = NULL;
@@ -377,6 +381,9 @@ static unsigned char* base_state(const fmu* f, int steps, size_t* size)
     size_t k;
     double last;
     int flag;
+    for (k = 0; k < MAX_VALUES; ++k) {
+        ones[k] = 1;
+    }
     if (!new_instance(f, &in, "base")) {
         return NULL;
     }
@@ -387,6 +394,7 @@ static unsigned char* base_state(const fmu* f, int steps, size_t* size)
         }
     }
     ok &= enter_initialization(&in, 1, 0.25) == 0;
+    ok &= !(f->version == 2 && f->md.interpolates) || set_rates(&in, ones);
     for (k = 0; k < f->n_inputs && steps == 0; ++k) {
         ok &= set_real(&in, f->inputs[k], input_value(var(f, f->inputs[k]), 0)) == 0;
     }
@@ -418,6 +426,9 @@ typedef struct restored {
     double values[MAX_VALUES]; /* parameters, inputs, then settings as read back */
     int64_t settings[MAX_VALUES];
     double states[MODEL_STATE_COUNT];
+    /* the inputs' first derivatives (FMI 2, a model that interpolates its inputs): the
+     * state's last fields, one per Real input in the variable table's order */
+    double rates[MAX_VALUES];
     int time_known;
     double time;
 } restored;
@@ -501,6 +512,20 @@ static int read_restored(instance* in, restored* r)
     return 1;
 }
 
+/* The first derivatives of every Real input (FMI 2); 1 if the set succeeds. */
+static int set_rates(instance* in, const double rates[])
+{
+    const fmu* f = in->f;
+    unsigned int vr[MAX_VALUES];
+    fmi2Integer order[MAX_VALUES];
+    size_t k;
+    for (k = 0; k < f->n_inputs; ++k) {
+        vr[k] = var(f, f->inputs[k])->vr;
+        order[k] = 1;
+    }
+    return f->f2.SetRealInputDerivatives(in->c, vr, f->n_inputs, order, rates) == fmi2OK;
+}
+
 /* A fresh instance given the restored one's values, in its state of the machine. */
 static int fresh_like(const fmu* f, instance* ref, const restored* r, reading* before,
                       reading* after_exit, char* why, size_t why_size)
@@ -531,6 +556,11 @@ static int fresh_like(const fmu* f, instance* ref, const restored* r, reading* b
                      var(f, f->settings[k])->name, (long long)r->settings[k], ref->book.last);
             return 0;
         }
+    }
+    if (f->version == 2 && f->md.interpolates && !set_rates(ref, r->rates)) {
+        snprintf(why, why_size, "it holds input derivatives which a set refuses: %s",
+                 ref->book.last);
+        return 0;
     }
     if (enter_initialization(ref, 1, r->time) != 0) {
         snprintf(why, why_size, "enterInitializationMode: %s", ref->book.last);
@@ -587,15 +617,21 @@ static int same_step(instance* in, instance* ref, const restored* r, char* why, 
     return 1;
 }
 
-/* Why the restored instance disagrees with a fresh one, into `why`; 1 if it agrees. */
-static int agrees(instance* in, tally* t, char* why, size_t why_size)
+/* Why the restored instance (of the state `bytes`) disagrees with a fresh one, into `why`;
+ * 1 if it agrees. */
+static int agrees(instance* in, const unsigned char* bytes, size_t size, tally* t, char* why,
+                  size_t why_size)
 {
     restored r;
     reading before, after_exit;
     instance ref;
     long bad;
     int ok;
+    size_t k;
     memset(&r, 0, sizeof r);
+    for (k = 0; in->f->md.interpolates && k < in->f->n_inputs; ++k) {
+        memcpy(&r.rates[k], bytes + size - 8 * (in->f->n_inputs - k), sizeof r.rates[k]);
+    }
     if (!read_restored(in, &r)) {
         snprintf(why, why_size, "cannot be read back: %s", in->book.last);
         return 0;
@@ -647,7 +683,7 @@ static void try_state(instance* target, const unsigned char* bytes, size_t size,
     ++t->accepted;
     if (status != 0 || set_state(target, state) != 0) {
         snprintf(why, sizeof why, "deserialized (%d) but not set: %s", status, target->book.last);
-    } else if (agrees(target, t, why, sizeof why)) {
+    } else if (agrees(target, bytes, size, t, why, sizeof why)) {
         free_state(target, &state);
         return;
     }

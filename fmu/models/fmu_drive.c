@@ -230,6 +230,12 @@ static int state_refused(const fmu_model* model, const void* input)
 static const fmu_states drive_state_table = {
     drive_states, sizeof drive_states / sizeof drive_states[0], state_refused};
 
-const fmu_behaviour fmu_drive_behaviour = {
-    sizeof(fmu_drive_input), sizeof(fmu_drive_output), initialise, evaluate, start, advance, NULL,
-    &drive_state_table};
+const fmu_behaviour fmu_drive_behaviour = {sizeof(fmu_drive_input),
+                                           sizeof(fmu_drive_output),
+                                           initialise,
+                                           evaluate,
+                                           start,
+                                           advance,
+                                           NULL,
+                                           &drive_state_table,
+                                           NULL};

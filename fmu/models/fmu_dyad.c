@@ -130,5 +130,12 @@ static void derivative(const fmu_model* model, const void* input, const void* se
     }
 }
 
-const fmu_behaviour fmu_dyad_behaviour = {
-    sizeof(dyad_input), sizeof(dyad_result), initialise, evaluate, NULL, NULL, derivative, NULL};
+const fmu_behaviour fmu_dyad_behaviour = {sizeof(dyad_input),
+                                          sizeof(dyad_result),
+                                          initialise,
+                                          evaluate,
+                                          NULL,
+                                          NULL,
+                                          derivative,
+                                          NULL,
+                                          NULL};

@@ -102,10 +102,26 @@ def efforts(scene: Scene) -> set[str]:
     return {f.effort()[0] for f in forward_drivers(scene) if f.motor is None}
 
 
+def interpolated_inputs(scene: Scene) -> list[Input]:
+    """The inputs the plant follows over a step as straight lines from their first
+    derivatives (canInterpolateInputs): every Real input of the plant, none of which is an
+    angle or bounded, so that a line carries it only to values its setter would take."""
+    found = public_inputs(scene)
+    wrong = [i.name for i in found if i.angle or i.domain]
+    if wrong:
+        raise ValueError(f"a plant's inputs are unbounded and no angles: {', '.join(wrong)}")
+    return found
+
+
+def slope_member(i: Input) -> str:
+    """The C member of the first derivative of an interpolated input."""
+    return f"plant_slope_{i.member}"
+
+
 def input_members(scene: Scene) -> dict[str, str]:
     """The plant's own members of the input block: efforts, start values, tolerances,
-    states."""
-    members: dict[str, str] = {}
+    states, the inputs' first derivatives."""
+    members: dict[str, str] = {slope_member(i): "real" for i in interpolated_inputs(scene)}
     for f in forward_drivers(scene):
         for what in ("effort", "position_start", "rate_start", "position", "rate"):
             members[f.c(what)] = "real"
@@ -512,6 +528,152 @@ def _state_table(scene: Scene, ident: str) -> list[str]:
     return lines + ["};", ""]
 
 
+def _input_lines(scene: Scene, ident: str) -> list[str]:
+    """The interpolated inputs' table, their values t seconds on and the first input a
+    line carries past the finite within h seconds."""
+    inputs = interpolated_inputs(scene)
+    lines = [
+        "/* The inputs followed as straight lines over a step: each one's value and first",
+        " * derivative. */",
+        "static const fmu_input_rate plant_input_rates[] = {",
+    ]
+    lines += [
+        f"    {{offsetof({ident}_input, {i.member}), offsetof({ident}_input, {slope_member(i)})}},"
+        for i in inputs
+    ]
+    lines += ["};", "static const char* const plant_input_names[] = {"]
+    lines += [f"    {c_string(i.name)}," for i in inputs]
+    lines += [
+        "};",
+        "enum { PLANT_INPUTS = sizeof plant_input_rates / sizeof plant_input_rates[0] };",
+        "",
+        "/* The double at `offset` of an input block. */",
+        f"static double* input_at({ident}_input* in, size_t offset)",
+        "{",
+        "    return (double*)(void*)((char*)in + offset);",
+        "}",
+        "",
+        "/* The double at `offset` of a constant input block. */",
+        f"static double input_value(const {ident}_input* in, size_t offset)",
+        "{",
+        "    return *(const double*)(const void*)((const char*)in + offset);",
+        "}",
+        "",
+        "/* The inputs t seconds into a step: each value on along its derivative (one",
+        " * without, as it is: -0 stays -0). */",
+        f"static void inputs_at(const {ident}_input* in, double t, {ident}_input* now)",
+        "{",
+        "    size_t k;",
+        "    *now = *in;",
+        "    for (k = 0; k < PLANT_INPUTS; ++k) {",
+        "        const double rate = input_value(in, plant_input_rates[k].rate_offset);",
+        "        if (rate != 0) {",
+        "            *input_at(now, plant_input_rates[k].value_offset) += t * rate;",
+        "        }",
+        "    }",
+        "}",
+        "",
+    ]
+    return lines + _input_checks(scene, ident)
+
+
+def _input_checks(scene: Scene, ident: str) -> list[str]:
+    """ramps(): whether any input moves; ramp_refused(): which one a step leaves infinite."""
+    return [
+        "/* Whether any input has a first derivative: the plant's motion then depends on t. */",
+        f"static int ramps(const {ident}_input* in)",
+        "{",
+        "    size_t k;",
+        "    for (k = 0; k < PLANT_INPUTS; ++k) {",
+        "        if (input_value(in, plant_input_rates[k].rate_offset) != 0) {",
+        "            return 1;",
+        "        }",
+        "    }",
+        "    return 0;",
+        "}",
+        "",
+        "/* The first input that its derivative carries past the finite within h seconds, or",
+        " * -1. */",
+        f"static int ramp_refused(const {ident}_input* in, double h)",
+        "{",
+        f"    {ident}_input end;",
+        "    size_t k;",
+        "    inputs_at(in, h, &end);",
+        "    for (k = 0; k < PLANT_INPUTS; ++k) {",
+        "        if (!isfinite(*input_at(&end, plant_input_rates[k].value_offset))) {",
+        "            return (int)k;",
+        "        }",
+        "    }",
+        "    return -1;",
+        "}",
+        "",
+    ]
+
+
+def _ramp_partials(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """put_input_seed() and ramp_partials(): what the inputs' derivatives add to df/dt."""
+    lines = [
+        "/* The inputs' derivatives as a seed of the inverse scene (its loads'; the efforts'",
+        " * are no inputs of the scene and change nothing there). */",
+        f"static void put_input_seed(const {ident}_input* in, {ident}_input* seed)",
+        "{",
+        "    size_t k;",
+        "    memset(seed, 0, sizeof *seed);",
+        "    for (k = 0; k < PLANT_INPUTS; ++k) {",
+        "        const fmu_input_rate* r = &plant_input_rates[k];",
+        "        *input_at(seed, r->value_offset) = input_value(in, r->rate_offset);",
+        "    }",
+        "}",
+        "",
+        "/* d(efforts)/dt of the drivers an effort drives, and d i'/dt of the motors' currents,",
+        " * from the inputs' derivatives. */",
+        f"static void ramp_partials(const {ident}_input* in, double* dr, double* di)",
+        "{",
+    ]
+    n = len(drivers)
+    if not any(f.motor for f in drivers):
+        lines.append("    (void)di;")
+    for f in drivers:
+        if f.motor is None:
+            lines.append(f"    dr[{f.index}] = in->{slope_member(_effort_input(scene, f))};")
+            continue
+        lines += [
+            f"    dr[{f.index}] = 0;",
+            f"    di[{f.current - 2 * n}] = in->{slope_member(_effort_input(scene, f))} / "
+            f"in->{f.c('motor_inductance')};",
+        ]
+    return lines + ["}", ""]
+
+
+def _motion_seed(ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """put_motion_seed(): the drivers' motion's rates into a seed of the inverse scene."""
+    lines = [
+        "/* The rates of the drivers' motion into a seed of the inverse scene at `at`: v of",
+        " * the positions, a of the rates, jerk of the accelerations. */",
+        f"static void put_motion_seed(const {ident}_input* at, {ident}_input* seed, "
+        "const double* v,",
+        "                            const double* a, const double* jerk)",
+        "{",
+    ]
+    if not any(f.position.angle for f in drivers):
+        lines.append("    (void)at;")
+    for f in drivers:
+        k, m = f.index, f.position.member
+        if f.position.angle:
+            lines.append(f"    seed->{m} = dyad_scale((dyad_real)v[{k}], dyad_perp(at->{m}));")
+        else:
+            lines.append(f"    seed->{m} = v[{k}];")
+        lines.append(f"    seed->{f.rate.member} = a[{k}];")
+        lines.append(f"    seed->{f.acceleration.member} = jerk[{k}];")
+    return lines + ["}", ""]
+
+
+def _effort_input(scene: Scene, f: ForwardDriver) -> Input:
+    """The input that drives f: its effort, or its motor's voltage."""
+    member_of = f.c("motor_voltage") if f.motor is not None else f.c("effort")
+    return next(i for i in public_inputs(scene) if i.member == member_of)
+
+
 def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
     """The counts of drivers, of y's values and of the FMU state's model states, and the
     C generated for the scene's drivers."""
@@ -527,5 +689,8 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         + _outputs(drivers, ident)
         + _no_outputs(scene, ident)
         + _state_table(scene, ident)
+        + _input_lines(scene, ident)
+        + _ramp_partials(scene, ident, drivers)
+        + _motion_seed(ident, drivers)
     )
     return len(drivers), state_size(scene), len(_state_names(scene)), parts

@@ -101,6 +101,9 @@ class Kind(Structs):
 
     #: Whether its FMUs give directional derivatives (the model descriptions' flag).
     directional_derivatives = "false"
+    #: Whether its FMUs follow their inputs' first derivatives over a step and give their
+    #: outputs' (canInterpolateInputs, maxOutputDerivativeOrder 1).
+    interpolates = False
     log_categories: tuple = ()
     #: How a scene of this kind is realised (scene.py --cmake-info) and named (--check).
     realisation = ""
@@ -347,6 +350,7 @@ class SceneKind(Kind):
             self.realisation = "forward"
             self.label = "forward mechanism"
             self.directional_derivatives = "false"
+            self.interpolates = True
             self.model_includes = (
                 "<math.h>",
                 "<stdio.h>",
@@ -456,7 +460,8 @@ def scene_behaviour(ident: str) -> list[str]:
         "",
         f"static const fmu_behaviour {ident}_behaviour = {{sizeof({ident}_input),",
         f"                                                sizeof({ident}_output), initialise,",
-        "                                                evaluate, NULL, NULL, derivative, NULL};",
+        "                                                evaluate, NULL, NULL, derivative, NULL,",
+        "                                                NULL};",
         "",
     ]
 

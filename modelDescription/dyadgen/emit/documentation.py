@@ -258,7 +258,8 @@ def _plant_takes(table: Table) -> str:
     return (
         f"only what drives it ({named}) and {rest}, integrates its drivers' motion inside "
         "each step to the tolerances solver.rtol and solver.atol (a plant: no motion is an "
-        "input), and gives that motion"
+        "input; through FMI 2 each input may also be given its first derivative, which the "
+        "plant follows it along within the steps), and gives that motion"
     )
 
 

@@ -15,6 +15,8 @@ from dyadgen.table import Table
 
 
 def _cosimulation(table: Table) -> list[str]:
+    interpolates = table.kind.interpolates
+    derivatives = [("maxOutputDerivativeOrder", "1")] if interpolates else []
     lines = [
         element(
             1,
@@ -22,7 +24,8 @@ def _cosimulation(table: Table) -> list[str]:
             [
                 ("modelIdentifier", table.identifier),
                 ("canHandleVariableCommunicationStepSize", "true"),
-                ("canInterpolateInputs", "false"),
+                ("canInterpolateInputs", "true" if interpolates else "false"),
+                *derivatives,
                 ("canBeInstantiatedOnlyOncePerProcess", "false"),
                 ("canGetAndSetFMUstate", "true"),
                 ("canSerializeFMUstate", "true"),

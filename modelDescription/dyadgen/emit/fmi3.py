@@ -19,12 +19,14 @@ _ELEMENT = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Enumeration"}
 
 
 def _cosimulation(table: Table) -> str:
+    derivatives = [("maxOutputDerivativeOrder", "1")] if table.kind.interpolates else []
     return element(
         1,
         "CoSimulation",
         [
             ("modelIdentifier", table.identifier),
             ("canHandleVariableCommunicationStepSize", "true"),
+            *derivatives,
             ("canBeInstantiatedOnlyOncePerProcess", "false"),
             ("canGetAndSetFMUState", "true"),
             ("canSerializeFMUState", "true"),

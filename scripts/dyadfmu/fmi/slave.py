@@ -224,6 +224,33 @@ class Slave:
             [float(s) for s in seed],
         )
 
+    def set_rates(self, names: tuple | str, rates: Sequence[float] | float) -> None:
+        """The first time derivatives of Real inputs, which a plant follows over its steps
+        until set again (FMI 2 only: fmi2SetRealInputDerivatives)."""
+        if isinstance(names, str):
+            names, rates = (names,), (rates,)
+        if self.version != 2:
+            raise SlaveError(self.label, "setRealInputDerivatives", 3, "FMI 3 has no such call")
+        refs = self._refs(tuple(names))
+        values = [float(r) for r in rates]
+        self._call(
+            "setRealInputDerivatives",
+            self.fmu.setRealInputDerivatives,
+            refs,
+            [1] * len(refs),
+            values,
+        )
+
+    def output_rates(self, names: tuple) -> list:
+        """The first time derivatives of Real outputs at the current point
+        (fmi2GetRealOutputDerivatives, fmi3GetOutputDerivatives)."""
+        refs = self._refs(tuple(names))
+        if self.version == 2:
+            get = self.fmu.getRealOutputDerivatives
+        else:
+            get = self.fmu.getOutputDerivatives
+        return self._call("getOutputDerivatives", get, refs, [1] * len(refs))
+
     def reset(self) -> None:
         """Back to the state after instantiation (start values, not initialised)."""
         self._call("reset", self.fmu.reset)

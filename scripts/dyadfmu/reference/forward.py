@@ -168,26 +168,31 @@ def integrate_chain(
     times: np.ndarray,
     rtol: float = 1e-12,
     atol: float = 1e-12,
+    effort_rate: float = 0.0,
 ) -> Trajectory:
-    """The motion of a chain with one driver under a constant ``effort`` [N m or N] from
-    (q0, dq0) at ``times[0]``, reported at ``times``, by DOP853: q'' = (effort - h) / J.
-    Raises RuntimeError where the solver fails."""
+    """The motion of a chain with one driver under an ``effort`` [N m or N] that grows by
+    ``effort_rate`` per second from ``times[0]`` (constant by default), from (q0, dq0) at
+    ``times[0]``, reported at ``times``, by DOP853: q'' = (effort - h) / J. Raises
+    RuntimeError where the solver fails."""
     from scipy.integrate import solve_ivp
 
     count = [0]
+    times = np.asarray(times, dtype=float)
+
+    def law(t: float) -> float:
+        return float(effort) + float(effort_rate) * (t - times[0])
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         count[0] += 1
         J, h = chain_terms(chain, t, y[0], y[1])
-        return np.array([y[1], (effort - h) / J])
+        return np.array([y[1], (law(t) - h) / J])
 
-    times = np.asarray(times, dtype=float)
     sol = solve_ivp(rhs, (times[0], times[-1]), [q0, dq0], "DOP853", times, rtol=rtol, atol=atol)
     if not sol.success:
         raise RuntimeError(f"{chain.name}: the forward run failed at t = {sol.t[-1]:.6g} s")
     q, dq = sol.y[0][:, None], sol.y[1][:, None]
     ddq = np.array([rhs(t, [a[0], b[0]])[1] for t, a, b in zip(sol.t, q, dq, strict=True)])
-    u = np.full_like(q, float(effort))
+    u = np.array([law(t) for t in sol.t])[:, None]
     return Trajectory(sol.t, q, dq, ddq[:, None], u, np.zeros_like(sol.t), count[0])
 
 
