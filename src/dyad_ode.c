@@ -1,4 +1,5 @@
-/* dyadfmu: the integrator of dyadfmu/ode.h, the Rosenbrock method RODASP.
+/* dyadfmu: the integrators of dyadfmu/ode.h, the Rosenbrock method RODASP and, further
+ * down, the explicit DOP853.
  *
  * The problem. A mechanism's equation of motion M(q) q'' = effort - h(q, q')
  * is smooth and mildly stiff at most; with a DC motor in the same system the
@@ -128,6 +129,7 @@ dyad_ode_options dyad_ode_options_default(void)
     o.h_initial = 0;
     o.h_min = 0;
     o.max_steps = 100000;
+    o.method = DYAD_ODE_RODASP;
     return o;
 }
 
@@ -146,7 +148,7 @@ static int ode_options_valid(const dyad_ode_options* o)
 {
     return isfinite(o->rtol) && o->rtol > 0 && isfinite(o->atol) && o->atol > 0 && o->h_max > 0 &&
            isfinite(o->h_initial) && o->h_initial >= 0 && isfinite(o->h_min) && o->h_min >= 0 &&
-           o->max_steps > 0;
+           o->max_steps > 0 && (o->method == DYAD_ODE_RODASP || o->method == DYAD_ODE_DOP853);
 }
 
 dyad_ode_status dyad_ode_init(dyad_ode_state* state, int n, dyad_real t0, const dyad_real* y0,
@@ -454,7 +456,7 @@ static void ode_accept(dyad_ode_state* s, const ode_work* w, dyad_real h, dyad_r
 
 /* A first step from the sizes of y and f (Hairer, Norsett, Wanner I, II.4):
  * 1e-2 |y| / |f| in the error's norm, 1e-6 where either is too small. */
-static dyad_real ode_initial_step(const dyad_ode_state* s, const ode_work* w)
+static dyad_real ode_first_step(const dyad_ode_state* s, const dyad_real* f0)
 {
     int i;
     dyad_real ny = 0, nf = 0;
@@ -464,7 +466,7 @@ static dyad_real ode_initial_step(const dyad_ode_state* s, const ode_work* w)
     for (i = 0; i < s->n; ++i) {
         dyad_real scale = s->options.atol + s->options.rtol * fabs(s->y[i]);
         ny += (s->y[i] / scale) * (s->y[i] / scale);
-        nf += (w->f0[i] / scale) * (w->f0[i] / scale);
+        nf += (f0[i] / scale) * (f0[i] / scale);
     }
     ny = sqrt(ny / s->n);
     nf = sqrt(nf / s->n);
@@ -554,6 +556,234 @@ static dyad_ode_status ode_step(dyad_ode_state* s, const dyad_ode_system* sys, o
     }
 }
 
+/* ---- the explicit method: DOP853 -------------------------------------------------------------
+ *
+ * Where the problem is not stiff (a mechanism driven by an effort, a motor whose L / R is
+ * not far below the motion's time scale) a Rosenbrock step's linear algebra and Jacobian
+ * buy nothing, and order 4 makes its steps short at tight tolerances: the step grows as
+ * rtol^(1/4). DOP853 (Dormand and Prince's explicit Runge-Kutta method of order 8, E.
+ * Hairer, S. P. Norsett, G. Wanner, Solving Ordinary Differential Equations I, 2nd ed.,
+ * Springer 1993, section II.10, and their code dop853.f) grows as rtol^(1/8): twelve
+ * evaluations of f per step (the last, at the step's end, is the next step's first) and
+ * no Jacobian. Its error estimate combines embedded solutions of order 5 and 3,
+ *      err = |h| |e5|^2 / sqrt(|e5|^2 + 0.01 |e3|^2)
+ * in the root mean square norm of atol + rtol max(|y0|, |y1|) (dop853.f's), accepted
+ * at <= 1; the next step is h / fac, fac = err^(1/8) / 0.9 limited to [1/6, 3] (no
+ * growth right after a rejection); err^(1/8) is three square roots, which every platform
+ * rounds alike. Its continuous output is the cubic Hermite interpolant of y and f at the
+ * step's ends, of order 3, in the form dyad_ode_dense() evaluates. The coefficients are
+ * dop853.f's, as the tests check (the order 8 measured on exact solutions). */
+#define DOP_STAGES     12
+#define DOP_MIN_SHRINK ((dyad_real)(1.0 / 3.0))
+
+static const dyad_real dop_c[DOP_STAGES] = {0.0,
+                                            0.05260015195876773,
+                                            0.0789002279381516,
+                                            0.1183503419072274,
+                                            0.2816496580927726,
+                                            0.3333333333333333,
+                                            0.25,
+                                            0.3076923076923077,
+                                            0.6512820512820513,
+                                            0.6,
+                                            0.8571428571428571,
+                                            1.0};
+/* a_ij, row i the stage, j < i (the rest 0) */
+static const dyad_real dop_a[DOP_STAGES][DOP_STAGES - 1] = {
+    {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+    {0.05260015195876773, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+    {0.0197250569845379, 0.0591751709536137, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+    {0.02958758547680685, 0.0, 0.08876275643042054, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0},
+    {0.2413651341592667, 0.0, -0.8845494793282861, 0.924834003261792, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+     0.0},
+    {0.037037037037037035, 0.0, 0.0, 0.17082860872947386, 0.12546768756682242, 0.0, 0.0, 0.0, 0.0,
+     0.0, 0.0},
+    {0.037109375, 0.0, 0.0, 0.17025221101954405, 0.06021653898045596, -0.017578125, 0.0, 0.0, 0.0,
+     0.0, 0.0},
+    {0.03709200011850479, 0.0, 0.0, 0.17038392571223998, 0.10726203044637328, -0.015319437748624402,
+     0.008273789163814023, 0.0, 0.0, 0.0, 0.0},
+    {0.6241109587160757, 0.0, 0.0, -3.3608926294469414, -0.868219346841726, 27.59209969944671,
+     20.154067550477894, -43.48988418106996, 0.0, 0.0, 0.0},
+    {0.47766253643826434, 0.0, 0.0, -2.4881146199716677, -0.590290826836843, 21.230051448181193,
+     15.279233632882423, -33.28821096898486, -0.020331201708508627, 0.0, 0.0},
+    {-0.9371424300859873, 0.0, 0.0, 5.186372428844064, 1.0914373489967295, -8.149787010746927,
+     -18.52006565999696, 22.739487099350505, 2.4936055526796523, -3.0467644718982196, 0.0},
+    {2.273310147516538, 0.0, 0.0, -10.53449546673725, -2.0008720582248625, -17.9589318631188,
+     27.94888452941996, -2.8589982771350235, -8.87285693353063, 12.360567175794303,
+     0.6433927460157636},
+};
+static const dyad_real dop_b[DOP_STAGES] = {0.054293734116568765,
+                                            0.0,
+                                            0.0,
+                                            0.0,
+                                            0.0,
+                                            4.450312892752409,
+                                            1.8915178993145003,
+                                            -5.801203960010585,
+                                            0.3111643669578199,
+                                            -0.1521609496625161,
+                                            0.20136540080403034,
+                                            0.04471061572777259};
+/* the error estimates of order 5 and 3: differences of the order-8 solution from them */
+static const dyad_real dop_e5[DOP_STAGES] = {0.01312004499419488,
+                                             0.0,
+                                             0.0,
+                                             0.0,
+                                             0.0,
+                                             -1.2251564463762044,
+                                             -0.4957589496572502,
+                                             1.6643771824549864,
+                                             -0.35032884874997366,
+                                             0.3341791187130175,
+                                             0.08192320648511571,
+                                             -0.022355307863886294};
+static const dyad_real dop_e3[DOP_STAGES] = {-0.18980075407240762,
+                                             0.0,
+                                             0.0,
+                                             0.0,
+                                             0.0,
+                                             4.450312892752409,
+                                             1.8915178993145003,
+                                             -5.801203960010585,
+                                             -0.4226823213237919,
+                                             -0.1521609496625161,
+                                             0.20136540080403034,
+                                             0.02265179219836082};
+
+/* The stages of a step, k[0] = f(t, y) given; k[DOP_STAGES] is f at the step's end, for
+ * the next step and the continuous output. */
+typedef struct dop_work {
+    dyad_real k[DOP_STAGES + 1][DYAD_ODE_MAX_DIM];
+    dyad_real arg[DYAD_ODE_MAX_DIM];
+    dyad_real ynew[DYAD_ODE_MAX_DIM];
+} dop_work;
+
+/* One attempt from (t, y) with step h: the solution in w->ynew and its error. */
+static dyad_ode_status dop_attempt(dyad_ode_state* s, const dyad_ode_system* sys, dop_work* w,
+                                   dyad_real h, dyad_real* error)
+{
+    int i, j, k, n = s->n;
+    dyad_real e5 = 0, e3 = 0;
+    for (k = 1; k < DOP_STAGES; ++k) {
+        for (i = 0; i < n; ++i) {
+            dyad_real sum = 0;
+            for (j = 0; j < k; ++j) {
+                sum += dop_a[k][j] * w->k[j][i];
+            }
+            w->arg[i] = s->y[i] + h * sum;
+        }
+        const dyad_ode_status status = ode_rhs(s, sys, s->t + dop_c[k] * h, w->arg, w->k[k]);
+        if (status != DYAD_ODE_OK) {
+            return status;
+        }
+    }
+    for (i = 0; i < n; ++i) {
+        dyad_real sum = 0, d5 = 0, d3 = 0, scale;
+        for (j = 0; j < DOP_STAGES; ++j) {
+            sum += dop_b[j] * w->k[j][i];
+            d5 += dop_e5[j] * w->k[j][i];
+            d3 += dop_e3[j] * w->k[j][i];
+        }
+        w->ynew[i] = s->y[i] + h * sum;
+        scale = s->options.atol + s->options.rtol * fmax(fabs(s->y[i]), fabs(w->ynew[i]));
+        e5 += (d5 / scale) * (d5 / scale);
+        e3 += (d3 / scale) * (d3 / scale);
+    }
+    /* not finite where the stages overflow: rejected, the step shrinks */
+    *error = e5 > 0 ? fabs(h) * e5 / sqrt((e5 + (dyad_real)0.01 * e3) * n) : 0;
+    return DYAD_ODE_OK;
+}
+
+/* h / h_new from the error: err^(1/8) / safety, limited. */
+static dyad_real dop_shrink(dyad_real error)
+{
+    dyad_real fac = isfinite(error) ? (dyad_real)sqrt(sqrt(sqrt((double)error))) / ODE_SAFETY
+                                    : 1 / DOP_MIN_SHRINK;
+    return fmax(1 / (dyad_real)DYAD_ODE_MAX_GROWTH, fmin(1 / DOP_MIN_SHRINK, fac));
+}
+
+/* Moves the state to the accepted step's end: f there (the next step's first stage), the
+ * continuous output's differences from it. */
+static dyad_ode_status dop_accept(dyad_ode_state* s, const dyad_ode_system* sys, dop_work* w,
+                                  dyad_real h, dyad_real t_new)
+{
+    int i, n = s->n;
+    dyad_ode_status status = ode_rhs(s, sys, t_new, w->ynew, w->k[DOP_STAGES]);
+    if (status != DYAD_ODE_OK) {
+        return status;
+    }
+    for (i = 0; i < n; ++i) {
+        const dyad_real rise = w->ynew[i] - s->y[i];
+        s->d1[i] = h * w->k[0][i] - rise;
+        s->d2[i] = 2 * rise - h * (w->k[0][i] + w->k[DOP_STAGES][i]);
+        s->y_last[i] = s->y[i];
+        s->y[i] = w->ynew[i];
+        w->k[0][i] = w->k[DOP_STAGES][i];
+    }
+    s->h_last = h;
+    s->t = t_new;
+    ++s->counters.accepted_steps;
+    return DYAD_ODE_OK;
+}
+
+/* One accepted step toward t_end, with the attempts it takes; *h the step proposed. */
+static dyad_ode_status dop_step(dyad_ode_state* s, const dyad_ode_system* sys, dop_work* w,
+                                dyad_real t_end, dyad_real* h, long* attempts)
+{
+    int rejected = 0;
+    for (;;) {
+        dyad_real error, try_h = *h, left = t_end - s->t;
+        const int last = try_h >= left;
+        dyad_ode_status status;
+        if (*attempts >= s->options.max_steps) {
+            s->t_failed = s->t;
+            return DYAD_ODE_TOO_MANY_STEPS;
+        }
+        if (last) {
+            try_h = left;
+        } else if (ode_step_too_small(s, try_h)) {
+            s->t_failed = s->t;
+            return DYAD_ODE_STEP_UNDERFLOW;
+        }
+        ++*attempts;
+        status = dop_attempt(s, sys, w, try_h, &error);
+        if (status != DYAD_ODE_OK) {
+            return status;
+        }
+        if (error <= 1) {
+            dyad_real next = fmin(try_h / dop_shrink(error), s->options.h_max);
+            next = rejected ? fmin(next, try_h) : next;
+            *h = last && try_h < *h ? fmax(*h, next) : next;
+            return dop_accept(s, sys, w, try_h, last ? t_end : s->t + try_h);
+        }
+        ++s->counters.rejected_steps;
+        rejected = 1;
+        *h = try_h / dop_shrink(error);
+    }
+}
+
+/* dyad_ode_advance() with DOP853, its arguments checked. */
+static dyad_ode_status dop_advance(dyad_ode_state* state, const dyad_ode_system* system,
+                                   dyad_real t_end)
+{
+    dop_work w;
+    long attempts = 0;
+    dyad_ode_status status = ode_rhs(state, system, state->t, state->y, w.k[0]);
+    while (status == DYAD_ODE_OK && state->t < t_end) {
+        dyad_real h = state->h_next > 0 ? state->h_next : ode_first_step(state, w.k[0]);
+        const long left = state->options.max_steps - attempts;
+        h = fmin(h, state->options.h_max);
+        if (ode_fewest_steps(h, state->options.h_max, t_end - state->t, left) > left) {
+            state->t_failed = state->t;
+            status = DYAD_ODE_TOO_MANY_STEPS;
+            break;
+        }
+        status = dop_step(state, system, &w, t_end, &h, &attempts);
+        state->h_next = h;
+    }
+    return status;
+}
+
 static dyad_ode_status ode_finish(dyad_ode_state* s, dyad_ode_status status)
 {
     s->status = status;
@@ -579,10 +809,13 @@ dyad_ode_status dyad_ode_advance(dyad_ode_state* state, const dyad_ode_system* s
         state->t_failed = state->t;
         return ode_finish(state, DYAD_ODE_TOO_MANY_STEPS);
     }
+    if (state->options.method == DYAD_ODE_DOP853) {
+        return ode_finish(state, state->t < t_end ? dop_advance(state, system, t_end) : status);
+    }
     while (status == DYAD_ODE_OK && state->t < t_end) {
         status = ode_linearise(state, system, &w);
         if (status == DYAD_ODE_OK) {
-            dyad_real h = state->h_next > 0 ? state->h_next : ode_initial_step(state, &w);
+            dyad_real h = state->h_next > 0 ? state->h_next : ode_first_step(state, w.f0);
             const long left = state->options.max_steps - attempts;
             h = fmin(h, state->options.h_max);
             if (ode_fewest_steps(h, state->options.h_max, t_end - state->t, left) > left) {

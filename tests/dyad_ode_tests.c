@@ -357,6 +357,75 @@ static int test_dense_output(void)
     return fails;
 }
 
+/* ---- (c) the explicit method, DOP853 ----------------------------------------------------- */
+
+/* The error at t = 2 of fixed steps h of DOP853. */
+static double dop_fixed_step_error(const dyad_ode_system* sys, const double* y0,
+                                   const double* exact, double h)
+{
+    int i;
+    double worst = 0;
+    dyad_ode_state s;
+    dyad_ode_options o = tolerances(1e20, 1e20);
+    o.h_initial = o.h_max = h;
+    o.method = DYAD_ODE_DOP853;
+    dyad_ode_init(&s, sys->n, 0, y0, &o);
+    dyad_ode_advance(&s, sys, 2);
+    for (i = 0; i < sys->n; ++i) {
+        worst = fmax(worst, fabs(s.y[i] - exact[i]));
+    }
+    return worst;
+}
+
+/* Order 8: the error of fixed steps falls 256 times per halving (the limit cycle, where
+ * round-off stays far below it at these steps). */
+static int test_dop_order_eight(void)
+{
+    int fails = 0;
+    double y0[2], exact[2], e1, e2, order;
+    dyad_ode_system sys = system_of(2, cycle_rhs, NULL, NULL);
+    cycle_exact(0, y0);
+    cycle_exact(2, exact);
+    e1 = dop_fixed_step_error(&sys, y0, exact, 0.2);
+    e2 = dop_fixed_step_error(&sys, y0, exact, 0.1);
+    order = log2(e1 / e2);
+    REPORT("DOP853, limit cycle: error %.3e at h 0.2, %.3e at 0.1: order %.2f\n", e1, e2, order);
+    CHECK(order > 7.5 && order < 8.8, "order %g", order);
+    return fails;
+}
+
+/* The linear system's exact solution under error control: within the tolerance, with
+ * fewer evaluations than RODASP at tight tolerances (it needs no Jacobian), and the
+ * continuous output within the tolerance too. */
+static int test_dop_linear_exact(void)
+{
+    int fails = 0, r, k, i;
+    static const double rtols[3] = {1e-6, 1e-8, 1e-10};
+    dyad_ode_system sys = system_of(3, linear_rhs, NULL, NULL);
+    sys.autonomous = 1;
+    for (r = 0; r < 3; ++r) {
+        double y0[3], out[51 * 3], worst = 0, exact[3], y[3];
+        dyad_ode_state s;
+        dyad_ode_options o = tolerances(rtols[r], rtols[r] * 1e-2);
+        o.method = DYAD_ODE_DOP853;
+        linear_exact(0, y0);
+        CHECK(run_grid(&s, &sys, y0, &o, 0.1, 50, out) == DYAD_ODE_OK, "status");
+        for (k = 1; k <= 50; ++k) {
+            linear_exact(0.1 * k, exact);
+            for (i = 0; i < 3; ++i) {
+                worst = fmax(worst, fabs(out[k * 3 + i] - exact[i]));
+            }
+        }
+        CHECK(dyad_ode_dense(&s, s.t - 0.5 * s.h_last, y, NULL) == DYAD_ODE_OK, "dense");
+        linear_exact(s.t - 0.5 * s.h_last, exact);
+        REPORT("DOP853 rtol %.0e: max error %.2e, %ld steps, %ld f; dense %.1e\n", rtols[r], worst,
+               s.counters.accepted_steps, s.counters.rhs_evaluations, fabs(y[0] - exact[0]));
+        CHECK(worst < rtols[r], "rtol %g: error %g", rtols[r], worst);
+        CHECK(fabs(y[0] - exact[0]) < 1e3 * rtols[r], "dense error %g", fabs(y[0] - exact[0]));
+    }
+    return fails;
+}
+
 /* ---- (b) against GSL ---------------------------------------------------------------------- */
 
 #ifdef DYAD_ODE_TESTS_GSL
@@ -438,6 +507,41 @@ static int test_gsl_pendulum(void)
         CHECK(error < 1e3 * pow(10, -r), "rtol 1e-%d: error %g", r, error);
         CHECK(error < last / 10, "rtol 1e-%d: error %g does not fall", r, error);
         last = error;
+    }
+    return fails;
+}
+
+/* The pendulum against GSL's rk8pd at 1e-14, on a grid of 1 s (on a finer one the grid,
+ * not the tolerance, would set DOP853's steps): the error falls with the tolerance, and
+ * at every tolerance DOP853 takes fewer evaluations of f than RODASP's stages alone. */
+static int test_dop_gsl_pendulum(void)
+{
+    int fails = 0, r;
+    double y0[2] = {2.5, 0}, ref[21 * 2], out[21 * 2], unit[2] = {1, 1}, last = 1;
+    dyad_ode_system sys = system_of(2, pendulum_rhs, NULL, NULL);
+    sys.autonomous = 1;
+    CHECK(gsl_reference(&sys, gsl_odeiv2_step_rk8pd, 1e-14, y0, 1.0, 20, ref) == GSL_SUCCESS,
+          "rk8pd");
+    for (r = 6; r <= 10; r += 2) {
+        dyad_ode_state s;
+        dyad_ode_options o = tolerances(pow(10, -r), pow(10, -r - 2));
+        double error;
+        long explicit_f;
+        o.method = DYAD_ODE_DOP853;
+        CHECK(run_grid(&s, &sys, y0, &o, 1.0, 20, out) == DYAD_ODE_OK, "status");
+        error = grid_error(2, 20, out, ref, unit);
+        explicit_f = s.counters.rhs_evaluations;
+        REPORT("DOP853 pendulum, rtol 1e-%d: error %.2e, %ld steps (%ld rejected), %ld f\n", r,
+               error, s.counters.accepted_steps, s.counters.rejected_steps, explicit_f);
+        CHECK(error < 1e3 * pow(10, -r), "rtol 1e-%d: error %g", r, error);
+        CHECK(error < last / 10, "rtol 1e-%d: error %g does not fall", r, error);
+        last = error;
+        o.method = DYAD_ODE_RODASP;
+        run_grid(&s, &sys, y0, &o, 1.0, 20, out);
+        REPORT("    RODASP: %ld steps, %ld f (its difference Jacobian's included)\n",
+               s.counters.accepted_steps, s.counters.rhs_evaluations);
+        CHECK(explicit_f < s.counters.rhs_evaluations - 2 * s.counters.jacobian_evaluations,
+              "rtol 1e-%d: DOP853 %ld f", r, explicit_f);
     }
     return fails;
 }
@@ -788,8 +892,11 @@ static const named_test tests[] = {
     {"stiff_forced", test_stiff_forced},
     {"order_four", test_order_four},
     {"dense_output", test_dense_output},
+    {"dop_order_eight", test_dop_order_eight},
+    {"dop_linear_exact", test_dop_linear_exact},
 #ifdef DYAD_ODE_TESTS_GSL
     {"gsl_pendulum", test_gsl_pendulum},
+    {"dop_gsl_pendulum", test_dop_gsl_pendulum},
     {"gsl_van_der_pol", test_gsl_van_der_pol},
     {"gsl_motor", test_gsl_motor},
 #else

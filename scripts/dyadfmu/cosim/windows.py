@@ -149,15 +149,12 @@ class Difference:
     #: each output that differs -> its largest distance in units in the last place
     #: (inf where one is finite and the other not, or their signs differ)
     ulps: dict = field(default_factory=dict)
-    #: each output that differs -> its largest |windows - linux| / peak |linux|
-    relative: dict = field(default_factory=dict)
 
 
 def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference:
     """``names``: value reference -> output name."""
     identical, worst, worst_output = 0, 0.0, ""
     ulps: dict = {}
-    relative: dict = {}
     for vr, a in linux.reals.items():
         b = windows.reals[vr]
         same = np.array_equal(a.view(np.uint64), b.view(np.uint64))
@@ -168,26 +165,16 @@ def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference
         ulps[names[vr]] = _ulps(a, b)
         if not np.array_equal(np.isfinite(a), np.isfinite(b)):
             worst, worst_output = float("inf"), names[vr]
-            relative[names[vr]] = float("inf")
             continue
         peak = float(np.max(np.abs(a[finite]))) if finite.any() else 0.0
         diff = float(np.max(np.abs(a[finite] - b[finite]))) / (peak or 1.0)
-        relative[names[vr]] = diff
         if diff > worst:
             worst, worst_output = diff, names[vr]
     same_status = np.array_equal(linux.status, windows.status) and all(
         np.array_equal(v, windows.integers[vr]) for vr, v in linux.integers.items()
     )
     return Difference(
-        fmu,
-        len(linux.status),
-        len(linux.reals),
-        identical,
-        worst,
-        worst_output,
-        same_status,
-        ulps,
-        relative,
+        fmu, len(linux.status), len(linux.reals), identical, worst, worst_output, same_status, ulps
     )
 
 

@@ -1,7 +1,8 @@
 /* dyadfmu: an error-controlled integrator for y' = f(t, y), stable on stiff
  * problems: the Rosenbrock method RODASP of order 4 (src/dyad_ode.c derives and
  * justifies it), with its embedded error estimate, step-size control and
- * continuous output.
+ * continuous output; and, for a problem that is not stiff, the explicit method
+ * DOP853 of order 8 (options.method), with the same interface.
  *
  * It is what a forward-dynamics FMU integrates its equation of motion with
  * inside doStep: the caller owns everything (a dyad_ode_state holds the whole
@@ -90,6 +91,16 @@ typedef struct dyad_ode_system {
     void* user; /**< passed to the callbacks */
 } dyad_ode_system;
 
+/** The method of dyad_ode_advance(). */
+typedef enum dyad_ode_method {
+    /** RODASP, the Rosenbrock method of order 4: stable on stiff problems, a Jacobian and
+     *  an LU factorisation per step (the default). */
+    DYAD_ODE_RODASP = 0,
+    /** DOP853, the explicit Runge-Kutta method of order 8: twelve evaluations of f per
+     *  step and nothing else, for a problem that is not stiff. */
+    DYAD_ODE_DOP853
+} dyad_ode_method;
+
 /** Settings: set by dyad_ode_init(), free to change between calls. */
 typedef struct dyad_ode_options {
     /** The error of a step, per component, within atol + rtol |y| (in the
@@ -106,6 +117,7 @@ typedef struct dyad_ode_options {
     dyad_real h_min;
     /** The most internal steps (accepted or not) one call may take (> 0). */
     long max_steps;
+    dyad_ode_method method;
 } dyad_ode_options;
 
 /** What the integrator did, summed over the calls since dyad_ode_init(). */
@@ -142,7 +154,8 @@ typedef struct dyad_ode_state {
     dyad_real t_failed; /**< where f or the step failed (t itself if before any step) */
 } dyad_ode_state;
 
-/** Defaults: rtol 1e-8, atol 1e-10, h_max +inf, h_initial 0, h_min 0, max_steps 100000. */
+/** Defaults: rtol 1e-8, atol 1e-10, h_max +inf, h_initial 0, h_min 0, max_steps 100000,
+ *  method RODASP. */
 dyad_ode_options dyad_ode_options_default(void);
 
 /** Starts the integrator at (t0, y0) of dimension n with the given options
