@@ -511,25 +511,38 @@ static int ode_step_too_small(const dyad_ode_state* s, dyad_real h)
 /* One accepted step from the state's point toward t_end, with the attempts
  * it takes; *h is the step to try and becomes the next one's. *attempts
  * counts against max_steps. */
+/* The size of the next attempt toward t_end from the proposed h: cut to end on t_end
+ * (*last set) or refused, with t_failed, where the attempts are used up or the step is
+ * below the time's resolution; counts the attempt. */
+static dyad_ode_status ode_attempt_size(dyad_ode_state* s, dyad_real t_end, dyad_real h,
+                                        long* attempts, dyad_real* try_h, int* last)
+{
+    const dyad_real left = t_end - s->t;
+    *last = h >= left;
+    *try_h = *last ? left : h;
+    if (*attempts >= s->options.max_steps) {
+        s->t_failed = s->t;
+        return DYAD_ODE_TOO_MANY_STEPS;
+    }
+    if (!*last && ode_step_too_small(s, h)) {
+        s->t_failed = s->t;
+        return DYAD_ODE_STEP_UNDERFLOW;
+    }
+    ++*attempts;
+    return DYAD_ODE_OK;
+}
+
 static dyad_ode_status ode_step(dyad_ode_state* s, const dyad_ode_system* sys, ode_work* w,
                                 dyad_real t_end, dyad_real* h, long* attempts)
 {
     int singular = 0, rejected = 0;
     for (;;) {
-        dyad_real error, try_h = *h, left = t_end - s->t;
-        int last = try_h >= left;
-        dyad_ode_status status;
-        if (*attempts >= s->options.max_steps) {
-            s->t_failed = s->t;
-            return DYAD_ODE_TOO_MANY_STEPS;
+        dyad_real error, try_h;
+        int last;
+        dyad_ode_status status = ode_attempt_size(s, t_end, *h, attempts, &try_h, &last);
+        if (status != DYAD_ODE_OK) {
+            return status;
         }
-        if (last) {
-            try_h = left;
-        } else if (ode_step_too_small(s, try_h)) {
-            s->t_failed = s->t;
-            return DYAD_ODE_STEP_UNDERFLOW;
-        }
-        ++*attempts;
         if (ode_iteration_matrix(s, w, try_h)) {
             if (++singular > DYAD_ODE_SINGULAR_RETRIES) {
                 s->t_failed = s->t;
@@ -732,20 +745,12 @@ static dyad_ode_status dop_step(dyad_ode_state* s, const dyad_ode_system* sys, d
 {
     int rejected = 0;
     for (;;) {
-        dyad_real error, try_h = *h, left = t_end - s->t;
-        const int last = try_h >= left;
-        dyad_ode_status status;
-        if (*attempts >= s->options.max_steps) {
-            s->t_failed = s->t;
-            return DYAD_ODE_TOO_MANY_STEPS;
+        dyad_real error, try_h;
+        int last;
+        dyad_ode_status status = ode_attempt_size(s, t_end, *h, attempts, &try_h, &last);
+        if (status != DYAD_ODE_OK) {
+            return status;
         }
-        if (last) {
-            try_h = left;
-        } else if (ode_step_too_small(s, try_h)) {
-            s->t_failed = s->t;
-            return DYAD_ODE_STEP_UNDERFLOW;
-        }
-        ++*attempts;
         status = dop_attempt(s, sys, w, try_h, &error);
         if (status != DYAD_ODE_OK) {
             return status;
