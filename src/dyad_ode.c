@@ -569,6 +569,21 @@ static dyad_ode_status ode_step(dyad_ode_state* s, const dyad_ode_system* sys, o
     }
 }
 
+/* The step the next attempts start from: the one proposed, or a first one from f0, at most
+ * h_max; TOO_MANY_STEPS (with t_failed) where the controller's limits already prove that
+ * the attempts left cannot reach t_end. */
+static dyad_ode_status ode_planned_next(dyad_ode_state* s, const dyad_real* f0, dyad_real t_end,
+                                        long attempts, dyad_real* h)
+{
+    const long left = s->options.max_steps - attempts;
+    *h = fmin(s->h_next > 0 ? s->h_next : ode_first_step(s, f0), s->options.h_max);
+    if (ode_fewest_steps(*h, s->options.h_max, t_end - s->t, left) > left) {
+        s->t_failed = s->t;
+        return DYAD_ODE_TOO_MANY_STEPS;
+    }
+    return DYAD_ODE_OK;
+}
+
 /* ---- the explicit method: DOP853 -------------------------------------------------------------
  *
  * Where the problem is not stiff (a mechanism driven by an effort, a motor whose L / R is
@@ -775,16 +790,12 @@ static dyad_ode_status dop_advance(dyad_ode_state* state, const dyad_ode_system*
     long attempts = 0;
     dyad_ode_status status = ode_rhs(state, system, state->t, state->y, w.k[0]);
     while (status == DYAD_ODE_OK && state->t < t_end) {
-        dyad_real h = state->h_next > 0 ? state->h_next : ode_first_step(state, w.k[0]);
-        const long left = state->options.max_steps - attempts;
-        h = fmin(h, state->options.h_max);
-        if (ode_fewest_steps(h, state->options.h_max, t_end - state->t, left) > left) {
-            state->t_failed = state->t;
-            status = DYAD_ODE_TOO_MANY_STEPS;
-            break;
+        dyad_real h;
+        status = ode_planned_next(state, w.k[0], t_end, attempts, &h);
+        if (status == DYAD_ODE_OK) {
+            status = dop_step(state, system, &w, t_end, &h, &attempts);
+            state->h_next = h;
         }
-        status = dop_step(state, system, &w, t_end, &h, &attempts);
-        state->h_next = h;
     }
     return status;
 }
@@ -818,17 +829,12 @@ dyad_ode_status dyad_ode_advance(dyad_ode_state* state, const dyad_ode_system* s
         return ode_finish(state, state->t < t_end ? dop_advance(state, system, t_end) : status);
     }
     while (status == DYAD_ODE_OK && state->t < t_end) {
+        dyad_real h;
         status = ode_linearise(state, system, &w);
         if (status == DYAD_ODE_OK) {
-            dyad_real h = state->h_next > 0 ? state->h_next : ode_first_step(state, w.f0);
-            const long left = state->options.max_steps - attempts;
-            h = fmin(h, state->options.h_max);
-            if (ode_fewest_steps(h, state->options.h_max, t_end - state->t, left) > left) {
-                /* the controller's limits already prove that the cap is too low */
-                state->t_failed = state->t;
-                status = DYAD_ODE_TOO_MANY_STEPS;
-                break;
-            }
+            status = ode_planned_next(state, w.f0, t_end, attempts, &h);
+        }
+        if (status == DYAD_ODE_OK) {
             status = ode_step(state, system, &w, t_end, &h, &attempts);
             state->h_next = h;
         }
