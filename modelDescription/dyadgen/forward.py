@@ -31,6 +31,13 @@ MAX_STEPS = 20000
 #: The tolerances' defaults: about 1e-8 relative in the driver's motion.
 RTOL_DEFAULT = 1e-10
 ATOL_DEFAULT = 1e-10
+#: The largest h R / L of a motor's circuit the explicit method takes on by default:
+#: half DOP853's stability limit on the negative real axis (about 6).
+EXPLICIT_LIMIT_DEFAULT = 3.0
+#: The largest a user may set: below that limit, with a margin.
+EXPLICIT_LIMIT_MAX = 5.0
+#: The share of the tolerances the explicit method holds each step's error to.
+EXPLICIT_SHARE = 1.0 / 64.0
 
 
 @dataclass
@@ -131,6 +138,8 @@ def input_members(scene: Scene) -> dict[str, str]:
             members[f.c("current")] = "real"
     for name in ("rtol", "atol", "step_start", "h_next", "steps", "evaluations"):
         members[f"plant_{name}"] = "real"
+    if any(f.motor is not None for f in forward_drivers(scene)):
+        members["plant_explicit_limit"] = "real"
     return members
 
 
@@ -216,6 +225,22 @@ def step_start_parameter() -> tuple[str, float, str]:
         "The integrator's first internal step (0: it chooses one from the motion's "
         "derivatives); solver.step continues it",
     )
+
+
+def explicit_limit_parameters(scene: Scene) -> list[tuple[str, float, str]]:
+    """(name, default, description) of the switch between the integrator's methods, for
+    a scene with a motor (without one, nothing is stiff: the explicit method always)."""
+    if not any(f.motor is not None for f in forward_drivers(scene)):
+        return []
+    return [
+        (
+            "solver.explicit_limit",
+            EXPLICIT_LIMIT_DEFAULT,
+            "The explicit method (DOP853) integrates a communication step while its internal "
+            "step times the fastest motor circuit's R / L stays at most this; above it, the "
+            "Rosenbrock method (RODASP). 0: RODASP wherever a circuit decays",
+        )
+    ]
 
 
 def motion_outputs(scene: Scene) -> list[Output]:
@@ -668,6 +693,68 @@ def _motion_seed(ident: str, drivers: list[ForwardDriver]) -> list[str]:
     return lines + ["}", ""]
 
 
+def _stiffness(ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """stiff_at(): whether an internal step would be held to the explicit method's
+    stability limit by the motors' circuits (their decay rates R / L, 1/s)."""
+    lines = [
+        "/* Whether a step of `step` seconds is beyond what the explicit method takes on:",
+        " * the fastest decay of the plant's own stiff parts, the motors' armature circuits",
+        " * (R / L), times the step above solver.explicit_limit. A mechanism driven by",
+        " * efforts alone is not stiff. */",
+        f"static int stiff_at(const {ident}_input* in, double step)",
+        "{",
+    ]
+    geared = [f for f in drivers if f.motor is not None]
+    if not geared:
+        return lines + ["    (void)in;", "    (void)step;", "    return 0;", "}", ""]
+    lines.append("    double rate = 0;")
+    for f in geared:
+        lines.append(
+            f"    rate = fmax(rate, in->{f.c('motor_resistance')} / in->{f.c('motor_inductance')});"
+        )
+    return lines + ["    return rate * step > in->plant_explicit_limit;", "}", ""]
+
+
+def _nearest_singular(scene: Scene, ident: str) -> list[str]:
+    """not_positive_reason(): why M has no Cholesky factor, naming the dyad nearest its
+    singular position (the largest amplification among the scene's dyads)."""
+    dyads = [o for o in scene.outputs if o.name.endswith(".amplification") and not o.integer]
+    lines = [
+        "/* Why M(q) has no Cholesky factor, in evaluation->reason: near a toggle a ram's",
+        " * effective mass grows without bound, so the dyad nearest its singular position",
+        " * (the largest amplification of the scene's) is named. */",
+        f"FMU_COLD static void not_positive_reason(const {ident}_output* out,",
+        "                                        fmu_evaluation* evaluation)",
+        "{",
+    ]
+    if not dyads:
+        return lines + [
+            "    (void)out;",
+            "    snprintf(evaluation->reason, sizeof evaluation->reason,",
+            '             "the drivers\' inertia matrix is not positive definite");',
+            "}",
+            "",
+        ]
+    names = ", ".join(c_string(o.name.removesuffix(".amplification")) for o in dyads)
+    values = ", ".join(f"out->{o.member}" for o in dyads)
+    return lines + [
+        f"    static const char* const names[] = {{{names}}};",
+        f"    const double amplification[] = {{{values}}};",
+        "    size_t k, worst = 0;",
+        "    for (k = 1; k < sizeof names / sizeof names[0]; ++k) {",
+        "        if (!(amplification[k] <= amplification[worst])) {",
+        "            worst = k;",
+        "        }",
+        "    }",
+        "    snprintf(evaluation->reason, sizeof evaluation->reason,",
+        '             "the drivers\' inertia matrix is not positive definite; nearest its "',
+        '             "singular position: dyad %.64s (amplification %.3g)",',
+        "             names[worst], amplification[worst]);",
+        "}",
+        "",
+    ]
+
+
 def _effort_input(scene: Scene, f: ForwardDriver) -> Input:
     """The input that drives f: its effort, or its motor's voltage."""
     member_of = f.c("motor_voltage") if f.motor is not None else f.c("effort")
@@ -692,5 +779,7 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         + _input_lines(scene, ident)
         + _ramp_partials(scene, ident, drivers)
         + _motion_seed(ident, drivers)
+        + _stiffness(ident, drivers)
+        + _nearest_singular(scene, ident)
     )
     return len(drivers), state_size(scene), len(_state_names(scene)), parts

@@ -529,6 +529,10 @@ def _forward_rows(scene: Scene) -> list[dict]:
     name, start, text = forward.step_start_parameter()
     raw = _row(rows, name, "parameter", "s", type="Real", start=start, description=text)
     raw.update(lives="input.plant_step_start", min=0.0, min_exclusive=False)
+    for name, start, text in forward.explicit_limit_parameters(scene):
+        raw = _row(rows, name, "parameter", None, type="Real", start=start, description=text)
+        raw.update(lives="input.plant_explicit_limit", min=0.0, min_exclusive=False)
+        raw.update(max=forward.EXPLICIT_LIMIT_MAX, max_exclusive=False)
     # no on_singular: a plant's step without an answer cannot go on (its states stop)
     _output_rows(rows, forward.public_outputs(scene))
     return rows
