@@ -212,6 +212,12 @@ def _own_commands(sub: argparse._SubParsersAction) -> None:
         "coupling against a monolithic reference (see 'dyadfmu cosim --help')",
     ).set_defaults(run=None)
     sub.add_parser(
+        "plants",
+        add_help=False,
+        help="what the forward FMUs' integration costs: steps, evaluations and callgrind "
+        "instructions per ms of motion, a slow and a stiff motor (see 'dyadfmu plants --help')",
+    ).set_defaults(run=None)
+    sub.add_parser(
         "scene-bench",
         add_help=False,
         help="time the scene generator (--check and --out) on chains of 25 to 200 dyads "
@@ -462,6 +468,7 @@ PATHS = {
 OWN_PARSERS = {
     "scenes": ".report.scenes",
     "cosim": ".report.cosim",
+    "plants": ".report.plants",
     "scene-bench": ".study.long_chain",
 }
 

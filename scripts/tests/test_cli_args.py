@@ -71,6 +71,8 @@ PATH_ARGUMENTS = [
     ("scenes", "--out", "out"),
     ("scenes", "--build", "folder"),
     ("cosim", "--out", "out"),
+    ("plants", "--out", "out"),
+    ("plants", "--build", "folder"),
     ("scene-bench", "--generator", "file"),
 ]
 
@@ -79,6 +81,7 @@ PATH_ARGUMENTS = [
 def nothing_runs(monkeypatch):
     """The work of every command fails the test: a bad path must stop it before."""
     from dyadfmu.report import cosim as cosim_report
+    from dyadfmu.report import plants as plants_report
     from dyadfmu.report import scenes as scenes_report
     from dyadfmu.study import long_chain
 
@@ -89,6 +92,7 @@ def nothing_runs(monkeypatch):
         monkeypatch.setattr(cli, name, refuse)
     monkeypatch.setattr(scenes_report, "_runs", refuse)
     monkeypatch.setattr(cosim_report, "run_study", refuse)
+    monkeypatch.setattr(plants_report, "measure", refuse)
     monkeypatch.setattr(long_chain, "measure", refuse)
 
 
