@@ -71,6 +71,7 @@
 #include "dyadfmu/ode.h"
 
 #include <math.h>
+#include <string.h>
 #include <stddef.h>
 
 #define ODE_STAGES 6
@@ -130,6 +131,7 @@ dyad_ode_options dyad_ode_options_default(void)
     o.h_min = 0;
     o.max_steps = 100000;
     o.method = DYAD_ODE_RODASP;
+    memset(o.magnitude, 0, sizeof o.magnitude);
     return o;
 }
 
@@ -144,11 +146,30 @@ static int ode_finite_vector(int n, const dyad_real* v)
     return 1;
 }
 
+static int ode_magnitudes_valid(const dyad_ode_options* o)
+{
+    int i;
+    for (i = 0; i < DYAD_ODE_MAX_DIM; ++i) {
+        if (!(isfinite(o->magnitude[i]) && o->magnitude[i] >= 0)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 static int ode_options_valid(const dyad_ode_options* o)
 {
-    return isfinite(o->rtol) && o->rtol > 0 && isfinite(o->atol) && o->atol > 0 && o->h_max > 0 &&
+    return ode_magnitudes_valid(o) && isfinite(o->rtol) && o->rtol > 0 && isfinite(o->atol) && o->atol > 0 && o->h_max > 0 &&
            isfinite(o->h_initial) && o->h_initial >= 0 && isfinite(o->h_min) && o->h_min >= 0 &&
            o->max_steps > 0 && (o->method == DYAD_ODE_RODASP || o->method == DYAD_ODE_DOP853);
+}
+
+/* The scale of component i's error where it goes from y_i to y1: atol + rtol times the
+ * larger magnitude, at least the component's own (options.magnitude). */
+static dyad_real ode_scale(const dyad_ode_state* s, int i, dyad_real y1)
+{
+    const dyad_real big = fmax(fmax(fabs(s->y[i]), fabs(y1)), s->options.magnitude[i]);
+    return s->options.atol + s->options.rtol * big;
 }
 
 dyad_ode_status dyad_ode_init(dyad_ode_state* state, int n, dyad_real t0, const dyad_real* y0,
@@ -394,7 +415,7 @@ static dyad_ode_status ode_attempt(dyad_ode_state* s, const dyad_ode_system* sys
     for (i = 0; i < n; ++i) {
         dyad_real scale, ratio;
         w->ynew[i] = w->arg[i] + w->u[5][i];
-        scale = s->options.atol + s->options.rtol * fmax(fabs(s->y[i]), fabs(w->ynew[i]));
+        scale = ode_scale(s, i, w->ynew[i]);
         ratio = w->u[5][i] / scale;
         sum += ratio * ratio;
     }
@@ -464,7 +485,7 @@ static dyad_real ode_first_step(const dyad_ode_state* s, const dyad_real* f0)
         return s->options.h_initial;
     }
     for (i = 0; i < s->n; ++i) {
-        dyad_real scale = s->options.atol + s->options.rtol * fabs(s->y[i]);
+        dyad_real scale = ode_scale(s, i, s->y[i]);
         ny += (s->y[i] / scale) * (s->y[i] / scale);
         nf += (f0[i] / scale) * (f0[i] / scale);
     }
@@ -713,7 +734,7 @@ static dyad_ode_status dop_attempt(dyad_ode_state* s, const dyad_ode_system* sys
             d3 += dop_e3[j] * w->k[j][i];
         }
         w->ynew[i] = s->y[i] + h * sum;
-        scale = s->options.atol + s->options.rtol * fmax(fabs(s->y[i]), fabs(w->ynew[i]));
+        scale = ode_scale(s, i, w->ynew[i]);
         e5 += (d5 / scale) * (d5 / scale);
         e3 += (d3 / scale) * (d3 / scale);
     }

@@ -715,6 +715,28 @@ def _stiffness(ident: str, drivers: list[ForwardDriver]) -> list[str]:
     return lines + ["    return rate * step > in->plant_explicit_limit;", "}", ""]
 
 
+def _current_magnitudes(ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """current_magnitudes(): each armature current's own scale for the relative
+    tolerance, the current its supply drives at stall (|V| / R)."""
+    lines = [
+        "/* Each armature current's error is held relative to at least the current its supply",
+        " * drives at stall (|V| / R), not to atol where it passes through zero (near no-load",
+        " * speed a 1e-10 A tolerance would set the steps). */",
+        f"static void current_magnitudes(const {ident}_input* in, dyad_ode_options* options)",
+        "{",
+    ]
+    geared = [f for f in drivers if f.motor is not None]
+    if not geared:
+        return lines + ["    (void)in;", "    (void)options;", "}", ""]
+    for f in geared:
+        voltage, resistance = f.c("motor_voltage"), f.c("motor_resistance")
+        lines.append(
+            f"    options->magnitude[{f.current}] = "
+            f"(dyad_real)(fabs(in->{voltage}) / in->{resistance});"
+        )
+    return lines + ["}", ""]
+
+
 def _nearest_singular(scene: Scene, ident: str) -> list[str]:
     """not_positive_reason(): why M has no Cholesky factor, naming the dyad nearest its
     singular position (the largest amplification among the scene's dyads)."""
@@ -781,5 +803,6 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         + _motion_seed(ident, drivers)
         + _stiffness(ident, drivers)
         + _nearest_singular(scene, ident)
+        + _current_magnitudes(ident, drivers)
     )
     return len(drivers), state_size(scene), len(_state_names(scene)), parts

@@ -118,6 +118,10 @@ typedef struct dyad_ode_options {
     /** The most internal steps (accepted or not) one call may take (> 0). */
     long max_steps;
     dyad_ode_method method;
+    /** The least magnitude rtol applies to, per component (default 0): the error of
+     *  component i within atol + rtol max(|y0_i|, |y1_i|, magnitude[i]), so that a
+     *  component passing through zero is held to its own scale, not to atol. */
+    dyad_real magnitude[DYAD_ODE_MAX_DIM];
 } dyad_ode_options;
 
 /** What the integrator did, summed over the calls since dyad_ode_init(). */
