@@ -159,9 +159,10 @@ static int ode_magnitudes_valid(const dyad_ode_options* o)
 
 static int ode_options_valid(const dyad_ode_options* o)
 {
-    return ode_magnitudes_valid(o) && isfinite(o->rtol) && o->rtol > 0 && isfinite(o->atol) && o->atol > 0 && o->h_max > 0 &&
-           isfinite(o->h_initial) && o->h_initial >= 0 && isfinite(o->h_min) && o->h_min >= 0 &&
-           o->max_steps > 0 && (o->method == DYAD_ODE_RODASP || o->method == DYAD_ODE_DOP853);
+    return ode_magnitudes_valid(o) && isfinite(o->rtol) && o->rtol > 0 && isfinite(o->atol) &&
+           o->atol > 0 && o->h_max > 0 && isfinite(o->h_initial) && o->h_initial >= 0 &&
+           isfinite(o->h_min) && o->h_min >= 0 && o->max_steps > 0 &&
+           (o->method == DYAD_ODE_RODASP || o->method == DYAD_ODE_DOP853);
 }
 
 /* The scale of component i's error where it goes from y_i to y1: atol + rtol times the

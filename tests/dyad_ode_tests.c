@@ -631,6 +631,67 @@ static int test_gsl_skipped(void)
 
 #endif
 
+/* ---- (b') a component's own magnitude ---------------------------------------------------- */
+
+/* The limit cycle's components pass through zero twice a turn. Held only to
+ * atol + rtol |y|, each crossing forces small steps; held to rtol times the cycle's
+ * radius (options.magnitude), the steps follow the motion, and the error stays within
+ * that scale. */
+static int magnitude_run(dyad_ode_method method, double magnitude, double* worst, long* steps)
+{
+    int k;
+    double y0[2], out[101 * 2], exact[2];
+    dyad_ode_system sys = system_of(2, cycle_rhs, cycle_jacobian, NULL);
+    dyad_ode_options o = tolerances(1e-8, 1e-15);
+    dyad_ode_state s;
+    o.method = method;
+    o.magnitude[0] = o.magnitude[1] = magnitude;
+    sys.autonomous = 1;
+    cycle_exact(0, y0);
+    if (run_grid(&s, &sys, y0, &o, 0.2, 100, out) != DYAD_ODE_OK) {
+        return 1;
+    }
+    *worst = 0;
+    for (k = 1; k <= 100; ++k) {
+        cycle_exact(0.2 * k, exact);
+        *worst = fmax(*worst, fmax(fabs(out[2 * k] - exact[0]), fabs(out[2 * k + 1] - exact[1])));
+    }
+    *steps = s.counters.accepted_steps + s.counters.rejected_steps;
+    return 0;
+}
+
+static int magnitude_by(dyad_ode_method method, const char* name)
+{
+    int fails = 0;
+    double own_error, floor_error;
+    long own_steps, floor_steps;
+    CHECK(magnitude_run(method, 0, &own_error, &own_steps) == 0, "%s without magnitude", name);
+    CHECK(magnitude_run(method, 1, &floor_error, &floor_steps) == 0, "%s magnitude 1", name);
+    REPORT("%s: without magnitude %ld steps, error %.2e; magnitude 1: %ld steps, error %.2e\n",
+           name, own_steps, own_error, floor_steps, floor_error);
+    CHECK(floor_steps < own_steps, "%s: %ld steps with magnitude, %ld without", name, floor_steps,
+          own_steps);
+    CHECK(floor_error < 10 * 1e-8, "%s: error %g with magnitude 1", name, floor_error);
+    return fails;
+}
+
+static int test_magnitude(void)
+{
+    int fails = 0;
+    double y0 = 1;
+    dyad_ode_state s;
+    dyad_ode_options o = tolerances(1e-8, 1e-10);
+    fails += magnitude_by(DYAD_ODE_RODASP, "RODASP");
+    fails += magnitude_by(DYAD_ODE_DOP853, "DOP853");
+    o.magnitude[3] = NAN;
+    CHECK(dyad_ode_init(&s, 1, 0, &y0, &o) == DYAD_ODE_INVALID_ARGUMENT, "NaN magnitude");
+    o.magnitude[3] = -1;
+    CHECK(dyad_ode_init(&s, 1, 0, &y0, &o) == DYAD_ODE_INVALID_ARGUMENT, "negative magnitude");
+    o.magnitude[3] = INFINITY;
+    CHECK(dyad_ode_init(&s, 1, 0, &y0, &o) == DYAD_ODE_INVALID_ARGUMENT, "infinite magnitude");
+    return fails;
+}
+
 /* ---- (c) reproducibility ------------------------------------------------------------------ */
 
 static int test_reproducible(void)
@@ -890,6 +951,7 @@ static const named_test tests[] = {
 #else
     {"gsl_skipped", test_gsl_skipped},
 #endif
+    {"magnitude", test_magnitude},
     {"reproducible", test_reproducible},
     {"save_restore", test_save_restore},
     {"rhs_failure", test_rhs_failure},
