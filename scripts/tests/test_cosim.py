@@ -479,12 +479,26 @@ def test_quick_report_writes_its_files(tmp_path):
     text = (folder / "report.md").read_text()
     assert "stabilised" in text and "explicit" in text and "diverged" in text
     # read back by a Markdown parser: the machines, the runs, the mechanism FMUs
-    _, runs, mechanism_fmus = markdown_check.check_file(folder / "report.md")
+    _, runs, mechanism_fmus, by_step, by_rtol = markdown_check.check_file(folder / "report.md")
     assert len(runs.rows) == 1 + len(rows) and len(mechanism_fmus.rows) == 1 + 3
+    assert len(by_step.rows) == 1 + 2 and len(by_rtol.rows) == 1 + 2
     assert "For a user of the dyad FMU" in text
+    assert result["plant_plot"].stat().st_size > 0
+    _check_plant_points(result["plant_points"])
     assert not any(r["diverged"] == "True" for r in rows if r["scheme"] == "stabilised")
     assert any(
         r["diverged"] == "True"
         for r in rows
         if r["scheme"] == "explicit" and r["mechanism"] == "four-bar"
     )
+
+
+def _check_plant_points(found: list[dict]) -> None:
+    """The motor inside the plant (a) within 1e-8 of travel and peak at every step and
+    tolerance; the drive FMU with the inverse mechanism FMU (c) first order in the step."""
+    inside = [p for p in found if p["coupling"].startswith("(a)")]
+    drive = sorted((p for p in found if p["coupling"].startswith("(c)")), key=lambda p: p["step"])
+    assert len(inside) == 4 and len(drive) == 2
+    assert max(max(p["angle"], p["speed"]) for p in inside) < 1e-8
+    assert drive[0]["speed"] < drive[1]["speed"]
+    assert min(p["speed"] for p in drive) > 1e4 * max(p["speed"] for p in inside)

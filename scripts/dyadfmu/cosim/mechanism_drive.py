@@ -125,9 +125,10 @@ def _point(d: Slave, y: Slave, t: float, checks: list) -> tuple:
     return phi, omega, eps, torque, j
 
 
-def run(name: str, step: float, fmi_version: int = 2) -> DriveRun:
-    """The stabilised co-simulation of ``name``'s machine with communication step ``step``."""
-    m = machine_of(name)
+def run(name: str, step: float, fmi_version: int = 2, m: Machine | None = None) -> DriveRun:
+    """The stabilised co-simulation of ``name``'s machine (or ``m``, a machine of that
+    mechanism FMU) with communication step ``step``."""
+    m = m or machine_of(name)
     n = int(round(m.t_end / step))
     if n < 1 or abs(n * step - m.t_end) > 1e-9 * m.t_end:
         raise ValueError(f"{m.t_end} s is not a whole number of steps of {step!r} s")
@@ -150,12 +151,12 @@ def run(name: str, step: float, fmi_version: int = 2) -> DriveRun:
     return DriveRun(name, step, t, *a.T, checks[0], checks[1], clock.perf_counter() - started)
 
 
-def reference(name: str, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(phi, omega) of the machine as one ODE on the grid t, from the harness's
-    kinematics."""
+def reference(name: str, t: np.ndarray, m: Machine | None = None) -> tuple:
+    """(phi, omega) of the machine (``name``'s, or ``m``) as one ODE on the grid t, from
+    the harness's kinematics."""
     from scipy.integrate import solve_ivp
 
-    m = machine_of(name)
+    m = m or machine_of(name)
     mech = mechanism_fmus.mechanism_of(name)
 
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
@@ -178,9 +179,10 @@ def reference(name: str, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return sol.y[0], sol.y[1]
 
 
-def errors(result: DriveRun) -> dict:
-    """Largest |phi - reference| [rad] and |omega - reference| / mean speed over the run."""
-    phi, omega = reference(result.name, result.t)
+def errors(result: DriveRun, m: Machine | None = None) -> dict:
+    """Largest |phi - reference| [rad] and |omega - reference| / mean speed over the run
+    (of ``result.name``'s machine, or ``m``)."""
+    phi, omega = reference(result.name, result.t, m)
     return {
         "phi": float(np.max(np.abs(result.phi - phi))),
         "omega": float(np.max(np.abs(result.omega - omega)) / np.mean(np.abs(omega))),

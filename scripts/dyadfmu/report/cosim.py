@@ -22,6 +22,7 @@ from .. import paths
 from ..cosim import master as cosim
 from ..cosim import mechanism_drive
 from . import markdown as markup
+from . import plant_cosim
 
 #: Inertia ratios (mean J over a revolution, crank included, / rotor inertia).
 RATIOS = (0.1, 1.0, 10.0, 100.0)
@@ -656,6 +657,9 @@ def run_study(
     points = write_csv(folder / "points.csv", rows)
     figure = plot(folder / "error_vs_time.png", rows)
     mechanism_lines = mechanism_section(quick, fmi_version)
+    found = plant_cosim.points(quick, lambda text: _log(verbose, text))
+    plant_figure = plant_cosim.plot(folder / "plant_vs_step.png", found)
+    mechanism_lines += plant_cosim.lines(found, plant_figure, quick)
     report = markdown(
         folder / "report.md",
         rows,
@@ -666,7 +670,14 @@ def run_study(
         fmi_version,
         tuple(mechanism_lines),
     )
-    return {"report": report, "points": points, "plot": figure, "rows": rows}
+    return {
+        "report": report,
+        "points": points,
+        "plot": figure,
+        "plant_plot": plant_figure,
+        "rows": rows,
+        "plant_points": found,
+    }
 
 
 def parser() -> argparse.ArgumentParser:
@@ -720,7 +731,7 @@ def main(argv: list[str] | None = None) -> int:
             f"error {best:.1e}"
         )
     print("written:")
-    for key in ("report", "points", "plot"):
+    for key in ("report", "points", "plot", "plant_plot"):
         print(f"  {result[key]}")
     return 0
 

@@ -1,0 +1,227 @@
+"""The machine with its motor inside the plant, against the same machine as one ODE.
+
+The plant ``slider_crank_motor`` (the slider-crank with its DC motor, supply voltage in)
+runs up from rest under a constant 290 V over 2 s, at communication steps from 0.1 s down
+to 10 us and at relative tolerances from 1e-6 down to 1e-11. Its crank angle and speed at
+every communication point are compared with the machine as one ODE, from the harness's
+own kinematics (:mod:`dyadfmu.mechanisms.driven`: the effective inertia J(phi), its
+derivative and the weights' generalised force Q_g(phi)) and the motor's circuit:
+
+    phi' = omega,
+    (J(phi) + r^2 J_r) omega' = r (k i - c r omega) + Q_g(phi) - J'(phi) omega^2 / 2,
+    L i' = V - R i - k r omega,
+
+integrated by SciPy (Radau where the circuit is stiff). J, J' and Q_g enter as their
+Fourier series from 128 of the harness's values, each within 2e-15 of the harness
+(``_Periodic.fit_error``), so that an evaluation costs tens of microseconds, not
+milliseconds. The drive FMU's machine (:func:`drive_run`) is the same one with L = 0.
+The motor's numbers are the plant's own parameters (read
+from its model description), so the two cannot drift apart.
+
+API: :data:`STEPS`, :data:`RTOLS`, :data:`CIRCUITS`, :func:`reference`, :func:`run`,
+:func:`errors`.
+"""
+
+from __future__ import annotations
+
+import math
+import time as clock
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .. import paths
+from ..fmi.slave import Slave
+from ..mechanisms import driven
+from ..reference import machine
+from . import mechanism_drive, mechanism_fmus
+
+__all__ = ["CIRCUITS", "RTOLS", "STEPS", "Circuit", "PlantRun", "errors", "reference", "run"]
+
+PLANT = "slider_crank_motor"
+MECHANISM = "slider_crank"
+START_ANGLE = 0.5  # rad
+VOLTAGE = 290.0  # V
+T_END = 2.0  # s
+#: Communication steps [s] and relative tolerances of the study.
+STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
+RTOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)
+#: The armature circuits compared: L / R of the scene's motor, and a stiff one.
+#: (The drive FMU's motor is the same one without inductance: LINEAR.)
+CIRCUITS = {"L/R 1.4 ms": None, "L/R 1 us": 1e-6}
+LINEAR = "L = 0"
+#: Angles at which the harness's J, J' and Q_g are sampled for their Fourier series.
+SAMPLES = 128
+_MOTOR_KEYS = ("resistance", "inductance", "torque_constant", "rotor_inertia", "friction", "ratio")
+
+
+@dataclass(frozen=True)
+class Circuit:
+    """The motor's numbers (SI units), as the plant's parameters ``crank.motor.*``."""
+
+    resistance: float
+    inductance: float
+    torque_constant: float
+    rotor_inertia: float
+    friction: float
+    ratio: float
+
+    def parameters(self) -> dict[str, float]:
+        """The plant's parameters for this motor."""
+        return {f"crank.motor.{k}": getattr(self, k) for k in _MOTOR_KEYS}
+
+
+def circuit(label: str, version: int = 2) -> Circuit:
+    """The plant's motor with the time constant of :data:`CIRCUITS` ``label``."""
+    md = Slave(paths.built_fmu(PLANT, version, how="scripts/run-tests"), "start values")
+    try:
+        starts = {v.name: float(v.start) for v in md.md.modelVariables if v.start is not None}
+    finally:
+        md.close()
+    motor = Circuit(*(starts[f"crank.motor.{k}"] for k in _MOTOR_KEYS))
+    time_constant = 0.0 if label == LINEAR else CIRCUITS[label]
+    if time_constant is None:
+        return motor
+    return replace(motor, inductance=time_constant * motor.resistance)
+
+
+@dataclass
+class PlantRun:
+    """The plant's crank angle [rad] and speed [rad/s] at its communication points, the
+    CPU time of the run [s] and the plant's internal evaluations."""
+
+    label: str
+    step: float
+    rtol: float
+    t: np.ndarray
+    phi: np.ndarray
+    omega: np.ndarray
+    cpu_time: float
+
+
+def run(label: str, step: float, rtol: float | None = None, version: int = 2) -> PlantRun:
+    """The plant with motor ``label`` over :data:`T_END` at communication step ``step``
+    (and ``solver.rtol`` = ``solver.atol`` = ``rtol`` where given)."""
+    n = int(round(T_END / step))
+    if n < 1 or abs(n * step - T_END) > 1e-9 * T_END:
+        raise ValueError(f"{T_END} s is not a whole number of steps of {step!r} s")
+    parameters = circuit(label, version).parameters()
+    parameters["crank.angle_start"] = START_ANGLE
+    if rtol is not None:
+        parameters.update({"solver.rtol": rtol, "solver.atol": rtol})
+    plant = Slave(paths.built_fmu(PLANT, version, how="scripts/run-tests"), "plant")
+    names = ("crank.angle", "crank.omega")
+    rows = np.empty((n + 1, 2))
+    started = clock.process_time()
+    try:
+        plant.set("crank.motor.voltage", VOLTAGE)
+        plant.initialize(parameters)
+        rows[0] = plant.get(names)
+        for k in range(n):
+            plant.do_step(k * step, step)
+            rows[k + 1] = plant.get(names)
+    finally:
+        plant.close()
+    cpu = clock.process_time() - started
+    t = step * np.arange(n + 1)
+    return PlantRun(label, step, rtol or math.nan, t, rows[:, 0], rows[:, 1], cpu)
+
+
+class _Periodic:
+    """A function of the crank angle with period 2 pi, as its Fourier series from the
+    harness's values at :data:`SAMPLES` angles (the slider-crank's are analytic: their
+    coefficients fall below 1e-18 long before the last); ``fit_error`` is its largest
+    distance to the harness at 1000 other angles, relative to its largest value."""
+
+    def __init__(self, of: object) -> None:
+        q = 2 * math.pi * np.arange(SAMPLES) / SAMPLES
+        c = np.fft.rfft(of(q)) / SAMPLES
+        c[1:] *= 2
+        keep = np.nonzero(np.abs(c) > 1e-19 * np.max(np.abs(c)))[0]
+        self.k, self.c = keep, c[keep]
+        probe = np.random.default_rng(7).uniform(0, 2 * math.pi, 1000)
+        truth = of(probe)
+        self.fit_error = float(np.max(np.abs(self(probe) - truth)) / np.max(np.abs(truth)))
+
+    def __call__(self, phi: np.ndarray | float) -> np.ndarray:
+        return (np.exp(1j * np.multiply.outer(phi, self.k)) @ self.c).real
+
+
+def _machine_terms() -> tuple[_Periodic, _Periodic, _Periodic]:
+    """J(phi), J'(phi) and Q_g(phi) of the slider-crank, from the harness's kinematics."""
+    mech = mechanism_fmus.mechanism_of(MECHANISM)
+    return (
+        _Periodic(lambda q: driven.effective_inertia(mech, q)[0]),
+        _Periodic(lambda q: driven.effective_inertia(mech, q)[1]),
+        _Periodic(lambda q: driven.generalized_gravity(mech, q)),
+    )
+
+
+def _rhs(motor: Circuit, terms: tuple):
+    inertia, slope, weight = terms
+    r, k = motor.ratio, motor.torque_constant
+
+    def rhs(_t: float, y: np.ndarray) -> np.ndarray:
+        if motor.inductance > 0:
+            current = y[2]
+        else:
+            current = (VOLTAGE - k * r * y[1]) / motor.resistance
+        torque = r * (k * current - motor.friction * r * y[1])
+        load = torque + weight(y[0]) - 0.5 * slope(y[0]) * y[1] ** 2
+        accel = load / (inertia(y[0]) + r * r * motor.rotor_inertia)
+        if motor.inductance == 0:
+            return np.array([y[1], accel])
+        di = (VOLTAGE - motor.resistance * current - k * r * y[1]) / motor.inductance
+        return np.array([y[1], accel, di])
+
+    return rhs
+
+
+def reference(label: str, t: np.ndarray, method: str = "Radau", rtol: float = 1e-12) -> tuple:
+    """(phi, omega) of the machine with motor ``label`` as one ODE on the grid t."""
+    from scipy.integrate import solve_ivp
+
+    motor = circuit(label)
+    start, scale = [START_ANGLE, 0.0, 0.0], [1.0, 1.0, VOLTAGE / motor.resistance]
+    n = 3 if motor.inductance > 0 else 2
+    sol = solve_ivp(
+        _rhs(motor, _machine_terms()),
+        (0.0, float(t[-1])),
+        start[:n],
+        method=method,
+        rtol=rtol,
+        atol=rtol * np.array(scale[:n]),
+        t_eval=t,
+    )
+    if not sol.success:
+        raise RuntimeError(f"the reference ({method}) failed: {sol.message}")
+    return sol.y[0], sol.y[1]
+
+
+def drive_run(step: float, version: int = 2) -> PlantRun:
+    """The same machine as the drive FMU (the motor's linear characteristic, L = 0: stall
+    torque k r V / R, no-load speed V / (k r)) and the inverse mechanism FMU of the
+    slider-crank, stabilised (:mod:`dyadfmu.cosim.mechanism_drive`)."""
+    motor = circuit(LINEAR)
+    gain = motor.torque_constant * motor.ratio
+    linear = machine.Motor(
+        gain * VOLTAGE / motor.resistance, VOLTAGE / gain, motor.ratio**2 * motor.rotor_inertia
+    )
+    m = mechanism_drive.Machine(MECHANISM, linear, 0.0, T_END)
+    started = clock.process_time()
+    r = mechanism_drive.run(MECHANISM, step, version, m)
+    cpu = clock.process_time() - started
+    return PlantRun(LINEAR, step, math.nan, r.t, r.phi, r.omega, cpu)
+
+
+def errors(result: PlantRun, ref: tuple) -> dict:
+    """The largest angle error over the run as a fraction of the angle travelled, the
+    largest speed error as a fraction of the peak speed."""
+    phi, omega = ref
+    step = max(1, int(round((len(phi) - 1) / (len(result.t) - 1))))
+    phi, omega = phi[::step], omega[::step]
+    travel = abs(phi[-1] - phi[0])
+    return {
+        "angle": float(np.max(np.abs(result.phi - phi)) / travel),
+        "speed": float(np.max(np.abs(result.omega - omega)) / np.max(np.abs(omega))),
+    }
