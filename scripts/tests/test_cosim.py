@@ -43,6 +43,7 @@ from dyadfmu.mechanisms import builtin as mechanisms  # noqa: E402
 from dyadfmu.reference import machine  # noqa: E402
 from dyadfmu.reference import newton_euler as reference  # noqa: E402
 from dyadfmu.report import cosim as cosim_report  # noqa: E402
+from dyadfmu.report import plant_cosim  # noqa: E402
 
 ROOT = HERE.parents[1]
 BUILD = Path(os.environ.get("DYADFMU_BUILD", ROOT / "build"))
@@ -481,7 +482,7 @@ def test_quick_report_writes_its_files(tmp_path):
     # read back by a Markdown parser: the machines, the runs, the mechanism FMUs
     _, runs, mechanism_fmus, by_step, by_rtol = markdown_check.check_file(folder / "report.md")
     assert len(runs.rows) == 1 + len(rows) and len(mechanism_fmus.rows) == 1 + 3
-    assert len(by_step.rows) == 1 + 2 and len(by_rtol.rows) == 1 + 2
+    assert len(by_step.rows) == 1 + 4 and len(by_rtol.rows) == 1 + 2
     assert "For a user of the dyad FMU" in text
     assert result["plant_plot"].stat().st_size > 0
     _check_plant_points(result["plant_points"])
@@ -502,3 +503,9 @@ def _check_plant_points(found: list[dict]) -> None:
     assert max(max(p["angle"], p["speed"]) for p in inside) < 1e-8
     assert drive[0]["speed"] < drive[1]["speed"]
     assert min(p["speed"] for p in drive) > 1e4 * max(p["speed"] for p in inside)
+    # (b) at 1 ms: the motor FMU's torque and the plant's speed exchanged with their rates
+    # beat holding them; at 10 ms the held torque runs the plant away: refused, with why
+    split = {(p["coupling"], p["step"]): p for p in found if p["coupling"].startswith("(b)")}
+    held, rates = (split[(name, 1e-3)] for name in plant_cosim.SPLIT.values())
+    assert rates["angle"] < held["angle"] / 4
+    assert "internal steps" in split[(plant_cosim.SPLIT[False], 1e-2)]["failed"]

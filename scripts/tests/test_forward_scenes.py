@@ -34,6 +34,7 @@ SCENES = {
     "slider_crank_motor": paths.SCENES_DIR / "slider_crank.toml",
     "leg_motor": paths.SCENES_DIR / "leg.toml",
     "four_bar_forward": paths.SCENES_DIR / "four_bar_payload.toml",
+    "slider_crank_rotor": paths.SCENES_DIR / "slider_crank.toml",
 }
 #: A constant cutting force on the shaper's ram [N] (the reference's load model made
 #: constant, as the FMU's input holds it)

@@ -88,7 +88,14 @@ STUDY_TEST_FMUS = {"balance_fmi2", "balance_fmi3", "toggles_fmi2", "toggles_fmi3
 #: and the plants of tests/scenes/ that test_forward_scenes.py runs against the reference
 STUDY_TEST_FMUS |= {
     f"{name}_fmi{version}"
-    for name in ("shaper_forward", "lift_forward", "leg_forward", "leg_motor", "four_bar_forward")
+    for name in (
+        "shaper_forward",
+        "lift_forward",
+        "leg_forward",
+        "leg_motor",
+        "four_bar_forward",
+        "slider_crank_rotor",
+    )
     for version in (2, 3)
 }
 
