@@ -230,3 +230,41 @@ def drive_absence_reason(lives: str) -> str:
             "cannot integrate leaves its states where they were, so it cannot go on"
         )
     return f"the drive FMU has no variable for '{lives}'"
+
+
+def motor_catalogue() -> dict[str, Entry]:
+    """Every variable of the DC motor, keyed by `lives`, in the canonical order.
+
+    The outputs' dependencies cover every inductance: the shaft torque r (k i - c r
+    omega) depends on shaft.omega through the friction, and, without inductance (the
+    current then u / R, u = V - k r omega), on both inputs through the current; the
+    current depends on both inputs only then, which a parameter cannot rule out, and so
+    does the status (3 where the current or the torque overflows)."""
+    positive = {"min": 0.0, "min_exclusive": True}
+    inputs = ("motor.voltage", "shaft.omega")
+    entries = [
+        Entry("input.voltage", "motor.voltage", "input", "V"),
+        Entry("input.omega", "shaft.omega", "input", "rad/s"),
+        Entry("input.resistance", "motor.resistance", "parameter", "Ohm", domain=positive),
+        Entry("input.inductance", "motor.inductance", "parameter", "H", domain={"min": 0.0}),
+        Entry(
+            "input.torque_constant", "motor.torque_constant", "parameter", "N.m/A", domain=positive
+        ),
+        Entry("input.friction", "motor.friction", "parameter", "N.m.s/rad", domain={"min": 0.0}),
+        Entry("input.ratio", "motor.ratio", "parameter", None, domain=positive),
+        Entry("input.current_start", "motor.current_start", "parameter", "A"),
+        Entry("result.torque", "shaft.torque", "output", "N.m", depends=inputs),
+        Entry("result.current", "motor.current", "output", "A", depends=inputs),
+        Entry("result.status", "status", "output", None, value_type="Integer", depends=inputs),
+    ]
+    return {entry.lives: entry for entry in entries}
+
+
+def motor_absence_reason(lives: str) -> str:
+    """Why a well-formed `lives` is not a variable of the motor."""
+    if lives == ON_SINGULAR.lives:
+        return (
+            "the motor has no on_singular: it has no singular position, and a step that "
+            "overflows leaves its current where it was, so it cannot go on"
+        )
+    return f"the motor FMU has no variable for '{lives}'"

@@ -8,6 +8,10 @@ and documentation:
     drive   the crank drive, a DC motor with states (crank angle and speed)
             integrated inside doStep; no ``type``; it lives in fmu_drive_input and
             fmu_drive_output (fmu/models/fmu_drive.h), behaviour fmu_drive.c.
+    motor   a DC motor with a gear, voltage and shaft speed in, shaft torque out, its
+            current a state solved in closed form inside doStep (inputs interpolated,
+            outputs differentiated); it lives in fmu_motor_input and fmu_motor_output
+            (fmu/models/fmu_motor.h), behaviour fmu_motor.c.
     scene   a tailored scene: flat input and output blocks and the code computing
             them, both generated from the scene (emit/scene_c.py).
 """
@@ -21,6 +25,8 @@ from dyadgen.catalogue import (
     drive_catalogue,
     dyad_absence_reason,
     dyad_catalogue,
+    motor_absence_reason,
+    motor_catalogue,
     setting_entry,
 )
 from dyadgen.corefiles import dyad_core_sources, scene_core_sources
@@ -37,6 +43,8 @@ from dyadgen.structs import (
     DRIVE_OUTPUT_MEMBERS,
     INPUT_MEMBERS,
     LINK_FIELD,
+    MOTOR_INPUT_MEMBERS,
+    MOTOR_OUTPUT_MEMBERS,
     RESULT_MEMBERS,
     Lives,
     Structs,
@@ -74,6 +82,22 @@ DRIVE_LOG_CATEGORIES = (
         "Discarded steps: a step that would need more than 1e7 integrator "
         "substeps, or a crank state that is no longer finite (the state stays at the step's "
         "start)",
+    ),
+    ("logCalls", "Calls into the FMU"),
+)
+#: The same categories as the motor uses them.
+MOTOR_LOG_CATEGORIES = (
+    (
+        "logStatusError",
+        "Errors: illegal call sequences, bad arguments, values outside a variable's range "
+        "or not finite, an input whose derivative carries it past the finite within a step "
+        "(the variable is named)",
+    ),
+    ("logStatusWarning", "Warnings"),
+    (
+        "logStatusDiscard",
+        "Discarded steps: a step that would end where the current or the shaft torque "
+        "overflows double (the current stays at the step's start)",
     ),
     ("logCalls", "Calls into the FMU"),
 )
@@ -314,6 +338,48 @@ class DriveKind(Kind):
         return drive_absence_reason(lives)
 
 
+class MotorKind(Kind):
+    """The DC motor (fmu/models/fmu_motor.c), from its table interface/motor.toml."""
+
+    tool = "modelDescription/generate.py"
+    interpolates = True
+    log_categories = MOTOR_LOG_CATEGORIES
+
+    def source_files(self, table: Table, version: int) -> list[str]:
+        """The motor's behaviour."""
+        return [
+            "fmu_motor.c",
+            "fmu_instance.c",
+            "fmu_state.c",
+            *SHIM_FILES[version],
+            f"{table.identifier}_model.c",
+        ]
+
+    def subject(self, table: Table) -> str:
+        """The motor."""
+        return "the DC motor FMU"
+
+    def table_source(self, table: Table) -> str:
+        """The motor's table, among the interface data."""
+        return f"modelDescription/interface/{table.path.name}"
+
+    def documentation(self, table: Table) -> str:
+        """The page of the motor."""
+        return documentation.motor_page(table)
+
+    def catalogue_for(self, model: dict) -> dict[str, Entry]:
+        """The motor's variables."""
+        return motor_catalogue()
+
+    def model_problems(self, model: dict) -> list[str]:
+        """A motor has no dyad type."""
+        return DriveKind.model_problems(self, model)
+
+    def absence_reason(self, model: dict, lives: str) -> str:
+        """The motor has no such variable."""
+        return motor_absence_reason(lives)
+
+
 class SceneKind(Kind):
     """A tailored scene: flat input and output blocks generated with the scene's C."""
 
@@ -427,8 +493,17 @@ DRIVE = DriveKind(
     "fmu_drive.h",
     "fmu_drive_behaviour",
 )
+MOTOR = MotorKind(
+    "motor",
+    "fmu_motor_input",
+    "fmu_motor_output",
+    MOTOR_INPUT_MEMBERS,
+    MOTOR_OUTPUT_MEMBERS,
+    "fmu_motor.h",
+    "fmu_motor_behaviour",
+)
 #: The kinds a table file may name in [model] kind.
-KINDS = {"dyad": DYAD, "drive": DRIVE}
+KINDS = {"dyad": DYAD, "drive": DRIVE, "motor": MOTOR}
 
 
 def scene_behaviour(ident: str) -> list[str]:

@@ -8,15 +8,15 @@ from pathlib import Path
 MODEL_DESCRIPTION = Path(__file__).resolve().parent.parent
 #: The checkout.
 ROOT = MODEL_DESCRIPTION.parent
-#: The interface data: the drive's table, the generic dyads' descriptions, the C names
-#: probe scene and the golden model descriptions.
+#: The interface data: the drive's and the motor's tables, the generic dyads'
+#: descriptions, the C names probe scene and the golden model descriptions.
 INTERFACE_DIR = MODEL_DESCRIPTION / "interface"
 GOLDEN_DIR = INTERFACE_DIR / "golden"
 SCENES_DIR = ROOT / "modelDescription" / "scenes"
 #: The scenes the build adds with its tests (fmu/CMakeLists.txt: tests/scenes/*.toml).
 TEST_SCENES_DIR = ROOT / "tests" / "scenes"
 #: The variable tables written by hand (interface/), each an FMU of the build.
-HAND_TABLES = ("drive.toml",)
+HAND_TABLES = ("drive.toml", "motor.toml")
 #: A scene with every feature of the generated code (see the file and scenefile.c_names).
 C_NAMES_PROBE = INTERFACE_DIR / "c_names_probe.toml"
 #: every probe: external kinematics, internal with a crank, a ram, a cylinder

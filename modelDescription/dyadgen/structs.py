@@ -96,8 +96,30 @@ DRIVE_OUTPUT_MEMBERS = {
     "status": "status",
 }
 
-#: The start parameter of each state of the drive.
-STATE_START = {"angle": "start.angle", "speed": "start.speed"}
+# Members of fmu_motor_input and fmu_motor_output (fmu/models/fmu_motor.h), in declaration
+# order. "rate": the first derivative of an input, set by fmi2SetRealInputDerivatives
+# and by no variable.
+MOTOR_INPUT_MEMBERS = {
+    "voltage": "real",
+    "omega": "real",
+    "voltage_rate": "rate",
+    "omega_rate": "rate",
+    "resistance": "real",
+    "inductance": "real",
+    "torque_constant": "real",
+    "friction": "real",
+    "ratio": "real",
+    "current_start": "real",
+    "current": "state",
+}
+MOTOR_OUTPUT_MEMBERS = {
+    "torque": "real",
+    "current": "real",
+    "status": "status",
+}
+
+#: The start parameter of each state of the drive and of the motor.
+STATE_START = {"angle": "start.angle", "speed": "start.speed", "current": "motor.current_start"}
 
 #: struct.member.path[@angle]; a scene's flat members keep the case of its variables'
 #: names (a pair point's parameter DYAD.D_m.x lives in input.DYAD_D_m_x). Matched whole.
@@ -217,6 +239,11 @@ class Structs:
                 f"'{STATE_START[path]}' when initialization ends and advanced "
                 f"by doStep, so no variable may set it (read it through "
                 f"{self.output_type}.{path})"
+            )
+        if members[path] == "rate":
+            raise ValueError(
+                f"{type_name}.{path} is the first derivative of an input, set by "
+                "fmi2SetRealInputDerivatives, so no variable may set it"
             )
         return Lives(struct, path, angle, self)
 

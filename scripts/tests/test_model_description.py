@@ -39,7 +39,12 @@ from dyadfmu.reference import newton_euler as ref  # noqa: E402
 from dyadgen import golden as golden_module  # noqa: E402
 from dyadgen import kinds, pipeline  # noqa: E402
 from dyadgen.cli import generate as generate_cli  # noqa: E402
-from dyadgen.structs import DRIVE_INPUT_MEMBERS, DRIVE_OUTPUT_MEMBERS  # noqa: E402
+from dyadgen.structs import (  # noqa: E402
+    DRIVE_INPUT_MEMBERS,
+    DRIVE_OUTPUT_MEMBERS,
+    MOTOR_INPUT_MEMBERS,
+    MOTOR_OUTPUT_MEMBERS,
+)
 from dyadgen.table import instantiation_token  # noqa: E402
 
 TYPES = ("RRR", "RRT", "RTR", "TRT", "RTT")
@@ -980,14 +985,15 @@ def generated_drive(tmp_path_factory):
     return out
 
 
-def test_tables_are_the_drive_and_the_scenes_of_the_five_dyads():
-    """The drive's table is the one written by hand; the dyads' tables come from their
-    scenes, and both are golden-checked. Only the dyad tables go through the dyad-only
-    tests (dependency derivation, reference solve)."""
+def test_tables_are_the_drive_the_motor_and_the_scenes_of_the_five_dyads():
+    """The drive's and the motor's tables are the ones written by hand; the dyads' tables
+    come from their scenes, and all are golden-checked. Only the dyad tables go through
+    the dyad-only tests (dependency derivation, reference solve)."""
     on_disk = {p.name for p in (MD_DIR / "interface").glob("*.toml")}
     # (c_names_probe.toml is a scene the scene generator learns its C names from)
     assert on_disk == {
         "drive.toml",
+        "motor.toml",
         "dyad_interface.toml",
         "c_names_probe.toml",
         "c_names_probe_internal.toml",
@@ -995,10 +1001,11 @@ def test_tables_are_the_drive_and_the_scenes_of_the_five_dyads():
         "c_names_probe_cylinder.toml",
         "c_names_probe_drivers.toml",
     }
-    assert golden_module.TABLES == ("drive.toml",)
+    assert golden_module.TABLES == ("drive.toml", "motor.toml")
     assert {p.name for p in TABLE_OF.values()} == set(golden_module.GOLDEN_SCENES)
     assert all((SCENES_DIR / name).is_file() for name in golden_module.GOLDEN_SCENES)
     assert pipeline.load_table(DRIVE_TABLE).kind is kinds.DRIVE
+    assert pipeline.load_table(MOTOR_TABLE).kind is kinds.MOTOR
     assert all(pipeline.load_table(p).kind is kinds.DYAD for p in TABLE_OF.values())
     for t in TYPES:
         built = pipeline.build_table(pipeline.load_scene(SCENES_DIR / f"dyad_{t.lower()}.toml"))
@@ -1525,7 +1532,7 @@ def test_malformed_drive_table_is_refused(tmp_path, mutation, name, fragment):
     "model,fragment",
     [
         ({"kind": "drive", "type": "RRT"}, "only a dyad has a type"),
-        ({"kind": "motor"}, "kind 'motor' is not one of dyad, drive"),
+        ({"kind": "pump"}, "kind 'pump' is not one of dyad, drive, motor"),
         ({"kind": "dyad"}, "type None is not one of"),
         ({"kind": "drive", "colour": "red"}, "[model]: unknown key 'colour'"),
     ],
@@ -1575,6 +1582,137 @@ def test_unmodified_drive_copy_is_accepted(tmp_path):
     proc = run_generator(table, "--out", tmp_path / "out")
     assert proc.returncode == 0, proc.stderr
     assert pipeline.load_table(table).token == pipeline.load_table(DRIVE_TABLE).token
+
+
+# ---------------------------------------------------------------------------
+# (e') the DC motor: a model with a state that interpolates its inputs
+# ---------------------------------------------------------------------------
+MOTOR_TABLE = MD_DIR / "interface" / "motor.toml"
+MOTOR_HEADER = ROOT / "fmu" / "models" / "fmu_motor.h"
+#: name -> (causality, unit, lives), in table order, written out from the specification.
+MOTOR_VARIABLES = {
+    "motor.voltage": ("input", "V", "input.voltage"),
+    "shaft.omega": ("input", "rad/s", "input.omega"),
+    "motor.resistance": ("parameter", "Ohm", "input.resistance"),
+    "motor.inductance": ("parameter", "H", "input.inductance"),
+    "motor.torque_constant": ("parameter", "N.m/A", "input.torque_constant"),
+    "motor.friction": ("parameter", "N.m.s/rad", "input.friction"),
+    "motor.ratio": ("parameter", None, "input.ratio"),
+    "motor.current_start": ("parameter", "A", "input.current_start"),
+    "shaft.torque": ("output", "N.m", "result.torque"),
+    "motor.current": ("output", "A", "result.current"),
+    "status": ("output", None, "result.status"),
+}
+#: (min, exclusive): R, k and r positive, L and c not negative.
+MOTOR_BOUNDS = {
+    "motor.resistance": (0.0, True),
+    "motor.inductance": (0.0, False),
+    "motor.torque_constant": (0.0, True),
+    "motor.friction": (0.0, False),
+    "motor.ratio": (0.0, True),
+}
+
+
+@pytest.fixture(scope="module")
+def generated_motor(tmp_path_factory):
+    out = tmp_path_factory.mktemp("generated_motor")
+    proc = run_generator(MOTOR_TABLE, "--out", out)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def test_motor_xml_equals_golden_and_is_deterministic(generated_motor, tmp_path):
+    for version in ("fmi2", "fmi3"):
+        golden = MD_DIR / "interface" / "golden" / f"motor_{version}.xml"
+        produced = generated_motor / version / "modelDescription.xml"
+        assert produced.read_bytes() == golden.read_bytes(), (
+            f"motor {version} description differs from {golden.name}; review the change and "
+            "run modelDescription/generate.py --update-golden"
+        )
+    assert run_generator(MOTOR_TABLE, "--out", tmp_path).returncode == 0
+    for path in generated_motor.rglob("*"):
+        if path.is_file():
+            assert (tmp_path / path.relative_to(generated_motor)).read_bytes() == path.read_bytes()
+
+
+def test_motor_fmpy_validates_and_interface_is_right(generated_motor, tmp_path):
+    md2 = read_fmi2(generated_motor / "fmi2" / "modelDescription.xml")
+    md3 = read_fmi3(generated_motor, tmp_path)
+    assert md3.instantiationToken == md2.guid == pipeline.load_table(MOTOR_TABLE).token
+    assert md2.coSimulation.canInterpolateInputs is True
+    for md, shim in (
+        (md2, ["fmi2_functions.c"]),
+        (md3, ["fmi3_functions.c", "fmi3_unsupported.c"]),
+    ):
+        assert md.coSimulation.modelIdentifier == "motor"
+        assert md.coSimulation.maxOutputDerivativeOrder == 1
+        assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+        (config,) = md.buildConfigurations
+        assert config.sourceFileSets[0].sourceFiles == [
+            "fmu_motor.c",
+            "fmu_instance.c",
+            "fmu_state.c",
+            *shim,
+            "motor_model.c",
+        ]
+        variables = [v for v in md.modelVariables if v.causality != "independent"]
+        assert [v.name for v in variables] == list(MOTOR_VARIABLES)
+        assert [v.valueReference for v in variables] == list(range(1, len(MOTOR_VARIABLES) + 1))
+        for v in variables:
+            causality, unit, _ = MOTOR_VARIABLES[v.name]
+            assert (v.causality, v.unit) == (causality, unit), v.name
+            if v.name in MOTOR_BOUNDS:
+                assert float(v.min) == MOTOR_BOUNDS[v.name][0] and v.max is None, v.name
+        # every output depends on both inputs: without inductance the current follows them
+        for unknown in md.outputs:
+            assert {d.name for d in unknown.dependencies} == {"motor.voltage", "shaft.omega"}
+    assert md2.coSimulation.providesDirectionalDerivative is False
+
+
+def test_motor_table_bounds_are_exclusive_where_positive():
+    with open(MOTOR_TABLE, "rb") as f:
+        raw = tomllib.load(f)
+    bounds = {
+        v["name"]: (v["min"], v.get("min_exclusive", False)) for v in raw["variable"] if "min" in v
+    }
+    assert bounds == MOTOR_BOUNDS
+    assert [v["lives"] for v in raw["variable"]] == [x[2] for x in MOTOR_VARIABLES.values()]
+
+
+def test_motor_members_match_the_header():
+    text = MOTOR_HEADER.read_text()
+    assert _struct_members(text, "fmu_motor_input") == list(MOTOR_INPUT_MEMBERS)
+    assert _struct_members(text, "fmu_motor_output") == list(MOTOR_OUTPUT_MEMBERS)
+
+
+def test_motor_state_and_rates_are_no_variables():
+    for lives, why in (
+        ("input.current", "is a state of the motor"),
+        ("input.voltage_rate", "first derivative of an input"),
+        ("input.torque", "has no member"),
+    ):
+        with pytest.raises(ValueError, match=why):
+            kinds.MOTOR.parse_lives(lives)
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available")
+def test_motor_c_table_compiles(generated_motor, tmp_path):
+    proc = subprocess.run(
+        ["gcc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror"]
+        + [f"-I{ROOT / 'fmu'}", f"-I{ROOT / 'fmu' / 'models'}", f"-I{ROOT / 'src' / 'include'}"]
+        + ["-c", str(generated_motor / "motor_model.c"), "-o", str(tmp_path / "motor_model.o")],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_motor_documentation_is_complete(generated_motor):
+    page = (generated_motor / "documentation" / "index.html").read_text()
+    for name in MOTOR_VARIABLES:
+        assert f"<code>{name}</code>" in page, name
+    for phrase in ("L di/dt = V - R i - k r omega", "expm1", "no rotor inertia", "phi2"):
+        assert phrase in page, phrase
 
 
 def _write_generic_tables():

@@ -148,6 +148,11 @@ def drive_page(table: Table) -> str:
     return page("drive.html", table)
 
 
+def motor_page(table: Table) -> str:
+    """The page of the DC motor (fmu/models/fmu_motor.c)."""
+    return page("motor.html", table)
+
+
 def _param_text(prm: Param) -> str:
     return f"<code>{prm.name}</code>" if prm.tunable else repr(prm.value)
 
