@@ -14,7 +14,8 @@
  *   - the status output is 0 exactly when the getter says OK, and then every
  *     output is finite; otherwise every output is NaN, except those the model
  *     descriptions keep defined (a dyad's conditioning and amplification; the
- *     drive's motor.torque, NaN only where it overflows itself), and doStep is
+ *     drive's motor.torque and the motor's motor.current, NaN only where they
+ *     overflow themselves), and doStep is
  *     not OK unless on_singular (set too, FMI 2 as Integer, FMI 3 as Int64) is 2,
  *     continue; a model's states (the drive's crank.angle and crank.omega, a
  *     plant's outputs X with a parameter X_start) and a plant's solver counts
@@ -56,7 +57,9 @@
 typedef enum fuzz_rule {
     FUZZ_NAN_WHEN_FAILED = 0, /* NaN unless status 0 (the reactions, crank.epsilon) */
     FUZZ_ANY_WHEN_FAILED,     /* explains the failure: a dyad's conditioning, amplification */
-    FUZZ_FINITE_OR_NAN,       /* NaN only where it overflows itself: the drive's motor.torque */
+    FUZZ_FINITE_OR_NAN,       /* NaN only where it overflows itself: the drive's motor.torque,
+                                 the motor's motor.current (a state, but without inductance it
+                                 follows the inputs) */
     FUZZ_ALWAYS_FINITE        /* a state, kept whatever the status, and a solver's counts */
 } fuzz_rule;
 
@@ -65,11 +68,11 @@ typedef struct fuzz_named_rule {
     fuzz_rule rule;
 } fuzz_named_rule;
 
-static const fuzz_named_rule fuzz_rules[] = {{"conditioning", FUZZ_ANY_WHEN_FAILED},
-                                             {"amplification", FUZZ_ANY_WHEN_FAILED},
-                                             {"motor.torque", FUZZ_FINITE_OR_NAN},
-                                             {"solver.steps", FUZZ_ALWAYS_FINITE},
-                                             {"solver.evaluations", FUZZ_ALWAYS_FINITE}};
+static const fuzz_named_rule fuzz_rules[] = {
+    {"conditioning", FUZZ_ANY_WHEN_FAILED}, {"amplification", FUZZ_ANY_WHEN_FAILED},
+    {"motor.torque", FUZZ_FINITE_OR_NAN},   {"motor.current", FUZZ_FINITE_OR_NAN},
+    {"solver.steps", FUZZ_ALWAYS_FINITE},   {"solver.evaluations", FUZZ_ALWAYS_FINITE},
+};
 
 typedef struct fuzz_fmu {
     probe_model model;
@@ -182,15 +185,16 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
             } else if (strcmp(v->name, "crank.epsilon") == 0) {
                 f->epsilon = (int)k;
             }
-            for (j = 0; j < sizeof fuzz_rules / sizeof fuzz_rules[0]; ++j) {
-                if (strcmp(v->name, fuzz_rules[j].name) == 0) {
-                    f->rule[k] = fuzz_rules[j].rule;
-                }
-            }
             if (probe_state_start(&f->model, v) != NULL) {
                 f->rule[k] = FUZZ_ALWAYS_FINITE;
                 f->first_state = f->has_states ? f->first_state : (int)k;
                 f->has_states = 1;
+            }
+            /* a rule by name comes before a state's: the motor's current */
+            for (j = 0; j < sizeof fuzz_rules / sizeof fuzz_rules[0]; ++j) {
+                if (strcmp(v->name, fuzz_rules[j].name) == 0) {
+                    f->rule[k] = fuzz_rules[j].rule;
+                }
             }
         }
     }

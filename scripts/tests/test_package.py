@@ -32,10 +32,10 @@ pytestmark = pytest.mark.slow  # about 2.5 minutes: one CMake build of the whole
 
 SCRIPTS = paths.ROOT / "scripts"
 CONSTRAINTS = SCRIPTS / "constraints.txt"
-#: The FMUs every package holds: the generic dyads and the drive, FMI 2 and 3.
+#: The FMUs every package holds: the generic dyads, the drive and the motor, FMI 2 and 3.
 EXPECTED_FMUS = [
     f"{name}_fmi{version}.fmu"
-    for name in ("drive", "dyad_rrr", "dyad_rrt", "dyad_rtr", "dyad_rtt", "dyad_trt")
+    for name in ("drive", "motor", "dyad_rrr", "dyad_rrt", "dyad_rtr", "dyad_rtt", "dyad_trt")
     for version in (2, 3)
 ]
 #: One RRT dyad (the inputs of Core().solve) and its reactions in closed form, which this

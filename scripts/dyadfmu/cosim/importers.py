@@ -105,7 +105,7 @@ def fmu_names() -> list[str]:
         + list(scenes.NAMES)
         + mechanisms
         + list(TAILORED)
-        + ["drive"]
+        + ["drive", "motor"]
         + list(PLANTS)
     )
 
@@ -150,14 +150,31 @@ def drive_setup(version: int, build: Path | None = None) -> CoSimSetup:
     return setup_for(path, t, inputs)
 
 
+def motor_setup(version: int, build: Path | None = None) -> CoSimSetup:
+    """The motor under a supply and a shaft speed that swing like a run-up's (290 V, up
+    to 145 rad/s at the shaft, its gear ratio 1), at the parameters' start values and
+    steps of 2^-8 s (as the drive's), inputs held over each."""
+    path = (build or paths.build_dir()) / "fmus" / f"motor_fmi{version}.fmu"
+    t = np.linspace(0.0, 0.5, 129)
+    phase = 2 * math.pi * t / 0.125
+    inputs = {
+        "motor.voltage": 290.0 * (1.0 + 0.2 * np.sin(phase)),
+        "shaft.omega": 145.0 * (1.0 - np.cos(phase / 4)) / 2 + 5.0 * np.sin(3 * phase),
+    }
+    return setup_for(path, t, inputs)
+
+
 def setup_of(name: str, version: int, build: Path | None = None, steps: int = 120) -> CoSimSetup:
     """The harness's co-simulation of the FMU `name` (one crank revolution at `steps`
     communication steps): a generic dyad over the mechanism of its type, a tailored scene
     over its scene's kinematics, a tailored test FMU over the generic dyad's mechanism
     with its own baked parameters, a scene with several drivers over one period of its
-    drivers' motion, the drive under a varying load."""
+    drivers' motion, the drive under a varying load, the motor under a varying supply and
+    shaft speed."""
     if name == "drive":
         return drive_setup(version, build)
+    if name == "motor":
+        return motor_setup(version, build)
     if name in PLANTS:
         return plant_setup(name, version, build)
     if name.startswith("dyad_"):
