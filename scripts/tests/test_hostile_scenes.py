@@ -927,8 +927,8 @@ def _builtin_files() -> list[tuple[Path, str]]:
     """(file, identifier) of every FMU the build always makes, read as CMake finds them."""
     files = sorted(SCENES_DIR.glob("*.toml")) + sorted((ROOT / "tests" / "scenes").glob("*.toml"))
     found = [(p, tomllib.loads(p.read_text())["scene"]["identifier"]) for p in files]
-    drive = MD_DIR / "interface" / "drive.toml"
-    return found + [(drive, tomllib.loads(drive.read_text())["model"]["identifier"])]
+    tables = [MD_DIR / "interface" / name for name in ("drive.toml", "motor.toml")]
+    return found + [(p, tomllib.loads(p.read_text())["model"]["identifier"]) for p in tables]
 
 
 @pytest.mark.parametrize("path, identifier", _builtin_files(), ids=lambda v: str(v)[-20:])
@@ -944,7 +944,7 @@ def test_a_built_in_fmu_s_identifier_is_refused_in_another_file(tmp_path, path, 
 
 
 def test_each_built_in_scene_keeps_its_own_identifier():
-    for path, _ in _builtin_files()[:-1]:
+    for path, _ in _builtin_files()[:-2]:
         pipeline.load_scene(path)  # no SceneError, dyad_rrr's 'dyad_' prefix included
 
 
