@@ -291,30 +291,44 @@ class DyadKind(Kind):
             raise SceneError(exc.args[0]) from None
 
 
-class DriveKind(Kind):
-    """The crank drive (fmu/models/fmu_drive.c), from its table interface/drive.toml."""
+class HandTableKind(Kind):
+    """A model of its own behaviour (fmu/models/fmu_<kind>.c) whose variable table is
+    written by hand (interface/<identifier>.toml) and checked against its catalogue."""
 
     tool = "modelDescription/generate.py"
 
-    log_categories = DRIVE_LOG_CATEGORIES
-
     def source_files(self, table: Table, version: int) -> list[str]:
-        """The drive's behaviour."""
+        """The model's behaviour."""
         return [
-            "fmu_drive.c",
+            f"fmu_{self.name}.c",
             "fmu_instance.c",
             "fmu_state.c",
             *SHIM_FILES[version],
             f"{table.identifier}_model.c",
         ]
 
+    def table_source(self, table: Table) -> str:
+        """The model's table, among the interface data."""
+        return f"modelDescription/interface/{table.path.name}"
+
+    def model_problems(self, model: dict) -> list[str]:
+        """Only a dyad has a type."""
+        if "type" in model:
+            return [
+                f"type {model['type']!r} given, but only a dyad has a type "
+                f"(this table is of kind '{self.name}')"
+            ]
+        return []
+
+
+class DriveKind(HandTableKind):
+    """The crank drive (fmu/models/fmu_drive.c), from its table interface/drive.toml."""
+
+    log_categories = DRIVE_LOG_CATEGORIES
+
     def subject(self, table: Table) -> str:
         """The crank drive."""
         return "the crank drive FMU"
-
-    def table_source(self, table: Table) -> str:
-        """The drive's table, among the interface data."""
-        return f"modelDescription/interface/{table.path.name}"
 
     def documentation(self, table: Table) -> str:
         """The page of the drive."""
@@ -324,44 +338,21 @@ class DriveKind(Kind):
         """The drive's variables."""
         return drive_catalogue()
 
-    def model_problems(self, model: dict) -> list[str]:
-        """A drive has no dyad type."""
-        if "type" in model:
-            return [
-                f"type {model['type']!r} given, but only a dyad has a type "
-                f"(this table is of kind '{self.name}')"
-            ]
-        return []
-
     def absence_reason(self, model: dict, lives: str) -> str:
         """The drive has no such variable."""
         return drive_absence_reason(lives)
 
 
-class MotorKind(Kind):
-    """The DC motor (fmu/models/fmu_motor.c), from its table interface/motor.toml."""
+class MotorKind(HandTableKind):
+    """The DC motor (fmu/models/fmu_motor.c), from its table interface/motor.toml: it
+    follows its inputs' first derivatives and gives its outputs'."""
 
-    tool = "modelDescription/generate.py"
     interpolates = True
     log_categories = MOTOR_LOG_CATEGORIES
-
-    def source_files(self, table: Table, version: int) -> list[str]:
-        """The motor's behaviour."""
-        return [
-            "fmu_motor.c",
-            "fmu_instance.c",
-            "fmu_state.c",
-            *SHIM_FILES[version],
-            f"{table.identifier}_model.c",
-        ]
 
     def subject(self, table: Table) -> str:
         """The motor."""
         return "the DC motor FMU"
-
-    def table_source(self, table: Table) -> str:
-        """The motor's table, among the interface data."""
-        return f"modelDescription/interface/{table.path.name}"
 
     def documentation(self, table: Table) -> str:
         """The page of the motor."""
@@ -370,10 +361,6 @@ class MotorKind(Kind):
     def catalogue_for(self, model: dict) -> dict[str, Entry]:
         """The motor's variables."""
         return motor_catalogue()
-
-    def model_problems(self, model: dict) -> list[str]:
-        """A motor has no dyad type."""
-        return DriveKind.model_problems(self, model)
 
     def absence_reason(self, model: dict, lives: str) -> str:
         """The motor has no such variable."""
