@@ -1,8 +1,8 @@
 /* dyadfmu FMU layer: the description of one model as the FMU layer sees it.
  * The table of variables is generated from the model's one source (a scene file,
- * by modelDescription/scene.py; the drive's modelDescription/interface/drive.toml,
- * by modelDescription/generate.py) together with both model descriptions, so the C
- * side and the XML cannot drift apart. */
+ * by modelDescription/scene.py; the drive's and the motor's variable tables,
+ * modelDescription/interface/drive.toml and motor.toml, by modelDescription/generate.py)
+ * together with both model descriptions, so the C side and the XML cannot drift apart. */
 #ifndef DYADFMU_FMU_MODEL_H
 #define DYADFMU_FMU_MODEL_H
 

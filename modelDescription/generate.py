@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """Generate everything an FMU of one model needs from its variable table.
 
-The table (interface/drive.toml for the crank drive; a generic dyad's comes from its
-scene) is the single source of truth for the interface of one FMU: names, value
-references, causalities, units, start values, bounds, descriptions, where each value
-lives in the model's structures and which inputs each output depends on. From it this
-script writes
+The table (interface/drive.toml for the crank drive, interface/motor.toml for the motor;
+a generic dyad's comes from its scene) is the single source of truth for the interface of
+one FMU: names, value references, causalities, units, start values, bounds, descriptions,
+where each value lives in the model's structures and which inputs each output depends on.
+From it this script writes
 
     DIR/fmi2/modelDescription.xml      the FMI 2.0 model description
     DIR/fmi3/modelDescription.xml      the FMI 3.0 model description

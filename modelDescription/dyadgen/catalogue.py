@@ -1,6 +1,6 @@
-"""The variables a generic dyad FMU and the crank drive have: where each one lives, what
-it must look like and, for an output, the inputs it truly depends on. A table of one
-of these kinds is checked against its catalogue (table.py)."""
+"""The variables a generic dyad FMU, the crank drive and the motor have: where each one
+lives, what it must look like and, for an output, the inputs it truly depends on. A table
+of one of these kinds is checked against its catalogue (table.py)."""
 
 from __future__ import annotations
 

@@ -4,7 +4,8 @@ setting of the FMU layer itself: ``fmu.<setting>`` (settings.py).
 
 A generic dyad lives in dyad_input and dyad_result (src/include/dyadfmu/types.h), whose
 members nest (link m's direction: input.m.dir); the drive in fmu_drive_input and
-fmu_drive_output (fmu/models/fmu_drive.h), and a tailored scene in the flat blocks its header
+fmu_drive_output (fmu/models/fmu_drive.h), the motor in fmu_motor_input and fmu_motor_output
+(fmu/models/fmu_motor.h), and a tailored scene in the flat blocks its header
 declares, whose members keep the case of its variables' names (a pair point's parameter
 DYAD.D_m.x lives in input.DYAD_D_m_x).
 """

@@ -2,9 +2,9 @@
 units, start values, bounds, descriptions), where each value lives in the model's
 structures and which inputs each output depends on.
 
-A table written by hand (interface/drive.toml) or derived from a generic dyad scene is
-validated first; every problem is reported with the file and the variable it
-concerns, and nothing is written unless the table is valid. A tailored scene's table is
+A table written by hand (interface/drive.toml, interface/motor.toml) or derived from a
+generic dyad scene is validated first; every problem is reported with the file and the
+variable it concerns, and nothing is written unless the table is valid. A tailored scene's table is
 made valid by construction (kinds.SceneKind).
 
 Value references start at 1: in FMI 3 the value reference 0 is the independent

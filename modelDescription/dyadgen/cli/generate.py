@@ -16,7 +16,7 @@ from dyadgen.table import TableError
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         description="Generate the model descriptions, C variable table and documentation "
-        "of a dyad or drive FMU from its variable table."
+        "of a dyad, drive or motor FMU from its variable table."
     )
     parser.add_argument("table", nargs="?", type=Path, help="the variable table (TOML)")
     parser.add_argument("--out", type=Path, help="directory to write the generated files to")

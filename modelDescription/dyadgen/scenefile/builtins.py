@@ -1,6 +1,6 @@
 """The identifiers of the FMUs the build always makes (fmu/CMakeLists.txt): every scene in
 modelDescription/scenes/, the test scenes in tests/scenes/ and the variable tables written by hand
-(the drive). A scene of another file may not take one: a build with both would define
+(the drive and the motor). A scene of another file may not take one: a build with both would define
 the CMake targets <identifier>_fmi2 and _fmi3 twice. Read from the files themselves,
 once per process."""
 
