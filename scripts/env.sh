@@ -99,8 +99,8 @@ dyadfmu_build() {
 
 # ---- probes of the FMU binaries (tests/fmu_fuzz.c, fmu_api_tests.c, fmu_threads.c) ----
 # The FMUs the ThreadSanitizer build makes: one of each kind (a generic dyad, a
-# tailored multi-dyad scene, the drive), enough for the thread test and no more.
-DYADFMU_TSAN_FMUS=${DYADFMU_TSAN_FMUS:-"dyad_rrt;sixbar;drive"}
+# tailored multi-dyad scene, the drive, the motor), enough for the thread test and no more.
+DYADFMU_TSAN_FMUS=${DYADFMU_TSAN_FMUS:-"dyad_rrt;sixbar;drive;motor"}
 
 # dyadfmu_build_tsan DIR: the thread test and the FMUs of DYADFMU_TSAN_FMUS,
 # all built with -fsanitize=thread; nothing else of the project.
