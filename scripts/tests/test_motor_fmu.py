@@ -36,8 +36,9 @@ PARAMS = {
     "motor.ratio": 3.0,
     "motor.current_start": 12.5,
 }
-#: L / R: 1.38 ms (about the step), 1e-9 s (1e6 times below it: stiff), none.
-INDUCTANCES = {"slow": 1e-3, "stiff": 0.725e-9, "none": 0.0}
+#: L / R: 1.38 ms (about the step: x = h R / L = 0.725, phi2 by its series), 0.28 ms
+#: (x = 3.6: both terms of the decay matter), 1e-9 s (x = 1e6: stiff), none.
+INDUCTANCES = {"slow": 1e-3, "fast": 2e-4, "stiff": 0.725e-9, "none": 0.0}
 STEP, STEPS = 1e-3, 12
 #: Largest error against the exact solution, relative to the stall current |V| / R and
 #: to the stall torque k r |V| / R (about 1,200 N.m): a few ulps of the step's terms.
