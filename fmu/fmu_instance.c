@@ -1761,3 +1761,14 @@ fmu_status fmu_evaluate_rows(const fmu_model* model, const char* token, int time
     fmu_free(instance);
     return FMU_OK;
 }
+
+int fmu_variable_named(const fmu_model* model, const char* name)
+{
+    size_t k;
+    for (k = 0; k < model->variable_count; ++k) {
+        if (strcmp(model->variables[k].name, name) == 0) {
+            return (int)k;
+        }
+    }
+    return -1;
+}

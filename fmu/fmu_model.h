@@ -183,6 +183,10 @@ typedef struct fmu_model {
     const fmu_copies* copies;
 } fmu_model;
 
+/* The index of the variable called `name` in model's table, -1 if it has none (the
+ * hand-written models name their bad variable by its FMU name). */
+int fmu_variable_named(const fmu_model* model, const char* name);
+
 /* The model compiled into this FMU, defined by the generated <model>_model.c. */
 extern const fmu_model fmu_this_model;
 

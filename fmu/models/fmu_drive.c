@@ -45,18 +45,6 @@
 /* Values of the status output. */
 enum { FMU_DRIVE_OK = 0, FMU_DRIVE_INVALID_INPUT = 2, FMU_DRIVE_OUT_OF_RANGE = 3 };
 
-/* Variable indices are those of the generated table, found by name. */
-static int variable_named(const fmu_model* model, const char* name)
-{
-    size_t k;
-    for (k = 0; k < model->variable_count; ++k) {
-        if (strcmp(model->variables[k].name, name) == 0) {
-            return (int)k;
-        }
-    }
-    return -1;
-}
-
 static double total_inertia(const fmu_drive_input* in)
 {
     return in->inertia + in->load_inertia;
@@ -97,7 +85,7 @@ static int check(const fmu_model* model, const fmu_drive_input* in, fmu_evaluati
 {
     if (!(total_inertia(in) > 0)) {
         e->status = FMU_ERROR;
-        e->bad_variable = variable_named(model, "load.inertia");
+        e->bad_variable = fmu_variable_named(model, "load.inertia");
         snprintf(e->reason, sizeof e->reason, "inertia + load.inertia = %g kg.m2 must be positive",
                  total_inertia(in));
         return 0;

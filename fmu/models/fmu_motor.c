@@ -41,18 +41,6 @@
 /* Values of the status output. */
 enum { FMU_MOTOR_OK = 0, FMU_MOTOR_OUT_OF_RANGE = 3 };
 
-/* Variable indices are those of the generated table, found by name. */
-static int variable_named(const fmu_model* model, const char* name)
-{
-    size_t k;
-    for (k = 0; k < model->variable_count; ++k) {
-        if (strcmp(model->variables[k].name, name) == 0) {
-            return (int)k;
-        }
-    }
-    return -1;
-}
-
 static void clear(fmu_evaluation* evaluation)
 {
     evaluation->status = FMU_OK;
@@ -161,7 +149,7 @@ FMU_COLD static double ramp_too_far(const fmu_model* model, const fmu_motor_inpu
     const int voltage = !isfinite(in->voltage + h * in->voltage_rate);
     const char* name = voltage ? "motor.voltage" : "shaft.omega";
     evaluation->status = FMU_ERROR;
-    evaluation->bad_variable = variable_named(model, name);
+    evaluation->bad_variable = fmu_variable_named(model, name);
     snprintf(evaluation->reason, sizeof evaluation->reason,
              "%s = %g with its derivative %g per second is not finite %g s on: set a smaller "
              "derivative or a shorter step",

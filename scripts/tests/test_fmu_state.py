@@ -14,30 +14,9 @@ import pytest
 from dyadfmu.cosim import importers
 from dyadfmu.fmi.slave import Slave
 from fmpy import read_model_description
-from fmpy.fmi3 import fmi3FMUState
 
 ALL = [(name, version) for name in importers.fmu_names() for version in importers.VERSIONS]
 IDS = [f"{name}_fmi{version}" for name, version in ALL]
-
-
-def _calls(s: Slave) -> tuple:
-    """fmpy's get, set, free, serialize and deserialize of the FMU state."""
-    f = s.fmu
-    if s.version == 2:
-        return (
-            f.getFMUstate,
-            f.setFMUstate,
-            f.freeFMUstate,
-            f.serializeFMUstate,
-            f.deSerializeFMUstate,
-        )
-
-    def deserialize(data: bytes) -> fmi3FMUState:
-        state = fmi3FMUState()
-        f.deserializeFMUState(data, state)
-        return state
-
-    return f.getFMUState, f.setFMUState, f.freeFMUState, f.serializeFMUState, deserialize
 
 
 def _run(s: Slave, setup, names: list, outputs: list, first: int, last: int) -> np.ndarray:
@@ -64,7 +43,7 @@ def test_a_restored_state_continues_bit_for_bit(name, version):
     s = Slave(setup.path, instance_name="state")
     try:
         s.initialize()
-        get, set_, free, serialize, deserialize = _calls(s)
+        get, set_, free, serialize, deserialize = s.state_calls()
         _run(s, setup, names, outputs, 0, 20)
         saved = get()
         first = _run(s, setup, names, outputs, 20, 40)
@@ -100,7 +79,7 @@ def test_a_crafted_state_is_refused_naming_its_field(name, version):
     s = Slave(setup.path, instance_name="crafted")
     try:
         s.initialize()
-        get, set_, free, serialize, deserialize = _calls(s)
+        get, set_, free, serialize, deserialize = s.state_calls()
         data = serialize(get())
         fields = (len(data) - 32) // 8
         assert fields >= 5

@@ -30,7 +30,6 @@ import pytest
 from dyadfmu import paths
 from dyadfmu.fmi.slave import Slave, SlaveError
 from fmpy import read_model_description
-from fmpy.fmi3 import fmi3FMUState
 from fmpy.validation import validate_fmu
 
 VERSIONS = (2, 3)
@@ -202,26 +201,6 @@ def test_fmi2_and_fmi3_agree_bit_for_bit(inductance):
     assert runs[0].tobytes() == runs[1].tobytes()
 
 
-def _state_calls(s: Slave) -> tuple:
-    """fmpy's get, set, free, serialize and deserialize of the FMU state."""
-    f = s.fmu
-    if s.version == 2:
-        return (
-            f.getFMUstate,
-            f.setFMUstate,
-            f.freeFMUstate,
-            f.serializeFMUstate,
-            f.deSerializeFMUstate,
-        )
-
-    def deserialize(data: bytes) -> fmi3FMUState:
-        state = fmi3FMUState()
-        f.deserializeFMUState(data, state)
-        return state
-
-    return f.getFMUState, f.setFMUState, f.freeFMUState, f.serializeFMUState, deserialize
-
-
 def _held_on(s: Slave, steps: range) -> np.ndarray:
     """Steps with no input set: the inputs go on along the derivatives last set."""
     rows = []
@@ -236,7 +215,7 @@ def _held_on(s: Slave, steps: range) -> np.ndarray:
 def test_a_restored_state_continues_bit_for_bit(version, inductance):
     ramps = version == 2
     s = motor(version, INDUCTANCES[inductance])
-    get_state, set_state, free_state, serialize, deserialize = _state_calls(s)
+    get_state, set_state, free_state, serialize, deserialize = s.state_calls()
     try:
         fmu_run(s, ramps, 0, 4)
         if ramps:
@@ -271,7 +250,7 @@ RATE_BOUND = 1e-8
 def test_output_derivatives_are_the_outputs_rates(version, inductance):
     ramps = version == 2
     s = motor(version, INDUCTANCES[inductance])
-    get_state, set_state, free_state, _, _ = _state_calls(s)
+    get_state, set_state, free_state, _, _ = s.state_calls()
     names = ("motor.current", "shaft.torque")
     d = 1e-7
     worst, scale = np.zeros(2), np.zeros(2)
@@ -308,7 +287,7 @@ def test_a_stiff_circuits_derivatives_along_straight_ramps():
     follow). di/dt = (u - R i) / L is then the small difference of two large voltages over
     L: its round-off, eps |u| / L, is about 2e-9 of u' / R here (measured 2.5e-9)."""
     s = motor(2, INDUCTANCES["stiff"])
-    get_state, set_state, free_state, _, _ = _state_calls(s)
+    get_state, set_state, free_state, _, _ = s.state_calls()
     names = ("motor.current", "shaft.torque")
     d = 1e-7
     s.set(("motor.voltage", "shaft.omega"), (290.0, 20.0))

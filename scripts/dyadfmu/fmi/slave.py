@@ -25,7 +25,7 @@ from fmpy.fmi2 import (
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
 )
-from fmpy.fmi3 import FMU3Slave
+from fmpy.fmi3 import FMU3Slave, fmi3FMUState
 
 __all__ = ["SlaveError", "Slave", "unpacked"]
 
@@ -250,6 +250,26 @@ class Slave:
         else:
             get = self.fmu.getOutputDerivatives
         return self._call("getOutputDerivatives", get, refs, [1] * len(refs))
+
+    def state_calls(self) -> tuple:
+        """fmpy's get, set, free, serialize and deserialize of the FMU state, the same
+        five for FMI 2 and 3 (FMI 3's deserialize made to return the new state)."""
+        f = self.fmu
+        if self.version == 2:
+            return (
+                f.getFMUstate,
+                f.setFMUstate,
+                f.freeFMUstate,
+                f.serializeFMUstate,
+                f.deSerializeFMUstate,
+            )
+
+        def deserialize(data: bytes) -> fmi3FMUState:
+            state = fmi3FMUState()
+            f.deserializeFMUState(data, state)
+            return state
+
+        return f.getFMUState, f.setFMUState, f.freeFMUState, f.serializeFMUState, deserialize
 
     def reset(self) -> None:
         """Back to the state after instantiation (start values, not initialised)."""
