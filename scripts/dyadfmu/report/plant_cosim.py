@@ -108,7 +108,7 @@ def _step_table(found: list[dict]) -> list[str]:
     rows = [p for p in found if math.isnan(p["rtol"])]
     steps = sorted({p["step"] for p in rows}, reverse=True)
     table = []
-    for coupling in dict.fromkeys(p["coupling"] for p in rows):
+    for coupling in sorted(dict.fromkeys(p["coupling"] for p in rows), key=lambda c: c[:3]):
         by_step = {p["step"]: p for p in rows if p["coupling"] == coupling}
         cells = [_cell(by_step[h]) for h in steps]
         table.append([coupling, *cells])
@@ -173,8 +173,10 @@ def _split_targets(found: list[dict]) -> list[str]:
                 text += f" (target at most {SPLIT_TARGET:g} rad): {held}"
         out.append(text + ".")
     for p in (p for p in found if "failed" in p):
-        reason = markup.text(p["failed"].split("(", 1)[-1].rstrip(")")[:160])
-        out.append(f"- {p['coupling']} at {p['step']:g} s: refused by the plant: {reason}")
+        reason = p["failed"].split("(", 1)[-1].split(" (", 1)[0]
+        out.append(
+            f"- {p['coupling']} at {p['step']:g} s: refused by the plant: {markup.text(reason)}."
+        )
     return out
 
 
