@@ -695,7 +695,7 @@ def parser() -> argparse.ArgumentParser:
         "--quick",
         action="store_true",
         help="steps 1e-2 and 1e-3 s, ratios 1 and 100, the slow motor only, looser "
-        "references (about 45 s of CPU time; the full study about 8.3 minutes)",
+        "references (about 40 s of CPU time; the full study about 8.8 minutes)",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out)")
     p.add_argument(
