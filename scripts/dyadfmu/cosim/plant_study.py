@@ -24,11 +24,13 @@ API: :data:`STEPS`, :data:`RTOLS`, :data:`CIRCUITS`, :func:`reference`, :func:`r
 
 from __future__ import annotations
 
+import functools
 import math
 import time as clock
 from dataclasses import dataclass, replace
 
 import numpy as np
+from fmpy import read_model_description
 
 from .. import paths
 from ..fmi.slave import Slave
@@ -73,11 +75,8 @@ class Circuit:
 
 def circuit(label: str, version: int = 2) -> Circuit:
     """The plant's motor with the time constant of :data:`CIRCUITS` ``label``."""
-    md = Slave(paths.built_fmu(PLANT, version, how="scripts/run-tests"), "start values")
-    try:
-        starts = {v.name: float(v.start) for v in md.md.modelVariables if v.start is not None}
-    finally:
-        md.close()
+    md = read_model_description(str(paths.built_fmu(PLANT, version, how="scripts/run-tests")))
+    starts = {v.name: float(v.start) for v in md.modelVariables if v.start is not None}
     motor = Circuit(*(starts[f"crank.motor.{k}"] for k in _MOTOR_KEYS))
     time_constant = 0.0 if label == LINEAR else CIRCUITS[label]
     if time_constant is None:
@@ -147,6 +146,7 @@ class _Periodic:
         return (np.exp(1j * np.multiply.outer(phi, self.k)) @ self.c).real
 
 
+@functools.cache
 def _machine_terms() -> tuple[_Periodic, _Periodic, _Periodic]:
     """J(phi), J'(phi) and Q_g(phi) of the slider-crank, from the harness's kinematics."""
     mech = mechanism_fmus.mechanism_of(MECHANISM)
@@ -155,6 +155,11 @@ def _machine_terms() -> tuple[_Periodic, _Periodic, _Periodic]:
         _Periodic(lambda q: driven.effective_inertia(mech, q)[1]),
         _Periodic(lambda q: driven.generalized_gravity(mech, q)),
     )
+
+
+def fit_error() -> float:
+    """The largest distance of the series of J, J' and Q_g to the harness (relative)."""
+    return max(term.fit_error for term in _machine_terms())
 
 
 def _rhs(motor: Circuit, terms: tuple):
