@@ -35,6 +35,8 @@ SCENES = {
     "leg_motor": paths.SCENES_DIR / "leg.toml",
     "four_bar_forward": paths.SCENES_DIR / "four_bar_payload.toml",
     "slider_crank_rotor": paths.SCENES_DIR / "slider_crank.toml",
+    "four_bar_motor": paths.SCENES_DIR / "four_bar_payload.toml",
+    "shaper_motor": paths.SCENES_DIR / "shaper.toml",
 }
 #: A constant cutting force on the shaper's ram [N] (the reference's load model made
 #: constant, as the FMU's input holds it)

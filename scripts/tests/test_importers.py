@@ -95,6 +95,8 @@ STUDY_TEST_FMUS |= {
         "leg_motor",
         "four_bar_forward",
         "slider_crank_rotor",
+        "four_bar_motor",
+        "shaper_motor",
     )
     for version in (2, 3)
 }

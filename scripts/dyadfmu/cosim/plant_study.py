@@ -1,11 +1,12 @@
 """The machine with its motor inside the plant, against the same machine as one ODE.
 
-The plant ``slider_crank_motor`` (the slider-crank with its DC motor, supply voltage in)
-runs up from rest under a constant 290 V over 2 s, at communication steps from 0.1 s down
-to 10 us and at relative tolerances from 1e-6 down to 1e-11. Its crank angle and speed at
-every communication point are compared with the machine as one ODE, from the harness's
-own kinematics (:mod:`dyadfmu.mechanisms.driven`: the effective inertia J(phi), its
-derivative and the weights' generalised force Q_g(phi)) and the motor's circuit:
+Each machine of :data:`MACHINES` (the slider-crank, the four-bar, the shaper: a plant with
+its DC motor inside, supply voltage in) runs up from rest under a constant voltage, at
+communication steps from 0.1 s down to 10 us and (the slider-crank) at relative
+tolerances from 1e-6 down to 1e-11. Its crank angle and speed at every communication
+point are compared with the machine as one ODE, from the harness's own kinematics
+(:mod:`dyadfmu.mechanisms.driven`: the effective inertia J(phi), its derivative and the
+weights' generalised force Q_g(phi)) and the motor's circuit:
 
     phi' = omega,
     (J(phi) + r^2 J_r) omega' = r (k i - c r omega) + Q_g(phi) - J'(phi) omega^2 / 2,
@@ -15,11 +16,11 @@ integrated by SciPy (Radau where the circuit is stiff). J, J' and Q_g enter as t
 Fourier series from 128 of the harness's values, each within 2e-15 of the harness
 (``_Periodic.fit_error``), so that an evaluation costs tens of microseconds, not
 milliseconds. The drive FMU's machine (:func:`drive_run`) is the same one with L = 0.
-The motor's numbers are the plant's own parameters (read
-from its model description), so the two cannot drift apart.
+The motor's numbers are the plant's own parameters (read from its model description), so
+the two cannot drift apart.
 
-API: :data:`STEPS`, :data:`RTOLS`, :data:`CIRCUITS`, :func:`reference`, :func:`run`,
-:func:`errors`.
+API: :data:`MACHINES`, :data:`STEPS`, :data:`RTOLS`, :data:`CIRCUITS`, :func:`reference`,
+:func:`run`, :func:`split_run`, :func:`drive_run`, :func:`errors`.
 """
 
 from __future__ import annotations
@@ -38,13 +39,51 @@ from ..mechanisms import driven
 from ..reference import machine
 from . import mechanism_drive, mechanism_fmus
 
-__all__ = ["CIRCUITS", "RTOLS", "STEPS", "Circuit", "PlantRun", "errors", "reference", "run"]
+__all__ = [
+    "CIRCUITS",
+    "MACHINES",
+    "RTOLS",
+    "STEPS",
+    "Circuit",
+    "PlantMachine",
+    "PlantRun",
+    "drive_run",
+    "errors",
+    "reference",
+    "run",
+    "split_run",
+]
 
-PLANT = "slider_crank_motor"
-MECHANISM = "slider_crank"
+
+@dataclass(frozen=True)
+class PlantMachine:
+    """A machine of the study: the plant with its motor inside (a), the plant whose crank
+    takes a separate motor FMU's rotor (b), the inverse mechanism FMU (c) whose harness
+    mechanism is the reference's, the supply voltage [V] and the run's duration [s]."""
+
+    name: str
+    plant: str
+    rotor_plant: str
+    mechanism: str
+    voltage: float
+    t_end: float
+
+
+#: The machines, each run up from rest at START_ANGLE (the motors: the plants' [motor]).
+MACHINES = {
+    m.name: m
+    for m in (
+        PlantMachine(
+            "slider-crank", "slider_crank_motor", "slider_crank_rotor", "slider_crank", 290.0, 2.0
+        ),
+        PlantMachine(
+            "four-bar", "four_bar_motor", "four_bar_forward", "four_bar_payload", 36.0, 0.5
+        ),
+        PlantMachine("shaper", "shaper_motor", "shaper_forward", "shaper", 7.5, 1.0),
+    )
+}
+SLIDER_CRANK = MACHINES["slider-crank"]
 START_ANGLE = 0.5  # rad
-VOLTAGE = 290.0  # V
-T_END = 2.0  # s
 #: Communication steps [s] and relative tolerances of the study.
 STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 RTOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)
@@ -73,9 +112,9 @@ class Circuit:
         return {f"crank.motor.{k}": getattr(self, k) for k in _MOTOR_KEYS}
 
 
-def circuit(label: str, version: int = 2) -> Circuit:
-    """The plant's motor with the time constant of :data:`CIRCUITS` ``label``."""
-    md = read_model_description(str(paths.built_fmu(PLANT, version, how="scripts/run-tests")))
+def circuit(label: str, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> Circuit:
+    """The motor of ``m``'s plant with the time constant of :data:`CIRCUITS` ``label``."""
+    md = read_model_description(str(paths.built_fmu(m.plant, version, how="scripts/run-tests")))
     starts = {v.name: float(v.start) for v in md.modelVariables if v.start is not None}
     motor = Circuit(*(starts[f"crank.motor.{k}"] for k in _MOTOR_KEYS))
     time_constant = 0.0 if label == LINEAR else CIRCUITS[label]
@@ -98,22 +137,33 @@ class PlantRun:
     cpu_time: float
 
 
-def run(label: str, step: float, rtol: float | None = None, version: int = 2) -> PlantRun:
-    """The plant with motor ``label`` over :data:`T_END` at communication step ``step``
-    (and ``solver.rtol`` = ``solver.atol`` = ``rtol`` where given)."""
-    n = int(round(T_END / step))
-    if n < 1 or abs(n * step - T_END) > 1e-9 * T_END:
-        raise ValueError(f"{T_END} s is not a whole number of steps of {step!r} s")
-    parameters = circuit(label, version).parameters()
+def _steps(m: PlantMachine, step: float) -> int:
+    n = int(round(m.t_end / step))
+    if n < 1 or abs(n * step - m.t_end) > 1e-9 * m.t_end:
+        raise ValueError(f"{m.t_end} s is not a whole number of steps of {step!r} s")
+    return n
+
+
+def run(
+    label: str,
+    step: float,
+    rtol: float | None = None,
+    version: int = 2,
+    m: PlantMachine = SLIDER_CRANK,
+) -> PlantRun:
+    """``m``'s plant with motor ``label`` over its run at communication step ``step`` (and
+    ``solver.rtol`` = ``solver.atol`` = ``rtol`` where given)."""
+    n = _steps(m, step)
+    parameters = circuit(label, version, m).parameters()
     parameters["crank.angle_start"] = START_ANGLE
     if rtol is not None:
         parameters.update({"solver.rtol": rtol, "solver.atol": rtol})
-    plant = Slave(paths.built_fmu(PLANT, version, how="scripts/run-tests"), "plant")
+    plant = Slave(paths.built_fmu(m.plant, version, how="scripts/run-tests"), "plant")
     names = ("crank.angle", "crank.omega")
     rows = np.empty((n + 1, 2))
     started = clock.process_time()
     try:
-        plant.set("crank.motor.voltage", VOLTAGE)
+        plant.set("crank.motor.voltage", m.voltage)
         plant.initialize(parameters)
         rows[0] = plant.get(names)
         for k in range(n):
@@ -128,9 +178,10 @@ def run(label: str, step: float, rtol: float | None = None, version: int = 2) ->
 
 class _Periodic:
     """A function of the crank angle with period 2 pi, as its Fourier series from the
-    harness's values at :data:`SAMPLES` angles (the slider-crank's are analytic: their
-    coefficients fall below 1e-18 long before the last); ``fit_error`` is its largest
-    distance to the harness at 1000 other angles, relative to its largest value."""
+    harness's values at :data:`SAMPLES` angles (analytic in the angle for a crank that
+    turns round: their coefficients fall below 1e-18 long before the last);
+    ``fit_error`` is its largest distance to the harness at 1000 other angles, relative to
+    its largest value."""
 
     def __init__(self, of: object) -> None:
         q = 2 * math.pi * np.arange(SAMPLES) / SAMPLES
@@ -147,9 +198,9 @@ class _Periodic:
 
 
 @functools.cache
-def _machine_terms() -> tuple[_Periodic, _Periodic, _Periodic]:
-    """J(phi), J'(phi) and Q_g(phi) of the slider-crank, from the harness's kinematics."""
-    mech = mechanism_fmus.mechanism_of(MECHANISM)
+def _machine_terms(mechanism: str) -> tuple[_Periodic, _Periodic, _Periodic]:
+    """J(phi), J'(phi) and Q_g(phi) of the mechanism FMU ``mechanism``'s harness mechanism."""
+    mech = mechanism_fmus.mechanism_of(mechanism)
     return (
         _Periodic(lambda q: driven.effective_inertia(mech, q)[0]),
         _Periodic(lambda q: driven.effective_inertia(mech, q)[1]),
@@ -157,12 +208,12 @@ def _machine_terms() -> tuple[_Periodic, _Periodic, _Periodic]:
     )
 
 
-def fit_error() -> float:
-    """The largest distance of the series of J, J' and Q_g to the harness (relative)."""
-    return max(term.fit_error for term in _machine_terms())
+def fit_error(m: PlantMachine = SLIDER_CRANK) -> float:
+    """The largest distance of ``m``'s series of J, J' and Q_g to the harness (relative)."""
+    return max(term.fit_error for term in _machine_terms(m.mechanism))
 
 
-def _rhs(motor: Circuit, terms: tuple):
+def _rhs(motor: Circuit, terms: tuple, voltage: float):
     inertia, slope, weight = terms
     r, k = motor.ratio, motor.torque_constant
 
@@ -170,27 +221,33 @@ def _rhs(motor: Circuit, terms: tuple):
         if motor.inductance > 0:
             current = y[2]
         else:
-            current = (VOLTAGE - k * r * y[1]) / motor.resistance
+            current = (voltage - k * r * y[1]) / motor.resistance
         torque = r * (k * current - motor.friction * r * y[1])
         load = torque + weight(y[0]) - 0.5 * slope(y[0]) * y[1] ** 2
         accel = load / (inertia(y[0]) + r * r * motor.rotor_inertia)
         if motor.inductance == 0:
             return np.array([y[1], accel])
-        di = (VOLTAGE - motor.resistance * current - k * r * y[1]) / motor.inductance
+        di = (voltage - motor.resistance * current - k * r * y[1]) / motor.inductance
         return np.array([y[1], accel, di])
 
     return rhs
 
 
-def reference(label: str, t: np.ndarray, method: str = "Radau", rtol: float = 1e-12) -> tuple:
-    """(phi, omega) of the machine with motor ``label`` as one ODE on the grid t."""
+def reference(
+    label: str,
+    t: np.ndarray,
+    method: str = "Radau",
+    rtol: float = 1e-12,
+    m: PlantMachine = SLIDER_CRANK,
+) -> tuple:
+    """(phi, omega) of ``m`` with motor ``label`` as one ODE on the grid t."""
     from scipy.integrate import solve_ivp
 
-    motor = circuit(label)
-    start, scale = [START_ANGLE, 0.0, 0.0], [1.0, 1.0, VOLTAGE / motor.resistance]
+    motor = circuit(label, m=m)
+    start, scale = [START_ANGLE, 0.0, 0.0], [1.0, 1.0, m.voltage / motor.resistance]
     n = 3 if motor.inductance > 0 else 2
     sol = solve_ivp(
-        _rhs(motor, _machine_terms()),
+        _rhs(motor, _machine_terms(m.mechanism), m.voltage),
         (0.0, float(t[-1])),
         start[:n],
         method=method,
@@ -203,32 +260,31 @@ def reference(label: str, t: np.ndarray, method: str = "Radau", rtol: float = 1e
     return sol.y[0], sol.y[1]
 
 
-def drive_run(step: float, version: int = 2) -> PlantRun:
-    """The same machine as the drive FMU (the motor's linear characteristic, L = 0: stall
-    torque k r V / R, no-load speed V / (k r)) and the inverse mechanism FMU of the
-    slider-crank, stabilised (:mod:`dyadfmu.cosim.mechanism_drive`)."""
-    motor = circuit(LINEAR)
+def drive_run(step: float, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> PlantRun:
+    """``m`` as the drive FMU (the motor's linear characteristic, L = 0: stall torque
+    k r V / R, no-load speed V / (k r)) and its inverse mechanism FMU, stabilised
+    (:mod:`dyadfmu.cosim.mechanism_drive`)."""
+    motor = circuit(LINEAR, m=m)
     gain = motor.torque_constant * motor.ratio
     linear = machine.Motor(
-        gain * VOLTAGE / motor.resistance, VOLTAGE / gain, motor.ratio**2 * motor.rotor_inertia
+        gain * m.voltage / motor.resistance, m.voltage / gain, motor.ratio**2 * motor.rotor_inertia
     )
-    m = mechanism_drive.Machine(MECHANISM, linear, 0.0, T_END)
+    drive = mechanism_drive.Machine(m.mechanism, linear, 0.0, m.t_end)
     started = clock.process_time()
-    r = mechanism_drive.run(MECHANISM, step, version, m)
+    r = mechanism_drive.run(m.mechanism, step, version, drive)
     cpu = clock.process_time() - started
     return PlantRun(LINEAR, step, math.nan, r.t, r.phi, r.omega, cpu)
 
 
-#: The plant of a separate motor's study: the slider-crank with its crank's inertia a
-#: parameter, to which the motor's rotor is added.
-ROTOR_PLANT = "slider_crank_rotor"
+#: The separate motor FMU of (b).
 MOTOR_FMU = "motor"
 
 
-def _split_fmus(label: str, version: int) -> tuple[Slave, Slave]:
-    """The motor FMU and the plant of :data:`ROTOR_PLANT`, initialised for ``label``."""
-    motor = circuit(label, version)
-    plant = Slave(paths.built_fmu(ROTOR_PLANT, version, how="scripts/run-tests"), "plant")
+def _split_fmus(label: str, version: int, m: PlantMachine) -> tuple[Slave, Slave]:
+    """The motor FMU and ``m``'s rotor plant (its crank's inertia a parameter, to which the
+    motor's rotor is added), initialised for ``label``."""
+    motor = circuit(label, version, m)
+    plant = Slave(paths.built_fmu(m.rotor_plant, version, how="scripts/run-tests"), "plant")
     crank = next(v for v in plant.md.modelVariables if v.name == "crank.inertia")
     rotor = motor.ratio**2 * motor.rotor_inertia
     plant.initialize(
@@ -236,7 +292,7 @@ def _split_fmus(label: str, version: int) -> tuple[Slave, Slave]:
     )
     fmu = Slave(paths.built_fmu(MOTOR_FMU, version, how="scripts/run-tests"), "motor")
     names = ("resistance", "inductance", "torque_constant", "friction", "ratio")
-    fmu.set("motor.voltage", VOLTAGE)
+    fmu.set("motor.voltage", m.voltage)
     fmu.initialize({f"motor.{k}": getattr(motor, k) for k in names})
     return fmu, plant
 
@@ -254,12 +310,13 @@ def _exchange(motor: Slave, plant: Slave, rates: bool) -> tuple:
     return phi, omega
 
 
-def split_run(label: str, step: float, rates: bool) -> PlantRun:
-    """The motor ``label`` as its own FMU (voltage and speed in, torque out) and the plant
-    (torque in, speed out), exchanged at each communication point: held over the step, or
-    with their first derivatives (``rates``: FMI 2's input and output derivatives)."""
-    n = int(round(T_END / step))
-    motor, plant = _split_fmus(label, 2)
+def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRANK) -> PlantRun:
+    """The motor ``label`` of ``m`` as its own FMU (voltage and speed in, torque out) and
+    the plant (torque in, speed out), exchanged at each communication point: held over the
+    step, or with their first derivatives (``rates``: FMI 2's input and output
+    derivatives)."""
+    n = _steps(m, step)
+    motor, plant = _split_fmus(label, 2, m)
     rows = np.empty((n + 1, 2))
     started = clock.process_time()
     try:

@@ -1,9 +1,10 @@
-"""The co-simulation report's section on plants: the slider-crank's machine with its motor
-inside the plant (a) against the drive FMU with the inverse mechanism FMU, stabilised (c),
-both against the machine as one ODE (:mod:`dyadfmu.cosim.plant_study`): the errors in
-crank angle and speed against the communication step and the run's CPU time, and (a)
-against its relative tolerance. Writes ``plant_vs_step.png`` beside the report and gives
-its lines and its points.
+"""The co-simulation report's section on plants: each machine of
+:data:`dyadfmu.cosim.plant_study.MACHINES` with its motor inside the plant (a), with the
+motor as its own FMU (b) and as the drive FMU with the inverse mechanism FMU, stabilised
+(c), all against the machine as one ODE: the errors in crank angle and speed against the
+communication step and the run's CPU time, and (a) against its relative tolerance (the
+slider-crank). Writes ``plant_vs_step.png`` beside the report and gives its lines and its
+points. The quick study runs the slider-crank only.
 """
 
 from __future__ import annotations
@@ -26,72 +27,86 @@ _QUICK_STEPS = (1e-2, 1e-3)
 _QUICK_RTOLS = (1e-8, 1e-10)
 
 
-def _reference_grid(steps: tuple) -> np.ndarray:
-    n = int(round(study.T_END / min(steps)))
-    return study.T_END * np.arange(n + 1) / n
+def _reference_grid(steps: tuple, m: study.PlantMachine) -> np.ndarray:
+    n = int(round(m.t_end / min(steps)))
+    return m.t_end * np.arange(n + 1) / n
 
 
 def _reference_rtol(quick: bool) -> float:
     return 1e-10 if quick else 1e-12
 
 
-def _reference(label: str, steps: tuple, quick: bool) -> tuple:
+def _reference(label: str, steps: tuple, quick: bool, m: study.PlantMachine) -> tuple:
     """The machine as one ODE: Radau where the circuit is stiff, else DOP853."""
     stiff = study.CIRCUITS.get(label) is not None
-    rtol = _reference_rtol(quick)
-    return study.reference(label, _reference_grid(steps), "Radau" if stiff else "DOP853", rtol)
+    grid, rtol = _reference_grid(steps, m), _reference_rtol(quick)
+    return study.reference(label, grid, "Radau" if stiff else "DOP853", rtol, m)
 
 
-def _point(coupling: str, step: float, rtol: float, run: object, ref: tuple) -> dict:
+def _point(
+    m: study.PlantMachine, coupling: str, step: float, rtol: float, run: object, ref: tuple
+) -> dict:
     e = study.errors(run, ref)
-    return {"coupling": coupling, "step": step, "rtol": rtol, **e, "cpu_time": run.cpu_time}
+    return {"machine": m.name, "coupling": coupling, "step": step, "rtol": rtol, **e} | {
+        "cpu_time": run.cpu_time
+    }
 
 
 #: The separate motor FMU's couplings: the inputs held over the step, or with their rates.
 SPLIT = {False: "(b) motor FMU + plant, held", True: "(b) motor FMU + plant, with rates"}
 
 
-def _split_points(label: str, steps: tuple, ref: tuple) -> list[dict]:
+def _split_points(label: str, steps: tuple, ref: tuple, m: study.PlantMachine) -> list[dict]:
     """(b) at each step, held and with rates; a run the plant refuses (its motion run away
     under a torque held too long) is kept with infinite errors and the plant's reason."""
     found = []
     for rates, coupling in SPLIT.items():
         for step in steps:
             try:
-                run = study.split_run(label, step, rates)
+                run = study.split_run(label, step, rates, m)
             except SlaveError as e:
                 lost = {"angle": math.inf, "speed": math.inf, "angle_rad": math.inf}
                 found.append(
-                    {"coupling": coupling, "step": step, "rtol": math.nan, **lost}
+                    {"machine": m.name, "coupling": coupling, "step": step, "rtol": math.nan}
+                    | lost
                     | {"cpu_time": math.nan, "failed": str(e)}
                 )
                 continue
-            found.append(_point(coupling, step, math.nan, run, ref))
+            found.append(_point(m, coupling, step, math.nan, run, ref))
     return found
 
 
-def points(quick: bool, log: Callable[[str], None]) -> list[dict]:
-    """Every run of the section: (a) per circuit and step, (a) per rtol, (b) and (c) per
-    step."""
+def _machine_points(m: study.PlantMachine, quick: bool, log: Callable[[str], None]) -> list:
+    """(a) per circuit and step, (a) per rtol (the slider-crank), (b) and (c) per step."""
     steps = _QUICK_STEPS if quick else study.STEPS
     circuits = list(study.CIRCUITS)[:1] if quick else list(study.CIRCUITS)
     found = []
     for label in circuits:
-        log(f"plant, motor {label}: the reference over {study.T_END:g} s")
-        ref = _reference(label, steps, quick)
+        log(f"{m.name}, motor {label}: the reference over {m.t_end:g} s and the plant")
+        ref = _reference(label, steps, quick, m)
         for step in steps:
-            found.append(_point(f"(a) motor {label}", step, math.nan, study.run(label, step), ref))
-        if label == circuits[0]:
+            run = study.run(label, step, m=m)
+            found.append(_point(m, f"(a) motor {label}", step, math.nan, run, ref))
+        if label != circuits[0]:
+            continue
+        if m == study.SLIDER_CRANK:
             for rtol in _QUICK_RTOLS if quick else study.RTOLS:
-                run = study.run(label, RTOL_STEP, rtol)
-                found.append(_point(f"(a) motor {label}", RTOL_STEP, rtol, run, ref))
-            log(f"motor FMU and plant, motor {label}")
-            found += _split_points(label, steps, ref)
-    log("drive FMU and mechanism FMU: the reference with L = 0")
-    ref = _reference(study.LINEAR, steps, quick)
+                run = study.run(label, RTOL_STEP, rtol, m=m)
+                found.append(_point(m, f"(a) motor {label}", RTOL_STEP, rtol, run, ref))
+        log(f"{m.name}: motor FMU and plant, motor {label}")
+        found += _split_points(label, steps, ref, m)
+    log(f"{m.name}: drive FMU and mechanism FMU, the reference with L = 0")
+    ref = _reference(study.LINEAR, steps, quick, m)
     for step in steps:
-        found.append(_point("(c) drive + inverse FMU", step, math.nan, study.drive_run(step), ref))
+        run = study.drive_run(step, m=m)
+        found.append(_point(m, "(c) drive + inverse FMU", step, math.nan, run, ref))
     return found
+
+
+def points(quick: bool, log: Callable[[str], None]) -> list[dict]:
+    """Every run of the section, machine by machine (the quick study: the slider-crank)."""
+    machines = [study.SLIDER_CRANK] if quick else list(study.MACHINES.values())
+    return [p for m in machines for p in _machine_points(m, quick, log)]
 
 
 def _e(x: float) -> str:
@@ -104,16 +119,21 @@ def _cell(p: dict) -> str:
     return f"{_e(p['angle'])} / {_e(p['speed'])}"
 
 
+def _machines(found: list[dict]) -> list[str]:
+    return list(dict.fromkeys(p["machine"] for p in found))
+
+
 def _step_table(found: list[dict]) -> list[str]:
     rows = [p for p in found if math.isnan(p["rtol"])]
     steps = sorted({p["step"] for p in rows}, reverse=True)
     table = []
-    for coupling in sorted(dict.fromkeys(p["coupling"] for p in rows), key=lambda c: c[:3]):
-        by_step = {p["step"]: p for p in rows if p["coupling"] == coupling}
-        cells = [_cell(by_step[h]) for h in steps]
-        table.append([coupling, *cells])
-    header = ["coupling", *(f"{h:g} s" for h in steps)]
-    return markup.table(header, table, "-" + "r" * len(steps))
+    for name in _machines(rows):
+        mine = [p for p in rows if p["machine"] == name]
+        for coupling in sorted(dict.fromkeys(p["coupling"] for p in mine), key=lambda c: c[:3]):
+            by_step = {p["step"]: p for p in mine if p["coupling"] == coupling}
+            table.append([name, coupling, *(_cell(by_step[h]) for h in steps)])
+    header = ["machine", "coupling", *(f"{h:g} s" for h in steps)]
+    return markup.table(header, table, "--" + "r" * len(steps))
 
 
 def _rtol_table(found: list[dict]) -> list[str]:
@@ -128,21 +148,24 @@ def _rtol_table(found: list[dict]) -> list[str]:
 def _targets(found: list[dict]) -> list[str]:
     out = []
     inside = [p for p in found if p["coupling"].startswith("(a)") and math.isnan(p["rtol"])]
-    for coupling in dict.fromkeys(p["coupling"] for p in inside):
-        sel = [p for p in inside if p["coupling"] == coupling]
+    for name, coupling in dict.fromkeys((p["machine"], p["coupling"]) for p in inside):
+        sel = [p for p in inside if (p["machine"], p["coupling"]) == (name, coupling)]
         worst = max(max(p["angle"], p["speed"]) for p in sel)
         verdict = "met" if worst <= TARGET else "NOT met"
         out.append(
-            f"- {coupling}, default tolerances: at most {worst:.1e} of the angle travelled or "
+            f"- {name}, {coupling}, default tolerances: at most {worst:.1e} of the angle "
+            "travelled or "
             f"of the peak speed at every communication step from {max(p['step'] for p in sel):g}"
             f" to {min(p['step'] for p in sel):g} s (target {TARGET:.0e}): {verdict}."
         )
     rt = [p for p in found if not math.isnan(p["rtol"])]
     if len(rt) > 1:
         falls = all(b["angle"] < a["angle"] for a, b in zip(rt, rt[1:], strict=False))
+        first, last = rt[0], rt[-1]
         out.append(
-            f"- (a) against rtol: the angle error goes from {rt[0]['angle']:.1e} at "
-            f"{rt[0]['rtol']:.0e} to {rt[-1]['angle']:.1e} at {rt[-1]['rtol']:.0e}"
+            f"- {first['machine']}, (a) against rtol: the angle error goes from "
+            f"{first['angle']:.1e} at {first['rtol']:.0e} to {last['angle']:.1e} at "
+            f"{last['rtol']:.0e}"
             + (", falling at every step." if falls else ", not falling at every step.")
         )
     return out
@@ -154,8 +177,13 @@ SPLIT_TARGET = 1e-3
 
 def _split_targets(found: list[dict]) -> list[str]:
     """(b)'s observed order between its two finest steps, its error at 1 ms, and the runs
-    the plant refused."""
+    the plant refused, machine by machine."""
+    return [line for name in _machines(found) for line in _split_lines(found, name)]
+
+
+def _split_lines(found: list[dict], name: str) -> list[str]:
     out = []
+    found = [p for p in found if p["machine"] == name]
     for rates, coupling in SPLIT.items():
         sel = [p for p in found if p["coupling"] == coupling and math.isfinite(p["angle"])]
         sel.sort(key=lambda p: -p["step"])
@@ -163,8 +191,8 @@ def _split_targets(found: list[dict]) -> list[str]:
             continue
         a, b = sel[-2], sel[-1]
         order = math.log(a["angle"] / b["angle"]) / math.log(a["step"] / b["step"])
-        text = f"- {coupling}: the angle error falls at order {order:.2f} from {a['step']:g} to "
-        text += f"{b['step']:g} s"
+        text = f"- {name}, {coupling}: the angle error falls at order {order:.2f} from "
+        text += f"{a['step']:g} to {b['step']:g} s"
         at_ms = [p for p in sel if p["step"] == 1e-3]
         if at_ms:
             text += f"; {at_ms[0]['angle_rad']:.1e} rad at 1 ms"
@@ -174,21 +202,36 @@ def _split_targets(found: list[dict]) -> list[str]:
         out.append(text + ".")
     for p in (p for p in found if "failed" in p):
         reason = p["failed"].split("(", 1)[-1].split(" (", 1)[0]
-        out.append(
-            f"- {p['coupling']} at {p['step']:g} s: refused by the plant: {markup.text(reason)}."
-        )
+        where = f"{name}, {p['coupling']} at {p['step']:g} s"
+        out.append(f"- {where}: refused by the plant: {markup.text(reason)}.")
     return out
 
 
 def plot(path: Path, found: list[dict]) -> Path:
-    """Angle error against the communication step and against the run's CPU time."""
+    """Angle error against the communication step and against the run's CPU time, one row
+    of two panels per machine."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
     rows = [p for p in found if math.isnan(p["rtol"])]
+    names = _machines(rows)
+    fig, grid = plt.subplots(len(names), 2, figsize=(12, 4.2 * len(names)), squeeze=False)
+    for name, axes in zip(names, grid, strict=True):
+        _plot_machine(axes, [p for p in rows if p["machine"] == name])
+        axes[0].set_title(f"{name}: run-up over {study.MACHINES[name].t_end:g} s", fontsize=10)
+    fig.suptitle(
+        f"Each machine's run-up against the machine as one ODE (dashed: {TARGET:.0e})",
+        fontsize=11,
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def _plot_machine(axes: object, rows: list[dict]) -> None:
     for coupling in dict.fromkeys(p["coupling"] for p in rows):
         sel = sorted(
             (p for p in rows if p["coupling"] == coupling and math.isfinite(p["angle"])),
@@ -203,15 +246,42 @@ def plot(path: Path, found: list[dict]) -> Path:
         ax.set_ylabel("crank angle error / angle travelled")
         ax.grid(which="both", alpha=0.3)
     axes[0].legend(fontsize=8)
-    fig.suptitle(
-        f"The slider-crank's run-up over {study.T_END:g} s against the machine as one ODE "
-        f"(dashed: {TARGET:.0e})",
-        fontsize=11,
-    )
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+
+
+def _machine_table(found: list[dict]) -> list[str]:
+    """Each machine of the section: its FMUs, its supply, its run and its motor."""
+    table = []
+    for name in _machines(found):
+        m = study.MACHINES[name]
+        motor = study.circuit(next(iter(study.CIRCUITS)), m=m)
+        gain = motor.torque_constant * motor.ratio
+        table.append(
+            [
+                name,
+                f"`{m.plant}`",
+                f"`{m.rotor_plant}`",
+                f"`{m.mechanism}`",
+                f"{m.voltage:g}",
+                f"{m.t_end:g}",
+                f"{gain * m.voltage / motor.resistance:g}",
+                f"{m.voltage / gain:g}",
+                f"{motor.ratio**2 * motor.rotor_inertia:g}",
+                f"{study.fit_error(m):.1e}",
+            ]
+        )
+    header = [
+        "machine",
+        "(a) plant",
+        "(b) plant",
+        "(c) mechanism FMU",
+        "supply (V)",
+        "run (s)",
+        "stall torque (N.m)",
+        "no-load speed (rad/s)",
+        "rotor at the crank (kg.m2)",
+        "series fit",
+    ]
+    return markup.table(header, table, "----rrrrrr")
 
 
 def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
@@ -220,26 +290,28 @@ def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
         "",
         "## The motor inside the plant",
         "",
-        f"The slider-crank with its DC motor runs up from rest at {study.START_ANGLE:g} rad "
-        f"under {study.VOLTAGE:g} V for {study.T_END:g} s. (a): the plant "
-        f"`{study.PLANT}`, the motor's circuit and the crank's motion integrated inside each "
-        "doStep, default tolerances; (c): the drive FMU with the motor's linear "
-        "characteristic (its L = 0 limit) and the inverse mechanism FMU, stabilised. "
-        "Reference: the machine as one ODE from the harness's kinematics (J, J' and Q_g as "
-        f"Fourier series of {study.SAMPLES} samples, within {study.fit_error():.1e} of the "
-        "harness), SciPy at rtol "
-        f"{_reference_rtol(quick):.0e} "
-        "(Radau where the circuit is stiff, else DOP853). Each cell: the largest crank angle "
-        "error over the communication points / the angle travelled, then the largest speed "
-        "error / the peak speed. (b): the same motor as its own FMU `motor` (voltage and "
-        "speed in, torque out, its circuit solved exactly over each step) and the plant "
-        f"`{study.ROTOR_PLANT}` (torque in; the rotor's inertia added to the crank's), "
-        "exchanging speed and torque at each communication point, held over the step or "
-        "with their first derivatives (FMI 2 input and output derivatives).",
+        f"Each machine with its DC motor runs up from rest at {study.START_ANGLE:g} rad "
+        "under a constant supply. (a): the plant with the motor inside, the motor's circuit "
+        "and the crank's motion integrated inside each doStep, default tolerances, with the "
+        "scene's armature (L/R 1.4 ms) and a stiff one (L/R 1 us); (b): the same motor as "
+        "its own FMU `motor` (voltage and speed in, torque out, its circuit solved exactly "
+        "over each step) and a plant with the crank's torque in (the rotor's inertia added "
+        "to the crank's), exchanging speed and torque at each communication point, held "
+        "over the step or with their first derivatives (FMI 2 input and output "
+        "derivatives); (c): the drive FMU with the motor's linear characteristic (its L = 0 "
+        "limit) and the inverse mechanism FMU, stabilised. Reference: the machine as one "
+        "ODE from the harness's kinematics (J, J' and Q_g as Fourier series of "
+        f"{study.SAMPLES} samples, within the 'series fit' of the harness), SciPy at rtol "
+        f"{_reference_rtol(quick):.0e} (Radau where the circuit is stiff, else DOP853).",
+        "",
+        *_machine_table(found),
+        "",
+        "Each cell: the largest crank angle error over the communication points / the angle "
+        "travelled, then the largest speed error / the peak speed.",
         "",
         *_step_table(found),
         "",
-        f"(a) with the slow motor at {RTOL_STEP:g} s steps, against its tolerances:",
+        f"(a) with the slider-crank's slow motor at {RTOL_STEP:g} s steps, against its tolerances:",
         "",
         *_rtol_table(found),
         "",
