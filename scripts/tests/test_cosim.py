@@ -481,10 +481,12 @@ def test_quick_report_writes_its_files(tmp_path):
     assert "stabilised" in text and "explicit" in text and "diverged" in text
     # read back by a Markdown parser: the machines, the runs, the mechanism FMUs
     tables = markdown_check.check_file(folder / "report.md")
-    _, runs, mechanism_fmus, machines, by_step, by_rtol = tables
+    _, runs, mechanism_fmus, machines, by_step, by_reactions, by_rtol = tables
     assert len(runs.rows) == 1 + len(rows) and len(mechanism_fmus.rows) == 1 + 3
     assert len(machines.rows) == 1 + 1  # the slider-crank
-    assert len(by_step.rows) == 1 + 4 and len(by_rtol.rows) == 1 + 2
+    assert len(by_step.rows) == len(by_reactions.rows) == 1 + 4 and len(by_rtol.rows) == 1 + 2
+    plant = machines.rows[1][1].children  # the FMU's name a code span, not escaped backticks
+    assert [c.content for c in plant if c.type == "code_inline"] == ["slider_crank_motor"]
     assert "For a user of the dyad FMU" in text
     assert result["plant_plot"].stat().st_size > 0
     _check_plant_points(result["plant_points"])
@@ -502,7 +504,8 @@ def _check_plant_points(found: list[dict]) -> None:
     inside = [p for p in found if p["coupling"].startswith("(a)")]
     drive = sorted((p for p in found if p["coupling"].startswith("(c)")), key=lambda p: p["step"])
     assert len(inside) == 4 and len(drive) == 2
-    assert max(max(p["angle"], p["speed"]) for p in inside) < 1e-8
+    assert max(max(p["angle"], p["speed"], p["reactions"]) for p in inside) < 1e-8
+    assert min(p["reactions"] for p in drive) > 1e4 * max(p["reactions"] for p in inside)
     assert drive[0]["speed"] < drive[1]["speed"]
     assert min(p["speed"] for p in drive) > 1e4 * max(p["speed"] for p in inside)
     # (b) at 1 ms: the motor FMU's torque and the plant's speed exchanged with their rates
@@ -517,7 +520,8 @@ def _check_plant_points(found: list[dict]) -> None:
 @pytest.mark.parametrize("name", ["four-bar", "shaper"])
 def test_every_machine_with_its_motor_inside_meets_the_reference(name):
     """The four-bar's and the shaper's plants with their motors inside (a) within 1e-8 of
-    the angle travelled and of the peak speed at 10 ms steps; their motor as a separate FMU
+    the angle travelled, of the peak speed and of the largest joint reaction's peak at 10
+    ms steps; their motor as a separate FMU
     (b) nearer with the rates exchanged than held at 1 ms; the drive FMU with the inverse
     mechanism FMU (c) falling with the step. Measured: (a) 1.8e-13 and 1.7e-14 of the
     travel, (b) with rates 4.7e-3 and 1.6e-3 rad at 1 ms, a fifth of held."""
@@ -528,9 +532,27 @@ def test_every_machine_with_its_motor_inside_meets_the_reference(name):
     grid = np.linspace(0.0, m.t_end, int(round(m.t_end / 1e-3)) + 1)
     ref = study.reference(label, grid, "DOP853", 1e-11, m)
     inside = study.errors(study.run(label, 1e-2, m=m), ref)
-    assert max(inside["angle"], inside["speed"]) < 1e-8, inside
+    assert max(inside["angle"], inside["speed"], inside["reactions"]) < 1e-8, inside
     held, rates = (study.errors(study.split_run(label, 1e-3, r, m), ref) for r in (False, True))
     assert rates["angle"] < held["angle"] / 3, (held, rates)
     linear = study.reference(study.LINEAR, grid, "DOP853", 1e-11, m)
     drive = [study.errors(study.drive_run(h, m=m), linear)["speed"] for h in (1e-2, 1e-3)]
     assert drive[1] < drive[0] / 5, drive
+
+
+@pytest.mark.parametrize("name", ["slider-crank", "four-bar", "shaper"])
+def test_the_reactions_reference_refuses_the_harness_loads(name):
+    """The FMUs of the plant study leave their load inputs at zero: the reference's
+    reactions come from the harness with its load models off, and the harness with them
+    on (the gas force, the four-bar's loads, the cutting force) is refused by name."""
+    from dyadfmu.cosim import mechanism_fmus as fmus
+    from dyadfmu.cosim import plant_study as study
+
+    m = study.MACHINES[name]
+    t = np.linspace(0.0, 0.02, 5)
+    phi, omega, eps = 0.5 + 20.0 * t, np.full(5, 20.0), np.zeros(5)
+    quiet = study.reactions(m, t, phi, omega, eps)
+    assert quiet and all(np.all(np.isfinite(v)) for v in quiet.values())
+    loaded = fmus.mechanism_of(m.mechanism)
+    with pytest.raises(ValueError, match=r"the harness applies the load \S+"):
+        study.reactions(m, t, phi, omega, eps, loaded)

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import time as clock
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -36,7 +36,16 @@ from ..mechanisms import driven
 from ..reference import machine
 from . import master, mechanism_fmus
 
-__all__ = ["MACHINES", "DriveRun", "Machine", "machine_of", "run", "reference", "errors"]
+__all__ = [
+    "MACHINES",
+    "DriveRun",
+    "Machine",
+    "machine_of",
+    "run",
+    "reference",
+    "errors",
+    "whole_steps",
+]
 
 #: The mechanism FMUs of the study: the harness's motor for the mechanism (the shaper a
 #: 100 N m motor of 7.5 rad/s no-load speed, as the quick-return's), the start speed
@@ -78,7 +87,8 @@ class DriveRun:
     """The co-simulation at its communication points: t, phi, omega, epsilon, the
     mechanism FMU's torque (N m) and J (kg m2, its directional derivative); the largest
     |J - crank.J| / crank.J (the derivative against the FMU's own output) and the largest
-    |torque - (torque0 + J eps)| / |torque| (the affine split)."""
+    |torque - (torque0 + J eps)| / |torque| (the affine split); ``extra``: the mechanism
+    FMU's further outputs asked for (name -> values at the communication points)."""
 
     name: str
     step: float
@@ -91,6 +101,7 @@ class DriveRun:
     inertia_mismatch: float
     affine_residual: float
     wall_time: float
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def _drive(m: Machine, fmi_version: int) -> Slave:
@@ -125,21 +136,35 @@ def _point(d: Slave, y: Slave, t: float, checks: list) -> tuple:
     return phi, omega, eps, torque, j
 
 
-def run(name: str, step: float, fmi_version: int = 2, m: Machine | None = None) -> DriveRun:
+def whole_steps(t_end: float, step: float) -> int:
+    """The number of communication steps ``step`` [s] in ``t_end`` [s], refused unless whole."""
+    n = int(round(t_end / step))
+    if n < 1 or abs(n * step - t_end) > 1e-9 * t_end:
+        raise ValueError(f"{t_end} s is not a whole number of steps of {step!r} s")
+    return n
+
+
+def run(
+    name: str,
+    step: float,
+    fmi_version: int = 2,
+    m: Machine | None = None,
+    outputs: tuple[str, ...] = (),
+) -> DriveRun:
     """The stabilised co-simulation of ``name``'s machine (or ``m``, a machine of that
-    mechanism FMU) with communication step ``step``."""
+    mechanism FMU) with communication step ``step``, recording the mechanism FMU's
+    ``outputs`` besides the crank's motion and torque."""
     m = m or machine_of(name)
-    n = int(round(m.t_end / step))
-    if n < 1 or abs(n * step - m.t_end) > 1e-9 * m.t_end:
-        raise ValueError(f"{m.t_end} s is not a whole number of steps of {step!r} s")
+    n = whole_steps(m.t_end, step)
     started = clock.perf_counter()
     d = _drive(m, fmi_version)
     y = Slave(paths.built_fmu(name, fmi_version, None, how="scripts/run-tests"), "mechanism")
     y.initialize()
-    rows, checks = [], [0.0, 0.0]
+    rows, checks, extra = [], [0.0, 0.0], []
     try:
         for k in range(n + 1):
             rows.append(_point(d, y, k * step, checks))
+            extra.append(y.get(outputs) if outputs else ())
             if k < n:
                 y.do_step(k * step, step)
                 d.do_step(k * step, step)
@@ -148,7 +173,9 @@ def run(name: str, step: float, fmi_version: int = 2, m: Machine | None = None) 
         y.close()
     a = np.array(rows)
     t = step * np.arange(len(rows))
-    return DriveRun(name, step, t, *a.T, checks[0], checks[1], clock.perf_counter() - started)
+    wall = clock.perf_counter() - started
+    columns = dict(zip(outputs, np.array(extra, dtype=float).reshape(len(rows), -1).T, strict=True))
+    return DriveRun(name, step, t, *a.T, checks[0], checks[1], wall, columns)
 
 
 def reference(name: str, t: np.ndarray, m: Machine | None = None) -> tuple:

@@ -98,21 +98,26 @@ def is_kinematic(output: str) -> bool:
     )
 
 
-def mechanism_of(name: str, branch: int = 1) -> builtin.Mechanism | chains.Chain:
+def mechanism_of(
+    name: str, branch: int = 1, data: dict | None = None
+) -> builtin.Mechanism | chains.Chain:
     """The harness mechanism behind a mechanism FMU, with the scene's effects (a scene
     without gravity, the monitor's horizontal four-bar, gets a weightless mechanism); a
     chain of BRANCHES on the harness's assembly ``branch`` (a built-in mechanism takes
-    its branch with its kinematics)."""
+    its branch with its kinematics). ``data`` overrides the harness's table of the
+    mechanism key by key (:func:`.chains.load`, :func:`.builtin.load`)."""
     kind, harness = MECHANISM_FMUS[name]
     if kind == "chain" and name in BRANCHES:
         parameter, sign = BRANCHES[name]
-        return chains.load(harness, branches={parameter.split(".")[0]: sign * branch})
+        return chains.load(harness, data, branches={parameter.split(".")[0]: sign * branch})
     if kind == "chain":
-        return chains.load(harness)
+        return chains.load(harness, data)
     with open(paths.SCENES_DIR / f"{name}.toml", "rb") as f:
         effects = tomllib.load(f).get("effects", {})
-    data = None if effects.get("gravity", False) else {"gravity": [0.0, 0.0]}
-    return builtin.load(harness, data)
+    data = dict(data or {})
+    if not effects.get("gravity", False):
+        data["gravity"] = [0.0, 0.0]
+    return builtin.load(harness, data or None)
 
 
 def scene_file(name: str) -> Path:

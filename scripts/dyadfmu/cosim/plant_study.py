@@ -19,8 +19,13 @@ milliseconds. The drive FMU's machine (:func:`drive_run`) is the same one with L
 The motor's numbers are the plant's own parameters (read from its model description), so
 the two cannot drift apart.
 
-API: :data:`MACHINES`, :data:`STEPS`, :data:`RTOLS`, :data:`CIRCUITS`, :func:`reference`,
-:func:`run`, :func:`split_run`, :func:`drive_run`, :func:`errors`.
+The joint reactions (every ``*.R_*`` output of the plant or the mechanism FMU) are compared
+with the harness's Newton-Euler solve along the reference's motion: its angle, speed and
+the acceleration its ODE gives, with the harness's load models switched off as the FMUs'
+load inputs stay at zero (a load the harness still applies refuses the reference).
+
+API: :data:`MACHINES`, :data:`STEPS`, :data:`RTOLS`, :data:`CIRCUITS`, :func:`reference`
+(-> :class:`Reference`), :func:`run`, :func:`split_run`, :func:`drive_run`, :func:`errors`.
 """
 
 from __future__ import annotations
@@ -28,14 +33,15 @@ from __future__ import annotations
 import functools
 import math
 import time as clock
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from fmpy import read_model_description
 
 from .. import paths
 from ..fmi.slave import Slave
-from ..mechanisms import driven
+from ..mechanisms import builtin, chains, driven
+from ..mechanisms.motion import CrankMotion
 from ..reference import machine
 from . import mechanism_drive, mechanism_fmus
 
@@ -47,11 +53,15 @@ __all__ = [
     "Circuit",
     "PlantMachine",
     "PlantRun",
+    "Reference",
     "drive_run",
     "errors",
+    "reaction_names",
+    "reactions",
     "reference",
     "run",
     "split_run",
+    "unloaded",
 ]
 
 
@@ -126,7 +136,7 @@ def circuit(label: str, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> Cir
 @dataclass
 class PlantRun:
     """The plant's crank angle [rad] and speed [rad/s] at its communication points, the
-    CPU time of the run [s] and the plant's internal evaluations."""
+    CPU time of the run [s], and its joint reactions there (output name -> [N] or [N.m])."""
 
     label: str
     step: float
@@ -135,13 +145,19 @@ class PlantRun:
     phi: np.ndarray
     omega: np.ndarray
     cpu_time: float
+    reactions: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def _steps(m: PlantMachine, step: float) -> int:
-    n = int(round(m.t_end / step))
-    if n < 1 or abs(n * step - m.t_end) > 1e-9 * m.t_end:
-        raise ValueError(f"{m.t_end} s is not a whole number of steps of {step!r} s")
-    return n
+def reaction_names(fmu: Slave) -> tuple[str, ...]:
+    """The joint reactions among ``fmu``'s outputs: every ``*.R_*`` (x and y)."""
+    return tuple(
+        v.name for v in fmu.md.modelVariables if v.causality == "output" and ".R_" in v.name
+    )
+
+
+def _recorded(names: tuple[str, ...], rows: np.ndarray, start: int) -> dict[str, np.ndarray]:
+    """The columns of ``rows`` from ``start`` on, by the names of ``names``."""
+    return {name: rows[:, start + k].copy() for k, name in enumerate(names)}
 
 
 def run(
@@ -153,14 +169,14 @@ def run(
 ) -> PlantRun:
     """``m``'s plant with motor ``label`` over its run at communication step ``step`` (and
     ``solver.rtol`` = ``solver.atol`` = ``rtol`` where given)."""
-    n = _steps(m, step)
+    n = mechanism_drive.whole_steps(m.t_end, step)
     parameters = circuit(label, version, m).parameters()
     parameters["crank.angle_start"] = START_ANGLE
     if rtol is not None:
         parameters.update({"solver.rtol": rtol, "solver.atol": rtol})
     plant = Slave(paths.built_fmu(m.plant, version, how="scripts/run-tests"), "plant")
-    names = ("crank.angle", "crank.omega")
-    rows = np.empty((n + 1, 2))
+    names = ("crank.angle", "crank.omega", *reaction_names(plant))
+    rows = np.empty((n + 1, len(names)))
     started = clock.process_time()
     try:
         plant.set("crank.motor.voltage", m.voltage)
@@ -173,7 +189,8 @@ def run(
         plant.close()
     cpu = clock.process_time() - started
     t = step * np.arange(n + 1)
-    return PlantRun(label, step, rtol or math.nan, t, rows[:, 0], rows[:, 1], cpu)
+    reactions = _recorded(names[2:], rows, 2)
+    return PlantRun(label, step, rtol or math.nan, t, rows[:, 0], rows[:, 1], cpu, reactions)
 
 
 class _Periodic:
@@ -233,21 +250,35 @@ def _rhs(motor: Circuit, terms: tuple, voltage: float):
     return rhs
 
 
+@dataclass(frozen=True)
+class Reference:
+    """The machine as one ODE on a time grid ``t`` [s]: crank angle [rad], speed [rad/s],
+    acceleration [rad/s2] and the harness's joint reactions along that motion (output
+    name -> [N] or [N.m], as the FMUs name them)."""
+
+    t: np.ndarray
+    phi: np.ndarray
+    omega: np.ndarray
+    epsilon: np.ndarray
+    reactions: dict[str, np.ndarray]
+
+
 def reference(
     label: str,
     t: np.ndarray,
     method: str = "Radau",
     rtol: float = 1e-12,
     m: PlantMachine = SLIDER_CRANK,
-) -> tuple:
-    """(phi, omega) of ``m`` with motor ``label`` as one ODE on the grid t."""
+) -> Reference:
+    """``m`` with motor ``label`` as one ODE on the grid t, and its joint reactions."""
     from scipy.integrate import solve_ivp
 
     motor = circuit(label, m=m)
     start, scale = [START_ANGLE, 0.0, 0.0], [1.0, 1.0, m.voltage / motor.resistance]
     n = 3 if motor.inductance > 0 else 2
+    rhs = _rhs(motor, _machine_terms(m.mechanism), m.voltage)
     sol = solve_ivp(
-        _rhs(motor, _machine_terms(m.mechanism), m.voltage),
+        rhs,
         (0.0, float(t[-1])),
         start[:n],
         method=method,
@@ -257,7 +288,88 @@ def reference(
     )
     if not sol.success:
         raise RuntimeError(f"the reference ({method}) failed: {sol.message}")
-    return sol.y[0], sol.y[1]
+    phi, omega = sol.y[0], sol.y[1]
+    epsilon = np.concatenate([rhs(0.0, y)[1] for y in np.array_split(sol.y, _chunks(t), axis=1)])
+    return Reference(t, phi, omega, epsilon, reactions(m, t, phi, omega, epsilon))
+
+
+#: Points of the grid per harness evaluation (the Fourier series and the kinematics hold
+#: arrays of a few dozen times as many numbers).
+_CHUNK = 20000
+
+
+def _chunks(t: np.ndarray) -> int:
+    return max(1, -(-len(t) // _CHUNK))
+
+
+#: The keys of a harness load model's table that scale its load (the chains' models and
+#: the built-in slider-crank's gas force): all zero, the model loads nothing.
+_LOAD_SCALES = ("F0", "T0", "c", "force", "force_swing", "moment", "moment_swing")
+_LOAD_SCALES += ("p_peak", "p_base")
+
+
+def _zeroed(table: dict) -> dict:
+    """``table`` with every key of :data:`_LOAD_SCALES` zero, in nested tables too."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out[key] = _zeroed(value)
+        elif key in _LOAD_SCALES:
+            out[key] = [0.0] * len(value) if isinstance(value, list) else 0.0
+    return out
+
+
+@functools.cache
+def unloaded(mechanism: str) -> builtin.Mechanism | chains.Chain:
+    """The harness mechanism of the mechanism FMU ``mechanism`` with its load models
+    switched off (their scales zero)."""
+    kind, harness = mechanism_fmus.MECHANISM_FMUS[mechanism]
+    tables = (chains if kind == "chain" else builtin).default_data()[harness]
+    return mechanism_fmus.mechanism_of(mechanism, data={"load": _zeroed(tables.get("load", {}))})
+
+
+def reactions(
+    m: PlantMachine,
+    t: np.ndarray,
+    phi: np.ndarray,
+    omega: np.ndarray,
+    epsilon: np.ndarray,
+    mechanism: builtin.Mechanism | chains.Chain | None = None,
+) -> dict[str, np.ndarray]:
+    """The harness's joint reactions of ``m``'s mechanism (:func:`unloaded`, or
+    ``mechanism``) along the crank motion phi, omega, epsilon at the times t. Refuses a
+    mechanism whose loads (the scene's load inputs) are not zero where the FMUs' are."""
+    mechanism = mechanism or unloaded(m.mechanism)
+    scene = mechanism_fmus.scene_file(m.mechanism)
+    kw = {"branch": 1} if isinstance(mechanism, builtin.Mechanism) else {}
+    parts: dict[str, list[np.ndarray]] = {}
+    for ix in np.array_split(np.arange(len(t)), _chunks(t)):
+        motion = _given(t, phi, omega, epsilon, ix)
+        series = driven.driver_motion_inputs(mechanism, t[ix], motion, scene, **kw)
+        for name, values in series.inputs.items():
+            if not name.startswith(f"{series.driver}.") and np.any(values != 0):
+                raise ValueError(
+                    f"{m.mechanism}: the harness applies the load {name} (up to "
+                    f"{np.max(np.abs(values)):.3g}), which the FMUs of {m.name} do not have"
+                )
+        for name, values in series.outputs.items():
+            if ".R_" in name:
+                parts.setdefault(name, []).append(values)
+    return {name: np.concatenate(p) for name, p in parts.items()}
+
+
+def _given(
+    t: np.ndarray, phi: np.ndarray, omega: np.ndarray, epsilon: np.ndarray, ix: np.ndarray
+) -> CrankMotion:
+    """The crank motion (phi, omega, epsilon)[ix] at the times t[ix], for the harness."""
+    return CrankMotion(
+        "reference",
+        lambda _t: phi[ix],
+        lambda _t: omega[ix],
+        lambda _t: epsilon[ix],
+        float(np.ptp(t[ix])),
+        float(np.ptp(phi[ix])) / (2 * math.pi),
+    )
 
 
 def drive_run(step: float, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> PlantRun:
@@ -270,10 +382,16 @@ def drive_run(step: float, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> 
         gain * m.voltage / motor.resistance, m.voltage / gain, motor.ratio**2 * motor.rotor_inertia
     )
     drive = mechanism_drive.Machine(m.mechanism, linear, 0.0, m.t_end)
+    path = paths.built_fmu(m.mechanism, version, how="scripts/run-tests")
+    names = tuple(
+        v.name
+        for v in read_model_description(str(path)).modelVariables
+        if v.causality == "output" and ".R_" in v.name
+    )
     started = clock.process_time()
-    r = mechanism_drive.run(m.mechanism, step, version, drive)
+    r = mechanism_drive.run(m.mechanism, step, version, drive, names)
     cpu = clock.process_time() - started
-    return PlantRun(LINEAR, step, math.nan, r.t, r.phi, r.omega, cpu)
+    return PlantRun(LINEAR, step, math.nan, r.t, r.phi, r.omega, cpu, r.extra)
 
 
 #: The separate motor FMU of (b).
@@ -297,17 +415,19 @@ def _split_fmus(label: str, version: int, m: PlantMachine) -> tuple[Slave, Slave
     return fmu, plant
 
 
-def _exchange(motor: Slave, plant: Slave, rates: bool) -> tuple:
+def _exchange(motor: Slave, plant: Slave, rates: bool, names: tuple) -> tuple:
     """One communication point: the plant's speed (and its rate) to the motor, the
-    motor's torque (and its rate) to the plant; (phi, omega)."""
-    phi, omega = plant.get(("crank.angle", "crank.omega"))
+    motor's torque (and its rate) to the plant; the plant's ``names`` (the crank's angle
+    and speed first)."""
+    values = plant.get(names)
+    omega = values[1]
     motor.set("shaft.omega", omega)
     if rates:
         motor.set_rates("shaft.omega", plant.output_rates(("crank.omega",))[0])
     plant.set("crank.torque", motor.get("shaft.torque"))
     if rates:
         plant.set_rates("crank.torque", motor.output_rates(("shaft.torque",))[0])
-    return phi, omega
+    return values
 
 
 def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRANK) -> PlantRun:
@@ -315,13 +435,14 @@ def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRA
     the plant (torque in, speed out), exchanged at each communication point: held over the
     step, or with their first derivatives (``rates``: FMI 2's input and output
     derivatives)."""
-    n = _steps(m, step)
+    n = mechanism_drive.whole_steps(m.t_end, step)
     motor, plant = _split_fmus(label, 2, m)
-    rows = np.empty((n + 1, 2))
+    names = ("crank.angle", "crank.omega", *reaction_names(plant))
+    rows = np.empty((n + 1, len(names)))
     started = clock.process_time()
     try:
         for k in range(n + 1):
-            rows[k] = _exchange(motor, plant, rates)
+            rows[k] = _exchange(motor, plant, rates, names)
             if k < n:
                 motor.do_step(k * step, step)
                 plant.do_step(k * step, step)
@@ -330,18 +451,31 @@ def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRA
         plant.close()
     cpu = clock.process_time() - started
     t = step * np.arange(n + 1)
-    return PlantRun(label, step, math.nan, t, rows[:, 0], rows[:, 1], cpu)
+    reactions = _recorded(names[2:], rows, 2)
+    return PlantRun(label, step, math.nan, t, rows[:, 0], rows[:, 1], cpu, reactions)
 
 
-def errors(result: PlantRun, ref: tuple) -> dict:
+def errors(result: PlantRun, ref: Reference) -> dict:
     """The largest angle error over the run as a fraction of the angle travelled, the
-    largest speed error as a fraction of the peak speed."""
-    phi, omega = ref
-    step = max(1, int(round((len(phi) - 1) / (len(result.t) - 1))))
-    phi, omega = phi[::step], omega[::step]
+    largest speed error as a fraction of the peak speed, and the largest error of a joint
+    reaction as a fraction of the largest reaction's peak (every reaction of the run;
+    one the reference lacks is refused)."""
+    step = max(1, int(round((len(ref.t) - 1) / (len(result.t) - 1))))
+    phi, omega = ref.phi[::step], ref.omega[::step]
+    if len(phi) != len(result.t) or abs(ref.t[::step][-1] - result.t[-1]) > 1e-9 * ref.t[-1]:
+        raise ValueError(f"the reference's grid does not hold the run's {len(result.t)} points")
     travel = abs(phi[-1] - phi[0])
+    missing = sorted(set(result.reactions) - set(ref.reactions))
+    if missing:
+        raise ValueError(f"the reference has no reactions {', '.join(missing)}")
+    peak = max((np.max(np.abs(ref.reactions[k])) for k in result.reactions), default=1.0)
+    worst = max(
+        (np.max(np.abs(v - ref.reactions[k][::step])) for k, v in result.reactions.items()),
+        default=math.nan,
+    )
     return {
         "angle_rad": float(np.max(np.abs(result.phi - phi))),
         "angle": float(np.max(np.abs(result.phi - phi)) / travel),
         "speed": float(np.max(np.abs(result.omega - omega)) / np.max(np.abs(omega))),
+        "reactions": float(worst / peak),
     }

@@ -1,10 +1,10 @@
 """The co-simulation report's section on plants: each machine of
 :data:`dyadfmu.cosim.plant_study.MACHINES` with its motor inside the plant (a), with the
 motor as its own FMU (b) and as the drive FMU with the inverse mechanism FMU, stabilised
-(c), all against the machine as one ODE: the errors in crank angle and speed against the
-communication step and the run's CPU time, and (a) against its relative tolerance (the
-slider-crank). Writes ``plant_vs_step.png`` beside the report and gives its lines and its
-points. The quick study runs the slider-crank only.
+(c), all against the machine as one ODE: the errors in crank angle, speed and the joint
+reactions against the communication step and the run's CPU time, and (a) against its
+relative tolerance (the slider-crank). Writes ``plant_vs_step.png`` beside the report and
+gives its lines and its points. The quick study runs the slider-crank only.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def _reference_rtol(quick: bool) -> float:
     return 1e-10 if quick else 1e-12
 
 
-def _reference(label: str, steps: tuple, quick: bool, m: study.PlantMachine) -> tuple:
+def _reference(label: str, steps: tuple, quick: bool, m: study.PlantMachine) -> study.Reference:
     """The machine as one ODE: Radau where the circuit is stiff, else DOP853."""
     stiff = study.CIRCUITS.get(label) is not None
     grid, rtol = _reference_grid(steps, m), _reference_rtol(quick)
@@ -44,7 +44,7 @@ def _reference(label: str, steps: tuple, quick: bool, m: study.PlantMachine) -> 
 
 
 def _point(
-    m: study.PlantMachine, coupling: str, step: float, rtol: float, run: object, ref: tuple
+    m: study.PlantMachine, coupling: str, step: float, rtol: float, run: object, ref: object
 ) -> dict:
     e = study.errors(run, ref)
     return {"machine": m.name, "coupling": coupling, "step": step, "rtol": rtol, **e} | {
@@ -56,7 +56,9 @@ def _point(
 SPLIT = {False: "(b) motor FMU + plant, held", True: "(b) motor FMU + plant, with rates"}
 
 
-def _split_points(label: str, steps: tuple, ref: tuple, m: study.PlantMachine) -> list[dict]:
+def _split_points(
+    label: str, steps: tuple, ref: study.Reference, m: study.PlantMachine
+) -> list[dict]:
     """(b) at each step, held and with rates; a run the plant refuses (its motion run away
     under a torque held too long) is kept with infinite errors and the plant's reason."""
     found = []
@@ -65,7 +67,7 @@ def _split_points(label: str, steps: tuple, ref: tuple, m: study.PlantMachine) -
             try:
                 run = study.split_run(label, step, rates, m)
             except SlaveError as e:
-                lost = {"angle": math.inf, "speed": math.inf, "angle_rad": math.inf}
+                lost = dict.fromkeys(("angle", "speed", "angle_rad", "reactions"), math.inf)
                 found.append(
                     {"machine": m.name, "coupling": coupling, "step": step, "rtol": math.nan}
                     | lost
@@ -123,7 +125,11 @@ def _machines(found: list[dict]) -> list[str]:
     return list(dict.fromkeys(p["machine"] for p in found))
 
 
-def _step_table(found: list[dict]) -> list[str]:
+def _reaction_cell(p: dict) -> str:
+    return "refused" if "failed" in p else _e(p["reactions"])
+
+
+def _step_table(found: list[dict], cell: Callable[[dict], str] = _cell) -> list[str]:
     rows = [p for p in found if math.isnan(p["rtol"])]
     steps = sorted({p["step"] for p in rows}, reverse=True)
     table = []
@@ -131,7 +137,7 @@ def _step_table(found: list[dict]) -> list[str]:
         mine = [p for p in rows if p["machine"] == name]
         for coupling in sorted(dict.fromkeys(p["coupling"] for p in mine), key=lambda c: c[:3]):
             by_step = {p["step"]: p for p in mine if p["coupling"] == coupling}
-            table.append([name, coupling, *(_cell(by_step[h]) for h in steps)])
+            table.append([name, coupling, *(cell(by_step[h]) for h in steps)])
     header = ["machine", "coupling", *(f"{h:g} s" for h in steps)]
     return markup.table(header, table, "--" + "r" * len(steps))
 
@@ -167,6 +173,20 @@ def _targets(found: list[dict]) -> list[str]:
             f"{first['angle']:.1e} at {first['rtol']:.0e} to {last['angle']:.1e} at "
             f"{last['rtol']:.0e}"
             + (", falling at every step." if falls else ", not falling at every step.")
+        )
+    return out + _reaction_targets(inside)
+
+
+def _reaction_targets(inside: list[dict]) -> list[str]:
+    """(a)'s reactions, machine by machine: the largest error over every circuit and step."""
+    out = []
+    for name in _machines(inside):
+        sel = [p for p in inside if p["machine"] == name]
+        worst = max(sel, key=lambda p: p["reactions"])
+        out.append(
+            f"- {name}, (a), joint reactions: at most {worst['reactions']:.1e} of the largest "
+            f"reaction's peak at every step and circuit (the largest: {worst['coupling']} at "
+            f"{worst['step']:g} s)."
         )
     return out
 
@@ -258,9 +278,9 @@ def _machine_table(found: list[dict]) -> list[str]:
         table.append(
             [
                 name,
-                f"`{m.plant}`",
-                f"`{m.rotor_plant}`",
-                f"`{m.mechanism}`",
+                markup.code(m.plant),
+                markup.code(m.rotor_plant),
+                markup.code(m.mechanism),
                 f"{m.voltage:g}",
                 f"{m.t_end:g}",
                 f"{gain * m.voltage / motor.resistance:g}",
@@ -310,6 +330,14 @@ def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
         "travelled, then the largest speed error / the peak speed.",
         "",
         *_step_table(found),
+        "",
+        "The joint reactions (every `*.R_*` output: the plant's, in (c) the mechanism FMU's) "
+        "against the harness's Newton-Euler solve along the reference's motion, the harness's "
+        "load models switched off as the FMUs' load inputs stay at zero; each cell: the "
+        "largest error over the reactions and communication points / the largest reaction's "
+        "peak.",
+        "",
+        *_step_table(found, _reaction_cell),
         "",
         f"(a) with the slider-crank's slow motor at {RTOL_STEP:g} s steps, against its tolerances:",
         "",
