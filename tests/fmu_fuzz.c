@@ -59,7 +59,8 @@ typedef enum fuzz_rule {
     FUZZ_ANY_WHEN_FAILED,     /* explains the failure: a dyad's conditioning, amplification */
     FUZZ_FINITE_OR_NAN,       /* NaN only where it overflows itself: the drive's motor.torque,
                                  the motor's motor.current (a state, but without inductance it
-                                 follows the inputs) */
+                                 follows the inputs), a plant's CRANK.motor.current without
+                                 inductance (it follows the state and the supply) */
     FUZZ_ALWAYS_FINITE        /* a state, kept whatever the status, and a solver's counts */
 } fuzz_rule;
 
@@ -73,6 +74,13 @@ static const fuzz_named_rule fuzz_rules[] = {
     {"motor.torque", FUZZ_FINITE_OR_NAN},   {"motor.current", FUZZ_FINITE_OR_NAN},
     {"solver.steps", FUZZ_ALWAYS_FINITE},   {"solver.evaluations", FUZZ_ALWAYS_FINITE},
 };
+
+/* Whether `name` ends with `suffix`. */
+static int ends_with(const char* name, const char* suffix)
+{
+    const size_t n = strlen(name), m = strlen(suffix);
+    return n >= m && strcmp(name + n - m, suffix) == 0;
+}
 
 typedef struct fuzz_fmu {
     probe_model model;
@@ -195,6 +203,11 @@ static int fuzz_prepare(fuzz_fmu* f, const char* directory)
                 if (strcmp(v->name, fuzz_rules[j].name) == 0) {
                     f->rule[k] = fuzz_rules[j].rule;
                 }
+            }
+            /* a plant's motor without inductance: its current no state, but (V - k ratio
+             * omega) / R of the state and the supply, whatever the status */
+            if (f->rule[k] != FUZZ_ALWAYS_FINITE && ends_with(v->name, ".motor.current")) {
+                f->rule[k] = FUZZ_FINITE_OR_NAN;
             }
         }
     }

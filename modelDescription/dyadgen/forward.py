@@ -68,25 +68,37 @@ class ForwardDriver:
         """The C member of one of the plant's own values of this driver."""
         return f"plant_{member(self.name)}_{what}"
 
+    @property
+    def circuit(self) -> bool:
+        """Whether it has a motor whose armature current is a state (inductance > 0)."""
+        return self.motor is not None and self.motor.circuit
+
+    @property
+    def steady(self) -> bool:
+        """Whether it has a motor without inductance: its current follows the speed."""
+        return self.motor is not None and not self.motor.circuit
+
 
 def forward_drivers(scene: Scene) -> list[ForwardDriver]:
     """The drivers of a forward scene with their motion's inputs, in the scene's order."""
     found = []
     motors = {m.driver: m for m in scene.motors}
-    geared = [d.name for d in scene.drivers if d.name in motors]
+    geared = [d.name for d in scene.drivers if d.name in motors and motors[d.name].circuit]
     for k, driver in enumerate(scene.drivers):
         motion = [i for i in scene.inputs if i.owner == driver.name and i.unit not in ("N", "N.m")]
         f = ForwardDriver(driver, k, *motion[:3])
         if driver.name in motors:
             f.motor = motors[driver.name]
+        if f.circuit:
             f.current = 2 * len(scene.drivers) + geared.index(driver.name)
         found.append(f)
     return found
 
 
 def state_size(scene: Scene) -> int:
-    """The dimension of y: each driver's position and rate, each motor's current."""
-    return 2 * len(scene.drivers) + len(scene.motors)
+    """The dimension of y: each driver's position and rate, each motor's current (where
+    it has an inductance)."""
+    return 2 * len(scene.drivers) + sum(m.circuit for m in scene.motors)
 
 
 def required_outputs(scene: Scene) -> list[str]:
@@ -138,7 +150,7 @@ def input_members(scene: Scene) -> dict[str, str]:
             members[f.c("current")] = "real"
     for name in ("rtol", "atol", "step_start", "h_next", "steps", "evaluations"):
         members[f"plant_{name}"] = "real"
-    if any(f.motor is not None for f in forward_drivers(scene)):
+    if any(f.circuit for f in forward_drivers(scene)):
         members["plant_explicit_limit"] = "real"
     return members
 
@@ -186,9 +198,14 @@ def start_parameters(scene: Scene) -> list[tuple[Input, float]]:
 
 
 def _motor_parameters(f: ForwardDriver) -> list[tuple[Input, float]]:
-    """A motor's numbers as parameters, with their bounds."""
+    """A motor's numbers as parameters, with their bounds (a motor without inductance has
+    neither it nor a start current: its current is no state)."""
     found = []
     for key, (unit, text, _, least, strict) in MOTOR_NUMBERS.items():
+        if key in ("inductance", "current") and not f.circuit:
+            continue
+        if key == "inductance":
+            strict = True  # a circuit's stays one: the state and its rate need L > 0
         name = f"{f.name}.motor.{key}" + ("_start" if key == "current" else "")
         domain = {} if least is None else {"min": least, "min_exclusive": strict}
         parameter = Input(name, unit or None, text, f.c(f"motor_{key}"), domain=domain)
@@ -230,7 +247,7 @@ def step_start_parameter() -> tuple[str, float, str]:
 def explicit_limit_parameters(scene: Scene) -> list[tuple[str, float, str]]:
     """(name, default, description) of the switch between the integrator's methods, for
     a scene with a motor (without one, nothing is stiff: the explicit method always)."""
-    if not any(f.motor is not None for f in forward_drivers(scene)):
+    if not any(f.circuit for f in forward_drivers(scene)):
         return []
     return [
         (
@@ -254,7 +271,10 @@ def motion_outputs(scene: Scene) -> list[Output]:
         found.append(Output(a.name, a.unit, a.description, f.c("acceleration"), depends=inputs))
         if f.motor is not None:
             text = f"Armature current of the motor of {f.name}"
-            found.append(Output(f"{f.name}.motor.current", "A", text, f.c("current")))
+            # a circuit's is a state; without inductance it follows the supply at once
+            supply = [] if f.circuit else [_effort_input(scene, f).name]
+            current = Output(f"{f.name}.motor.current", "A", text, f.c("current"), depends=supply)
+            found.append(current)
     return found + [
         Output(
             "solver.step",
@@ -314,7 +334,7 @@ def _state_names(scene: Scene) -> list[tuple[str, str, str]]:
 
 def _geared(scene: Scene) -> list[ForwardDriver]:
     """The drivers with a motor, in the order of their currents in y."""
-    return sorted((f for f in forward_drivers(scene) if f.motor), key=lambda f: f.current)
+    return sorted((f for f in forward_drivers(scene) if f.circuit), key=lambda f: f.current)
 
 
 def _motion_into(ident: str, drivers: list[ForwardDriver]) -> list[str]:
@@ -373,10 +393,23 @@ def _equation_of_motion(scene: Scene, ident: str, drivers: list[ForwardDriver]) 
         lines += [
             "    /* the motor's torque at the crank, its rotor's inertia on M's diagonal */",
             f"    m[{k * n + k}] += {ratio} * {ratio} * in->{f.c('motor_rotor_inertia')};",
-            f"    r[{k}] = {ratio} * (in->{f.c('motor_torque_constant')} * y[{f.current}] -",
+            f"    r[{k}] = {ratio} * (in->{f.c('motor_torque_constant')} * {_current(f, 'y', n)} -",
             f"            in->{f.c('motor_friction')} * {ratio} * y[{n + k}]) - {h};",
         ]
     return lines + ["}", ""]
+
+
+def _current(f: ForwardDriver, y: str, n: int, voltage: str = "") -> str:
+    """The C expression of f's armature current at the state ``y``: the state's, or
+    without inductance (V - k ratio q') / R, V the member ``voltage`` (the supply's)."""
+    if f.circuit:
+        return f"{y}[{f.current}]"
+    c = f.c
+    supply = voltage or f"in->{c('motor_voltage')}"
+    return (
+        f"({supply} - in->{c('motor_torque_constant')} * in->{c('motor_ratio')} * "
+        f"{y}[{n + f.index}]) / in->{c('motor_resistance')}"
+    )
 
 
 def _inertia_and_bias_members(scene: Scene, drivers: list[ForwardDriver]) -> tuple[list, list]:
@@ -435,13 +468,22 @@ def _motor_partials(ident: str, drivers: list[ForwardDriver], n: int) -> list[st
         "{",
         "    memset(dr, 0, sizeof(double) * PLANT_DRIVERS * PLANT_SIZE);",
     ]
-    geared = [f for f in drivers if f.motor is not None]
+    geared = [f for f in drivers if f.circuit]
     if geared:
         rows = "(PLANT_SIZE - 2 * PLANT_DRIVERS)"
         lines.append(f"    memset(di, 0, sizeof(double) * {rows} * PLANT_SIZE);")
     else:
-        lines += ["    (void)in;", "    (void)di;"]
+        lines.append("    (void)di;")
+    if not any(f.motor for f in drivers):
+        lines.append("    (void)in;")
     size = 2 * n + len(geared)
+    for f in (f for f in drivers if f.steady):
+        c, k = f.c, f.index
+        ratio, kt = f"in->{c('motor_ratio')}", f"in->{c('motor_torque_constant')}"
+        lines.append(
+            f"    dr[{k * size + n + k}] = -{ratio} * {ratio} * (in->{c('motor_friction')} + "
+            f"{kt} * {kt} / in->{c('motor_resistance')});"
+        )
     for f in geared:
         c, k, row = f.c, f.index, f.current - 2 * n
         ratio = f"in->{c('motor_ratio')}"
@@ -463,7 +505,7 @@ def _currents(ident: str, drivers: list[ForwardDriver], n: int) -> list[str]:
         f"static void currents_rate(const {ident}_input* in, const dyad_real* y, dyad_real* dydt)",
         "{",
     ]
-    geared = [f for f in drivers if f.motor is not None]
+    geared = [f for f in drivers if f.circuit]
     if not geared:
         lines += ["    (void)in;", "    (void)y;", "    (void)dydt;"]
     for f in geared:
@@ -490,7 +532,7 @@ def _state_io(drivers: list[ForwardDriver], ident: str) -> list[str]:
         get.append(f"    y[{n + f.index}] = in->{f.c('rate')};")
         put.append(f"    in->{f.c('position')} = (double)y[{f.index}];")
         put.append(f"    in->{f.c('rate')} = (double)y[{n + f.index}];")
-        if f.motor is not None:
+        if f.circuit:
             get.append(f"    y[{f.current}] = in->{f.c('current')};")
             put.append(f"    in->{f.c('current')} = (double)y[{f.current}];")
     return [*get, "}", "", *put, "}", ""]
@@ -507,7 +549,7 @@ def _start(drivers: list[ForwardDriver], ident: str) -> list[str]:
     for f in drivers:
         lines.append(f"    in->{f.c('position')} = in->{f.c('position_start')};")
         lines.append(f"    in->{f.c('rate')} = in->{f.c('rate_start')};")
-        if f.motor is not None:
+        if f.circuit:
             lines.append(f"    in->{f.c('current')} = in->{f.c('motor_current')};")
     lines += [
         "    in->plant_h_next = in->plant_step_start;",
@@ -519,19 +561,34 @@ def _start(drivers: list[ForwardDriver], ident: str) -> list[str]:
     return lines
 
 
-def _outputs(drivers: list[ForwardDriver], ident: str) -> list[str]:
+def _outputs(scene: Scene, drivers: list[ForwardDriver], ident: str) -> list[str]:
+    """put_outputs(): the drivers' motion and currents at the state y with the
+    accelerations a, or (``rates``: y the state's rates, a the jerks) their rates, a
+    current without inductance's from the supply's derivative."""
     lines = [
-        "/* The drivers' own outputs. */",
-        f"static void put_outputs({ident}_output* out, const double* y, const double* a)",
+        "/* The drivers' own outputs, or with `rates` their rates (y then y', a a'). */",
+        f"static void put_outputs(const {ident}_input* in, {ident}_output* out, const double* y,",
+        "                        const double* a, int rates)",
         "{",
     ]
+    if not any(f.steady for f in drivers):
+        lines += ["    (void)in;", "    (void)rates;"]
     n = len(drivers)
     for f in drivers:
         lines.append(f"    out->{f.c('position')} = y[{f.index}];")
         lines.append(f"    out->{f.c('rate')} = y[{n + f.index}];")
         lines.append(f"    out->{f.c('acceleration')} = a[{f.index}];")
-        if f.motor is not None:
+        if f.circuit:
             lines.append(f"    out->{f.c('current')} = y[{f.current}];")
+        elif f.steady:
+            slope, value = slope_member(_effort_input(scene, f)), f.c("motor_voltage")
+            supply = f"(rates ? in->{slope} : in->{value})"
+            lines += [
+                "    {  /* NaN, not an infinity, where the current overflows */",
+                f"        const double current = {_current(f, 'y', n, supply)};",
+                f"        out->{f.c('current')} = isfinite(current) ? current : (double)NAN;",
+                "    }",
+            ]
     return lines + ["}", ""]
 
 
@@ -656,11 +713,18 @@ def _ramp_partials(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> li
         "{",
     ]
     n = len(drivers)
-    if not any(f.motor for f in drivers):
+    if not any(f.circuit for f in drivers):
         lines.append("    (void)di;")
     for f in drivers:
         if f.motor is None:
             lines.append(f"    dr[{f.index}] = in->{slope_member(_effort_input(scene, f))};")
+            continue
+        if f.steady:
+            c = f.c
+            lines.append(
+                f"    dr[{f.index}] = in->{c('motor_ratio')} * in->{c('motor_torque_constant')} "
+                f"* in->{slope_member(_effort_input(scene, f))} / in->{c('motor_resistance')};"
+            )
             continue
         lines += [
             f"    dr[{f.index}] = 0;",
@@ -704,7 +768,7 @@ def _stiffness(ident: str, drivers: list[ForwardDriver]) -> list[str]:
         f"static int stiff_at(const {ident}_input* in, double step)",
         "{",
     ]
-    geared = [f for f in drivers if f.motor is not None]
+    geared = [f for f in drivers if f.circuit]
     if not geared:
         return lines + ["    (void)in;", "    (void)step;", "    return 0;", "}", ""]
     lines.append("    double rate = 0;")
@@ -725,7 +789,7 @@ def _current_magnitudes(ident: str, drivers: list[ForwardDriver]) -> list[str]:
         f"static void current_magnitudes(const {ident}_input* in, dyad_ode_options* options)",
         "{",
     ]
-    geared = [f for f in drivers if f.motor is not None]
+    geared = [f for f in drivers if f.circuit]
     if not geared:
         return lines + ["    (void)in;", "    (void)options;", "}", ""]
     for f in geared:
@@ -795,7 +859,7 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         + _jacobian_parts(scene, ident, drivers)
         + _state_io(drivers, ident)
         + _start(drivers, ident)
-        + _outputs(drivers, ident)
+        + _outputs(scene, drivers, ident)
         + _no_outputs(scene, ident)
         + _state_table(scene, ident)
         + _input_lines(scene, ident)

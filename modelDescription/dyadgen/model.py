@@ -167,17 +167,25 @@ class Motor:
     """A DC motor geared to a crank of a forward scene ([[motor]]): with the rotor at
     ratio q' and the armature current i, inductance i' = V - resistance i -
     torque_constant ratio q', and the crank's torque ratio (torque_constant i - friction
-    ratio q') - ratio^2 rotor_inertia q''. Its numbers are the FMU's parameters."""
+    ratio q') - ratio^2 rotor_inertia q''. Its numbers are the FMU's parameters (but a
+    zero inductance, and then the start current: see :attr:`circuit`)."""
 
     driver: str  # the crank's name
     line: int | None
     numbers: dict  # key -> value, every key of MOTOR_NUMBERS
 
+    @property
+    def circuit(self) -> bool:
+        """Whether its armature current is a state (inductance > 0); with none, the current
+        is (V - torque_constant ratio q') / resistance at every instant: the drive FMU's
+        linear torque-speed characteristic."""
+        return self.numbers["inductance"] > 0
+
 
 #: A motor's numbers: key -> (unit, what, default or None where required, least, strict)
 MOTOR_NUMBERS = {
     "resistance": ("Ohm", "Armature resistance", None, 0.0, True),
-    "inductance": ("H", "Armature inductance", None, 0.0, True),
+    "inductance": ("H", "Armature inductance (0: no current state)", None, 0.0, False),
     "torque_constant": (
         "N.m/A",
         "Torque constant, in SI also the back-EMF constant (V.s/rad)",

@@ -484,7 +484,7 @@ def test_quick_report_writes_its_files(tmp_path):
     _, runs, mechanism_fmus, machines, by_step, by_reactions, by_rtol = tables
     assert len(runs.rows) == 1 + len(rows) and len(mechanism_fmus.rows) == 1 + 3
     assert len(machines.rows) == 1 + 1  # the slider-crank
-    assert len(by_step.rows) == len(by_reactions.rows) == 1 + 4 and len(by_rtol.rows) == 1 + 2
+    assert len(by_step.rows) == len(by_reactions.rows) == 1 + 5 and len(by_rtol.rows) == 1 + 2
     plant = machines.rows[1][1].children  # the FMU's name a code span, not escaped backticks
     assert [c.content for c in plant if c.type == "code_inline"] == ["slider_crank_motor"]
     assert "For a user of the dyad FMU" in text
@@ -500,10 +500,15 @@ def test_quick_report_writes_its_files(tmp_path):
 
 def _check_plant_points(found: list[dict]) -> None:
     """The motor inside the plant (a) within 1e-8 of travel and peak at every step and
-    tolerance; the drive FMU with the inverse mechanism FMU (c) first order in the step."""
+    tolerance, with the scene's circuit and without inductance (the drive's linear
+    characteristic); the drive FMU with the inverse mechanism FMU (c) first order in the
+    step."""
     inside = [p for p in found if p["coupling"].startswith("(a)")]
     drive = sorted((p for p in found if p["coupling"].startswith("(c)")), key=lambda p: p["step"])
-    assert len(inside) == 4 and len(drive) == 2
+    assert len(inside) == 6 and len(drive) == 2
+    # the plant with the drive's own linear characteristic inside, against the same reference
+    linear = [p for p in inside if p["coupling"] == "(a) motor L = 0"]
+    assert sorted(p["step"] for p in linear) == sorted(p["step"] for p in drive)
     assert max(max(p["angle"], p["speed"], p["reactions"]) for p in inside) < 1e-8
     assert min(p["reactions"] for p in drive) > 1e4 * max(p["reactions"] for p in inside)
     assert drive[0]["speed"] < drive[1]["speed"]
@@ -524,7 +529,8 @@ def test_every_machine_with_its_motor_inside_meets_the_reference(name):
     ms steps; their motor as a separate FMU
     (b) nearer with the rates exchanged than held at 1 ms; the drive FMU with the inverse
     mechanism FMU (c) falling with the step. Measured: (a) 1.8e-13 and 1.7e-14 of the
-    travel, (b) with rates 4.7e-3 and 1.6e-3 rad at 1 ms, a fifth of held."""
+    travel, (b) with rates 4.7e-3 and 1.6e-3 rad at 1 ms, a fifth of held, and the
+    reactions 3.8e-2 and 9.8e-3 of their peak, a quarter and a sixth of held."""
     from dyadfmu.cosim import plant_study as study
 
     m = study.MACHINES[name]
@@ -535,6 +541,7 @@ def test_every_machine_with_its_motor_inside_meets_the_reference(name):
     assert max(inside["angle"], inside["speed"], inside["reactions"]) < 1e-8, inside
     held, rates = (study.errors(study.split_run(label, 1e-3, r, m), ref) for r in (False, True))
     assert rates["angle"] < held["angle"] / 3, (held, rates)
+    assert rates["reactions"] < held["reactions"] / 3, (held, rates)
     linear = study.reference(study.LINEAR, grid, "DOP853", 1e-11, m)
     drive = [study.errors(study.drive_run(h, m=m), linear)["speed"] for h in (1e-2, 1e-3)]
     assert drive[1] < drive[0] / 5, drive

@@ -37,6 +37,7 @@ SCENES = {
     "slider_crank_rotor": paths.SCENES_DIR / "slider_crank.toml",
     "four_bar_motor": paths.SCENES_DIR / "four_bar_payload.toml",
     "shaper_motor": paths.SCENES_DIR / "shaper.toml",
+    "slider_crank_linear_motor": paths.SCENES_DIR / "slider_crank.toml",
 }
 #: A constant cutting force on the shaper's ram [N] (the reference's load model made
 #: constant, as the FMU's input holds it)
@@ -324,6 +325,63 @@ def test_the_explicit_limit_chooses_the_method_not_the_motion():
         apart = np.max(np.abs(rosenbrock[f"{n}.angle"] - chosen[f"{n}.angle"]))
         print(f"{n}: the two methods {apart:.1e} rad apart")
         assert apart < 1e-9
+
+
+@pytest.mark.parametrize("identifier", sorted(SCENES))
+def test_every_output_an_input_moves_at_once_is_declared_to_depend_on_it(identifier):
+    """Each input changed alone at a communication point, no step between: every Real
+    output that moves declares that input among its dependencies (the model structure
+    from which a master finds its algebraic loops)."""
+    from dyadfmu.fmi.slave import Slave
+
+    path = _fmu(identifier)
+    md = read_model_description(path)
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    outputs = [u for u in md.outputs if u.variable.type in ("Real", "Float64")]
+    declared = {u.variable.name: {d.name for d in u.dependencies or ()} for u in outputs}
+    names = tuple(declared)
+    slave = Slave(path)
+    try:
+        slave.initialize()
+        before = np.array(slave.get(names))
+        for name in inputs:
+            value = slave.get(name)
+            slave.set(name, value + 1.0 + 0.01 * abs(value))
+            after = np.array(slave.get(names))
+            slave.set(name, value)
+            moved = ~((after == before) | (np.isnan(after) & np.isnan(before)))
+            undeclared = [
+                n for n, m in zip(names, moved, strict=True) if m and name not in declared[n]
+            ]
+            assert not undeclared, f"{name} moves {undeclared}, which do not declare it"
+    finally:
+        slave.close()
+
+
+def test_a_motor_without_inductance_is_the_drive_fmus_line():
+    """slider_crank_linear_motor (slider_crank_motor's motor with L = 0): no current state
+    and no inductance or start current to set; its current is (V - k omega) / R and the
+    torque at the crank the line 400 N.m (1 - omega / 290 rad/s) less the rotor's
+    inertia torque, at every communication point of a run-up."""
+    md = read_model_description(_fmu("slider_crank_linear_motor"))
+    names = {v.name for v in md.modelVariables}
+    assert not {"crank.motor.inductance", "crank.motor.current_start"} & names
+    # the current follows the supply at once (an algebraic loop for a master closing it)
+    (current,) = (u for u in md.outputs if u.variable.name == "crank.motor.current")
+    assert [v.name for v in current.dependencies] == ["crank.motor.voltage"]
+    rows = simulate_fmu(
+        _fmu("slider_crank_linear_motor"),
+        stop_time=0.2,
+        output_interval=1e-3,
+        start_values={"crank.motor.voltage": 290.0, "crank.angle_start": 0.5},
+    )
+    omega, eps = rows["crank.omega"], rows["crank.epsilon"]
+    current = (290.0 - 1.0 * omega) / 0.725
+    line = 400.0 * (1.0 - omega / 290.0) - 5.0e-3 * eps
+    print(f"linear motor: speed {omega[-1]:.1f} rad/s after 0.2 s")
+    assert omega[-1] > 50.0 and np.all(rows["status"] == 0)
+    assert np.max(np.abs(rows["crank.motor.current"] - current)) <= 1e-12 * 400.0
+    assert np.max(np.abs(rows["crank.torque"] - line)) <= 1e-12 * 400.0
 
 
 def test_a_free_four_bar_keeps_its_energy():

@@ -97,6 +97,7 @@ STUDY_TEST_FMUS |= {
         "slider_crank_rotor",
         "four_bar_motor",
         "shaper_motor",
+        "slider_crank_linear_motor",
     )
     for version in (2, 3)
 }

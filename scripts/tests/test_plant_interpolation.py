@@ -106,6 +106,10 @@ RAMPS = {
         {"crank.omega_start": 30.0},
     ),
     "leg_motor": ({}, {}),
+    "slider_crank_linear_motor": (
+        {"crank.motor.voltage": (100.0, 2.0e3), "piston.force.x": (-50.0, -1.0e4)},
+        {"crank.omega_start": 30.0},
+    ),
 }
 DELTA = 5e-7
 

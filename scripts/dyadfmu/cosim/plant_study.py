@@ -69,7 +69,9 @@ __all__ = [
 class PlantMachine:
     """A machine of the study: the plant with its motor inside (a), the plant whose crank
     takes a separate motor FMU's rotor (b), the inverse mechanism FMU (c) whose harness
-    mechanism is the reference's, the supply voltage [V] and the run's duration [s]."""
+    mechanism is the reference's, the supply voltage [V] and the run's duration [s]; where
+    given, ``linear_plant``: the plant with the same motor without inductance (the drive
+    FMU's linear characteristic, (a) one to one with (c))."""
 
     name: str
     plant: str
@@ -77,6 +79,7 @@ class PlantMachine:
     mechanism: str
     voltage: float
     t_end: float
+    linear_plant: str = ""
 
 
 #: The machines, each run up from rest at START_ANGLE (the motors: the plants' [motor]).
@@ -84,7 +87,13 @@ MACHINES = {
     m.name: m
     for m in (
         PlantMachine(
-            "slider-crank", "slider_crank_motor", "slider_crank_rotor", "slider_crank", 290.0, 2.0
+            "slider-crank",
+            "slider_crank_motor",
+            "slider_crank_rotor",
+            "slider_crank",
+            290.0,
+            2.0,
+            "slider_crank_linear_motor",
         ),
         PlantMachine(
             "four-bar", "four_bar_motor", "four_bar_forward", "four_bar_payload", 36.0, 0.5
@@ -168,13 +177,20 @@ def run(
     m: PlantMachine = SLIDER_CRANK,
 ) -> PlantRun:
     """``m``'s plant with motor ``label`` over its run at communication step ``step`` (and
-    ``solver.rtol`` = ``solver.atol`` = ``rtol`` where given)."""
+    ``solver.rtol`` = ``solver.atol`` = ``rtol`` where given); motor :data:`LINEAR`: its
+    plant without inductance (``m.linear_plant``)."""
     n = mechanism_drive.whole_steps(m.t_end, step)
     parameters = circuit(label, version, m).parameters()
+    name = m.plant
+    if label == LINEAR:
+        if not m.linear_plant:
+            raise ValueError(f"{m.name} has no plant with a motor without inductance")
+        name = m.linear_plant
+        del parameters["crank.motor.inductance"]  # no parameter there: no current state
     parameters["crank.angle_start"] = START_ANGLE
     if rtol is not None:
         parameters.update({"solver.rtol": rtol, "solver.atol": rtol})
-    plant = Slave(paths.built_fmu(m.plant, version, how="scripts/run-tests"), "plant")
+    plant = Slave(paths.built_fmu(name, version, how="scripts/run-tests"), "plant")
     names = ("crank.angle", "crank.omega", *reaction_names(plant))
     rows = np.empty((n + 1, len(names)))
     started = clock.process_time()
@@ -415,19 +431,18 @@ def _split_fmus(label: str, version: int, m: PlantMachine) -> tuple[Slave, Slave
     return fmu, plant
 
 
-def _exchange(motor: Slave, plant: Slave, rates: bool, names: tuple) -> tuple:
+def _exchange(motor: Slave, plant: Slave, rates: bool, reactions: tuple) -> tuple:
     """One communication point: the plant's speed (and its rate) to the motor, the
-    motor's torque (and its rate) to the plant; the plant's ``names`` (the crank's angle
-    and speed first)."""
-    values = plant.get(names)
-    omega = values[1]
+    motor's torque (and its rate) to the plant; the crank's angle and speed, then the
+    plant's ``reactions`` under the torque it now has (as a master records them)."""
+    phi, omega = plant.get(("crank.angle", "crank.omega"))
     motor.set("shaft.omega", omega)
     if rates:
         motor.set_rates("shaft.omega", plant.output_rates(("crank.omega",))[0])
     plant.set("crank.torque", motor.get("shaft.torque"))
     if rates:
         plant.set_rates("crank.torque", motor.output_rates(("shaft.torque",))[0])
-    return values
+    return (phi, omega, *(plant.get(reactions) if reactions else ()))
 
 
 def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRANK) -> PlantRun:
@@ -442,7 +457,7 @@ def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRA
     started = clock.process_time()
     try:
         for k in range(n + 1):
-            rows[k] = _exchange(motor, plant, rates, names)
+            rows[k] = _exchange(motor, plant, rates, names[2:])
             if k < n:
                 motor.do_step(k * step, step)
                 plant.do_step(k * step, step)

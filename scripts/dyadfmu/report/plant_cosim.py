@@ -99,6 +99,9 @@ def _machine_points(m: study.PlantMachine, quick: bool, log: Callable[[str], Non
         found += _split_points(label, steps, ref, m)
     log(f"{m.name}: drive FMU and mechanism FMU, the reference with L = 0")
     ref = _reference(study.LINEAR, steps, quick, m)
+    for step in steps if m.linear_plant else ():
+        run = study.run(study.LINEAR, step, m=m)
+        found.append(_point(m, f"(a) motor {study.LINEAR}", step, math.nan, run, ref))
     for step in steps:
         run = study.drive_run(step, m=m)
         found.append(_point(m, "(c) drive + inverse FMU", step, math.nan, run, ref))
@@ -268,6 +271,11 @@ def _plot_machine(axes: object, rows: list[dict]) -> None:
     axes[0].legend(fontsize=8)
 
 
+def _linear(found: list[dict]) -> list[study.PlantMachine]:
+    """The machines of ``found`` with a plant whose motor has no inductance."""
+    return [study.MACHINES[n] for n in _machines(found) if study.MACHINES[n].linear_plant]
+
+
 def _machine_table(found: list[dict]) -> list[str]:
     """Each machine of the section: its FMUs, its supply, its run and its motor."""
     table = []
@@ -319,7 +327,11 @@ def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
         "to the crank's), exchanging speed and torque at each communication point, held "
         "over the step or with their first derivatives (FMI 2 input and output "
         "derivatives); (c): the drive FMU with the motor's linear characteristic (its L = 0 "
-        "limit) and the inverse mechanism FMU, stabilised. Reference: the machine as one "
+        "limit) and the inverse mechanism FMU, stabilised; (a) motor L = 0: a plant with that "
+        "characteristic inside (its motor without inductance, the current no state), one to "
+        "one with (c) against the same reference, where the machine has one ("
+        + ", ".join(markup.code(m.linear_plant) for m in _linear(found))
+        + "). Reference: the machine as one "
         "ODE from the harness's kinematics (J, J' and Q_g as Fourier series of "
         f"{study.SAMPLES} samples, within the 'series fit' of the harness), SciPy at rtol "
         f"{_reference_rtol(quick):.0e} (Radau where the circuit is stiff, else DOP853).",
