@@ -51,7 +51,7 @@ class ForwardDriver:
     rate: Input
     acceleration: Input
     motor: Motor | None = None
-    #: the place of its motor's current in the state y, if it has a motor
+    #: the place of its motor's current in the state y, if its motor has an inductance
     current: int = -1
 
     @property
@@ -246,7 +246,8 @@ def step_start_parameter() -> tuple[str, float, str]:
 
 def explicit_limit_parameters(scene: Scene) -> list[tuple[str, float, str]]:
     """(name, default, description) of the switch between the integrator's methods, for
-    a scene with a motor (without one, nothing is stiff: the explicit method always)."""
+    a scene with a motor that has an inductance (without one, no circuit decays: the
+    explicit method always)."""
     if not any(f.circuit for f in forward_drivers(scene)):
         return []
     return [
@@ -333,7 +334,8 @@ def _state_names(scene: Scene) -> list[tuple[str, str, str]]:
 
 
 def _geared(scene: Scene) -> list[ForwardDriver]:
-    """The drivers with a motor, in the order of their currents in y."""
+    """The drivers whose motor has an inductance (a current state), in the order of their
+    currents in y."""
     return sorted((f for f in forward_drivers(scene) if f.circuit), key=lambda f: f.current)
 
 
@@ -460,8 +462,9 @@ def _jacobian_parts(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> l
 
 def _motor_partials(ident: str, drivers: list[ForwardDriver], n: int) -> list[str]:
     """motor_partials(): d r / d y of the motors' torques (r = efforts - h, row-major N x
-    PLANT_SIZE) and d i' / d y of their currents (row-major motors x PLANT_SIZE), the rest
-    zero: both are linear in y."""
+    PLANT_SIZE; a motor without inductance's through its current's speed term) and d i' / d y
+    of the current states (row-major circuits x PLANT_SIZE), the rest zero: both are linear
+    in y."""
     lines = [
         "/* The motors' part of d(efforts - h)/dy and the currents' d i'/dy. */",
         f"static void motor_partials(const {ident}_input* in, double* dr, double* di)",

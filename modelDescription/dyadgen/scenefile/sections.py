@@ -771,5 +771,14 @@ def motors(p: Problems, data: dict, drivers: list[Crank], forward: bool) -> list
                 nonnegative=least == 0.0 and not strict,
             )
             numbers[key] = value if value is not None else 1.0
+        if numbers["inductance"] == 0 and "current" in table:
+            p.add(
+                f"[motor]: the motor of '{driver}' has no inductance, so its current is no "
+                "state and has no start value: leave 'current' out",
+                "motor",
+                i,
+                "current",
+            )
+            continue
         found.append(Motor(driver, p.loc.line("motor", i), numbers))
     return found

@@ -470,22 +470,29 @@ def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRA
     return PlantRun(label, step, math.nan, t, rows[:, 0], rows[:, 1], cpu, reactions)
 
 
+def _largest(error: np.ndarray) -> float:
+    """max |error|, infinite where any of it is not finite."""
+    return float(np.max(np.abs(error))) if np.all(np.isfinite(error)) else math.inf
+
+
 def errors(result: PlantRun, ref: Reference) -> dict:
     """The largest angle error over the run as a fraction of the angle travelled, the
     largest speed error as a fraction of the peak speed, and the largest error of a joint
-    reaction as a fraction of the largest reaction's peak (every reaction of the run;
-    one the reference lacks is refused)."""
+    reaction as a fraction of the largest reaction's peak (a run and a reference with
+    different reactions are refused; NaN where the run has none, inf where one is not
+    finite)."""
     step = max(1, int(round((len(ref.t) - 1) / (len(result.t) - 1))))
     phi, omega = ref.phi[::step], ref.omega[::step]
     if len(phi) != len(result.t) or abs(ref.t[::step][-1] - result.t[-1]) > 1e-9 * ref.t[-1]:
         raise ValueError(f"the reference's grid does not hold the run's {len(result.t)} points")
     travel = abs(phi[-1] - phi[0])
-    missing = sorted(set(result.reactions) - set(ref.reactions))
-    if missing:
-        raise ValueError(f"the reference has no reactions {', '.join(missing)}")
+    if set(result.reactions) != set(ref.reactions):
+        apart = sorted(set(result.reactions) ^ set(ref.reactions))
+        raise ValueError(f"the run and the reference differ in the reactions {', '.join(apart)}")
     peak = max((np.max(np.abs(ref.reactions[k])) for k in result.reactions), default=1.0)
+    # a reaction that is not finite (NaN included) counts as infinitely wrong
     worst = max(
-        (np.max(np.abs(v - ref.reactions[k][::step])) for k, v in result.reactions.items()),
+        (_largest(v - ref.reactions[k][::step]) for k, v in result.reactions.items()),
         default=math.nan,
     )
     return {
