@@ -563,3 +563,18 @@ def test_the_reactions_reference_refuses_the_harness_loads(name):
     loaded = fmus.mechanism_of(m.mechanism)
     with pytest.raises(ValueError, match=r"the harness applies the load \S+"):
         study.reactions(m, t, phi, omega, eps, loaded)
+
+
+@pytest.mark.parametrize("friction", [0.0, 0.02])
+def test_the_drive_line_is_the_circuit_without_inductance(friction):
+    """The drive FMU's line for a motor with L = 0, friction included, gives the torque at
+    the crank that the circuit gives, r (k i - c r omega) with i = (V - k r omega) / R."""
+    from dyadfmu.cosim import plant_study as study
+
+    motor = study.Circuit(0.8, 0.0, 0.3, 2e-4, friction, 12.0)
+    line = study.drive_line(motor, 24.0)
+    for omega in (-3.0, 0.0, 2.5, 5.0, 7.0):
+        current = (24.0 - 0.3 * 12.0 * omega) / 0.8
+        want = 12.0 * (0.3 * current - friction * 12.0 * omega)
+        assert line.torque(omega) == pytest.approx(want, rel=1e-13, abs=1e-12)
+    assert line.rotor_inertia == pytest.approx(144.0 * 2e-4, rel=1e-15)

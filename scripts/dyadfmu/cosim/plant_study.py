@@ -54,6 +54,7 @@ __all__ = [
     "PlantMachine",
     "PlantRun",
     "Reference",
+    "drive_line",
     "drive_run",
     "errors",
     "reaction_names",
@@ -157,11 +158,9 @@ class PlantRun:
     reactions: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def reaction_names(fmu: Slave) -> tuple[str, ...]:
-    """The joint reactions among ``fmu``'s outputs: every ``*.R_*`` (x and y)."""
-    return tuple(
-        v.name for v in fmu.md.modelVariables if v.causality == "output" and ".R_" in v.name
-    )
+def reaction_names(variables: list) -> tuple[str, ...]:
+    """The joint reactions among an FMU's model ``variables``: every ``*.R_*`` output."""
+    return tuple(v.name for v in variables if v.causality == "output" and ".R_" in v.name)
 
 
 def _recorded(names: tuple[str, ...], rows: np.ndarray, start: int) -> dict[str, np.ndarray]:
@@ -191,7 +190,7 @@ def run(
     if rtol is not None:
         parameters.update({"solver.rtol": rtol, "solver.atol": rtol})
     plant = Slave(paths.built_fmu(name, version, how="scripts/run-tests"), "plant")
-    names = ("crank.angle", "crank.omega", *reaction_names(plant))
+    names = ("crank.angle", "crank.omega", *reaction_names(plant.md.modelVariables))
     rows = np.empty((n + 1, len(names)))
     started = clock.process_time()
     try:
@@ -388,22 +387,25 @@ def _given(
     )
 
 
+def drive_line(motor: Circuit, voltage: float) -> machine.Motor:
+    """The drive FMU's motor for ``motor`` at ``voltage`` [V] with L = 0: the torque at
+    the crank r (k i - c r omega), i = (V - k r omega) / R, as a line: stall torque
+    k r V / R, no-load speed where the line reaches zero, the rotor at the crank."""
+    gain = motor.torque_constant * motor.ratio
+    stall = gain * voltage / motor.resistance
+    slope = gain**2 / motor.resistance + motor.friction * motor.ratio**2
+    return machine.Motor(stall, stall / slope, motor.ratio**2 * motor.rotor_inertia)
+
+
 def drive_run(step: float, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> PlantRun:
     """``m`` as the drive FMU (the motor's linear characteristic, L = 0: stall torque
-    k r V / R, no-load speed V / (k r)) and its inverse mechanism FMU, stabilised
+    k r V / R, falling with the speed at k^2 r^2 / R + c r^2, the friction c's share
+    included) and its inverse mechanism FMU, stabilised
     (:mod:`dyadfmu.cosim.mechanism_drive`)."""
-    motor = circuit(LINEAR, m=m)
-    gain = motor.torque_constant * motor.ratio
-    linear = machine.Motor(
-        gain * m.voltage / motor.resistance, m.voltage / gain, motor.ratio**2 * motor.rotor_inertia
-    )
+    linear = drive_line(circuit(LINEAR, m=m), m.voltage)
     drive = mechanism_drive.Machine(m.mechanism, linear, 0.0, m.t_end)
     path = paths.built_fmu(m.mechanism, version, how="scripts/run-tests")
-    names = tuple(
-        v.name
-        for v in read_model_description(str(path)).modelVariables
-        if v.causality == "output" and ".R_" in v.name
-    )
+    names = reaction_names(read_model_description(str(path)).modelVariables)
     started = clock.process_time()
     r = mechanism_drive.run(m.mechanism, step, version, drive, names)
     cpu = clock.process_time() - started
@@ -452,7 +454,7 @@ def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRA
     derivatives)."""
     n = mechanism_drive.whole_steps(m.t_end, step)
     motor, plant = _split_fmus(label, 2, m)
-    names = ("crank.angle", "crank.omega", *reaction_names(plant))
+    names = ("crank.angle", "crank.omega", *reaction_names(plant.md.modelVariables))
     rows = np.empty((n + 1, len(names)))
     started = clock.process_time()
     try:
