@@ -652,6 +652,16 @@ static void step_completed(fmu_instance* instance, double end)
     instance->terminate_requested = 0;
 }
 
+/* The time where a failed step stopped, `reached` seconds into it: before the step's end
+ * even where the time's resolution (at t = 1e9 s, 1.2e-7 s) rounds the stop to it, so that
+ * a master never reads a discarded step's last successful time as its end. */
+static double stop_time(double current_time, double step_size, double reached)
+{
+    const double end = current_time + step_size;
+    const double stopped = reached > 0 ? current_time + reached : current_time;
+    return stopped < end ? stopped : nextafter(end, current_time);
+}
+
 /* A step of a model with states: the outputs at its start, the states
  * advanced, the outputs at its end. */
 static fmu_status advance_states(fmu_instance* instance, double current_time, double step_size,
@@ -672,7 +682,7 @@ static fmu_status advance_states(fmu_instance* instance, double current_time, do
             /* A step that failed: the states where it stopped, the outputs there */
             fmu_log(instance, FMU_DISCARD, "%s: at t = %g s: %s", function, current_time,
                     e->reason);
-            instance->time = reached > 0 ? current_time + reached : current_time;
+            instance->time = stop_time(current_time, step_size, reached);
             instance->last_successful_time = instance->time;
             instance->terminate_requested = 1;
             return FMU_DISCARD;

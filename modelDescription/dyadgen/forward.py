@@ -150,7 +150,7 @@ def input_members(scene: Scene) -> dict[str, str]:
             members[f.c("current")] = "real"
     for name in ("rtol", "atol", "step_start", "h_next", "steps", "evaluations"):
         members[f"plant_{name}"] = "real"
-    if any(f.circuit for f in forward_drivers(scene)):
+    if any(f.motor is not None for f in forward_drivers(scene)):
         members["plant_explicit_limit"] = "real"
     return members
 
@@ -246,17 +246,19 @@ def step_start_parameter() -> tuple[str, float, str]:
 
 def explicit_limit_parameters(scene: Scene) -> list[tuple[str, float, str]]:
     """(name, default, description) of the switch between the integrator's methods, for
-    a scene with a motor that has an inductance (without one, no circuit decays: the
-    explicit method always)."""
-    if not any(f.circuit for f in forward_drivers(scene)):
+    a scene with a motor (without one, nothing of the plant's own is stiff: the explicit
+    method always)."""
+    if not any(f.motor is not None for f in forward_drivers(scene)):
         return []
     return [
         (
             "solver.explicit_limit",
             EXPLICIT_LIMIT_DEFAULT,
             "The explicit method (DOP853) integrates a communication step while its internal "
-            "step times the fastest motor circuit's R / L stays at most this; above it, the "
-            "Rosenbrock method (RODASP). 0: RODASP wherever a circuit decays",
+            "step times the fastest motor's decay rate (its circuit's R / L; without "
+            "inductance, its damping over its rotor's inertia) stays at most this; above it, "
+            "the Rosenbrock method (RODASP). 0: RODASP wherever a motor's circuit or damping "
+            "decays",
         )
     ]
 
@@ -567,14 +569,19 @@ def _start(drivers: list[ForwardDriver], ident: str) -> list[str]:
 def _outputs(scene: Scene, drivers: list[ForwardDriver], ident: str) -> list[str]:
     """put_outputs(): the drivers' motion and currents at the state y with the
     accelerations a, or (``rates``: y the state's rates, a the jerks) their rates, a
-    current without inductance's from the supply's derivative."""
+    current without inductance's from the supply's derivative; 1 where such a current
+    (or its rate) overflows double, which it then leaves NaN."""
     lines = [
-        "/* The drivers' own outputs, or with `rates` their rates (y then y', a a'). */",
-        f"static void put_outputs(const {ident}_input* in, {ident}_output* out, const double* y,",
-        "                        const double* a, int rates)",
+        "/* The drivers' own outputs, or with `rates` their rates (y then y', a a'); 1 where",
+        " * the current of a motor without inductance overflows (it is then NaN). */",
+        f"static int put_outputs(const {ident}_input* in, {ident}_output* out, const double* y,",
+        "                       const double* a, int rates)",
         "{",
     ]
-    if not any(f.steady for f in drivers):
+    steady = [f for f in drivers if f.steady]
+    if steady:
+        lines.append("    int overflows = 0;")
+    else:
         lines += ["    (void)in;", "    (void)rates;"]
     n = len(drivers)
     for f in drivers:
@@ -590,9 +597,10 @@ def _outputs(scene: Scene, drivers: list[ForwardDriver], ident: str) -> list[str
                 "    {  /* NaN, not an infinity, where the current overflows */",
                 f"        const double current = {_current(f, 'y', n, supply)};",
                 f"        out->{f.c('current')} = isfinite(current) ? current : (double)NAN;",
+                "        overflows |= !isfinite(current);",
                 "    }",
             ]
-    return lines + ["}", ""]
+    return lines + ["    return overflows;" if steady else "    return 0;", "}", ""]
 
 
 def _no_outputs(scene: Scene, ident: str) -> list[str]:
@@ -762,23 +770,35 @@ def _motion_seed(ident: str, drivers: list[ForwardDriver]) -> list[str]:
 
 def _stiffness(ident: str, drivers: list[ForwardDriver]) -> list[str]:
     """stiff_at(): whether an internal step would be held to the explicit method's
-    stability limit by the motors' circuits (their decay rates R / L, 1/s)."""
+    stability limit by the motors: their circuits' decay rates R / L, and a motor
+    without inductance's damping on its rotor, (c + k^2 / R) / J_r (1/s)."""
     lines = [
         "/* Whether a step of `step` seconds is beyond what the explicit method takes on:",
-        " * the fastest decay of the plant's own stiff parts, the motors' armature circuits",
-        " * (R / L), times the step above solver.explicit_limit. A mechanism driven by",
-        " * efforts alone is not stiff. */",
+        " * the fastest decay of the plant's own stiff parts times the step above",
+        " * solver.explicit_limit. They are the motors' armature circuits (R / L) and the",
+        " * damping a motor without inductance puts on its crank, r^2 (c + k^2 / R), which",
+        " * slows the crank's speed at most at (c + k^2 / R) / J_r, its rotor's share of the",
+        " * inertia (a rotor without inertia gives no bound). A mechanism driven by efforts",
+        " * alone is not stiff. */",
         f"static int stiff_at(const {ident}_input* in, double step)",
         "{",
     ]
-    geared = [f for f in drivers if f.circuit]
+    geared = [f for f in drivers if f.motor is not None]
     if not geared:
         return lines + ["    (void)in;", "    (void)step;", "    return 0;", "}", ""]
     lines.append("    double rate = 0;")
     for f in geared:
-        lines.append(
-            f"    rate = fmax(rate, in->{f.c('motor_resistance')} / in->{f.c('motor_inductance')});"
-        )
+        resistance = f"in->{f.c('motor_resistance')}"
+        if f.circuit:
+            lines.append(f"    rate = fmax(rate, {resistance} / in->{f.c('motor_inductance')});")
+            continue
+        k, rotor = f"in->{f.c('motor_torque_constant')}", f"in->{f.c('motor_rotor_inertia')}"
+        lines += [
+            f"    if ({rotor} > 0) {{",
+            f"        rate = fmax(rate, (in->{f.c('motor_friction')} + {k} * {k} / {resistance}) /",
+            f"                              {rotor});",
+            "    }",
+        ]
     return lines + ["    return rate * step > in->plant_explicit_limit;", "}", ""]
 
 

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 from dyadfmu import paths
 from dyadfmu.mechanisms import chains, multidriver
+from dyadfmu.mechanisms import geometry as geo
 from dyadfmu.reference import forward
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
@@ -38,6 +39,7 @@ SCENES = {
     "four_bar_motor": paths.SCENES_DIR / "four_bar_payload.toml",
     "shaper_motor": paths.SCENES_DIR / "shaper.toml",
     "slider_crank_linear_motor": paths.SCENES_DIR / "slider_crank.toml",
+    "leg_mixed_motor": paths.SCENES_DIR / "leg.toml",
 }
 #: A constant cutting force on the shaper's ram [N] (the reference's load model made
 #: constant, as the FMU's input holds it)
@@ -382,6 +384,134 @@ def test_a_motor_without_inductance_is_the_drive_fmus_line():
     assert omega[-1] > 50.0 and np.all(rows["status"] == 0)
     assert np.max(np.abs(rows["crank.motor.current"] - current)) <= 1e-12 * 400.0
     assert np.max(np.abs(rows["crank.torque"] - line)) <= 1e-12 * 400.0
+
+
+#: leg_mixed_motor.toml's rear motor (no inductance), as (resistance, torque constant,
+#: rotor inertia, friction, ratio)
+REAR_MOTOR = (1.5, 0.05, 2.0e-5, 3.0e-6, 16.0)
+
+
+def _leg_with_rear_rotor(extra: float) -> multidriver.MultiChain:
+    """The leg, its foot loaded as at rest, with ``extra`` [kg m2] on its rear crank."""
+    with open(multidriver.scene_path("leg"), "rb") as f:
+        scene = tomllib.load(f)
+    (rear,) = (c for c in scene["crank"] if c["name"] == "rear")
+    rear["inertia"] += extra
+    data = {"load": {"foot": {"force": [0.0, 30.0], "force_swing": [0.0, 0.0]}}}
+    return multidriver.MultiChain(
+        "leg", scene, geo.overridden(chains.default_data()["leg"], "leg", data)
+    )
+
+
+def test_a_motor_with_and_one_without_inductance_in_one_scene():
+    """leg_mixed_motor: the front motor with a current state, the rear one without. The
+    reference takes the front motor as the motor it is and the rear one as what a motor
+    without inductance is at the crank: its rotor's inertia on the crank and the torque
+    r (k (V - k r q') / R - c r q'), an effort law; each hip within 1e-8 of its travel
+    and each current (the front one a state, the rear one (V - k r q') / R) within 1e-8
+    of its peak."""
+    resistance, k, rotor, friction, ratio = REAR_MOTOR
+    chain = _leg_with_rear_rotor(ratio**2 * rotor)
+    _, q0, _ = _leg_at_rest()
+    volts = {"front": 12.0, "rear": 6.0}
+
+    def law(_t, _q, dq):
+        current = (volts["rear"] - k * ratio * dq[1]) / resistance
+        return np.array([volts["front"], ratio * (k * current - friction * ratio * dq[1])])
+
+    times = np.linspace(0.0, 0.1, 11)
+    ref = forward.integrate_with_motors(
+        chain,
+        {"front": LEG_MOTOR},
+        law,
+        q0,
+        0.0 * q0,
+        {"front": 10.0},
+        times,
+        rtol=1e-12,
+        atol=1e-13,
+        method="DOP853",
+    )
+    start = {f"{n}.angle_start": q for n, q in zip(chain.driver_names, q0, strict=True)}
+    start.update({f"{n}.motor.voltage": v for n, v in volts.items()})
+    start.update({"front.motor.current_start": 10.0, "foot.force.y": 30.0})
+    rows = _on_grid(
+        simulate_fmu(
+            _fmu("leg_mixed_motor"), stop_time=0.1, output_interval=0.01, start_values=start
+        ),
+        times,
+    )
+    for j, n in enumerate(chain.driver_names):
+        travel = np.ptp(ref.run.q[:, j])
+        error = np.max(np.abs(rows[f"{n}.angle"] - ref.run.q[:, j])) / travel
+        print(f"leg_mixed_motor: {n} within {error:.1e} of its travel {travel:.3g} rad")
+        assert travel > 0.01 and error < 1e-8
+    rear_current = (volts["rear"] - k * ratio * ref.run.dq[:, 1]) / resistance
+    for n, want in (("front", ref.current[:, 0]), ("rear", rear_current)):
+        error = np.max(np.abs(rows[f"{n}.motor.current"] - want)) / np.max(np.abs(want))
+        print(f"leg_mixed_motor: {n} current within {error:.1e} of its peak")
+        assert error < 1e-8
+
+
+def test_a_stiff_damping_without_inductance_takes_the_rosenbrock_method():
+    """slider_crank_linear_motor with R = 1e-5 ohm: its damping at the crank, r^2 k^2 / R
+    = 1e5 N.m.s/rad, slows the crank at most at 2e7 1/s over the rotor's 5e-3 kg.m2,
+    which selects RODASP: the run-up goes on at 1 ms steps, its speed within 1e-8 of its
+    peak of the machine as one ODE (SciPy's Radau). With the rotor's inertia 0 there is
+    no bound, the explicit method takes the damping, and a 0.1 s step needs more internal
+    steps than the cap: refused, saying so."""
+    from dyadfmu.cosim import plant_study as study
+    from dyadfmu.fmi.slave import Slave, SlaveError
+    from scipy.integrate import solve_ivp
+
+    stiff = {"crank.motor.resistance": 1e-5}
+    start = {**stiff, "crank.motor.voltage": 290.0, "crank.angle_start": 0.5}
+    rows = simulate_fmu(
+        _fmu("slider_crank_linear_motor"),
+        stop_time=0.02,
+        output_interval=1e-3,
+        start_values=start,
+    )
+    motor = study.Circuit(1e-5, 0.0, 1.0, 5.0e-3, 0.0, 1.0)
+    rhs = study._rhs(motor, study._machine_terms("slider_crank"), 290.0)
+    ref = solve_ivp(rhs, (0.0, 0.02), [0.5, 0.0], "Radau", rows["time"], rtol=1e-12, atol=1e-12)
+    speed = np.max(np.abs(rows["crank.omega"] - ref.y[1])) / np.max(np.abs(ref.y[1]))
+    per_ms = _per_ms(rows, "solver.evaluations")
+    print(f"R = 1e-5 ohm: speed within {speed:.1e} of its peak, {per_ms:.0f} evaluations per ms")
+    assert np.all(rows["status"] == 0) and speed < 1e-8 and per_ms < 1000
+    slave = Slave(_fmu("slider_crank_linear_motor"))
+    try:
+        slave.set("crank.motor.voltage", 290.0)
+        slave.initialize({**stiff, "crank.motor.rotor_inertia": 0.0, "crank.angle_start": 0.5})
+        with pytest.raises(SlaveError, match="needs more than 20000 internal steps"):
+            slave.do_step(0.0, 0.1)
+    finally:
+        slave.close()
+
+
+def test_a_current_beyond_double_is_status_3():
+    """slider_crank_linear_motor with a supply of -1.8e308 V: the current (V - k r q') / R
+    overflows double while the torque, k times it, and so the motion stay finite. Status
+    3 then, the current and every output but the states NaN, and a step refused
+    (Discard), saying why; never a NaN output with status 0 (the fuzz found it)."""
+    from dyadfmu.fmi.slave import Slave, SlaveError
+
+    slave = Slave(_fmu("slider_crank_linear_motor"))
+    heavy = {"crank.motor.torque_constant": 0.555, "crank.motor.rotor_inertia": 2.4}
+    heavy["crank.motor.ratio"] = 0.552
+    try:
+        slave.set("crank.motor.voltage", 50.0)
+        slave.initialize({**heavy, "crank.angle_start": 0.5})
+        slave.do_step(0.0, 0.01)
+        assert slave.get("status") == 0
+        slave.set("crank.motor.voltage", -1.7976931348623157e308)
+        current, epsilon, angle = slave.get(("crank.motor.current", "crank.epsilon", "crank.angle"))
+        assert slave.get("status") == 3
+        assert np.isnan(current) and np.isnan(epsilon) and np.isfinite(angle)
+        with pytest.raises(SlaveError, match="current of a motor without inductance overflows"):
+            slave.do_step(0.01, 0.01)
+    finally:
+        slave.close()
 
 
 def test_a_free_four_bar_keeps_its_energy():

@@ -98,6 +98,7 @@ STUDY_TEST_FMUS |= {
         "four_bar_motor",
         "shaper_motor",
         "slider_crank_linear_motor",
+        "leg_mixed_motor",
     )
     for version in (2, 3)
 }

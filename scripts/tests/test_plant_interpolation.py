@@ -110,6 +110,10 @@ RAMPS = {
         {"crank.motor.voltage": (100.0, 2.0e3), "piston.force.x": (-50.0, -1.0e4)},
         {"crank.omega_start": 30.0},
     ),
+    "leg_mixed_motor": (
+        {"front.motor.voltage": (2.0, 40.0), "rear.motor.voltage": (-1.0, 30.0)},
+        {"front.omega_start": 1.0},
+    ),
 }
 DELTA = 5e-7
 
