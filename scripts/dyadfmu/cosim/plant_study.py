@@ -1,7 +1,7 @@
 """The machine with its motor inside the plant, against the same machine as one ODE.
 
-Each machine of :data:`MACHINES` (the slider-crank, the four-bar, the shaper: a plant with
-its DC motor inside, supply voltage in) runs up from rest under a constant voltage, at
+Each machine of :data:`MACHINES` (the slider-crank, the four-bar, the shaper, the leg: a
+plant with its DC motor inside, supply voltage in) runs up from rest under a constant voltage, at
 communication steps from 0.1 s down to 10 us and (the slider-crank) at relative
 tolerances from 1e-6 down to 1e-11. Its crank angle and speed at every communication
 point are compared with the machine as one ODE, from the harness's own kinematics
@@ -15,7 +15,10 @@ weights' generalised force Q_g(phi)) and the motor's circuit:
 integrated by SciPy (Radau where the circuit is stiff). J, J' and Q_g enter as their
 Fourier series from 128 of the harness's values, each within 2e-15 of the harness
 (``_Periodic.fit_error``), so that an evaluation costs tens of microseconds, not
-milliseconds. The drive FMU's machine (:func:`drive_run`) is the same one with L = 0.
+milliseconds. The leg, with two drivers, is the same ODE in both hips' angles
+(:mod:`dyadfmu.cosim.chain_reference`: M(q) and h's terms as Chebyshev series); its rear
+hip takes no effort, and no drive FMU turns it (no :func:`drive_run`). The drive FMU's
+machine (:func:`drive_run`) is the same one with L = 0.
 The motor's numbers are the plant's own parameters (read from its model description), so
 the two cannot drift apart.
 
@@ -40,10 +43,10 @@ from fmpy import read_model_description
 
 from .. import paths
 from ..fmi.slave import Slave
-from ..mechanisms import builtin, chains, driven
+from ..mechanisms import builtin, chains, driven, multidriver
 from ..mechanisms.motion import CrankMotion
 from ..reference import machine
-from . import mechanism_drive, mechanism_fmus
+from . import chain_reference, mechanism_drive, mechanism_fmus
 
 __all__ = [
     "CIRCUITS",
@@ -63,6 +66,7 @@ __all__ = [
     "run",
     "split_run",
     "unloaded",
+    "unloaded_chain",
 ]
 
 
@@ -72,7 +76,14 @@ class PlantMachine:
     takes a separate motor FMU's rotor (b), the inverse mechanism FMU (c) whose harness
     mechanism is the reference's, the supply voltage [V] and the run's duration [s]; where
     given, ``linear_plant``: the plant with the same motor without inductance (the drive
-    FMU's linear characteristic, (a) one to one with (c))."""
+    FMU's linear characteristic, (a) one to one with (c)).
+
+    A machine with several drivers names its harness ``chain``
+    (:mod:`dyadfmu.mechanisms.multidriver`) instead of a ``mechanism``: no drive FMU turns
+    more than one crank, so it has no (c). ``driver`` carries the motor, the ``others``
+    take no effort; ``start`` holds each driver's angle at rest [rad] (the motor's first),
+    ``domain`` the drivers' ranges [rad] over which the reference's series of M and h hold,
+    and ``armature`` the slow circuit's L / R [s] where it is not the scene's."""
 
     name: str
     plant: str
@@ -81,9 +92,20 @@ class PlantMachine:
     voltage: float
     t_end: float
     linear_plant: str = ""
+    driver: str = "crank"
+    others: tuple[str, ...] = ()
+    start: tuple[float, ...] = (mechanism_drive.START_ANGLE,)
+    chain: str = ""
+    domain: tuple[tuple[float, float], ...] = ()
+    armature: float | None = None
+
+    @property
+    def drivers(self) -> tuple[str, ...]:
+        """The motor's driver, then the others."""
+        return (self.driver, *self.others)
 
 
-#: The machines, each run up from rest at START_ANGLE (the motors: the plants' [motor]).
+#: The machines, each run up from rest at its ``start`` (the motors: the plants' [motor]).
 MACHINES = {
     m.name: m
     for m in (
@@ -100,10 +122,23 @@ MACHINES = {
             "four-bar", "four_bar_motor", "four_bar_forward", "four_bar_payload", 36.0, 0.5
         ),
         PlantMachine("shaper", "shaper_motor", "shaper_forward", "shaper", 7.5, 1.0),
+        PlantMachine(
+            "leg",
+            "leg_motor",
+            "leg_forward",
+            "",
+            1.0,
+            0.5,
+            driver="front",
+            others=("rear",),
+            start=(-math.pi / 3, -2 * math.pi / 3),
+            chain="leg",
+            domain=((-1.2, -0.5), (-2.2, -0.7)),
+            armature=1.4e-3,
+        ),
     )
 }
 SLIDER_CRANK = MACHINES["slider-crank"]
-START_ANGLE = 0.5  # rad
 #: Communication steps [s] and relative tolerances of the study.
 STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 RTOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)
@@ -127,17 +162,20 @@ class Circuit:
     friction: float
     ratio: float
 
-    def parameters(self) -> dict[str, float]:
-        """The plant's parameters for this motor."""
-        return {f"crank.motor.{k}": getattr(self, k) for k in _MOTOR_KEYS}
+    def parameters(self, driver: str = "crank") -> dict[str, float]:
+        """The plant's parameters for this motor at ``driver``."""
+        return {f"{driver}.motor.{k}": getattr(self, k) for k in _MOTOR_KEYS}
 
 
 def circuit(label: str, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> Circuit:
-    """The motor of ``m``'s plant with the time constant of :data:`CIRCUITS` ``label``."""
+    """The motor of ``m``'s plant with the time constant of :data:`CIRCUITS` ``label``
+    (the slow one: ``m.armature`` where given, else the scene's)."""
     md = read_model_description(str(paths.built_fmu(m.plant, version, how="scripts/run-tests")))
     starts = {v.name: float(v.start) for v in md.modelVariables if v.start is not None}
-    motor = Circuit(*(starts[f"crank.motor.{k}"] for k in _MOTOR_KEYS))
+    motor = Circuit(*(starts[f"{m.driver}.motor.{k}"] for k in _MOTOR_KEYS))
     time_constant = 0.0 if label == LINEAR else CIRCUITS[label]
+    if time_constant is None:
+        time_constant = m.armature
     if time_constant is None:
         return motor
     return replace(motor, inductance=time_constant * motor.resistance)
@@ -145,8 +183,9 @@ def circuit(label: str, version: int = 2, m: PlantMachine = SLIDER_CRANK) -> Cir
 
 @dataclass
 class PlantRun:
-    """The plant's crank angle [rad] and speed [rad/s] at its communication points, the
-    CPU time of the run [s], and its joint reactions there (output name -> [N] or [N.m])."""
+    """The plant's crank angle [rad] and speed [rad/s] at its communication points (one
+    column per driver where the machine has several, the motor's first), the CPU time of
+    the run [s], and its joint reactions there (output name -> [N] or [N.m])."""
 
     label: str
     step: float
@@ -168,6 +207,43 @@ def _recorded(names: tuple[str, ...], rows: np.ndarray, start: int) -> dict[str,
     return {name: rows[:, start + k].copy() for k, name in enumerate(names)}
 
 
+def _inputs_at_zero(slave: Slave, keep: str) -> None:
+    """Every continuous input of ``slave`` but ``keep`` set to zero: the drivers without
+    a motor take no effort and the loads are off, as in the reference."""
+    for v in slave.md.modelVariables:
+        if v.causality == "input" and v.type in ("Real", "Float64") and v.name != keep:
+            slave.set(v.name, 0.0)
+
+
+def _starts(m: PlantMachine) -> dict[str, float]:
+    """The plant's parameters that start ``m``'s drivers at rest at ``m.start``."""
+    return {f"{d}.angle_start": q for d, q in zip(m.drivers, m.start, strict=True)}
+
+
+def _motion_names(m: PlantMachine) -> tuple[str, ...]:
+    """The drivers' angles, then their speeds."""
+    return (*(f"{d}.angle" for d in m.drivers), *(f"{d}.omega" for d in m.drivers))
+
+
+def _plant_run(
+    label: str,
+    step: float,
+    rtol: float,
+    m: PlantMachine,
+    rows: np.ndarray,
+    cpu: float,
+    names: tuple,
+) -> PlantRun:
+    """The run of ``rows`` (the drivers' angles and speeds, then the reactions ``names``):
+    one column per driver where ``m`` has several."""
+    n = len(m.drivers)
+    phi, omega = rows[:, :n], rows[:, n : 2 * n]
+    if n == 1:
+        phi, omega = phi[:, 0], omega[:, 0]
+    t = step * np.arange(len(rows))
+    return PlantRun(label, step, rtol, t, phi, omega, cpu, _recorded(names, rows, 2 * n))
+
+
 def run(
     label: str,
     step: float,
@@ -179,22 +255,25 @@ def run(
     ``solver.rtol`` = ``solver.atol`` = ``rtol`` where given); motor :data:`LINEAR`: its
     plant without inductance (``m.linear_plant``)."""
     n = mechanism_drive.whole_steps(m.t_end, step)
-    parameters = circuit(label, version, m).parameters()
+    parameters = circuit(label, version, m).parameters(m.driver)
     name = m.plant
     if label == LINEAR:
         if not m.linear_plant:
             raise ValueError(f"{m.name} has no plant with a motor without inductance")
         name = m.linear_plant
-        del parameters["crank.motor.inductance"]  # no parameter there: no current state
-    parameters["crank.angle_start"] = START_ANGLE
+        del parameters[f"{m.driver}.motor.inductance"]  # no parameter there: no current state
+    parameters.update(_starts(m))
     if rtol is not None:
         parameters.update({"solver.rtol": rtol, "solver.atol": rtol})
     plant = Slave(paths.built_fmu(name, version, how="scripts/run-tests"), "plant")
-    names = ("crank.angle", "crank.omega", *reaction_names(plant.md.modelVariables))
+    reactions = reaction_names(plant.md.modelVariables)
+    names = (*_motion_names(m), *reactions)
     rows = np.empty((n + 1, len(names)))
     started = clock.process_time()
     try:
-        plant.set("crank.motor.voltage", m.voltage)
+        voltage = f"{m.driver}.motor.voltage"
+        _inputs_at_zero(plant, voltage)
+        plant.set(voltage, m.voltage)
         plant.initialize(parameters)
         rows[0] = plant.get(names)
         for k in range(n):
@@ -203,9 +282,7 @@ def run(
     finally:
         plant.close()
     cpu = clock.process_time() - started
-    t = step * np.arange(n + 1)
-    reactions = _recorded(names[2:], rows, 2)
-    return PlantRun(label, step, rtol or math.nan, t, rows[:, 0], rows[:, 1], cpu, reactions)
+    return _plant_run(label, step, rtol or math.nan, m, rows, cpu, reactions)
 
 
 class _Periodic:
@@ -241,7 +318,10 @@ def _machine_terms(mechanism: str) -> tuple[_Periodic, _Periodic, _Periodic]:
 
 
 def fit_error(m: PlantMachine = SLIDER_CRANK) -> float:
-    """The largest distance of ``m``'s series of J, J' and Q_g to the harness (relative)."""
+    """The largest distance of ``m``'s series of J, J' and Q_g (several drivers: of M and
+    h's terms) to the harness, relative to each one's largest value."""
+    if m.chain:
+        return chain_reference.series(unloaded_chain(m.chain), m.domain).fit_error
     return max(term.fit_error for term in _machine_terms(m.mechanism))
 
 
@@ -268,8 +348,9 @@ def _rhs(motor: Circuit, terms: tuple, voltage: float):
 @dataclass(frozen=True)
 class Reference:
     """The machine as one ODE on a time grid ``t`` [s]: crank angle [rad], speed [rad/s],
-    acceleration [rad/s2] and the harness's joint reactions along that motion (output
-    name -> [N] or [N.m], as the FMUs name them)."""
+    acceleration [rad/s2] (one column per driver where it has several, the motor's first)
+    and the harness's joint reactions along that motion (output name -> [N] or [N.m], as
+    the FMUs name them)."""
 
     t: np.ndarray
     phi: np.ndarray
@@ -289,7 +370,9 @@ def reference(
     from scipy.integrate import solve_ivp
 
     motor = circuit(label, m=m)
-    start, scale = [START_ANGLE, 0.0, 0.0], [1.0, 1.0, m.voltage / motor.resistance]
+    if m.chain:
+        return _chain_reference(motor, t, method, rtol, m)
+    start, scale = [m.start[0], 0.0, 0.0], [1.0, 1.0, m.voltage / motor.resistance]
     n = 3 if motor.inductance > 0 else 2
     rhs = _rhs(motor, _machine_terms(m.mechanism), m.voltage)
     sol = solve_ivp(
@@ -306,6 +389,19 @@ def reference(
     phi, omega = sol.y[0], sol.y[1]
     epsilon = np.concatenate([rhs(0.0, y)[1] for y in np.array_split(sol.y, _chunks(t), axis=1)])
     return Reference(t, phi, omega, epsilon, reactions(m, t, phi, omega, epsilon))
+
+
+def _chain_reference(
+    motor: Circuit, t: np.ndarray, method: str, rtol: float, m: PlantMachine
+) -> Reference:
+    """``m`` (several drivers) as one ODE (:mod:`dyadfmu.cosim.chain_reference`)."""
+    fit = chain_reference.series(unloaded_chain(m.chain), m.domain)
+    a = fit.chain.driver_names.index(m.driver)
+    start = [m.start[m.drivers.index(d)] for d in fit.chain.driver_names]
+    run = chain_reference.motion(fit, motor, m.voltage, a, tuple(start), t, method, rtol)
+    order = [fit.chain.driver_names.index(d) for d in m.drivers]
+    moved = (x[:, order] for x in (run.q, run.dq, run.ddq))
+    return Reference(t, *moved, chain_reference.reactions(fit.chain, run))
 
 
 #: Points of the grid per harness evaluation (the Fourier series and the kinematics hold
@@ -341,6 +437,12 @@ def unloaded(mechanism: str) -> builtin.Mechanism | chains.Chain:
     kind, harness = mechanism_fmus.MECHANISM_FMUS[mechanism]
     tables = (chains if kind == "chain" else builtin).default_data()[harness]
     return mechanism_fmus.mechanism_of(mechanism, data={"load": _zeroed(tables.get("load", {}))})
+
+
+@functools.cache
+def unloaded_chain(name: str) -> multidriver.MultiChain:
+    """The harness chain ``name`` (several drivers) with its load models switched off."""
+    return multidriver.load(name, {"load": _zeroed(chains.default_data()[name].get("load", {}))})
 
 
 def reactions(
@@ -417,15 +519,15 @@ MOTOR_FMU = "motor"
 
 
 def _split_fmus(label: str, version: int, m: PlantMachine) -> tuple[Slave, Slave]:
-    """The motor FMU and ``m``'s rotor plant (its crank's inertia a parameter, to which the
-    motor's rotor is added), initialised for ``label``."""
+    """The motor FMU and ``m``'s rotor plant (its motor driver's inertia a parameter, to
+    which the motor's rotor is added), initialised for ``label``."""
     motor = circuit(label, version, m)
     plant = Slave(paths.built_fmu(m.rotor_plant, version, how="scripts/run-tests"), "plant")
-    crank = next(v for v in plant.md.modelVariables if v.name == "crank.inertia")
+    inertia = f"{m.driver}.inertia"
+    own = next(v for v in plant.md.modelVariables if v.name == inertia)
     rotor = motor.ratio**2 * motor.rotor_inertia
-    plant.initialize(
-        {"crank.angle_start": START_ANGLE, "crank.inertia": float(crank.start) + rotor}
-    )
+    _inputs_at_zero(plant, f"{m.driver}.torque")
+    plant.initialize({**_starts(m), inertia: float(own.start) + rotor})
     fmu = Slave(paths.built_fmu(MOTOR_FMU, version, how="scripts/run-tests"), "motor")
     names = ("resistance", "inductance", "torque_constant", "friction", "ratio")
     fmu.set("motor.voltage", m.voltage)
@@ -433,18 +535,20 @@ def _split_fmus(label: str, version: int, m: PlantMachine) -> tuple[Slave, Slave
     return fmu, plant
 
 
-def _exchange(motor: Slave, plant: Slave, rates: bool, reactions: tuple) -> tuple:
-    """One communication point: the plant's speed (and its rate) to the motor, the
-    motor's torque (and its rate) to the plant; the crank's angle and speed, then the
-    plant's ``reactions`` under the torque it now has (as a master records them)."""
-    phi, omega = plant.get(("crank.angle", "crank.omega"))
+def _exchange(motor: Slave, plant: Slave, rates: bool, driver: str, recorded: tuple) -> tuple:
+    """One communication point: the plant's speed of ``driver`` (and its rate) to the
+    motor, the motor's torque (and its rate) to the plant; then the plant's ``recorded``
+    outputs under the torque it now has (as a master records them)."""
+    speed = f"{driver}.omega"
+    omega = plant.get(speed)
     motor.set("shaft.omega", omega)
     if rates:
-        motor.set_rates("shaft.omega", plant.output_rates(("crank.omega",))[0])
-    plant.set("crank.torque", motor.get("shaft.torque"))
+        motor.set_rates("shaft.omega", plant.output_rates((speed,))[0])
+    torque = f"{driver}.torque"
+    plant.set(torque, motor.get("shaft.torque"))
     if rates:
-        plant.set_rates("crank.torque", motor.output_rates(("shaft.torque",))[0])
-    return (phi, omega, *(plant.get(reactions) if reactions else ()))
+        plant.set_rates(torque, motor.output_rates(("shaft.torque",))[0])
+    return plant.get(recorded)
 
 
 def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRANK) -> PlantRun:
@@ -454,12 +558,13 @@ def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRA
     derivatives)."""
     n = mechanism_drive.whole_steps(m.t_end, step)
     motor, plant = _split_fmus(label, 2, m)
-    names = ("crank.angle", "crank.omega", *reaction_names(plant.md.modelVariables))
+    reactions = reaction_names(plant.md.modelVariables)
+    names = (*_motion_names(m), *reactions)
     rows = np.empty((n + 1, len(names)))
     started = clock.process_time()
     try:
         for k in range(n + 1):
-            rows[k] = _exchange(motor, plant, rates, names[2:])
+            rows[k] = _exchange(motor, plant, rates, m.driver, names)
             if k < n:
                 motor.do_step(k * step, step)
                 plant.do_step(k * step, step)
@@ -467,9 +572,7 @@ def split_run(label: str, step: float, rates: bool, m: PlantMachine = SLIDER_CRA
         motor.close()
         plant.close()
     cpu = clock.process_time() - started
-    t = step * np.arange(n + 1)
-    reactions = _recorded(names[2:], rows, 2)
-    return PlantRun(label, step, math.nan, t, rows[:, 0], rows[:, 1], cpu, reactions)
+    return _plant_run(label, step, math.nan, m, rows, cpu, reactions)
 
 
 def _largest(error: np.ndarray) -> float:
@@ -477,20 +580,28 @@ def _largest(error: np.ndarray) -> float:
     return float(np.max(np.abs(error))) if np.all(np.isfinite(error)) else math.inf
 
 
+def _columns(x: np.ndarray, count: int) -> np.ndarray:
+    """x as (count, drivers)."""
+    return np.reshape(x, (count, -1))
+
+
 def errors(result: PlantRun, ref: Reference) -> dict:
     """The largest angle error over the run as a fraction of the angle travelled, the
-    largest speed error as a fraction of the peak speed, and the largest error of a joint
-    reaction as a fraction of the largest reaction's peak (a run and a reference with
-    different reactions are refused; NaN where the run has none, inf where one is not
-    finite)."""
+    largest speed error as a fraction of the peak speed (the worst driver's, where the
+    machine has several), and the largest error of a joint reaction as a fraction of the
+    largest reaction's peak (a run and a reference with different reactions are refused;
+    NaN where the run has none, inf where one is not finite)."""
     step = max(1, int(round((len(ref.t) - 1) / (len(result.t) - 1))))
-    phi, omega = ref.phi[::step], ref.omega[::step]
-    if len(phi) != len(result.t) or abs(ref.t[::step][-1] - result.t[-1]) > 1e-9 * ref.t[-1]:
-        raise ValueError(f"the reference's grid does not hold the run's {len(result.t)} points")
-    travel = abs(phi[-1] - phi[0])
+    count = len(result.t)
+    phi, omega = (_columns(x[::step], len(ref.t[::step])) for x in (ref.phi, ref.omega))
+    if len(phi) != count or abs(ref.t[::step][-1] - result.t[-1]) > 1e-9 * ref.t[-1]:
+        raise ValueError(f"the reference's grid does not hold the run's {count} points")
     if set(result.reactions) != set(ref.reactions):
         apart = sorted(set(result.reactions) ^ set(ref.reactions))
         raise ValueError(f"the run and the reference differ in the reactions {', '.join(apart)}")
+    angle = np.max(np.abs(_columns(result.phi, count) - phi), axis=0)
+    speed = np.max(np.abs(_columns(result.omega, count) - omega), axis=0)
+    travel = np.abs(phi[-1] - phi[0])
     peak = max((np.max(np.abs(ref.reactions[k])) for k in result.reactions), default=1.0)
     # a reaction that is not finite (NaN included) counts as infinitely wrong
     worst = max(
@@ -498,8 +609,8 @@ def errors(result: PlantRun, ref: Reference) -> dict:
         default=math.nan,
     )
     return {
-        "angle_rad": float(np.max(np.abs(result.phi - phi))),
-        "angle": float(np.max(np.abs(result.phi - phi)) / travel),
-        "speed": float(np.max(np.abs(result.omega - omega)) / np.max(np.abs(omega))),
+        "angle_rad": float(np.max(angle)),
+        "angle": float(np.max(angle / travel)),
+        "speed": float(np.max(speed / np.max(np.abs(omega), axis=0))),
         "reactions": float(worst / peak),
     }

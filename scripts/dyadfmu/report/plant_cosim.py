@@ -3,8 +3,9 @@
 motor as its own FMU (b) and as the drive FMU with the inverse mechanism FMU, stabilised
 (c), all against the machine as one ODE: the errors in crank angle, speed and the joint
 reactions against the communication step and the run's CPU time, and (a) against its
-relative tolerance (the slider-crank). Writes ``plant_vs_step.png`` beside the report and
-gives its lines and its points. The quick study runs the slider-crank only.
+relative tolerance (the slider-crank). A machine with two drivers (the leg) has no (c).
+Writes ``plant_vs_step.png`` beside the report and gives its lines and its points. The
+quick study runs the slider-crank only.
 """
 
 from __future__ import annotations
@@ -97,6 +98,8 @@ def _machine_points(m: study.PlantMachine, quick: bool, log: Callable[[str], Non
                 found.append(_point(m, f"(a) motor {label}", RTOL_STEP, rtol, run, ref))
         log(f"{m.name}: motor FMU and plant, motor {label}")
         found += _split_points(label, steps, ref, m)
+    if not m.mechanism:
+        return found  # several drivers: no drive FMU turns them, no (c)
     log(f"{m.name}: drive FMU and mechanism FMU, the reference with L = 0")
     ref = _reference(study.LINEAR, steps, quick, m)
     for step in steps if m.linear_plant else ():
@@ -266,7 +269,7 @@ def _plot_machine(axes: object, rows: list[dict]) -> None:
     for ax, xlabel in zip(axes, ("communication step (s)", "CPU time of the run (s)"), strict=True):
         ax.axhline(TARGET, color="gray", ls="--", lw=0.8)
         ax.set_xlabel(xlabel)
-        ax.set_ylabel("crank angle error / angle travelled")
+        ax.set_ylabel("driver angle error / angle travelled")
         ax.grid(which="both", alpha=0.3)
     axes[0].legend(fontsize=8)
 
@@ -288,7 +291,8 @@ def _machine_table(found: list[dict]) -> list[str]:
                 name,
                 markup.code(m.plant),
                 markup.code(m.rotor_plant),
-                markup.code(m.mechanism),
+                markup.code(m.mechanism) if m.mechanism else "none: two drivers",
+                ", ".join(f"{d} {q:.4g}" for d, q in zip(m.drivers, m.start, strict=True)),
                 f"{m.voltage:g}",
                 f"{m.t_end:g}",
                 f"{gain * m.voltage / motor.resistance:g}",
@@ -302,6 +306,7 @@ def _machine_table(found: list[dict]) -> list[str]:
         "(a) plant",
         "(b) plant",
         "(c) mechanism FMU",
+        "at rest (rad)",
         "supply (V)",
         "run (s)",
         "stall torque (N.m)",
@@ -309,7 +314,7 @@ def _machine_table(found: list[dict]) -> list[str]:
         "rotor at the crank (kg.m2)",
         "series fit",
     ]
-    return markup.table(header, table, "----rrrrrr")
+    return markup.table(header, table, "-----rrrrrr")
 
 
 def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
@@ -318,10 +323,11 @@ def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
         "",
         "## The motor inside the plant",
         "",
-        f"Each machine with its DC motor runs up from rest at {study.START_ANGLE:g} rad "
-        "under a constant supply. (a): the plant with the motor inside, the motor's circuit "
-        "and the crank's motion integrated inside each doStep, default tolerances, with the "
-        "scene's armature (L/R 1.4 ms) and a stiff one (L/R 1 us); (b): the same motor as "
+        "Each machine with its DC motor runs up from rest (at the angles of the table; the "
+        "leg's rear hip free, no effort on it) under a constant supply. (a): the plant with "
+        "the motor inside, the motor's circuit and the crank's motion integrated inside each "
+        "doStep, default tolerances, with an armature of L/R 1.4 ms and a stiff one (L/R "
+        "1 us); (b): the same motor as "
         "its own FMU `motor` (voltage and speed in, torque out, its circuit solved exactly "
         "over each step) and a plant with the crank's torque in (the rotor's inertia added "
         "to the crank's), exchanging speed and torque at each communication point, held "
@@ -333,13 +339,16 @@ def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
         + ", ".join(markup.code(m.linear_plant) for m in _linear(found))
         + "). Reference: the machine as one "
         "ODE from the harness's kinematics (J, J' and Q_g as Fourier series of "
-        f"{study.SAMPLES} samples, within the 'series fit' of the harness), SciPy at rtol "
+        f"{study.SAMPLES} samples; with two drivers M(q) and h's terms in q as Chebyshev "
+        "series in both drivers' angles; each within the 'series fit' of the harness), "
+        "SciPy at rtol "
         f"{_reference_rtol(quick):.0e} (Radau where the circuit is stiff, else DOP853).",
         "",
         *_machine_table(found),
         "",
         "Each cell: the largest crank angle error over the communication points / the angle "
-        "travelled, then the largest speed error / the peak speed.",
+        "travelled, then the largest speed error / the peak speed (with two drivers, the "
+        "worse driver's).",
         "",
         *_step_table(found),
         "",
