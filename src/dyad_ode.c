@@ -804,6 +804,14 @@ static dyad_ode_status dop_step(dyad_ode_state* s, const dyad_ode_system* sys, d
     }
 }
 
+/* The step proposed next, finite: where every error is 0 (a state at rest) each step grows
+ * by the controller's largest factor, which over a span near the largest number would
+ * carry it to infinity. */
+static dyad_real ode_finite_step(dyad_real h)
+{
+    return fmin(h, DYAD_REAL_MAX);
+}
+
 /* dyad_ode_advance() with DOP853, its arguments checked. */
 static dyad_ode_status dop_advance(dyad_ode_state* state, const dyad_ode_system* system,
                                    dyad_real t_end)
@@ -816,7 +824,7 @@ static dyad_ode_status dop_advance(dyad_ode_state* state, const dyad_ode_system*
         status = ode_planned_next(state, w.k[0], t_end, attempts, &h);
         if (status == DYAD_ODE_OK) {
             status = dop_step(state, system, &w, t_end, &h, &attempts);
-            state->h_next = h;
+            state->h_next = ode_finite_step(h);
         }
     }
     return status;
@@ -858,7 +866,7 @@ dyad_ode_status dyad_ode_advance(dyad_ode_state* state, const dyad_ode_system* s
         }
         if (status == DYAD_ODE_OK) {
             status = ode_step(state, system, &w, t_end, &h, &attempts);
-            state->h_next = h;
+            state->h_next = ode_finite_step(h);
         }
     }
     return ode_finish(state, status);

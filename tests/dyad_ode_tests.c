@@ -824,6 +824,48 @@ static int test_step_cap(void)
     return fails;
 }
 
+/* y' = 0: every step's error is 0 and each step grows by the controller's largest
+ * factor. Over a span near DBL_MAX, by both methods, the span is covered and the step
+ * it proposes next stays finite (a state, and a plant's solver.step output). */
+static int still_rhs(void* user, double t, const double* y, double* f)
+{
+    (void)user, (void)t, (void)y;
+    f[0] = 0;
+    return 0;
+}
+
+static int still_jacobian(void* user, double t, const double* y, const double* f, double* jac,
+                          double* dfdt)
+{
+    (void)user, (void)t, (void)y, (void)f;
+    jac[0] = 0;
+    dfdt[0] = 0;
+    return 0;
+}
+
+static int test_growth_stays_finite(void)
+{
+    int fails = 0, k;
+    const dyad_ode_method methods[2] = {DYAD_ODE_RODASP, DYAD_ODE_DOP853};
+    const char* names[2] = {"RODASP", "DOP853"};
+    dyad_ode_system sys = system_of(1, still_rhs, still_jacobian, NULL);
+    for (k = 0; k < 2; ++k) {
+        dyad_ode_options o = tolerances(1e-8, 1e-10);
+        dyad_ode_state s;
+        dyad_ode_status st;
+        double y0 = 1;
+        o.method = methods[k];
+        o.max_steps = 20000;
+        dyad_ode_init(&s, 1, 0, &y0, &o);
+        st = dyad_ode_advance(&s, &sys, 1.0);
+        st = st == DYAD_ODE_OK ? dyad_ode_advance(&s, &sys, 1.7976931348623157e308) : st;
+        CHECK(st == DYAD_ODE_OK, "%s: status %s", names[k], dyad_ode_status_name(st));
+        CHECK(isfinite(s.h_next) && s.h_next > 0 && s.y[0] == 1, "%s: h_next %g, y %g", names[k],
+              s.h_next, s.y[0]);
+    }
+    return fails;
+}
+
 /* y' = -1 above 0, +1 below: no step across 0 meets the tolerance. */
 static int switching_rhs(void* user, double t, const double* y, double* f)
 {
@@ -951,6 +993,7 @@ static const named_test tests[] = {
     {"save_restore", test_save_restore},
     {"rhs_failure", test_rhs_failure},
     {"step_cap", test_step_cap},
+    {"growth_stays_finite", test_growth_stays_finite},
     {"step_underflow", test_step_underflow},
     {"singular", test_singular},
     {"invalid_arguments", test_invalid_arguments},
