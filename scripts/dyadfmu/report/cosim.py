@@ -689,8 +689,8 @@ def parser() -> argparse.ArgumentParser:
         "communication steps 1e-2 to 1e-5 s) against the monolithic machine, and the "
         "slider-crank, the four-bar, the shaper and a leg of two drivers with their motor "
         "inside the plant (the slider-crank's also without inductance), as a motor FMU beside "
-        "the plant, and (one driver) as the drive FMU with the mechanism FMU, in driver angle, "
-        "speed and joint reactions "
+        "the plant, and (one driver) as the drive FMU with the mechanism FMU, and the lift "
+        "under a force law, in driver angle, speed and joint reactions "
         "(communication steps 1e-1 to 1e-5 s, the plant's rtol 1e-6 to 1e-11); "
         "writes OUT/cosim/report.md, points.csv, error_vs_time.png and plant_vs_step.png.",
     )
@@ -698,7 +698,7 @@ def parser() -> argparse.ArgumentParser:
         "--quick",
         action="store_true",
         help="steps 1e-2 and 1e-3 s, ratios 1 and 100, the slider-crank's slow motor only, "
-        "looser references (about 15 s of CPU time; the full study about 3.7 minutes)",
+        "looser references (about 15 s of CPU time; the full study about 3.8 minutes)",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out)")
     p.add_argument(

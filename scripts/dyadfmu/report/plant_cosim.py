@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..cosim import force_study
 from ..cosim import plant_study as study
 from ..fmi.slave import SlaveError
 from . import markdown as markup
@@ -111,10 +112,34 @@ def _machine_points(m: study.PlantMachine, quick: bool, log: Callable[[str], Non
     return found
 
 
+#: The force law's couplings: its value at each communication point with its rate (the
+#: plant's interpolation is then the law), or held over the step.
+FORCE = {True: "(a) force law with its rate", False: "force law held over the step"}
+
+
+def _force_points(m: force_study.ForceMachine, log: Callable[[str], None]) -> list[dict]:
+    """The lift under its force law at each step, with the force's rate and held."""
+    log(f"{m.name}, force law: the reference over {m.t_end:g} s and the plant")
+    ref = force_study.reference(_reference_grid(study.STEPS, m), _reference_rtol(False), m)
+    return [
+        _point(m, coupling, step, math.nan, force_study.run(step, rates, m), ref)
+        for rates, coupling in FORCE.items()
+        for step in study.STEPS
+    ]
+
+
 def points(quick: bool, log: Callable[[str], None]) -> list[dict]:
-    """Every run of the section, machine by machine (the quick study: the slider-crank)."""
+    """Every run of the section, machine by machine (the quick study: the slider-crank;
+    the full one also the lift under a force law)."""
     machines = [study.SLIDER_CRANK] if quick else list(study.MACHINES.values())
-    return [p for m in machines for p in _machine_points(m, quick, log)]
+    found = [p for m in machines for p in _machine_points(m, quick, log)]
+    return found if quick else found + _force_points(force_study.LIFT, log)
+
+
+def _run_of(name: str) -> float:
+    """The duration [s] of the machine ``name``'s run."""
+    m = study.MACHINES.get(name)
+    return m.t_end if m else force_study.LIFT.t_end
 
 
 def _e(x: float) -> str:
@@ -246,12 +271,12 @@ def plot(path: Path, found: list[dict]) -> Path:
     fig, grid = plt.subplots(len(names), 2, figsize=(12, 4.2 * len(names)), squeeze=False)
     for name, axes in zip(names, grid, strict=True):
         _plot_machine(axes, [p for p in rows if p["machine"] == name])
-        axes[0].set_title(f"{name}: run-up over {study.MACHINES[name].t_end:g} s", fontsize=10)
+        axes[0].set_title(f"{name}: run over {_run_of(name):g} s", fontsize=10)
     fig.suptitle(
-        f"Each machine's run-up against the machine as one ODE (dashed: {TARGET:.0e})",
+        f"Each machine's run against the machine as one ODE (dashed: {TARGET:.0e})",
         fontsize=11,
     )
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.3 / fig.get_figheight()))
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
@@ -276,13 +301,14 @@ def _plot_machine(axes: object, rows: list[dict]) -> None:
 
 def _linear(found: list[dict]) -> list[study.PlantMachine]:
     """The machines of ``found`` with a plant whose motor has no inductance."""
-    return [study.MACHINES[n] for n in _machines(found) if study.MACHINES[n].linear_plant]
+    machines = [study.MACHINES[n] for n in _machines(found) if n in study.MACHINES]
+    return [m for m in machines if m.linear_plant]
 
 
 def _machine_table(found: list[dict]) -> list[str]:
     """Each machine of the section: its FMUs, its supply, its run and its motor."""
     table = []
-    for name in _machines(found):
+    for name in (n for n in _machines(found) if n in study.MACHINES):
         m = study.MACHINES[name]
         motor = study.circuit(next(iter(study.CIRCUITS)), m=m)
         gain = motor.torque_constant * motor.ratio
@@ -317,6 +343,26 @@ def _machine_table(found: list[dict]) -> list[str]:
     return markup.table(header, table, "-----rrrrrr")
 
 
+def _force_lines(found: list[dict]) -> list[str]:
+    """What the lift's rows are, where the study has them."""
+    m = force_study.LIFT
+    if m.name not in _machines(found):
+        return []
+    hold = force_study.holding_force(m)
+    return [
+        "",
+        f"The {m.name} ({markup.code(m.plant)}, its ram's force in, no motor: no (b) or (c)) "
+        f"under the force law F(t) = F_hold ({m.hold:g} {'-' if m.slope < 0 else '+'} "
+        f"{abs(m.slope):g} t / s), F_hold = "
+        f"{hold:.1f} N the force that holds the ram at rest at {m.start:g} m with its loads "
+        f"off: the platform rises and slows down over {m.t_end:g} s. (a) the force with its "
+        "rate at each communication point (FMI 2 input derivatives: the plant's "
+        "interpolation is then the law itself), and held over the step. Its reference: the "
+        "harness's effort J(x) x'' + h(x, x') = F(t) itself (no series), SciPy's DOP853 at "
+        f"rtol {_reference_rtol(False):.0e}.",
+    ]
+
+
 def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
     """The section's Markdown lines."""
     return [
@@ -345,6 +391,7 @@ def lines(found: list[dict], figure: Path, quick: bool) -> list[str]:
         f"{_reference_rtol(quick):.0e} (Radau where the circuit is stiff, else DOP853).",
         "",
         *_machine_table(found),
+        *_force_lines(found),
         "",
         "Each cell: the largest crank angle error over the communication points / the angle "
         "travelled, then the largest speed error / the peak speed (with two drivers, the "
