@@ -4,7 +4,8 @@ A plant is an FMU of a scene with ``dynamics = "forward"`` (modelDescription/sce
 README.md, "Plants"): the drivers' efforts (or a motor's voltage) and the loads in, the
 motion integrated inside each ``doStep``, every output at the state reached. ``forward``
 instantiates it, holds each input law over each communication step (its value at the
-step's start) and returns every output at every communication point as NumPy arrays.
+step's start) or, with ``interpolate=True`` (FMI 2), follows it linearly between the grid's
+points, and returns every output at every communication point as NumPy arrays.
 Where the motion has no answer (a toggle, a chain that stops assembling) the plant stops
 at the last point that has one: the trajectory ends there and says why.
 """
@@ -58,16 +59,20 @@ def forward(
     *,
     version: int = 3,
     progress: Callable[[float], None] | None = None,
+    interpolate: bool = False,
 ) -> Trajectory:
     """Runs a plant over the communication points `time` (s, increasing, from the start).
 
     `fmu` is a built plant's identifier (``"slider_crank_motor"``: build/fmus/, FMI
     `version` 2 or 3) or the path of a .fmu. `inputs` maps input names to laws: a
     number, a function of t, or an array with one value per point of `time`; each is held
-    over a step at its value at the step's start, and an input left out keeps its start
-    value. `parameters` are set before initialisation (the states' ``*_start``, the
-    tolerances ``solver.rtol`` and ``solver.atol``, a motor's numbers). `progress`, if
-    given, is called with the time reached after every step.
+    over a step at its value at the step's start, or with `interpolate` (FMI 2 only: its
+    input derivatives) followed along the line to its value at the step's end, which the
+    plant integrates exactly (a law linear over each step, an array's polyline, is then
+    the input itself; a smooth one is second order in the step instead of first); an
+    input left out keeps its start value. `parameters` are set before initialisation (the
+    states' ``*_start``, the tolerances ``solver.rtol`` and ``solver.atol``, a motor's
+    numbers). `progress`, if given, is called with the time reached after every step.
 
     Raises ValueError naming the bad argument; FileNotFoundError if the FMU is not built;
     dyadfmu.fmi.slave.SlaveError if the FMU refuses a call (its message says why)."""
@@ -76,9 +81,14 @@ def forward(
     slave = Slave(path, label=path.stem)
     try:
         _check_plant(slave)
-        laws = _laws(slave, grid, dict(inputs or {}))
+        if interpolate and slave.version != 2:
+            raise ValueError(
+                f"interpolate: {path.name} is an FMI {slave.version} FMU; following an input "
+                "between the points takes FMI 2's input derivatives (version=2)"
+            )
+        laws = _laws(slave, grid, dict(inputs or {}), interpolate)
         _check_parameters(slave, dict(parameters or {}))
-        return _run(slave, grid, laws, dict(parameters or {}), progress)
+        return _run(slave, grid, laws, dict(parameters or {}), progress, interpolate)
     finally:
         slave.close()
 
@@ -108,18 +118,18 @@ def _causality(slave: Slave, causality: str) -> list[str]:
     return [v.name for v in slave.md.modelVariables if v.causality == causality]
 
 
-def _laws(slave: Slave, grid: np.ndarray, inputs: dict) -> dict[str, np.ndarray]:
-    """Each input's values at the grid's points (the last one unused)."""
+def _laws(slave: Slave, grid: np.ndarray, inputs: dict, interpolate: bool) -> dict[str, np.ndarray]:
+    """Each input's values at the grid's points (the last one unused where held)."""
     known = _causality(slave, "input")
     laws = {}
     for name, law in inputs.items():
         if name not in known:
             raise ValueError(f"inputs: {name!r} is not an input of {slave.path.name}: {known}")
-        laws[name] = _values(name, law, grid)
+        laws[name] = _values(name, law, grid, interpolate)
     return laws
 
 
-def _values(name: str, law: Law, grid: np.ndarray) -> np.ndarray:
+def _values(name: str, law: Law, grid: np.ndarray, interpolate: bool = False) -> np.ndarray:
     if callable(law):
         values = np.array([float(law(float(t))) for t in grid])
     else:
@@ -131,7 +141,7 @@ def _values(name: str, law: Law, grid: np.ndarray) -> np.ndarray:
                 f"inputs[{name!r}]: one value per point of time ({grid.size}) is needed, "
                 f"got shape {values.shape}"
             )
-    bad = ~np.isfinite(values[:-1])
+    bad = ~np.isfinite(values if interpolate else values[:-1])
     if np.any(bad):
         k = int(np.argmax(bad))
         raise ValueError(f"inputs[{name!r}] is {values[k]} at t = {grid[k]} s")
@@ -153,6 +163,7 @@ def _run(
     laws: dict[str, np.ndarray],
     parameters: dict,
     progress: Callable[[float], None] | None,
+    interpolate: bool = False,
 ) -> Trajectory:
     reals = tuple(
         v.name
@@ -169,6 +180,9 @@ def _run(
     for k in range(grid.size - 1):
         if names:
             slave.set(names, [laws[n][k] for n in names])
+        if names and interpolate:
+            h = grid[k + 1] - grid[k]
+            slave.set_rates(names, [(laws[n][k + 1] - laws[n][k]) / h for n in names])
         try:
             slave.do_step(float(grid[k]), float(grid[k + 1] - grid[k]))
         except SlaveError as e:

@@ -90,6 +90,39 @@ def test_a_run_into_a_toggle_ends_where_the_plant_stopped():
     assert all(len(values) == len(run.time) for values in run.values.values())
 
 
+def test_an_interpolated_law_is_followed_between_the_points():
+    """The lift's force law F(t) = F_hold (1.1 - 0.2 t / s) as a function over a 10 ms
+    grid: with interpolate=True the plant follows it along each step and the ram's motion
+    is the harness's to 1e-10 of its travel (1.0e-12); held, 2.9e-2 off, first order. An array
+    on the grid is its polyline: the same run, bit for bit."""
+    from dyadfmu.cosim import force_study
+
+    m = force_study.LIFT
+    force, rate = force_study.law(m)
+    grid = np.linspace(0.0, m.t_end, 101)
+    ref = force_study.reference(grid, 1e-12, m)
+    travel = np.ptp(ref.phi)
+    law = {"ram.force": lambda t: force + rate * t}
+    start = {"ram.position_start": m.start}
+    runs = {
+        how: dyadfmu.forward("lift_forward", grid, law, start, version=2, interpolate=how)
+        for how in (True, False)
+    }
+    off = {how: np.max(np.abs(r["ram.position"] - ref.phi)) / travel for how, r in runs.items()}
+    print(f"lift: interpolated {off[True]:.1e}, held {off[False]:.1e} of the travel")
+    assert off[True] < 1e-10 and off[False] > 1e-3
+    along = dyadfmu.forward(
+        "lift_forward",
+        grid,
+        {"ram.force": force + rate * grid},
+        start,
+        version=2,
+        interpolate=True,
+    )
+    assert np.array_equal(along["ram.position"], runs[True]["ram.position"])
+    assert np.array_equal(along["ram.force"], force + rate * grid)
+
+
 @pytest.mark.parametrize(
     ("call", "named"),
     [
@@ -107,6 +140,20 @@ def test_a_run_into_a_toggle_ends_where_the_plant_stopped():
         ),
         (lambda: dyadfmu.forward("slider_crank_forward", [0.0, 0.1, 0.1]), "not increasing"),
         (lambda: dyadfmu.forward("slider_crank_forward", [0.0]), "at least 2 points"),
+        (
+            lambda: dyadfmu.forward("slider_crank_forward", GRID, interpolate=True),
+            "interpolate: slider_crank_forward_fmi3.fmu is an FMI 3 FMU",
+        ),
+        (
+            lambda: dyadfmu.forward(
+                "slider_crank_forward",
+                GRID,
+                {"crank.torque": np.append(np.zeros(GRID.size - 1), math.inf)},
+                version=2,
+                interpolate=True,
+            ),
+            "inputs['crank.torque'] is inf at t = ",
+        ),
         (
             lambda: dyadfmu.forward("slider_crank_forward", GRID, parameters={"crank.mass": 1}),
             "'crank.mass' is not a parameter",
