@@ -257,8 +257,8 @@ def explicit_limit_parameters(scene: Scene) -> list[tuple[str, float, str]]:
             "The explicit method (DOP853) integrates a communication step while its internal "
             "step times the fastest motor's decay rate (its circuit's R / L; without "
             "inductance, its damping over its rotor's inertia) stays at most this; above it, "
-            "the Rosenbrock method (RODASP). 0: RODASP wherever a motor's circuit or damping "
-            "decays",
+            "the Rosenbrock method (RODASP). 0: RODASP wherever a motor has a decay rate (a "
+            "circuit, or a rotor with inertia)",
         )
     ]
 
@@ -501,6 +501,61 @@ def _motor_partials(ident: str, drivers: list[ForwardDriver], n: int) -> list[st
             f"in->{c('motor_inductance')};",
         ]
     return lines + ["}", ""]
+
+
+def _steady_lost(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """steady_lost(): whether a motor without inductance's torque is lost in round-off."""
+    lines = [
+        "/* 1 where the current of a motor without inductance, (V - k r q') / R, carries more",
+        " * round-off in its torque than solver.rtol of the torques its crank balances (the",
+        " * torque, h and the inertia torque M_aa q'^2): a resistance so small that the motor",
+        " * is a speed source to double precision, whose current no double can resolve. */",
+        f"static int steady_lost(const {ident}_input* in, const {ident}_output* out, "
+        "const double* y,",
+        "                       const double* m, fmu_evaluation* evaluation)",
+        "{",
+    ]
+    steady = [f for f in drivers if f.steady]
+    if not steady:
+        return (
+            lines
+            + ["    (void)in, (void)out, (void)y, (void)m, (void)evaluation;"]
+            + [
+                "    return 0;",
+                "}",
+                "",
+            ]
+        )
+    n = len(drivers)
+    for f in steady:
+        k, c = f.index, f.c
+        h = f"out->{member(f.name)}_{effort_of(f.driver)[0]}0"
+        resistance, rate = f"in->{c('motor_resistance')}", f"y[{n + k}]"
+        lines += [
+            "    {",
+            f"        const double ratio = in->{c('motor_ratio')};",
+            f"        const double kt = in->{c('motor_torque_constant')};",
+            f"        const double supply = in->{c('motor_voltage')}, back = kt * ratio * {rate};",
+            f"        const double torque = ratio * (kt * (supply - back) / {resistance} -",
+            f"                                       in->{c('motor_friction')} * ratio * {rate});",
+            "        const double noise =",
+            "            4 * DBL_EPSILON * fabs(ratio * kt) * (fabs(supply) + fabs(back)) /",
+            f"            {resistance};",
+            "        const double scale =",
+            f"            fabs(torque) + fabs({h}) + m[{k * n + k}] * {rate} * {rate};",
+            "        if (noise > in->plant_rtol * scale) {",
+            "            evaluation->status = FMU_DISCARD;",
+            "            snprintf(evaluation->reason, sizeof evaluation->reason,",
+            '                     "%s: the current of a motor without inductance lost in "',
+            '                     "round-off (torque known to %.2g of %.2g N.m, beyond "',
+            '                     "solver.rtol): %.2g ohm is too small; give it an inductance or "',
+            '                     "more resistance; outputs are NaN",',
+            f"                     {c_string(f.name)}, noise, scale, {resistance});",
+            "            return 1;",
+            "        }",
+            "    }",
+        ]
+    return lines + ["    return 0;", "}", ""]
 
 
 def _currents(ident: str, drivers: list[ForwardDriver], n: int) -> list[str]:
@@ -878,6 +933,7 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
     parts = (
         _motion_into(ident, drivers)
         + _equation_of_motion(scene, ident, drivers)
+        + _steady_lost(scene, ident, drivers)
         + _currents(ident, drivers, len(drivers))
         + _jacobian_parts(scene, ident, drivers)
         + _state_io(drivers, ident)

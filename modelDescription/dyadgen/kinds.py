@@ -405,6 +405,7 @@ class SceneKind(Kind):
             self.directional_derivatives = "false"
             self.interpolates = True
             self.model_includes = (
+                "<float.h>",
                 "<math.h>",
                 "<stdio.h>",
                 "<string.h>",

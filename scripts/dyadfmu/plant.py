@@ -32,7 +32,8 @@ _DISCARD = 2
 @dataclass
 class Trajectory:
     """The plant's outputs at the communication points it reached, and its inputs there
-    (a law's value from that point on; where the run stopped, the value it stopped in).
+    (a law's value at that point; where the run stopped, the value the plant had there:
+    held, the step's start value; interpolated, the line's value at the stop).
 
     ``trajectory["crank.angle"]`` is an output's (or an input's) array, one value per
     point of ``time``; ``units`` gives each one's unit ("" where it has none).
@@ -145,6 +146,14 @@ def _values(name: str, law: Law, grid: np.ndarray, interpolate: bool = False) ->
     if np.any(bad):
         k = int(np.argmax(bad))
         raise ValueError(f"inputs[{name!r}] is {values[k]} at t = {grid[k]} s")
+    if interpolate:
+        with np.errstate(over="ignore"):
+            steep = ~np.isfinite(np.diff(values) / np.diff(grid))
+        if np.any(steep):
+            k = int(np.argmax(steep))
+            raise ValueError(
+                f"inputs[{name!r}]: its rate from t = {grid[k]} to {grid[k + 1]} s overflows double"
+            )
     return values
 
 
@@ -203,6 +212,10 @@ def _run(
         held[-1] -= 1  # inside the step that stopped
     for name, law in laws.items():
         values[name] = law[held]
+        if stopped is not None and interpolate:  # where the line had come to
+            k = held[-1]
+            share = (times[-1] - grid[k]) / (grid[k + 1] - grid[k])
+            values[name][-1] = law[k] + share * (law[k + 1] - law[k])
     if "status" in slave.names:
         values["status"] = table[:, -1]
     units = {v.name: v.unit or "" for v in slave.md.modelVariables if v.name in values}

@@ -123,6 +123,21 @@ def test_an_interpolated_law_is_followed_between_the_points():
     assert np.array_equal(along["ram.force"], force + rate * grid)
 
 
+def test_an_interpolated_run_that_stops_records_the_input_it_stopped_at():
+    """The leg driven by supplies ramping over 1 s runs into a limit inside its one step:
+    the last row's inputs are the lines' values where it stopped, the plant's own."""
+    run = dyadfmu.forward(
+        "leg_mixed_motor",
+        [0.0, 1.0],
+        {"front.motor.voltage": [0.0, 24.0], "rear.motor.voltage": [0.0, -24.0]},
+        version=2,
+        interpolate=True,
+    )
+    assert run.stopped is not None and 0.0 < run.time[-1] < 1.0
+    assert run["front.motor.voltage"][-1] == pytest.approx(24.0 * run.time[-1], rel=1e-12)
+    assert run["rear.motor.voltage"][-1] == pytest.approx(-24.0 * run.time[-1], rel=1e-12)
+
+
 @pytest.mark.parametrize(
     ("call", "named"),
     [
@@ -153,6 +168,16 @@ def test_an_interpolated_law_is_followed_between_the_points():
                 interpolate=True,
             ),
             "inputs['crank.torque'] is inf at t = ",
+        ),
+        (
+            lambda: dyadfmu.forward(
+                "slider_crank_forward",
+                [0.0, 1.0, 2.0],
+                {"crank.torque": [-1e308, 1e308, 0.0]},
+                version=2,
+                interpolate=True,
+            ),
+            "inputs['crank.torque']: its rate from t = 0.0 to 1.0 s overflows double",
         ),
         (
             lambda: dyadfmu.forward("slider_crank_forward", GRID, parameters={"crank.mass": 1}),
