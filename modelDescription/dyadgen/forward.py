@@ -517,15 +517,8 @@ def _steady_lost(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list
     ]
     steady = [f for f in drivers if f.steady]
     if not steady:
-        return (
-            lines
-            + ["    (void)in, (void)out, (void)y, (void)m, (void)evaluation;"]
-            + [
-                "    return 0;",
-                "}",
-                "",
-            ]
-        )
+        unused = "    (void)in, (void)out, (void)y, (void)m, (void)evaluation;"
+        return lines + [unused, "    return 0;", "}", ""]
     n = len(drivers)
     for f in steady:
         k, c = f.index, f.c
@@ -536,7 +529,7 @@ def _steady_lost(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list
             f"        const double ratio = in->{c('motor_ratio')};",
             f"        const double kt = in->{c('motor_torque_constant')};",
             f"        const double supply = in->{c('motor_voltage')}, back = kt * ratio * {rate};",
-            f"        const double torque = ratio * (kt * (supply - back) / {resistance} -",
+            f"        const double torque = ratio * (kt * {_current(f, 'y', n)} -",
             f"                                       in->{c('motor_friction')} * ratio * {rate});",
             "        const double noise =",
             "            4 * DBL_EPSILON * fabs(ratio * kt) * (fabs(supply) + fabs(back)) /",

@@ -79,7 +79,7 @@ def run(step: float, rates: bool, m: ForceMachine = LIFT, version: int = 2) -> p
     effort = f"{m.driver}.force"
     started = clock.process_time()
     try:
-        plant_study._inputs_at_zero(plant, effort)
+        plant_study.inputs_at_zero(plant, effort)
         plant.set(effort, force)
         plant.initialize({f"{m.driver}.position_start": m.start})
         for k in range(n + 1):
@@ -115,10 +115,6 @@ def reference(t: np.ndarray, rtol: float = 1e-12, m: ForceMachine = LIFT) -> pla
     x, v = sol.y
     a = np.empty_like(x)
     for ix in np.array_split(np.arange(len(t)), max(1, -(-len(t) // 20000))):
-        count = len(ix)
-        still = chain._solve(t[ix], x[ix], v[ix], np.zeros(count))
-        unit = chain._solve(t[ix], x[ix], v[ix], np.ones(count))
-        h = np.real(chain.reference(still)[chain.drive_output])
-        J = np.real(chain.reference(unit)[chain.drive_output]) - h
+        J, h = forward.chain_terms_at(chain, t[ix], x[ix], v[ix])
         a[ix] = (force + rate * t[ix] - h) / J
     return plant_study.Reference(t, x, v, a, plant_study.reactions(m, t, x, v, a))

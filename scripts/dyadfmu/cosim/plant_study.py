@@ -60,6 +60,7 @@ __all__ = [
     "drive_line",
     "drive_run",
     "errors",
+    "inputs_at_zero",
     "reaction_names",
     "reactions",
     "reference",
@@ -207,7 +208,7 @@ def _recorded(names: tuple[str, ...], rows: np.ndarray, start: int) -> dict[str,
     return {name: rows[:, start + k].copy() for k, name in enumerate(names)}
 
 
-def _inputs_at_zero(slave: Slave, keep: str) -> None:
+def inputs_at_zero(slave: Slave, keep: str) -> None:
     """Every continuous input of ``slave`` but ``keep`` set to zero: the drivers without
     a motor take no effort and the loads are off, as in the reference."""
     for v in slave.md.modelVariables:
@@ -272,7 +273,7 @@ def run(
     started = clock.process_time()
     try:
         voltage = f"{m.driver}.motor.voltage"
-        _inputs_at_zero(plant, voltage)
+        inputs_at_zero(plant, voltage)
         plant.set(voltage, m.voltage)
         plant.initialize(parameters)
         rows[0] = plant.get(names)
@@ -526,7 +527,7 @@ def _split_fmus(label: str, version: int, m: PlantMachine) -> tuple[Slave, Slave
     inertia = f"{m.driver}.inertia"
     own = next(v for v in plant.md.modelVariables if v.name == inertia)
     rotor = motor.ratio**2 * motor.rotor_inertia
-    _inputs_at_zero(plant, f"{m.driver}.torque")
+    inputs_at_zero(plant, f"{m.driver}.torque")
     plant.initialize({**_starts(m), inertia: float(own.start) + rotor})
     fmu = Slave(paths.built_fmu(MOTOR_FMU, version, how="scripts/run-tests"), "motor")
     names = ("resistance", "inductance", "torque_constant", "friction", "ratio")

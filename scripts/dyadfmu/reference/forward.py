@@ -40,6 +40,7 @@ __all__ = [
     "Trajectory",
     "accelerations",
     "chain_terms",
+    "chain_terms_at",
     "integrate_chain",
     "energy",
     "holding",
@@ -154,10 +155,19 @@ def chain_terms(chain: Chain, t: float, q: float, dq: float) -> tuple[float, flo
     """J(q) and h(t, q, q') of a chain with one driver, effort = J q'' + h: its
     Newton-Euler effort at zero and at unit acceleration (the effort is affine in q''),
     with the chain's load models at the state."""
-    pair = np.array([0.0, 1.0])
-    kin = chain._solve(np.full(2, float(t)), np.full(2, float(q)), np.full(2, float(dq)), pair)
-    effort = chain.reference(kin)[chain.drive_output]
-    return float(effort[1] - effort[0]), float(effort[0])
+    J, h = chain_terms_at(chain, np.array([t]), np.array([q]), np.array([dq]))
+    return float(J[0]), float(h[0])
+
+
+def chain_terms_at(
+    chain: Chain, t: np.ndarray, q: np.ndarray, dq: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`chain_terms` at N states at once (arrays (N,)): J and h, each (N,)."""
+    count = len(q)
+    at = (np.tile(np.asarray(x, dtype=float), 2) for x in (t, q, dq))
+    kin = chain._solve(*at, np.repeat([0.0, 1.0], count))
+    effort = np.real(chain.reference(kin)[chain.drive_output])
+    return effort[count:] - effort[:count], effort[:count]
 
 
 def integrate_chain(
