@@ -28,16 +28,17 @@ from dyadgen.textsafe import c_string
 DYNAMICS = ("inverse", "forward")
 #: The most internal steps one communication step may take.
 MAX_STEPS = 20000
-#: The tolerances' defaults: about 1e-8 relative in the driver's motion.
-RTOL_DEFAULT = 1e-10
-ATOL_DEFAULT = 1e-10
+#: The tolerances' defaults: the drivers' motion within about 1e-8 of its travel and
+#: peak rate over seconds of motion.
+RTOL_DEFAULT = 1e-8
+ATOL_DEFAULT = 1e-8
 #: The largest h R / L of a motor's circuit the explicit method takes on by default:
 #: half DOP853's stability limit on the negative real axis (about 6).
 EXPLICIT_LIMIT_DEFAULT = 3.0
 #: The largest a user may set: below that limit, with a margin.
 EXPLICIT_LIMIT_MAX = 5.0
-#: The share of the tolerances the explicit method holds each step's error to.
-EXPLICIT_SHARE = 1.0 / 64.0
+#: The share of the tolerances each internal step's error is held to, by either method.
+STEP_SHARE = 1.0 / 64.0
 
 
 @dataclass

@@ -501,15 +501,18 @@ def test_quick_report_writes_its_files(tmp_path):
 def _check_plant_points(found: list[dict]) -> None:
     """The motor inside the plant (a) within 1e-8 of travel and peak at every step and
     tolerance, with the scene's circuit and without inductance (the drive's linear
-    characteristic); the drive FMU with the inverse mechanism FMU (c) first order in the
-    step."""
+    characteristic), and its reactions within 1e-7 of their peak (the motor's torque
+    moves with the speed by k^2 / R: the slider-crank's speed error of 1.6e-9 of its peak
+    is 1.4e-8 of the largest reaction's at the default tolerances); the drive FMU with the
+    inverse mechanism FMU (c) first order in the step."""
     inside = [p for p in found if p["coupling"].startswith("(a)")]
     drive = sorted((p for p in found if p["coupling"].startswith("(c)")), key=lambda p: p["step"])
     assert len(inside) == 6 and len(drive) == 2
     # the plant with the drive's own linear characteristic inside, against the same reference
     linear = [p for p in inside if p["coupling"] == "(a) motor L = 0"]
     assert sorted(p["step"] for p in linear) == sorted(p["step"] for p in drive)
-    assert all(p[k] < 1e-8 for p in inside for k in ("angle", "speed", "reactions"))
+    assert all(p[k] < 1e-8 for p in inside for k in ("angle", "speed"))
+    assert all(p["reactions"] < 1e-7 for p in inside)
     assert min(p["reactions"] for p in drive) > 1e4 * max(p["reactions"] for p in inside)
     assert drive[0]["speed"] < drive[1]["speed"]
     assert min(p["speed"] for p in drive) > 1e4 * max(p["speed"] for p in inside)
@@ -528,7 +531,7 @@ def test_every_machine_with_its_motor_inside_meets_the_reference(name):
     the angle travelled, of the peak speed and of the largest joint reaction's peak at 10
     ms steps; their motor as a separate FMU
     (b) nearer with the rates exchanged than held at 1 ms; the drive FMU with the inverse
-    mechanism FMU (c) falling with the step. Measured: (a) 1.8e-13 and 1.7e-14 of the
+    mechanism FMU (c) falling with the step. Measured: (a) 2.4e-13 and 1.2e-12 of the
     travel, (b) with rates 4.7e-3 and 1.6e-3 rad at 1 ms, a fifth of held, and the
     reactions 3.8e-2 and 9.8e-3 of their peak, a quarter and a sixth of held."""
     from dyadfmu.cosim import plant_study as study
@@ -548,12 +551,29 @@ def test_every_machine_with_its_motor_inside_meets_the_reference(name):
 
 
 @needs_drive
+def test_no_step_passes_on_an_error_estimate_that_vanished_by_chance():
+    """The slider-crank's plant with the drive's linear motor (no inductance) over its 2 s
+    run-up at 10 ms steps and the default tolerances: within 1e-8 of its travel and peak
+    speed. DOP853's estimate once vanished by chance at 1.165 s; the step then grew sixfold
+    to 4.6 ms, where the estimate no longer holds, and was taken with 1e-6 of the peak
+    speed wrong. Its steps now at most double: measured 2.8e-11 and 1.6e-9."""
+    from dyadfmu.cosim import plant_study as study
+
+    m = study.MACHINES["slider-crank"]
+    grid = np.linspace(0.0, m.t_end, int(round(m.t_end / 1e-2)) + 1)
+    ref = study.reference(study.LINEAR, grid, "DOP853", 1e-12, m)
+    found = study.errors(study.run(study.LINEAR, 1e-2, m=m), ref)
+    print(f"slider-crank, (a) motor L = 0 at 10 ms: {found}")
+    assert found["angle"] < 1e-8 and found["speed"] < 1e-8, found
+
+
+@needs_drive
 def test_the_leg_with_its_motor_inside_meets_the_reference():
     """The leg (two drivers: its front hip on the motor, its rear hip free) in the plant
     study: (a) within 1e-8 of each hip's travel and peak speed and of the largest joint
     reaction's peak at 10 ms steps, with the scene's circuit and the stiff one; (b) with
     the rates exchanged within 1e-3 rad at 1 ms and at second order below it, ten times
-    nearer than held at 0.1 ms. Measured: (a) 4.6e-14 and 1.3e-10 of the travel, (b) with
+    nearer than held at 0.1 ms. Measured: (a) 2.3e-11 and 2.0e-10 of the travel, (b) with
     rates 1.3e-4 rad at 1 ms and 1.3e-6 at 0.1 ms, held 4.3e-5."""
     from dyadfmu.cosim import plant_study as study
 
@@ -579,7 +599,7 @@ def test_the_lift_under_a_force_law_meets_the_reference():
     force with its rate at each communication point, its linear interpolation is the law,
     and the ram's position, speed and the joint reactions are within 1e-8 of the travel
     and the peaks at 0.1 s and 10 ms steps; held over the step, first order (ten times
-    nearer at a ten times smaller step). Measured: 2.0e-12 and 1.0e-12 of the travel with
+    nearer at a ten times smaller step). Measured: 5.2e-11 and 1.0e-12 of the travel with
     the rate, held 2.9e-2 and 2.9e-3."""
     from dyadfmu.cosim import force_study
     from dyadfmu.cosim import plant_study as study

@@ -76,3 +76,9 @@ def test_callgrind_splits_a_stiff_plants_work(tmp_path: Path):
     spent += figures["jacobians_per_ms"] * figures["per_jacobian"]
     assert spent < figures["per_ms"] < 1.3 * spent
     assert all(math.isfinite(v) for v in figures.values())
+
+
+def test_the_report_gives_the_plants_own_default_tolerances():
+    """Read from the model description, not written into the report's text."""
+    fmu = _fmu(plants.CASES[0].identifier)
+    assert plants.default_tolerances(fmu) == "solver.rtol = 1e-08, solver.atol = 1e-08"

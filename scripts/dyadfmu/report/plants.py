@@ -29,6 +29,8 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from fmpy import read_model_description
+
 from .. import paths
 from ..fmi.slave import Slave
 from . import markdown as markup
@@ -317,14 +319,23 @@ def _sweep_lines(sweep: list[dict]) -> list[str]:
     return markup.table(header, rows, "l" + "r" * len(steps))
 
 
-def markdown(path: Path, table: list[dict], sweep: list[dict], figure: Path, took: float) -> Path:
-    """The report."""
+def default_tolerances(fmu: str) -> str:
+    """The plant's default tolerances as its model description gives them."""
+    md = read_model_description(fmu)
+    start = {v.name: v.start for v in md.modelVariables}
+    return f"solver.rtol = {start['solver.rtol']}, solver.atol = {start['solver.atol']}"
+
+
+def markdown(
+    path: Path, table: list[dict], sweep: list[dict], figure: Path, took: float, tolerances: str
+) -> Path:
+    """The report; `tolerances` the plants' defaults, as :func:`default_tolerances`."""
     lines = [
         "# What a plant's integration costs",
         "",
         markup.provenance("dyadfmu plants"),
         "",
-        f"Default tolerances (rtol = atol = 1e-10); inputs held; {took:.0f} s to measure. "
+        f"Default tolerances ({tolerances}); inputs held; {took:.0f} s to measure. "
         "An evaluation is one of the equation of motion q'' = M^-1 (efforts - h): the "
         "inverse scene's evaluation at zero acceleration and an N x N solve; a Jacobian is "
         "the inverse scene's directional derivatives along each driver's position and "
@@ -374,8 +385,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--quick",
         action="store_true",
-        help="at most 0.2 s of motion per case and no 1e-5 s steps (about a minute of CPU "
-        "time; the full study about 2.5 minutes)",
+        help="at most 0.2 s of motion per case and no 1e-5 s steps (45 s of CPU time, most "
+        "of it under callgrind; the full study 52 s)",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out)")
     p.add_argument(
@@ -403,7 +414,9 @@ def main(argv: list[str] | None = None) -> int:
     folder = Path(args.out) / "plants"
     folder.mkdir(parents=True, exist_ok=True)
     figure = plot(folder / "cost_vs_step.png", sweep)
-    report = markdown(folder / "report.md", table, sweep, figure, clock.perf_counter() - start)
+    tolerances = default_tolerances(str(paths.built_fmu(CASES[0].identifier, 2, args.build)))
+    took = clock.perf_counter() - start
+    report = markdown(folder / "report.md", table, sweep, figure, took, tolerances)
     points = write_csv(folder / "points.csv", sweep)
     print("\n".join(_target_lines(table)))
     print("written:")
