@@ -28,12 +28,20 @@ from string import Template
 
 from dyadgen import textsafe
 from dyadgen.corefiles import scene_core_sources
+from dyadgen.emit.forward_c import plant_c, plant_header
 from dyadgen.emit.scene_c import scene_c, scene_header, scene_tangent_c
 from dyadgen.locations import ROOT
 from dyadgen.model import c_num
 from dyadgen.table import Table, Variable
 
 CORE_SOURCES = ROOT / "src"
+#: the FMU layer's model header, which a plant's C (<identifier>_plant.c) includes: FMI-free
+MODEL_HEADER = ROOT / "fmu" / "fmu_model.h"
+#: a plant's example: steps of EXAMPLE_STEP seconds
+EXAMPLE_STEPS, EXAMPLE_STEP = 100, 1e-3
+#: the float build of a plant against the double build, both tolerances 1e-6 (of the
+#: travel and of the peak rate; the README states it, scripts/tests/test_bundle.py holds it)
+FLOAT_PLANT_BOUND = 1e-4
 CORE_HEADERS = ROOT / "src" / "include"
 TEMPLATES = Path(__file__).resolve().parent / "emit" / "templates"
 #: the first line of a bundle's CMakeLists.txt: what marks a folder as a bundle to replace
@@ -97,13 +105,19 @@ def scene_sources(table: Table, derivatives: bool) -> dict[str, str]:
     }
     if derivatives:
         files[f"scene/{ident}_scene_tangent.c"] = scene_tangent_c(table.scene)
+    if table.scene.forward():
+        files[f"scene/{ident}_plant.h"] = plant_header(table.scene)
+        files[f"scene/{ident}_plant.c"] = plant_c(table.scene)
     return files
 
 
 def core_files(table: Table, derivatives: bool, generated: dict[str, str]) -> dict[str, Path]:
     """core/: bundle path -> checkout file of every core source the scene calls and every
     header it or they include."""
-    sources = [CORE_SOURCES / name for name in scene_core_sources(table.scene, derivatives)]
+    names = scene_core_sources(table.scene, derivatives)
+    if table.scene.forward():
+        names.append("dyad_ode.c")
+    sources = [CORE_SOURCES / name for name in names]
     texts = list(generated.values()) + [p.read_text(encoding="utf-8") for p in sources]
     files = {_core_place(p): p for p in sources}
     for path in _included_core_files(texts):
@@ -187,6 +201,15 @@ def _derivative_code(table: Table) -> list[str]:
 
 def example_c(table: Table, derivatives: bool) -> str:
     """example/<identifier>_example.c."""
+    if table.scene.forward():
+        return _template("bundle_plant_example.c.in").substitute(
+            ident=table.identifier,
+            scene_file=textsafe.c_comment(table.scene.path.name),
+            steps=EXAMPLE_STEPS,
+            step=c_num(EXAMPLE_STEP),
+            fill="\n".join("    " + line for line in fill_lines(table)),
+            prints="\n".join(_print_lines(table, "out")),
+        )
     derivative = _derivative_code(table) if derivatives else []
     return _template("bundle_example.c.in").substitute(
         ident=table.identifier,
@@ -274,13 +297,37 @@ def _derivative_fields(table: Table, derivatives: bool) -> dict[str, str]:
     }
 
 
+def _plant_fields(table: Table) -> dict[str, str]:
+    """The README's fields of a plant (a forward scene): its files and its section."""
+    ident = table.identifier
+    if not table.scene.forward():
+        return {
+            "plant_rows": "",
+            "plant_section": "",
+            "example_does": "one evaluation at the scene's start values, every output printed",
+            "kept": "nothing is kept between calls",
+        }
+    return {
+        "plant_rows": f"| `scene/{ident}_plant.h`, `scene/{ident}_plant.c` | the plant: "
+        f"`{ident}_plant_start`, `{ident}_plant_advance`, `{ident}_plant_evaluate`, "
+        f"`{ident}_plant_rates` |\n| `scene/fmu_model.h` | the types the plant's C shares "
+        "with the FMU layer (no FMI) |\n",
+        "plant_section": _template("bundle_plant.md.in").substitute(
+            ident=ident, float_bound=f"{FLOAT_PLANT_BOUND:.0e}"
+        ),
+        "example_does": f"the plant started at the scene's start values and advanced "
+        f"{EXAMPLE_STEPS} steps of {EXAMPLE_STEP:g} s, every output printed",
+        "kept": "the plant's states are kept in the input block",
+    }
+
+
 def readme(table: Table, files: list[str], derivatives: bool, sizes: str) -> str:
     """README.md: what is here, how to call it and build it, and its size."""
     scene = table.scene
     ident = table.identifier
     cannot = ", 4 cannot assemble" if scene.internal() else ""
     return _template("bundle_README.md.in").substitute(
-        _file_fields(table, files) | _derivative_fields(table, derivatives),
+        _file_fields(table, files) | _derivative_fields(table, derivatives) | _plant_fields(table),
         ident=ident,
         description=markdown(scene.description),
         scene_file=code_span(scene.path.name),
@@ -422,9 +469,12 @@ def _clear(folder: Path) -> None:
 def bundle_files(table: Table, derivatives: bool) -> tuple[dict[str, str], dict[str, Path]]:
     """(generated bundle path -> text, copied bundle path -> checkout file), the README
     without its size."""
+    derivatives = derivatives or table.scene.forward()
     generated = scene_sources(table, derivatives)
     copied = core_files(table, derivatives, generated)
     copied["LICENSE"] = ROOT / "LICENSE"
+    if table.scene.forward():
+        copied["scene/fmu_model.h"] = MODEL_HEADER
     generated[f"example/{table.identifier}_example.c"] = example_c(table, derivatives)
     names = sorted([*generated, *copied])
     generated["CMakeLists.txt"] = cmakelists(table, names)
@@ -435,6 +485,7 @@ def write_bundle(table: Table, out: Path, derivatives: bool, measured: bool) -> 
     """Write the scene's bundle into out/<identifier>/ (replacing an earlier bundle there)
     and return that folder; with `measured`, its size measured into the README."""
     folder = Path(out) / table.identifier
+    derivatives = derivatives or table.scene.forward()
     _clear(folder)
     generated, copied = bundle_files(table, derivatives)
     names = sorted([*generated, *copied, "README.md"])

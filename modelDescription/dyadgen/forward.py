@@ -224,13 +224,14 @@ def tolerance_parameters() -> list[tuple[str, float, str]]:
         (
             "solver.rtol",
             RTOL_DEFAULT,
-            "Relative tolerance of the integrator's error per internal step",
+            "Relative tolerance of the integrator (each internal step's error is held to "
+            f"1/{round(1 / STEP_SHARE)} of it)",
         ),
         (
             "solver.atol",
             ATOL_DEFAULT,
-            "Absolute tolerance of the integrator's error per internal step (in the "
-            "drivers' units: rad, m, rad/s, m/s)",
+            "Absolute tolerance of the integrator (in the drivers' units: rad, m, rad/s, "
+            f"m/s; each internal step's error is held to 1/{round(1 / STEP_SHARE)} of it)",
         ),
     ]
 
@@ -919,9 +920,14 @@ def _effort_input(scene: Scene, f: ForwardDriver) -> Input:
     return next(i for i in public_inputs(scene) if i.member == member_of)
 
 
+def state_table(scene: Scene) -> list[str]:
+    """The table of the plant's states for the FMU layer (its FMU state's model states)."""
+    return _state_table(scene, scene.identifier)
+
+
 def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
     """The counts of drivers, of y's values and of the FMU state's model states, and the
-    C generated for the scene's drivers."""
+    C generated for the scene's drivers (all but :func:`state_table`)."""
     ident = scene.identifier
     drivers = forward_drivers(scene)
     parts = (
@@ -934,7 +940,6 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         + _start(drivers, ident)
         + _outputs(scene, drivers, ident)
         + _no_outputs(scene, ident)
-        + _state_table(scene, ident)
         + _input_lines(scene, ident)
         + _ramp_partials(scene, ident, drivers)
         + _motion_seed(ident, drivers)
