@@ -662,12 +662,25 @@ static double stop_time(double current_time, double step_size, double reached)
     return stopped < end ? stopped : nextafter(end, current_time);
 }
 
+/* solve() for a step, which says why whenever it returns Discard: a failure found before
+ * the step (at initialisation, say) was logged by the call that found it, and is logged
+ * again by the step it stops. */
+static fmu_status solve_step(fmu_instance* instance, fmu_status not_solvable, const char* function)
+{
+    const int found_now = instance->dirty;
+    const fmu_status status = solve(instance, not_solvable, function, 1);
+    if (status == FMU_DISCARD && !found_now) {
+        log_failure(instance, FMU_DISCARD, function);
+    }
+    return status;
+}
+
 /* A step of a model with states: the outputs at its start, the states
  * advanced, the outputs at its end. */
 static fmu_status advance_states(fmu_instance* instance, double current_time, double step_size,
                                  const char* function)
 {
-    fmu_status status = solve(instance, FMU_DISCARD, function, 1);
+    fmu_status status = solve_step(instance, FMU_DISCARD, function);
     if (status == FMU_OK) {
         fmu_evaluation* e = &instance->evaluation;
         const double reached =
@@ -713,7 +726,7 @@ static fmu_status step_algebraic(fmu_instance* instance, double current_time, do
                                  const char* function)
 {
     fmu_status status =
-        solve(instance, continues(instance) ? FMU_WARNING : FMU_DISCARD, function, 1);
+        solve_step(instance, continues(instance) ? FMU_WARNING : FMU_DISCARD, function);
     if (status == FMU_WARNING) {
         status = FMU_OK; /* on_singular = continue: the outputs NaN, the status set */
     }

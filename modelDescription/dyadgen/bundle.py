@@ -107,7 +107,7 @@ def scene_sources(table: Table, derivatives: bool) -> dict[str, str]:
         files[f"scene/{ident}_scene_tangent.c"] = scene_tangent_c(table.scene)
     if table.scene.forward():
         files[f"scene/{ident}_plant.h"] = plant_header(table.scene)
-        files[f"scene/{ident}_plant.c"] = plant_c(table.scene)
+        files[f"scene/{ident}_plant.c"] = plant_c(table)
     return files
 
 
@@ -298,12 +298,12 @@ def _derivative_fields(table: Table, derivatives: bool) -> dict[str, str]:
 
 
 def _plant_fields(table: Table) -> dict[str, str]:
-    """The README's fields of a plant (a forward scene): its files and its section."""
+    """The README's fields of a plant (a forward scene): its files, what it holds and how
+    to call it (none of them for another scene)."""
     ident = table.identifier
     if not table.scene.forward():
         return {
             "plant_rows": "",
-            "plant_section": "",
             "example_does": "one evaluation at the scene's start values, every output printed",
             "kept": "nothing is kept between calls",
         }
@@ -312,9 +312,13 @@ def _plant_fields(table: Table) -> dict[str, str]:
         f"`{ident}_plant_start`, `{ident}_plant_advance`, `{ident}_plant_evaluate`, "
         f"`{ident}_plant_rates` |\n| `scene/fmu_model.h` | the types the plant's C shares "
         "with the FMU layer (no FMI) |\n",
-        "plant_section": _template("bundle_plant.md.in").substitute(
-            ident=ident, float_bound=f"{FLOAT_PLANT_BOUND:.0e}"
+        "calling": _template("bundle_plant.md.in").substitute(
+            ident=ident,
+            float_bound=f"{FLOAT_PLANT_BOUND:.0e}",
+            fill="\n".join(fill_lines(table)),
         ),
+        "holds": f"the plant (`{ident}_plant_start`, `_advance`, `_evaluate`, `_rates`) on "
+        f"`{ident}_evaluate` and `{ident}_derivative`",
         "example_does": f"the plant started at the scene's start values and advanced "
         f"{EXAMPLE_STEPS} steps of {EXAMPLE_STEP:g} s, every output printed",
         "kept": "the plant's states are kept in the input block",
@@ -326,8 +330,13 @@ def readme(table: Table, files: list[str], derivatives: bool, sizes: str) -> str
     scene = table.scene
     ident = table.identifier
     cannot = ", 4 cannot assemble" if scene.internal() else ""
+    statuses = f"1 singular, 3 out of range{cannot}"
+    fields = _file_fields(table, files) | _derivative_fields(table, derivatives)
+    fields["calling"] = _template("bundle_calling.md.in").substitute(
+        fields, ident=ident, statuses=statuses, fill="\n".join(fill_lines(table))
+    )
     return _template("bundle_README.md.in").substitute(
-        _file_fields(table, files) | _derivative_fields(table, derivatives) | _plant_fields(table),
+        fields | _plant_fields(table),
         ident=ident,
         description=markdown(scene.description),
         scene_file=code_span(scene.path.name),

@@ -431,7 +431,10 @@ def _plant_main(table, values: dict[str, float], tolerance: float | None) -> str
         given.update({"solver.rtol": tolerance, "solver.atol": tolerance})
     for v in _block_inputs(table):
         lines.append(f"    in.{v.lives.path} = {given.get(v.name, float(v.start))!r};")
-    lines += [f"    {ident}_plant_start(&in);", f"    for (k = 0; k < {PLANT_STEPS}; ++k) {{"]
+    lines += [
+        f"    {ident}_plant_start(&in, &evaluation);",
+        f"    for (k = 0; k < {PLANT_STEPS}; ++k) {{",
+    ]
     lines += [
         f"        (void){ident}_plant_advance(&in, {PLANT_STEP!r}, &evaluation);",
         "        if (evaluation.status == FMU_OK) {",
@@ -506,6 +509,63 @@ def test_a_plants_bundle_integrates_as_its_fmu_does(real, tmp_path):
     off = np.max(np.abs(found - expected), axis=0) / scale
     print(f"float plant against double: {dict(zip(PLANT_SEEN, off, strict=True))}")
     assert np.all(off < bundles.FLOAT_PLANT_BOUND), off
+
+
+#: (member set, value, what the start or the first step says), for the plant's bundle
+PLANT_HOSTILE = (
+    ("plant_crank_motor_resistance", "-1.0", "crank.motor.resistance = -1"),
+    ("plant_rtol", "NAN", "solver.rtol = nan"),
+    ("plant_crank_motor_ratio", "0.0", "crank.motor.ratio = 0"),
+    ("plant_step_start", "1e-18", "ok"),
+)
+
+
+def _hostile_main(table) -> str:
+    """A program that, for each case of PLANT_HOSTILE, fills the block at its start
+    values with that one member changed, starts the plant, takes a 1 ms step and prints
+    the reason, or ok and the time the step returned."""
+    ident = table.identifier
+    lines = ["#include <math.h>", "#include <stdio.h>", "#include <string.h>"]
+    lines += [f'#include "{ident}_plant.h"', "", "int main(void)", "{"]
+    lines += [f"    {ident}_input in;", "    fmu_evaluation evaluation;", "    double reached;"]
+    for member, value, _ in PLANT_HOSTILE:
+        lines.append("    memset(&in, 0, sizeof in);")
+        lines += [f"    in.{v.lives.path} = {float(v.start)!r};" for v in _block_inputs(table)]
+        lines.append(f"    in.{member} = {value};")
+        lines.append(f"    {ident}_plant_start(&in, &evaluation);")
+        lines.append("    reached = evaluation.status == FMU_OK ?")
+        lines.append(f"        {ident}_plant_advance(&in, 1e-3, &evaluation) : 0;")
+        lines.append('    if (evaluation.status == FMU_OK) printf("ok %.17g\\n", reached);')
+        lines.append('    else printf("%d %s\\n", (int)evaluation.status, evaluation.reason);')
+    return "\n".join(lines + ["    return 0;", "}", ""])
+
+
+@pytest.mark.parametrize("real", ["double", "float"])
+def test_a_plants_bundle_refuses_what_its_fmu_refuses(real, tmp_path):
+    """The bundle has no setters: its start and its steps refuse, by name, what the FMU's
+    setters refuse (a resistance below 0, a tolerance not finite, a gear ratio of 0);
+    those ran on with status ok before. A first step below the step's resolution
+    (solver.step_start = 1e-18 s) lets the integrator choose instead of failing every
+    step; a step that ends returns h itself, in float too."""
+    required_tool("cc")
+    table = pipeline.build_table(pipeline.load_scene(PLANT, check_c_names=False))
+    done = _scene_tool(PLANT, "--bundle", tmp_path / "written")
+    assert done.returncode == 0, done.stderr
+    folder = tmp_path / "written" / table.identifier
+    (tmp_path / "main.c").write_text(_hostile_main(table))
+    sources = sorted(folder.glob("scene/*.c")) + sorted(folder.glob("core/src/*.c"))
+    flags = [] if real == "double" else [FLOAT]
+    _run(
+        "cc", *WARNINGS, *flags, f"-I{folder / 'scene'}", f"-I{folder / 'core' / 'include'}",
+        "-o", tmp_path / "main", tmp_path / "main.c", *sources, "-lm",
+    )  # fmt: skip
+    said = _run(tmp_path / "main").splitlines()
+    assert len(said) == len(PLANT_HOSTILE), said
+    for line, (_, _, expected) in zip(said, PLANT_HOSTILE, strict=True):
+        if expected == "ok":
+            assert line == "ok 0.001", line
+        else:
+            assert line.startswith(f"3 {expected}:"), (line, expected)  # FMU_ERROR
 
 
 def _text_sizes(readme: str) -> dict[str, tuple[int, int]]:

@@ -541,6 +541,23 @@ def test_a_current_beyond_double_is_status_3():
         slave.close()
 
 
+def test_a_step_from_a_state_without_an_answer_says_why():
+    """The lift's ram started beyond reach: initialisation warns, and the step it then
+    discards logs the reason itself (it returned Discard without a message before)."""
+    from dyadfmu.fmi.slave import Slave, SlaveError
+
+    slave = Slave(_fmu("lift_forward"), "lift")
+    try:
+        slave.initialize({"ram.position_start": 5.0})
+        assert len(slave.messages) == 1 and "cannot assemble" in slave.messages[0]
+        with pytest.raises(SlaveError, match="doStep returned discard"):
+            slave.do_step(0.0, 0.01)
+        assert len(slave.messages) == 2
+        assert slave.messages[1].startswith("fmi2DoStep: at t = 0 s: dyad lever cannot assemble")
+    finally:
+        slave.close()
+
+
 def test_a_free_four_bar_keeps_its_energy():
     """The four-bar swinging under gravity from rest, no torque and no load, for 100 s
     at rtol = atol = 1e-10: its total energy, the reference's T + V at

@@ -10,8 +10,9 @@ from pathlib import Path
 from string import Template
 
 from dyadgen.forward import MAX_STEPS, RTOL_MIN, STEP_SHARE, behaviour_parts, state_table
-from dyadgen.model import Scene
-from dyadgen.textsafe import c_comment
+from dyadgen.model import Scene, c_num
+from dyadgen.table import Table
+from dyadgen.textsafe import c_comment, c_string
 
 TEMPLATES = Path(__file__).parent / "templates"
 
@@ -31,8 +32,43 @@ def forward_behaviour(scene: Scene) -> list[str]:
     return _plant(scene) + state_table(scene) + _lines("forward_tables.c.in", ident=ident) + [""]
 
 
-def plant_c(scene: Scene) -> str:
+def _domain_check(table: Table) -> list[str]:
+    """plant_limits[]: each Real input and parameter of the block with its variable's
+    bounds, for a bundle's plant_domain_refused() (templates/bundle_plant.c.in): what the
+    FMU's setters refuse, a bundle, which has no setters, refuses there."""
+    ident = table.identifier
+    lines = [
+        "/* The block's Real inputs and parameters: name, place, bounds (min, max, whether",
+        " * each holds and is exclusive), as the FMU's variables give them. */",
+        "typedef struct plant_limit {",
+        "    const char* name;",
+        "    size_t offset;",
+        "    double min, max;",
+        "    int has_min, min_exclusive, has_max, max_exclusive;",
+        "} plant_limit;",
+        "",
+        "static const plant_limit plant_limits[] = {",
+    ]
+    for v in table.variables:
+        if v.lives.target != "FMU_TARGET_INPUT_REAL":
+            continue
+        low, high = v.min is not None, v.max is not None
+        bounds = (
+            c_num(float(v.min)) if low else "0.0",
+            c_num(float(v.max)) if high else "0.0",
+            str(int(low)),
+            str(int(bool(v.min_exclusive))),
+            str(int(high)),
+            str(int(bool(v.max_exclusive))),
+        )
+        place = f"offsetof({ident}_input, {v.lives.path})"
+        lines.append(f"    {{{c_string(v.name)}, {place}, {', '.join(bounds)}}},")
+    return lines + ["};", ""]
+
+
+def plant_c(table: Table) -> str:
     """<identifier>_plant.c of a bundle: the plant's C and its functions."""
+    scene = table.scene
     ident = scene.identifier
     includes = [
         "<float.h>",
@@ -52,7 +88,13 @@ def plant_c(scene: Scene) -> str:
         *(f"#include {i}" if i else "" for i in includes),
         "",
     ]
-    return "\n".join(lines + _plant(scene) + _lines("bundle_plant.c.in", ident=ident) + [""])
+    return "\n".join(
+        lines
+        + _plant(scene)
+        + _domain_check(table)
+        + _lines("bundle_plant.c.in", ident=ident)
+        + [""]
+    )
 
 
 def plant_header(scene: Scene) -> str:
