@@ -182,6 +182,11 @@ def public_inputs(scene: Scene) -> list[Input]:
     return found + [i for i in scene.inputs if i.name not in moved]
 
 
+#: The largest start position (rad or m): beyond 2^32 a double resolves a position no
+#: finer than 1e-6, and a crank started there would not be seen to move.
+POSITION_START_LIMIT = 2.0**32
+
+
 def start_parameters(scene: Scene) -> list[tuple[Input, float]]:
     """The start values of the states as parameters, with their defaults (the inverse
     scene's start values of the driver's motion)."""
@@ -189,10 +194,13 @@ def start_parameters(scene: Scene) -> list[tuple[Input, float]]:
     for f in forward_drivers(scene):
         for motion, what in ((f.position, "position"), (f.rate, "rate")):
             text = f"{motion.description} at the start"
-            start = motion.start
-            found.append(
-                (Input(f"{motion.name}_start", motion.unit, text, f.c(f"{what}_start")), start)
+            domain = {}
+            if what == "position":
+                domain = {"min": -POSITION_START_LIMIT, "max": POSITION_START_LIMIT}
+            parameter = Input(
+                f"{motion.name}_start", motion.unit, text, f.c(f"{what}_start"), domain=domain
             )
+            found.append((parameter, motion.start))
         if f.motor is not None:
             found += _motor_parameters(f)
     return found

@@ -516,6 +516,7 @@ PLANT_HOSTILE = (
     ("plant_crank_motor_resistance", "-1.0", "crank.motor.resistance = -1"),
     ("plant_rtol", "NAN", "solver.rtol = nan"),
     ("plant_crank_motor_ratio", "0.0", "crank.motor.ratio = 0"),
+    ("plant_crank_position_start", "1e20", "crank.angle_start = 1e+20"),
     ("plant_step_start", "1e-18", "ok"),
 )
 
@@ -543,10 +544,11 @@ def _hostile_main(table) -> str:
 @pytest.mark.parametrize("real", ["double", "float"])
 def test_a_plants_bundle_refuses_what_its_fmu_refuses(real, tmp_path):
     """The bundle has no setters: its start and its steps refuse, by name, what the FMU's
-    setters refuse (a resistance below 0, a tolerance not finite, a gear ratio of 0);
-    those ran on with status ok before. A first step below the step's resolution
-    (solver.step_start = 1e-18 s) lets the integrator choose instead of failing every
-    step; a step that ends returns h itself, in float too."""
+    setters refuse (a resistance below 0, a tolerance not finite, a gear ratio of 0, a
+    start angle of 1e20 rad, which no step moved); those ran on with status ok before.
+    A first step below the step's resolution (solver.step_start = 1e-18 s) lets the
+    integrator choose instead of failing every step; a step that ends returns h itself,
+    in float too."""
     required_tool("cc")
     table = pipeline.build_table(pipeline.load_scene(PLANT, check_c_names=False))
     done = _scene_tool(PLANT, "--bundle", tmp_path / "written")

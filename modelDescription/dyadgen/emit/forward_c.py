@@ -9,7 +9,15 @@ import functools
 from pathlib import Path
 from string import Template
 
-from dyadgen.forward import MAX_STEPS, RTOL_MIN, STEP_SHARE, behaviour_parts, state_table
+from dyadgen.forward import (
+    MAX_STEPS,
+    POSITION_START_LIMIT,
+    RTOL_MIN,
+    STEP_SHARE,
+    behaviour_parts,
+    forward_drivers,
+    state_table,
+)
 from dyadgen.model import Scene, c_num
 from dyadgen.table import Table
 from dyadgen.textsafe import c_comment, c_string
@@ -115,6 +123,12 @@ def _plant(scene: Scene) -> list[str]:
     head = [
         f"enum {{ PLANT_DRIVERS = {drivers}, PLANT_SIZE = {size}, PLANT_STATES = {states}, "
         f"PLANT_MAX_STEPS = {MAX_STEPS} }};",
+        "/* The largest position a driver starts from or steps from (rad or m): beyond it a",
+        " * double resolves it no finer than 1e-6. */",
+        f"#define PLANT_POSITION_LIMIT {POSITION_START_LIMIT!r}",
+        "static const char* const plant_position_names[PLANT_DRIVERS] = {",
+        *(f"    {c_string(f.position.name)}," for f in forward_drivers(scene)),
+        "};",
         "/* How closely a step that fails is located, in parts of the communication step. */",
         "#define PLANT_LOCATE_TOLERANCE 1e-10",
         "/* The share of solver.rtol and solver.atol each internal step's error is held to,",
