@@ -331,17 +331,18 @@ def readme(table: Table, files: list[str], derivatives: bool, sizes: str) -> str
     ident = table.identifier
     cannot = ", 4 cannot assemble" if scene.internal() else ""
     statuses = f"1 singular, 3 out of range{cannot}"
+    fill = "\n".join(fill_lines(table))
     fields = _file_fields(table, files) | _derivative_fields(table, derivatives)
     fields["calling"] = _template("bundle_calling.md.in").substitute(
-        fields, ident=ident, statuses=statuses, fill="\n".join(fill_lines(table))
+        fields, ident=ident, statuses=statuses, fill=fill
     )
     return _template("bundle_README.md.in").substitute(
         fields | _plant_fields(table),
         ident=ident,
         description=markdown(scene.description),
         scene_file=code_span(scene.path.name),
-        statuses=f"1 singular, 3 out of range{cannot}",
-        fill="\n".join(fill_lines(table)),
+        statuses=statuses,
+        fill=fill,
         input_rows="\n".join(_variable_rows(block_inputs(table), start=True)),
         output_rows="\n".join(_variable_rows(block_outputs(table), start=False)),
         sizes=sizes,
