@@ -86,15 +86,66 @@ dyadfmu_ensure_venv() {
     fi
 }
 
-# dyadfmu_build DIR [cmake options...]: configure and build into DIR, the FMUs
-# with the venv's Python (its fmpy supplies the FMI headers).
+# dyadfmu_build DIR [cmake options...]: configure and build into DIR, the FMUs with the
+# venv's Python (its fmpy supplies the FMI headers). A build whose options are those of
+# its last whole build and that no source is newer than (dyadfmu_sources_newer) is left
+# as it is, in well under a second (DYADFMU_REBUILD=1 has make check it all the same);
+# CMake configures again only for new options (else make does, when a scene or the
+# generator changed). Progress: a line per FMU packaged; the whole log in DIR/build.log,
+# whose end is shown if the build fails.
 dyadfmu_build() {
     local dir=$1
     shift
+    local stamp="$dir/.dyadfmu-built" last="" wanted
+    [ -f "$stamp" ] && last=$(cat "$stamp")
+    # no options: those the build directory's cache holds
+    wanted="options: ${*:-${last#options: }}"
+    if [ -n "$last" ] && [ "$last" = "$wanted" ] && [ -z "${DYADFMU_REBUILD:-}" ] &&
+        ! dyadfmu_sources_newer "$stamp"; then
+        dyadfmu_log "$dir is up to date: no source is newer than its last build (DYADFMU_REBUILD=1 checks it all)"
+        return 0
+    fi
     dyadfmu_log "building in $dir $*"
-    cmake -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
-        -DPython3_EXECUTABLE="$DYADFMU_VENV/bin/python" "$@" >/dev/null
-    cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
+    if [ "$last" != "$wanted" ] || [ ! -f "$dir/CMakeCache.txt" ]; then
+        cmake -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
+            -DPython3_EXECUTABLE="$DYADFMU_VENV/bin/python" "$@" >/dev/null
+    fi
+    # the stamp's time is the build's start: a source saved during the build is newer
+    rm -f "$stamp"
+    printf '%s' "$wanted" >"$stamp.new"
+    dyadfmu_build_logged "$dir" "$dir/build.log" || return 1
+    mv "$stamp.new" "$stamp"
+}
+
+# dyadfmu_build_logged DIR LOG [cmake --build options...]: build, the output in LOG, a line
+# per FMU packaged on stderr; on failure the log's last 40 lines and where it is.
+dyadfmu_build_logged() {
+    local dir=$1 log=$2
+    shift 2
+    local status
+    # PIPESTATUS read in either branch: with or without pipefail, cmake's own status
+    if cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" "$@" 2>&1 | tee "$log" |
+        sed -un 's/^\[ *\([0-9]*\)%\] Packaging \(.*\.fmu\)$/== [\1%] packaged \2/p' >&2; then
+        status=${PIPESTATUS[0]}
+    else
+        status=${PIPESTATUS[0]}
+    fi
+    if [ "$status" -ne 0 ]; then
+        tail -n 40 "$log" >&2
+        dyadfmu_log "the build failed: its whole output is in $log"
+        return 1
+    fi
+}
+
+# dyadfmu_sources_newer STAMP: true if a file the build reads (the checkout's C, CMake,
+# generator, scenes, tests, the license, the venv's packages) is newer than STAMP.
+dyadfmu_sources_newer() {
+    local found
+    found=$(find "$DYADFMU_ROOT/CMakeLists.txt" "$DYADFMU_ROOT/LICENSE" "$DYADFMU_ROOT/src" \
+        "$DYADFMU_ROOT/fmu" "$DYADFMU_ROOT/modelDescription" "$DYADFMU_ROOT/tests" \
+        "$DYADFMU_VENV/.dyadfmu-installed" -name __pycache__ -prune -o -newer "$1" -print \
+        -quit 2>/dev/null)
+    [ -n "$found" ]
 }
 
 # ---- probes of the FMU binaries (tests/fmu_fuzz.c, fmu_api_tests.c, fmu_threads.c) ----

@@ -536,6 +536,7 @@ class SceneTable(Table):
         model = {"kind": "scene", "identifier": scene.identifier, "description": scene.description}
         super().__init__(scene.path, model, rows, kind)
         self.scene = scene
+        self.experiment = scene.experiment
 
 
 def _bounds(raw: dict, domain: dict) -> None:
@@ -683,6 +684,7 @@ def generic_data(scene: Scene) -> dict:
             start = params[entry.name].value if entry.causality == "parameter" else None
         rows.append(entry_row(entry, len(rows) + 1, start))
     model = {"type": d.type, "identifier": scene.identifier, "description": scene.description}
+    model.update(stop_time=scene.experiment.stop, step_size=scene.experiment.step)
     return {"model": model, "variable": rows}
 
 

@@ -227,6 +227,18 @@ class Input:
     owner: str = ""  # link the input belongs to ("" for a dyad's guide)
 
 
+@dataclass(frozen=True)
+class Experiment:
+    """A model description's DefaultExperiment: from 0 to stop (s), a row every step (s)."""
+
+    stop: float
+    step: float
+
+
+#: The run of a model that states none (the hand-written tables').
+DEFAULT_EXPERIMENT = Experiment(1.0, 1.0e-3)
+
+
 @dataclass
 class Scene:
     """A checked scene: the mechanism, its effects and numbers, and (once derived) its
@@ -261,6 +273,8 @@ class Scene:
     drivers: list = field(default_factory=list)
     #: a forward scene's DC motors, one per crank at most, in file order
     motors: list = field(default_factory=list)
+    #: the DefaultExperiment ([experiment], or derived: scenefile/experiment.py)
+    experiment: Experiment = DEFAULT_EXPERIMENT
 
     def driver_of(self, name: str) -> Crank | None:
         """The driver whose moving link is `name` (a crank, a ram, a cylinder's link)."""

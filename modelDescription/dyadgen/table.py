@@ -31,6 +31,7 @@ from typing import Protocol
 from dyadgen import textsafe
 from dyadgen.catalogue import Entry
 from dyadgen.dyadtypes import UNITS
+from dyadgen.model import DEFAULT_EXPERIMENT, Experiment
 from dyadgen.structs import Lives, Structs
 
 CAUSALITIES = ("input", "parameter", "output")
@@ -50,7 +51,9 @@ VARIABLE_KEYS = {
     "lives",
     "depends",
 }
-MODEL_KEYS = {"kind", "type", "identifier", "description"}
+#: [model]'s keys of the DefaultExperiment (s)
+EXPERIMENT = ("stop_time", "step_size")
+MODEL_KEYS = {"kind", "type", "identifier", "description", "stop_time", "step_size"}
 REQUIRED_KEYS = ("name", "vr", "causality", "type", "description", "lives")
 _RANK = {"input": 0, "parameter": 1, "output": 2}
 _REAL_KEYS = ("start", "min", "max")
@@ -114,6 +117,11 @@ class Table:
         self.description = model["description"]
         self.variables = [Variable(raw, k, kind) for k, raw in enumerate(rows)]
         self.by_name = {v.name: v for v in self.variables}
+        #: the DefaultExperiment: [model] stop_time and step_size, else the project's default
+        self.experiment = Experiment(
+            float(model.get("stop_time", DEFAULT_EXPERIMENT.stop)),
+            float(model.get("step_size", DEFAULT_EXPERIMENT.step)),
+        )
 
     @functools.cached_property
     def token(self) -> str:
@@ -216,7 +224,18 @@ class _Check:
         problem = textsafe.description_problem(model.get("description"))
         if problem:
             self.fail(f"[model]: description {problem}")
+        self.check_experiment(model)
         return model
+
+    def check_experiment(self, model: dict) -> None:
+        """[model] stop_time and step_size (s): finite, positive, the step within the run."""
+        run = {k: model.get(k, getattr(DEFAULT_EXPERIMENT, k.split("_")[0])) for k in EXPERIMENT}
+        for key, value in run.items():
+            if not (_finite(value) and value > 0):
+                self.fail(f"[model]: {key} must be a positive number of seconds, not {value!r}")
+                return
+        if run["step_size"] > run["stop_time"]:
+            self.fail("[model]: step_size must not exceed stop_time")
 
     # ---- one row
     def row(self, k: int, raw: object) -> bool:

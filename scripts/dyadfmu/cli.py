@@ -218,6 +218,12 @@ def _own_commands(sub: argparse._SubParsersAction) -> None:
         "instructions per ms of motion, a slow and a stiff motor (see 'dyadfmu plants --help')",
     ).set_defaults(run=None)
     sub.add_parser(
+        "rows",
+        add_help=False,
+        help="run an FMU over a CSV table of inputs, each row with the inputs and outputs of "
+        "one instant (see 'dyadfmu rows --help')",
+    ).set_defaults(run=None)
+    sub.add_parser(
         "scene-bench",
         add_help=False,
         help="time the scene generator (--check and --out) on chains of 25 to 200 dyads "
@@ -470,6 +476,7 @@ OWN_PARSERS = {
     "cosim": ".report.cosim",
     "plants": ".report.plants",
     "scene-bench": ".study.long_chain",
+    "rows": ".fmi.rows_command",
 }
 
 

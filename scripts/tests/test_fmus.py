@@ -106,7 +106,7 @@ def test_cosimulation_reproduces_core(core, dyad, version):
         str(path),
         start_time=0,
         stop_time=1,
-        step_size=0.005,
+        output_interval=0.005,  # fmpy's co-simulation step (step_size is its solver's)
         input=signals,
         output=inputs + outputs,
     )
@@ -284,8 +284,12 @@ def test_source_fmu_rebuilds(tmp_path, version):
     md = read_model_description(str(path))
     signals = input_signals(md, samples=20)
     outputs = ["R_mk.y", "R_np.x", "R_np.y", "R_mn.x", "N_mk", "M_mk", "status"]
-    original = simulate_fmu(str(path), stop_time=1, step_size=0.05, input=signals, output=outputs)
-    again = simulate_fmu(str(rebuilt), stop_time=1, step_size=0.05, input=signals, output=outputs)
+    original = simulate_fmu(
+        str(path), stop_time=1, output_interval=0.05, input=signals, output=outputs
+    )
+    again = simulate_fmu(
+        str(rebuilt), stop_time=1, output_interval=0.05, input=signals, output=outputs
+    )
     for name in outputs:
         np.testing.assert_allclose(again[name], original[name], rtol=1e-13, atol=0)
 

@@ -348,7 +348,7 @@ def test_check_golden_reports_a_difference(tmp_path, monkeypatch):
     monkeypatch.setattr(golden_module, "GOLDEN_DIR", tmp_path)
     assert generate_cli.main(["--update-golden"]) == 0
     target = tmp_path / "dyad_rrt_fmi3.xml"
-    target.write_text(target.read_text().replace('stopTime="1"', 'stopTime="2"'))
+    target.write_text(target.read_text().replace('stopTime="1.0"', 'stopTime="2.0"'))
     assert generate_cli.main(["--check-golden"]) == 1
 
 

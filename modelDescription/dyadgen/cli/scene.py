@@ -22,7 +22,9 @@ def _parser() -> argparse.ArgumentParser:
         description="Generate a tailored FMU's model descriptions, C model and documentation "
         "from a scene (see modelDescription/scenes/README.md)."
     )
-    parser.add_argument("scene", type=Path, help="the scene file (TOML)")
+    parser.add_argument(
+        "scene", type=Path, nargs="+", help="the scene file (TOML); with --cmake-info, any number"
+    )
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument("--out", type=Path, help="directory to write the generated files to")
     what.add_argument(
@@ -39,7 +41,8 @@ def _parser() -> argparse.ArgumentParser:
     what.add_argument(
         "--cmake-info",
         action="store_true",
-        help="print 'identifier;type;...' (its dyad types, lower case) for CMake",
+        help="print 'identifier;realisation;type;...' (its dyad types, lower case) for CMake, "
+        "a line per scene file, in their order (one Python run for every scene of a build)",
     )
     what.add_argument(
         "--bundle",
@@ -93,10 +96,13 @@ def _out_problem(out: Path) -> str | None:
 
 
 def _path_problem(args: argparse.Namespace) -> str | None:
-    """'NAME PATH: problem' for the scene file or the --out folder, or None."""
-    problem = _scene_problem(args.scene)
-    if problem:
-        return f"{args.scene}: {problem}"
+    """'NAME PATH: problem' for a scene file or the --out folder, or None."""
+    if len(args.scene) > 1 and not args.cmake_info:
+        return "one scene file at a time (several only with --cmake-info)"
+    for scene in args.scene:
+        problem = _scene_problem(scene)
+        if problem:
+            return f"{scene}: {problem}"
     for option, folder in (("--out", args.out), ("--bundle", args.bundle)):
         problem = _out_problem(folder) if folder is not None else None
         if problem:
@@ -115,21 +121,14 @@ def main(argv: list[str] | None = None) -> int:
     problem = _path_problem(args)
     if problem:  # one line, before the scene is read
         parser.exit(2, f"{parser.prog}: error: {problem}\n")
-    try:
-        scene = load_scene(args.scene)
-        table = build_table(scene)
-    except SceneError as exc:
-        for problem in exc.args[0]:
-            print(f"error: {problem}", file=sys.stderr)
-        print(f"{args.scene}: rejected, nothing written", file=sys.stderr)
-        return 1
-    kind = table.kind
     if args.cmake_info:
-        types = sorted({d.type.lower() for d in scene.dyads})
-        if any(d.is_cylinder() for d in scene.drivers):
-            types.append("cylinder")  # its closed forms link as a type's do
-        print(";".join([scene.identifier, kind.realisation] + types))
-        return 0
+        return _cmake_info(args.scene)
+    (args.scene,) = args.scene
+    loaded = _loaded(args.scene)
+    if loaded is None:
+        return 1
+    scene, table = loaded
+    kind = table.kind
     if args.external_inputs:
         print("\n".join(inputs_with_external_kinematics(scene)))
         return 0
@@ -145,6 +144,32 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as error:  # the folder went bad after the check (a full disk, say)
         print(f"{parser.prog}: error: {error.filename}: {error.strerror or error}", file=sys.stderr)
         return 2
+    return 0
+
+
+def _loaded(path: Path) -> tuple[Scene, Table] | None:
+    """The scene and its table, or None after printing every problem."""
+    try:
+        scene = load_scene(path)
+        return scene, build_table(scene)
+    except SceneError as exc:
+        for problem in exc.args[0]:
+            print(f"error: {problem}", file=sys.stderr)
+        print(f"{path}: rejected, nothing written", file=sys.stderr)
+        return None
+
+
+def _cmake_info(paths: list[Path]) -> int:
+    """--cmake-info: a line per scene, or 1 at the first malformed one."""
+    for path in paths:
+        loaded = _loaded(path)
+        if loaded is None:
+            return 1
+        scene, table = loaded
+        types = sorted({d.type.lower() for d in scene.dyads})
+        if any(d.is_cylinder() for d in scene.drivers):
+            types.append("cylinder")  # its closed forms link as a type's do
+        print(";".join([scene.identifier, table.kind.realisation] + types))
     return 0
 
 

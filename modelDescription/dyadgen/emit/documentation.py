@@ -305,5 +305,7 @@ def scene_page(table: Table) -> str:
         outputs=n["output"],
         inertia="yes" if scene.inertia else "no",
         gravity="yes" if scene.gravity else "no",
+        stop=h(f"{scene.experiment.stop:.6g}"),
+        step=h(f"{scene.experiment.step:.6g}"),
         **_scene_sections(scene),
     )

@@ -104,7 +104,8 @@ def common_tail(table: Table) -> list[str]:
         for n, d in table.kind.log_categories
     ]
     lines.append("  </LogCategories>")
-    lines.append('  <DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>')
+    run = [("startTime", num(0.0)), ("stopTime", num(table.experiment.stop))]
+    lines.append(element(1, "DefaultExperiment", run + [("stepSize", num(table.experiment.step))]))
     return lines
 
 

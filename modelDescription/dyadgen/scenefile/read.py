@@ -18,8 +18,8 @@ from dyadgen.emit.scene_c import inputs_read
 from dyadgen.forward import required_outputs
 from dyadgen.model import Crank, Param, Scene
 from dyadgen.needs import derive_inputs, derive_outputs
+from dyadgen.scenefile import experiment, mechanism, sections
 from dyadgen.scenefile import loads as point_loads
-from dyadgen.scenefile import mechanism, sections
 from dyadgen.scenefile.locator import Locator
 from dyadgen.scenefile.names import CNames, c_name_clashes, identifier_problem
 from dyadgen.scenefile.problems import Problems, SceneError
@@ -130,6 +130,7 @@ def read_scene(path: Path, c_names: Callable[[], CNames] | None = None) -> Scene
         point_loads=placed,
     )
     scene.motors = sections.motors(p, data, drivers, scene.forward())
+    scene.experiment = experiment.experiment(p, data, scene)
     sections.tunable(p, scene_t, scene, found.tables_of_names(data.get("dyad", [])))
     if not p.items:
         _derive(p, scene, scene_t, data)

@@ -44,6 +44,7 @@ CYLINDER_PART_KEYS = {"mass", "com", "inertia"}
 DRIVERS = ("crank", "ram", "cylinder")
 LOAD_KEYS = {"force", "moment"}
 TOP_KEYS = {"scene", "effects", "gravity", "dyad", "link", "loads", "load", "start", "motor"}
+TOP_KEYS |= {"experiment"}
 TOP_KEYS |= set(DRIVERS)
 MOTOR_KEYS = {"driver", *MOTOR_NUMBERS}
 KINEMATICS = ("internal", "external")
