@@ -108,12 +108,16 @@ dyadfmu_build() {
     dyadfmu_log "building in $dir $*"
     if [ "$last" != "$wanted" ] || [ ! -f "$dir/CMakeCache.txt" ]; then
         cmake -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
-            -DPython3_EXECUTABLE="$DYADFMU_VENV/bin/python" "$@" >/dev/null
+            -DPython3_EXECUTABLE="$DYADFMU_VENV/bin/python" "$@" >/dev/null || {
+            local status=$?
+            dyadfmu_log "configuring $dir failed (CMake's messages above)"
+            return "$status"
+        }
     fi
     # the stamp's time is the build's start: a source saved during the build is newer
     rm -f "$stamp"
     printf '%s' "$wanted" >"$stamp.new"
-    dyadfmu_build_logged "$dir" "$dir/build.log" || return 1
+    dyadfmu_build_logged "$dir" "$dir/build.log" || return $?
     mv "$stamp.new" "$stamp"
 }
 
@@ -133,7 +137,7 @@ dyadfmu_build_logged() {
     if [ "$status" -ne 0 ]; then
         tail -n 40 "$log" >&2
         dyadfmu_log "the build failed: its whole output is in $log"
-        return 1
+        return "$status"
     fi
 }
 

@@ -218,6 +218,12 @@ def _own_commands(sub: argparse._SubParsersAction) -> None:
         "instructions per ms of motion, a slow and a stiff motor (see 'dyadfmu plants --help')",
     ).set_defaults(run=None)
     sub.add_parser(
+        "build-scene",
+        add_help=False,
+        help="check scene files and build their FMUs (FMI 2 and 3) into a folder of your "
+        "choice, or their bundles for firmware (see 'dyadfmu build-scene --help')",
+    ).set_defaults(run=None)
+    sub.add_parser(
         "rows",
         add_help=False,
         help="run an FMU over a CSV table of inputs, each row with the inputs and outputs of "
@@ -477,6 +483,7 @@ OWN_PARSERS = {
     "plants": ".report.plants",
     "scene-bench": ".study.long_chain",
     "rows": ".fmi.rows_command",
+    "build-scene": ".build_scene",
 }
 
 

@@ -349,8 +349,54 @@ def test_a_wrapper_refuses_a_bad_path_in_one_line_before_it_builds(tmp_path, scr
 
 
 def test_a_wrapper_with_good_arguments_goes_on_to_build(tmp_path):
+    """(The fake venv is newer than any build: the build is not skipped.)"""
     done, calls = _wrapper(tmp_path, "run-main", "four-bar", "--steps", "36")
-    assert done.returncode == 97 and calls.startswith("cmake -S"), (done.stderr, calls)
+    assert done.returncode == 97 and calls.startswith("cmake "), (done.stderr, calls)
+    assert "failed" in done.stderr.splitlines()[-1]
+
+
+def _build_in(root: Path, build: Path, env: dict, *options: str) -> subprocess.CompletedProcess:
+    """dyadfmu_build of scripts/env.sh on the checkout `root`, into `build`."""
+    script = f'source "{SCRIPTS / "env.sh"}" && dyadfmu_build "{build}" {" ".join(options)}'
+    return subprocess.run(
+        ["bash", "-c", script], capture_output=True, text=True, env=dict(env, DYADFMU_ROOT=root)
+    )
+
+
+def test_a_build_no_source_is_newer_than_is_left_as_it_is(tmp_path):
+    """dyadfmu_build: configured and built the first time, then nothing until a source
+    changes (only built then: make configures again where it must), configured again for
+    new options; a line per FMU packaged, the rest in build.log."""
+    env, log = _fake_machine(tmp_path)
+    (tmp_path / "bin" / "cmake").write_text(
+        f'#!/bin/sh\necho "cmake $*" >> "{log}"\n'
+        'echo "[ 50%] Packaging x_fmi2.fmu"\necho "compiling x.c"\n'
+    )
+    root, build = tmp_path / "checkout", tmp_path / "build"
+    for folder in ("src", "fmu", "modelDescription", "tests"):
+        (root / folder).mkdir(parents=True)
+    (root / "CMakeLists.txt").write_text("")
+    (root / "LICENSE").write_text("")
+    build.mkdir()
+    (build / "CMakeCache.txt").write_text("")
+
+    def calls() -> list[str]:
+        text = log.read_text() if log.exists() else ""
+        log.write_text("")
+        return [line.split()[1] for line in text.splitlines()]
+
+    os.utime(root / "src", (1, 1))  # sources older than the first build
+    done = _build_in(root, build, env, "-DX=1")
+    assert done.returncode == 0, done.stderr
+    assert calls() == ["-S", "--build"] and "== [50%] packaged x_fmi2.fmu" in done.stderr
+    assert "compiling x.c" in (build / "build.log").read_text()
+    assert "compiling" not in done.stderr
+    done = _build_in(root, build, env)  # no options: those of the last build
+    assert calls() == [] and "is up to date" in done.stderr
+    (root / "src" / "dyad_new.c").write_text("")
+    assert _build_in(root, build, env).returncode == 0 and calls() == ["--build"]
+    assert _build_in(root, build, env, "-DX=1").returncode == 0 and calls() == []
+    assert _build_in(root, build, env, "-DX=2").returncode == 0 and calls() == ["-S", "--build"]
 
 
 @pytest.mark.parametrize("args", [["--quick"], ["extra"], ["--help-me"], ["--serial", "-s"]])

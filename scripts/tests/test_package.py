@@ -299,6 +299,13 @@ def test_installed_package_runs_a_scene_study_from_its_own_sources_only(venv, tm
         assert float(best[2]) < 1e-9 and "| 4 | 0.666667 |" in out
         built = list((work / "out" / "study" / "build-scene" / "fmus").glob("balance_sweep_*.fmu"))
         assert len(built) == 1  # in the study's own folder, from the bundled sources
+        # a user's scene built by the installed command, where asked, from the same sources
+        built = _run(dyadfmu, "build-scene", "balance.toml", "--out", "mine", "--windows", "off",
+                     cwd=work, env=_clean_env())  # fmt: skip
+        assert not marker.exists(), marker.read_text()
+        for version in (2, 3):
+            fmu = work / "mine" / "fmus" / f"balance_fmi{version}.fmu"
+            assert f"{fmu}: " in built and fmu.is_file()
     finally:
         for name in ("modelDescription", "scripts", "build", "CMakeLists.txt"):
             target = derived / name

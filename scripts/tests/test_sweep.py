@@ -1150,9 +1150,10 @@ def test_an_installed_copy_never_takes_the_folders_around_it_for_a_checkout(tmp_
 
 
 def test_a_scene_study_without_cmake_or_a_compiler_is_refused_in_one_line(monkeypatch, tmp_path):
+    from dyadfmu import build_scene
     from dyadfmu.sweep import scenebuild
 
-    monkeypatch.setattr(scenebuild.shutil, "which", lambda name: None)
+    monkeypatch.setattr(build_scene.shutil, "which", lambda name: None)
     problem = scenebuild.tools_problem()
     assert problem.startswith(
         "building the study's mechanism FMU from its scene needs CMake (cmake), a C compiler "
