@@ -190,7 +190,9 @@ def _scene_command(sub: argparse._SubParsersAction) -> None:
         nargs="*",
         metavar="SCENE",
         default=["shaper"],
-        help="scene names (default shaper; 'all' for every example scene)",
+        help="scene names (default shaper; 'all' for every example scene), or scene files "
+        "(FILE.toml: built where needed, drawn and reported over one turn of the first "
+        "crank)",
     )
     _cosimulation_options(scene, Path("out/scenes"), "crank revolutions to simulate (default 2)")
     scene.set_defaults(run=_scene)
@@ -436,12 +438,36 @@ def _scene_outputs(args: argparse.Namespace, result: scenes.SceneRun) -> list[Pa
     return written
 
 
+def _is_file(name: str) -> bool:
+    """A scene named by its file (SCENE.toml), not by a built-in scene's name."""
+    return name.endswith(".toml")
+
+
 def _scene(args: argparse.Namespace) -> int:
-    names = _chosen(args.scenes, scenes.NAMES, "scene")
+    files = [Path(n) for n in args.scenes if _is_file(n)]
+    names = _chosen([n for n in args.scenes if not _is_file(n)], scenes.NAMES, "scene")
     if names is None:
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
-    return _run_each(args, names, scenes.run, _scene_outputs)
+    status = _run_each(args, names, scenes.run, _scene_outputs) if names else 0
+    for file in files:
+        status = max(status, _own_scene(args, file))
+    return status
+
+
+def _own_scene(args: argparse.Namespace, file: Path) -> int:
+    """A scene file: built where needed, drawn and reported (report/own_scene.py)."""
+    from .report import cylinder_drawing, own_scene
+
+    version = 3 if args.fmi == "3" else 2
+    try:
+        written = own_scene.run(file, args.out, version, lambda text: print(text, flush=True))
+    except cylinder_drawing.DrawingError as error:
+        print(f"dyadfmu scene: error: {error}", file=sys.stderr)
+        return 2
+    for path in written:
+        print(f"wrote {path}")
+    return 0
 
 
 def _problem(args: argparse.Namespace) -> str | None:
@@ -451,6 +477,10 @@ def _problem(args: argparse.Namespace) -> str | None:
         names, what, known = args.mechanisms, "mechanism", builtin.NAMES
     else:
         names, what, known = args.scenes, "scene", scenes.NAMES
+        missing = [n for n in names if _is_file(n) and not Path(n).is_file()]
+        if missing:
+            return f"no such scene file: {', '.join(missing)}"
+        names = [n for n in names if not _is_file(n)]
     unknown = [n for n in names if n not in known] if names != ["all"] else []
     if unknown:
         return f"unknown {what} {', '.join(unknown)}; the {what}s are: {', '.join(known)}"
