@@ -130,6 +130,13 @@ def test_a_bad_table_is_refused_by_name():
     assert "has 2 values, 'time' has 3" in _refusal(fmu, {"time": t, "crank.angle": t[:2]})
     assert "'nothing' is not a variable" in _refusal(fmu, {"time": t}, outputs=["nothing"])
     assert "not an FMU that loads here" in _refusal(ROOT / "README.md", {"time": t})
+    assert "column 'crank.angle' is not numbers" in _refusal(
+        fmu, {"time": t, "crank.angle": ["a", "b", "c"]}
+    )
+    message = _refusal(fmu, {"time": t}, start_values={"gravity.z": 1.0})
+    assert "start value of 'gravity.z': not a variable" in message
+    message = _refusal(fmu, {"time": t}, start_values={"gravity.y": math.nan})
+    assert "refused to initialise" in message and "gravity.y" in message
 
 
 def test_a_refused_input_names_the_time_and_keeps_the_rows_before():

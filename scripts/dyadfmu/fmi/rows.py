@@ -70,13 +70,21 @@ def default_grid(path: Path | str) -> np.ndarray:
 def _columns(table: object) -> dict:
     """name -> 1-d float array of a structured array or a mapping of columns."""
     if isinstance(table, np.ndarray) and table.dtype.names:
-        return {n: np.asarray(table[n], dtype=float) for n in table.dtype.names}
-    if isinstance(table, Mapping):
-        return {str(n): np.atleast_1d(np.asarray(v, dtype=float)) for n, v in table.items()}
-    raise RowsError(
-        "the input table must be a structured array or a mapping of columns, "
-        f"not {type(table).__name__}"
-    )
+        given = {n: table[n] for n in table.dtype.names}
+    elif isinstance(table, Mapping):
+        given = {str(n): v for n, v in table.items()}
+    else:
+        raise RowsError(
+            "the input table must be a structured array or a mapping of columns, "
+            f"not {type(table).__name__}"
+        )
+    columns = {}
+    for name, values in given.items():
+        try:
+            columns[name] = np.atleast_1d(np.asarray(values, dtype=float))
+        except (TypeError, ValueError):
+            raise RowsError(f"column '{name}' is not numbers") from None
+    return columns
 
 
 def _checked_time(columns: dict) -> np.ndarray:
@@ -182,6 +190,9 @@ def _run(slave: Slave, inputs: object, outputs: list | None, start_values: dict 
     names = ["time", *recorded, *chosen]
     table = np.full(len(time), np.nan, dtype=[(n, float) for n in names])
     read = _reader(slave, names[1:])
+    for name in start_values or {}:
+        if name not in slave.names:
+            raise RowsError(f"start value of '{name}': not a variable of {slave.path.name}")
     try:
         slave.initialize(start_values, start_time=float(time[0]))
     except SlaveError as exc:
