@@ -51,8 +51,8 @@ VARIABLE_KEYS = {
     "lives",
     "depends",
 }
-#: [model]'s keys of the DefaultExperiment (s)
-EXPERIMENT = ("stop_time", "step_size")
+#: [model]'s keys of the DefaultExperiment (s) and their values where not given
+EXPERIMENT = {"stop_time": DEFAULT_EXPERIMENT.stop, "step_size": DEFAULT_EXPERIMENT.step}
 MODEL_KEYS = {"kind", "type", "identifier", "description", "stop_time", "step_size"}
 REQUIRED_KEYS = ("name", "vr", "causality", "type", "description", "lives")
 _RANK = {"input": 0, "parameter": 1, "output": 2}
@@ -118,10 +118,7 @@ class Table:
         self.variables = [Variable(raw, k, kind) for k, raw in enumerate(rows)]
         self.by_name = {v.name: v for v in self.variables}
         #: the DefaultExperiment: [model] stop_time and step_size, else the project's default
-        self.experiment = Experiment(
-            float(model.get("stop_time", DEFAULT_EXPERIMENT.stop)),
-            float(model.get("step_size", DEFAULT_EXPERIMENT.step)),
-        )
+        self.experiment = Experiment(*(float(model.get(k, v)) for k, v in EXPERIMENT.items()))
 
     @functools.cached_property
     def token(self) -> str:
@@ -229,13 +226,13 @@ class _Check:
 
     def check_experiment(self, model: dict) -> None:
         """[model] stop_time and step_size (s): finite, positive, the step within the run."""
-        run = {k: model.get(k, getattr(DEFAULT_EXPERIMENT, k.split("_")[0])) for k in EXPERIMENT}
+        run = {k: model.get(k, v) for k, v in EXPERIMENT.items()}
         for key, value in run.items():
             if not (_finite(value) and value > 0):
-                self.fail(f"[model]: {key} must be a positive number of seconds, not {value!r}")
+                self.fail(f"[model]: '{key}' must be a positive number of seconds, not {value!r}")
                 return
         if run["step_size"] > run["stop_time"]:
-            self.fail("[model]: step_size must not exceed stop_time")
+            self.fail("[model]: 'step_size' must not exceed 'stop_time'")
 
     # ---- one row
     def row(self, k: int, raw: object) -> bool:

@@ -894,6 +894,18 @@ MALFORMED = [
         "unknown key 'colour'",
     ),
     ("missing variable", lambda r: r["variable"].pop(), "status", "missing variable"),
+    (
+        "a default run's step beyond its stop",
+        lambda r: r["model"].update(stop_time=0.01, step_size=0.1),
+        "step_size",
+        "must not exceed 'stop_time'",
+    ),
+    (
+        "a default run that is no time",
+        lambda r: r["model"].update(stop_time=-1.0),
+        "stop_time",
+        "must be a positive number of seconds",
+    ),
 ]
 
 
