@@ -16,11 +16,12 @@ ROOT = Path(__file__).resolve().parents[2]
 SLIDER_CRANK = ROOT / "modelDescription" / "scenes" / "slider_crank.toml"
 
 
-def _scene(tmp_path: Path, identifier: str, rod: float = 0.18) -> Path:
+def _scene(tmp_path: Path, identifier: str, rod: float = 0.18, offset: float = 0.01) -> Path:
     text = SLIDER_CRANK.read_text().replace(
         'identifier = "slider_crank"', f'identifier = "{identifier}"'
     )
     text = text.replace("length = 0.18", f"length = {rod}")
+    text = text.replace("at = [0.0, 0.01] }", f"at = [0.0, {offset}] }}")
     path = tmp_path / f"{identifier}.toml"
     path.write_text(text)
     return path
@@ -82,6 +83,17 @@ def test_a_scene_that_does_not_assemble_everywhere_is_marked_not_fatal(tmp_path)
     share = rows["share"][missing]
     assert 0.6 < share.min() and share.max() < 0.88 and 0 < missing.sum() < 100
     assert (tmp_path / "users_short_rod.png").is_file()  # the poses that assemble
+
+
+def test_a_scene_that_never_assembles_says_why_in_one_line(tmp_path):
+    """A rod of 0.05 m on a crank of 0.05 m: it never reaches an axis 0.2 m off the pivot."""
+    required_tool("cmake")
+    scene = _scene(tmp_path, "users_no_rod", rod=0.05, offset=0.2)
+    done = _scene_command(scene, "--out", tmp_path)
+    assert done.returncode == 2, done.stderr[-3000:]
+    (line,) = [ln for ln in done.stderr.splitlines() if ln.startswith("dyadfmu scene: error:")]
+    assert "no instant of the turn of crank.angle has an answer" in line
+    assert not (tmp_path / "users_no_rod.png").exists()
 
 
 def test_a_scene_without_a_crank_says_how_to_draw_it(tmp_path):

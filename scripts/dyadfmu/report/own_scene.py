@@ -157,6 +157,8 @@ def _drawn(mechanism: dd.Mechanism, angle: str, out: Path, fmu: Path, say: Calla
     loads = cd.loads_given(mechanism, None)
     say(f"{identifier}: {SAMPLES} instants over one turn of {angle}")
     moving, failed = _sampled(mechanism, ranges, loads, moving=mechanism.rated)
+    if len(failed) == SAMPLES:
+        raise cd.DrawingError(f"no instant of the turn of {angle} has an answer: {failed[0][1]}")
     resting, _ = _sampled(mechanism, ranges, loads, moving=False)
     good = [s for s in POSES if not any(abs(s - f) < 1e-12 for f, _ in failed)]
     written = []
