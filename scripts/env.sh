@@ -89,7 +89,8 @@ dyadfmu_ensure_venv() {
 # dyadfmu_build DIR [cmake options...]: configure and build into DIR, the FMUs with the
 # venv's Python (its fmpy supplies the FMI headers). A build whose options are those of
 # its last whole build and that no source is newer than (dyadfmu_sources_newer) is left
-# as it is, in well under a second (DYADFMU_REBUILD=1 has make check it all the same);
+# as it is, in well under a second, as long as every FMU and library it made is there
+# (DYADFMU_REBUILD=1 has make check it all the same);
 # CMake configures again only for new options (else make does, when a scene or the
 # generator changed). Progress: a line per FMU packaged; the whole log in DIR/build.log,
 # whose end is shown if the build fails.
@@ -101,7 +102,7 @@ dyadfmu_build() {
     # no options: those the build directory's cache holds
     wanted="options: ${*:-${last#options: }}"
     if [ -n "$last" ] && [ "$last" = "$wanted" ] && [ -z "${DYADFMU_REBUILD:-}" ] &&
-        ! dyadfmu_sources_newer "$stamp"; then
+        ! dyadfmu_sources_newer "$stamp" && dyadfmu_products_there "$stamp.products"; then
         dyadfmu_log "$dir is up to date: no source is newer than its last build (DYADFMU_REBUILD=1 checks it all)"
         return 0
     fi
@@ -118,7 +119,19 @@ dyadfmu_build() {
     rm -f "$stamp"
     printf '%s' "$wanted" >"$stamp.new"
     dyadfmu_build_logged "$dir" "$dir/build.log" || return $?
+    find "$dir" "$dir/fmus" -maxdepth 1 \( -name '*.fmu' -o -name 'lib*.so' \) -print \
+        2>/dev/null >"$stamp.products" || true
     mv "$stamp.new" "$stamp"
+}
+
+# dyadfmu_products_there LIST: true if every file LIST names (a build's FMUs and
+# libraries, one a line) is there.
+dyadfmu_products_there() {
+    local product
+    [ -f "$1" ] || return 1
+    while IFS= read -r product; do
+        [ -f "$product" ] || return 1
+    done <"$1"
 }
 
 # dyadfmu_build_logged DIR LOG [cmake --build options...]: build, the output in LOG, a line

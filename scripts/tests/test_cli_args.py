@@ -397,6 +397,15 @@ def test_a_build_no_source_is_newer_than_is_left_as_it_is(tmp_path):
     assert _build_in(root, build, env).returncode == 0 and calls() == ["--build"]
     assert _build_in(root, build, env, "-DX=1").returncode == 0 and calls() == []
     assert _build_in(root, build, env, "-DX=2").returncode == 0 and calls() == ["-S", "--build"]
+    # a product of the build removed: built again
+    (build / "fmus").mkdir()
+    (build / "fmus" / "x_fmi2.fmu").write_text("")  # as if the build had made it
+    again = dict(env, DYADFMU_REBUILD="1")
+    assert _build_in(root, build, again).returncode == 0 and calls() == ["--build"]
+    assert _build_in(root, build, env).returncode == 0 and calls() == []
+    (build / "fmus" / "x_fmi2.fmu").unlink()
+    done = _build_in(root, build, env)
+    assert done.returncode == 0 and calls() == ["--build"], done.stderr
 
 
 @pytest.mark.parametrize("args", [["--quick"], ["extra"], ["--help-me"], ["--serial", "-s"]])
