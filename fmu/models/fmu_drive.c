@@ -2,14 +2,17 @@
  *
  * The crank turns about the fixed pivot O at angle phi and speed omega:
  *
- *     (J + J_load) eps = T_m(omega) + tau_load + (r_c x m_c g),
+ *     (J + J_load) eps = T_m(omega) + tau_load - tau_demand + (r_c x m_c g),
  *     T_m(omega) = T_stall (1 - omega / omega_0),
  *
  * with J the rotor's and crank's inertia about O, r_c the crank's centre of
  * mass turned by phi, tau_load the mechanism's torque on the crank at zero
  * acceleration and J_load the inertia it adds (its torque is tau_load -
  * J_load eps; a co-simulation master that knows the mechanism's sensitivity
- * passes it so that the loop closes inside the step).
+ * passes it so that the loop closes inside the step). tau_demand is the same
+ * torque with the sign of a mechanism FMU's driving torque (its crank.torque0):
+ * a system that connects that output here needs no change of sign, which some
+ * importers do not apply (fmpy's SSP runner).
  *
  * Integrator: the classical 4th-order Runge-Kutta method, with the inputs held
  * over the communication step and as many equal substeps as keep each below a
@@ -61,7 +64,8 @@ static double acceleration(const fmu_drive_input* in, double angle, double speed
     const double rx = c * in->crank_com_x - s * in->crank_com_y;
     const double ry = s * in->crank_com_x + c * in->crank_com_y;
     const double gravity = in->crank_mass * (rx * in->gravity_y - ry * in->gravity_x);
-    return (motor_torque(in, speed) + in->load_torque + gravity) / total_inertia(in);
+    return (motor_torque(in, speed) + in->load_torque - in->load_demand + gravity) /
+           total_inertia(in);
 }
 
 static void initialise(const fmu_model* model, void* input)

@@ -9,6 +9,7 @@
 typedef struct fmu_drive_input {
     double load_torque;  /* N m: torque of the driven mechanism on the crank at zero acceleration */
     double load_inertia; /* kg m^2: inertia the mechanism adds at the crank */
+    double load_demand;  /* N m: torque the mechanism needs at the crank at zero acceleration */
     double stall_torque; /* N m: motor torque at standstill */
     double no_load_speed; /* rad/s: speed where the motor torque vanishes */
     double inertia;       /* kg m^2: rotor and crank about the crank pivot O */

@@ -195,14 +195,15 @@ def drive_catalogue() -> dict[str, Entry]:
 
     The outputs' dependencies are exact: the angle and speed are states at the
     communication point, the motor torque a function of the speed alone, the
-    acceleration (J + J_load) eps = T_m(omega) + tau_load + r_c x m_c g depends on
-    both load inputs, and so does the status (2 unless J + J_load > 0, 3 where the
+    acceleration (J + J_load) eps = T_m(omega) + tau_load - tau_demand + r_c x m_c g depends
+    on the three load inputs, and so does the status (2 unless J + J_load > 0, 3 where the
     acceleration overflows)."""
     positive = {"min": 0.0, "min_exclusive": True}
-    loads = ("load.torque", "load.inertia")
+    loads = ("load.torque", "load.inertia", "load.demand")
     entries = [
         Entry("input.load_torque", "load.torque", "input", "N.m"),
         Entry("input.load_inertia", "load.inertia", "input", "kg.m2"),
+        Entry("input.load_demand", "load.demand", "input", "N.m"),
         Entry("input.stall_torque", "motor.stall_torque", "parameter", "N.m", domain=positive),
         Entry("input.no_load_speed", "motor.no_load_speed", "parameter", "rad/s", domain=positive),
         Entry("input.inertia", "inertia", "parameter", "kg.m2", domain=positive),

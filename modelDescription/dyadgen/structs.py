@@ -76,6 +76,7 @@ LINK_FIELD = {
 DRIVE_INPUT_MEMBERS = {
     "load_torque": "real",
     "load_inertia": "real",
+    "load_demand": "real",
     "stall_torque": "real",
     "no_load_speed": "real",
     "inertia": "real",

@@ -132,6 +132,31 @@ def test_drive_states_bad_inertia_and_reset(version, tmp_path):
     d.close()
 
 
+@pytest.mark.parametrize("version", VERSIONS)
+def test_a_demand_is_a_load_of_the_other_sign(version):
+    """load.demand = x moves the crank as load.torque = -x does, bit for bit, and the two
+    add (to round-off): a mechanism's crank.torque0 connects to load.demand as it is."""
+    runs = []
+    for loads in (
+        {"load.torque": -1.7},
+        {"load.demand": 1.7},
+        {"load.torque": 0.3, "load.demand": 2.0},
+    ):
+        d = drive(version)
+        for name, value in PARAMS.items():
+            d.set(name, value)
+        d.initialize()
+        for name, value in loads.items():
+            d.set(name, value)
+        for k in range(20):
+            d.do_step(0.01 * k, 0.01)
+        runs.append(d.get(("crank.angle", "crank.omega", "crank.epsilon")))
+        d.close()
+    assert runs[0] == runs[1]
+    assert runs[2] == pytest.approx(runs[0], rel=1e-12)  # 0.3 - 2.0 rounds as -1.7 may not
+    assert runs[0][1] != PARAMS["start.speed"]
+
+
 def _state(d):
     return d.get("crank.angle"), d.get("crank.omega")
 

@@ -944,6 +944,7 @@ DRIVE_HEADER = ROOT / "fmu" / "models" / "fmu_drive.h"
 DRIVE_VARIABLES = {
     "load.torque": ("input", "N.m", "input.load_torque"),
     "load.inertia": ("input", "kg.m2", "input.load_inertia"),
+    "load.demand": ("input", "N.m", "input.load_demand"),
     "motor.stall_torque": ("parameter", "N.m", "input.stall_torque"),
     "motor.no_load_speed": ("parameter", "rad/s", "input.no_load_speed"),
     "inertia": ("parameter", "kg.m2", "input.inertia"),
@@ -963,6 +964,7 @@ DRIVE_VARIABLES = {
 DRIVE_STARTS = {
     "load.torque": 0.0,
     "load.inertia": 0.0,
+    "load.demand": 0.0,
     "motor.stall_torque": 12.0,
     "motor.no_load_speed": 36.0,
     "inertia": 2e-3,
@@ -977,9 +979,9 @@ DRIVE_STARTS = {
 DRIVE_DEPENDS = {
     "crank.angle": set(),
     "crank.omega": set(),
-    "crank.epsilon": {"load.torque", "load.inertia"},
+    "crank.epsilon": {"load.torque", "load.inertia", "load.demand"},
     "motor.torque": set(),
-    "status": {"load.torque", "load.inertia"},
+    "status": {"load.torque", "load.inertia", "load.demand"},
 }
 DRIVE_UNITS = {"rad", "rad/s", "rad/s2", "m", "m/s2", "N.m", "kg", "kg.m2"}  # no N
 
@@ -1173,13 +1175,13 @@ def test_drive_fmpy_validates_and_interface_is_right(generated_drive, tmp_path):
 def test_drive_empty_dependencies_and_no_derivatives_in_the_xml(generated_drive):
     text2 = (generated_drive / "fmi2" / "modelDescription.xml").read_text()
     text3 = (generated_drive / "fmi3" / "modelDescription.xml").read_text()
-    for vr in (13, 14, 16):  # crank.angle, crank.omega, motor.torque: index = vr in FMI 2
+    for vr in (14, 15, 17):  # crank.angle, crank.omega, motor.torque: index = vr in FMI 2
         assert f'<Unknown index="{vr}" dependencies=""/>' in text2
         assert f'<Output valueReference="{vr}" dependencies=""/>' in text3
-    assert '<Unknown index="15" dependencies="1 2"/>' in text2
-    assert '<Output valueReference="15" dependencies="1 2"/>' in text3
-    assert '<Unknown index="17" dependencies="1 2"/>' in text2
-    assert '<Output valueReference="17" dependencies="1 2"/>' in text3
+    assert '<Unknown index="16" dependencies="1 2 3"/>' in text2
+    assert '<Output valueReference="16" dependencies="1 2 3"/>' in text3
+    assert '<Unknown index="18" dependencies="1 2 3"/>' in text2
+    assert '<Output valueReference="18" dependencies="1 2 3"/>' in text3
     assert 'providesDirectionalDerivative="false"' in text2
     assert 'providesDirectionalDerivatives="false"' in text3
     assert '<Unit name="N">' not in text2 and '<Unit name="N">' not in text3
@@ -1308,7 +1310,7 @@ def drive_outputs(values, angle, speed):
     rx = c * values["crank.com.x"] - s * values["crank.com.y"]
     ry = s * values["crank.com.x"] + c * values["crank.com.y"]
     gravity = values["crank.mass"] * (rx * values["gravity.y"] - ry * values["gravity.x"])
-    epsilon = (motor + values["load.torque"] + gravity) / total
+    epsilon = (motor + values["load.torque"] - values["load.demand"] + gravity) / total
     if not (math.isfinite(epsilon) and math.isfinite(motor)):
         return {
             "crank.angle": angle,
@@ -1329,7 +1331,7 @@ def drive_outputs(values, angle, speed):
 def test_drive_declared_dependencies_are_the_true_ones():
     """As for the dyads: among valid inputs, an output depends on an input if it changes
     with it; `status` depends on what decides validity (inertia + load.inertia > 0) and
-    on what can overflow the acceleration (load.torque)."""
+    on what can overflow the acceleration (load.torque, load.demand)."""
     rng = np.random.default_rng(7)
     raw = load_drive_raw()
     inputs = names_of(raw, "input")
@@ -1348,7 +1350,7 @@ def test_drive_declared_dependencies_are_the_true_ones():
                 if out != "status" and abs(other[out] - base[out]) > 1e-12 * (1 + abs(base[out])):
                     derived[out].add(name)
     # validity: inertia (a parameter) + load.inertia > 0, and a finite acceleration
-    derived["status"] = {"load.inertia", "load.torque"}
+    derived["status"] = {"load.inertia", "load.torque", "load.demand"}
     assert drive_outputs(dict(DRIVE_STARTS, **{"load.inertia": -1.0}), 0.0, 0.0)["status"] == 2
     assert (
         drive_outputs(dict(DRIVE_STARTS, **{"load.torque": -1.7976931348623157e308}), 0.0, 0.0)[
@@ -1356,6 +1358,8 @@ def test_drive_declared_dependencies_are_the_true_ones():
         ]
         == 3
     )
+    demand = dict(DRIVE_STARTS, **{"load.demand": 1.7976931348623157e308})
+    assert drive_outputs(demand, 0.0, 0.0)["status"] == 3
     declared = {v["name"]: set(v["depends"]) for v in raw["variable"] if v["causality"] == "output"}
     assert declared == derived == DRIVE_DEPENDS
 

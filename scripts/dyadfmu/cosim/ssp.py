@@ -9,14 +9,15 @@ the order a communication point evaluates them:
 
     drive.crank.angle        -> mechanism.crank.angle
     drive.crank.omega        -> mechanism.crank.omega
-    mechanism.crank.torque0  -> drive.load.torque     (LinearTransformation factor -1)
+    mechanism.crank.torque0  -> drive.load.demand
     mechanism.crank.J        -> drive.load.inertia
     drive.crank.epsilon      -> mechanism.crank.epsilon
 
 The mechanism's driving torque is torque0 + J eps. The drive gets the part at zero
-acceleration with the sign of a load (load.torque = -torque0) and the mechanism's inertia
-at the crank, and solves (J_r + J) eps = T_motor - torque0: the loop through the links'
-inertia closes inside the drive. torque0 and J do not depend on eps, so the last
+acceleration as the torque the mechanism demands (load.demand, the sign of a driving
+torque: no connection needs a transformation, which some importers do not apply) and the
+mechanism's inertia at the crank, and solves (J_r + J) eps = T_motor - torque0: the loop
+through the links' inertia closes inside the drive. torque0 and J do not depend on eps, so the last
 connection only brings the mechanism's reactions to the solved acceleration.
 
 ``acceleration="zero"`` leaves that connection out: the mechanism's crank.epsilon stays at
@@ -125,7 +126,7 @@ def connections(acceleration: str = "connected") -> list[Link]:
     links = [
         Link((DRIVE, "crank.angle"), (MECHANISM, "crank.angle")),
         Link((DRIVE, "crank.omega"), (MECHANISM, "crank.omega")),
-        Link((MECHANISM, torque), (DRIVE, "load.torque"), factor=-1.0),
+        Link((MECHANISM, torque), (DRIVE, "load.demand")),
         Link((MECHANISM, "crank.J"), (DRIVE, "load.inertia")),
     ]
     if connected:
@@ -490,7 +491,8 @@ def simulate_fmpy(path: Path | str) -> np.ndarray:
     communication step, its parameter bindings passed as fmpy's parameter set (which
     ``simulate_ssp`` does not read from the .ssd). fmpy steps every FMU with the inputs of
     the previous communication point and copies outputs to inputs without their
-    transformations; row k holds the outputs after the step from t_k."""
+    transformations (this package has none); row k holds the outputs after the step from
+    t_k."""
     from fmpy.ssp.simulation import simulate_ssp
     from fmpy.ssp.ssd import Parameter, ParameterSet
 
