@@ -67,6 +67,29 @@ def test_a_users_scene_is_built_drawn_and_reported(tmp_path):
     assert again.returncode == 0 and "building" not in again.stdout + again.stderr
 
 
+def test_an_fmu_older_than_its_scene_or_the_sources_is_stale(tmp_path):
+    import os
+
+    from dyadfmu.report.own_scene import BUILT_FROM, stale
+
+    project, scene, fmu = tmp_path / "project", tmp_path / "a.toml", tmp_path / "a_fmi2.fmu"
+    for folder in BUILT_FROM:
+        (project / folder).mkdir(parents=True)
+        (project / folder / "x.c").write_text("")
+        os.utime(project / folder / "x.c", (100, 100))
+    scene.write_text("")
+    os.utime(scene, (100, 100))
+    assert stale(fmu, scene, project)  # missing
+    fmu.write_text("")
+    os.utime(fmu, (200, 200))
+    assert not stale(fmu, scene, project)
+    os.utime(project / "src" / "x.c", (300, 300))
+    assert stale(fmu, scene, project)  # a core source changed
+    os.utime(project / "src" / "x.c", (100, 100))
+    os.utime(scene, (300, 300))
+    assert stale(fmu, scene, project)  # the scene changed
+
+
 def test_a_scene_that_does_not_assemble_everywhere_is_marked_not_fatal(tmp_path):
     """A rod of 0.05 m on a crank of 0.05 m off the axis by 0.01 m: no assembly where
     0.01 - 0.05 sin(phi) > 0.05, about 233 to 307 degrees."""

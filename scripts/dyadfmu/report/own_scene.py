@@ -1,6 +1,6 @@
 """``dyadfmu scene FILE.toml``: a user's own scene, built where its FMU is missing or older
-than the file, then drawn and reported over one revolution of its first crank (the other
-drivers at their start values, the loads at the FMU's start values):
+than the file or the project's sources, then drawn and reported over one revolution of its
+first crank (the other drivers at their start values, the loads at the FMU's start values):
 
 - ``<id>.png``: the mechanism to scale from the FMU's outputs at four poses a quarter turn
   apart, with every pair reaction and load at the first pose (:mod:`.drivers_drawing`);
@@ -25,7 +25,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .. import build_scene  # noqa: E402
+from .. import build_scene, paths  # noqa: E402
 from ..sweep import scenebuild  # noqa: E402
 from . import cylinder_drawing as cd  # noqa: E402
 from . import drivers_drawing as dd  # noqa: E402
@@ -35,12 +35,30 @@ from . import markdown as md  # noqa: E402
 SAMPLES, POSES, TURN = 361, (0.0, 0.25, 0.5, 0.75), 1.0
 
 
+#: The project's folders an FMU is built from (beside its scene file).
+BUILT_FROM = ("src", "fmu", "modelDescription/dyadgen")
+
+
+def stale(fmu: Path, scene: Path, project: Path) -> bool:
+    """Whether the FMU is missing or older than its scene file or any file of the
+    project's sources it is built from (BUILT_FROM under `project`)."""
+    if not fmu.is_file():
+        return True
+    built = fmu.stat().st_mtime
+    if scene.stat().st_mtime > built:
+        return True
+    for folder in BUILT_FROM:
+        for path in (project / folder).rglob("*"):
+            if path.is_file() and "__pycache__" not in path.parts and path.stat().st_mtime > built:
+                return True
+    return False
+
+
 def _fmu(scene: Path, identifier: str, fmi: int, out: Path, say: Callable) -> Path:
-    """The scene's FMU, built (into the build folder of scene studies) where it is missing
-    or older than the scene file."""
+    """The scene's FMU, built (into the build folder of scene studies) where it is stale."""
     folder = scenebuild.build_folder(out)
     fmu = folder / "fmus" / f"{identifier}_fmi{fmi}.fmu"
-    if not fmu.is_file() or fmu.stat().st_mtime < scene.stat().st_mtime:
+    if stale(fmu, scene, paths.project_dir()):
         say(f"building {identifier} in {folder}")
         try:
             build_scene.build([scene], folder, windows="off")
