@@ -7,7 +7,7 @@ import argparse
 import math
 from collections.abc import Callable
 
-__all__ = ["whole", "real"]
+__all__ = ["whole", "real", "assignment"]
 
 
 def whole(low: int, high: int) -> Callable[[str], int]:
@@ -41,3 +41,17 @@ def real(low: float, high: float, above: bool = False) -> Callable[[str], float]
         return value
 
     return check
+
+
+def assignment(text: str) -> tuple[str, float]:
+    """An argparse type: NAME=VALUE, VALUE a finite number."""
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    try:
+        number = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name}: not a number: {value!r}") from None
+    if not math.isfinite(number):
+        raise argparse.ArgumentTypeError(f"{name}: not a finite number: {value!r}")
+    return name.strip(), number

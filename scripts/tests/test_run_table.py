@@ -231,6 +231,6 @@ def test_the_rows_command_names_what_it_refuses(tmp_path):
     assert done.stderr.startswith("dyadfmu rows: error: column 'crank.angel'")
     assert len(done.stderr.splitlines()) == 1
     done = _rows_command(fmu, "--start", "gravity.y", "--out", tmp_path)
-    assert done.returncode == 2 and "is not NAME=VALUE" in done.stderr
+    assert done.returncode == 2 and "expected NAME=VALUE" in done.stderr
     done = _rows_command(tmp_path / "none.fmu")
     assert done.returncode == 2 and "none.fmu" in done.stderr

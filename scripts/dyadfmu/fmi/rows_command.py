@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import paths
+from .. import argtypes, paths
 from .rows import Rows, RowsError, run_table
 
 #: The arguments naming a path, checked before any work (cli.py).
@@ -18,18 +18,6 @@ PATHS = (
     ("--input", "input", paths.FILE),
     ("--out", "out", paths.OUT),
 )
-
-
-def _assignment(text: str) -> tuple[str, float]:
-    name, sep, value = text.partition("=")
-    try:
-        if not sep or not name:
-            raise ValueError
-        return name, float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not NAME=VALUE with a number (e.g. crank.motor.voltage=290)"
-        ) from None
 
 
 def parser() -> argparse.ArgumentParser:
@@ -60,7 +48,7 @@ def parser() -> argparse.ArgumentParser:
         "--start",
         nargs="+",
         metavar="NAME=VALUE",
-        type=_assignment,
+        type=argtypes.assignment,
         default=[],
         help="parameters' start values (in the variables' units)",
     )

@@ -918,20 +918,6 @@ def _mark_peak(ax: Axes, curve: dict) -> None:
 # ---------------------------------------------------------------------------
 # the command line
 # ---------------------------------------------------------------------------
-def _assignment(text: str) -> tuple[str, float]:
-    """An argparse type: NAME=VALUE, VALUE a finite number."""
-    name, sep, value = text.partition("=")
-    if not sep or not name.strip():
-        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
-    try:
-        number = float(value)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{name}: not a number: {value!r}") from None
-    if not math.isfinite(number):
-        raise argparse.ArgumentTypeError(f"{name}: not a finite number: {value!r}")
-    return name.strip(), number
-
-
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="python -m dyadfmu.report.cylinder_drawing",
@@ -990,7 +976,7 @@ def load_options(p: argparse.ArgumentParser) -> None:
     """The options --load and --set."""
     p.add_argument(
         "--load",
-        type=_assignment,
+        type=argtypes.assignment,
         action="append",
         default=None,
         metavar="INPUT=N",
@@ -999,7 +985,7 @@ def load_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--set",
-        type=_assignment,
+        type=argtypes.assignment,
         action="append",
         default=[],
         metavar="PARAMETER=VALUE",
