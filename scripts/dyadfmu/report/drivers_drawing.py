@@ -152,7 +152,8 @@ def read_scene(path: Path | str) -> DriversScene:
             drivers.append(Driver(kind, name, t["link"] if kind == "cylinder" else name, t))
     if not drivers:
         raise DrawingError(f"{path}: no [crank], [ram] or [cylinder]: nothing drives it")
-    if data["scene"].get("kinematics") != "internal":
+    # A scene with a driver has internal kinematics unless it says otherwise.
+    if data["scene"].get("kinematics", "internal") != "internal":
         raise DrawingError(f'{path}: the drawing needs kinematics = "internal"')
     links = {t["name"]: tuple(t.get("com", (0.0, 0.0))) for t in data.get("link", [])}
     links.update({d.link: tuple(d.table.get("com", (0.0, 0.0))) for d in drivers})
