@@ -232,6 +232,13 @@ def _own_commands(sub: argparse._SubParsersAction) -> None:
         "one instant (see 'dyadfmu rows --help')",
     ).set_defaults(run=None)
     sub.add_parser(
+        "animate",
+        add_help=False,
+        help="a mechanism in motion with its forces and curves: an HTML page with a time "
+        "slider and a GIF, from a shipped mechanism, a scene file or a recorded run (see "
+        "'dyadfmu animate --help')",
+    ).set_defaults(run=None)
+    sub.add_parser(
         "scene-bench",
         add_help=False,
         help="time the scene generator (--check and --out) on chains of 25 to 200 dyads "
@@ -514,6 +521,7 @@ OWN_PARSERS = {
     "scene-bench": ".study.long_chain",
     "rows": ".fmi.rows_command",
     "build-scene": ".build_scene",
+    "animate": ".animation.command",
 }
 
 

@@ -198,6 +198,10 @@ class Instance:
         """The outputs drawn (none here)."""
         return []
 
+    def drawn_outputs(self) -> list:
+        """The outputs the drawing needs of the FMU."""
+        return self._need()
+
     def _point(self, prefix: str, default: Sequence) -> np.ndarray:
         """The point of the parameters prefix.x and prefix.y, each the FMU's where it has
         it (tunable), else the default's."""

@@ -68,6 +68,7 @@ __all__ = [
     "DriversPose",
     "read_scene",
     "motion",
+    "evaluate",
     "pose",
     "draw",
     "figure",
@@ -270,6 +271,23 @@ def rates(ranges: dict, duration: float | None) -> dict:
     return {n: (hi - lo) / duration for n, (lo, hi) in ranges.items()}
 
 
+def evaluate(
+    mechanism: Mechanism, ranges: dict, shares: Sequence[float], loads: dict, speeds: dict | None
+) -> tuple[list, list]:
+    """The FMU's outputs at each share of the motion over ``ranges`` (see :func:`motion`),
+    moving at ``speeds`` (see :meth:`Mechanism.at`): ([row, or None where the FMU has no
+    answer], [None, or the reason])."""
+    rows, reasons = [], []
+    for coordinates in motion(ranges, shares):
+        try:
+            rows.append(mechanism.at(coordinates, loads, speeds))
+            reasons.append(None)
+        except DrawingError as e:
+            rows.append(None)
+            reasons.append(str(e))
+    return rows, reasons
+
+
 # ---------------------------------------------------------------------------
 # one pose: the points, bodies and forces drawn
 # ---------------------------------------------------------------------------
@@ -418,7 +436,7 @@ def force_unit(forces: list) -> tuple[str, float]:
     return ("kN", 1e3) if largest >= 1e3 else ("N", 1.0)
 
 
-def _colours(scene: DriversScene) -> dict:
+def body_colours(scene: DriversScene) -> dict:
     """Each moving body's colour: the drivers' links in the drivers' colours, the dyads'
     links in the links' colours, in turn."""
     palette = (sketch.DRIVER_COLOUR, "#c44e52", "#937860", "#da8bc3")
@@ -430,7 +448,7 @@ def _colours(scene: DriversScene) -> dict:
     return colours
 
 
-def _names(pose_: DriversPose, scene: DriversScene) -> dict:
+def point_labels(pose_: DriversPose, scene: DriversScene) -> dict:
     """The label of every point drawn: pivots O, cylinder pins A and B, crank pins, the
     dyads' pairs, the loads' names."""
     names = {}
@@ -462,22 +480,24 @@ def draw(
     poses: list,
     reactions_at: int = -1,
     scale: float | None = None,
+    unit: tuple[str, float] | None = None,
 ) -> dict:
     """Draw the poses (from :func:`pose`) overlaid on ``ax`` to scale, the later fainter,
     each numbered, and the forces of pose ``reactions_at`` as arrows on one scale:
-    ``scale`` (kN, or N where every force is below 1 kN, per m of arrow) if given, else a
-    round one. Returns {"scale", "unit": (name, N), "arrows": {name: patch}, "size": m}."""
+    ``scale`` (``unit``, by default kN, or N where every force is below 1 kN, per m of
+    arrow) if given, else a round one. Returns {"scale", "unit": (name, N), "arrows":
+    {name: patch}, "size": m}."""
     scene, n = mechanism.scene, len(poses)
     size = cd._size(poses)
     u = 0.018 * size
-    colours = _colours(scene)
+    colours = body_colours(scene)
     cd._draw_frame(ax, poses[0], poses, u)
     origin = next(iter(poses[0].pivots))
     for i in reversed(range(n)):
         alpha = 1.0 - (1.0 - cd.FADED) * i / max(n - 1, 1)
         cd._draw_pose(ax, poses[i], colours, u, (alpha, 1.0 if i == 0 else 0.55), z=2.0 - 0.05 * i)
         cd.tag(ax, poses[i], list(poses[i].points), origin, str(i + 1), alpha)
-    names = _names(poses[0], scene)
+    names = point_labels(poses[0], scene)
     drawn = cd._drawn_points(poses)
     sketch.label_points(
         ax, poses[0].points, names, size, fontsize=7, drop_dotted=False, avoid=drawn
@@ -485,9 +505,9 @@ def draw(
     cylinders = {d.name: d.name for d in scene.drivers if d.kind == "cylinder"}
     cd._label_bodies(ax, poses[0], cylinders, colours, u)
     loaded = poses[reactions_at]
-    unit = force_unit(loaded.forces)
+    unit = unit or force_unit(loaded.forces)
     scale = sketch.checked_scale(scale) or cd.force_scale(loaded.forces, size, unit[1])
-    arrows = cd._arrows(ax, loaded, scale, u, _names(loaded, scene), unit)
+    arrows = cd._arrows(ax, loaded, scale, u, point_labels(loaded, scene), unit)
     if arrows:
         number = reactions_at % n + 1
         ax.legend(

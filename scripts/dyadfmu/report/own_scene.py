@@ -54,7 +54,7 @@ def stale(fmu: Path, scene: Path, project: Path) -> bool:
     return False
 
 
-def _fmu(scene: Path, identifier: str, fmi: int, out: Path, say: Callable) -> Path:
+def scene_fmu(scene: Path, identifier: str, fmi: int, out: Path, say: Callable) -> Path:
     """The scene's FMU, built (into the build folder of scene studies) where it is stale."""
     folder = scenebuild.build_folder(out)
     fmu = folder / "fmus" / f"{identifier}_fmi{fmi}.fmu"
@@ -72,13 +72,9 @@ def _sampled(mechanism: dd.Mechanism, ranges: dict, loads: dict, moving: bool) -
     the FMU has no answer) and the failing instants [(share, reason)]."""
     shares = np.linspace(0.0, 1.0, SAMPLES)
     speeds = dd.rates(ranges, TURN) if moving else None
-    rows, failed = [], []
-    for share, coordinates in zip(shares, dd.motion(ranges, shares), strict=True):
-        try:
-            rows.append(mechanism.at(coordinates, loads, speeds))
-        except cd.DrawingError as e:
-            rows.append({})
-            failed.append((float(share), str(e)))
+    found, reasons = dd.evaluate(mechanism, ranges, shares, loads, speeds)
+    rows = [r or {} for r in found]
+    failed = [(float(s), why) for s, why in zip(shares, reasons, strict=True) if why]
     names = next((list(r) for r in rows if r), [])
     table = {n: np.array([r.get(n, math.nan) for r in rows]) for n in names}
     return {"share": shares, **table}, failed
@@ -159,7 +155,7 @@ def run(scene_file: Path, out: Path, fmi: int, say: Callable[[str], None]) -> li
             f"{scene_file.name}: no crank to turn; draw it along a stroke with 'python -m "
             "dyadfmu.report.drivers_drawing FILE --range INPUT MIN MAX'"
         )
-    fmu = _fmu(scene_file, scene.identifier, fmi, out, say)
+    fmu = scene_fmu(scene_file, scene.identifier, fmi, out, say)
     out.mkdir(parents=True, exist_ok=True)
     mechanism = dd.Mechanism(scene, fmu, {})
     try:
