@@ -54,8 +54,10 @@ def stale(fmu: Path, scene: Path, project: Path) -> bool:
     return False
 
 
-def _fmu(scene: Path, identifier: str, fmi: int, out: Path, say: Callable) -> Path:
-    """The scene's FMU, built (into the build folder of scene studies) where it is stale."""
+def scene_fmu(scene: Path, identifier: str, fmi: int, out: Path, say: Callable) -> Path:
+    """The scene's FMU of FMI version `fmi`, built (into the build folder of scene studies,
+    :func:`dyadfmu.sweep.scenebuild.build_folder`) where it is stale; DrawingError where the
+    build refuses the scene."""
     folder = scenebuild.build_folder(out)
     fmu = folder / "fmus" / f"{identifier}_fmi{fmi}.fmu"
     if stale(fmu, scene, paths.project_dir()):
@@ -159,7 +161,7 @@ def run(scene_file: Path, out: Path, fmi: int, say: Callable[[str], None]) -> li
             f"{scene_file.name}: no crank to turn; draw it along a stroke with 'python -m "
             "dyadfmu.report.drivers_drawing FILE --range INPUT MIN MAX'"
         )
-    fmu = _fmu(scene_file, scene.identifier, fmi, out, say)
+    fmu = scene_fmu(scene_file, scene.identifier, fmi, out, say)
     out.mkdir(parents=True, exist_ok=True)
     mechanism = dd.Mechanism(scene, fmu, {})
     try:
