@@ -122,9 +122,9 @@ def add_machine_options(parser: argparse.ArgumentParser) -> None:
         "--step",
         type=argtypes.real(0.0, 1.0, above=True),
         metavar="S",
-        help="the communication step, s; the duration must be a whole number of steps "
-        f"(default: the longest of 1, 2, 5 x 10^k s up to {LONGEST_STEP:g} s that takes "
-        f"{STEPS_PER_REVOLUTION} steps per revolution at the no-load speed)",
+        help="the communication step, s (default: the longest of 1, 2, 5 x 10^k s up to "
+        f"{LONGEST_STEP:g} s that takes {STEPS_PER_REVOLUTION} steps per revolution at the "
+        "no-load speed); the duration must be a whole number of steps",
     )
 
 
