@@ -141,8 +141,9 @@ def summary(s: scene_drive.SceneMachine, r: mechanism_drive.DriveRun, files: lis
     worst = max(peaks, key=peaks.get)
     k_worst = int(np.argmax(magnitudes(r.extra)[worst]))
     return [
-        f"{s.identifier}: motor {motor.stall_torque:g} N m at stall, {motor.no_load_speed:g} "
-        f"rad/s at no load, rotor {motor.rotor_inertia:.4g} kg m2 (the mean crank.J); start "
+        f"{s.identifier} ({s.fmu}): motor {motor.stall_torque:g} N m at stall, "
+        f"{motor.no_load_speed:g} rad/s at no load, rotor {motor.rotor_inertia:.4g} kg m2 "
+        "(the mean crank.J); start "
         f"{s.machine.omega0:.4g} rad/s; {s.machine.t_end:g} s in {len(r.t) - 1} steps of "
         f"{s.step:g} s ({r.wall_time:.2f} s of wall time)",
         f"mean speed {mean:.6g} rad/s ({mean * 30 / np.pi:.5g} rpm); speed ripple "
