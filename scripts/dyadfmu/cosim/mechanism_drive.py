@@ -19,14 +19,17 @@ The reference (:func:`reference`) integrates the same machine as one ODE,
 generalised weight force Q_g from the harness's own kinematics
 (:mod:`dyadfmu.mechanisms.driven`), by Radau at rtol 1e-11.
 
-API: :data:`MACHINES`, :func:`run` (-> :class:`DriveRun`), :func:`reference`, :func:`errors`.
+API: :data:`MACHINES`, :func:`run` (-> :class:`DriveRun`), :func:`run_fmu` (any mechanism
+FMU with a :class:`Machine`), :func:`drive_parameters`, :func:`reference`, :func:`errors`.
 """
 
 from __future__ import annotations
 
 import math
 import time as clock
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -42,6 +45,8 @@ __all__ = [
     "Machine",
     "machine_of",
     "run",
+    "run_fmu",
+    "drive_parameters",
     "reference",
     "errors",
     "whole_steps",
@@ -104,18 +109,22 @@ class DriveRun:
     extra: dict[str, np.ndarray] = field(default_factory=dict)
 
 
+def drive_parameters(m: Machine) -> dict[str, float]:
+    """The drive FMU's parameters for the machine ``m``: its motor and rotor, no crank mass
+    (the crank, with its weight, is the mechanism FMU's), the start angle and speed."""
+    return {
+        "motor.stall_torque": m.motor.stall_torque,
+        "motor.no_load_speed": m.motor.no_load_speed,
+        "inertia": m.motor.rotor_inertia,
+        "crank.mass": 0.0,
+        "start.angle": START_ANGLE,
+        "start.speed": m.omega0,
+    }
+
+
 def _drive(m: Machine, fmi_version: int) -> Slave:
     d = Slave(master.drive_fmu_path(fmi_version), instance_name="drive")
-    d.initialize(
-        {
-            "motor.stall_torque": m.motor.stall_torque,
-            "motor.no_load_speed": m.motor.no_load_speed,
-            "inertia": m.motor.rotor_inertia,
-            "crank.mass": 0.0,  # the crank, with its weight, is the mechanism FMU's
-            "start.angle": START_ANGLE,
-            "start.speed": m.omega0,
-        }
-    )
+    d.initialize(drive_parameters(m))
     return d
 
 
@@ -154,11 +163,26 @@ def run(
     """The stabilised co-simulation of ``name``'s machine (or ``m``, a machine of that
     mechanism FMU) with communication step ``step``, recording the mechanism FMU's
     ``outputs`` besides the crank's motion and torque."""
-    m = m or machine_of(name)
+    fmu = paths.built_fmu(name, fmi_version, None, how="scripts/run-tests")
+    return run_fmu(fmu, m or machine_of(name), step, fmi_version, outputs)
+
+
+def run_fmu(
+    fmu: Path,
+    m: Machine,
+    step: float,
+    fmi_version: int = 2,
+    outputs: tuple[str, ...] = (),
+    progress: Callable[[int, int], None] | None = None,
+) -> DriveRun:
+    """The stabilised co-simulation of the machine ``m`` turning the crank of the mechanism
+    FMU ``fmu`` (of this FMI version) with communication step ``step`` [s], recording the
+    FMU's ``outputs`` besides the crank's motion and torque; ``progress(k, n)`` is called
+    after each of the n steps."""
     n = whole_steps(m.t_end, step)
     started = clock.perf_counter()
     d = _drive(m, fmi_version)
-    y = Slave(paths.built_fmu(name, fmi_version, None, how="scripts/run-tests"), "mechanism")
+    y = Slave(fmu, "mechanism")
     y.initialize()
     rows, checks, extra = [], [0.0, 0.0], []
     try:
@@ -168,6 +192,8 @@ def run(
             if k < n:
                 y.do_step(k * step, step)
                 d.do_step(k * step, step)
+                if progress is not None:
+                    progress(k + 1, n)
     finally:
         d.close()
         y.close()
@@ -175,7 +201,7 @@ def run(
     t = step * np.arange(len(rows))
     wall = clock.perf_counter() - started
     columns = dict(zip(outputs, np.array(extra, dtype=float).reshape(len(rows), -1).T, strict=True))
-    return DriveRun(name, step, t, *a.T, checks[0], checks[1], wall, columns)
+    return DriveRun(m.name, step, t, *a.T, checks[0], checks[1], wall, columns)
 
 
 def reference(name: str, t: np.ndarray, m: Machine | None = None) -> tuple:

@@ -28,7 +28,10 @@ motion is the same; the mechanism's reactions are then those at zero acceleratio
 
 The drive's parameters are the harness's (:func:`drive_parameters`: the machine of
 :data:`dyadfmu.cosim.mechanism_drive.MACHINES`, the crank's mass 0 since the crank is the
-mechanism FMU's); the mechanism keeps its defaults, as in the harness. The
+mechanism FMU's); the mechanism keeps its defaults, as in the harness. A user's scene
+(:func:`write_fmu`, ``--scene FILE.toml``) brings its own mechanism FMU, and the drive the
+machine :mod:`dyadfmu.cosim.scene_drive` derives from that FMU, as ``dyadfmu cosim --scene``
+runs it. The
 DefaultExperiment spans the harness's run; the communication step, which SSP 1.0's
 DefaultExperiment does not carry, is in an annotation of type :data:`COUPLING_ANNOTATION`.
 
@@ -42,9 +45,10 @@ connections in the order listed, applying their transformations, at each communi
 point, then steps the mechanism and the drive: the scheme of
 :func:`dyadfmu.cosim.mechanism_drive.run`.
 
-API: :func:`write`, :func:`read_package` (-> :class:`Package`), :func:`validate`,
-:func:`simulate` (-> :class:`SspRun`), :func:`compare`, :func:`drive_parameters`,
-:func:`connections`; ``python -m dyadfmu.cosim.ssp --help``.
+API: :func:`write`, :func:`write_fmu`, :func:`read_package` (-> :class:`Package`),
+:func:`validate`, :func:`simulate` (-> :class:`SspRun`), :func:`compare`,
+:func:`compare_fmu`, :func:`drive_parameters`, :func:`connections`;
+``python -m dyadfmu.cosim.ssp --help``.
 """
 
 from __future__ import annotations
@@ -53,7 +57,9 @@ import argparse
 import sys
 import tempfile
 import zipfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -63,7 +69,7 @@ from lxml import etree
 
 from .. import paths
 from ..fmi.slave import Slave
-from . import master, mechanism_drive
+from . import master, mechanism_drive, scene_drive
 
 __all__ = [
     "DRIVE",
@@ -78,11 +84,13 @@ __all__ = [
     "drive_parameters",
     "communication_step",
     "write",
+    "write_fmu",
     "validate",
     "read_package",
     "simulate",
     "simulate_fmpy",
     "compare",
+    "compare_fmu",
     "main",
 ]
 
@@ -136,15 +144,7 @@ def connections(acceleration: str = "connected") -> list[Link]:
 
 def drive_parameters(name: str) -> dict[str, float]:
     """The drive FMU's parameters in the harness's stiff co-simulation of ``name``."""
-    m = mechanism_drive.machine_of(name)
-    return {
-        "motor.stall_torque": m.motor.stall_torque,
-        "motor.no_load_speed": m.motor.no_load_speed,
-        "inertia": m.motor.rotor_inertia,
-        "crank.mass": 0.0,
-        "start.angle": mechanism_drive.START_ANGLE,
-        "start.speed": m.omega0,
-    }
+    return mechanism_drive.drive_parameters(mechanism_drive.machine_of(name))
 
 
 def communication_step(name: str) -> float:
@@ -256,8 +256,12 @@ def _coupling(root: etree._Element, step: float, acceleration: str) -> None:
     )
 
 
-def _ssd(name: str, sources: dict, mds: dict, acceleration: str) -> etree._Element:
-    """The SystemStructure.ssd of the drive and ``name``'s mechanism FMU."""
+def _ssd(
+    m: mechanism_drive.Machine, step: float, sources: dict, mds: dict, acceleration: str
+) -> etree._Element:
+    """The SystemStructure.ssd of the drive and the mechanism FMU ``m.name`` turned by the
+    machine ``m`` with communication step ``step`` [s]."""
+    name = m.name
     root = etree.Element(
         _q("ssd", "SystemStructureDescription"), version="1.0", name=f"drive_{name}", nsmap=NS
     )
@@ -265,13 +269,13 @@ def _ssd(name: str, sources: dict, mds: dict, acceleration: str) -> etree._Eleme
     system.set("description", f"the drive FMU turning the crank of the {name} mechanism FMU")
     elements = _sub(system, "ssd", "Elements")
     links = connections(acceleration)
-    _component(elements, DRIVE, sources[DRIVE], mds[DRIVE], drive_parameters(name), links)
+    parameters = mechanism_drive.drive_parameters(m)
+    _component(elements, DRIVE, sources[DRIVE], mds[DRIVE], parameters, links)
     _component(elements, MECHANISM, sources[MECHANISM], mds[MECHANISM], {}, links)
     _connections(system, links)
     _units(root, list(mds.values()))
-    t_end = mechanism_drive.machine_of(name).t_end
-    _sub(root, "ssd", "DefaultExperiment", startTime="0.0", stopTime=repr(float(t_end)))
-    _coupling(root, communication_step(name), acceleration)
+    _sub(root, "ssd", "DefaultExperiment", startTime="0.0", stopTime=repr(float(m.t_end)))
+    _coupling(root, step, acceleration)
     return root
 
 
@@ -293,20 +297,34 @@ def write(
     version, their connections and the harness's parameters; returns its path."""
     if name not in MECHANISMS:
         raise ValueError(f"no stiff co-simulation of {name!r}; expected one of {MECHANISMS}")
-    fmus = {
-        DRIVE: master.drive_fmu_path(fmi_version, build),
-        MECHANISM: paths.built_fmu(name, fmi_version, build, what=f"the {name} FMU"),
-    }
+    fmu = paths.built_fmu(name, fmi_version, build, what=f"the {name} FMU")
+    m = mechanism_drive.machine_of(name)
+    return write_fmu(fmu, m, communication_step(name), fmi_version, out, acceleration, build)
+
+
+def write_fmu(
+    fmu: Path,
+    m: mechanism_drive.Machine,
+    step: float,
+    fmi_version: int = 2,
+    out: Path | str = paths.ROOT / "out" / "ssp",
+    acceleration: str = "connected",
+    build: Path | None = None,
+) -> Path:
+    """Write <out>/drive_<m.name>_fmi<v>.ssp: the mechanism FMU ``fmu`` (a scene's, of this
+    FMI version) and the built drive FMU, their connections, the drive's parameters of the
+    machine ``m`` and the communication step ``step`` [s]; returns its path."""
+    fmus = {DRIVE: master.drive_fmu_path(fmi_version, build), MECHANISM: Path(fmu)}
     mds = {k: read_model_description(str(p)) for k, p in fmus.items()}
     _check_names(mds, connections(acceleration))
     sources = {k: f"resources/{p.name}" for k, p in fmus.items()}
     ssd = etree.tostring(
-        _ssd(name, sources, mds, acceleration),
+        _ssd(m, step, sources, mds, acceleration),
         xml_declaration=True,
         encoding="UTF-8",
         pretty_print=True,
     )
-    target = Path(out) / f"drive_{name}_fmi{fmi_version}.ssp"
+    target = Path(out) / f"drive_{m.name}_fmi{fmi_version}.ssp"
     target.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as z:
         z.writestr("SystemStructure.ssd", ssd)
@@ -522,10 +540,10 @@ def _reaction_names(md: object) -> list[str]:
     ]
 
 
-def _harness_reactions(name: str, fmi_version: int, run: object, names: list) -> np.ndarray:
+def _harness_reactions(fmu: Path, run: object, names: list) -> np.ndarray:
     """The mechanism FMU's reactions at the harness's states (it has no state of its own, so
     these are the outputs the harness's instance held at each communication point)."""
-    y = Slave(paths.built_fmu(name, fmi_version), "harness_mechanism")
+    y = Slave(fmu, "harness_mechanism")
     y.initialize()
     try:
         out = []
@@ -547,18 +565,28 @@ def compare(path: Path | str, fmi_version: int, name: str) -> dict[str, float]:
     the same step: largest |phi| difference [rad], largest omega, epsilon and torque
     difference over their peaks, and the largest reaction difference over each reaction's
     peak (all at the harness's solved acceleration)."""
+    fmu = paths.built_fmu(name, fmi_version)
+    return compare_fmu(path, fmi_version, fmu, mechanism_drive.machine_of(name))
+
+
+def compare_fmu(
+    path: Path | str, fmi_version: int, fmu: Path, m: mechanism_drive.Machine
+) -> dict[str, float]:
+    """The package's run against :func:`dyadfmu.cosim.mechanism_drive.run_fmu` of the
+    mechanism FMU ``fmu`` and the machine ``m`` at the same step (the differences of
+    :func:`compare`)."""
     ours = simulate(path)
-    theirs = mechanism_drive.run(name, ours.package.step, fmi_version)
+    theirs = mechanism_drive.run_fmu(fmu, m, ours.package.step, fmi_version)
     if len(theirs.t) != len(ours.t):
         raise ValueError("the package and the harness ran different communication points")
-    names = _reaction_names(read_model_description(str(paths.built_fmu(name, fmi_version))))
+    names = _reaction_names(read_model_description(str(fmu)))
     reactions = np.array([ours[f"{MECHANISM}.{r}"] for r in names]).T
     return {
         "phi": float(np.max(np.abs(ours["drive.crank.angle"] - theirs.phi))),
         "omega": _relative(ours["drive.crank.omega"], theirs.omega),
         "epsilon": _relative(ours["drive.crank.epsilon"], theirs.epsilon),
         "torque": _relative(ours[f"{MECHANISM}.crank.torque"], theirs.torque),
-        "reactions": _relative(reactions, _harness_reactions(name, fmi_version, theirs, names)),
+        "reactions": _relative(reactions, _harness_reactions(fmu, theirs, names)),
         "points": len(ours.t),
     }
 
@@ -566,18 +594,30 @@ def compare(path: Path | str, fmi_version: int, name: str) -> dict[str, float]:
 # ---------------------------------------------------------------------------
 # the command line
 # ---------------------------------------------------------------------------
+PROG = "python -m dyadfmu.cosim.ssp"
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="python -m dyadfmu.cosim.ssp",
+        prog=PROG,
         description="Write an SSP 1.0 package of the drive FMU and a mechanism FMU with the "
         "connections and parameters of the harness's stiff co-simulation, validate it "
         "against the SSD schema, and (with --compare) run it against the harness.",
     )
-    p.add_argument(
+    which = p.add_mutually_exclusive_group()
+    which.add_argument(
         "--mechanism",
         choices=MECHANISMS,
         default="slider_crank",
         help="the mechanism FMU (default slider_crank)",
+    )
+    which.add_argument(
+        "--scene",
+        type=Path,
+        metavar="FILE.toml",
+        help="instead: the mechanism FMU of your own scene (one crank, no other driver; "
+        "built where it is stale), the drive's machine derived from it as 'dyadfmu cosim "
+        "--scene' does (rotor inertia the mean of its crank.J over a revolution)",
     )
     p.add_argument(
         "--fmi",
@@ -606,17 +646,41 @@ def _parser() -> argparse.ArgumentParser:
         help="run the package and print its largest differences from the "
         "harness's stiff co-simulation",
     )
+    scene_drive.add_machine_options(p)
     return p
+
+
+def _scene_package(args: argparse.Namespace) -> tuple[Path, Callable[[Path], dict]]:
+    """The package of --scene's FMU and machine, and its comparison with the harness."""
+
+    def say(text: str) -> None:
+        print(f"{PROG}: {text}", file=sys.stderr, flush=True)
+
+    s = scene_drive.prepare(args.scene, args, args.fmi, args.out, say)
+    path = write_fmu(s.fmu, s.machine, s.step, args.fmi, args.out, args.acceleration)
+    return path, lambda package: compare_fmu(package, args.fmi, s.fmu, s.machine)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Write (and optionally compare) one package; prints its path."""
-    args = _parser().parse_args(argv)
-    path = write(args.mechanism, args.fmi, args.out, args.acceleration)
+    command = _parser()
+    args = command.parse_args(argv)
+    problem = scene_drive.options_problem(args)
+    if problem:
+        command.error(problem)
+    if args.scene is None:
+        path = write(args.mechanism, args.fmi, args.out, args.acceleration)
+        differences = partial(compare, fmi_version=args.fmi, name=args.mechanism)
+    else:
+        try:
+            path, differences = _scene_package(args)
+        except scene_drive.SceneRefused as refused:
+            print(f"{PROG}: error: {refused}", file=sys.stderr)
+            return 1
     validate(path)
     print(path)
     if args.compare:
-        for key, value in compare(path, args.fmi, args.mechanism).items():
+        for key, value in differences(path).items():
             print(f"{key}: {value:.3g}" if isinstance(value, float) else f"{key}: {value}")
     return 0
 

@@ -3,9 +3,13 @@
 the monolithic machine; writes ``<out>/cosim/report.md``, ``points.csv`` and
 ``error_vs_time.png``.
 
+With ``--scene FILE.toml`` it turns a user's own mechanism instead
+(:mod:`dyadfmu.report.scene_cosim`).
+
 Command line (the ``dyadfmu cosim`` subcommand calls :func:`main`)::
 
     python -m dyadfmu.report.cosim [--quick] [--out DIR] [--fmi-version {2,3}]
+    python -m dyadfmu.report.cosim --scene FILE.toml [--fmi {2,3}] [--motor NAME] ... --out DIR
 """
 
 from __future__ import annotations
@@ -20,9 +24,9 @@ from pathlib import Path
 
 from .. import paths
 from ..cosim import master as cosim
-from ..cosim import mechanism_drive
+from ..cosim import mechanism_drive, scene_drive
 from . import markdown as markup
-from . import plant_cosim
+from . import plant_cosim, scene_cosim
 
 #: Inertia ratios (mean J over a revolution, crank included, / rotor inertia).
 RATIOS = (0.1, 1.0, 10.0, 100.0)
@@ -692,7 +696,8 @@ def parser() -> argparse.ArgumentParser:
         "the plant, and (one driver) as the drive FMU with the mechanism FMU, and the lift "
         "under a force law, in driver angle, speed and joint reactions "
         "(communication steps 1e-1 to 1e-5 s, the plant's rtol 1e-6 to 1e-11); "
-        "writes OUT/cosim/report.md, points.csv, error_vs_time.png and plant_vs_step.png.",
+        "writes OUT/cosim/report.md, points.csv, error_vs_time.png and plant_vs_step.png. "
+        "With --scene, your own mechanism instead (see --scene).",
     )
     p.add_argument(
         "--quick",
@@ -703,22 +708,49 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=Path("out"), help="output directory (default: out)")
     p.add_argument(
         "--fmi-version",
+        "--fmi",
         type=int,
         choices=(2, 3),
         default=2,
         help="FMI version of both FMUs (default: 2)",
     )
     p.add_argument("--verbose", action="store_true", help="print each run on stderr")
+    p.add_argument(
+        "--scene",
+        type=Path,
+        metavar="FILE.toml",
+        help="instead of the study: turn the crank of your own scene (one crank, no other "
+        "driver; its FMU built where it is stale) with the drive FMU in the stabilised "
+        "coupling, the rotor inertia the mean of its crank.J over a revolution; writes "
+        "OUT/<identifier>_cosim.csv (time, crank angle, speed, acceleration, torque and "
+        "every pair reaction, units in the header) and OUT/<identifier>_cosim.png, and "
+        "prints the mean speed, the speed ripple and the peak torque and reaction",
+    )
+    scene_drive.add_machine_options(p)
     return p
 
 
 #: The path arguments, checked before any work (dyadfmu.paths.parse_checked).
-PATHS = (("--out", "out", paths.OUT),)
+PATHS = (("--out", "out", paths.OUT), ("--scene", "scene", paths.FILE))
+
+
+def _options_problem(args: argparse.Namespace) -> str | None:
+    """What is wrong with the options beyond each one's own type, or None: those of
+    :func:`dyadfmu.cosim.scene_drive.options_problem`, and the study's --quick with --scene."""
+    if args.scene is not None and args.quick:
+        return "--quick is the study's, not a scene's"
+    return scene_drive.options_problem(args)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run 'dyadfmu cosim' with `argv`: the study, its report and a summary."""
-    args = paths.parse_checked(parser(), argv, PATHS)
+    command = parser()
+    args = paths.parse_checked(command, argv, PATHS)
+    problem = _options_problem(args)
+    if problem:
+        command.error(problem)
+    if args.scene is not None:
+        return scene_cosim.main(args)
     try:
         result = run_study(
             args.out, quick=args.quick, fmi_version=args.fmi_version, verbose=args.verbose

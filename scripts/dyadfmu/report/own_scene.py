@@ -55,7 +55,9 @@ def stale(fmu: Path, scene: Path, project: Path) -> bool:
 
 
 def scene_fmu(scene: Path, identifier: str, fmi: int, out: Path, say: Callable) -> Path:
-    """The scene's FMU, built (into the build folder of scene studies) where it is stale."""
+    """The scene's FMU of FMI version `fmi`, built (into the build folder of scene studies,
+    :func:`dyadfmu.sweep.scenebuild.build_folder`) where it is stale; DrawingError where the
+    build refuses the scene."""
     folder = scenebuild.build_folder(out)
     fmu = folder / "fmus" / f"{identifier}_fmi{fmi}.fmu"
     if stale(fmu, scene, paths.project_dir()):
