@@ -27,7 +27,8 @@ dyadfmu_check_args() {
 # compiler, make, CMake, pkg-config (scripts/tests/test_install.py) and Python with
 # venv; NEED `study`: GSL (the generic-solve baseline of the benchmark) and valgrind
 # (its instruction counts); `windows`: the MinGW-w64 cross compiler and Wine (the
-# FMUs' Windows binaries, tested under Wine).
+# FMUs' Windows binaries, tested under Wine); `browser`: chromium and chromium-driver (the
+# animation's page in a real browser, headless).
 # As root the missing ones are installed; otherwise the command stops, naming them
 # and itself.
 dyadfmu_ensure_system() {
@@ -50,8 +51,12 @@ dyadfmu_ensure_system() {
             command -v x86_64-w64-mingw32-gcc >/dev/null 2>&1 || missing+=(gcc-mingw-w64-x86-64)
             command -v wine >/dev/null 2>&1 || missing+=(wine wine64)
             ;;
+        browser)
+            command -v chromium >/dev/null 2>&1 || missing+=(chromium)
+            command -v chromedriver >/dev/null 2>&1 || missing+=(chromium-driver)
+            ;;
         *)
-            dyadfmu_log "dyadfmu_ensure_system: unknown need '$need' (study, windows)"
+            dyadfmu_log "dyadfmu_ensure_system: unknown need '$need' (study, windows, browser)"
             return 2
             ;;
         esac

@@ -150,6 +150,7 @@ def test_wheel_holds_core_and_fmus(wheel):
     assert set(EXPECTED_FMUS) <= fmus, sorted(fmus)
     assert all(name.endswith(".fmu") for name in fmus)
     assert "dyadfmu/mechanisms/builtin.py" in names
+    assert "dyadfmu/animation/page.html" in names  # the animation's page template
     assert any(n.startswith("dyadfmu/mechanisms/") and n.endswith(".toml") for n in names)
     # the C install of `cmake --install` (headers, static libraries, CMake package) stays out;
     # the sources of a scene's FMU are there, under dyadfmu/_project only
@@ -306,6 +307,26 @@ def test_installed_package_runs_a_scene_study_from_its_own_sources_only(venv, tm
         for version in (2, 3):
             fmu = work / "mine" / "fmus" / f"balance_fmi{version}.fmu"
             assert f"{fmu}: " in built and fmu.is_file()
+        # and, with every output, animated by the installed command from its own template
+        every = (
+            (work / "balance.toml")
+            .read_text()
+            .replace('outputs = ["crank.R_O", "crank.torque"]', 'outputs = ["all"]')
+        )
+        (work / "shown.toml").write_text(every.replace('"balance"', '"shown"', 1))
+        shown = _run(dyadfmu, "animate", "shown.toml", "--no-gif", "--instants", "9",
+                     "--out", "anim", cwd=work, env=_clean_env())  # fmt: skip
+        assert not marker.exists(), marker.read_text()
+        page = work / "anim" / "shown_animation.html"
+        assert "shown_animation.html" in shown and "__DYADFMU_DATA__" not in page.read_text()
+        # drawn and reported, and turned by the drive FMU, its FMU built once
+        drawn = _run(dyadfmu, "scene", "shown.toml", "--out", "anim", cwd=work, env=_clean_env())
+        assert "shown_report.md" in drawn
+        turned = _run(dyadfmu, "cosim", "--scene", "shown.toml", "--duration", "0.1", "--out",
+                      "anim", cwd=work, env=_clean_env())  # fmt: skip
+        assert "mean speed" in turned and (work / "anim" / "shown_cosim.csv").is_file()
+        assert len(list((work / "anim" / "build-scene" / "fmus").glob("shown_fmi*.fmu"))) == 2
+        assert not marker.exists(), marker.read_text()
     finally:
         for name in ("modelDescription", "scripts", "build", "CMakeLists.txt"):
             target = derived / name

@@ -230,6 +230,19 @@ def test_a_scene_the_drive_cannot_turn_is_refused_in_one_line(scene, why, tmp_pa
     assert not list(tmp_path.iterdir())
 
 
+def test_a_mechanism_that_does_not_go_through_a_turn_is_refused_in_one_line(tmp_path, capsys):
+    """A slider-crank whose rod is shorter than the crank: no assembly over part of the turn."""
+    required_tool("cmake")
+    text = (SCENES / "slider_crank.toml").read_text().replace("length = 0.18", "length = 0.05")
+    scene = tmp_path / "short_rod.toml"
+    scene.write_text(text.replace('identifier = "slider_crank"', 'identifier = "short_rod"'))
+    status, out, err = _cosim(capsys, "--scene", scene, "--out", tmp_path / "out")
+    said = err.strip().splitlines()[-1]  # after the build's progress, one line
+    assert status == 1 and said.startswith("dyadfmu cosim: error: "), err
+    assert "no answer at 73 of 360 crank angles (the first 4.084 rad)" in said
+    assert "a drive cannot turn it" in said and not (tmp_path / "out").exists()
+
+
 def test_an_fmu_without_the_drive_s_outputs_is_named():
     """The press (no inertia) has no crank.J nor crank.torque0: the refusal says so."""
     fmu = paths.built_fmu("press", 2)

@@ -28,7 +28,8 @@ from .frames import DrawingError, Frames, Run, frames
 
 #: The arguments naming a path, checked before any work (cli.py).
 PATHS = (("--out", "out", paths.OUT),)
-MOST_INSTANTS = 20_000
+#: The most instants of a run (the page holds every one).
+MOST_INSTANTS = 5_000
 
 
 def _motion_options(p: argparse.ArgumentParser) -> None:
@@ -159,11 +160,9 @@ def _run(args: argparse.Namespace, say: Callable) -> tuple[Path, Path, Callable]
 
 def write_csv(found: Frames, path: Path) -> Path:
     """The values drawn: time, the drivers' coordinates, the pair positions and the
-    curves at each instant (NaN where there is no answer)."""
+    curves at each instant (NaN where there is no answer), every name the FMU's."""
     run = found.run
-    first = next(r for r in run.rows if r is not None)
-    names = [n for n in first if n.endswith((".position.x", ".position.y"))]
-    names = [*found.coordinates, *names]
+    names = [*found.coordinates, *found.positions]
     columns = [run.times] + [
         np.array([np.nan if r is None else r[n] for r in run.rows]) for n in names
     ]

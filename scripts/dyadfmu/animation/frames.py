@@ -48,7 +48,7 @@ class Curve:
 class Frames:
     """Everything an animation shows: the run, a pose per instant (None where the run
     has no answer), each point's label, each body's colour, the curves, the drivers'
-    efforts (outputs) and coordinates (inputs)."""
+    efforts (outputs), coordinates (inputs) and the pair positions drawn (outputs)."""
 
     identifier: str
     run: Run
@@ -58,6 +58,7 @@ class Frames:
     curves: tuple
     efforts: tuple
     coordinates: tuple
+    positions: tuple
 
     @property
     def answered(self) -> list[int]:
@@ -131,4 +132,10 @@ def frames(mechanism: dd.Mechanism, run: Run, names: list | None = None) -> Fram
         curves=curves(mechanism, run, names),
         efforts=tuple(d.effort for d in mechanism.scene.drivers),
         coordinates=tuple(d.input(0) for d in mechanism.scene.drivers),
+        positions=tuple(
+            f"{n[:-2]}.{axis}"
+            for n in mechanism.drawn_outputs()
+            if n.endswith(".position.x")
+            for axis in "xy"
+        ),
     )

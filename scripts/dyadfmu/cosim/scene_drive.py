@@ -168,13 +168,22 @@ def revolution_means(fmu: Path) -> tuple[float, float]:
                 '[effects] inertia = true and dynamics = "inverse"'
             )
         y.initialize()
+        angles = np.linspace(0.0, 2.0 * math.pi, SAMPLES, endpoint=False)
         rows = []
-        for angle in np.linspace(0.0, 2.0 * math.pi, SAMPLES, endpoint=False):
+        for angle in angles:
             y.set(("crank.angle", "crank.omega", "crank.epsilon"), (angle, 0.0, 0.0))
             rows.append(y.get(NEEDED))
     finally:
         y.close()
-    inertia, demand = np.mean(np.array(rows, dtype=float), axis=0)
+    rows = np.array(rows, dtype=float)
+    unanswered = np.flatnonzero(~np.all(np.isfinite(rows), axis=1))
+    if len(unanswered):
+        raise SceneRefused(
+            f"{fmu}: no answer at {len(unanswered)} of {SAMPLES} crank angles (the first "
+            f"{angles[unanswered[0]]:.4g} rad): the mechanism does not go through a whole turn, "
+            "so a drive cannot turn it (see where with 'dyadfmu scene FILE')"
+        )
+    inertia, demand = np.mean(rows, axis=0)
     return float(inertia), float(demand)
 
 
