@@ -182,6 +182,7 @@ static size_t round_up(size_t size)
 }
 
 static void build_slots(fmu_instance* instance);
+static void choose_evaluation(fmu_instance* instance);
 
 static void load_start_values(fmu_instance* instance)
 {
@@ -221,6 +222,19 @@ static void accepted_range(const fmu_variable* v, fmu_slot* slot)
     }
 }
 
+/* Whether `vr` is an output of the model's fmu_later. */
+static int is_later(const fmu_model* model, unsigned int vr)
+{
+    const fmu_later* later = model->behaviour->later;
+    size_t k;
+    for (k = 0; later != NULL && k < later->count; ++k) {
+        if (later->vrs[k] == vr) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
 static void build_slot(fmu_instance* instance, unsigned int vr, fmu_slot* slot)
 {
     const fmu_model* model = instance->model;
@@ -231,10 +245,12 @@ static void build_slot(fmu_instance* instance, unsigned int vr, fmu_slot* slot)
     slot->write = NULL;
     slot->read = NULL;
     slot->is_output = 0;
+    slot->later = 0;
     if (v == NULL) {
         slot->read = vr == 0 && instance->time_at_vr_0 ? &instance->time : NULL;
     } else if (v->causality == FMU_OUTPUT) {
         slot->is_output = 1;
+        slot->later = is_later(model, vr);
         if (v->target == FMU_TARGET_RESULT_REAL) {
             slot->read = (const double*)(const void*)((const char*)instance->output + v->offset);
         }
@@ -258,6 +274,8 @@ static void build_slots(fmu_instance* instance)
     }
     instance->set_plan.count = FMU_NO_PLAN; /* the accepted intervals changed */
     instance->get_plan.count = FMU_NO_PLAN;
+    instance->get_plan.later = 0;
+    choose_evaluation(instance);
 }
 
 void fmu_restored(fmu_instance* instance, fmu_state state)
@@ -527,6 +545,24 @@ FMU_COLD static void log_failure(fmu_instance* instance, fmu_status not_solvable
     }
 }
 
+/* The evaluation a step makes for what the importer reads: every output; but where the
+ * model can leave some to their first read (fmu_later) and the importer's get did not
+ * read any of them (an importer repeats its gets), the others alone. Chosen anew with
+ * each new get plan. */
+static void choose_evaluation(fmu_instance* instance)
+{
+    const fmu_behaviour* behaviour = instance->model->behaviour;
+    instance->leaves_later = behaviour->later != NULL && !instance->get_plan.later;
+    instance->evaluate_now = instance->leaves_later ? behaviour->later->first : behaviour->evaluate;
+}
+
+FMU_INLINE void evaluate_for_reads(fmu_instance* instance)
+{
+    instance->evaluate_now(instance->model, instance->input, instance->output,
+                           &instance->evaluation);
+    instance->later_pending = instance->leaves_later;
+}
+
 /* Evaluates if an input changed since the last evaluation. Returns FMU_OK,
  * FMU_ERROR for inputs the model rejects, or `not_solvable` where the model has
  * no answer (a singular dyad). A failure is logged when it is found; an Error
@@ -539,7 +575,7 @@ static fmu_status solve(fmu_instance* instance, fmu_status not_solvable, const c
     fmu_evaluation* e = &instance->evaluation;
     if (instance->dirty) {
         sync_angles(instance);
-        instance->model->behaviour->evaluate(instance->model, instance->input, instance->output, e);
+        evaluate_for_reads(instance);
         instance->dirty = 0;
         if (e->status != FMU_OK) {
             log_failure(instance, not_solvable, function);
@@ -662,6 +698,32 @@ static double stop_time(double current_time, double step_size, double reached)
     return stopped < end ? stopped : nextafter(end, current_time);
 }
 
+/* The outputs of the model's fmu_later now, after an evaluation that went well: 1 if
+ * they did too, else 0 (logged). */
+FMU_COLD static int later_now(fmu_instance* instance, const char* function)
+{
+    fmu_evaluation* e = &instance->evaluation;
+    instance->later_pending = 0;
+    instance->model->behaviour->later->later(instance->model, instance->input, instance->output, e);
+    if (e->status == FMU_OK) {
+        return 1;
+    }
+    log_failure(instance, FMU_WARNING, function);
+    return 0;
+}
+
+/* solve(), then the outputs of the model's fmu_later where they are not computed since
+ * the evaluation; a failure of theirs is logged when it is found (FMU_WARNING, as a
+ * get's failed solve). */
+static fmu_status solve_later(fmu_instance* instance, const char* function, int each_error)
+{
+    const fmu_status status = solve(instance, FMU_WARNING, function, each_error);
+    if (status != FMU_OK || !instance->later_pending) {
+        return status;
+    }
+    return later_now(instance, function) ? FMU_OK : FMU_WARNING;
+}
+
 /* solve() for a step, which says why whenever it returns Discard: a failure found before
  * the step (at initialisation, say) was logged by the call that found it, and is logged
  * again by the step it stops. */
@@ -778,8 +840,7 @@ fmu_status fmu_do_step(fmu_instance* instance, double current_time, double step_
         fmu_evaluation* e = &instance->evaluation;
         if (instance->dirty) {
             sync_angles(instance);
-            instance->model->behaviour->evaluate(instance->model, instance->input, instance->output,
-                                                 e);
+            evaluate_for_reads(instance);
             if (e->status != FMU_OK) {
                 /* found now: do_step_checked logs it, once, and decides */
                 instance->dirty = 1;
@@ -1129,6 +1190,9 @@ static fmu_status get_values(fmu_instance* instance, const unsigned int vr[], si
             worst = solve_counts ? solved_status : FMU_OK;
             solved = 1;
         }
+        if (slot != NULL && slot->later && instance->later_pending && worst == FMU_OK) {
+            worst = solve_later(instance, function, solve_counts);
+        }
         store_at(values, access.array, k, read_variable(instance, v));
     }
     return worst;
@@ -1150,6 +1214,9 @@ static int get_reals_at_once(fmu_instance* instance, const unsigned int vr[], si
         if (slots[vr[k]].is_output && !have_solved) {
             *solved = solve(instance, FMU_WARNING, function, 1);
             have_solved = 1;
+        }
+        if (slots[vr[k]].later && instance->later_pending && *solved == FMU_OK) {
+            *solved = solve_later(instance, function, 1);
         }
         values[k] = *slots[vr[k]].read;
     }
@@ -1332,6 +1399,10 @@ static void make_plan(const fmu_instance* instance, fmu_plan* plan, const unsign
     plan->bounded_count = bounded;
     plan->store = NULL;
     plan->load = NULL;
+    plan->later = 0;
+    for (k = 0; k < count; ++k) {
+        plan->later |= instance->slots[vr[k]].later;
+    }
     if (copies != NULL && count == copies->input_count && count > 0 &&
         same_references(copies->input_vrs, vr, count)) {
         plan->store = copies->store_inputs;
@@ -1407,6 +1478,7 @@ FMU_COLD static fmu_status get_reals_checked(fmu_instance* instance, const unsig
     if (vr != NULL && values != NULL &&
         get_reals_at_once(instance, vr, count, values, &solved, function)) {
         make_plan(instance, &instance->get_plan, vr, count);
+        choose_evaluation(instance);
         return solved;
     }
     return get_values(instance, vr, count, values, reals, 1, function);
@@ -1420,6 +1492,9 @@ fmu_status fmu_get_real(fmu_instance* instance, const unsigned int vr[], size_t 
         quiet_call(instance, FMU_OP_GET) && !instance->dirty &&
         instance->evaluation.status == FMU_OK &&
         same_references(instance->get_plan.vr, vr, count)) {
+        /* A plan that reads outputs of the model's fmu_later was made by a get that
+         * computed them, and a step after it evaluates every output (choose_evaluation):
+         * here they are never pending. */
         get_by_plan(&instance->get_plan, instance->output, count, values);
         return FMU_OK;
     }

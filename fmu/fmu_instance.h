@@ -76,6 +76,7 @@ typedef struct fmu_slot {
     double* write;      /* where a Real set stores the value */
     const double* read; /* where a Real get reads it; NULL: not a Real */
     int is_output;      /* the value is the model's: evaluate before reading */
+    int later;          /* an output of the model's fmu_later: computed when first read */
 } fmu_slot;
 
 /* The places of the last Real set or get that the slots accepted, by position,
@@ -97,6 +98,7 @@ typedef struct fmu_plan {
      * NULL: by `write` or `read`. */
     void (*store)(void* input, double* values, const double* from);
     void (*load)(const void* output, double* to);
+    int later; /* a get that reads an output of the model's fmu_later */
 } fmu_plan;
 
 /* An angle variable: kept as set, read by the model as its unit vector. */
@@ -127,8 +129,15 @@ typedef struct fmu_instance {
     /* the latest end of a step (s): the importer's stopTime, less the rounding of a
      * sum of steps that reaches it; +inf where none is defined */
     double stop_limit;
-    int terminate_requested;   /* set when a step cannot be completed */
-    int dirty;                 /* inputs changed since the last evaluation */
+    int terminate_requested; /* set when a step cannot be completed */
+    int dirty;               /* inputs changed since the last evaluation */
+    int later_pending;       /* the model's fmu_later outputs not computed since it */
+    /* The evaluation a step makes (choose_evaluation): the model's whole one, or where
+     * the importer's gets read none of its fmu_later outputs, its first half; and whether
+     * it leaves those outputs to their first read. */
+    void (*evaluate_now)(const struct fmu_model* model, const void* input, void* output,
+                         fmu_evaluation* evaluation);
+    int leaves_later;
     fmu_evaluation evaluation; /* of the last evaluation */
     double* values;            /* one per variable, as set; outputs unused */
     fmu_slot* slots;           /* one per value reference below model->vr_limit */

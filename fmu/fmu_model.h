@@ -125,6 +125,22 @@ typedef struct fmu_interpolation {
                          fmu_evaluation* evaluation);
 } fmu_interpolation;
 
+/* Outputs an evaluation may leave to their first read (a scene's effective inertia: a
+ * kinematic pass of its own that an importer reading only torques and reactions need not
+ * pay for at every step): fmu_behaviour.evaluate in two halves, which together give what
+ * it gives, bit for bit. */
+typedef struct fmu_later {
+    const unsigned int* vrs; /* their value references */
+    size_t count;
+    /* Every output but those, which it leaves NaN. */
+    void (*first)(const struct fmu_model* model, const void* input, void* output,
+                  fmu_evaluation* evaluation);
+    /* After `first` returned FMU_OK on these blocks: those outputs too; FMU_DISCARD
+     * (every output NaN, the status output saying why) where they are not finite. */
+    void (*later)(const struct fmu_model* model, const void* input, void* output,
+                  fmu_evaluation* evaluation);
+} fmu_later;
+
 /* What a kind of model computes, on its own input and output blocks. */
 typedef struct fmu_behaviour {
     size_t input_size;  /* bytes of the input block */
@@ -154,6 +170,9 @@ typedef struct fmu_behaviour {
     /* A model with states that interpolates its inputs and differentiates its outputs
      * (canInterpolateInputs, maxOutputDerivativeOrder 1). NULL: it does neither. */
     const fmu_interpolation* interpolation;
+    /* Outputs computed when first read after an evaluation (an algebraic model only);
+     * NULL: the evaluation computes every output. */
+    const fmu_later* later;
 } fmu_behaviour;
 
 /* The calls an importer makes every step, set every Real input and get every Real

@@ -230,4 +230,5 @@ const fmu_behaviour fmu_drive_behaviour = {sizeof(fmu_drive_input),
                                            advance,
                                            NULL,
                                            &drive_state_table,
+                                           NULL,
                                            NULL};

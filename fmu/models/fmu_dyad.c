@@ -138,4 +138,5 @@ const fmu_behaviour fmu_dyad_behaviour = {sizeof(dyad_input),
                                           NULL,
                                           derivative,
                                           NULL,
+                                          NULL,
                                           NULL};

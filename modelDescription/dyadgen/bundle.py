@@ -100,8 +100,9 @@ def scene_sources(table: Table, derivatives: bool) -> dict[str, str]:
     """scene/: the generated header and C of the scene, by bundle path."""
     ident = table.identifier
     files = {
-        f"scene/{ident}_scene.h": scene_header(table),
-        f"scene/{ident}_scene.c": scene_c(table.scene),
+        # without the halves of evaluate an FMU step uses: a controller evaluates whole
+        f"scene/{ident}_scene.h": scene_header(table, halves=False),
+        f"scene/{ident}_scene.c": scene_c(table.scene, halves=False),
     }
     if derivatives:
         files[f"scene/{ident}_scene_tangent.c"] = scene_tangent_c(table.scene)

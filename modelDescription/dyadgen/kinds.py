@@ -34,7 +34,7 @@ from dyadgen.dyadtypes import PAIRS
 from dyadgen.emit import documentation, fmi2, fmi3
 from dyadgen.emit.c_table import model_c
 from dyadgen.emit.forward_c import forward_behaviour
-from dyadgen.emit.scene_c import scene_c, scene_header, scene_tangent_c
+from dyadgen.emit.scene_c import later_members, scene_c, scene_header, scene_tangent_c
 from dyadgen.model import Input, Param, Scene, member
 from dyadgen.scenefile.problems import SceneError
 from dyadgen.settings import ON_SINGULAR
@@ -452,7 +452,7 @@ class SceneKind(Kind):
         layer's untyped blocks."""
         if table.scene.forward():
             return forward_behaviour(table.scene), "NULL"
-        return scene_behaviour(table.identifier), "NULL"
+        return scene_behaviour(table), "NULL"
 
     def documentation(self, table: Table) -> str:
         """The page of the scene."""
@@ -494,10 +494,13 @@ MOTOR = MotorKind(
 KINDS = {"dyad": DYAD, "drive": DRIVE, "motor": MOTOR}
 
 
-def scene_behaviour(ident: str) -> list[str]:
+def scene_behaviour(table: Table) -> list[str]:
     """The C of a scene's fmu_behaviour, <identifier>_behaviour: its initialise, and its
-    evaluate and derivative on the scene's functions."""
-    return [
+    evaluate and derivative on the scene's functions; where some outputs can come later
+    (emit/scene_c.py, later_members), the halves of evaluate as its fmu_later."""
+    ident = table.identifier
+    later = later_members(table.scene)
+    lines = [
         f"/* The scene's functions ({ident}_scene.c, {ident}_scene_tangent.c) as the FMU",
         " * layer calls them. */",
         "static void initialise(const fmu_model* model, void* input)",
@@ -521,12 +524,40 @@ def scene_behaviour(ident: str) -> list[str]:
         f"                       ({ident}_output*)output, ({ident}_output*)rate, evaluation);",
         "}",
         "",
+        *(_later_behaviour(table, later) if later else []),
         f"static const fmu_behaviour {ident}_behaviour = {{sizeof({ident}_input),",
         f"                                                sizeof({ident}_output), initialise,",
         "                                                evaluate, NULL, NULL, derivative, NULL,",
-        "                                                NULL};",
+        f"                                                NULL, {'&later' if later else 'NULL'}}};",
         "",
     ]
+    return lines
+
+
+def _later_behaviour(table: Table, later: tuple[str, ...]) -> list[str]:
+    """The outputs an FMU step can leave to their first read: their value references and
+    the two halves of the evaluation."""
+    ident = table.identifier
+    vrs = [v.vr for v in table.variables if v.lives.struct == "result" and v.lives.path in later]
+    lines = [
+        "/* The effective inertia's outputs, computed by a kinematic pass of their own: an",
+        " * importer that does not read them does not wait for them. */",
+        f"static const unsigned int later_vrs[] = {{{', '.join(f'{vr}u' for vr in vrs)}}};",
+        "",
+    ]
+    for half in ("first", "later"):
+        lines += [
+            f"static void evaluate_{half}(const fmu_model* model, const void* input, void* output,",
+            f"                          {' ' * len(half)}fmu_evaluation* evaluation)",
+            "{",
+            "    (void)model;",
+            f"    {ident}_evaluate_{half}((const {ident}_input*)input, ({ident}_output*)output,",
+            f"    {' ' * len(ident)}               {' ' * len(half)}evaluation);",
+            "}",
+            "",
+        ]
+    halves = "evaluate_first, evaluate_later"
+    return [*lines, f"static const fmu_later later = {{later_vrs, {len(vrs)}, {halves}}};", ""]
 
 
 class SceneTable(Table):

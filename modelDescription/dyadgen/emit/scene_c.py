@@ -37,6 +37,7 @@ KINEMATICS_TEMPLATE = TEMPLATE.with_name("scene_kinematics.c.in")
 HELPERS_TEMPLATE = TEMPLATE.with_name("scene_helpers.c.in")
 TANGENT_TEMPLATE = TEMPLATE.with_name("scene_tangent.c.in")
 FIXED_POINT_TEMPLATE = TEMPLATE.with_name("scene_fixed_point.c.in")
+CHECK_TEMPLATE = TEMPLATE.with_name("scene_check.c.in")
 #: the failure of a dyad whose values solve while their rates overflow: the derivative's alone
 DERIVATIVE_CASE = """    } else if (dyad->status == DYAD_STATUS_OK) {
         /* the values solve, their rates overflow */
@@ -819,7 +820,8 @@ def _output_exprs(scene: Scene) -> dict[str, str]:
     return exprs
 
 
-def _outputs(plan: Plan, code: _Code) -> None:
+def _outputs(plan: Plan, code: _Code, later: tuple[str, ...] = ()) -> None:
+    """Every output written, those given later (see :func:`later_members`) NaN."""
     code()
     code("/* Outputs */")
     exprs = _output_exprs(plan.scene)
@@ -827,9 +829,61 @@ def _outputs(plan: Plan, code: _Code) -> None:
         exprs[MECHANISM_AMPLIFICATION] = mechanism_amplification(plan)
     for o in plan.scene.outputs:
         if not o.integer:
-            code(f"out->{o.member} = {exprs[o.member]};")
+            code(f"out->{o.member} = {'NAN' if o.member in later else exprs[o.member]};")
     code("out->status = 0;")
     code("check(out, evaluation);")
+
+
+def _inertia_members(plan: Plan) -> tuple[set[str], list[str]]:
+    """The effective inertia's pass (:func:`_driver_inertia`): (the output members it
+    gives, the drivers' efforts it reads)."""
+    scene = plan.scene
+    if len(plan.drivers) > 1:
+        drivers = plan.drivers
+        gives = {inertia_entry_member(scene, a, b) for a in drivers for b in drivers}
+        efforts = [(member(a.driver_name()), effort_of(a)[0]) for a in drivers]
+        efforts = [
+            (c, e) for (c, e), a in zip(efforts, drivers, strict=True) if _wanted(plan, a, f"{e}0")
+        ]
+    else:
+        c = member(scene.crank.driver_name())
+        balance = "force" if scene.crank.balances_with_force() else "torque"
+        gives = {f"{c}_reduced_j", f"{c}_reduced_djdq"}
+        efforts = [(c, balance)] if _wanted(plan, scene.crank, f"{balance}0") else []
+    gives |= {f"{c}_{e}0" for c, e in efforts}
+    return gives, [f"{c}_{e}" for c, e in efforts]
+
+
+def later_members(scene: Scene) -> tuple[str, ...]:
+    """The outputs of the effective inertia's own kinematic pass (J and dJ/dq, or M(q),
+    and each driver's effort at zero acceleration) where that pass can run after the
+    rest, as <identifier>_evaluate_later: a mechanism of inverse dynamics whose every
+    effort the pass reads is an output. An FMU step leaves them to their first read.
+    Empty where there is no such pass, or where a plant's step needs it."""
+    plan = Plan(scene)
+    if not (scene.internal() and plan.inertia_needed) or scene.forward():
+        return ()
+    gives, reads = _inertia_members(plan)
+    exprs = _output_exprs(scene)
+    outputs = {o.member for o in scene.outputs if not o.integer}
+    if any(r not in outputs or exprs.get(r) != r for r in reads):
+        return ()
+    return tuple(o.member for o in scene.outputs if o.member in gives)
+
+
+def _later_body(plan: Plan, later: tuple[str, ...]) -> list[str]:
+    """<identifier>_evaluate_later's body: the efforts from the outputs, the effective
+    inertia's pass, its outputs and their check."""
+    code = _Code()
+    for effort in _inertia_members(plan)[1]:
+        code(f"const double {effort} = out->{effort};")
+    _driver_inertia(plan, code)
+    exprs = _output_exprs(plan.scene)
+    code()
+    for m in later:
+        code(f"out->{m} = {exprs[m]};")
+    code("check_later(out, evaluation);")
+    return drop_unused_constants(code.lines)
 
 
 def drop_unused_constants(lines: list) -> list:
@@ -944,9 +998,11 @@ def _failure_text(scene: Scene) -> str:
     return "\n".join(lines)
 
 
-def _helpers(plan: Plan, tangent: bool = False, later: str = "") -> str:
+def _helpers(
+    plan: Plan, tangent: bool = False, later_code: str = "", later: tuple[str, ...] = ()
+) -> str:
     """What a file of the scene reports a failure with: set_nan, fail, the kinematics
-    (see _kinematics_code) and check."""
+    (see _kinematics_code) and check (with check_later for the outputs ``later``)."""
     reals = [o.member for o in plan.scene.outputs if not o.integer]
     return _template(HELPERS_TEMPLATE).substitute(
         ident=plan.scene.identifier,
@@ -956,20 +1012,42 @@ def _helpers(plan: Plan, tangent: bool = False, later: str = "") -> str:
         )
         if plan.solved
         else "",
-        kinematics_code=_kinematics_code(plan, tangent, later),
+        kinematics_code=_kinematics_code(plan, tangent, later_code),
         fail_cylinder=_template(FAIL_CYLINDER_TEMPLATE).substitute(ident=plan.scene.identifier)
         if plan.crank_needed and kinematics_c.cylinders(plan.scene)
         else "",
-        check_terms=" + ".join(f"(out->{m} - out->{m})" for m in reals) or "0.0",
+        check_functions=_checks(plan.scene.identifier, reals, later),
     )
 
 
-def _evaluation(scene: Scene) -> tuple[Plan, list[str], list[str], list[str]]:
-    """(plan, dyad declarations, crank declarations, body) of the scene's evaluate."""
+def _checks(ident: str, reals: list[str], later: list[str]) -> str:
+    """check: every Real output finite, else each one NaN and status 3; with outputs given
+    later (see :func:`later_members`), check over the others and check_later over those."""
+
+    def one(name: str, members: list[str]) -> str:
+        terms = " + ".join(f"(out->{m} - out->{m})" for m in members) or "0.0"
+        return _template(CHECK_TEMPLATE).substitute(ident=ident, name=name, check_terms=terms)
+
+    if not later:
+        return one("check", reals)
+    first = [m for m in reals if m not in later]
+    return one("check", first) + "\n" + one("check_later", [m for m in reals if m in later])
+
+
+def _evaluation(
+    scene: Scene, later: tuple[str, ...] = ()
+) -> tuple[Plan, list[str], list[str], list[str]]:
+    """(plan, dyad declarations, crank declarations, body) of the scene's evaluate; with
+    outputs given later (:func:`later_members`), of <identifier>_evaluate_first."""
     plan = Plan(scene)
     code = _Code()
     for write in PASSES:
-        write(plan, code)
+        if not later:
+            write(plan, code)
+        elif write is _outputs:
+            _outputs(plan, code, later)
+        elif write is not _driver_inertia:
+            write(plan, code)
     dyad_decls, crank_decls = _declarations(plan)
     return plan, dyad_decls, crank_decls, drop_unused_constants(code.lines)
 
@@ -993,20 +1071,47 @@ def _file_fields(plan: Plan) -> dict[str, str]:
     }
 
 
-def scene_c(scene: Scene) -> str:
-    """<identifier>_scene.c: the computation of the scene (of its current outputs),
-    <identifier>_evaluate."""
+def _function(ident: str, name: str, body: list[str]) -> list[str]:
+    """A function of the scene on (in, out, evaluation) with this body."""
+    head = f"void {ident}_{name}("
+    return [
+        f"{head}const {ident}_input* in, {ident}_output* out,",
+        f"{' ' * len(head)}fmu_evaluation* evaluation)",
+        "{",
+        *body,
+        "}",
+    ]
+
+
+def _functions(scene: Scene, later: tuple[str, ...]) -> tuple[Plan, str]:
+    """<identifier>_evaluate; with outputs ``later`` (:func:`later_members`), its two halves
+    too, <identifier>_evaluate_first and <identifier>_evaluate_later (the same terms, so
+    the same values bit for bit), for a caller that reads those only now and then."""
     plan, dyad_decls, crank_decls, body = _evaluation(scene)
+    ident = scene.identifier
+    lines = _function(ident, "evaluate", [*dyad_decls, *crank_decls, "    (void)in;", *body])
+    if later:
+        plan, dyad_decls, crank_decls, body = _evaluation(scene, later)
+        first = [*dyad_decls, *crank_decls, "    (void)in;", *body]
+        lines += ["", *_function(ident, "evaluate_first", first), ""]
+        lines += _function(ident, "evaluate_later", _later_body(plan, later))
+    return plan, "\n".join(lines) + "\n"
+
+
+def scene_c(scene: Scene, halves: bool = True) -> str:
+    """<identifier>_scene.c: the computation of the scene (of its current outputs),
+    <identifier>_evaluate; with ``halves``, where some of its outputs can come after the
+    others (:func:`later_members`), <identifier>_evaluate_first and _later too (an FMU's;
+    a bundle for a controller leaves them out)."""
+    later = later_members(scene) if halves else ()
+    plan, functions = _functions(scene, later)
     return _template().substitute(
         _file_fields(plan),
         description=textsafe.c_comment(scene.description),
         inertia="on" if scene.inertia else "off",
         gravity="on" if scene.gravity else "off",
-        helpers=_helpers(plan),
-        evaluate_indent=" " * len(f"void {scene.identifier}_evaluate("),
-        dyad_decls="\n".join(dyad_decls),
-        crank_decls="\n".join(crank_decls),
-        body="\n".join(body),
+        helpers=_helpers(plan, later=later),
+        functions=functions,
     )
 
 
@@ -1020,7 +1125,7 @@ def scene_tangent_c(scene: Scene) -> str:
     reals = [o.member for o in scene.outputs if not o.integer]
     return _template(TANGENT_TEMPLATE).substitute(
         _file_fields(plan),
-        helpers=_helpers(plan, tangent=True, later=kinematics + derivative),
+        helpers=_helpers(plan, tangent=True, later_code=kinematics + derivative),
         kinematics_tangent=kinematics,
         rate_check_terms=" + ".join(f"(rate->{m} - rate->{m})" for m in reals) or "0.0",
         derivative_indent=" " * len(f"void {scene.identifier}_derivative("),
@@ -1028,8 +1133,9 @@ def scene_tangent_c(scene: Scene) -> str:
     )
 
 
-def scene_header(table: Table) -> str:
-    """<identifier>_scene.h: the input and output blocks of the scene."""
+def scene_header(table: Table, halves: bool = True) -> str:
+    """<identifier>_scene.h: the input and output blocks of the scene and its functions
+    (``halves``: as :func:`scene_c`)."""
     scene = table.scene
     ident = scene.identifier
     guard = f"DYADFMU_SCENE_{ident.upper()}_H"
@@ -1061,8 +1167,27 @@ def scene_header(table: Table) -> str:
             lines.append(f"    int {name}; /* 0 ok, 1 singular, 3 out of range{cannot} */")
         else:
             lines.append(f"    double {name}; /* {units.get(name) or '-'} */")
-    lines += [f"}} {ident}_output;", "", *_prototypes(ident), "", f"#endif /* {guard} */"]
+    lines += [f"}} {ident}_output;", "", *_prototypes(ident)]
+    if halves and later_members(scene):
+        lines += ["", *_later_prototypes(ident, later_members(scene))]
+    lines += ["", f"#endif /* {guard} */"]
     return "\n".join(lines) + "\n"
+
+
+def _later_prototypes(ident: str, later: tuple[str, ...]) -> list[str]:
+    """The two halves of <identifier>_evaluate, where some outputs can come later."""
+    first, second = f"void {ident}_evaluate_first(", f"void {ident}_evaluate_later("
+    return [
+        f"/* {ident}_evaluate in two halves, for a caller that does not always read every",
+        f" * output: {ident}_evaluate_first gives every output but {', '.join(later)},",
+        " * which it leaves NaN (they need a kinematic pass of their own); after it returned",
+        f" * FMU_OK, {ident}_evaluate_later, with the same `in` and `out`, gives those too.",
+        f" * Together they give what {ident}_evaluate gives, bit for bit. */",
+        f"{first}const {ident}_input* in, {ident}_output* out,",
+        f"{' ' * len(first)}fmu_evaluation* evaluation);",
+        f"{second}const {ident}_input* in, {ident}_output* out,",
+        f"{' ' * len(second)}fmu_evaluation* evaluation);",
+    ]
 
 
 def _prototypes(ident: str) -> list[str]:

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 
 from ..study.speed import (
@@ -51,6 +52,7 @@ SCENE_HEADER = (
     "directions",
     "step / evaluation",
     "step / (evaluation + directions)",
+    "per step reading efforts and reactions only, FMI 2 / 3",
 )
 
 
@@ -88,9 +90,17 @@ def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
                 f"{two.directions:.0f}",
                 _both(two.ratio, three.ratio),
                 _both(two.ratio_with_directions, three.ratio_with_directions),
+                _partial(two, three),
             ]
         )
     return markup.table(SCENE_HEADER, rows, "-" + "r" * (len(SCENE_HEADER) - 1))
+
+
+def _partial(two: object, three: object) -> str:
+    """A step reading only efforts and reactions, and its share of the whole step."""
+    if math.isnan(two.partial):
+        return "-"
+    return f"{_both(two.partial, three.partial, 0)} ({two.partial / two.step:.2f})"
 
 
 def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
@@ -136,7 +146,10 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "count atop `src/dyad_<type>.c`. Time per row: the best call of `dyadfmu.solve` on "
         "contiguous arrays of 10,000 rows (they fit the caches), over rounds that visit "
         "every type in turn (this shared machine has slow spells), its outputs new on every "
-        "call or written into the last call's (`out=`).",
+        "call or written into the last call's (`out=`). A mechanism FMU computes its "
+        "effective inertia (J, M(q), the efforts at zero acceleration: a kinematic pass of "
+        "their own) only when they are read: its step is also counted with a get of the "
+        "drivers' efforts and the pair reactions alone.",
         "",
         *_type_rows(types),
         "",
@@ -162,6 +175,7 @@ def write_csv(path: Path, types: list[TypeSpeed], scenes: list[SceneSpeed]) -> N
                 "instructions_per_batch_row",
                 "numpy_seconds_per_row",
                 "numpy_seconds_per_row_out",
+                "instructions_per_step_reading_efforts_and_reactions",
             ]
         )
         for t in types:
@@ -171,11 +185,12 @@ def write_csv(path: Path, types: list[TypeSpeed], scenes: list[SceneSpeed]) -> N
                     + [f"{t.solve_instructions:.1f}", f"{s.step:.1f}", f"{s.evaluate:.1f}"]
                     + [f"{s.directions:.1f}", f"{t.batch_instructions:.1f}"]
                     + [f"{t.numpy_seconds_per_row[False]:.4g}"]
-                    + [f"{t.numpy_seconds_per_row[True]:.4g}"]
+                    + [f"{t.numpy_seconds_per_row[True]:.4g}", ""]
                 )
         for scene in scenes:
             for version, s in scene.steps.items():
                 out.writerow(
                     [scene.scene, version, "", "", "", f"{s.step:.1f}", f"{s.evaluate:.1f}"]
                     + [f"{s.directions:.1f}", "", "", ""]
+                    + ["" if math.isnan(s.partial) else f"{s.partial:.1f}"]
                 )

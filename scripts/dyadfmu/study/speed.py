@@ -48,6 +48,9 @@ class Step:
     evaluate: float
     directions: float
     bare: float
+    #: a step whose get reads only the efforts and the pair reactions (a mechanism FMU
+    #: leaves its effective inertia to their first read); NaN where not measured
+    partial: float = math.nan
 
     @property
     def ratio(self) -> float:
@@ -173,11 +176,25 @@ def step_rows(md: ModelDescription, count: int, seed: int) -> tuple[list, list, 
     return inputs, outputs, rows
 
 
+def efforts_and_reactions(outputs: list) -> list:
+    """The outputs a step reading torques and bearing loads reads: every driver's effort
+    (``*.torque``, ``*.force``) and every pair reaction (``*.R_*``)."""
+    return [v for v in outputs if ".R_" in v.name or v.name.endswith((".torque", ".force"))]
+
+
 def _step_instructions(
-    build: Path, identifier: str, version: int, md: ModelDescription, rows: np.ndarray, work: Path
+    build: Path,
+    identifier: str,
+    version: int,
+    md: ModelDescription,
+    rows: np.ndarray,
+    work: Path,
+    read: Callable[[list], list] | None = None,
 ) -> tuple[float, float]:
-    """(instructions per step, of the evaluation inside it) over `rows`."""
+    """(instructions per step, of the evaluation inside it) over `rows`, the get reading
+    every Real output or those ``read`` chooses of them."""
     inputs, outputs, _ = step_rows(md, 1, seed=version)
+    outputs = read(outputs) if read else outputs
     data = work / "speed_fmu.bin"
     rows.astype("<f8").tofile(data)
     binary = paths.stage_binary(build, identifier, version)
@@ -198,7 +215,11 @@ def step_counts(build: Path, identifier: str, version: int, count: int, work: Pa
     angles = [k for k, v in enumerate(inputs) if v.unit == "rad"]
     held[:, angles] = rows[0, angles]
     step_held, _ = _step_instructions(build, identifier, version, md, held, work)
-    return Step(step=step, evaluate=evaluate, directions=step - step_held, bare=evaluate)
+    found = Step(step=step, evaluate=evaluate, directions=step - step_held, bare=evaluate)
+    if any(v.name.endswith(".J") or v.name.startswith("M.") for v in md.modelVariables):
+        read = efforts_and_reactions
+        found.partial, _ = _step_instructions(build, identifier, version, md, rows, work, read)
+    return found
 
 
 def batch_keywords(rows: np.ndarray) -> dict[str, np.ndarray]:
