@@ -1,0 +1,162 @@
+"""A whole mechanism over NumPy arrays: ``dyadfmu.evaluate(mechanism, inputs, outputs)``
+runs a mechanism FMU's model over every sample of a batch in one call of its binary
+(``dyadfmu_evaluate_rows``, no per-sample Python), computing only what the outputs asked
+need (a mechanism FMU leaves its effective inertia out unless it is asked).
+
+The mechanism: a shipped scene's name (its built FMU), a scene file ``.toml`` (its FMU
+built where missing or older than the file) or an ``.fmu``. Inputs and parameters by the
+FMU's variable names, in its units (an angle in rad); each an array or a number, all
+broadcast together (NumPy's rules) to the batch's shape; an input left out keeps its
+start value. Every value must be a finite real number; a name that is not an input
+(parameter) of the FMU, values that do not broadcast or are not finite are refused with
+the name, before anything runs. Each sample is the FMU's own answer to those inputs, bit
+for bit what its FMI calls give; a sample without an answer (the mechanism does not
+assemble there, a dyad at a dead centre) has NaN outputs and its status says so."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+
+from . import paths
+from .batch import _shown
+
+__all__ = ["Evaluation", "evaluate"]
+
+#: Samples per call of the binary: bounds the contiguous copy of the inputs.
+CHUNK = 65_536
+#: The FMI status of a sample with an answer.
+OK = 0
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The outputs asked, by name (arrays of the batch's shape, in ``units``), and each
+    sample's FMI status (0 ok; else the FMU had no answer there and the outputs are NaN)."""
+
+    values: dict
+    units: dict
+    status: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.values[name]
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Where the FMU answered."""
+        return self.status == OK
+
+
+def _fmu(mechanism: str | Path, fmi: int) -> Path:
+    """The FMU of a shipped scene's name, a scene file (built where stale) or an .fmu."""
+    text = str(mechanism)
+    if text.endswith(".fmu"):
+        if not Path(text).is_file():
+            raise ValueError(f"{text}: no such FMU")
+        return Path(text)
+    if text.endswith(".toml"):
+        from .report import drivers_drawing, own_scene
+
+        scene = Path(text).resolve()
+        if not scene.is_file():
+            raise ValueError(f"{text}: no such scene file")
+        identifier = drivers_drawing.read_scene(scene).identifier
+        return own_scene.scene_fmu(scene, identifier, fmi, Path.cwd(), lambda _: None)
+    if not (paths.SCENES_DIR / f"{text}.toml").is_file():
+        raise ValueError(
+            f"unknown mechanism {text!r}: a shipped scene's name, a scene file .toml or an .fmu"
+        )
+    return paths.built_fmu(text, fmi)
+
+
+def _named(given: dict, allowed: dict, what: str, fmu: Path) -> dict[str, np.ndarray]:
+    """The arrays ``given``, each name one of ``allowed`` (name -> unit), as float64."""
+    unknown = sorted(set(given) - set(allowed))
+    if unknown:
+        shown = ", ".join(sorted(allowed)) or "none"
+        raise ValueError(f"{', '.join(unknown)}: not {what} of {fmu.name} (its {what}: {shown})")
+    arrays = {}
+    for name, value in given.items():
+        try:
+            array = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError, OverflowError):
+            raise ValueError(f"{name} must be real numbers, not {_shown(value)}") from None
+        bad = np.flatnonzero(~np.isfinite(array))
+        if len(bad):
+            at = f"[{', '.join(map(str, np.unravel_index(bad[0], array.shape)))}]"
+            raise ValueError(
+                f"{name}{at if array.ndim else ''} is {array.flat[bad[0]]}: every value "
+                "must be finite"
+            )
+        arrays[name] = array
+    return arrays
+
+
+def _shape(arrays: dict[str, np.ndarray]) -> tuple[int, ...]:
+    try:
+        return tuple(np.broadcast_shapes(*(a.shape for a in arrays.values())))
+    except ValueError:
+        listed = ", ".join(f"{n} {a.shape}" for n, a in arrays.items())
+        raise ValueError(f"the inputs do not broadcast to one batch shape: {listed}") from None
+
+
+def _columns(arrays: dict, names: tuple, shape: tuple, start: int, stop: int) -> np.ndarray:
+    """Samples start to stop of the named arrays as contiguous rows."""
+    out = np.empty((stop - start, len(names)))
+    for k, name in enumerate(names):
+        out[:, k] = np.broadcast_to(arrays[name], shape).reshape(-1)[start:stop]
+    return out
+
+
+def evaluate(
+    mechanism: str | Path,
+    inputs: dict | None = None,
+    outputs: list | tuple = (),
+    parameters: dict | None = None,
+    fmi: int = 2,
+) -> Evaluation:
+    """The ``outputs`` (names of the FMU's Real variables) of ``mechanism`` at every sample
+    of ``inputs`` (name -> array or number) with ``parameters`` (tunable parameters,
+    name -> array or number); see the module's text."""
+    from .sweep.rows import rows_entry
+
+    fmu = _fmu(mechanism, fmi)
+    md = read_model_description(str(fmu))
+    reals = [v for v in md.modelVariables if v.type in ("Real", "Float64")]
+    units = {v.name: v.unit or "" for v in reals}
+    tunable = {v.name: units[v.name] for v in reals if v.causality == "parameter"}
+    x = _named(
+        dict(inputs or {}), {v.name: 0 for v in reals if v.causality == "input"}, "inputs", fmu
+    )
+    p = _named(dict(parameters or {}), tunable, "tunable parameters", fmu)
+    wanted = tuple(dict.fromkeys(outputs))
+    missing = [n for n in wanted if n not in units]
+    if missing or not wanted:
+        raise ValueError(
+            f"outputs: {', '.join(missing) or 'none asked'}: name Real variables of {fmu.name}"
+        )
+    shape = _shape({**x, **p})
+    entry = rows_entry(fmu)
+    if entry is None:
+        raise ValueError(f"{fmu.name} has no dyadfmu_evaluate_rows: not an FMU of this project")
+    return _run(entry, x, p, wanted, shape, {n: units[n] for n in wanted})
+
+
+def _run(entry: object, x: dict, p: dict, wanted: tuple, shape: tuple, units: dict) -> Evaluation:
+    """Every sample in chunks of CHUNK, into the outputs' arrays."""
+    count = math.prod(shape)
+    y = np.empty((count, len(wanted)))
+    status = np.empty(count, dtype=np.intc)
+    x_names, p_names = tuple(x), tuple(p)
+    for start in range(0, count, CHUNK):
+        stop = min(start + CHUNK, count)
+        y[start:stop], status[start:stop] = entry.evaluate(
+            p_names, _columns(p, p_names, shape, start, stop),
+            x_names, _columns(x, x_names, shape, start, stop), wanted,
+        )  # fmt: skip
+    values = {n: np.ascontiguousarray(y[:, k]).reshape(shape) for k, n in enumerate(wanted)}
+    return Evaluation(values, units, status.reshape(shape))

@@ -1,0 +1,110 @@
+"""``dyadfmu.evaluate``: a whole mechanism over NumPy arrays in one call of its FMU binary.
+Each sample is the FMU's own answer, bit for bit what fmpy's FMI calls give (run here row
+by row through ``run_table``), the physics against the harness's Newton-Euler reference,
+a sample without an answer NaN with its status, and every bad argument refused by name
+before anything runs."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from dyadfmu import evaluate, paths, run_table
+from dyadfmu.cosim import mechanism_fmus
+from tool_checks import required_tool
+
+OUTPUTS = ["crank.torque", "crank.R_O.x", "crank.R_O.y", "engine.R_mk.x", "engine.R_np.y"]
+SLIDER_CRANK = paths.SCENES_DIR / "slider_crank.toml"
+
+
+def test_every_sample_is_what_the_fmi_calls_give_bit_for_bit():
+    angle = np.linspace(-1.0, 7.0, 257)
+    omega = 50.0 + 10.0 * np.sin(angle)
+    found = evaluate("slider_crank", {"crank.angle": angle, "crank.omega": omega}, OUTPUTS)
+    assert found.ok.all() and found["crank.torque"].shape == (257,)
+    table = {"time": np.arange(257) * 1e-3, "crank.angle": angle, "crank.omega": omega}
+    rows = run_table(paths.built_fmu("slider_crank", 2), table, OUTPUTS)
+    for name in OUTPUTS:
+        assert np.array_equal(found[name], rows[name]), name
+    assert found.units["crank.torque"] == "N.m" and found.units["crank.R_O.x"] == "N"
+
+
+def test_the_reactions_are_the_reference_s():
+    """Against the harness's NumPy kinematics and Newton-Euler reference over a turn of
+    varying speed (the inputs and reference outputs of dyadfmu.cosim.mechanism_fmus)."""
+    co, series, _ = mechanism_fmus.setup("slider_crank", 2, motion="varying", revolutions=1)
+    found = evaluate("slider_crank", co.inputs, OUTPUTS)
+    for name in OUTPUTS:
+        want = np.asarray(series.outputs[name])
+        assert np.max(np.abs(found[name] - want)) <= 1e-13 * np.max(np.abs(want)), name
+
+
+def test_numbers_broadcast_to_the_batch_shape_and_parameters_apply():
+    angle = np.linspace(0.0, 1.0, 12).reshape(3, 4)
+    found = evaluate(
+        "shaper",
+        {"crank.angle": angle, "crank.omega": 6.0},
+        ["crank.torque", "crank.J"],
+        parameters={"slider.mass": 20.0},
+    )
+    assert found["crank.J"].shape == (3, 4) and found.status.shape == (3, 4)
+    light = evaluate("shaper", {"crank.angle": angle, "crank.omega": 6.0}, ["crank.J"])
+    assert np.all(found["crank.J"] > light["crank.J"])  # the heavier ram: more inertia
+    empty = evaluate("shaper", {"crank.angle": np.empty(0)}, ["crank.torque"])
+    assert empty["crank.torque"].shape == (0,) and empty.status.shape == (0,)
+
+
+def test_more_samples_than_a_chunk_are_all_there():
+    from dyadfmu import mechanism_batch
+
+    count = mechanism_batch.CHUNK + 5
+    angle = np.linspace(0.0, 2.0 * math.pi, count)
+    found = evaluate("four_bar", {"crank.angle": angle}, ["crank.torque"])
+    again = evaluate("four_bar", {"crank.angle": angle[-7:]}, ["crank.torque"])
+    assert np.array_equal(found["crank.torque"][-7:], again["crank.torque"])
+
+
+def test_a_scene_file_is_built_and_samples_without_an_answer_are_nan(tmp_path):
+    required_tool("cmake")
+    text = SLIDER_CRANK.read_text().replace('identifier = "slider_crank"', 'identifier = "rod5"')
+    scene = tmp_path / "rod5.toml"
+    scene.write_text(text.replace("length = 0.18", "length = 0.05"))
+    angle = np.linspace(0.0, 2.0 * math.pi, 361)
+    found = evaluate(scene, {"crank.angle": angle}, ["crank.torque"])
+    failed = ~found.ok
+    assert 0 < failed.sum() < 361
+    assert np.all(np.isnan(found["crank.torque"][failed]))
+    assert np.all(np.isfinite(found["crank.torque"][~failed]))
+    fmu = next(Path(paths.ROOT / "build-scene" / "fmus").glob("rod5_fmi2.fmu"))
+    by_file = evaluate(fmu, {"crank.angle": angle}, ["crank.torque"])
+    assert np.array_equal(by_file["crank.torque"], found["crank.torque"], equal_nan=True)
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (("nonesuch", {}, ["x"]), "unknown mechanism 'nonesuch'"),
+        (("x.fmu", {}, ["x"]), "x.fmu: no such FMU"),
+        (("slider_crank", {"crank.speed": 1.0}, OUTPUTS), "crank.speed: not inputs of"),
+        (("slider_crank", {}, ["crank.torque", "crank.force"]), "outputs: crank.force"),
+        (("slider_crank", {}, []), "outputs: none asked"),
+        (("slider_crank", {"crank.angle": [0.0, np.nan]}, OUTPUTS), "crank.angle[1] is nan"),
+        (("slider_crank", {"crank.omega": np.inf}, OUTPUTS), "crank.omega is inf"),
+        (("slider_crank", {"crank.angle": "fast"}, OUTPUTS), "crank.angle must be real numbers"),
+        (
+            ("slider_crank", {"crank.angle": np.zeros(3), "crank.omega": np.zeros(4)}, OUTPUTS),
+            "do not broadcast to one batch shape: crank.angle (3,), crank.omega (4,)",
+        ),
+    ],
+)
+def test_bad_arguments_are_refused_by_name(args, message):
+    with pytest.raises(ValueError) as refused:
+        evaluate(*args)
+    assert message in str(refused.value)
+
+
+def test_a_parameter_that_is_not_tunable_is_refused():
+    with pytest.raises(ValueError, match="slider.length: not tunable parameters of shaper_fmi2"):
+        evaluate("shaper", {}, ["crank.torque"], parameters={"slider.length": 1.0})
