@@ -20,7 +20,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from fmpy import read_model_description
 
 from . import paths
 from .batch import _shown
@@ -125,7 +124,10 @@ def evaluate(
     from .sweep.rows import rows_entry
 
     fmu = _fmu(mechanism, fmi)
-    md = read_model_description(str(fmu))
+    entry = rows_entry(fmu)  # loaded once per FMU
+    if entry is None:
+        raise ValueError(f"{fmu.name} has no dyadfmu_evaluate_rows: not an FMU of this project")
+    md = entry.md
     reals = [v for v in md.modelVariables if v.type in ("Real", "Float64")]
     units = {v.name: v.unit or "" for v in reals}
     tunable = {v.name: units[v.name] for v in reals if v.causality == "parameter"}
@@ -140,9 +142,6 @@ def evaluate(
             f"outputs: {', '.join(missing) or 'none asked'}: name Real variables of {fmu.name}"
         )
     shape = _shape({**x, **p})
-    entry = rows_entry(fmu)
-    if entry is None:
-        raise ValueError(f"{fmu.name} has no dyadfmu_evaluate_rows: not an FMU of this project")
     return _run(entry, x, p, wanted, shape, {n: units[n] for n in wanted})
 
 

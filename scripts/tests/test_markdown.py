@@ -243,7 +243,8 @@ def _speeds() -> tuple[list[TypeSpeed], list[SceneSpeed]]:
     types = [
         TypeSpeed(t, 60, 70.0, 200.0, dict(step), 150.0, {False: 2e-7, True: 1e-7}) for t in TYPES
     ]
-    return types, [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step))]
+    batch = {(73, False): 1e-6, (73, True): 2e-6, (10_000, False): 3e-7, (10_000, True): 5e-7}
+    return types, [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step), batch)]
 
 
 def test_the_study_report_and_its_speed_section_read_as_tables(tmp_path):
@@ -261,6 +262,7 @@ def test_the_study_report_and_its_speed_section_read_as_tables(tmp_path):
         study_report.CONTRACT_HEADER,
         speed_report.TYPE_HEADER,
         speed_report.SCENE_HEADER,
+        speed_report.BATCH_HEADER,
     ]
     assert [tuple(t.texts(0)) for t in found] == headers
     assert len(found[0].rows) == 1 + len(_summary()) and len(found[2].rows) == 1 + len(TYPES)

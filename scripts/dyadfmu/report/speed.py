@@ -96,6 +96,27 @@ def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
     return markup.table(SCENE_HEADER, rows, "-" + "r" * (len(SCENE_HEADER) - 1))
 
 
+#: The table of whole mechanisms over arrays: its header.
+BATCH_HEADER = (
+    "mechanism",
+    "samples",
+    "efforts and reactions, CPU per sample",
+    "every output, CPU per sample",
+)
+
+
+def _batch_rows(scenes: list[SceneSpeed]) -> list[str]:
+    """dyadfmu.evaluate per sample, where it was timed; none: no table."""
+    rows = []
+    for s in scenes:
+        for count in sorted({c for c, _ in s.samples}):
+            some, every = s.samples[count, False], s.samples[count, True]
+            rows.append([s.scene, f"{count:,}", f"{some * 1e9:.0f} ns", f"{every * 1e9:.0f} ns"])
+    if not rows:
+        return []
+    return ["", *markup.table(BATCH_HEADER, rows, "-rrr")]
+
+
 def _partial(two: object, three: object) -> str:
     """A step reading only efforts and reactions, and its share of the whole step."""
     if math.isnan(two.partial):
@@ -149,11 +170,14 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "call or written into the last call's (`out=`). A mechanism FMU computes its "
         "effective inertia (J, M(q), the efforts at zero acceleration: a kinematic pass of "
         "their own) only when they are read: its step is also counted with a get of the "
-        "drivers' efforts and the pair reactions alone.",
+        "drivers' efforts and the pair reactions alone. A whole mechanism over NumPy arrays "
+        "(`dyadfmu.evaluate`, one call of the FMU's binary): the CPU time per sample, the "
+        "best of several calls, asking the efforts and the reactions or every output.",
         "",
         *_type_rows(types),
         "",
         *_scene_rows(scenes),
+        *_batch_rows(scenes),
         *_targets(types, scenes),
     ]
 

@@ -80,10 +80,38 @@ class TypeSpeed:
 
 @dataclass
 class SceneSpeed:
-    """One built-in scene FMU's step against its evaluation, per FMI version."""
+    """One built-in scene FMU's step against its evaluation, per FMI version; for the
+    mechanisms of BATCH_SCENES, ``dyadfmu.evaluate``'s CPU seconds per sample, by (batch
+    size, whether every Real output is asked, else the efforts and reactions alone)."""
 
     scene: str
     steps: dict[int, Step] = field(default_factory=dict)
+    samples: dict = field(default_factory=dict)
+
+
+#: The mechanisms whose batch over arrays (dyadfmu.evaluate) is timed, and the batch sizes
+#: (the quick study: the first two).
+BATCH_SCENES = ("slider_crank", "four_bar", "shaper", "lift")
+BATCH_SIZES = (73, 10_000, 1_000_000)
+
+
+def batch_seconds(scene: str, count: int, every: bool, rounds: int) -> float:
+    """CPU seconds per sample of ``dyadfmu.evaluate`` on ``scene`` over ``count`` samples
+    of its inputs swinging about their start values (step_rows), asking every Real output
+    or the efforts and reactions alone: the best of ``rounds`` calls."""
+    from ..mechanism_batch import evaluate
+
+    md = read_model_description(str(paths.built_fmu(scene, 2)))
+    inputs, outputs, rows = step_rows(md, count, seed=11)
+    asked = [v.name for v in (outputs if every else efforts_and_reactions(outputs))]
+    given = {v.name: rows[:, k] for k, v in enumerate(inputs)}
+    evaluate(scene, {n: a[:1] for n, a in given.items()}, asked)  # loaded before timing
+    best = math.inf
+    for _ in range(rounds):
+        started = clock.process_time()
+        evaluate(scene, given, asked)
+        best = min(best, clock.process_time() - started)
+    return best / count
 
 
 def opening_comment(dyad: str, root: Path | None = None) -> tuple[Path, str]:
@@ -302,4 +330,9 @@ def measure(
         scenes.append(
             SceneSpeed(scene, {v: step_counts(build, scene, v, steps, work) for v in (2, 3)})
         )
+        if scene in BATCH_SCENES:
+            for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
+                for every in (False, True):
+                    rounds = 2 if count >= 1_000_000 else 5
+                    scenes[-1].samples[count, every] = batch_seconds(scene, count, every, rounds)
     return types, scenes

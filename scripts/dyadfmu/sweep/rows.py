@@ -28,6 +28,7 @@ class RowsEntry:
 
     def __init__(self, function: ctypes._CFuncPtr, md: ModelDescription):
         self._f = function
+        self.md = md
         self._token = md.guid.encode()
         self._vr = {v.name: v.valueReference for v in md.modelVariables}
         function.restype = ctypes.c_int
