@@ -228,6 +228,20 @@ def test_a_recorded_run_is_animated_and_a_bad_one_refused_in_one_line(tmp_path):
         another: "is not a recording of shaper_fmi2.fmu: none of its columns (motor.speed, "
         "tank.level) is a variable of it",
     }
+
+    def no_reactions(header, body):
+        keep = [i for i, n in enumerate(header) if ".R_" not in n]
+        return [header[i] for i in keep], [[r[i] for i in keep] for r in body]
+
+    # what the drawing needs is there: drawn, with the efforts alone beside it
+    bare = _rewritten(recorded, tmp_path / "no_reactions.csv", no_reactions)
+    shown = _animate(bare, "--scene", "shaper", "--no-gif", "--out", tmp_path / "bare")
+    assert shown.returncode == 0, shown.stderr[-2000:]
+    assert _csv(tmp_path / "bare" / "shaper_animation.csv").keys() >= {"crank.torque"}
+    named = _animate(
+        bare, "--scene", "shaper", "--curve", "slot.R_mk", "--no-gif", "--out", tmp_path
+    )
+    assert named.returncode == 1 and "--curve slot.R_mk: not in no_reactions.csv" in named.stderr
     for change, message in cases.items():
         bad = _rewritten(recorded, tmp_path / f"{change.__name__}.csv", change)
         refused = _animate(bad, "--scene", "shaper", "--no-gif", "--out", tmp_path / "bad")

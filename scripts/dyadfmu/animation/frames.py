@@ -96,15 +96,19 @@ def _curve(mechanism: dd.Mechanism, run: Run, name: str, units: dict) -> Curve:
 
 def curves(mechanism: dd.Mechanism, run: Run, names: list | None) -> tuple:
     """The curves ``names`` (by default every driver's effort and every pair reaction's
-    magnitude); a DrawingError naming one the FMU has not."""
+    magnitude the run holds); a DrawingError naming one the FMU has not, or the run."""
     known = curve_names(mechanism)
-    chosen = names or [d.effort for d in mechanism.scene.drivers] + reaction_names(mechanism)
+    held = set(next(r for r in run.rows if r is not None))
+    reactions = [n for n in reaction_names(mechanism) if f"{n}.x" in held and f"{n}.y" in held]
+    chosen = names or [d.effort for d in mechanism.scene.drivers] + reactions
     for name in chosen:
         if name not in known:
             raise DrawingError(
                 f"--curve {name}: not an output of {mechanism.path.name} nor a pair reaction "
                 f"(its reactions: {', '.join(reaction_names(mechanism)) or 'none'})"
             )
+        if name not in held and name not in reactions:
+            raise DrawingError(f"--curve {name}: not in {run.source}")
     units = {n: u for n, u in _units(mechanism).items() if n in mechanism.reals}
     return tuple(_curve(mechanism, run, n, units) for n in dict.fromkeys(chosen))
 
