@@ -102,6 +102,7 @@ BATCH_HEADER = (
     "samples",
     "efforts and reactions, CPU per sample",
     "every output, CPU per sample",
+    "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
 )
 
 
@@ -111,10 +112,14 @@ def _batch_rows(scenes: list[SceneSpeed]) -> list[str]:
     for s in scenes:
         for count in sorted({c for c, _ in s.samples}):
             some, every = s.samples[count, False], s.samples[count, True]
-            rows.append([s.scene, f"{count:,}", f"{some * 1e9:.0f} ns", f"{every * 1e9:.0f} ns"])
+            numpy = s.samples.get((count, "numpy"), math.nan)
+            yardstick = "-" if math.isnan(numpy) else f"{numpy * 1e9:.0f} ns ({numpy / some:.1f}x)"
+            rows.append(
+                [s.scene, f"{count:,}", f"{some * 1e9:.0f} ns", f"{every * 1e9:.0f} ns", yardstick]
+            )
     if not rows:
         return []
-    return ["", *markup.table(BATCH_HEADER, rows, "-rrr")]
+    return ["", *markup.table(BATCH_HEADER, rows, "-rrrr")]
 
 
 def _partial(two: object, three: object) -> str:
@@ -172,7 +177,9 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "their own) only when they are read: its step is also counted with a get of the "
         "drivers' efforts and the pair reactions alone. A whole mechanism over NumPy arrays "
         "(`dyadfmu.evaluate`, one call of the FMU's binary): the CPU time per sample, the "
-        "best of several calls, asking the efforts and the reactions or every output.",
+        "best of several calls, asking the efforts and the reactions or every output; against "
+        "the harness's stacked NumPy solve of a chain (its kinematics and every body's "
+        "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick.",
         "",
         *_type_rows(types),
         "",

@@ -82,7 +82,8 @@ class TypeSpeed:
 class SceneSpeed:
     """One built-in scene FMU's step against its evaluation, per FMI version; for the
     mechanisms of BATCH_SCENES, ``dyadfmu.evaluate``'s CPU seconds per sample, by (batch
-    size, whether every Real output is asked, else the efforts and reactions alone)."""
+    size, whether every Real output is asked, else the efforts and reactions alone), and
+    by (batch size, "numpy") the stacked NumPy solve of a chain (the yardstick)."""
 
     scene: str
     steps: dict[int, Step] = field(default_factory=dict)
@@ -93,6 +94,26 @@ class SceneSpeed:
 #: (the quick study: the first two).
 BATCH_SCENES = ("slider_crank", "four_bar", "shaper", "lift")
 BATCH_SIZES = (73, 10_000, 1_000_000)
+
+
+def numpy_yardstick_seconds(scene: str, count: int, rounds: int) -> float:
+    """CPU seconds per sample of the harness's stacked NumPy solve of a chain over
+    ``count`` samples of a turn: its kinematics and the Newton-Euler equations of every
+    body, one ``np.linalg.solve`` over the samples (``chains.Chain.reference``), the best
+    of ``rounds``; NaN for a mechanism that is not a chain (it has no such solve)."""
+    from ..cosim import mechanism_fmus
+
+    if mechanism_fmus.MECHANISM_FMUS[scene][0] != "chain":
+        return math.nan
+    chain = mechanism_fmus.mechanism_of(scene)
+    motion = chain.motion("constant", 1.0)
+    t = np.linspace(0.0, motion.duration, count)
+    best = math.inf
+    for _ in range(rounds):
+        started = clock.process_time()
+        chain.reference(chain.kinematics(t, motion))
+        best = min(best, clock.process_time() - started)
+    return best / count
 
 
 def batch_seconds(scene: str, count: int, every: bool, rounds: int) -> float:
@@ -332,7 +353,11 @@ def measure(
         )
         if scene in BATCH_SCENES:
             for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
+                rounds = 2 if count >= 1_000_000 else 5
                 for every in (False, True):
-                    rounds = 2 if count >= 1_000_000 else 5
                     scenes[-1].samples[count, every] = batch_seconds(scene, count, every, rounds)
+                if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
+                    scenes[-1].samples[count, "numpy"] = numpy_yardstick_seconds(
+                        scene, count, rounds
+                    )
     return types, scenes
