@@ -245,7 +245,9 @@ def _speeds() -> tuple[list[TypeSpeed], list[SceneSpeed]]:
     ]
     batch = {(73, False): 1e-6, (73, True): 2e-6, (10_000, False): 3e-7, (10_000, True): 5e-7}
     batch[10_000, "numpy"] = 2e-6
-    return types, [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step), batch)]
+    plant = {v: Step(4000.0, 250.0, 0.0, 200.0) for v in (2, 3)}  # 20x: not the rule's
+    scenes = [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step), batch)]
+    return types, [*scenes, SceneSpeed("plant", plant, plant=True)]
 
 
 def test_the_study_report_and_its_speed_section_read_as_tables(tmp_path):
@@ -270,6 +272,8 @@ def test_the_study_report_and_its_speed_section_read_as_tables(tmp_path):
     assert _cell(found[3], 1, 0) == SHOWN
     printed = "\n".join(speed_report.markdown(*_speeds()))
     assert [tuple(t.texts(0)) for t in mc.tables(printed)] == headers[2:]
+    # a plant's step (20x its evaluation: it integrates) is not held to the step rule
+    assert "`dyadfmu plants` measures it): worst 2.05x" in printed
 
 
 def _cosim_row(name: str, scheme: str, step: float, diverged: bool) -> dict:

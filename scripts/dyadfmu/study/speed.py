@@ -13,6 +13,7 @@ import re
 import shutil
 import subprocess
 import time as clock
+import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -88,6 +89,9 @@ class SceneSpeed:
     scene: str
     steps: dict[int, Step] = field(default_factory=dict)
     samples: dict = field(default_factory=dict)
+    #: a plant (dynamics = "forward"): its step integrates its motion over many
+    #: evaluations, so the step-to-evaluation rule is not its (dyadfmu plants measures it)
+    plant: bool = False
 
 
 #: The mechanisms whose batch over arrays (dyadfmu.evaluate) is timed, and the batch sizes
@@ -312,6 +316,13 @@ def builtin_scenes(root: Path | None = None) -> list[str]:
     return sorted(p.stem for p in folder.glob("*.toml") if not p.stem.startswith("dyad_"))
 
 
+def is_plant(scene: str, root: Path | None = None) -> bool:
+    """Whether the scene file says dynamics = "forward" (its FMU integrates its motion)."""
+    path = (root or paths.ROOT) / "modelDescription" / "scenes" / f"{scene}.toml"
+    with path.open("rb") as handle:
+        return tomllib.load(handle).get("scene", {}).get("dynamics") == "forward"
+
+
 def _time_numpy(types: list[TypeSpeed], rows_of: dict, quick: bool) -> None:
     """dyadfmu.solve's best time per row, over rounds that visit every type in turn: a
     spell in which this shared machine runs slow (it happens, for a second or so) spoils
@@ -349,7 +360,11 @@ def measure(
     for scene in builtin_scenes():
         log(f"speed: scene {scene}")
         scenes.append(
-            SceneSpeed(scene, {v: step_counts(build, scene, v, steps, work) for v in (2, 3)})
+            SceneSpeed(
+                scene,
+                {v: step_counts(build, scene, v, steps, work) for v in (2, 3)},
+                plant=is_plant(scene),
+            )
         )
         if scene in BATCH_SCENES:
             for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
