@@ -317,3 +317,18 @@ FMI2_Export int dyadfmu_evaluate_rows(const char* token, const unsigned int vr_p
     return (int)fmu_evaluate_rows(&fmu_this_model, token, 0, vr_p, n_p, p, vr_i, n_i, x, vr_o, n_o,
                                   y, status, rows);
 }
+
+/* Not FMI: the model at many samples in columns in one call, without an importer's
+ * instance (fmu_evaluate_columns), for dyadfmu.evaluate. Returns the fmu_status. */
+FMI2_Export int dyadfmu_evaluate_columns(const char* token, const unsigned int vr_x[], size_t n_x,
+                                         const double* const x[], const ptrdiff_t x_step[],
+                                         const unsigned int vr_y[], size_t n_y, double* const y[],
+                                         const ptrdiff_t y_step[], int status[], size_t count);
+FMI2_Export int dyadfmu_evaluate_columns(const char* token, const unsigned int vr_x[], size_t n_x,
+                                         const double* const x[], const ptrdiff_t x_step[],
+                                         const unsigned int vr_y[], size_t n_y, double* const y[],
+                                         const ptrdiff_t y_step[], int status[], size_t count)
+{
+    return (int)fmu_evaluate_columns(&fmu_this_model, token, 0, vr_x, n_x, x, x_step, vr_y, n_y, y,
+                                     y_step, status, count);
+}

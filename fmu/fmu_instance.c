@@ -1860,6 +1860,218 @@ fmu_status fmu_evaluate_rows(const fmu_model* model, const char* token, int time
     return FMU_OK;
 }
 
+/* ---- many samples in columns ---------------------------------------------------------------- */
+
+/* Where a column's values come from: its first value, and the doubles between two. */
+typedef struct column_source {
+    const double* at;
+    ptrdiff_t step;
+} column_source;
+
+/* Where an x column's values go in the input block (an angle as its unit vector), and
+ * the interval a value must lie in to be stored (fmu_slot's low and high). */
+typedef struct column_place {
+    double* at;
+    double low, high;
+    int angle;
+} column_place;
+
+/* The variable of a value reference, NULL where it names none. */
+static const fmu_variable* variable_of(const fmu_model* model, unsigned int vr)
+{
+    if (vr >= model->vr_limit || model->index_of_vr[vr] < 0) {
+        return NULL;
+    }
+    return &model->variables[model->index_of_vr[vr]];
+}
+
+/* A Real the input block keeps: an input or a parameter, as a number or an angle. */
+static int kept_in_input(const fmu_variable* v)
+{
+    return v != NULL && v->type == FMU_REAL &&
+           (v->causality == FMU_INPUT || v->causality == FMU_PARAMETER) &&
+           (v->target == FMU_TARGET_INPUT_REAL || v->target == FMU_TARGET_INPUT_ANGLE);
+}
+
+/* The columns of one call: x (inputs and parameters), y (outputs), a status each. */
+typedef struct column_call {
+    const unsigned int* vr_x;
+    size_t n_x;
+    const double* const* x;
+    const ptrdiff_t* x_step;
+    const unsigned int* vr_y;
+    size_t n_y;
+    double* const* y;
+    const ptrdiff_t* y_step;
+    int* status;
+    size_t count;
+} column_call;
+
+/* 1 if the call can be made: an algebraic model, every column there, the x columns
+ * inputs or parameters of the input block, the y columns Real outputs or such. */
+static int columns_valid(const fmu_model* model, const column_call* c)
+{
+    size_t k;
+    if (model->behaviour == NULL || model->behaviour->advance != NULL ||
+        (c->n_x > 0 && (c->vr_x == NULL || c->x == NULL || c->x_step == NULL)) ||
+        (c->n_y > 0 && (c->vr_y == NULL || c->y == NULL || c->y_step == NULL)) ||
+        (c->count > 0 && c->status == NULL)) {
+        return 0;
+    }
+    for (k = 0; k < c->n_x; ++k) {
+        if (c->x[k] == NULL || !kept_in_input(variable_of(model, c->vr_x[k]))) {
+            return 0;
+        }
+    }
+    for (k = 0; k < c->n_y; ++k) {
+        const fmu_variable* v = variable_of(model, c->vr_y[k]);
+        if (c->y[k] == NULL || v == NULL ||
+            !(kept_in_input(v) || (v->type == FMU_REAL && v->target == FMU_TARGET_RESULT_REAL))) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Where each x column's values go, and what a value must be. */
+static void place_columns(const fmu_instance* instance, const column_call* c, column_place place[])
+{
+    size_t k;
+    for (k = 0; k < c->n_x; ++k) {
+        const fmu_variable* v = variable_of(instance->model, c->vr_x[k]);
+        fmu_slot range;
+        accepted_range(v, &range);
+        place[k].at = (double*)(void*)((char*)instance->input + v->offset);
+        place[k].low = range.low;
+        place[k].high = range.high;
+        place[k].angle = v->target == FMU_TARGET_INPUT_ANGLE;
+    }
+}
+
+/* Where each y column's values come from: the output block, the x column of the same
+ * variable, or the value the instance keeps (a start value). */
+static void find_sources(fmu_instance* instance, const column_call* c, column_source source[])
+{
+    const fmu_model* model = instance->model;
+    size_t k, j;
+    for (k = 0; k < c->n_y; ++k) {
+        const fmu_variable* v = variable_of(model, c->vr_y[k]);
+        source[k].step = 0;
+        source[k].at = &instance->values[model->index_of_vr[c->vr_y[k]]];
+        if (v->target == FMU_TARGET_RESULT_REAL) {
+            source[k].at = (const double*)(const void*)((const char*)instance->output + v->offset);
+        } else if (v->target == FMU_TARGET_INPUT_REAL) {
+            source[k].at = (const double*)(const void*)((const char*)instance->input + v->offset);
+        }
+        for (j = 0; j < c->n_x; ++j) {
+            if (c->vr_x[j] == c->vr_y[k]) {
+                source[k].at = c->x[j];
+                source[k].step = c->x_step[j];
+            }
+        }
+    }
+}
+
+/* Sample `i`'s x values into the input block; 0 where the model refuses one (outside
+ * its bounds, or not finite), as a set of it would. */
+static int store_sample(const column_call* c, const column_place place[], size_t i)
+{
+    size_t k;
+    for (k = 0; k < c->n_x; ++k) {
+        const double value = c->x[k][(ptrdiff_t)i * c->x_step[k]];
+        if (!(value >= place[k].low && value <= place[k].high)) {
+            return 0;
+        }
+        if (place[k].angle) {
+            dyad_cos_sin(value, &place[k].at[0], &place[k].at[1]);
+        } else {
+            *place[k].at = value;
+        }
+    }
+    return 1;
+}
+
+/* 1 if a y column reads an output of the model's fmu_later. */
+static int reads_later(const fmu_model* model, const column_call* c)
+{
+    size_t k;
+    for (k = 0; k < c->n_y; ++k) {
+        if (is_later(model, c->vr_y[k])) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* As an importer's get after a set reports the evaluation: Warning where the model
+ * has no answer. */
+static fmu_status sample_status(fmu_status evaluated)
+{
+    if (evaluated == FMU_OK || evaluated == FMU_ERROR) {
+        return evaluated;
+    }
+    return FMU_WARNING;
+}
+
+static void evaluate_samples(fmu_instance* instance, const column_call* c,
+                             const column_place place[], const column_source source[])
+{
+    const fmu_model* model = instance->model;
+    const fmu_later* later = model->behaviour->later;
+    void (*evaluate)(const fmu_model*, const void*, void*, fmu_evaluation*) =
+        later != NULL && !reads_later(model, c) ? later->first : model->behaviour->evaluate;
+    fmu_evaluation* e = &instance->evaluation;
+    size_t i, k;
+    for (i = 0; i < c->count; ++i) {
+        fmu_status s = FMU_ERROR;
+        if (store_sample(c, place, i)) {
+            evaluate(model, instance->input, instance->output, e);
+            s = sample_status(e->status);
+        }
+        c->status[i] = (int)s;
+        for (k = 0; k < c->n_y; ++k) {
+            c->y[k][(ptrdiff_t)i * c->y_step[k]] =
+                s == FMU_OK ? source[k].at[(ptrdiff_t)i * source[k].step] : NAN;
+        }
+    }
+}
+
+fmu_status fmu_evaluate_columns(const fmu_model* model, const char* token, int time_at_vr_0,
+                                const unsigned int vr_x[], size_t n_x, const double* const x[],
+                                const ptrdiff_t x_step[], const unsigned int vr_y[], size_t n_y,
+                                double* const y[], const ptrdiff_t y_step[], int status[],
+                                size_t count)
+{
+    const fmu_logger quiet = {NULL, NULL, NULL, "columns"};
+    const column_call c = {vr_x, n_x, x, x_step, vr_y, n_y, y, y_step, status, count};
+    fmu_instance* instance;
+    column_place* place;
+    column_source* source;
+    if (!columns_valid(model, &c)) {
+        return FMU_ERROR;
+    }
+    instance = fmu_instantiate(model, "columns", token, quiet, 0, NULL, NULL, time_at_vr_0);
+    if (instance == NULL) {
+        return FMU_FATAL;
+    }
+    place = (column_place*)malloc((n_x + 1) * sizeof *place);
+    source = (column_source*)malloc((n_y + 1) * sizeof *source);
+    if (place == NULL || source == NULL || start_design(instance, 1, NULL, 0, NULL) != FMU_OK) {
+        const fmu_status why = place == NULL || source == NULL ? FMU_FATAL : FMU_ERROR;
+        free(place);
+        free(source);
+        fmu_free(instance);
+        return why;
+    }
+    place_columns(instance, &c, place);
+    find_sources(instance, &c, source);
+    evaluate_samples(instance, &c, place, source);
+    free(place);
+    free(source);
+    fmu_free(instance);
+    return FMU_OK;
+}
+
 int fmu_variable_named(const fmu_model* model, const char* name)
 {
     size_t k;

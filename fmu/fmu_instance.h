@@ -256,6 +256,23 @@ fmu_status fmu_evaluate_rows(const fmu_model* model, const char* token, int time
                              const unsigned int vr_o[], size_t n_o, double y[], int status[],
                              size_t rows);
 
+/* The model at `count` samples given in columns, without an importer's instance: the
+ * values of the inputs and tunable parameters vr_x (sample i of column k at
+ * x[k][i * x_step[k]]; a step of 0 holds one value for every sample; a variable left
+ * out keeps its start value) and the Real outputs vr_y read into y[k][i * y_step[k]]
+ * (an input or parameter among them reads as set), with that sample's status in
+ * status[i] as fmu_evaluate_rows gives it: each sample's values are what a set of its
+ * x and a get of its y give, bit for bit. A sample's outputs are computed only as far
+ * as y needs (a model's fmu_later outputs where one is read). No column may overlap
+ * another. FMU_ERROR (nothing written) for a model with states, a value reference
+ * that is not of these kinds, or a missing array; FMU_FATAL where no instance could
+ * be made. Not part of FMI: exported as dyadfmu_evaluate_columns for dyadfmu.evaluate. */
+fmu_status fmu_evaluate_columns(const fmu_model* model, const char* token, int time_at_vr_0,
+                                const unsigned int vr_x[], size_t n_x, const double* const x[],
+                                const ptrdiff_t x_step[], const unsigned int vr_y[], size_t n_y,
+                                double* const y[], const ptrdiff_t y_step[], int status[],
+                                size_t count);
+
 /* Error with a logged "not supported" for an entry point this FMU does not offer. */
 fmu_status fmu_unsupported(fmu_instance* instance, const char* function, const char* why);
 

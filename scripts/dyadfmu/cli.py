@@ -157,8 +157,10 @@ def _sweep_command(sub: argparse._SubParsersAction) -> None:
     sweep.add_argument(
         "--workers",
         type=whole(0, 256),
-        default=2,
-        help="local Dask worker processes (default 2; 0 runs in this process, without Dask)",
+        default=None,
+        help="local Dask worker processes (0 runs in this process, without Dask; default: "
+        "none for a crank, ram or cylinder run of at most 1,000,000 samples, designs x points, "
+        "which takes about a second here, else 2)",
     )
     sweep.add_argument(
         "--scheduler",

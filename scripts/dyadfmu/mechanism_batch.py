@@ -1,7 +1,8 @@
 """A whole mechanism over NumPy arrays: ``dyadfmu.evaluate(mechanism, inputs, outputs)``
-runs a mechanism FMU's model over every sample of a batch in one call of its binary
-(``dyadfmu_evaluate_rows``, no per-sample Python), computing only what the outputs asked
-need (a mechanism FMU leaves its effective inertia out unless it is asked).
+runs a mechanism FMU's model over every sample of a batch in calls of its binary
+(``dyadfmu_evaluate_columns``; a plant's through ``dyadfmu_evaluate_rows``; no per-sample
+Python), computing only what the outputs asked need (a mechanism FMU leaves its
+effective inertia out unless it is asked).
 
 The mechanism: a shipped scene's name (its built FMU), a scene file ``.toml`` (its FMU
 built where missing or older than the file) or an ``.fmu``. Inputs and parameters by the
@@ -121,7 +122,7 @@ def evaluate(
     """The ``outputs`` (names of the FMU's Real variables) of ``mechanism`` at every sample
     of ``inputs`` (name -> array or number) with ``parameters`` (tunable parameters,
     name -> array or number); see the module's text."""
-    from .sweep.rows import rows_entry
+    from .sweep.rows import columns_entry, rows_entry
 
     fmu = _fmu(mechanism, fmi)
     entry = rows_entry(fmu)  # loaded once per FMU
@@ -142,7 +143,30 @@ def evaluate(
             f"outputs: {', '.join(missing) or 'none asked'}: name Real variables of {fmu.name}"
         )
     shape = _shape({**x, **p})
-    return _run(entry, x, p, wanted, shape, {n: units[n] for n in wanted})
+    units = {n: units[n] for n in wanted}
+    by_columns = columns_entry(fmu)
+    done = _by_columns(by_columns, {**x, **p}, wanted, shape, units) if by_columns else None
+    return done if done is not None else _run(entry, x, p, wanted, shape, units)
+
+
+def _by_columns(entry: object, x: dict, wanted: tuple, shape: tuple, units: dict):
+    """Every sample in chunks of CHUNK through the columns entry (a value held for every
+    sample passed once); None where the binary refuses it (a model with states)."""
+    count = math.prod(shape)
+    flat = {n: a if a.size == 1 else np.broadcast_to(a, shape).reshape(-1) for n, a in x.items()}
+    values = {n: np.empty(count) for n in wanted}
+    status = np.empty(count, dtype=np.intc)
+    for start in range(0, max(count, 1), CHUNK):
+        stop = min(start + CHUNK, count)
+        part = {n: a if a.size == 1 else a[start:stop] for n, a in flat.items()}
+        done = entry.evaluate(part, wanted, stop - start)
+        if done is None:
+            return None
+        for n in wanted:
+            values[n][start:stop] = done[0][n]
+        status[start:stop] = done[1]
+    shaped = {n: v.reshape(shape) for n, v in values.items()}
+    return Evaluation(shaped, units, status.reshape(shape))
 
 
 def _run(entry: object, x: dict, p: dict, wanted: tuple, shape: tuple, units: dict) -> Evaluation:

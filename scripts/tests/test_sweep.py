@@ -614,19 +614,25 @@ def test_a_malformed_scene_is_refused_with_the_scene_checker_s_line(tmp_path):
         assert str(info.value).startswith(str(tmp_path / "bad.toml")) and words in str(info.value)
 
 
-def test_a_chunk_the_rows_entry_refuses_runs_through_fmi(tmp_path, monkeypatch):
+def test_a_chunk_the_columns_or_rows_entry_refuses_runs_through_the_next(tmp_path, monkeypatch):
+    """The columns entry first; where it refuses, the rows entry; where that refuses too,
+    FMI: the same outcomes each way, to the last bit."""
     _needs_balance()
     s, run, values, _ = study.prepare(_write(tmp_path, BALANCE_STUDY), tmp_path)
     rows = list(enumerate(values[:3]))
-    through_rows = run.chunk(rows)
+    through_columns = run.chunk(rows)
+
+    from dyadfmu.sweep import rows as rows_module
+
+    used = []
+    monkeypatch.setattr(rows_module.ColumnsEntry, "evaluate", lambda *a: used.append(1))
+    assert run.chunk(rows) == through_columns and used  # refused: None
 
     def refuse(*args, **kwargs):
         raise RuntimeError("dyadfmu_evaluate_rows refused the call (status 3)")
 
-    from dyadfmu.sweep import rows as rows_module
-
     monkeypatch.setattr(rows_module.RowsEntry, "evaluate", refuse)
-    assert run.chunk(rows) == through_rows
+    assert run.chunk(rows) == through_columns
 
 
 @pytest.mark.parametrize(
@@ -1635,3 +1641,61 @@ def test_a_one_driver_run_of_a_mechanism_fmu_with_several_drivers_is_refused_nam
         "crank rear): a run over one driver would leave the others at their start values; "
         "give each driver its range in a [[run.driver]] table (name, and angle or stroke)"
     )
+
+
+def test_a_small_crank_study_runs_in_this_process_without_a_worker_count(tmp_path, monkeypatch):
+    """No cluster for a study whose runs evaluate in calls of the binary and take less
+    than a cluster takes to start; the same table as with --workers 0."""
+    _needs_balance()
+
+    def no_cluster(*args, **kwargs):
+        raise AssertionError("a local cluster was started for a small study")
+
+    monkeypatch.setattr(execute, "run_dask", no_cluster)
+    chosen = study.run_study(_write(tmp_path, BALANCE_STUDY), tmp_path / "a", plots=False)
+    serial = study.run_study(_write(tmp_path, BALANCE_STUDY), tmp_path / "b", workers=0)
+    assert np.array_equal(chosen.table.figures, serial.table.figures)
+    assert "this process" in (tmp_path / "a" / "study" / "report.md").read_text(encoding="utf-8")
+
+
+def test_the_worker_count_is_the_user_s_or_chosen_by_the_study_s_size():
+    crank = runs.KinetostaticRun.__new__(runs.KinetostaticRun)
+    object.__setattr__(crank, "points", 360)
+    object.__setattr__(crank, "use_rows", True)
+    assert study.workers_for(crank, 61, None) == 0
+    assert study.workers_for(crank, study.IN_PROCESS_SAMPLES // 360 + 1, None) == 2
+    assert study.workers_for(crank, 61, 3) == 3 and study.workers_for(crank, 10**6, 0) == 0
+    object.__setattr__(crank, "use_rows", False)  # through FMI, design by design
+    assert study.workers_for(crank, 61, None) == 2
+    assert study.workers_for(object(), 1, None) == 2  # a driven run co-simulates
+
+
+def test_a_study_s_scene_fmu_is_built_again_where_it_is_older_than_the_sources(
+    tmp_path, monkeypatch
+):
+    """Named by its scene's content, the FMU is still built by the project's sources: one
+    older than any of them (an update of the core or the FMU layer) is built again."""
+    from dyadfmu.sweep import scenebuild
+
+    project, out = tmp_path / "project", tmp_path / "out"
+    for folder in scenebuild.BUILT_FROM:
+        (project / folder).mkdir(parents=True)
+        (project / folder / "source.c").write_text("/* */\n")
+    scene = tmp_path / "scene.toml"
+    scene.write_text("# a scene\n")
+    monkeypatch.setattr(scenebuild.paths, "project_dir", lambda: project)
+    monkeypatch.setattr(scenebuild.paths, "in_checkout", lambda: False)  # built under out
+    fmu = scenebuild.build_folder(out) / "fmus" / "s_fmi2.fmu"
+    assert fmu.is_relative_to(out)
+    fmu.parent.mkdir(parents=True)
+    fmu.write_bytes(b"built")
+    built = []
+    monkeypatch.setattr(scenebuild, "tools_problem", lambda: None)
+    monkeypatch.setattr(scenebuild, "configure", lambda *a, **k: None)
+    monkeypatch.setattr(
+        scenebuild, "build_logged", lambda build, targets, **k: built.append(targets)
+    )
+    os.utime(fmu, (2e9, 2e9))  # newer than every source: taken as it is
+    assert scenebuild.scene_fmu(scene, "s", 2, out) == fmu and built == []
+    os.utime(fmu, (1e9, 1e9))  # older than the sources: built again
+    assert scenebuild.scene_fmu(scene, "s", 2, out) == fmu and built == [["s_fmi2_package"]]

@@ -27,31 +27,13 @@ import numpy as np  # noqa: E402
 
 from .. import build_scene, paths  # noqa: E402
 from ..sweep import scenebuild  # noqa: E402
+from ..sweep.scenebuild import BUILT_FROM, stale  # noqa: E402, F401
 from . import cylinder_drawing as cd  # noqa: E402
 from . import drivers_drawing as dd  # noqa: E402
 from . import markdown as md  # noqa: E402
 
 #: Samples over the turn (a degree apart), the poses drawn, the turn's duration (60 rpm).
 SAMPLES, POSES, TURN = 361, (0.0, 0.25, 0.5, 0.75), 1.0
-
-
-#: The project's folders an FMU is built from (beside its scene file).
-BUILT_FROM = ("src", "fmu", "modelDescription/dyadgen")
-
-
-def stale(fmu: Path, scene: Path, project: Path) -> bool:
-    """Whether the FMU is missing or older than its scene file or any file of the
-    project's sources it is built from (BUILT_FROM under `project`)."""
-    if not fmu.is_file():
-        return True
-    built = fmu.stat().st_mtime
-    if scene.stat().st_mtime > built:
-        return True
-    for folder in BUILT_FROM:
-        for path in (project / folder).rglob("*"):
-            if path.is_file() and "__pycache__" not in path.parts and path.stat().st_mtime > built:
-                return True
-    return False
 
 
 def scene_fmu(scene: Path, identifier: str, fmi: int, out: Path, say: Callable) -> Path:

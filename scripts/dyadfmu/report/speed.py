@@ -102,6 +102,7 @@ BATCH_HEADER = (
     "samples",
     "efforts and reactions, CPU per sample",
     "every output, CPU per sample",
+    "efforts and reactions through the rows entry, CPU per sample",
     "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
 )
 
@@ -113,13 +114,14 @@ def _batch_rows(scenes: list[SceneSpeed]) -> list[str]:
         for count in sorted({c for c, _ in s.samples}):
             some, every = s.samples[count, False], s.samples[count, True]
             numpy = s.samples.get((count, "numpy"), math.nan)
+            by_rows = s.samples.get((count, "rows"), math.nan)
             yardstick = "-" if math.isnan(numpy) else f"{numpy * 1e9:.0f} ns ({numpy / some:.1f}x)"
-            rows.append(
-                [s.scene, f"{count:,}", f"{some * 1e9:.0f} ns", f"{every * 1e9:.0f} ns", yardstick]
-            )
+            through_rows = "-" if math.isnan(by_rows) else f"{by_rows * 1e9:.0f} ns"
+            times = [f"{some * 1e9:.0f} ns", f"{every * 1e9:.0f} ns", through_rows, yardstick]
+            rows.append([s.scene, f"{count:,}", *times])
     if not rows:
         return []
-    return ["", *markup.table(BATCH_HEADER, rows, "-rrrr")]
+    return ["", *markup.table(BATCH_HEADER, rows, "-rrrrr")]
 
 
 def _partial(two: object, three: object) -> str:
@@ -176,8 +178,9 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "effective inertia (J, M(q), the efforts at zero acceleration: a kinematic pass of "
         "their own) only when they are read: its step is also counted with a get of the "
         "drivers' efforts and the pair reactions alone. A whole mechanism over NumPy arrays "
-        "(`dyadfmu.evaluate`, one call of the FMU's binary): the CPU time per sample, the "
-        "best of several calls, asking the efforts and the reactions or every output; against "
+        "(`dyadfmu.evaluate`, through the FMU binary's columns entry): the CPU time per sample, "
+        "the best of several calls, asking the efforts and the reactions or every output; the "
+        "same samples through its rows entry (a set and a get per sample); against "
         "the harness's stacked NumPy solve of a chain (its kinematics and every body's "
         "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick.",
         "",

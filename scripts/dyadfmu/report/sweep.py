@@ -13,21 +13,32 @@ Names from the study file and units from its FMU reach the Markdown as literal t
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.axes import Axes  # noqa: E402
-from matplotlib.colors import LogNorm, Normalize, SymLogNorm  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+from ..sweep.results import Table, best_designs, feasible, pareto_front
+from ..sweep.studyfile import Constraint, Study
+from .markdown import provenance as markdown_provenance
+from .markdown import table as markdown_table
+from .markdown import text as markdown_text
 
-from ..sweep.results import Table, best_designs, feasible, pareto_front  # noqa: E402
-from ..sweep.studyfile import Constraint, Study  # noqa: E402
-from .markdown import provenance as markdown_provenance  # noqa: E402
-from .markdown import table as markdown_table  # noqa: E402
-from .markdown import text as markdown_text  # noqa: E402
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.colors import Normalize
+    from matplotlib.figure import Figure
+
+
+def _pyplot():
+    """matplotlib's pyplot on the Agg backend, imported when a plot is drawn: a study run
+    with --no-plots does not wait for it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
 
 __all__ = ["plot_study", "study_figure", "report_text", "scale_of", "LOG_DECADES"]
 
@@ -75,13 +86,15 @@ def _set_scale(ax: Axes, which: str, values: np.ndarray) -> None:
 
 def _norm(values: np.ndarray) -> Normalize | None:
     """The colour scale of `values`: logarithmic where scale_of says so, else None."""
+    from matplotlib import colors
+
     scale, threshold = scale_of(values)
     finite = np.asarray(values, dtype=float)
     finite = finite[np.isfinite(finite)]
     if scale == "log":
-        return LogNorm(vmin=finite.min(), vmax=finite.max())
+        return colors.LogNorm(vmin=finite.min(), vmax=finite.max())
     if scale == "symlog":
-        return SymLogNorm(linthresh=threshold, vmin=finite.min(), vmax=finite.max())
+        return colors.SymLogNorm(linthresh=threshold, vmin=finite.min(), vmax=finite.max())
     return None
 
 
@@ -93,7 +106,7 @@ def _heat_map(ax: Axes, table: Table, z: np.ndarray, label: str) -> None:
             k
         ]
     mesh = ax.pcolormesh(xs, ys, grid, shading="nearest", cmap="viridis", norm=_norm(z))
-    plt.colorbar(mesh, ax=ax, label=label)
+    _pyplot().colorbar(mesh, ax=ax, label=label)
 
 
 def _design_plot(ax: Axes, table: Table, study: Study, ok: np.ndarray, units: dict) -> None:
@@ -114,7 +127,7 @@ def _design_plot(ax: Axes, table: Table, study: Study, ok: np.ndarray, units: di
             _heat_map(ax, table, z, _axis_label(study.objective.minimize, units))
         else:
             points = ax.scatter(x, table.values[:, 1], c=z, s=12, cmap="viridis", norm=_norm(z))
-            plt.colorbar(points, ax=ax, label=_axis_label(study.objective.minimize, units))
+            _pyplot().colorbar(points, ax=ax, label=_axis_label(study.objective.minimize, units))
         out = ~ok
         ax.plot(x[out], table.values[out, 1], "x", color="w", ms=5, label="infeasible or failed")
         ax.legend(fontsize=8, loc="lower right")
@@ -146,6 +159,7 @@ def study_figure(table: Table, study: Study, units: dict | None = None) -> Figur
     units = units or {}
     ok = feasible(table, study)
     panels = 2 if study.objective.constraints else 1
+    plt = _pyplot()
     fig, axes = plt.subplots(1, panels, figsize=(6.5 * panels, 5), squeeze=False)
     _design_plot(axes[0][0], table, study, ok, units)
     for k in best_designs(table, study)[:1]:
@@ -166,7 +180,7 @@ def plot_study(table: Table, study: Study, path: Path, units: dict | None = None
     try:
         fig.savefig(path, dpi=110)
     finally:
-        plt.close(fig)
+        _pyplot().close(fig)
     return path
 
 

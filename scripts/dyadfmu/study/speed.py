@@ -139,6 +139,24 @@ def batch_seconds(scene: str, count: int, every: bool, rounds: int) -> float:
     return best / count
 
 
+def rows_seconds(scene: str, count: int, rounds: int) -> float:
+    """CPU seconds per sample of the FMU binary's rows entry (``dyadfmu_evaluate_rows``, a
+    set and a get per row) over the samples batch_seconds times, asking the efforts and
+    reactions: the best of ``rounds`` calls."""
+    from ..sweep.rows import rows_entry
+
+    entry = rows_entry(paths.built_fmu(scene, 2))
+    inputs, outputs, rows = step_rows(entry.md, count, seed=11)
+    x_names = tuple(v.name for v in inputs)
+    asked = tuple(v.name for v in efforts_and_reactions(outputs))
+    best = math.inf
+    for _ in range(rounds):
+        started = clock.process_time()
+        entry.evaluate((), np.empty((count, 0)), x_names, rows, asked)
+        best = min(best, clock.process_time() - started)
+    return best / count
+
+
 def opening_comment(dyad: str, root: Path | None = None) -> tuple[Path, str]:
     """The type's source file and its opening comment as one line of text."""
     source = (root or paths.ROOT) / "src" / f"dyad_{dyad.lower()}.c"
@@ -371,6 +389,7 @@ def measure(
                 rounds = 2 if count >= 1_000_000 else 5
                 for every in (False, True):
                     scenes[-1].samples[count, every] = batch_seconds(scene, count, every, rounds)
+                scenes[-1].samples[count, "rows"] = rows_seconds(scene, count, rounds)
                 if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
                     scenes[-1].samples[count, "numpy"] = numpy_yardstick_seconds(
                         scene, count, rounds

@@ -3,6 +3,9 @@ every dyadfmu FMU binary exports beside the FMI API (fmu/fmu_instance.c,
 ``fmu_evaluate_rows``). A kinetostatic study evaluates all the crank angles of a chunk
 of designs in one call instead of two FMI calls per angle from Python; the values are
 those the FMI calls give, bit for bit (each row goes through the same set and get).
+``dyadfmu_evaluate_columns`` (``fmu_evaluate_columns``) gives the same values from
+columns, the inputs and parameters written straight into the model's input block and
+its outputs read straight out, for a model without states.
 """
 
 from __future__ import annotations
@@ -16,15 +19,19 @@ from fmpy.model_description import ModelDescription
 from .. import paths
 from ..fmi.slave import unpacked
 
-__all__ = ["RowsEntry", "rows_entry"]
+__all__ = ["ColumnsEntry", "RowsEntry", "columns_entry", "rows_entry"]
 
 _UINT_P = ctypes.POINTER(ctypes.c_uint)
 _DOUBLE_P = ctypes.POINTER(ctypes.c_double)
 _INT_P = ctypes.POINTER(ctypes.c_int)
+_STEP_P = ctypes.POINTER(ctypes.c_ssize_t)
 
 
-class RowsEntry:
-    """``dyadfmu_evaluate_rows`` of one FMU binary, by variable names."""
+class _Entry:
+    """A function of one FMU binary beside the FMI API, called by variable names."""
+
+    #: The function's argument types after the instantiation token.
+    ARGUMENTS: list = []
 
     def __init__(self, function: ctypes._CFuncPtr, md: ModelDescription):
         self._f = function
@@ -32,12 +39,16 @@ class RowsEntry:
         self._token = md.guid.encode()
         self._vr = {v.name: v.valueReference for v in md.modelVariables}
         function.restype = ctypes.c_int
-        function.argtypes = [ctypes.c_char_p]
-        function.argtypes += [_UINT_P, ctypes.c_size_t, _DOUBLE_P] * 2
-        function.argtypes += [_UINT_P, ctypes.c_size_t, _DOUBLE_P, _INT_P, ctypes.c_size_t]
+        function.argtypes = [ctypes.c_char_p, *self.ARGUMENTS]
 
     def _refs(self, names: tuple) -> ctypes.Array:
         return (ctypes.c_uint * max(len(names), 1))(*(self._vr[n] for n in names))
+
+
+class RowsEntry(_Entry):
+    """``dyadfmu_evaluate_rows`` of one FMU binary, by variable names."""
+
+    ARGUMENTS = [_UINT_P, ctypes.c_size_t, _DOUBLE_P] * 3 + [_INT_P, ctypes.c_size_t]
 
     def evaluate(
         self, p_names: tuple, p: np.ndarray, x_names: tuple, x: np.ndarray, y_names: tuple
@@ -61,22 +72,91 @@ class RowsEntry:
         return y, status
 
 
-_ENTRIES: dict = {}
+class ColumnsEntry(_Entry):
+    """``dyadfmu_evaluate_columns`` of one FMU binary, by variable names: the model at
+    many samples, each input a column (one value for every sample, or one per sample)."""
+
+    ARGUMENTS = [_UINT_P, ctypes.c_size_t, ctypes.POINTER(_DOUBLE_P), _STEP_P] * 2
+    ARGUMENTS += [_INT_P, ctypes.c_size_t]
+
+    def evaluate(
+        self, x: dict[str, np.ndarray], y_names: tuple, count: int
+    ) -> tuple[dict[str, np.ndarray], np.ndarray] | None:
+        """(the outputs ``y_names``, each an array of ``count`` samples; the FMU status of
+        each sample: 0 is OK) at the inputs and parameters ``x`` (name -> an array of
+        ``count`` float64 values, or of one for every sample). None where the binary
+        refuses the call (a model with states)."""
+        x_names = tuple(x)
+        columns = [_column(x[n]) for n in x_names]
+        if any(c.size not in (1, count) for c in columns):
+            raise ValueError("every column holds one value or one per sample")
+        steps = [0 if c.size == 1 else c.strides[0] // c.itemsize for c in columns]
+        y = {n: np.empty(count) for n in y_names}
+        status = np.empty(count, dtype=np.intc)
+        done = self._f(
+            self._token,
+            self._refs(x_names), len(x_names), _pointers(columns), _steps(steps),
+            self._refs(y_names), len(y_names), _pointers(list(y.values())),
+            _steps([1] * len(y_names)), status.ctypes.data_as(_INT_P), count,
+        )  # fmt: skip
+        return None if done != 0 else (y, status)
 
 
-def rows_entry(fmu: str | Path) -> RowsEntry | None:
-    """The rows entry of an FMU's binary for this platform, None where it has none (an
-    FMU from another tool, say)."""
+def _column(values: object) -> np.ndarray:
+    """Values as a one-dimensional float64 array the binary reads in place: a view where
+    its stride is a whole number of doubles, else a copy."""
+    column = np.asarray(values, dtype=np.float64).reshape(-1)
+    if column.size > 1 and column.strides[0] % column.itemsize != 0:
+        column = np.ascontiguousarray(column)
+    return column
+
+
+def _pointers(arrays: list) -> ctypes.Array:
+    return (_DOUBLE_P * max(len(arrays), 1))(*(a.ctypes.data_as(_DOUBLE_P) for a in arrays))
+
+
+def _steps(steps: list) -> ctypes.Array:
+    return (ctypes.c_ssize_t * max(len(steps), 1))(*steps)
+
+
+_BINARIES: dict = {}
+
+
+def _binary(fmu: str | Path) -> tuple[ctypes.CDLL | None, ModelDescription]:
+    """The loaded binary of an FMU for this platform (None where it cannot load), and its
+    model description; loaded once per FMU."""
     key = str(fmu)
-    if key not in _ENTRIES:
+    if key not in _BINARIES:
         md, directory = unpacked(fmu)
         version = int(md.fmiVersion.split(".")[0])
         identifier = md.coSimulation.modelIdentifier
         binary = Path(directory) / "binaries" / paths.PLATFORM[version] / f"{identifier}.so"
         try:
-            function = ctypes.CDLL(str(binary)).dyadfmu_evaluate_rows
-        except (OSError, AttributeError):
-            _ENTRIES[key] = None
-        else:
-            _ENTRIES[key] = RowsEntry(function, md)
+            _BINARIES[key] = (ctypes.CDLL(str(binary)), md)
+        except OSError:
+            _BINARIES[key] = (None, md)
+    return _BINARIES[key]
+
+
+_ENTRIES: dict = {}
+
+
+def _entry(fmu: str | Path, name: str, kind: type) -> object:
+    key = (str(fmu), name)
+    if key not in _ENTRIES:
+        library, md = _binary(fmu)
+        function = getattr(library, name, None) if library is not None else None
+        _ENTRIES[key] = kind(function, md) if function is not None else None
     return _ENTRIES[key]
+
+
+def rows_entry(fmu: str | Path) -> RowsEntry | None:
+    """The rows entry of an FMU's binary for this platform, None where it has none (an
+    FMU from another tool, say)."""
+    return _entry(fmu, "dyadfmu_evaluate_rows", RowsEntry)
+
+
+def columns_entry(fmu: str | Path) -> ColumnsEntry | None:
+    """The columns entry of an FMU's binary for this platform, None where it has none
+    (an FMU from another tool, or built before the entry)."""
+    return _entry(fmu, "dyadfmu_evaluate_columns", ColumnsEntry)

@@ -44,7 +44,7 @@ from ..fmi.slave import Slave, SlaveError
 from . import stroke
 from .checks import Driver, base_values, driver_of, drivers_of
 from .figures import UndefinedFigure, figure_value, series_names
-from .rows import RowsEntry, rows_entry
+from .rows import RowsEntry, columns_entry, rows_entry
 from .studyfile import (
     MIN_DIGITS,
     Driven,
@@ -323,7 +323,9 @@ class KinetostaticRun(_Common):
         names, n = self.read(), self.points
         p = np.repeat(np.array([[params[j][k] for k in p_names] for j, _ in runnable]), n, axis=0)
         x = np.concatenate([xj for _, xj in runnable])
-        y, status = entry.evaluate(p_names, p, self.inputs(), x, names)
+        y, status = _by_columns(self.mechanism, p_names, p, self.inputs(), x, names) or (
+            entry.evaluate(p_names, p, self.inputs(), x, names)
+        )
         out = {}
         for m, (j, xj) in enumerate(runnable):
             index, values = rows[j]
@@ -345,6 +347,26 @@ class KinetostaticRun(_Common):
             rows[k] = mech.get(names)
             _check_point(mech, rows[k], self.where(k, x[k]))
         return self.result(dict(zip(names, rows.T, strict=True)), x)
+
+
+def _by_columns(
+    mechanism: str, p_names: tuple, p: np.ndarray, x_names: tuple, x: np.ndarray, y_names: tuple
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """(outputs per row, status per row) of the rows of parameters ``p`` and inputs ``x``
+    through the binary's columns entry, the same values as its rows entry gives; None
+    where it has none or refuses the call (a model with states)."""
+    entry = columns_entry(mechanism)
+    if entry is None or set(p_names) & set(x_names):
+        return None
+    columns = {n: p[:, k] for k, n in enumerate(p_names)}
+    columns.update({n: x[:, k] for k, n in enumerate(x_names)})
+    done = entry.evaluate(columns, y_names, len(x))
+    if done is None:
+        return None
+    y = np.empty((len(x), len(y_names)))
+    for k, name in enumerate(y_names):
+        y[:, k] = done[0][name]
+    return y, done[1]
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,34 @@ from pathlib import Path
 from .. import paths
 from ..build_scene import Refused, build_logged, configure, tools_problem
 
-__all__ = ["BuildError", "generator", "build_folder", "tools_problem", "scene_fmu"]
+__all__ = [
+    "BUILT_FROM",
+    "BuildError",
+    "build_folder",
+    "generator",
+    "scene_fmu",
+    "stale",
+    "tools_problem",
+]
+
+
+#: The project's folders an FMU is built from (beside its scene file).
+BUILT_FROM = ("src", "fmu", "modelDescription/dyadgen")
+
+
+def stale(fmu: Path, scene: Path, project: Path) -> bool:
+    """Whether the FMU is missing or older than its scene file or any file of the
+    project's sources it is built from (BUILT_FROM under `project`)."""
+    if not fmu.is_file():
+        return True
+    built = fmu.stat().st_mtime
+    if scene.stat().st_mtime > built:
+        return True
+    for folder in BUILT_FROM:
+        for path in (project / folder).rglob("*"):
+            if path.is_file() and "__pycache__" not in path.parts and path.stat().st_mtime > built:
+                return True
+    return False
 
 
 class BuildError(RuntimeError):
@@ -35,11 +62,12 @@ def build_folder(out: Path) -> Path:
 
 
 def scene_fmu(scene: Path, identifier: str, fmi: int, out: Path) -> Path:
-    """<build folder>/fmus/<identifier>_fmi<fmi>.fmu of the scene file `scene`, built where
-    it is not there yet (its identifier names the scene's content); BuildError otherwise."""
+    """<build folder>/fmus/<identifier>_fmi<fmi>.fmu of the scene file `scene` (its
+    identifier names the scene's content), built where it is stale (:func:`stale`: missing,
+    or older than the scene or the project's sources); BuildError otherwise."""
     build = build_folder(out)
     fmu = build / "fmus" / f"{identifier}_fmi{fmi}.fmu"
-    if fmu.is_file():
+    if not stale(fmu, Path(scene), paths.project_dir()):
         return fmu
     problem = tools_problem()
     if problem:

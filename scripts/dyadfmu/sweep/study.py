@@ -44,7 +44,7 @@ def prepare(
     if planned is not None:
         check_names(study, planned[0], drive_md, planned[1])
     mechanism = sources.mechanism_fmu(study, out)
-    md = sources.model_description(mechanism)
+    md = sources.model_description(mechanism, trial=study.fmu is not None)
     check_names(study, md, drive_md, mechanism.name)
     try:
         run = run_of(study, str(mechanism), str(drive) if drive else None, md)
@@ -58,16 +58,36 @@ def prepare(
     return study, run, values, units_of(study, md, drive_md)
 
 
+#: Samples of a study whose runs evaluate in calls of the binary (a kinetostatic or a
+#: stroke run) that it runs in this process when no worker count is given: they take
+#: about a second at most, less than a local cluster takes to start.
+IN_PROCESS_SAMPLES = 1_000_000
+#: Local worker processes when no count is given and the study is larger.
+DEFAULT_WORKERS = 2
+
+
+def workers_for(run: object, designs: int, workers: int | None) -> int:
+    """The worker processes to run ``designs`` designs of ``run`` on: ``workers`` where
+    given; else none (this process) for a study evaluated in calls of the binary with at
+    most IN_PROCESS_SAMPLES samples, DEFAULT_WORKERS for any other."""
+    if workers is not None:
+        return workers
+    batched = isinstance(run, KinetostaticRun) and run.use_rows
+    small = batched and designs * run.points <= IN_PROCESS_SAMPLES
+    return 0 if small else DEFAULT_WORKERS
+
+
 def run_study(
     path: Path,
     out: Path,
-    workers: int = 2,
+    workers: int | None = None,
     scheduler: str | None = None,
     build: Path | None = None,
     plots: bool = True,
 ) -> SweepResult:
     """Run a study: ``workers`` = 0 runs it in this process, else on a local Dask cluster
-    of that many processes, or on the cluster at ``scheduler``."""
+    of that many processes, or on the cluster at ``scheduler``; None chooses
+    (:func:`workers_for`)."""
     if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}", Path(path).stem):
         raise StudyError(
             f"{path}: a study file's name (its output folder) must be letters, "
@@ -77,6 +97,7 @@ def run_study(
     study_out.mkdir(parents=True, exist_ok=True)
     study, run, values, units = prepare(Path(path), study_out, build)
     progress = execute.Progress(len(values))
+    workers = workers_for(run, len(values), workers) if scheduler is None else workers
     if workers == 0 and scheduler is None:
         outcomes, where = execute.run_serial(run, values, progress), "this process"
     else:
