@@ -2418,6 +2418,67 @@ static int rows_match_the_core(void* library, const char* token)
     return fails;
 }
 
+typedef int (*columns_entry)(const char* token, const unsigned int vr_x[], size_t n_x,
+                             const double* const x[], const ptrdiff_t x_step[],
+                             const unsigned int vr_y[], size_t n_y, double* const y[],
+                             const ptrdiff_t y_step[], int status[], size_t count);
+
+/* dyadfmu_evaluate_columns of one binary: the inputs read from the rows of one matrix (a
+ * stride of 3) and one held for every sample (a step of 0), the outputs written into the
+ * columns of another, each sample what dyadfmu_evaluate_rows gives bit for bit (a NaN
+ * input too: status error, NaN outputs); a bad call refused whole, nothing written. */
+static int columns_match_the_rows(void* library, const char* token)
+{
+    int fails = 0;
+    columns_entry columns;
+    rows_entry rows;
+    const unsigned set[3] = {vr_of("link_n.angle"), vr_of("link_m.force.x"), vr_of("link_n.omega")};
+    const double x[3][3] = {{0.3, -2500, 40}, {-0.5, 700, 40}, {0.1, NAN, 40}};
+    const double* const from[3] = {&x[0][0], &x[0][1], &x[0][2]};
+    const ptrdiff_t x_step[3] = {3, 3, 0};
+    unsigned outs[32];
+    double y[3 * 32], want[3 * 32];
+    double* into[32];
+    ptrdiff_t y_step[32];
+    int status[3] = {-1, -1, -1}, want_status[3] = {-1, -1, -1};
+    const size_t n = real_outputs(outs);
+    size_t k;
+    *(void**)(&columns) = dlsym(library, "dyadfmu_evaluate_columns");
+    *(void**)(&rows) = dlsym(library, "dyadfmu_evaluate_rows");
+    CHECK(columns != NULL && rows != NULL, "dyadfmu_evaluate_columns is not exported");
+    if (columns == NULL || rows == NULL) {
+        return fails;
+    }
+    for (k = 0; k < n; ++k) {
+        into[k] = y + k; /* the samples' rows of n outputs */
+        y_step[k] = (ptrdiff_t)n;
+    }
+    CHECK(rows(token, NULL, 0, NULL, set, 3, &x[0][0], outs, n, want, want_status, 3) == 0 &&
+              columns(token, set, 3, from, x_step, outs, n, into, y_step, status, 3) == 0,
+          "valid calls");
+    CHECK(memcmp(status, want_status, sizeof status) == 0 && status[2] == 3, "statuses %d %d %d",
+          status[0], status[1], status[2]);
+    for (k = 0; k < 3 * n; ++k) {
+        CHECK(memcmp(&y[k], &want[k], sizeof y[k]) == 0, "value %zu: %g, not %g", k, y[k], want[k]);
+    }
+    y[0] = 12345.0;
+    status[0] = -1;
+    CHECK(columns(token, outs, 1, from, x_step, outs, n, into, y_step, status, 1) == 3,
+          "an output set is refused");
+    CHECK(columns("not the token", set, 3, from, x_step, outs, n, into, y_step, status, 1) == 4,
+          "a wrong token is refused");
+    CHECK(columns(token, set, 3, from, x_step, outs, n, into, y_step, NULL, 1) == 3,
+          "no status array is refused");
+    CHECK(y[0] == 12345.0 && status[0] == -1, "a refused call wrote");
+    return fails;
+}
+
+static int test_rrt_columns_match_the_rows(void)
+{
+    return columns_match_the_rows(api2.library, md2.token) +
+           columns_match_the_rows(api3.library, md3.token);
+}
+
 static int test_rrt_rows_match_the_core(void)
 {
     return rows_match_the_core(api2.library, md2.token) +
@@ -3496,6 +3557,7 @@ static const named_test generic_tests[] = {
 static const named_test rrt_tests[] = {
     {"rrt_fmi2_core", test_rrt_fmi2_core},
     {"rrt_rows_match_the_core", test_rrt_rows_match_the_core},
+    {"rrt_columns_match_the_rows", test_rrt_columns_match_the_rows},
     {"rrt_bad_input_names_its_variable", test_rrt_bad_input_names_its_variable},
     {"rrt_fmi2_singular", test_rrt_fmi2_singular},
     {"rrt_fmi3_core", test_rrt_fmi3_core},
