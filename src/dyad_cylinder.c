@@ -124,13 +124,13 @@ static const char* const cylinder_field_names[DYAD_CYL_FIELD_COUNT] = {
 
 dyad_cylinder_input dyad_cylinder_input_default(void)
 {
-    static const dyad_cylinder_input zero;
-    dyad_cylinder_input in = zero;
-    in.pin_b = dyad_vec2_make(1, 0);
-    in.length = 1;
-    in.branch = 1;
-    in.singular_threshold = DYAD_DEFAULT_SINGULAR_THRESHOLD;
-    return in;
+    /* one copy of a constant: a generated scene starts every cylinder's input from it */
+    static const dyad_cylinder_input defaults = {.pin_b = {1, 0},
+                                                 .length = 1,
+                                                 .branch = 1,
+                                                 .singular_threshold =
+                                                     DYAD_DEFAULT_SINGULAR_THRESHOLD};
+    return defaults;
 }
 
 const char* dyad_cylinder_field_name(dyad_cylinder_field field)
@@ -161,8 +161,42 @@ static int cyl_part_bad(const dyad_cylinder_part* p, dyad_cylinder_field first,
     return *bad != DYAD_CYL_FIELD_NONE;
 }
 
+static dyad_real cyl_residue(dyad_vec2 v)
+{
+    return (v.x - v.x) + (v.y - v.y);
+}
+
+static dyad_real cyl_motion_residue(const dyad_point_motion* p)
+{
+    return cyl_residue(p->position) + cyl_residue(p->velocity) + cyl_residue(p->acceleration);
+}
+
+static dyad_real cyl_part_residue(const dyad_cylinder_part* p)
+{
+    return (p->mass - p->mass) + (p->com - p->com) + (p->inertia - p->inertia);
+}
+
+/* 1 where cyl_first_bad finds no bad field: every check at once, without a branch per
+ * field (x - x is 0 for a finite x, NaN otherwise; a sum of them 0 where all are). */
+static int cyl_fields_good(const dyad_cylinder_input* in)
+{
+    const dyad_cylinder_link* l = &in->link;
+    const dyad_real residue =
+        cyl_motion_residue(&in->a) + cyl_motion_residue(&in->o) + cyl_residue(in->pin_b) +
+        (in->length - in->length) + (in->rate - in->rate) + (in->accel - in->accel) +
+        cyl_part_residue(&in->barrel) + cyl_part_residue(&in->rod) + (l->mass - l->mass) +
+        cyl_residue(l->com) + (l->inertia - l->inertia) + cyl_residue(l->force) +
+        (l->moment - l->moment) + cyl_residue(in->gravity) +
+        (in->mount_amplification - in->mount_amplification);
+    return (residue == 0) & (dyad_dot(in->pin_b, in->pin_b) > 0) & (in->length > 0) &
+           ((in->branch == 1) | (in->branch == -1)) & (in->barrel.mass >= 0) &
+           (in->barrel.inertia >= 0) & (in->rod.mass >= 0) & (in->rod.inertia >= 0) &
+           (l->mass >= 0) & (l->inertia >= 0) & (in->singular_threshold > 0) &
+           (in->singular_threshold < 1) & (in->mount_amplification >= 0);
+}
+
 /* The first field out of its domain, in the order of dyad_cylinder_field. */
-dyad_cylinder_field dyad_cyl_first_bad_field(const dyad_cylinder_input* in)
+static dyad_cylinder_field cyl_first_bad(const dyad_cylinder_input* in)
 {
     const dyad_cylinder_link* l = &in->link;
     const int checks[] = {
@@ -200,6 +234,11 @@ dyad_cylinder_field dyad_cyl_first_bad_field(const dyad_cylinder_input* in)
            : !(cyl_finite(in->mount_amplification) && in->mount_amplification >= 0)
                ? DYAD_CYL_FIELD_MOUNT_AMPLIFICATION
                : DYAD_CYL_FIELD_NONE;
+}
+
+dyad_cylinder_field dyad_cyl_first_bad_field(const dyad_cylinder_input* in)
+{
+    return cyl_fields_good(in) ? DYAD_CYL_FIELD_NONE : cyl_first_bad(in);
 }
 
 static void cyl_fill_motion(dyad_point_motion* p, dyad_real v)
@@ -242,24 +281,35 @@ dyad_status dyad_cyl_reject(dyad_cylinder_result* value, dyad_cylinder_result* r
     return status;
 }
 
-static dyad_real cyl_motion_residue(const dyad_point_motion* p)
-{
-    return (p->position.x - p->position.x) + (p->position.y - p->position.y) +
-           (p->velocity.x - p->velocity.x) + (p->velocity.y - p->velocity.y) +
-           (p->acceleration.x - p->acceleration.x) + (p->acceleration.y - p->acceleration.y);
-}
+/* The four motions of a result (B and the centres of mass), one after the other: one
+ * array of reals. */
+#define CYL_MOTION_REALS 24
+typedef char cyl_motions_are_contiguous[offsetof(dyad_cylinder_result, link_com) +
+                                                    sizeof(dyad_point_motion) -
+                                                    offsetof(dyad_cylinder_result, b) ==
+                                                CYL_MOTION_REALS * sizeof(dyad_real)
+                                            ? 1
+                                            : -1];
 
 int dyad_cyl_outputs_finite(const dyad_cylinder_result* r)
 {
-    /* x - x is 0 for a finite x and NaN otherwise: one sum tests them all. */
-    const dyad_real residue =
-        cyl_motion_residue(&r->b) + cyl_motion_residue(&r->barrel_com) +
-        cyl_motion_residue(&r->rod_com) + cyl_motion_residue(&r->link_com) +
-        (r->link_omega - r->link_omega) + (r->link_epsilon - r->link_epsilon) +
-        (r->cylinder_omega - r->cylinder_omega) + (r->cylinder_epsilon - r->cylinder_epsilon) +
-        (r->axial_force - r->axial_force) + (r->r_a.x - r->r_a.x) + (r->r_a.y - r->r_a.y) +
-        (r->r_b.x - r->r_b.x) + (r->r_b.y - r->r_b.y) + (r->r_o.x - r->r_o.x) +
-        (r->r_o.y - r->r_o.y) + (r->n_rod - r->n_rod) + (r->m_rod - r->m_rod);
+    /* x - x is 0 for a finite x and NaN otherwise: the sum of them is 0 where all are.
+     * The motions summed in two lanes, which the compiler makes one vector of two
+     * (SSE2): half the operations of one chain of dependent adds. */
+    const dyad_real* v =
+        (const dyad_real*)(const void*)((const char*)r + offsetof(dyad_cylinder_result, b));
+    dyad_real even = 0, odd = 0, residue;
+    size_t k;
+    for (k = 0; k < CYL_MOTION_REALS; k += 2) {
+        even += v[k] - v[k];
+        odd += v[k + 1] - v[k + 1];
+    }
+    residue = even + odd + (r->link_omega - r->link_omega) + (r->link_epsilon - r->link_epsilon) +
+              (r->cylinder_omega - r->cylinder_omega) +
+              (r->cylinder_epsilon - r->cylinder_epsilon) + (r->axial_force - r->axial_force) +
+              (r->r_a.x - r->r_a.x) + (r->r_a.y - r->r_a.y) + (r->r_b.x - r->r_b.x) +
+              (r->r_b.y - r->r_b.y) + (r->r_o.x - r->r_o.x) + (r->r_o.y - r->r_o.y) +
+              (r->n_rod - r->n_rod) + (r->m_rod - r->m_rod);
     return residue == 0;
 }
 

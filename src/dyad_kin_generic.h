@@ -460,9 +460,9 @@ DYAD_CLOSED_FORM dyad_status DYAD_KIN(dyad_kin_run)(dyad_type type, kin_position
                    ? DYAD_STATUS_INVALID_INPUT
                    : dyad_kin_reject(value, NULL, DYAD_STATUS_INVALID_INPUT, DYAD_KIN_FIELD_INPUT);
     }
-    bad = input == NULL || (DYAD_KIN_IS_DUAL && seed == NULL)
-              ? DYAD_KIN_FIELD_INPUT
-              : dyad_kin_first_bad_field(type, input);
+    bad = input == NULL || (DYAD_KIN_IS_DUAL && seed == NULL) ? DYAD_KIN_FIELD_INPUT
+          : dyad_kin_fields_good(type, input) ? DYAD_KIN_FIELD_NONE
+                                              : dyad_kin_first_bad_field(type, input);
     if (bad != DYAD_KIN_FIELD_NONE) {
         return dyad_kin_reject(value, rate, DYAD_STATUS_INVALID_INPUT, bad);
     }

@@ -52,6 +52,62 @@ static inline int dyad_kin_slides(dyad_type type, dyad_pair pair)
  * among the fields the type reads; DYAD_KIN_FIELD_NONE if all are good. */
 dyad_kin_field dyad_kin_first_bad_field(dyad_type type, const dyad_kin_input* input);
 
+/* x - x: 0 for a finite x, NaN otherwise; a sum of them is 0 where all are finite. */
+static inline dyad_real dyad_kin_residue(dyad_vec2 v)
+{
+    return (v.x - v.x) + (v.y - v.y);
+}
+
+static inline dyad_real dyad_kin_point_residue(const dyad_point_motion* p)
+{
+    return dyad_kin_residue(p->position) + dyad_kin_residue(p->velocity) +
+           dyad_kin_residue(p->acceleration);
+}
+
+/* What a mount must be: its point finite; where it slides, its guide a unit and its
+ * rates finite. */
+static inline int dyad_kin_mount_good(const dyad_mount* g, int slides)
+{
+    if (!slides) {
+        return dyad_kin_point_residue(&g->point) == 0;
+    }
+    return (dyad_kin_point_residue(&g->point) + dyad_kin_residue(g->guide) + (g->omega - g->omega) +
+                (g->epsilon - g->epsilon) ==
+            0) &
+           dyad_is_unit(g->guide);
+}
+
+/* 1 where dyad_kin_first_bad_field finds no bad field: every check at once, without a
+ * branch per field (the common case; inlined where the type is a constant, the checks
+ * of the fields it does not read go). */
+static inline int dyad_kin_fields_good(dyad_type type, const dyad_kin_input* in)
+{
+    const int slides_dm = dyad_kin_slides(type, DYAD_PAIR_DM);
+    const int slides_e = dyad_kin_slides(type, DYAD_PAIR_E);
+    const int slides_dn = dyad_kin_slides(type, DYAD_PAIR_DN);
+    const int two_ways = type == DYAD_RRR || type == DYAD_RRT || type == DYAD_RTR;
+    const dyad_real m = in->length_m, n = in->length_n, threshold = in->singular_threshold;
+    const dyad_real mounted = in->mount_amplification;
+    int good = dyad_kin_mount_good(&in->k, slides_dm) & dyad_kin_mount_good(&in->p, slides_dn);
+    good &= dyad_kin_residue(in->com_m) + dyad_kin_residue(in->com_n) + (n - n) +
+                (threshold - threshold) + (mounted - mounted) ==
+            0;
+    if (!slides_e) {
+        good &= (m - m == 0) & (type == DYAD_RRR ? m > 0 : m >= 0);
+    }
+    good &= type == DYAD_RRR || type == DYAD_RRT ? n > 0 : n >= 0;
+    if (slides_dm) {
+        good &= dyad_is_unit(in->turn_m);
+    }
+    if (slides_e || slides_dn) {
+        good &= dyad_is_unit(in->turn_n);
+    }
+    if (two_ways) {
+        good &= (in->branch == 1) | (in->branch == -1);
+    }
+    return good & (threshold > 0) & (threshold < 1) & (mounted >= 0);
+}
+
 /* Every motion output, conditioning and amplification of `result` NaN, gap 0,
  * failure CLOSES; status and field as given. */
 void dyad_kin_fill_nan(dyad_kin_result* result, dyad_status status, dyad_kin_field field);

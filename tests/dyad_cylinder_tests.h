@@ -516,6 +516,89 @@ static int cyl_expect_invalid(const dyad_cylinder_input* in, dyad_cylinder_field
     return fails;
 }
 
+/* Every real field of the input, by its place, with the field that names it. */
+typedef struct cyl_real_field {
+    size_t offset;
+    dyad_cylinder_field field;
+} cyl_real_field;
+
+#define CYL_FIELD(member, name) {offsetof(dyad_cylinder_input, member), DYAD_CYL_FIELD_##name}
+static const cyl_real_field cyl_real_fields[] = {
+    CYL_FIELD(a.position.x, A_POSITION),
+    CYL_FIELD(a.position.y, A_POSITION),
+    CYL_FIELD(a.velocity.x, A_VELOCITY),
+    CYL_FIELD(a.velocity.y, A_VELOCITY),
+    CYL_FIELD(a.acceleration.x, A_ACCELERATION),
+    CYL_FIELD(a.acceleration.y, A_ACCELERATION),
+    CYL_FIELD(o.position.x, O_POSITION),
+    CYL_FIELD(o.position.y, O_POSITION),
+    CYL_FIELD(o.velocity.x, O_VELOCITY),
+    CYL_FIELD(o.velocity.y, O_VELOCITY),
+    CYL_FIELD(o.acceleration.x, O_ACCELERATION),
+    CYL_FIELD(o.acceleration.y, O_ACCELERATION),
+    CYL_FIELD(pin_b.x, PIN_B),
+    CYL_FIELD(pin_b.y, PIN_B),
+    CYL_FIELD(length, LENGTH),
+    CYL_FIELD(rate, RATE),
+    CYL_FIELD(accel, ACCEL),
+    CYL_FIELD(barrel.mass, BARREL_MASS),
+    CYL_FIELD(barrel.com, BARREL_COM),
+    CYL_FIELD(barrel.inertia, BARREL_INERTIA),
+    CYL_FIELD(rod.mass, ROD_MASS),
+    CYL_FIELD(rod.com, ROD_COM),
+    CYL_FIELD(rod.inertia, ROD_INERTIA),
+    CYL_FIELD(link.mass, LINK_MASS),
+    CYL_FIELD(link.com.x, LINK_COM),
+    CYL_FIELD(link.com.y, LINK_COM),
+    CYL_FIELD(link.inertia, LINK_INERTIA),
+    CYL_FIELD(link.force.x, LINK_FORCE),
+    CYL_FIELD(link.force.y, LINK_FORCE),
+    CYL_FIELD(link.moment, LINK_MOMENT),
+    CYL_FIELD(gravity.x, GRAVITY),
+    CYL_FIELD(gravity.y, GRAVITY),
+    CYL_FIELD(singular_threshold, SINGULAR_THRESHOLD),
+    CYL_FIELD(mount_amplification, MOUNT_AMPLIFICATION),
+};
+#undef CYL_FIELD
+
+/* Each real field NaN, infinite or (a mass or an inertia, the amplification of the
+ * mounts) negative is named, alone or with a later field bad too; one left as it was
+ * solves. */
+static int test_cylinder_every_field_poisoned(void)
+{
+    int fails = 0;
+    rng r = {0xC7100006u};
+    const dyad_cylinder_input base = cyl_random(&r, 1);
+    const double poisons[3] = {NAN, INFINITY, -1};
+    dyad_cylinder_result out;
+    size_t f;
+    int p;
+    CHECK(dyad_cylinder(&base, &out) == DYAD_STATUS_OK, "the base case does not solve");
+    for (f = 0; f < sizeof cyl_real_fields / sizeof cyl_real_fields[0]; ++f) {
+        const cyl_real_field* field = &cyl_real_fields[f];
+        for (p = 0; p < 3; ++p) {
+            dyad_cylinder_input in = base;
+            const int negative_is_bad = field->field == DYAD_CYL_FIELD_BARREL_MASS ||
+                                        field->field == DYAD_CYL_FIELD_BARREL_INERTIA ||
+                                        field->field == DYAD_CYL_FIELD_ROD_MASS ||
+                                        field->field == DYAD_CYL_FIELD_ROD_INERTIA ||
+                                        field->field == DYAD_CYL_FIELD_LINK_MASS ||
+                                        field->field == DYAD_CYL_FIELD_LINK_INERTIA ||
+                                        field->field == DYAD_CYL_FIELD_LENGTH ||
+                                        field->field == DYAD_CYL_FIELD_SINGULAR_THRESHOLD ||
+                                        field->field == DYAD_CYL_FIELD_MOUNT_AMPLIFICATION;
+            if (p == 2 && !negative_is_bad) {
+                continue;
+            }
+            *(dyad_real*)(void*)((char*)&in + field->offset) = (dyad_real)poisons[p];
+            fails += cyl_expect_invalid(&in, field->field);
+            in.mount_amplification = (dyad_real)-1; /* the last field bad too */
+            fails += cyl_expect_invalid(&in, field->field);
+        }
+    }
+    return fails;
+}
+
 static int test_cylinder_invalid(void)
 {
     int fails = 0;

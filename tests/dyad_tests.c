@@ -2692,6 +2692,7 @@ static const named_test tests[] = {
     {"cylinder_statuses", test_cylinder_statuses},
     {"cylinder_pins_close", test_cylinder_pins_close},
     {"cylinder_invalid", test_cylinder_invalid},
+    {"cylinder_every_field_poisoned", test_cylinder_every_field_poisoned},
 };
 
 int main(int argc, char** argv)
