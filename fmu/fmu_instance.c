@@ -1933,15 +1933,40 @@ static int columns_valid(const fmu_model* model, const column_call* c)
     return 1;
 }
 
+/* The blocks a call evaluates in: the model's input block as an instance's is after
+ * initialisation (its start values), and its output block. */
+typedef struct column_blocks {
+    void* input;
+    void* output;
+    fmu_evaluation evaluation;
+} column_blocks;
+
+/* The start values into the input block, angles as their unit vectors. */
+static void load_starts(const fmu_model* model, void* input)
+{
+    size_t k;
+    model->behaviour->initialise(model, input);
+    for (k = 0; k < model->variable_count; ++k) {
+        const fmu_variable* v = &model->variables[k];
+        double* at = (double*)(void*)((char*)input + v->offset);
+        if (v->target == FMU_TARGET_INPUT_REAL) {
+            *at = v->start;
+        } else if (v->target == FMU_TARGET_INPUT_ANGLE) {
+            dyad_cos_sin(v->start, &at[0], &at[1]);
+        }
+    }
+}
+
 /* Where each x column's values go, and what a value must be. */
-static void place_columns(const fmu_instance* instance, const column_call* c, column_place place[])
+static void place_columns(const fmu_model* model, const column_blocks* b, const column_call* c,
+                          column_place place[])
 {
     size_t k;
     for (k = 0; k < c->n_x; ++k) {
-        const fmu_variable* v = variable_of(instance->model, c->vr_x[k]);
+        const fmu_variable* v = variable_of(model, c->vr_x[k]);
         fmu_slot range;
         accepted_range(v, &range);
-        place[k].at = (double*)(void*)((char*)instance->input + v->offset);
+        place[k].at = (double*)(void*)((char*)b->input + v->offset);
         place[k].low = range.low;
         place[k].high = range.high;
         place[k].angle = v->target == FMU_TARGET_INPUT_ANGLE;
@@ -1949,19 +1974,19 @@ static void place_columns(const fmu_instance* instance, const column_call* c, co
 }
 
 /* Where each y column's values come from: the output block, the x column of the same
- * variable, or the value the instance keeps (a start value). */
-static void find_sources(fmu_instance* instance, const column_call* c, column_source source[])
+ * variable, or its start value. */
+static void find_sources(const fmu_model* model, const column_blocks* b, const column_call* c,
+                         column_source source[])
 {
-    const fmu_model* model = instance->model;
     size_t k, j;
     for (k = 0; k < c->n_y; ++k) {
         const fmu_variable* v = variable_of(model, c->vr_y[k]);
         source[k].step = 0;
-        source[k].at = &instance->values[model->index_of_vr[c->vr_y[k]]];
+        source[k].at = &v->start;
         if (v->target == FMU_TARGET_RESULT_REAL) {
-            source[k].at = (const double*)(const void*)((const char*)instance->output + v->offset);
+            source[k].at = (const double*)(const void*)((const char*)b->output + v->offset);
         } else if (v->target == FMU_TARGET_INPUT_REAL) {
-            source[k].at = (const double*)(const void*)((const char*)instance->input + v->offset);
+            source[k].at = (const double*)(const void*)((const char*)b->input + v->offset);
         }
         for (j = 0; j < c->n_x; ++j) {
             if (c->vr_x[j] == c->vr_y[k]) {
@@ -2013,20 +2038,18 @@ static fmu_status sample_status(fmu_status evaluated)
     return FMU_WARNING;
 }
 
-static void evaluate_samples(fmu_instance* instance, const column_call* c,
+static void evaluate_samples(const fmu_model* model, column_blocks* b, const column_call* c,
                              const column_place place[], const column_source source[])
 {
-    const fmu_model* model = instance->model;
     const fmu_later* later = model->behaviour->later;
     void (*evaluate)(const fmu_model*, const void*, void*, fmu_evaluation*) =
         later != NULL && !reads_later(model, c) ? later->first : model->behaviour->evaluate;
-    fmu_evaluation* e = &instance->evaluation;
     size_t i, k;
     for (i = 0; i < c->count; ++i) {
         fmu_status s = FMU_ERROR;
         if (store_sample(c, place, i)) {
-            evaluate(model, instance->input, instance->output, e);
-            s = sample_status(e->status);
+            evaluate(model, b->input, b->output, &b->evaluation);
+            s = sample_status(b->evaluation.status);
         }
         c->status[i] = (int)s;
         for (k = 0; k < c->n_y; ++k) {
@@ -2042,34 +2065,34 @@ fmu_status fmu_evaluate_columns(const fmu_model* model, const char* token, int t
                                 double* const y[], const ptrdiff_t y_step[], int status[],
                                 size_t count)
 {
-    const fmu_logger quiet = {NULL, NULL, NULL, "columns"};
     const column_call c = {vr_x, n_x, x, x_step, vr_y, n_y, y, y_step, status, count};
-    fmu_instance* instance;
+    column_blocks b;
     column_place* place;
     column_source* source;
+    int ready;
+    (void)time_at_vr_0; /* value reference 0 is no Real of the table: refused either way */
     if (!columns_valid(model, &c)) {
         return FMU_ERROR;
     }
-    instance = fmu_instantiate(model, "columns", token, quiet, 0, NULL, NULL, time_at_vr_0);
-    if (instance == NULL) {
-        return FMU_FATAL;
+    if (token == NULL || strcmp(token, model->token) != 0) {
+        return FMU_FATAL; /* as an instance would not be made */
     }
+    b.input = calloc(1, model->behaviour->input_size + 1);
+    b.output = calloc(1, model->behaviour->output_size + 1);
     place = (column_place*)malloc((n_x + 1) * sizeof *place);
     source = (column_source*)malloc((n_y + 1) * sizeof *source);
-    if (place == NULL || source == NULL || start_design(instance, 1, NULL, 0, NULL) != FMU_OK) {
-        const fmu_status why = place == NULL || source == NULL ? FMU_FATAL : FMU_ERROR;
-        free(place);
-        free(source);
-        fmu_free(instance);
-        return why;
+    ready = b.input != NULL && b.output != NULL && place != NULL && source != NULL;
+    if (ready) {
+        load_starts(model, b.input);
+        place_columns(model, &b, &c, place);
+        find_sources(model, &b, &c, source);
+        evaluate_samples(model, &b, &c, place, source);
     }
-    place_columns(instance, &c, place);
-    find_sources(instance, &c, source);
-    evaluate_samples(instance, &c, place, source);
     free(place);
     free(source);
-    fmu_free(instance);
-    return FMU_OK;
+    free(b.output);
+    free(b.input);
+    return ready ? FMU_OK : FMU_FATAL;
 }
 
 int fmu_variable_named(const fmu_model* model, const char* name)

@@ -263,10 +263,11 @@ fmu_status fmu_evaluate_rows(const fmu_model* model, const char* token, int time
  * (an input or parameter among them reads as set), with that sample's status in
  * status[i] as fmu_evaluate_rows gives it: each sample's values are what a set of its
  * x and a get of its y give, bit for bit. A sample's outputs are computed only as far
- * as y needs (a model's fmu_later outputs where one is read). No column may overlap
- * another. FMU_ERROR (nothing written) for a model with states, a value reference
- * that is not of these kinds, or a missing array; FMU_FATAL where no instance could
- * be made. Not part of FMI: exported as dyadfmu_evaluate_columns for dyadfmu.evaluate. */
+ * as y needs (a model's fmu_later outputs where one is read), in the model's own
+ * blocks without an instance. No column may overlap another. FMU_ERROR (nothing
+ * written) for a model with states, a value reference that is not of these kinds, or a
+ * missing array; FMU_FATAL for a token that is not the model's, or no memory. Not part of FMI:
+ * exported as dyadfmu_evaluate_columns for dyadfmu.evaluate. */
 fmu_status fmu_evaluate_columns(const fmu_model* model, const char* token, int time_at_vr_0,
                                 const unsigned int vr_x[], size_t n_x, const double* const x[],
                                 const ptrdiff_t x_step[], const unsigned int vr_y[], size_t n_y,

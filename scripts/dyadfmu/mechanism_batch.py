@@ -16,6 +16,7 @@ assemble there, a dyad at a dead centre) has NaN outputs and its status says so.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,11 +67,29 @@ def _fmu(mechanism: str | Path, fmi: int) -> Path:
             raise ValueError(f"{text}: no such scene file")
         identifier = drivers_drawing.read_scene(scene).identifier
         return own_scene.scene_fmu(scene, identifier, fmi, Path.cwd(), lambda _: None)
-    if not (paths.SCENES_DIR / f"{text}.toml").is_file():
+    return _shipped(text, fmi)
+
+
+@functools.lru_cache(maxsize=64)
+def _shipped(name: str, fmi: int) -> Path:
+    """The built FMU of a shipped scene, found once per process (its binary is loaded
+    once too: a rebuild reaches a new process)."""
+    if not (paths.SCENES_DIR / f"{name}.toml").is_file():
         raise ValueError(
-            f"unknown mechanism {text!r}: a shipped scene's name, a scene file .toml or an .fmu"
+            f"unknown mechanism {name!r}: a shipped scene's name, a scene file .toml or an .fmu"
         )
-    return paths.built_fmu(text, fmi)
+    return paths.built_fmu(name, fmi)
+
+
+@functools.lru_cache(maxsize=64)
+def _reals(md: object) -> tuple[dict, dict, dict]:
+    """(unit by name of every Real variable, the inputs', the parameters'), read once per
+    model description."""
+    reals = [v for v in md.modelVariables if v.type in ("Real", "Float64")]
+    units = {v.name: v.unit or "" for v in reals}
+    of = {kind: {v.name: units[v.name] for v in reals if v.causality == kind} for kind in
+          ("input", "parameter")}  # fmt: skip
+    return units, of["input"], of["parameter"]
 
 
 def _named(given: dict, allowed: dict, what: str, fmu: Path) -> dict[str, np.ndarray]:
@@ -128,13 +147,8 @@ def evaluate(
     entry = rows_entry(fmu)  # loaded once per FMU
     if entry is None:
         raise ValueError(f"{fmu.name} has no dyadfmu_evaluate_rows: not an FMU of this project")
-    md = entry.md
-    reals = [v for v in md.modelVariables if v.type in ("Real", "Float64")]
-    units = {v.name: v.unit or "" for v in reals}
-    tunable = {v.name: units[v.name] for v in reals if v.causality == "parameter"}
-    x = _named(
-        dict(inputs or {}), {v.name: 0 for v in reals if v.causality == "input"}, "inputs", fmu
-    )
+    units, given, tunable = _reals(entry.md)
+    x = _named(dict(inputs or {}), given, "inputs", fmu)
     p = _named(dict(parameters or {}), tunable, "tunable parameters", fmu)
     wanted = tuple(dict.fromkeys(outputs))
     missing = [n for n in wanted if n not in units]

@@ -115,15 +115,10 @@ def _call(fmu, x_names, x_columns, x_steps, y_names, y_columns, y_steps, count):
     """dyadfmu_evaluate_columns through ctypes with the columns as given (any strides)."""
     entry = entries.columns_entry(fmu)
     vr = {v.name: v.valueReference for v in entry.md.modelVariables}
-    double_p = ctypes.POINTER(ctypes.c_double)
 
     def pointers(arrays, offsets):
-        return (double_p * max(len(arrays), 1))(
-            *(
-                ctypes.cast(a.ctypes.data + 8 * o, double_p)
-                for a, o in zip(arrays, offsets, strict=True)
-            )
-        )
+        addresses = [a.ctypes.data + 8 * o for a, o in zip(arrays, offsets, strict=True)]
+        return (ctypes.c_void_p * max(len(arrays), 1))(*addresses)
 
     status = np.full(max(count, 1), -7, dtype=np.intc)
     done = entry._f(
@@ -134,7 +129,7 @@ def _call(fmu, x_names, x_columns, x_steps, y_names, y_columns, y_steps, count):
         (ctypes.c_uint * max(len(y_names), 1))(*(vr[n] for n in y_names)), len(y_names),
         pointers([c for c, _ in y_columns], [o for _, o in y_columns]),
         (ctypes.c_ssize_t * max(len(y_steps), 1))(*y_steps),
-        status.ctypes.data_as(ctypes.POINTER(ctypes.c_int)), count,
+        status.ctypes.data, count,
     )  # fmt: skip
     return done, status
 
@@ -162,16 +157,14 @@ def test_columns_with_strides_and_held_values_read_and_write_where_they_say():
 
 
 def _raw(fmu, vr_x, x_column, vr_y, out, status, token=None) -> int:
-    """One call with one x column (angle-like, contiguous) and one y column, raw."""
+    """One call with one x column (contiguous) and one y column, raw."""
     entry = entries.columns_entry(fmu)
-    double_p = ctypes.POINTER(ctypes.c_double)
     return entry._f(
         token or entry.md.guid.encode(), (ctypes.c_uint * 1)(vr_x), 1,
-        (double_p * 1)(x_column.ctypes.data_as(double_p) if x_column is not None else None),
+        (ctypes.c_void_p * 1)(x_column.ctypes.data if x_column is not None else None),
         (ctypes.c_ssize_t * 1)(1), (ctypes.c_uint * 1)(vr_y), 1,
-        (double_p * 1)(out.ctypes.data_as(double_p)), (ctypes.c_ssize_t * 1)(1),
-        status.ctypes.data_as(ctypes.POINTER(ctypes.c_int)) if status is not None else None,
-        len(out),
+        (ctypes.c_void_p * 1)(out.ctypes.data), (ctypes.c_ssize_t * 1)(1),
+        status.ctypes.data if status is not None else None, len(out),
     )  # fmt: skip
 
 

@@ -76,8 +76,10 @@ class ColumnsEntry(_Entry):
     """``dyadfmu_evaluate_columns`` of one FMU binary, by variable names: the model at
     many samples, each input a column (one value for every sample, or one per sample)."""
 
-    ARGUMENTS = [_UINT_P, ctypes.c_size_t, ctypes.POINTER(_DOUBLE_P), _STEP_P] * 2
-    ARGUMENTS += [_INT_P, ctypes.c_size_t]
+    # the columns by address (an array of void*, as the C arrays of double* are passed):
+    # ctypes' pointer objects cost more than a small call's evaluation
+    ARGUMENTS = [_UINT_P, ctypes.c_size_t, ctypes.POINTER(ctypes.c_void_p), _STEP_P] * 2
+    ARGUMENTS += [ctypes.c_void_p, ctypes.c_size_t]
 
     def evaluate(
         self, x: dict[str, np.ndarray], y_names: tuple, count: int
@@ -91,15 +93,17 @@ class ColumnsEntry(_Entry):
         if any(c.size not in (1, count) for c in columns):
             raise ValueError("every column holds one value or one per sample")
         steps = [0 if c.size == 1 else c.strides[0] // c.itemsize for c in columns]
-        y = {n: np.empty(count) for n in y_names}
+        block = np.empty((len(y_names), count))  # one row per output
+        start = _address(block)
         status = np.empty(count, dtype=np.intc)
         done = self._f(
             self._token,
-            self._refs(x_names), len(x_names), _pointers(columns), _steps(steps),
-            self._refs(y_names), len(y_names), _pointers(list(y.values())),
-            _steps([1] * len(y_names)), status.ctypes.data_as(_INT_P), count,
+            self._refs(x_names), len(x_names), _addresses(map(_address, columns)), _steps(steps),
+            self._refs(y_names), len(y_names),
+            _addresses(start + 8 * count * k for k in range(len(y_names))),
+            _steps([1] * len(y_names)), _address(status), count,
         )  # fmt: skip
-        return None if done != 0 else (y, status)
+        return None if done != 0 else (dict(zip(y_names, block, strict=True)), status)
 
 
 def _column(values: object) -> np.ndarray:
@@ -111,8 +115,13 @@ def _column(values: object) -> np.ndarray:
     return column
 
 
-def _pointers(arrays: list) -> ctypes.Array:
-    return (_DOUBLE_P * max(len(arrays), 1))(*(a.ctypes.data_as(_DOUBLE_P) for a in arrays))
+def _address(array: np.ndarray) -> int:
+    return array.__array_interface__["data"][0]
+
+
+def _addresses(addresses: object) -> ctypes.Array:
+    listed = list(addresses)
+    return (ctypes.c_void_p * max(len(listed), 1))(*listed)
 
 
 def _steps(steps: list) -> ctypes.Array:
