@@ -246,7 +246,8 @@ def _speeds() -> tuple[list[TypeSpeed], list[SceneSpeed]]:
     batch = {(73, False): 1e-6, (73, True): 2e-6, (10_000, False): 3e-7, (10_000, True): 5e-7}
     batch[10_000, "numpy"] = batch[73, "rows"] = 2e-6
     plant = {v: Step(4000.0, 250.0, 0.0, 200.0) for v in (2, 3)}  # 20x: not the rule's
-    scenes = [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step), batch)]
+    flops = {False: 900.0, True: 1500.0}
+    scenes = [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step), batch, flops)]
     return types, [*scenes, SceneSpeed("plant", plant, plant=True)]
 
 

@@ -100,28 +100,42 @@ def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
 BATCH_HEADER = (
     "mechanism",
     "samples",
-    "efforts and reactions, CPU per sample",
-    "every output, CPU per sample",
+    "flops per sample: efforts and reactions / every output (floor at the solve's rate)",
+    "efforts and reactions, CPU per sample (to its floor)",
+    "every output, CPU per sample (to its floor)",
     "efforts and reactions through the rows entry, CPU per sample",
     "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
 )
 
 
-def _batch_rows(scenes: list[SceneSpeed]) -> list[str]:
-    """dyadfmu.evaluate per sample, where it was timed; none: no table."""
+def _ns(seconds: float) -> str:
+    return "-" if math.isnan(seconds) else f"{seconds * 1e9:.0f} ns"
+
+
+def _to_floor(seconds: float, floor: float) -> str:
+    return f"{_ns(seconds)} ({seconds / floor:.1f}x)" if floor > 0 else _ns(seconds)
+
+
+def _batch_rows(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
+    """dyadfmu.evaluate per sample, where it was timed, against the floor: the flops a
+    step executes at the rate the RRR solve executes its own; none timed: no table."""
+    rrr = next((t for t in types if t.dyad == "RRR"), None)
+    rate = rrr.solve_flops / rrr.numpy_seconds_per_row[True] if rrr else math.nan
     rows = []
     for s in scenes:
+        some_flops, every_flops = s.flops.get(False, math.nan), s.flops.get(True, math.nan)
+        floor = {False: some_flops / rate, True: every_flops / rate}
+        work = f"{some_flops:.0f} / {every_flops:.0f} ({_ns(floor[False])} / {_ns(floor[True])})"
         for count in sorted({c for c, _ in s.samples}):
-            some, every = s.samples[count, False], s.samples[count, True]
             numpy = s.samples.get((count, "numpy"), math.nan)
-            by_rows = s.samples.get((count, "rows"), math.nan)
-            yardstick = "-" if math.isnan(numpy) else f"{numpy * 1e9:.0f} ns ({numpy / some:.1f}x)"
-            through_rows = "-" if math.isnan(by_rows) else f"{by_rows * 1e9:.0f} ns"
-            times = [f"{some * 1e9:.0f} ns", f"{every * 1e9:.0f} ns", through_rows, yardstick]
-            rows.append([s.scene, f"{count:,}", *times])
+            some = s.samples[count, False]
+            yardstick = "-" if math.isnan(numpy) else f"{_ns(numpy)} ({numpy / some:.1f}x)"
+            times = [_to_floor(some, floor[False]), _to_floor(s.samples[count, True], floor[True])]
+            times += [_ns(s.samples.get((count, "rows"), math.nan)), yardstick]
+            rows.append([s.scene, f"{count:,}", work, *times])
     if not rows:
         return []
-    return ["", *markup.table(BATCH_HEADER, rows, "-rrrrr")]
+    return ["", *markup.table(BATCH_HEADER, rows, "-rrrrrr")]
 
 
 def _partial(two: object, three: object) -> str:
@@ -182,12 +196,14 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "the best of several calls, asking the efforts and the reactions or every output; the "
         "same samples through its rows entry (a set and a get per sample); against "
         "the harness's stacked NumPy solve of a chain (its kinematics and every body's "
-        "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick.",
+        "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick. Its "
+        "floor: the flops an FMU step executes for the job (callgrind, libm's among them) at "
+        "the rate `dyadfmu.solve` executes the RRR solve's own (flops per CPU second).",
         "",
         *_type_rows(types),
         "",
         *_scene_rows(scenes),
-        *_batch_rows(scenes),
+        *_batch_rows(types, scenes),
         *_targets(types, scenes),
     ]
 

@@ -84,11 +84,14 @@ class SceneSpeed:
     """One built-in scene FMU's step against its evaluation, per FMI version; for the
     mechanisms of BATCH_SCENES, ``dyadfmu.evaluate``'s CPU seconds per sample, by (batch
     size, whether every Real output is asked, else the efforts and reactions alone), and
-    by (batch size, "numpy") the stacked NumPy solve of a chain (the yardstick)."""
+    by (batch size, "numpy") the stacked NumPy solve of a chain (the yardstick); ``flops``:
+    the floating-point operations a step executes per sample, by whether every Real output
+    is read (else the efforts and reactions alone)."""
 
     scene: str
     steps: dict[int, Step] = field(default_factory=dict)
     samples: dict = field(default_factory=dict)
+    flops: dict[bool, float] = field(default_factory=dict)
     #: a plant (dynamics = "forward"): its step integrates its motion over many
     #: evaluations, so the step-to-evaluation rule is not its (dyadfmu plants measures it)
     plant: bool = False
@@ -275,6 +278,22 @@ def _step_instructions(
     return _collected(out) / len(rows), inclusive(out, "evaluate") / len(rows)
 
 
+def step_flops(build: Path, identifier: str, count: int, work: Path, every: bool) -> float:
+    """Floating-point operations an FMU step from C executes (FMI 2, libm's among them),
+    its get reading every Real output or the efforts and reactions alone: per sample, the
+    arithmetic of the batch's job."""
+    md = read_model_description(str(paths.built_fmu(identifier, 2, build)))
+    inputs, outputs, rows = step_rows(md, count, seed=2)
+    outputs = outputs if every else efforts_and_reactions(outputs)
+    data = work / "speed_fmu.bin"
+    rows.astype("<f8").tofile(data)
+    binary = paths.stage_binary(build, identifier, 2)
+    program = [str(bench.bench_binary(build, "double"))]
+    program += bench.fmu_step_arguments(binary, 2, md.guid, data, inputs, outputs)
+    out = _callgrind(program + ["--repeat", "1"], work, "bench_loop_*", per_instruction=True)
+    return flops.operations(out) / len(rows)
+
+
 def step_counts(build: Path, identifier: str, version: int, count: int, work: Path) -> Step:
     """Instructions per step of an FMU's binary from C, of its evaluation inside the step,
     and of its angles' directions: what the step costs more where every angle changes
@@ -385,6 +404,8 @@ def measure(
             )
         )
         if scene in BATCH_SCENES:
+            for every in (False, True):
+                scenes[-1].flops[every] = step_flops(build, scene, steps, work, every)
             for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
                 rounds = 2 if count >= 1_000_000 else 5
                 for every in (False, True):
