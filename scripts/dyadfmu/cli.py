@@ -159,8 +159,8 @@ def _sweep_command(sub: argparse._SubParsersAction) -> None:
         type=whole(0, 256),
         default=None,
         help="local Dask worker processes (0 runs in this process, without Dask; default: "
-        "none for a crank, ram or cylinder run of at most 1,000,000 samples, designs x points, "
-        "which takes about a second here, else 2)",
+        "none for a crank, ram or cylinder run of at most 200,000 samples, designs x points, "
+        "which takes less than a cluster takes to start, else 2)",
     )
     sweep.add_argument(
         "--scheduler",

@@ -59,9 +59,10 @@ def prepare(
 
 
 #: Samples of a study whose runs evaluate in calls of the binary (a kinetostatic or a
-#: stroke run) that it runs in this process when no worker count is given: they take
-#: about a second at most, less than a local cluster takes to start.
-IN_PROCESS_SAMPLES = 1_000_000
+#: stroke run) that it runs in this process when no worker count is given: about a
+#: second at most for the built-in scenes (the tipper's 10,000 instructions a sample),
+#: about what a local cluster takes to start.
+IN_PROCESS_SAMPLES = 200_000
 #: Local worker processes when no count is given and the study is larger.
 DEFAULT_WORKERS = 2
 
