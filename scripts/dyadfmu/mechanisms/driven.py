@@ -52,7 +52,13 @@ from . import crank as crank_balance
 from . import geometry as geo
 from .motion import CrankMotion, RamMotion
 
-__all__ = ["SCENE_OF", "DrivenSeries", "driver_motion_inputs", "effective_inertia"]
+__all__ = [
+    "SCENE_OF",
+    "DrivenSeries",
+    "builtin_outputs",
+    "driver_motion_inputs",
+    "effective_inertia",
+]
 
 #: The mechanism FMU scene (``modelDescription/scenes/<name>.toml``) of each built-in mechanism.
 SCENE_OF = {
@@ -196,7 +202,7 @@ def _link_and_points(kin: dict, links: Mapping, points: Mapping) -> dict:
     return out
 
 
-def _builtin_outputs(mech: builtin.Mechanism, kin: dict, scene: Mapping) -> dict:
+def builtin_outputs(mech: builtin.Mechanism, kin: dict, scene: Mapping) -> dict:
     """The reference outputs of a built-in mechanism under its scene's names."""
     dyad = scene["dyad"][0]
     d, c = dyad["name"], scene.get("crank", {}).get("name", "crank")
@@ -312,7 +318,7 @@ def driver_motion_inputs(
         driver = scene.get("crank", {}).get("name", "crank")
         dyad = scene["dyad"][0]
         role = {dyad["m"]: "m", dyad["n"]: "n"}
-        out = _builtin_outputs(mechanism, kin, scene)
+        out = builtin_outputs(mechanism, kin, scene)
         effort = f"{driver}.torque"
         conditioning = {dyad.get("name", ""): mechanism.conditioning(kin)}
         names, keys = _CRANK, [f"crank.{k}" for k in _CRANK]

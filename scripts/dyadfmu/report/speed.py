@@ -195,7 +195,7 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "(`dyadfmu.evaluate`, through the FMU binary's columns entry): the CPU time per sample, "
         "the best of several calls, asking the efforts and the reactions or every output; the "
         "same samples through its rows entry (a set and a get per sample); against "
-        "the harness's stacked NumPy solve of a chain (its kinematics and every body's "
+        "the harness's stacked NumPy solve of the mechanism (its kinematics and every body's "
         "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick. Its "
         "floor: the flops an FMU step executes for the job (callgrind, libm's among them) at "
         "the rate `dyadfmu.solve` executes the RRR solve's own (flops per CPU second).",

@@ -104,21 +104,28 @@ BATCH_SIZES = (73, 10_000, 1_000_000)
 
 
 def numpy_yardstick_seconds(scene: str, count: int, rounds: int) -> float:
-    """CPU seconds per sample of the harness's stacked NumPy solve of a chain over
+    """CPU seconds per sample of the harness's stacked NumPy solve of a mechanism over
     ``count`` samples of a turn: its kinematics and the Newton-Euler equations of every
-    body, one ``np.linalg.solve`` over the samples (``chains.Chain.reference``), the best
-    of ``rounds``; NaN for a mechanism that is not a chain (it has no such solve)."""
+    body, one ``np.linalg.solve`` over the samples (a chain's ``chains.Chain.reference``,
+    a built-in crank and dyad's ``driven.builtin_outputs``), the best of ``rounds``."""
     from ..cosim import mechanism_fmus
+    from ..mechanisms import driven
 
-    if mechanism_fmus.MECHANISM_FMUS[scene][0] != "chain":
-        return math.nan
-    chain = mechanism_fmus.mechanism_of(scene)
-    motion = chain.motion("constant", 1.0)
+    mechanism = mechanism_fmus.mechanism_of(scene)
+    motion = mechanism.motion("constant", 1.0)
     t = np.linspace(0.0, motion.duration, count)
+    if mechanism_fmus.MECHANISM_FMUS[scene][0] == "chain":
+        solve_all = lambda: mechanism.reference(mechanism.kinematics(t, motion))  # noqa: E731
+    else:
+        text = mechanism_fmus.scene_file(scene).read_text(encoding="utf-8")
+        kind = tomllib.loads(text)
+        solve_all = lambda: driven.builtin_outputs(  # noqa: E731
+            mechanism, mechanism.kinematics(t, motion), kind
+        )
     best = math.inf
     for _ in range(rounds):
         started = clock.process_time()
-        chain.reference(chain.kinematics(t, motion))
+        solve_all()
         best = min(best, clock.process_time() - started)
     return best / count
 
