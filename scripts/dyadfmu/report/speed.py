@@ -100,9 +100,9 @@ def _scene_rows(scenes: list[SceneSpeed]) -> list[str]:
 BATCH_HEADER = (
     "mechanism",
     "samples",
-    "flops per sample: efforts and reactions / every output (floor at the solve's rate)",
-    "efforts and reactions, CPU per sample (to its floor)",
-    "every output, CPU per sample (to its floor)",
+    "flops per sample: efforts and reactions / every output (their time at the RRR solve's rate)",
+    "efforts and reactions, CPU per sample (to that time)",
+    "every output, CPU per sample (to that time)",
     "efforts and reactions through the rows entry, CPU per sample",
     "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
 )
@@ -117,8 +117,8 @@ def _to_floor(seconds: float, floor: float) -> str:
 
 
 def _batch_rows(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
-    """dyadfmu.evaluate per sample, where it was timed, against the floor: the flops a
-    step executes at the rate the RRR solve executes its own; none timed: no table."""
+    """dyadfmu.evaluate per sample, where it was timed, against the flops a step executes
+    for the job at the rate the RRR solve executes its own; none timed: no table."""
     rrr = next((t for t in types if t.dyad == "RRR"), None)
     rate = rrr.solve_flops / rrr.numpy_seconds_per_row[True] if rrr else math.nan
     rows = []
@@ -196,9 +196,10 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "the best of several calls, asking the efforts and the reactions or every output; the "
         "same samples through its rows entry (a set and a get per sample); against "
         "the harness's stacked NumPy solve of the mechanism (its kinematics and every body's "
-        "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick. Its "
-        "floor: the flops an FMU step executes for the job (callgrind, libm's among them) at "
-        "the rate `dyadfmu.solve` executes the RRR solve's own (flops per CPU second).",
+        "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick. Beside "
+        "them the flops an FMU step executes for the job (callgrind, libm's among them) and "
+        "their time at the rate `dyadfmu.solve` executes the RRR solve's own (flops per CPU "
+        "second): a time near it says the evaluation is bound by the arithmetic it does.",
         "",
         *_type_rows(types),
         "",
