@@ -163,23 +163,33 @@ def evaluate(
     return done if done is not None else _run(entry, x, p, wanted, shape, units)
 
 
+def _flat(array: np.ndarray, shape: tuple) -> np.ndarray:
+    """The array's values over the batch, one dimension: as it is where it holds one value
+    or has the batch's shape (a view where it can be), else broadcast."""
+    if array.size == 1 or array.shape == shape:
+        return array.reshape(-1)
+    return np.broadcast_to(array, shape).reshape(-1)
+
+
 def _by_columns(entry: object, x: dict, wanted: tuple, shape: tuple, units: dict):
     """Every sample in chunks of CHUNK through the columns entry (a value held for every
     sample passed once); None where the binary refuses it (a model with states)."""
     count = math.prod(shape)
-    flat = {n: a if a.size == 1 else np.broadcast_to(a, shape).reshape(-1) for n, a in x.items()}
-    values = {n: np.empty(count) for n in wanted}
-    status = np.empty(count, dtype=np.intc)
+    flat = {n: _flat(a, shape) for n, a in x.items()}
+    chunks = []
     for start in range(0, max(count, 1), CHUNK):
         stop = min(start + CHUNK, count)
         part = {n: a if a.size == 1 else a[start:stop] for n, a in flat.items()}
         done = entry.evaluate(part, wanted, stop - start)
         if done is None:
             return None
-        for n in wanted:
-            values[n][start:stop] = done[0][n]
-        status[start:stop] = done[1]
-    shaped = {n: v.reshape(shape) for n, v in values.items()}
+        chunks.append(done)
+    if len(chunks) == 1:  # the arrays the binary wrote, as they are
+        values, status = chunks[0]
+    else:
+        values = {n: np.concatenate([c[0][n] for c in chunks]) for n in wanted}
+        status = np.concatenate([c[1] for c in chunks])
+    shaped = {n: np.ascontiguousarray(values[n]).reshape(shape) for n in wanted}
     return Evaluation(shaped, units, status.reshape(shape))
 
 
