@@ -238,3 +238,41 @@ def _start_lines(table: object) -> str:
         else:
             lines.append(f"        in.{v.lives.path} = {start!r} * (1.0 + 0.01 * k) + 0.01 * k;")
     return "\n".join(lines)
+
+
+#: A program on a scene's C: the check the whole evaluation ends with, on outputs where one
+#: the second half gives (MEMBER) is not finite: status 3, every output NaN, Discard.
+CHECK_MAIN = r"""
+#include "IDENT_scene.c"
+
+int main(void)
+{
+    IDENT_output out;
+    fmu_evaluation evaluation;
+    memset(&out, 0, sizeof out);
+    out.MEMBER = INFINITY;
+    check(&out, &evaluation);
+    return !(evaluation.status == FMU_DISCARD && out.status == 3 && isnan(out.MEMBER));
+}
+"""
+
+
+@pytest.mark.parametrize("name", ("slider_crank", "leg"))
+def test_the_whole_evaluation_checks_the_outputs_the_second_half_gives(name, tmp_path):
+    """<id>_evaluate, which an FMU runs where its get reads the effective inertia, checks
+    every output it gives, those of the second half among them (an overflow there is
+    status 3, not a status 0 beside an infinite J)."""
+    required_tool("cc")
+    folder = _sources(name, tmp_path)
+    table = pipeline.build_table(pipeline.load_scene(paths.SCENES_DIR / f"{name}.toml"))
+    core = sorted(folder.glob("core/src/*.c"))
+    for member in later_members(table.scene):
+        main = tmp_path / f"check_{member}.c"
+        main.write_text(CHECK_MAIN.replace("IDENT", name).replace("MEMBER", member))
+        subprocess.run(
+            ["cc", "-std=c99", "-O1", f"-I{folder / 'scene'}", f"-I{folder / 'core' / 'include'}",
+             "-o", str(tmp_path / "check"), str(main), *map(str, core), "-lm"],
+            check=True,
+        )  # fmt: skip
+        done = subprocess.run([str(tmp_path / "check")], capture_output=True, text=True)
+        assert done.returncode == 0, f"{name}: {member} not finite passes the check"

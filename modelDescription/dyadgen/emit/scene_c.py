@@ -831,7 +831,7 @@ def _outputs(plan: Plan, code: _Code, later: tuple[str, ...] = ()) -> None:
         if not o.integer:
             code(f"out->{o.member} = {'NAN' if o.member in later else exprs[o.member]};")
     code("out->status = 0;")
-    code("check(out, evaluation);")
+    code("check_first(out, evaluation);" if later else "check(out, evaluation);")
 
 
 def _inertia_members(plan: Plan) -> tuple[set[str], list[str]]:
@@ -1022,7 +1022,8 @@ def _helpers(
 
 def _checks(ident: str, reals: list[str], later: list[str]) -> str:
     """check: every Real output finite, else each one NaN and status 3; with outputs given
-    later (see :func:`later_members`), check over the others and check_later over those."""
+    later (see :func:`later_members`) also check_first over the others, for the first half,
+    and check_later over those, for the second (the whole evaluation checks them all)."""
 
     def one(name: str, members: list[str]) -> str:
         terms = " + ".join(f"(out->{m} - out->{m})" for m in members) or "0.0"
@@ -1031,7 +1032,8 @@ def _checks(ident: str, reals: list[str], later: list[str]) -> str:
     if not later:
         return one("check", reals)
     first = [m for m in reals if m not in later]
-    return one("check", first) + "\n" + one("check_later", [m for m in reals if m in later])
+    halves = one("check_first", first) + "\n" + one("check_later", [m for m in reals if m in later])
+    return one("check", reals) + "\n" + halves
 
 
 def _evaluation(
