@@ -1948,11 +1948,11 @@ static void load_starts(const fmu_model* model, void* input)
     model->behaviour->initialise(model, input);
     for (k = 0; k < model->variable_count; ++k) {
         const fmu_variable* v = &model->variables[k];
-        double* at = (double*)(void*)((char*)input + v->offset);
         if (v->target == FMU_TARGET_INPUT_REAL) {
-            *at = v->start;
+            *(double*)(void*)((char*)input + v->offset) = v->start;
         } else if (v->target == FMU_TARGET_INPUT_ANGLE) {
-            dyad_cos_sin(v->start, &at[0], &at[1]);
+            double* unit = (double*)(void*)((char*)input + v->offset);
+            dyad_cos_sin(v->start, &unit[0], &unit[1]);
         }
     }
 }

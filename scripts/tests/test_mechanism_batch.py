@@ -108,3 +108,25 @@ def test_bad_arguments_are_refused_by_name(args, message):
 def test_a_parameter_that_is_not_tunable_is_refused():
     with pytest.raises(ValueError, match="slider.length: not tunable parameters of shaper_fmi2"):
         evaluate("shaper", {}, ["crank.torque"], parameters={"slider.length": 1.0})
+
+
+def test_strided_and_reversed_inputs_give_what_their_contiguous_copies_give():
+    """Views NumPy hands over as they are (every other sample, a reversed array, a column
+    of a matrix): read in place by the binary, with the values a contiguous copy gives."""
+    table = np.linspace(0.0, 7.0, 600).reshape(200, 3)
+    angle, omega = table[:, 0], table[::-1, 1] * 10.0  # a column, a reversed column
+    found = evaluate("slider_crank", {"crank.angle": angle, "crank.omega": omega}, OUTPUTS)
+    copies = {"crank.angle": angle.copy(), "crank.omega": omega.copy()}
+    want = evaluate("slider_crank", copies, OUTPUTS)
+    every_other = evaluate("slider_crank", {"crank.angle": angle[::2]}, OUTPUTS)
+    plain = evaluate("slider_crank", {"crank.angle": angle[::2].copy()}, OUTPUTS)
+    for name in OUTPUTS:
+        assert np.array_equal(found[name], want[name]), name
+        assert np.array_equal(every_other[name], plain[name]), name
+
+
+def test_ten_million_samples_with_one_bad_value_are_refused_before_anything_runs():
+    angle = np.zeros(10_000_000)
+    angle[-1] = np.inf
+    with pytest.raises(ValueError, match=r"crank.angle\[9999999\] is inf"):
+        evaluate("slider_crank", {"crank.angle": angle}, OUTPUTS)
