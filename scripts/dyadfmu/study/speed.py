@@ -32,6 +32,8 @@ from . import configurations as cfg
 STEP_TARGET = 2.0
 FLOPS_TARGET = 2.0
 ROWS_PER_SECOND_TARGET = 10e6
+#: A whole mechanism from NumPy (dyadfmu.evaluate) against the stacked NumPy solve.
+NUMPY_RATIO_TARGET = 20.0
 #: Rows per timed call of dyadfmu.solve: inputs and outputs (about 4 MB) fit the caches,
 #: so that the solve is timed and not the memory bus (as the study times the core).
 NUMPY_ROWS = 10_000
