@@ -107,10 +107,6 @@ def test_a_scene_with_samples_without_an_answer_gives_their_status():
         assert np.isnan(y[name][status != 0]).all(), name
 
 
-def _start(md, name: str) -> float:
-    return float(next(v for v in md.modelVariables if v.name == name).start)
-
-
 def _call(fmu, x_names, x_columns, x_steps, y_names, y_columns, y_steps, count):
     """dyadfmu_evaluate_columns through ctypes with the columns as given (any strides)."""
     entry = entries.columns_entry(fmu)
