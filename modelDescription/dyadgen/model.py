@@ -19,11 +19,17 @@ def c_num(x: float) -> str:
     return text if ("." in text or "e" in text or "inf" in text or "nan" in text) else text + ".0"
 
 
+def c_real(x: float) -> str:
+    """A number of the scene's arithmetic in C: in the scalar's precision (DYAD_R,
+    dyadfmu/types.h), so that a float build computes in float; exact in double."""
+    return f"DYAD_R({c_num(x)})"
+
+
 def unit_vector_c(angle: Param) -> str:
     """The unit vector at an angle (rad) in C: a constant, or computed where it is tunable."""
     if angle.tunable:
         return f"dyad_dir_from_angle({angle.c()})"
-    return f"dyad_vec2_make({c_num(math.cos(angle.value))}, {c_num(math.sin(angle.value))})"
+    return f"dyad_vec2_make({c_real(math.cos(angle.value))}, {c_real(math.sin(angle.value))})"
 
 
 def member(name: str) -> str:
@@ -45,7 +51,7 @@ class Param:
 
     def c(self) -> str:
         """The value in C: the input block's member, or the constant."""
-        return f"in->{self.member}" if self.tunable else c_num(self.value)
+        return f"in->{self.member}" if self.tunable else c_real(self.value)
 
     def is_zero(self) -> bool:
         """Baked at 0: a term it multiplies is not written."""

@@ -174,7 +174,7 @@ def test_static_press_takes_no_motion_and_computes_no_inertia_or_weight():
     for absent in ("omega", "epsilon", "gravity", "accel", "crank_r_o"):
         assert absent not in body, absent
     # baked constants, not parameters: the rod length and the crank radius
-    assert "0.18" in body and "dyad_scale(0.05, crank_i)" in body
+    assert "DYAD_R(0.18)" in body and "dyad_scale(DYAD_R(0.05), crank_i)" in body
 
 
 def test_horizontal_monitor_has_no_weight_and_one_reaction():
@@ -215,9 +215,12 @@ def test_a_mechanism_fmu_always_bounds_what_it_reports(tmp_path):
     amplification of each dyad whose kinematics run, every one carried to the next."""
     text = (SCENES_DIR / "sixbar.toml").read_text()
     for wanted, terms in (
-        ('["second.R_np"]', ["second_bound", "3.0 * kin.first.amplification"]),
-        ('["rocker.omega"]', ["3.0 * kin.first.amplification"]),
-        ('["output.epsilon"]', ["3.0 * kin.first.amplification", "3.0 * kin.second.amplification"]),
+        ('["second.R_np"]', ["second_bound", "DYAD_R(3.0) * kin.first.amplification"]),
+        ('["rocker.omega"]', ["DYAD_R(3.0) * kin.first.amplification"]),
+        (
+            '["output.epsilon"]',
+            ["DYAD_R(3.0) * kin.first.amplification", "DYAD_R(3.0) * kin.second.amplification"],
+        ),
     ):
         scene = tmp_path / "sixbar_some.toml"
         scene.write_text(
@@ -229,7 +232,7 @@ def test_a_mechanism_fmu_always_bounds_what_it_reports(tmp_path):
         assert run_tool(scene, "--out", out).returncode == 0
         code = (out / "sixbar_some_scene.c").read_text()
         line = re.search(r"out->amplification = ([^N].*);", code).group(1)
-        assert line == " + ".join(["1.0", *terms]), (wanted, line)
+        assert line == " + ".join(["DYAD_R(1.0)", *terms]), (wanted, line)
         carried = "k.mount_amplification = kin->first.amplification;" in code
         assert carried == any("second" in t for t in terms), wanted  # where second moves
         md = (out / "fmi2" / "modelDescription.xml").read_text()

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from dyadgen import textsafe
-from dyadgen.model import Attachment, Crank, Dyad, Param, Scene, c_num, member
+from dyadgen.model import Attachment, Crank, Dyad, Param, Scene, c_real, member
 from dyadgen.needs import kin_name, kin_name_of_cylinder
 
 #: the core's failure statuses and the scene status each one reports
@@ -135,7 +135,7 @@ class _Mounts:
 def _unit(angle: Param) -> str:
     if angle.tunable:
         return f"dyad_dir_from_angle({angle.c()})"
-    return _vec(c_num(math.cos(angle.value)), c_num(math.sin(angle.value)))
+    return _vec(c_real(math.cos(angle.value)), c_real(math.sin(angle.value)))
 
 
 def _turned(angle: Param, direction: str) -> str:
@@ -360,14 +360,14 @@ def kinematics_function(scene: Scene, dyads: list[Dyad]) -> str:
             " * `in` moving at `rate` with `accel` (rad/s and rad/s2, or m/s and m/s2 for a ram).",
             " * Returns NULL, or the result of the first dyad that does not solve (its index",
             " * in `failed`). */",
-            f"static const dyad_kin_result* kinematics(const {ident}_input* in, double rate,",
-            f"                                         double accel, {ident}_kinematics* kin,",
+            f"static const dyad_kin_result* kinematics(const {ident}_input* in, dyad_real rate,",
+            f"                                         dyad_real accel, {ident}_kinematics* kin,",
             "                                         int* failed)",
             "{",
         ]
     else:
         rates = ", ".join(
-            f"double {rate}, double {accel}"
+            f"dyad_real {rate}, dyad_real {accel}"
             for rate, accel in (rate_names(scene, d) for d in scene.drivers)
         )
         lines += [

@@ -25,7 +25,7 @@ from string import Template
 
 from dyadgen import textsafe
 from dyadgen.emit import kinematics_c, tangent_c
-from dyadgen.model import Attachment, Crank, Dyad, Param, Scene, c_num, loaders, member
+from dyadgen.model import Attachment, Crank, Dyad, Param, Scene, c_real, loaders, member
 from dyadgen.needs import effort_of, inertia_entry_member, kin_name_of_cylinder
 from dyadgen.table import Table
 
@@ -67,7 +67,7 @@ def _sum(terms: list) -> str:
 
 
 def _unit_vector(angle: float) -> str:
-    return _vec(c_num(math.cos(angle)), c_num(math.sin(angle)))
+    return _vec(c_real(math.cos(angle)), c_real(math.sin(angle)))
 
 
 class _Code:
@@ -230,7 +230,7 @@ def _carried_accel(plan: Plan, code: _Code, g: str, att: Attachment) -> None:
         w, e = plan.omega(carrier), plan.epsilon(carrier)
         if e:
             terms.append(f"dyad_scale({e}, dyad_perp({c}_r_d))")
-            sizes.append(f"fabs({e}) * dyad_norm1({c}_r_d)")
+            sizes.append(f"dyad_fabs({e}) * dyad_norm1({c}_r_d)")
         if w:
             terms.append(f"dyad_scale(-{w} * {w}, {c}_r_d)")
             sizes.append(f"{w} * {w} * dyad_norm1({c}_r_d)")
@@ -239,7 +239,7 @@ def _carried_accel(plan: Plan, code: _Code, g: str, att: Attachment) -> None:
         return
     code(f"const dyad_vec2 {c}_a_d = {_sum(terms)};")
     plan.accel[g] = f"{c}_a_d"
-    code(f"const double {c}_a_d_size = {' + '.join(sizes)};")
+    code(f"const dyad_real {c}_a_d_size = {' + '.join(sizes)};")
     plan.accel_size[g] = f"{c}_a_d_size"
 
 
@@ -259,7 +259,7 @@ def _accelerations(plan: Plan, code: _Code) -> None:
             c = member(driver.name)
             code(f"const dyad_vec2 {c}_a_d = dyad_scale(in->{c}_acceleration, {c}_i);")
             plan.accel[driver.name] = f"{c}_a_d"
-            plan.accel_size[driver.name] = f"fabs(in->{c}_acceleration)"
+            plan.accel_size[driver.name] = f"dyad_fabs(in->{c}_acceleration)"
     for d in plan.solved:
         for g, att in ((d.m, d.k), (d.n, d.p)):
             c = member(g)
@@ -293,7 +293,7 @@ def _mass_terms(plan: Plan, g: str, r: str | None) -> tuple[list, list]:
         e = plan.epsilon(g)
         if e and r is not None:
             tang.append(f"dyad_scale({e}, dyad_perp({c}_r))")
-            inner_sizes.append(f"fabs({e}) * dyad_norm1({c}_r)")
+            inner_sizes.append(f"dyad_fabs({e}) * dyad_norm1({c}_r)")
         inner += [f"dyad_neg({t})" for t in tang]
     return inner, inner_sizes
 
@@ -324,10 +324,10 @@ def _moment_terms(plan: Plan, g: str) -> tuple[list, list]:
     sizes = []
     if link is not None and link.moment:
         terms.append(plan.inp(g + ".moment"))
-        sizes.append(f"fabs({terms[-1]})")
+        sizes.append(f"dyad_fabs({terms[-1]})")
     if plan.scene.inertia and inert is not None and not inert.is_zero() and e:
         terms.append(f"-{inert.c()} * {e}")
-        sizes.append(f"{inert.c()} * fabs({e})")
+        sizes.append(f"{inert.c()} * dyad_fabs({e})")
     return terms, sizes
 
 
@@ -349,7 +349,7 @@ def _point_loads(plan: Plan, g: str, r: str | None) -> tuple[list, list, list, l
             if load.components == "link":  # a follower force turns with its link
                 f = f"dyad_combine({fx}, {c}_i, {fy}, {c}_j)"
                 # its components' sizes: the turn's products may cancel
-                size = f"fabs({fx}) * dyad_norm1({c}_i) + fabs({fy}) * dyad_norm1({c}_j)"
+                size = f"dyad_fabs({fx}) * dyad_norm1({c}_i) + dyad_fabs({fy}) * dyad_norm1({c}_j)"
             forces.append(f)
             force_sizes.append(size)
             p = plan.point(g, load.at)
@@ -359,7 +359,7 @@ def _point_loads(plan: Plan, g: str, r: str | None) -> tuple[list, list, list, l
                 moment_sizes.append(f"dyad_norm1({arm}) * ({size})")
         if load.moment:
             moments.append(plan.inp(f"{n}.moment"))
-            moment_sizes.append(f"fabs({moments[-1]})")
+            moment_sizes.append(f"dyad_fabs({moments[-1]})")
     return forces, force_sizes, moments, moment_sizes
 
 
@@ -378,14 +378,14 @@ def _resultant(plan: Plan, code: _Code, g: str) -> None:
     moment_terms, moment_sizes = _moment_terms(plan, g)
     moment_terms += placed_moments
     moment_sizes += placed_moment_sizes
-    code(f"double {c}_m = {' + '.join(moment_terms) if moment_terms else '0.0'};")
+    code(f"dyad_real {c}_m = {' + '.join(moment_terms) if moment_terms else '0.0'};")
     if r is not None and force_terms:
-        code(f"double {c}_m_d = {c}_m + dyad_cross({c}_r, {c}_f);")
+        code(f"dyad_real {c}_m_d = {c}_m + dyad_cross({c}_r, {c}_f);")
         moment_sizes.append(f"dyad_norm1({c}_r) * {c}_f_size")
     else:
-        code(f"double {c}_m_d = {c}_m;")
-    code(f"double {c}_f_size = {' + '.join(force_sizes) or '0.0'};")
-    code(f"double {c}_m_d_size = {' + '.join(moment_sizes) or '0.0'};")
+        code(f"dyad_real {c}_m_d = {c}_m;")
+    code(f"dyad_real {c}_f_size = {' + '.join(force_sizes) or '0.0'};")
+    code(f"dyad_real {c}_m_d_size = {' + '.join(moment_sizes) or '0.0'};")
     mass = plan.scene.params_of(g).get("mass")
     w = plan.omega(g)
     if plan.scene.inertia and mass is not None and not mass.is_zero() and r is not None and w:
@@ -417,7 +417,7 @@ def _guide(plan: Plan, d: Dyad, side: str, att: Attachment) -> str:
         return f"{carrier}_i"
     if guide.tunable:
         return f"dyad_combine(cos({guide.c()}), {carrier}_i, sin({guide.c()}), {carrier}_j)"
-    cos, sin = c_num(math.cos(guide.value)), c_num(math.sin(guide.value))
+    cos, sin = c_real(math.cos(guide.value)), c_real(math.sin(guide.value))
     return f"dyad_combine({cos}, {carrier}_i, {sin}, {carrier}_j)"
 
 
@@ -483,17 +483,17 @@ def _bound(plan: Plan, code: _Code, d: Dyad) -> None:
     dn = member(d.name or "dyad")
     extra = []
     if d in plan.kinematic:
-        extra.append(f"2.0 * kin.{kinematics_c.kin_name(d)}.amplification")
+        extra.append(f"DYAD_R(2.0) * kin.{kinematics_c.kin_name(d)}.amplification")
     solved = {x.index for x in plan.solved}
     for loader in plan.direct_loaders(d):
         if loader.index in solved:
             ln = member(loader.name or "dyad")
             extra.append(f"({ln}_bound - {ln}.amplification)")
     if not extra:
-        code(f"const double {dn}_bound = {dn}.amplification;")
+        code(f"const dyad_real {dn}_bound = {dn}.amplification;")
         return
     code(
-        f"const double {dn}_bound = {dn}.amplification + {dn}.amplification * "
+        f"const dyad_real {dn}_bound = {dn}.amplification + {dn}.amplification * "
         f"{dn}.conditioning * ({' + '.join(extra)});"
     )
 
@@ -504,14 +504,14 @@ def mechanism_amplification(plan: Plan) -> str:
     motion's amplification twice over; one whose motion alone is reported, three times
     its motion's (the accelerations and the effective inertia square the rates)."""
     solved = {d.index for d in plan.solved}
-    terms = ["1.0"] + [f"{member(d.name or 'dyad')}_bound" for d in plan.solved]
+    terms = ["DYAD_R(1.0)"] + [f"{member(d.name or 'dyad')}_bound" for d in plan.solved]
     for driver in kinematics_c.cylinders(plan.scene):
         kin = f"kin.{kin_name_of_cylinder(driver)}"
-        terms.append(f"3.0 * {kin}.kin_amplification")
+        terms.append(f"DYAD_R(3.0) * {kin}.kin_amplification")
         if plan.crank_needed:
             terms.append(f"{member(driver.actuator)}_bound")
     terms += [
-        f"3.0 * kin.{kinematics_c.kin_name(d)}.amplification"
+        f"DYAD_R(3.0) * kin.{kinematics_c.kin_name(d)}.amplification"
         for d in plan.kinematic
         if d.index not in solved
     ]
@@ -578,12 +578,12 @@ def _cylinder_bound(driver: Crank) -> str:
     params = driver.params
     pin = f"dyad_norm1({kinematics_c._vec(params['pin.x'].c(), params['pin.y'].c())})"
     forces = " + ".join(
-        [f"fabs({c}_cyl.axial_force)"] + [f"dyad_norm1({c}_cyl.r_{p})" for p in "abo"]
+        [f"dyad_fabs({c}_cyl.axial_force)"] + [f"dyad_norm1({c}_cyl.r_{p})" for p in "abo"]
     )
     sizes = f"{link}_f_size + {link}_m_d_size / {pin}"
     return (
         f"{c}_cyl.amplification + {c}_cyl.kin_amplification * "
-        f"(1.0 + 4.0 * ({sizes}) / ({forces} + 2.2250738585072014e-308))"
+        f"(DYAD_R(1.0) + DYAD_R(4.0) * ({sizes}) / ({forces} + DYAD_REAL_MIN))"
     )
 
 
@@ -619,7 +619,7 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
     code("    }")
     code("}")
     code(f"{c}_force = {c}_cyl.axial_force;")
-    code(f"const double {c}_bound = {_cylinder_bound(driver)};")
+    code(f"const dyad_real {c}_bound = {_cylinder_bound(driver)};")
 
 
 def _crank(plan: Plan, code: _Code) -> None:
@@ -694,12 +694,12 @@ def _driver_inertia(plan: Plan, code: _Code) -> None:
     code(" * dJ/dq = 2 sum (m V.V' + I W W'). */")
     code(f"{scene.identifier}_kinematics unit;")
     _unit_kinematics(plan, code, "unit", "1.0, 0.0")
-    code(f"const double {c}_reduced_j = {' + '.join(j_terms) or '0.0'};")
-    code(f"const double {c}_reduced_djdq = 2.0 * ({' + '.join(dj_terms) or '0.0'});")
+    code(f"const dyad_real {c}_reduced_j = {' + '.join(j_terms) or '0.0'};")
+    code(f"const dyad_real {c}_reduced_djdq = DYAD_R(2.0) * ({' + '.join(dj_terms) or '0.0'});")
     _, accel = kinematics_c.driver_rates(scene, scene.crank)
     balance = "force" if scene.crank.balances_with_force() else "torque"
     if _wanted(plan, scene.crank, f"{balance}0"):
-        code(f"const double {c}_{balance}0 = {c}_{balance} - {c}_reduced_j * {accel};")
+        code(f"const dyad_real {c}_{balance}0 = {c}_{balance} - {c}_reduced_j * {accel};")
 
 
 def _unit_kinematics(plan: Plan, code: _Code, target: str, rates: str) -> None:
@@ -734,16 +734,16 @@ def _inertia_matrix(plan: Plan, code: _Code) -> None:
     for i, a in enumerate(drivers):
         for b in drivers[i:]:
             terms = kinematics_c.inertia_matrix_terms(scene, plan.kinematic, a, b)
-            code(f"const double {entry(a, b)} = {' + '.join(terms) or '0.0'};")
+            code(f"const dyad_real {entry(a, b)} = {' + '.join(terms) or '0.0'};")
         for b in drivers[:i]:
-            code(f"const double {entry(a, b)} = {entry(b, a)};")
+            code(f"const dyad_real {entry(a, b)} = {entry(b, a)};")
     for a in drivers:
         effort = effort_of(a)[0]
         if not _wanted(plan, a, f"{effort}0"):
             continue
         c = member(a.driver_name())
         terms = [f"{entry(a, b)} * {kinematics_c.driver_rates(scene, b)[1]}" for b in drivers]
-        code(f"const double {c}_{effort}0 = {c}_{effort} - ({' + '.join(terms)});")
+        code(f"const dyad_real {c}_{effort}0 = {c}_{effort} - ({' + '.join(terms)});")
 
 
 def _kinematic_exprs(scene: Scene) -> dict[str, str]:
@@ -754,7 +754,7 @@ def _kinematic_exprs(scene: Scene) -> dict[str, str]:
         pre = member(d.prefix())
         for side, g in (("m", d.m), ("n", d.n)):
             c = member(g)
-            exprs[f"{c}_angle"] = f"atan2({kin}.{side}.dir.y, {kin}.{side}.dir.x)"
+            exprs[f"{c}_angle"] = f"dyad_atan2({kin}.{side}.dir.y, {kin}.{side}.dir.x)"
             exprs[f"{c}_omega"] = f"{kin}.{side}.omega"
             exprs[f"{c}_epsilon"] = f"{kin}.{side}.epsilon"
             exprs[f"{c}_length"] = f"{kin}.{side}.length"
@@ -876,7 +876,7 @@ def _later_body(plan: Plan, later: tuple[str, ...]) -> list[str]:
     inertia's pass, its outputs and their check."""
     code = _Code()
     for effort in _inertia_members(plan)[1]:
-        code(f"const double {effort} = out->{effort};")
+        code(f"const dyad_real {effort} = out->{effort};")
     _driver_inertia(plan, code)
     exprs = _output_exprs(plan.scene)
     code()
@@ -934,15 +934,15 @@ def _declarations(plan: Plan) -> tuple[list[str], list[str]]:
     for driver in plan.drivers if plan.crank_needed else []:
         if driver.is_cylinder():
             c = member(driver.actuator)
-            crank += [f"    dyad_cylinder_result {c}_cyl;", f"    double {c}_force;"]
+            crank += [f"    dyad_cylinder_result {c}_cyl;", f"    dyad_real {c}_force;"]
         elif driver.is_ram():
             c = member(driver.name)
-            crank += [f"    double {c}_{key};" for key in ("force", "guide_n", "guide_m")]
+            crank += [f"    dyad_real {c}_{key};" for key in ("force", "guide_n", "guide_m")]
         else:
             c = member(driver.name)
             torque, r_o = _crank_outputs(plan, driver)
             if torque or _wanted(plan, driver, "torque0"):
-                crank.append(f"    double {c}_torque;")
+                crank.append(f"    dyad_real {c}_torque;")
             if r_o:
                 crank.append(f"    dyad_vec2 {c}_r_o;")
     return dyads, crank
@@ -1141,6 +1141,8 @@ def scene_header(table: Table, halves: bool = True) -> str:
     scene = table.scene
     ident = scene.identifier
     guard = f"DYADFMU_SCENE_{ident.upper()}_H"
+    # the blocks' numbers in the scalar's precision; a plant's stay double, its integrator's
+    real = "double" if scene.forward() else "dyad_real"
     lines = [
         f"/* {ident}_scene.h: the scene {ident} in C: its input and output blocks, the",
         f" * function that computes it ({ident}_scene.c) and the one that also gives its",
@@ -1153,22 +1155,24 @@ def scene_header(table: Table, halves: bool = True) -> str:
         '#include "dyadfmu/evaluation.h"',
         '#include "dyadfmu/vec2.h"',
         "",
-        "/* Inputs and tunable parameters; an angle is kept as its unit vector. */",
+        "/* Inputs and tunable parameters; an angle is kept as its unit vector. The numbers are",
+        " * dyad_real (float with DYAD_REAL_FLOAT, else double)"
+        + (", but for a plant's, which stay double. */" if scene.forward() else ". */"),
         f"typedef struct {ident}_input {{",
     ]
     units = {v.lives.path: v.unit for v in table.variables}
     for name, leaf in table.kind.input_members.items():
-        ctype = "dyad_vec2" if leaf == "dir" else "double"
+        ctype = "dyad_vec2" if leaf == "dir" else real
         lines.append(f"    {ctype} {name}; /* {units.get(name) or '-'} */")
     if not table.kind.input_members:
-        lines.append("    double unused; /* the scene has no inputs */")
+        lines.append(f"    {real} unused; /* the scene has no inputs */")
     lines += [f"}} {ident}_input;", "", f"typedef struct {ident}_output {{"]
     for name, leaf in table.kind.output_members.items():
         if leaf == "status":
             cannot = ", 4 cannot assemble" if scene.internal() else ""
             lines.append(f"    int {name}; /* 0 ok, 1 singular, 3 out of range{cannot} */")
         else:
-            lines.append(f"    double {name}; /* {units.get(name) or '-'} */")
+            lines.append(f"    {real} {name}; /* {units.get(name) or '-'} */")
     lines += [f"}} {ident}_output;", "", *_prototypes(ident)]
     if halves and later_members(scene):
         lines += ["", *_later_prototypes(ident, later_members(scene))]

@@ -86,12 +86,13 @@ _DUAL_FUNCTIONS = {
     "dyad_dot": ("dyad_kdv_dot", REAL),
     "dyad_combine": ("dyad_kdv_combine", VEC),
     "dyad_turn": ("dyad_kdv_cmul", VEC),
-    "fabs": ("dyad_kd_abs", REAL),
-    "atan2": ("dyad_kd_atan2", REAL),
+    "dyad_fabs": ("dyad_kd_abs", REAL),
+    "dyad_atan2": ("dyad_kd_atan2", REAL),
     "dyad_point_on_link": ("dyad_point_on_link_dual", POINT),
 }
 #: functions of parameters only (constant along every seed), with their result's type
 _CONSTANT_FUNCTIONS = {
+    "DYAD_R": REAL,
     "cos": REAL,
     "sin": REAL,
     "dyad_dir_from_angle": VEC,
@@ -99,6 +100,8 @@ _CONSTANT_FUNCTIONS = {
     "dyad_kin_input_default": STRUCT,
     "dyad_cylinder_input_default": STRUCT,
 }
+#: the macros of constants the generated code names (dyadfmu/types.h)
+_CONSTANT_NAMES = frozenset(["DYAD_REAL_MIN"])
 _SIZE_FUNCTIONS = {
     "dyad_force_size": "dyad_force_size_rate",
     "dyad_moment_size": "dyad_moment_size_rate",
@@ -329,6 +332,8 @@ class Names:
 
     def read(self, path: Path) -> Dual:
         """A name with its members as a dual expression."""
+        if path.root in _CONSTANT_NAMES and not path.steps:
+            return Dual(path.root, REAL, constant=True)
         if path.root == "in":
             return self._input(path)
         if path.root in self.duals:

@@ -20,16 +20,23 @@
 typedef float dyad_real;
 #define DYAD_REAL_EPSILON FLT_EPSILON
 #define DYAD_REAL_MAX     FLT_MAX
+#define DYAD_REAL_MIN     FLT_MIN
 /** Default singular threshold: sqrt(FLT_EPSILON) = 2^-11.5. */
 #define DYAD_DEFAULT_SINGULAR_THRESHOLD 3.4526698e-4f
 #else
 typedef double dyad_real;
 #define DYAD_REAL_EPSILON               DBL_EPSILON
 #define DYAD_REAL_MAX                   DBL_MAX
+#define DYAD_REAL_MIN                   DBL_MIN
 /** Default singular threshold: sqrt(DBL_EPSILON) = 2^-26. At this conditioning
  *  the round-off bound eps * amplification is sqrt(eps): half the digits survive. */
 #define DYAD_DEFAULT_SINGULAR_THRESHOLD 1.4901161193847656e-8
 #endif
+
+/* A constant in the scalar's precision: generated code writes its numbers so, because a
+ * double constant would make a float build compute the whole expression in double (in
+ * software on an FPU of single precision). In a double build it is the number itself. */
+#define DYAD_R(x) ((dyad_real)(x))
 
 /** A direction vector passes as unit when | |v|^2 - 1 | is at most this (-).
  *  It is then normalised exactly before use. */

@@ -94,6 +94,26 @@ static inline dyad_vec2 dyad_dir_from_angle(dyad_real angle)
 #endif
 }
 
+/** fabs in the scalar's precision. */
+static inline dyad_real dyad_fabs(dyad_real a)
+{
+#ifdef DYAD_REAL_FLOAT
+    return fabsf(a);
+#else
+    return fabs(a);
+#endif
+}
+
+/** The angle of the vector (x, y) from the x axis (rad), in the scalar's precision. */
+static inline dyad_real dyad_atan2(dyad_real y, dyad_real x)
+{
+#ifdef DYAD_REAL_FLOAT
+    return atan2f(y, x);
+#else
+    return atan2(y, x);
+#endif
+}
+
 static inline int dyad_is_valid_real(dyad_real a)
 {
     return isfinite(a) != 0;
