@@ -28,7 +28,9 @@ dyadfmu_check_args() {
 # venv; NEED `study`: GSL (the generic-solve baseline of the benchmark) and valgrind
 # (its instruction counts); `windows`: the MinGW-w64 cross compiler and Wine (the
 # FMUs' Windows binaries, tested under Wine); `browser`: chromium and chromium-driver (the
-# animation's page in a real browser, headless).
+# animation's page in a real browser, headless); `embedded`: the Cortex-M4F toolchain
+# with newlib and QEMU's ARM machines (dyadfmu embedded), the 64-bit ARM Linux cross
+# compiler and QEMU's user mode (the FMUs' aarch64-linux binaries, replayed under it).
 # As root the missing ones are installed; otherwise the command stops, naming them
 # and itself.
 dyadfmu_ensure_system() {
@@ -55,8 +57,16 @@ dyadfmu_ensure_system() {
             command -v chromium >/dev/null 2>&1 || missing+=(chromium)
             command -v chromedriver >/dev/null 2>&1 || missing+=(chromium-driver)
             ;;
+        embedded)
+            command -v arm-none-eabi-gcc >/dev/null 2>&1 || missing+=(gcc-arm-none-eabi)
+            [ -d /usr/lib/arm-none-eabi/newlib ] || missing+=(libnewlib-arm-none-eabi)
+            command -v qemu-system-arm >/dev/null 2>&1 || missing+=(qemu-system-arm)
+            command -v aarch64-linux-gnu-gcc >/dev/null 2>&1 || missing+=(gcc-aarch64-linux-gnu)
+            [ -d /usr/aarch64-linux-gnu/lib ] || missing+=(libc6-dev-arm64-cross)
+            command -v qemu-aarch64 >/dev/null 2>&1 || missing+=(qemu-user)
+            ;;
         *)
-            dyadfmu_log "dyadfmu_ensure_system: unknown need '$need' (study, windows, browser)"
+            dyadfmu_log "dyadfmu_ensure_system: unknown need '$need' (study, windows, browser, embedded)"
             return 2
             ;;
         esac

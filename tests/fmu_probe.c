@@ -10,13 +10,19 @@
 #include <string.h>
 
 /* The binary of this platform, and how to load it: the probes run on the Linux
- * binaries natively and, cross-compiled with MinGW-w64, on the Windows ones
- * under Wine (tests/fmu_replay.c). */
+ * binaries natively and, cross-compiled, on the Windows ones under Wine and on the
+ * 64-bit ARM ones under QEMU's user mode (tests/fmu_replay.c). FMI 2 names no folder
+ * for 64-bit ARM: there only the FMI 3 FMUs carry a binary. */
 #if defined(_WIN32)
 #include <windows.h>
 #define PROBE_PLATFORM_FMI2 "win64"
 #define PROBE_PLATFORM_FMI3 "x86_64-windows"
 #define PROBE_BINARY_SUFFIX ".dll"
+#elif defined(__aarch64__)
+#include <dlfcn.h>
+#define PROBE_PLATFORM_FMI2 "aarch64-linux"
+#define PROBE_PLATFORM_FMI3 "aarch64-linux"
+#define PROBE_BINARY_SUFFIX ".so"
 #else
 #include <dlfcn.h>
 #define PROBE_PLATFORM_FMI2 "linux64"

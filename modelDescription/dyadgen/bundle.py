@@ -157,6 +157,28 @@ def fill_lines(table: Table, block: str = "in") -> list[str]:
     return lines
 
 
+def block_members(table: Table) -> dict[str, list[dict]]:
+    """The members of the input block ("inputs": inputs, "input" true, and tunable
+    parameters; an angle as its unit vector, "angle" true) and of the output block
+    ("outputs": the Real outputs; the block's int `status` besides), each with its
+    variable's name, unit and start (None for an output)."""
+
+    def member(v: Variable, start: bool) -> dict:
+        return {
+            "name": v.name,
+            "member": v.lives.path,
+            "unit": v.unit or "-",
+            "start": float(v.start) if start else None,
+            "angle": _is_angle(v),
+            "input": v.causality == "input",
+        }
+
+    return {
+        "inputs": [member(v, True) for v in block_inputs(table)],
+        "outputs": [member(v, False) for v in block_outputs(table)],
+    }
+
+
 def _print_lines(table: Table, block: str) -> list[str]:
     lines = []
     for v in block_outputs(table):

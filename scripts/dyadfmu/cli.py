@@ -241,6 +241,13 @@ def _own_commands(sub: argparse._SubParsersAction) -> None:
         "'dyadfmu animate --help')",
     ).set_defaults(run=None)
     sub.add_parser(
+        "embedded",
+        add_help=False,
+        help="scenes as Cortex-M4F firmware under QEMU, in float: instructions and cycles per "
+        "tick, flash, RAM, stack, outputs against this machine's (see 'dyadfmu embedded "
+        "--help')",
+    ).set_defaults(run=None)
+    sub.add_parser(
         "scene-bench",
         add_help=False,
         help="time the scene generator (--check and --out) on chains of 25 to 200 dyads "
@@ -524,6 +531,7 @@ OWN_PARSERS = {
     "rows": ".fmi.rows_command",
     "build-scene": ".build_scene",
     "animate": ".animation.command",
+    "embedded": ".embedded.command",
 }
 
 

@@ -125,9 +125,11 @@ def wheel(tmp_path_factory) -> Path:
     required_tool("cmake")
     required_tool("cc")
     out = tmp_path_factory.mktemp("wheel")
-    # without the FMUs' Windows binaries, to be quicker (tests/test_windows.py has them)
+    # without the FMUs' Windows and ARM binaries, to be quicker (test_windows.py and
+    # test_aarch64.py have them)
     windows = "--config-settings=cmake.define.DYADFMU_WINDOWS=OFF"
-    command = ("-m", "pip", "wheel", SCRIPTS, "-w", out, "--no-deps", "-q", windows)
+    arm = "--config-settings=cmake.define.DYADFMU_AARCH64=OFF"
+    command = ("-m", "pip", "wheel", SCRIPTS, "-w", out, "--no-deps", "-q", windows, arm)
     _run(sys.executable, *command, env=_clean_env())
     (found,) = out.glob("dyadfmu-*.whl")
     return found

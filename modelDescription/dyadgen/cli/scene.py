@@ -4,12 +4,13 @@ firmware."""
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import tempfile
 from pathlib import Path
 
-from dyadgen.bundle import BundleError, write_bundle
+from dyadgen.bundle import BundleError, block_members, write_bundle
 from dyadgen.model import Scene
 from dyadgen.pipeline import build_table, load_scene, outputs_of, write_files
 from dyadgen.scenefile.problems import SceneError
@@ -43,6 +44,13 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="print 'identifier;realisation;type;...' (its dyad types, lower case) for CMake, "
         "a line per scene file, in their order (one Python run for every scene of a build)",
+    )
+    what.add_argument(
+        "--blocks",
+        action="store_true",
+        help="print, as JSON, the members of the input and output blocks of its bundle's "
+        "C (each with its variable's name, unit and start; an angle input is kept as its "
+        "unit vector): what a program that fills and reads them needs",
     )
     what.add_argument(
         "--bundle",
@@ -114,7 +122,7 @@ def _path_problem(args: argparse.Namespace) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """scene.py SCENE --out DIR | --check | --external-inputs | --cmake-info |
+    """scene.py SCENE --out DIR | --check | --external-inputs | --cmake-info | --blocks |
     --bundle DIR [--with-derivatives] [--measure]."""
     parser = _parser()
     args = parser.parse_args(argv)
@@ -131,6 +139,9 @@ def main(argv: list[str] | None = None) -> int:
     kind = table.kind
     if args.external_inputs:
         print("\n".join(inputs_with_external_kinematics(scene)))
+        return 0
+    if args.blocks:
+        print(json.dumps(block_members(table), indent=1))
         return 0
     if args.bundle is not None:
         return _bundle(args, scene, table, parser.prog)

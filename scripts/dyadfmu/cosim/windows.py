@@ -1,13 +1,17 @@
-"""The Windows binaries of the FMUs against the Linux ones, over the harness's inputs.
+"""The FMUs' binaries for other platforms against their Linux x86-64 ones, over the
+harness's inputs.
 
 Every FMU carries a Windows binary (binaries/win64, binaries/x86_64-windows) cross-compiled
-with MinGW-w64 beside its Linux one. tests/fmu_replay.c drives an extracted FMU over given
-inputs and writes every output as its bit pattern; the build makes it for Linux
-(build/fmu/fmu_replay) and for Windows (build/fmu_replay.exe, run under Wine). Both run each
-FMU's stage directory (build/fmus/stage/<id>_fmi<v>: what the .fmu holds) over the inputs of
-:func:`dyadfmu.cosim.importers.setup_of`, and :func:`compare` sets the two side by side.
+with MinGW-w64 beside its Linux one, and every FMI 3 FMU a 64-bit ARM Linux one
+(binaries/aarch64-linux). tests/fmu_replay.c drives an extracted FMU over given inputs and
+writes every output as its bit pattern; the build makes it for Linux (build/fmu/fmu_replay),
+for Windows (build/fmu_replay.exe, run under Wine) and for 64-bit ARM Linux
+(build/fmu_replay_aarch64, run under qemu-aarch64). Each runs each FMU's stage directory
+(build/fmus/stage/<id>_fmi<v>: what the .fmu holds) over the inputs of
+:func:`dyadfmu.cosim.importers.setup_of`, and :func:`compare` sets two side by side.
 
-``python -m dyadfmu.cosim.windows`` prints the table over every FMU of the build.
+``python -m dyadfmu.cosim.windows [--platform aarch64]`` prints the table over every FMU of
+the build.
 """
 
 from __future__ import annotations
@@ -32,8 +36,11 @@ from . import importers
 __all__ = [
     "Replay",
     "Difference",
+    "PLATFORMS",
     "wine_executable",
+    "qemu_aarch64_executable",
     "replay_programs",
+    "replay_program",
     "write_inputs",
     "read_outputs",
     "run",
@@ -47,10 +54,28 @@ def wine_executable() -> str | None:
     return shutil.which("wine")
 
 
+#: The platforms whose binaries replay against Linux x86-64's, and the FMI versions whose
+#: FMUs carry one (FMI 2 names no folder for 64-bit ARM).
+PLATFORMS = {"windows": (2, 3), "aarch64": (3,)}
+#: Where qemu-aarch64 finds the 64-bit ARM C library (Debian libc6-arm64-cross).
+AARCH64_SYSROOT = "/usr/aarch64-linux-gnu"
+
+
+def qemu_aarch64_executable() -> str | None:
+    """QEMU's 64-bit ARM user mode (Debian ``qemu-user``), None where it is not installed."""
+    return shutil.which("qemu-aarch64")
+
+
 def replay_programs(build: Path | None = None) -> tuple[Path, Path]:
     """(the Linux fmu_replay, the Windows fmu_replay.exe) of the build."""
+    return replay_program("linux", build), replay_program("windows", build)
+
+
+def replay_program(platform: str, build: Path | None = None) -> Path:
+    """The build's fmu_replay for `platform`: linux, windows or aarch64."""
     build = build or paths.build_dir()
-    return build / "fmu" / "fmu_replay", build / "fmu_replay.exe"
+    names = {"linux": Path("fmu") / "fmu_replay", "windows": Path("fmu_replay.exe")}
+    return build / names.get(platform, Path(f"fmu_replay_{platform}"))
 
 
 def _bits(x: float) -> str:
@@ -116,20 +141,26 @@ def _wine_env(build: Path) -> dict:
     return env
 
 
-def run(jobs: list, workdir: Path, windows: bool, build: Path | None = None) -> None:
-    """Runs fmu_replay (under Wine if ``windows``) over [(stage dir, input, output)]."""
+def _command(platform: str, build: Path, jobs: Path) -> tuple[list[str], dict | None]:
+    program = str(replay_program(platform, build))
+    if platform == "windows":
+        return ["wine", program, _windows_path(jobs)], _wine_env(build)
+    if platform == "aarch64":
+        return ["qemu-aarch64", "-L", AARCH64_SYSROOT, program, str(jobs.resolve())], None
+    return [program, str(jobs.resolve())], None
+
+
+def run(jobs: list, workdir: Path, platform: str, build: Path | None = None) -> None:
+    """Runs fmu_replay for `platform` (linux; windows under Wine; aarch64 under
+    qemu-aarch64) over [(stage dir, input, output)]."""
     build = build or paths.build_dir()
-    linux, exe = replay_programs(build)
     workdir.mkdir(parents=True, exist_ok=True)
-    name = "jobs_windows.txt" if windows else "jobs_linux.txt"
-    spell = _windows_path if windows else (lambda p: str(p.resolve()))
-    (workdir / name).write_text(
+    spell = _windows_path if platform == "windows" else (lambda p: str(p.resolve()))
+    listing = workdir / f"jobs_{platform}.txt"
+    listing.write_text(
         "".join(" ".join(spell(Path(p)) for p in job) + "\n" for job in jobs), encoding="ascii"
     )
-    command = (
-        ["wine", str(exe), spell(workdir / name)] if windows else [str(linux), str(workdir / name)]
-    )
-    env = _wine_env(build) if windows else None
+    command, env = _command(platform, build, listing)
     done = subprocess.run(command, capture_output=True, text=True, env=env, timeout=1800)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} failed:\n{done.stdout}\n{done.stderr}")
@@ -187,14 +218,17 @@ def _ulps(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.max(np.abs(ia - ib))) if finite.any() else 0.0
 
 
-def replay_all(workdir: Path, build: Path | None = None, names: list | None = None) -> list:
+def replay_all(
+    workdir: Path, build: Path | None = None, names: list | None = None, platform: str = "windows"
+) -> list:
     """[Difference] of every FMU of the build (or those in ``names``, each as
-    ``<name>_fmi<v>``), Windows binaries under Wine against Linux ones."""
+    ``<name>_fmi<v>``) whose FMI version carries a `platform` binary: that binary (under
+    Wine or QEMU) against the Linux x86-64 one."""
     build = build or paths.build_dir()
     workdir.mkdir(parents=True, exist_ok=True)
     jobs, runs = [], []
     for name in importers.fmu_names():
-        for version in importers.VERSIONS:
+        for version in PLATFORMS[platform]:
             fmu = f"{name}_fmi{version}"
             if names is not None and fmu not in names:
                 continue
@@ -203,35 +237,40 @@ def replay_all(workdir: Path, build: Path | None = None, names: list | None = No
             write_inputs(setup, workdir / f"{fmu}.in")
             jobs.append((stage, workdir / f"{fmu}.in", workdir / f"{fmu}.linux"))
             runs.append((fmu, setup))
-    run(jobs, workdir, windows=False, build=build)
-    run([(s, i, o.with_suffix(".windows")) for s, i, o in jobs], workdir, windows=True, build=build)
+    run(jobs, workdir, "linux", build)
+    run([(s, i, o.with_suffix(f".{platform}")) for s, i, o in jobs], workdir, platform, build)
     out = []
     for (fmu, setup), (_, _, linux) in zip(runs, jobs, strict=True):
         md = read_model_description(str(setup.path))
         names_of = {v.valueReference: v.name for v in md.modelVariables}
-        out.append(
-            compare(fmu, names_of, read_outputs(linux), read_outputs(linux.with_suffix(".windows")))
-        )
+        other = read_outputs(linux.with_suffix(f".{platform}"))
+        out.append(compare(fmu, names_of, read_outputs(linux), other))
     return out
 
 
 def main(argv: list | None = None) -> int:
-    """Prints, per FMU, how the Windows binary's outputs compare with the Linux one's."""
+    """Prints, per FMU, how a platform's binary's outputs compare with the Linux one's."""
     parser = argparse.ArgumentParser(
         prog="python -m dyadfmu.cosim.windows",
-        description="Every FMU's Windows binary (under Wine) against its Linux binary over "
-        "the harness's inputs: outputs equal bit for bit, and the largest difference "
-        "relative to an output's peak.",
+        description="Every FMU's binary for another platform (Windows under Wine, 64-bit ARM "
+        "Linux under qemu-aarch64) against its Linux x86-64 binary over the harness's inputs: "
+        "outputs equal bit for bit, and the largest difference relative to an output's peak.",
     )
     parser.add_argument("--build", type=Path, default=None, help="the build (default build/)")
     parser.add_argument(
-        "--work", type=Path, default=Path("out/windows"), help="folder for the runs' files"
+        "--platform", choices=sorted(PLATFORMS), default="windows", help="default windows"
+    )
+    parser.add_argument(
+        "--work", type=Path, default=None, help="folder for the runs' files (default out/PLATFORM)"
     )
     args = parser.parse_args(argv)
-    if wine_executable() is None:
-        print("python -m dyadfmu.cosim.windows: wine is not installed", file=sys.stderr)
+    runner = wine_executable() if args.platform == "windows" else qemu_aarch64_executable()
+    if runner is None:
+        tool = "wine" if args.platform == "windows" else "qemu-aarch64 (Debian qemu-user)"
+        print(f"python -m dyadfmu.cosim.windows: {tool} is not installed", file=sys.stderr)
         return 2
-    print("\n".join(table_lines(replay_all(args.work, args.build))))
+    work = args.work or Path("out") / args.platform
+    print("\n".join(table_lines(replay_all(work, args.build, platform=args.platform))))
     return 0
 
 
