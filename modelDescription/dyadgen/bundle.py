@@ -161,7 +161,8 @@ def block_members(table: Table) -> dict[str, list[dict]]:
     """The members of the input block ("inputs": inputs, "input" true, and tunable
     parameters; an angle as its unit vector, "angle" true) and of the output block
     ("outputs": the Real outputs; the block's int `status` besides), each with its
-    variable's name, unit and start (None for an output)."""
+    variable's name, unit and start (None for an output); "plant": whether the scene is
+    a plant (dynamics = "forward"), whose bundle integrates its motion."""
 
     def member(v: Variable, start: bool) -> dict:
         return {
@@ -174,6 +175,7 @@ def block_members(table: Table) -> dict[str, list[dict]]:
         }
 
     return {
+        "plant": table.scene.forward(),
         "inputs": [member(v, True) for v in block_inputs(table)],
         "outputs": [member(v, False) for v in block_outputs(table)],
     }

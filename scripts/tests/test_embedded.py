@@ -12,6 +12,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from dyadfmu import paths
 from dyadfmu.embedded import firmware, sizes, stack, study, ticks, trace
 from tool_checks import required
 
@@ -149,6 +150,14 @@ def test_the_tick_table_holds_the_inputs_exactly():
     assert "{" + ", ".join(float(v).hex() for v in row) + "}" in text
     assert f"in->slider_mass = {(12.0).hex()};" in text
     assert "shaper_evaluate(&in, &out, &evaluation);" in text
+
+
+def test_a_plant_is_refused_by_name():
+    """A plant's bundle integrates its motion: a tick program of given motion has nothing
+    to evaluate there, and says so before building anything."""
+    scene = paths.SCENES_DIR / "slider_crank_motor.toml"
+    with pytest.raises(ticks.EmbeddedError, match=r"slider_crank_motor.toml: a plant"):
+        ticks.read_blocks(scene, "slider_crank_motor")
 
 
 def test_the_tick_program_refuses_what_it_cannot_write():

@@ -91,10 +91,41 @@ def main(argv: list[str] | None = None) -> int:
             print(f"dyadfmu embedded: {name}: {error}", file=sys.stderr)
             return 1
     report = args.out / "report.md"
+    plot_budget(results, args.out / BUDGET_PLOT)
     report.write_text(report_text(results), encoding="utf-8")
     print(report.read_text(encoding="utf-8"))
     print(f"report: {report}")
     return 0
+
+
+#: The picture of the report: each scene's share of a tick.
+BUDGET_PLOT = "tick_budget.png"
+
+
+def plot_budget(results: list[study.SceneResult], path: Path) -> Path:
+    """Each scene's estimated cycles per tick as a share of 1 ms at 168 MHz, the shaper's
+    target marked: `path` (PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 0.6 + 0.5 * len(results)))
+    shares = [100 * r.cycles_share() for r in results]
+    ax.barh([r.scene for r in results], shares, color="tab:blue")
+    for k, share in enumerate(shares):
+        ax.annotate(f"{share:.1f} %", (share, k), xytext=(4, 0), textcoords="offset points",
+                    va="center")  # fmt: skip
+    ax.axvline(100 * SHAPER_SHARE_TARGET, color="tab:red", linestyle="--",
+               label="the shaper's target")  # fmt: skip
+    ax.set_xlim(0, 100)
+    ax.set_xlabel("estimated cycles of one evaluation, % of a 1 ms tick at 168 MHz")
+    ax.invert_yaxis()
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
 
 
 def _log(text: str) -> None:
@@ -225,6 +256,8 @@ def report_text(results: list[study.SceneResult]) -> str:
             *markdown.table(COST_HEADER, [_cost_row(r) for r in results], "-rrrrrrrr"),
             "",
             *_target_line(results),
+            markdown.image("each scene's share of a 1 ms tick at 168 MHz", BUDGET_PLOT),
+            "",
             "## Against the host's float build",
             "",
             "The same tick program built with `cc` for this machine in float, both without "

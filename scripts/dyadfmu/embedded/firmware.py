@@ -148,7 +148,10 @@ def run(build: Build, trace: Path | None = None) -> str:
         command = [*QEMU_COMMAND, "-kernel", str(build.program)]
         if trace is not None:
             command += ["-singlestep", "-d", "exec,nochain", "-D", str(trace)]
-    done = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, check=False)
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT, check=False)
+    except subprocess.TimeoutExpired as error:
+        raise EmbeddedError(f"{build.program.name} ran over {TIMEOUT} s: stopped") from error
     # QEMU writes what the firmware sends through semihosting to its standard error
     text = done.stderr if build.m4f else done.stdout
     if done.returncode != 0 or "exit status nonzero" in text or "fault:" in text:

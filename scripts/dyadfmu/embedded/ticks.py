@@ -78,6 +78,11 @@ def read_blocks(scene: Path, identifier: str) -> Blocks:
     if not _IDENTIFIER.fullmatch(identifier):
         raise EmbeddedError(f"{identifier!r} is not a scene identifier")
     data = json.loads(_generator(scene, "--blocks"))
+    if data["plant"]:
+        raise EmbeddedError(
+            f'{scene}: a plant (dynamics = "forward"): its bundle integrates its motion '
+            "over a step, and a tick program evaluates a mechanism at given motion"
+        )
     return Blocks(
         identifier,
         tuple(_member(e) for e in data["inputs"]),
