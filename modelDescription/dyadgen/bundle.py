@@ -175,6 +175,7 @@ def block_members(table: Table) -> dict[str, list[dict]]:
         }
 
     return {
+        "identifier": table.identifier,
         "plant": table.scene.forward(),
         "inputs": [member(v, True) for v in block_inputs(table)],
         "outputs": [member(v, False) for v in block_outputs(table)],

@@ -152,12 +152,27 @@ def test_the_tick_table_holds_the_inputs_exactly():
     assert "shaper_evaluate(&in, &out, &evaluation);" in text
 
 
+def test_a_scene_file_turns_its_first_crank_or_moves_what_is_asked():
+    """Without ranges the first angle input turns once from its start; a range moves its
+    input from MIN to MAX; an input the scene does not have is refused with the list."""
+    turned = ticks.swept_inputs(_blocks(), {}, 5)
+    assert list(turned) == ["crank.angle"]
+    np.testing.assert_allclose(turned["crank.angle"], np.linspace(0.5, 0.5 + 2 * np.pi, 5))
+    moved = ticks.swept_inputs(_blocks(), {"crank.omega": (1.0, 3.0)}, 3)
+    np.testing.assert_array_equal(moved["crank.omega"], [1.0, 2.0, 3.0])
+    with pytest.raises(ticks.EmbeddedError, match="not an input of shaper; its inputs are: "):
+        ticks.swept_inputs(_blocks(), {"slider.mass": (1.0, 2.0)}, 3)  # a parameter
+    no_angle = ticks.Blocks("lift", _blocks().inputs[1:], _blocks().outputs)
+    with pytest.raises(ticks.EmbeddedError, match="no angle input to turn: give the motion"):
+        ticks.swept_inputs(no_angle, {}, 3)
+
+
 def test_a_plant_is_refused_by_name():
     """A plant's bundle integrates its motion: a tick program of given motion has nothing
     to evaluate there, and says so before building anything."""
     scene = paths.SCENES_DIR / "slider_crank_motor.toml"
     with pytest.raises(ticks.EmbeddedError, match=r"slider_crank_motor.toml: a plant"):
-        ticks.read_blocks(scene, "slider_crank_motor")
+        ticks.read_blocks(scene)
 
 
 def test_the_tick_program_refuses_what_it_cannot_write():

@@ -41,8 +41,18 @@ def parser() -> argparse.ArgumentParser:
         nargs="*",
         metavar="SCENE",
         default=list(DEFAULT_SCENES),
-        help=f"built-in scenes (modelDescription/scenes/NAME.toml; default "
-        f"{' '.join(DEFAULT_SCENES)})",
+        help=f"built-in scenes by name (over the harness's motion; default "
+        f"{' '.join(DEFAULT_SCENES)}) or scene files FILE.toml (yours; the first crank one "
+        "turn, or --range)",
+    )
+    command.add_argument(
+        "--range",
+        nargs=3,
+        action="append",
+        default=[],
+        metavar=("INPUT", "MIN", "MAX"),
+        help="move the input INPUT (a driver's coordinate, rad or m) from MIN to MAX over the "
+        "ticks instead, the other inputs at their start values; repeatable",
     )
     command.add_argument(
         "--ticks", type=whole(4, 2000), default=120, help="ticks per run (default 120)"
@@ -66,11 +76,30 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _scene_problem(names: list[str]) -> str | None:
+    for name in names:
+        if name.endswith(".toml"):
+            problem = paths.path_problem("SCENE", name, paths.FILE)
+            if problem:
+                return problem
     known = sorted(p.stem for p in paths.SCENES_DIR.glob("*.toml"))
-    unknown = [n for n in names if n not in known]
+    unknown = [n for n in names if n not in known and not n.endswith(".toml")]
     if unknown:
-        return f"unknown scene {', '.join(unknown)}; the built-in scenes are: {', '.join(known)}"
+        return (
+            f"unknown scene {', '.join(unknown)} (a scene file ends in .toml); the built-in "
+            f"scenes are: {', '.join(known)}"
+        )
     return None
+
+
+def _ranges(given: list[list[str]]) -> dict[str, tuple[float, float]]:
+    """--range INPUT MIN MAX ..., each MIN and MAX a number."""
+    ranges = {}
+    for name, low, high in given:
+        try:
+            ranges[name] = (float(low), float(high))
+        except ValueError:
+            raise EmbeddedError(f"--range {name} {low} {high}: MIN and MAX are numbers") from None
+    return ranges
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -83,9 +112,11 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     for name in args.scenes:
         print(f"{name}: building and running on the Cortex-M4F model ...", file=sys.stderr)
+        work = args.out / Path(name).stem
         try:
+            ranges = _ranges(args.range)
             results.append(
-                study.run_scene(name, args.out / name, args.ticks, args.traced, args.build, _log)
+                study.run_scene(name, work, args.ticks, args.traced, args.build, _log, ranges)
             )
         except EmbeddedError as error:
             print(f"dyadfmu embedded: {name}: {error}", file=sys.stderr)

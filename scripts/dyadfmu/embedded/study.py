@@ -77,18 +77,33 @@ class SceneResult:
         return max(c.cycles for c in self.costs) / (CLOCK_HZ * TICK_SECONDS)
 
 
-def _inputs(name: str, ticks_count: int, build: Path | None) -> dict[str, np.ndarray]:
+def scene_file(scene: str | Path) -> tuple[Path, bool]:
+    """(the scene file, whether it is a built-in scene) of a built-in scene's name or a
+    scene file's path."""
+    if str(scene).endswith(".toml"):
+        return Path(scene), False
+    return paths.SCENES_DIR / f"{scene}.toml", True
+
+
+def _inputs(
+    scene: str | Path, blocks: ticks.Blocks, count: int, build: Path | None, ranges: dict
+) -> dict[str, np.ndarray]:
+    """The ticks' inputs: a built-in scene's over the harness's motion (its built FMU's
+    setup), or over `ranges` (ticks.swept_inputs) where given or for a scene file."""
+    path, builtin = scene_file(scene)
+    if ranges or not builtin:
+        return ticks.swept_inputs(blocks, ranges, count)
     from ..cosim import importers
 
-    setup = importers.setup_of(name, 3, build, steps=ticks_count)
-    return {n: np.asarray(v, dtype=float)[:ticks_count] for n, v in setup.inputs.items()}
+    setup = importers.setup_of(path.stem, 3, build, steps=count)
+    return {n: np.asarray(v, dtype=float)[:count] for n, v in setup.inputs.items()}
 
 
 def _program(
     scene: Path, work: Path, inputs: dict, count: int, derivative: bool
 ) -> tuple[ticks.Blocks, Path, Path]:
     bundle = ticks.write_bundle(scene, work / "bundle", derivatives=derivative)
-    blocks = ticks.read_blocks(scene, bundle.name)
+    blocks = ticks.read_blocks(scene)
     tick_c = work / f"{bundle.name}_ticks.c"
     text = ticks.source(blocks, inputs, count, derivative=derivative)
     tick_c.write_text(text, encoding="utf-8")
@@ -105,17 +120,20 @@ def _bound(built: firmware.Build, function: str) -> stack.StackBound:
 
 
 def run_scene(
-    name: str,
+    source: str | Path,
     work: Path,
     count: int = 120,
     traced: int = 12,
     build: Path | None = None,
     log: Callable[[str], None] = lambda _: None,
+    ranges: dict | None = None,
 ) -> SceneResult:
-    """Measure the scene `name` (a built-in scene of modelDescription/scenes/) over
-    `count` ticks, `traced` of them (evenly spread) traced for the instruction count."""
-    scene = paths.SCENES_DIR / f"{name}.toml"
-    inputs = _inputs(name, count, build)
+    """Measure a scene (a built-in scene's name, or a scene file) over `count` ticks,
+    `traced` of them (evenly spread) traced for the instruction count; its inputs as
+    :func:`_inputs` gives them."""
+    scene, _ = scene_file(source)
+    name = scene.stem
+    inputs = _inputs(source, ticks.read_blocks(scene), count, build, ranges or {})
     blocks, bundle, tick_c = _program(scene, work / "evaluate", inputs, count, False)
     n = len(blocks.outputs)
     log(f"{name}: the host's float build and the M4F's, {count} ticks")
@@ -130,7 +148,7 @@ def run_scene(
     d_blocks, d_bundle, d_tick = _program(scene, work / "derivative", inputs, count, True)
     d_built, d_text = _m4f_run(d_bundle, d_tick, work / "derivative" / "m4f")
     return SceneResult(
-        name,
+        blocks.identifier,
         count,
         names,
         compare(names, host, m4f),

@@ -20,7 +20,15 @@ import numpy as np
 
 from .. import paths
 
-__all__ = ["Member", "Blocks", "EmbeddedError", "read_blocks", "write_bundle", "source"]
+__all__ = [
+    "Member",
+    "Blocks",
+    "EmbeddedError",
+    "read_blocks",
+    "swept_inputs",
+    "write_bundle",
+    "source",
+]
 
 #: A member path of a block as the generator names it (C identifiers joined by dots).
 _MEMBER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
@@ -73,11 +81,13 @@ def _member(entry: dict) -> Member:
     )
 
 
-def read_blocks(scene: Path, identifier: str) -> Blocks:
-    """The blocks of the scene's C (modelDescription/scene.py --blocks)."""
+def read_blocks(scene: Path) -> Blocks:
+    """The blocks of the scene's C (modelDescription/scene.py --blocks); a plant, whose
+    bundle integrates its motion, refused."""
+    data = json.loads(_generator(scene, "--blocks"))
+    identifier = data["identifier"]
     if not _IDENTIFIER.fullmatch(identifier):
         raise EmbeddedError(f"{identifier!r} is not a scene identifier")
-    data = json.loads(_generator(scene, "--blocks"))
     if data["plant"]:
         raise EmbeddedError(
             f'{scene}: a plant (dynamics = "forward"): its bundle integrates its motion '
@@ -97,6 +107,32 @@ def write_bundle(scene: Path, out: Path, derivatives: bool = False) -> Path:
     if len(folders) != 1:
         raise EmbeddedError(f"{out}: expected one bundle, found {len(folders)}")
     return folders[0]
+
+
+def swept_inputs(
+    blocks: Blocks, ranges: dict[str, tuple[float, float]], count: int
+) -> dict[str, np.ndarray]:
+    """Each input of `ranges` (name -> (min, max)) from its min to its max over `count`
+    ticks; without ranges, the scene's first angle input one turn from its start. The
+    other inputs keep their start values."""
+    inputs = {m.name: m for m in blocks.inputs if m.input}
+    if not ranges:
+        angle = next((m for m in inputs.values() if m.angle), None)
+        if angle is None:
+            raise EmbeddedError(
+                f"{blocks.identifier} has no angle input to turn: give the motion with --range "
+                f"INPUT MIN MAX (its inputs: {', '.join(inputs) or 'none'})"
+            )
+        ranges = {angle.name: (angle.start, angle.start + 2.0 * np.pi)}
+    for name, (low, high) in ranges.items():
+        if name not in inputs:
+            raise EmbeddedError(
+                f"--range {name}: not an input of {blocks.identifier}; its inputs are: "
+                f"{', '.join(inputs) or 'none'}"
+            )
+        if not (np.isfinite(low) and np.isfinite(high)):
+            raise EmbeddedError(f"--range {name} {low} {high}: the range must be finite")
+    return {name: np.linspace(low, high, count) for name, (low, high) in ranges.items()}
 
 
 def _literal(value: float) -> str:
