@@ -69,6 +69,7 @@ STANDARD_HEADERS = {
         strerror strlen strdup strndup""".split()
     ),
     "stddef.h": frozenset("ptrdiff_t size_t wchar_t max_align_t NULL offsetof".split()),
+    "stdarg.h": frozenset("va_list va_start va_arg va_end va_copy".split()),
     "float.h": frozenset(
         """
         FLT_ROUNDS FLT_EVAL_METHOD FLT_RADIX FLT_MANT_DIG DBL_MANT_DIG LDBL_MANT_DIG

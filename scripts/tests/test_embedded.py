@@ -254,3 +254,28 @@ def test_the_call_graphs_bound_holds_the_painted_stack(shaper):
     assert "atan2f" in bound.outside
     assert 1_000 < bound.bytes <= shaper.stack
     assert shaper.derivative_stack_bound.bytes > bound.bytes
+
+
+def test_a_refusal_says_why_without_stdio(tmp_path):
+    """A firmware built with DYAD_SCENE_TERSE links no printf, yet a refused tick still
+    says why: the reason's words and names, each number as '?'. The lift's ram pushed far
+    beyond its reach cannot assemble; the ticks before it answer."""
+    missing = firmware.missing_tools()
+    required(not missing, f"missing {', '.join(missing)}")
+    scene = paths.SCENES_DIR / "lift.toml"
+    blocks = ticks.read_blocks(scene)
+    bundle = ticks.write_bundle(scene, tmp_path / "bundle")
+    source = tmp_path / "lift_ticks.c"
+    source.write_text(ticks.source(blocks, {"ram.position": np.array([0.55, 50.0])}, 2))
+    for built in (
+        firmware.build_host(bundle, source, tmp_path / "host"),
+        firmware.build_m4f(bundle, source, tmp_path / "m4f"),
+    ):
+        run = firmware.parse(firmware.run(built), len(blocks.outputs))
+        assert list(run.status) == [0, 4]
+        assert np.isnan(run.values[1]).all() and np.isfinite(run.values[0]).all()
+        (reason,) = run.reasons
+        assert "cannot assemble at this driver position" in reason and "?" in reason, reason
+        assert "%" not in reason
+    linked = sizes.read_map(built.map_file, built.scene_objects).members
+    assert not {m for m in linked if "printf" in m}, linked

@@ -42,8 +42,8 @@ CHECK_TEMPLATE = TEMPLATE.with_name("scene_check.c.in")
 DERIVATIVE_CASE = """    } else if (dyad->status == DYAD_STATUS_OK) {
         /* the values solve, their rates overflow */
         out->status = 0;
-        snprintf(evaluation->reason, sizeof evaluation->reason,
-                 "the directional derivative of dyad %s is not finite at these inputs", name);
+        SCENE_REASON(evaluation->reason, sizeof evaluation->reason,
+                     "the directional derivative of dyad %s is not finite at these inputs", name);
 """
 KINEMATICS_INCLUDE = '#include "dyadfmu/dyad.h"\n#include "dyadfmu/kinematics.h"\n'
 FAIL_TEMPLATE = TEMPLATE.with_name("scene_fail.c.in")

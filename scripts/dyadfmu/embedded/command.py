@@ -278,7 +278,7 @@ def report_text(results: list[study.SceneResult]) -> str:
             "each instruction at the Cortex-M4's documented count (taken branches at the "
             "worst refill, zero-wait memory: dyadfmu/embedded/trace.py). Flash: code, "
             "read-only data and initial data of the scene's and the core's objects, and of "
-            "the C library's they pull in (the failure reasons' `snprintf` among them). RAM: "
+            "what they pull in of the C library and libm (no printf: `DYAD_SCENE_TERSE`). RAM: "
             "their `.data` and `.bss`. Stack: the deepest chain of frames from "
             "`<id>_evaluate` in GCC's call graph (`-fcallgraph-info=su`; the C library's "
             f"frames left out: {_outside(results)}), and the deepest over every tick, "

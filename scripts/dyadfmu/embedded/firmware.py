@@ -5,7 +5,9 @@ its single-precision FPU), with an instruction trace when asked.
 Both builds are float builds of the bundle (``DYAD_REAL_FLOAT``) at ``-O2`` with ISO C's
 rules for ``a*b+c`` (``-ffp-contract=off``: no fused multiply-add, which the host build
 does not use either) unless ``contract`` asks for GCC's default on the M4F (``fast``: its
-``vfma.f32``), to show what contraction changes.
+``vfma.f32``), to show what contraction changes. Both define ``DYAD_SCENE_TERSE``: a
+refusal's reason is written without the C library's printf (its numbers as '?'), so that
+the firmware links no stdio.
 """
 
 from __future__ import annotations
@@ -39,7 +41,17 @@ M4F_CC = "arm-none-eabi-gcc"
 QEMU_ARM = "qemu-system-arm"
 #: The Cortex-M4F with its FPU (fpv4-sp-d16: single precision only), hard-float calls.
 M4F_CPU = ("-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard")
-COMMON = ("-std=c99", "-O2", "-DDYAD_REAL_FLOAT", "-Wall", "-Wextra", "-Wpedantic", "-Werror")
+#: float; a refusal's reason without printf (DYAD_SCENE_TERSE: no stdio linked)
+COMMON = (
+    "-std=c99",
+    "-O2",
+    "-DDYAD_REAL_FLOAT",
+    "-DDYAD_SCENE_TERSE",
+    "-Wall",
+    "-Wextra",
+    "-Wpedantic",
+    "-Werror",
+)
 QEMU_COMMAND = (
     QEMU_ARM,
     "-machine",
@@ -165,16 +177,18 @@ def run(build: Build, trace: Path | None = None) -> str:
 @dataclass(frozen=True)
 class TickRun:
     """A tick program's output: per tick its status and every output (float outputs
-    widened to the block's double), and the deepest stack (bytes; 0 where not known)."""
+    widened to the block's double), the reasons of the refused ticks, and the deepest
+    stack (bytes; 0 where not known)."""
 
     status: np.ndarray
     values: np.ndarray  # ticks x outputs
     stack: int
+    reasons: tuple[str, ...] = ()
 
 
 def parse(text: str, outputs: int) -> TickRun:
     """The TickRun of what a tick program wrote."""
-    status, rows, stack = [], [], 0
+    status, rows, stack, reasons = [], [], 0, []
     for line in text.splitlines():
         words = line.split()
         if words[:1] == ["tick"] and len(words) == 3 + outputs:
@@ -182,7 +196,9 @@ def parse(text: str, outputs: int) -> TickRun:
             rows.append([int(w, 16) for w in words[3:]])
         elif words[:1] == ["stack"] and len(words) == 2:
             stack = int(words[1])
+        elif words[:1] == ["reason"]:
+            reasons.append(line.removeprefix("reason "))
     if not rows:
         raise EmbeddedError(f"the tick program wrote no ticks: {text[:200]!r}")
     bits = np.array(rows, dtype=np.uint64)
-    return TickRun(np.array(status), bits.view(np.float64), stack)
+    return TickRun(np.array(status), bits.view(np.float64), stack, tuple(reasons))

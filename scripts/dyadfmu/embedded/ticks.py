@@ -256,11 +256,16 @@ static void fill(long k, {ident}_input* in)
 {per_tick}
 }}
 
-static void emit(long k, const {ident}_output* out)
+static void emit(long k, const {ident}_output* out, const fmu_evaluation* evaluation)
 {{
     ticks_write_tick(k, out->status);
 {writes}
     ticks_write_end_of_line();
+    if (evaluation->status != FMU_OK) {{
+        ticks_write("reason ");
+        ticks_write(evaluation->reason);
+        ticks_write_end_of_line();
+    }}
 }}
 
 int ticks_main(void)
@@ -275,7 +280,7 @@ int ticks_main(void)
         ticks_begin(k);
         {call}
         ticks_end(k);
-        emit(k, &out);
+        emit(k, &out, &evaluation);
     }}
     ticks_write_count("stack", ticks_stack_used());
     return 0;
