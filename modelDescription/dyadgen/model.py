@@ -48,10 +48,15 @@ class Param:
     domain: dict = field(default_factory=dict)
     tunable: bool = False
     member: str = ""  # C member of the input block when tunable
+    #: a macro of the core that stands for the value in C: the scalar's own default,
+    #: which differs between the double and the float build
+    macro: str = ""
 
     def c(self) -> str:
-        """The value in C: the input block's member, or the constant."""
-        return f"in->{self.member}" if self.tunable else c_real(self.value)
+        """The value in C: the input block's member, the macro, or the constant."""
+        if self.tunable:
+            return f"in->{self.member}"
+        return self.macro or c_real(self.value)
 
     def is_zero(self) -> bool:
         """Baked at 0: a term it multiplies is not written."""

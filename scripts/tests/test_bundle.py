@@ -570,6 +570,115 @@ def test_a_plants_bundle_refuses_what_its_fmu_refuses(real, tmp_path):
             assert line.startswith(f"3 {expected}:"), (line, expected)  # FMU_ERROR
 
 
+#: the four-bar with a crank of the rocker's length: no longer Grashof, so that the crank
+#: meets an assembly limit, where the rocker and the coupler stand in line
+TOGGLE_CRANK = ("length = 0.05 ", "length = 0.12 ")
+TOGGLE_MAIN = r"""#include <math.h>
+#include <stdio.h>
+#include "toggle_bar_scene.h"
+
+static int at(double c, double s, toggle_bar_output* out)
+{
+    toggle_bar_input in;
+    fmu_evaluation evaluation;
+    in.crank_dir = dyad_vec2_make((dyad_real)c, (dyad_real)s);
+    in.crank_omega = 10;
+    in.crank_epsilon = 0;
+    in.rocker_moment = 5;
+    in.linkage_branch = -1;
+    in.gravity_x = 0;
+    in.gravity_y = -9.81;
+    toggle_bar_evaluate(&in, out, &evaluation);
+    return out->status;
+}
+
+/* With an argument: the crank's direction (rounded to float) 1e-2 .. 1e-14 rad before the
+ * assembly limit, found by bisection. Without: the status and the forces at each line of
+ * directions read. */
+int main(int argc, char** argv)
+{
+    toggle_bar_output out;
+    float c, s;
+    (void)argv;
+    if (argc > 1) {
+        double lo = 2.3, hi = 2.36;
+        for (int i = 0; i < 100; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            if (at(cos(mid), sin(mid), &out) != 4) lo = mid; else hi = mid;
+        }
+        for (int k = 2; k <= 14; ++k) {
+            const double t = lo - pow(10, -k);
+            printf("%.9g %.9g\n", (double)(float)cos(t), (double)(float)sin(t));
+        }
+        return 0;
+    }
+    while (scanf("%f %f", &c, &s) == 2) {
+        const int status = at(c, s, &out);
+        printf("%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", status,
+               (double)out.crank_torque, (double)out.linkage_r_mk_x, (double)out.linkage_r_mk_y,
+               (double)out.linkage_r_np_x, (double)out.linkage_r_np_y,
+               (double)out.linkage_r_mn_x, (double)out.linkage_r_mn_y,
+               (double)out.crank_r_o_x, (double)out.crank_r_o_y,
+               (double)out.linkage_conditioning);
+    }
+    return 0;
+}
+"""
+
+
+def test_a_float_build_flags_the_toggle_float_cannot_resolve(tmp_path):
+    """A scene that does not set singular_threshold takes the scalar's own default:
+    sqrt(eps) of float (3.45e-4) in a float build, not double's 1.49e-8 baked in. Near a
+    four-bar's assembly limit every force the float build gives with status 0 is within
+    sqrt(FLT_EPSILON) of the largest force there, against the double build at the same
+    (float) inputs; before, float said status 0 with forces 0.09 % to 36 % off while double
+    still resolved them. Double flags nothing more than it did."""
+    required_tool("cc")
+    four_bar = (SCENES_DIR / "four_bar.toml").read_text()
+    assert TOGGLE_CRANK[0] in four_bar
+    scene = tmp_path / "toggle_bar.toml"
+    scene.write_text(four_bar.replace(*TOGGLE_CRANK).replace('"four_bar"', '"toggle_bar"'))
+    done = _scene_tool(scene, "--bundle", tmp_path / "written")
+    assert done.returncode == 0, done.stderr
+    folder = tmp_path / "written" / "toggle_bar"
+    evaluation = (folder / "scene" / "toggle_bar_scene.c").read_text()
+    assert "DYAD_DEFAULT_SINGULAR_THRESHOLD" in evaluation and "1.49" not in evaluation
+    (tmp_path / "main.c").write_text(TOGGLE_MAIN)
+    sources = sorted(folder.glob("scene/*.c")) + sorted(folder.glob("core/src/*.c"))
+    programs = {}
+    for real, flags in (("double", []), ("float", [FLOAT])):
+        programs[real] = tmp_path / f"main_{real}"
+        _run(
+            "cc", *WARNINGS, *flags, f"-I{folder / 'scene'}", f"-I{folder / 'core' / 'include'}",
+            "-o", programs[real], tmp_path / "main.c", *sources, "-lm",
+        )  # fmt: skip
+    points = _run(programs["double"], "limit")
+
+    def forces(real: str) -> list[tuple[int, np.ndarray]]:
+        done = subprocess.run(
+            [programs[real]], input=points, capture_output=True, text=True, check=True
+        )
+        rows = [line.split() for line in done.stdout.splitlines()]
+        return [(int(r[0]), np.array([float(x) for x in r[1:]])) for r in rows]
+
+    double, single = forces("double"), forces("float")
+    assert len(double) == len(single) == 13
+    resolved = [k for k, (status, _) in enumerate(double) if status == 0]
+    assert len(resolved) >= 5, double  # down to a conditioning of about 1e-3
+    held = 0
+    for k, (status, found) in enumerate(single):
+        if status != 0:
+            assert status == 1, (k, status)  # singular, not a failure of some other kind
+            continue
+        assert k in resolved, k
+        truth = double[k][1]
+        largest = np.abs(truth[:-1]).max()
+        worst = np.abs(found[:-1] - truth[:-1]).max() / largest
+        assert worst <= 2.0**-11.5, (k, worst, found, truth)  # sqrt(FLT_EPSILON)
+        held += 1
+    assert held >= 1, single
+
+
 def _text_sizes(readme: str) -> dict[str, tuple[int, int]]:
     rows = re.findall(r"^\| (double|float) \| (\d+) \| (\d+) \|$", readme, re.M)
     return {real: (int(objects), int(linked)) for real, objects, linked in rows}

@@ -101,7 +101,7 @@ _CONSTANT_FUNCTIONS = {
     "dyad_cylinder_input_default": STRUCT,
 }
 #: the macros of constants the generated code names (dyadfmu/types.h)
-_CONSTANT_NAMES = frozenset(["DYAD_REAL_MIN"])
+_CONSTANT_NAMES = frozenset(["DYAD_REAL_MIN", "DYAD_DEFAULT_SINGULAR_THRESHOLD"])
 _SIZE_FUNCTIONS = {
     "dyad_force_size": "dyad_force_size_rate",
     "dyad_moment_size": "dyad_moment_size_rate",

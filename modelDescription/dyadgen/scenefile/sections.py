@@ -138,7 +138,10 @@ def gravity(p: Problems, data: dict, on: bool) -> tuple[Param, Param] | None:
 
 
 def threshold(p: Problems, scene_t: dict) -> Param:
-    """[scene] singular_threshold, in (0, 1)."""
+    """[scene] singular_threshold, in (0, 1). Where the scene does not set it, the C says
+    DYAD_DEFAULT_SINGULAR_THRESHOLD: sqrt(eps) of the scalar it is compiled with (in float
+    3.45e-4, not double's 1.49e-8, below which float keeps no digits worth a status 0)."""
+    given = "singular_threshold" in scene_t
     value = real(scene_t.get("singular_threshold", DEFAULT_THRESHOLD))
     if value is None or not 0 < value < 1:
         p.add(
@@ -148,13 +151,14 @@ def threshold(p: Problems, scene_t: dict) -> Param:
             0,
             "singular_threshold",
         )
-        value = DEFAULT_THRESHOLD
+        value, given = DEFAULT_THRESHOLD, False
     return Param(
         "singular_threshold",
         value,
         None,
         "Conditioning below which a dyad is reported singular (default sqrt(eps) = 1.49e-8)",
         {"min": 0.0, "max": 1.0, "min_exclusive": True, "max_exclusive": True},
+        macro="" if given else "DYAD_DEFAULT_SINGULAR_THRESHOLD",
     )
 
 
