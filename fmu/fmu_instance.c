@@ -1997,20 +1997,24 @@ static void find_sources(const fmu_model* model, const column_blocks* b, const c
     }
 }
 
-/* Sample `i`'s x values into the input block; 0 where the model refuses one (outside
- * its bounds, or not finite), as a set of it would. */
-static int store_sample(const column_call* c, const column_place place[], size_t i)
+/* Sample `i`'s x values where they go: with `to` NULL into the input block (each to its
+ * place's `at`), else into lane `lane` of the columns `to` (an angle's unit vector in
+ * two, `stride` apart); 0 where the model refuses one (outside its bounds, or not
+ * finite), as a set of it would. */
+static int store_values(const column_call* c, const column_place place[], double* const to[],
+                        size_t stride, size_t i, size_t lane)
 {
     size_t k;
     for (k = 0; k < c->n_x; ++k) {
         const double value = c->x[k][(ptrdiff_t)i * c->x_step[k]];
+        double* at = to != NULL ? to[k] + lane : place[k].at;
         if (!(value >= place[k].low && value <= place[k].high)) {
             return 0;
         }
         if (place[k].angle) {
-            dyad_cos_sin(value, &place[k].at[0], &place[k].at[1]);
+            dyad_cos_sin(value, &at[0], &at[stride]);
         } else {
-            *place[k].at = value;
+            *at = value;
         }
     }
     return 1;
@@ -2047,7 +2051,7 @@ static void evaluate_samples(const fmu_model* model, column_blocks* b, const col
     size_t i, k;
     for (i = 0; i < c->count; ++i) {
         fmu_status s = FMU_ERROR;
-        if (store_sample(c, place, i)) {
+        if (store_values(c, place, NULL, 1, i, 0)) {
             evaluate(model, b->input, b->output, &b->evaluation);
             s = sample_status(b->evaluation.status);
         }
@@ -2057,6 +2061,134 @@ static void evaluate_samples(const fmu_model* model, column_blocks* b, const col
                 s == FMU_OK ? source[k].at[(ptrdiff_t)i * source[k].step] : NAN;
         }
     }
+}
+
+/* ---- the same in a model's lanes (fmu_lanes): many samples at once ---------------------- */
+
+/* The call's lanes: the grid of columns; per x column, the lane column its values go to;
+ * per y column, the lane column its values come from (NULL: where find_sources said); the
+ * outputs wanted; which samples were stored. */
+typedef struct lane_grid {
+    const fmu_lanes* lanes;
+    double* cells;         /* columns x lanes */
+    double** to;           /* n_x */
+    const double** from;   /* n_y */
+    unsigned char* wanted; /* outputs */
+    int* stored;           /* lanes */
+} lane_grid;
+
+/* The column of the real at `at` in `block` (the input's or the output's). */
+static size_t lane_column_of(const void* block, const void* at)
+{
+    return (size_t)((const char*)at - (const char*)block) / sizeof(double);
+}
+
+/* Where each x column goes and each y column comes from in the lanes, and which outputs
+ * are wanted. */
+static void place_lanes(const column_blocks* b, const column_call* c, const column_place place[],
+                        const column_source source[], lane_grid* g)
+{
+    const size_t lanes = g->lanes->lanes;
+    const char* in = (const char*)b->input;
+    const char* out = (const char*)b->output;
+    size_t k;
+    for (k = 0; k < c->n_x; ++k) {
+        g->to[k] = g->cells + lane_column_of(b->input, place[k].at) * lanes;
+    }
+    memset(g->wanted, 0, g->lanes->outputs);
+    for (k = 0; k < c->n_y; ++k) {
+        const char* at = (const char*)(const void*)source[k].at;
+        g->from[k] = NULL;
+        if (at >= out && at < out + g->lanes->outputs * sizeof(double)) {
+            const size_t j = lane_column_of(b->output, at);
+            g->wanted[j] = 1;
+            g->from[k] = g->cells + (g->lanes->inputs + j) * lanes;
+        } else if (at >= in && at < in + g->lanes->inputs * sizeof(double)) {
+            g->from[k] = g->cells + lane_column_of(b->input, at) * lanes;
+        }
+    }
+}
+
+/* Sample `i`, in lane `lane`, alone in the blocks: its status and its outputs as evaluate
+ * gives them, where its checks failed in the lanes. */
+static fmu_status evaluate_lane_alone(const fmu_model* model, column_blocks* b, const lane_grid* g,
+                                      int halves, size_t lane)
+{
+    const fmu_behaviour* behaviour = model->behaviour;
+    size_t j;
+    for (j = 0; j < g->lanes->inputs; ++j) {
+        ((double*)b->input)[j] = g->cells[j * g->lanes->lanes + lane];
+    }
+    (halves ? behaviour->later->first : behaviour->evaluate)(model, b->input, b->output,
+                                                             &b->evaluation);
+    return sample_status(b->evaluation.status);
+}
+
+/* The samples from `first` on, at most a call's lanes: stored, evaluated at once, and
+ * those whose checks failed once more alone in the blocks. */
+static void evaluate_lanes(const fmu_model* model, column_blocks* b, const column_call* c,
+                           const column_place place[], const column_source source[],
+                           const lane_grid* g, size_t first)
+{
+    const fmu_lanes* lanes = g->lanes;
+    const fmu_later* later = model->behaviour->later;
+    const int halves = later != NULL && lanes->first != NULL && !reads_later(model, c);
+    const size_t count = c->count - first < lanes->lanes ? c->count - first : lanes->lanes;
+    const double* failed = g->cells + (lanes->inputs + lanes->outputs) * lanes->lanes;
+    size_t lane, k;
+    for (lane = 0; lane < count; ++lane) {
+        g->stored[lane] = store_values(c, place, g->to, lanes->lanes, first + lane, lane);
+    }
+    (halves ? lanes->first : lanes->whole)(count, g->cells, g->wanted);
+    for (lane = 0; lane < count; ++lane) {
+        const size_t i = first + lane;
+        const int alone = g->stored[lane] && failed[lane] != 0;
+        const fmu_status s = !g->stored[lane] ? FMU_ERROR
+                             : alone          ? evaluate_lane_alone(model, b, g, halves, lane)
+                                              : FMU_OK;
+        c->status[i] = (int)s;
+        for (k = 0; k < c->n_y; ++k) {
+            const double* from = g->from[k] != NULL && !alone
+                                     ? g->from[k] + lane
+                                     : source[k].at + (ptrdiff_t)i * source[k].step;
+            c->y[k][(ptrdiff_t)i * c->y_step[k]] = s == FMU_OK ? *from : NAN;
+        }
+    }
+}
+
+/* Every sample in the model's lanes: the start values into every lane once, then the
+ * samples a call's lanes at a time. 0 where memory ran out. */
+static int evaluate_samples_in_lanes(const fmu_model* model, column_blocks* b, const column_call* c,
+                                     const column_place place[], const column_source source[])
+{
+    lane_grid g;
+    size_t first, j, lane;
+    int ready;
+    g.lanes = model->behaviour->lanes;
+    g.cells = (double*)malloc(g.lanes->columns * g.lanes->lanes * sizeof(double));
+    g.to = (double**)malloc((c->n_x + 1) * sizeof *g.to);
+    g.from = (const double**)malloc((c->n_y + 1) * sizeof *g.from);
+    g.wanted = (unsigned char*)malloc(g.lanes->outputs + 1);
+    g.stored = (int*)malloc(g.lanes->lanes * sizeof(int));
+    ready =
+        g.cells != NULL && g.to != NULL && g.from != NULL && g.wanted != NULL && g.stored != NULL;
+    if (ready) {
+        for (j = 0; j < g.lanes->inputs; ++j) {
+            for (lane = 0; lane < g.lanes->lanes; ++lane) {
+                g.cells[j * g.lanes->lanes + lane] = ((const double*)b->input)[j];
+            }
+        }
+        place_lanes(b, c, place, source, &g);
+        for (first = 0; first < c->count; first += g.lanes->lanes) {
+            evaluate_lanes(model, b, c, place, source, &g, first);
+        }
+    }
+    free(g.cells);
+    free(g.to);
+    free(g.from);
+    free(g.wanted);
+    free(g.stored);
+    return ready;
 }
 
 fmu_status fmu_evaluate_columns(const fmu_model* model, const char* token, int time_at_vr_0,
@@ -2086,7 +2218,11 @@ fmu_status fmu_evaluate_columns(const fmu_model* model, const char* token, int t
         load_starts(model, b.input);
         place_columns(model, &b, &c, place);
         find_sources(model, &b, &c, source);
-        evaluate_samples(model, &b, &c, place, source);
+        if (model->behaviour->lanes != NULL) {
+            ready = evaluate_samples_in_lanes(model, &b, &c, place, source);
+        } else {
+            evaluate_samples(model, &b, &c, place, source);
+        }
     }
     free(place);
     free(source);

@@ -141,6 +141,25 @@ typedef struct fmu_later {
                   fmu_evaluation* evaluation);
 } fmu_later;
 
+/* An algebraic model's evaluation at many samples at once, in columns (a scene's
+ * <identifier>_evaluate_lanes): lanes[j * lanes + i] is real j of sample i: the input
+ * block's reals in its order (an angle as the x and y of its unit vector), then the
+ * output block's before its status, then the count of the sample's failed checks, then
+ * scratch; `columns` in all. Where the count is 0 the sample's outputs are what
+ * `evaluate` (or `later->first`) gives, bit for bit, with FMU_OK; elsewhere they mean
+ * nothing, and `evaluate` says what went wrong. The loop over samples vectorises. */
+typedef struct fmu_lanes {
+    size_t lanes;   /* samples per call, at most */
+    size_t inputs;  /* reals of the input block */
+    size_t outputs; /* reals of the output block, its status aside */
+    size_t columns;
+    /* `wanted`: NULL, or a flag per real of the output block; an output not wanted may be
+     * left out */
+    void (*whole)(size_t count, double* lanes, const unsigned char* wanted);
+    /* as later->first; NULL where the model has no fmu_later */
+    void (*first)(size_t count, double* lanes, const unsigned char* wanted);
+} fmu_lanes;
+
 /* What a kind of model computes, on its own input and output blocks. */
 typedef struct fmu_behaviour {
     size_t input_size;  /* bytes of the input block */
@@ -173,6 +192,8 @@ typedef struct fmu_behaviour {
     /* Outputs computed when first read after an evaluation (an algebraic model only);
      * NULL: the evaluation computes every output. */
     const fmu_later* later;
+    /* The evaluation at many samples at once (an algebraic model only); NULL: none. */
+    const fmu_lanes* lanes;
 } fmu_behaviour;
 
 /* The calls an importer makes every step, set every Real input and get every Real

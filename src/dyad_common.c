@@ -135,8 +135,8 @@ void dyad_angle_cos_sin(double angle, double* cos_out, double* sin_out)
 static dyad_real dyad_error_scale(const dyad_result* result, dyad_real mk, dyad_real np,
                                   dyad_real mn)
 {
-    const dyad_real largest = mk > np ? (mk > mn ? mk : mn) : (np > mn ? np : mn);
-    return result->status == DYAD_STATUS_OK ? result->amplification * largest : (dyad_real)NAN;
+    return result->status == DYAD_STATUS_OK ? result->amplification * dyad_largest_of3(mk, np, mn)
+                                            : (dyad_real)NAN;
 }
 
 dyad_real dyad_force_size(const dyad_result* result)

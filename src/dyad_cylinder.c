@@ -293,23 +293,16 @@ typedef char cyl_motions_are_contiguous[offsetof(dyad_cylinder_result, link_com)
 
 int dyad_cyl_outputs_finite(const dyad_cylinder_result* r)
 {
-    /* x - x is 0 for a finite x and NaN otherwise: the sum of them is 0 where all are.
-     * The motions summed in two lanes, which the compiler makes one vector of two
-     * (SSE2): half the operations of one chain of dependent adds. */
+    /* x - x is 0 for a finite x and NaN otherwise: the sum of them is 0 where all are */
     const dyad_real* v =
         (const dyad_real*)(const void*)((const char*)r + offsetof(dyad_cylinder_result, b));
-    dyad_real even = 0, odd = 0, residue;
-    size_t k;
-    for (k = 0; k < CYL_MOTION_REALS; k += 2) {
-        even += v[k] - v[k];
-        odd += v[k + 1] - v[k + 1];
-    }
-    residue = even + odd + (r->link_omega - r->link_omega) + (r->link_epsilon - r->link_epsilon) +
-              (r->cylinder_omega - r->cylinder_omega) +
-              (r->cylinder_epsilon - r->cylinder_epsilon) + (r->axial_force - r->axial_force) +
-              (r->r_a.x - r->r_a.x) + (r->r_a.y - r->r_a.y) + (r->r_b.x - r->r_b.x) +
-              (r->r_b.y - r->r_b.y) + (r->r_o.x - r->r_o.x) + (r->r_o.y - r->r_o.y) +
-              (r->n_rod - r->n_rod) + (r->m_rod - r->m_rod);
+    const dyad_real residue =
+        dyad_residue_of(v, CYL_MOTION_REALS) + (r->link_omega - r->link_omega) +
+        (r->link_epsilon - r->link_epsilon) + (r->cylinder_omega - r->cylinder_omega) +
+        (r->cylinder_epsilon - r->cylinder_epsilon) + (r->axial_force - r->axial_force) +
+        (r->r_a.x - r->r_a.x) + (r->r_a.y - r->r_a.y) + (r->r_b.x - r->r_b.x) +
+        (r->r_b.y - r->r_b.y) + (r->r_o.x - r->r_o.x) + (r->r_o.y - r->r_o.y) +
+        (r->n_rod - r->n_rod) + (r->m_rod - r->m_rod);
     return residue == 0;
 }
 

@@ -50,6 +50,30 @@ static inline dyad_real dyad_abs(dyad_real a)
     return a < 0 ? -a : a;
 }
 
+/* x - x is 0 for a finite x and NaN otherwise: the sum of them over `count` (even) reals,
+ * 0 where all are finite. Summed in two lanes, which the compiler makes one vector of two
+ * (SSE2): half the operations of one chain of dependent adds; unrolled whole where
+ * `count` is a constant, since a batch's loop over samples (dyad_lanes.h) vectorises only
+ * without a loop inside. */
+static inline dyad_real dyad_residue_of(const dyad_real* v, size_t count)
+{
+    dyad_real even = 0, odd = 0;
+    size_t k;
+#if defined(__GNUC__)
+#pragma GCC unroll 32
+#endif
+    for (k = 0; k < count; k += 2) {
+        even += v[k] - v[k];
+        odd += v[k + 1] - v[k + 1];
+    }
+    return even + odd;
+}
+
+static inline dyad_real dyad_largest_of3(dyad_real a, dyad_real b, dyad_real c)
+{
+    return a > b ? (a > c ? a : c) : (b > c ? b : c);
+}
+
 /* Where two sums are equal in exact arithmetic (a force or moment closing one
  * link's balance or the other's), the one built from smaller terms loses
  * fewer digits to cancellation: a stiff dyad, one link's inertia dwarfing the
@@ -223,16 +247,27 @@ static inline dyad_status dyad_prepare(dyad_type type, const dyad_input* input,
     return DYAD_STATUS_OK;
 }
 
-/* Stores the conditioning; below the threshold (or NaN) the dyad is singular.
- * The amplification is 1 / conditioning until dyad_finish adds the data factor:
- * what a singular or out-of-range result reports. */
-static inline dyad_status dyad_accept_conditioning(dyad_real threshold, dyad_real denominator,
-                                                   dyad_real conditioning, dyad_result* result)
+/* A type's denominator d and its conditioning (in [0, 1]; |d| but for RTR), and for
+ * RTR the distance |D_m D_n| its closed forms divide by too. */
+typedef struct dyad_conditioned {
+    dyad_real d, conditioning, dist;
+} dyad_conditioned;
+
+/* The conditioning into the result. The amplification is 1 / conditioning until
+ * dyad_finish adds the data factor: what a singular or out-of-range result reports. */
+static inline void dyad_store_conditioning(dyad_conditioned c, dyad_result* result)
 {
-    result->denominator = denominator;
-    result->conditioning = conditioning;
-    result->amplification = 1 / conditioning;
-    if (!(conditioning >= threshold)) {
+    result->denominator = c.d;
+    result->conditioning = c.conditioning;
+    result->amplification = 1 / c.conditioning;
+}
+
+/* Stores the conditioning; below the threshold (or NaN) the dyad is singular. */
+static inline dyad_status dyad_accept_conditioning(dyad_real threshold, dyad_conditioned c,
+                                                   dyad_result* result)
+{
+    dyad_store_conditioning(c, result);
+    if (!(c.conditioning >= threshold)) {
         return dyad_reject(result, DYAD_STATUS_SINGULAR, DYAD_FIELD_NONE);
     }
     return DYAD_STATUS_OK;
@@ -253,36 +288,44 @@ static inline dyad_size_terms dyad_size_terms_of(const dyad_loaded* p, dyad_real
     return t;
 }
 
+/* x - x is 0 for a finite x and NaN otherwise: one sum, 0 where every reaction is finite. */
+static inline dyad_real dyad_outputs_residue(const dyad_result* r)
+{
+    return (r->r_mk.x - r->r_mk.x) + (r->r_mk.y - r->r_mk.y) + (r->r_np.x - r->r_np.x) +
+           (r->r_np.y - r->r_np.y) + (r->r_mn.x - r->r_mn.x) + (r->r_mn.y - r->r_mn.y) +
+           (r->n_mk - r->n_mk) + (r->n_np - r->n_np) + (r->n_mn - r->n_mn) + (r->m_mk - r->m_mk) +
+           (r->m_np - r->m_np) + (r->m_mn - r->m_mn);
+}
+
 /* The last step of every type: a reaction that is not finite is out of range. */
 static inline dyad_status dyad_check_finite(dyad_result* result)
 {
-    const dyad_result* r = result;
-    /* x - x is 0 for a finite x and NaN otherwise: one sum tests all outputs. */
-    const dyad_real nonfinite = (r->r_mk.x - r->r_mk.x) + (r->r_mk.y - r->r_mk.y) +
-                                (r->r_np.x - r->r_np.x) + (r->r_np.y - r->r_np.y) +
-                                (r->r_mn.x - r->r_mn.x) + (r->r_mn.y - r->r_mn.y) +
-                                (r->n_mk - r->n_mk) + (r->n_np - r->n_np) + (r->n_mn - r->n_mn) +
-                                (r->m_mk - r->m_mk) + (r->m_np - r->m_np) + (r->m_mn - r->m_mn);
-    if (nonfinite != 0) {
+    if (dyad_outputs_residue(result) != 0) {
         return dyad_reject(result, DYAD_STATUS_OUT_OF_RANGE, DYAD_FIELD_NONE);
     }
     return DYAD_STATUS_OK;
 }
 
-/* The last step of every type: out of range unless finite; then the
- * amplification from the output sizes (the rates are never read here). */
+/* The amplification of a finite result from its output sizes (the rates are never read
+ * here). */
+static inline dyad_real dyad_result_amplification(dyad_type type, dyad_output_sizes sizes,
+                                                  const dyad_result* result)
+{
+    return dyad_amplification_of(sizes, dyad_largest_force(result, result),
+                                 dyad_largest_moment(result, result,
+                                                     dyad_guide_used(type, DYAD_PAIR_DM),
+                                                     dyad_guide_used(type, DYAD_PAIR_E),
+                                                     dyad_guide_used(type, DYAD_PAIR_DN)),
+                                 dyad_dual_const(result->conditioning))
+        .v;
+}
+
+/* The last step of every type: out of range unless finite; then the amplification. */
 static inline dyad_status dyad_finish(dyad_type type, dyad_output_sizes sizes, dyad_result* result)
 {
     const dyad_status status = dyad_check_finite(result);
     if (status == DYAD_STATUS_OK) {
-        result->amplification =
-            dyad_amplification_of(sizes, dyad_largest_force(result, result),
-                                  dyad_largest_moment(result, result,
-                                                      dyad_guide_used(type, DYAD_PAIR_DM),
-                                                      dyad_guide_used(type, DYAD_PAIR_E),
-                                                      dyad_guide_used(type, DYAD_PAIR_DN)),
-                                  dyad_dual_const(result->conditioning))
-                .v;
+        result->amplification = dyad_result_amplification(type, sizes, result);
     }
     return status;
 }
@@ -301,6 +344,21 @@ static inline dyad_status dyad_name_failure(dyad_type type, const dyad_input* in
         }
     }
     return status;
+}
+
+/* A type's closed forms: the reactions of a dyad whose conditioning c is accepted, and
+ * the sizes of their terms. */
+typedef dyad_output_sizes (*dyad_closed_forms_fn)(const dyad_loaded* p, dyad_conditioned c,
+                                                  dyad_result* result);
+
+/* A type's reactions: its conditioning accepted, its closed forms, finished. */
+DYAD_CLOSED_FORM dyad_status dyad_reactions(dyad_type type, const dyad_loaded* p,
+                                            dyad_conditioned c, dyad_closed_forms_fn closed_forms,
+                                            dyad_result* result)
+{
+    const dyad_status status = dyad_accept_conditioning(p->singular_threshold, c, result);
+    return status == DYAD_STATUS_OK ? dyad_finish(type, closed_forms(p, c, result), result)
+                                    : status;
 }
 
 /* dyad_react_<type>: the result starts ok with zero outputs. */

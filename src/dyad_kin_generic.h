@@ -261,9 +261,9 @@ static inline void DYAD_KIN(dyad_kin_solve2)(dyad_kv a, dyad_kv b, dyad_kv r, dy
  * differentiated the same in their derivatives (x', y'): r is the difference
  * of E's velocity (then acceleration) from the two sides with the unknowns at
  * 0. (x, x') and (y, y') point into st. */
-static inline void DYAD_KIN(dyad_kin_rates)(const kin_in* in, kin_state* st, kin_sides_fn sides,
-                                            dyad_kv a, dyad_kv b, dyad_ks* x, dyad_ks* dx,
-                                            dyad_ks* y, dyad_ks* dy)
+DYAD_CLOSED_FORM void DYAD_KIN(dyad_kin_rates)(const kin_in* in, kin_state* st, kin_sides_fn sides,
+                                               dyad_kv a, dyad_kv b, dyad_ks* x, dyad_ks* dx,
+                                               dyad_ks* y, dyad_ks* dy)
 {
     kin_motion from_m, from_n;
     *x = *dx = *y = *dy = ks_c(0);
@@ -486,3 +486,46 @@ DYAD_CLOSED_FORM dyad_status DYAD_KIN(dyad_kin_run)(dyad_type type, kin_position
     value->gap = rate->gap = 0;
     return DYAD_STATUS_OK;
 }
+
+#if !DYAD_KIN_IS_DUAL
+/* The motion of the point `at` in the frame of a link whose origin moves as `origin`
+ * (dyad_point_on_link, and its twin in a batch's loop). */
+static inline dyad_point_motion dyad_kin_point_on_link(const dyad_point_motion* origin,
+                                                       dyad_vec2 dir, dyad_real omega,
+                                                       dyad_real epsilon, dyad_vec2 at)
+{
+    kin_motion o, p;
+    dyad_point_motion r;
+    o.pos = origin->position;
+    o.vel = origin->velocity;
+    o.acc = origin->acceleration;
+    p = dyad_kin_on_link_plain(&o, dir, omega, epsilon, at);
+    r.position = p.pos;
+    r.velocity = p.vel;
+    r.acceleration = p.acc;
+    return r;
+}
+
+/* One sample of a batch (dyad_lanes.h): dyad_kin_run's steps without a branch, so that
+ * a loop over samples vectorises. Every check is made and counted: 0 is returned where
+ * dyad_kin_run gives DYAD_STATUS_OK, and then `value` holds its outputs bit for bit
+ * (not its status, field, failure or gap, which are not written); elsewhere the count
+ * of the failed checks, and outputs that mean nothing (dyad_kinematics_<type> says
+ * why). */
+DYAD_CLOSED_FORM dyad_real dyad_kin_lane(dyad_type type, kin_position_fn position,
+                                         kin_motion_fn motion, const dyad_kin_input* input,
+                                         dyad_kin_result* value)
+{
+    kin_in in;
+    kin_state st;
+    dyad_real bad = DYAD_FAILED(dyad_kin_fields_good(type, input));
+    dyad_kin_load_plain(type, input, input, &in);
+    dyad_kin_start_plain(&in, &st);
+    bad += DYAD_FAILED(position(&in, &st) == DYAD_KIN_CLOSES);
+    st.amplification = dyad_kin_amplification_plain(&in, &st);
+    bad += DYAD_FAILED(st.amplification * in.threshold <= 1);
+    motion(&in, &st);
+    dyad_kin_store_plain(&in, &st, value, value);
+    return bad + DYAD_FAILED(dyad_kin_motion_residue(value) == 0);
+}
+#endif

@@ -20,6 +20,27 @@
 #include <math.h>
 #include <stddef.h>
 
+/* 0 where `ok`, else 1, as a real: a batch's count of failed checks (dyad_lanes.h), in the
+ * scalar of the values it is taken from, so that the count stays in the vector's lanes. */
+#define DYAD_FAILED(ok) ((ok) ? (dyad_real)0 : (dyad_real)1)
+
+/* A type's steps (its position, its two sides of the closure, its rates): inlined into
+ * dyad_kin_run, where they are called through pointers, and into a batch's loop
+ * (dyad_lanes.h), which a call would keep from vectorising. */
+#define DYAD_KIN_STEP DYAD_CLOSED_FORM
+
+/* dyad_kin_input_default's values: guides and turns along x, lengths 1, branch +1, the
+ * default threshold, everything else 0. */
+#define DYAD_KIN_INPUT_DEFAULTS \
+    {.k = {.guide = {1, 0}},    \
+     .p = {.guide = {1, 0}},    \
+     .length_m = 1,             \
+     .length_n = 1,             \
+     .turn_m = {1, 0},          \
+     .turn_n = {1, 0},          \
+     .branch = 1,               \
+     .singular_threshold = DYAD_DEFAULT_SINGULAR_THRESHOLD}
+
 /* ---- plain arithmetic the vec2.h set lacks ----------------------------------------------------
  */
 
@@ -115,6 +136,24 @@ void dyad_kin_fill_nan(dyad_kin_result* result, dyad_status status, dyad_kin_fie
 /* Rejects the call in value and, if not NULL, derivative; returns status. */
 dyad_status dyad_kin_reject(dyad_kin_result* value, dyad_kin_result* derivative, dyad_status status,
                             dyad_kin_field field);
+
+/* The reals of a result's motion, from m to slide_p: the structs between hold nothing
+ * else (no padding between reals), so they are one array. */
+#define DYAD_KIN_MOTION_REALS 50
+typedef char dyad_kin_motion_reals_are_contiguous[offsetof(dyad_kin_result, slide_p) +
+                                                              sizeof(dyad_slide) -
+                                                              offsetof(dyad_kin_result, m) ==
+                                                          DYAD_KIN_MOTION_REALS * sizeof(dyad_real)
+                                                      ? 1
+                                                      : -1];
+
+/* 0 where every motion output of a result is finite (dyad_residue_of). */
+static inline dyad_real dyad_kin_motion_residue(const dyad_kin_result* r)
+{
+    return dyad_residue_of(
+        (const dyad_real*)(const void*)((const char*)r + offsetof(dyad_kin_result, m)),
+        DYAD_KIN_MOTION_REALS);
+}
 
 /* 1 if every motion output of result is finite. */
 int dyad_kin_outputs_finite(const dyad_kin_result* result);

@@ -66,7 +66,7 @@ dyad_status dyad_kinematics_rrr(const dyad_kin_input* input, dyad_kin_result* re
 
 #else /* the formulas, over the pass's scalar */
 
-static dyad_kin_failure DYAD_KIN(rrr_position)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP dyad_kin_failure DYAD_KIN(rrr_position)(const kin_in* in, kin_state* st)
 {
     const dyad_kv d = kv_sub(in->p.point.pos, in->k.point.pos);
     const dyad_ks l2 = kv_dot(d, d);
@@ -105,14 +105,14 @@ static dyad_kin_failure DYAD_KIN(rrr_position)(const kin_in* in, kin_state* st)
 }
 
 /* E from D_m along link m and from D_n along link n. */
-static void DYAD_KIN(rrr_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
-                                kin_motion* from_n)
+DYAD_KIN_STEP void DYAD_KIN(rrr_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
+                                       kin_motion* from_n)
 {
     *from_m = DYAD_KIN(dyad_kin_arm)(&in->k.point, st->l_m, st->i_m, st->w_m, st->e_m);
     *from_n = DYAD_KIN(dyad_kin_arm)(&in->p.point, st->l_n, st->i_n, st->w_n, st->e_n);
 }
 
-static void DYAD_KIN(rrr_motion)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP void DYAD_KIN(rrr_motion)(const kin_in* in, kin_state* st)
 {
     const dyad_kv a = kv_scale(in->l_m, kv_perp(st->i_m));
     const dyad_kv b = kv_scale(ks_neg(in->l_n), kv_perp(st->i_n));

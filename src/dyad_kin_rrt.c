@@ -55,7 +55,7 @@ dyad_status dyad_kinematics_rrt(const dyad_kin_input* input, dyad_kin_result* re
 
 #else /* the formulas, over the pass's scalar */
 
-static dyad_kin_failure DYAD_KIN(rrt_position)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP dyad_kin_failure DYAD_KIN(rrt_position)(const kin_in* in, kin_state* st)
 {
     const dyad_kv i_k = in->k.guide;
     const dyad_kv j_k = kv_perp(i_k);
@@ -82,15 +82,15 @@ static dyad_kin_failure DYAD_KIN(rrt_position)(const kin_in* in, kin_state* st)
 }
 
 /* E from the slider on guide k along link m, and from D_n along link n. */
-static void DYAD_KIN(rrt_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
-                                kin_motion* from_n)
+DYAD_KIN_STEP void DYAD_KIN(rrt_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
+                                       kin_motion* from_n)
 {
     const kin_motion d_m = DYAD_KIN(dyad_kin_on_guide)(&in->k, st->s_k);
     *from_m = DYAD_KIN(dyad_kin_arm)(&d_m, st->l_m, st->i_m, st->w_m, st->e_m);
     *from_n = DYAD_KIN(dyad_kin_arm)(&in->p.point, st->l_n, st->i_n, st->w_n, st->e_n);
 }
 
-static void DYAD_KIN(rrt_motion)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP void DYAD_KIN(rrt_motion)(const kin_in* in, kin_state* st)
 {
     const dyad_kv b = kv_scale(ks_neg(in->l_n), kv_perp(st->i_n));
     DYAD_KIN(dyad_kin_rates)(in, st, DYAD_KIN(rrt_sides), in->k.guide, b, &st->s_k.dq, &st->s_k.ddq,

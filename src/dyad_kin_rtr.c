@@ -59,7 +59,7 @@ dyad_status dyad_kinematics_rtr(const dyad_kin_input* input, dyad_kin_result* re
 
 /* l_m, the root of l^2 - 2 l c + (l_n^2 - |d|^2) = 0 the branch takes, given
  * c = l_n cos delta and r; neither root cancels. */
-static dyad_ks DYAD_KIN(rtr_length)(const kin_in* in, dyad_ks c, dyad_ks r, dyad_ks dist)
+DYAD_KIN_STEP dyad_ks DYAD_KIN(rtr_length)(const kin_in* in, dyad_ks c, dyad_ks r, dyad_ks dist)
 {
     const dyad_ks outer = ks_val(c) >= 0 ? ks_add(c, r) : ks_sub(c, r);
     const dyad_ks product = ks_mul(ks_sub(in->l_n, dist), ks_add(in->l_n, dist));
@@ -68,7 +68,7 @@ static dyad_ks DYAD_KIN(rtr_length)(const kin_in* in, dyad_ks c, dyad_ks r, dyad
     return (in->branch > 0) == (ks_val(c) >= 0) ? outer : inner;
 }
 
-static dyad_kin_failure DYAD_KIN(rtr_position)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP dyad_kin_failure DYAD_KIN(rtr_position)(const kin_in* in, kin_state* st)
 {
     const dyad_kv d = kv_sub(in->p.point.pos, in->k.point.pos);
     const dyad_ks d2 = kv_dot(d, d);
@@ -96,14 +96,14 @@ static dyad_kin_failure DYAD_KIN(rtr_position)(const kin_in* in, kin_state* st)
 }
 
 /* E along m from D_m, and along n from D_n; n turns with m. */
-static void DYAD_KIN(rtr_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
-                                kin_motion* from_n)
+DYAD_KIN_STEP void DYAD_KIN(rtr_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
+                                       kin_motion* from_n)
 {
     *from_m = DYAD_KIN(dyad_kin_arm)(&in->k.point, st->l_m, st->i_m, st->w_m, st->e_m);
     *from_n = DYAD_KIN(dyad_kin_arm)(&in->p.point, st->l_n, st->i_n, st->w_m, st->e_m);
 }
 
-static void DYAD_KIN(rtr_motion)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP void DYAD_KIN(rtr_motion)(const kin_in* in, kin_state* st)
 {
     const dyad_kv b = kv_perp(kv_sub(in->p.point.pos, in->k.point.pos));
     DYAD_KIN(dyad_kin_rates)(in, st, DYAD_KIN(rtr_sides), st->i_m, b, &st->l_m.dq, &st->l_m.ddq,

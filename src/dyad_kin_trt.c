@@ -47,7 +47,7 @@ dyad_status dyad_kinematics_trt(const dyad_kin_input* input, dyad_kin_result* re
 
 #else /* the formulas, over the pass's scalar */
 
-static dyad_kin_failure DYAD_KIN(trt_position)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP dyad_kin_failure DYAD_KIN(trt_position)(const kin_in* in, kin_state* st)
 {
     const dyad_kv i_k = in->k.guide;
     const dyad_kv i_p = in->p.guide;
@@ -69,8 +69,8 @@ static dyad_kin_failure DYAD_KIN(trt_position)(const kin_in* in, kin_state* st)
 }
 
 /* E from the slider on guide k along m, and from the slider on guide p along n. */
-static void DYAD_KIN(trt_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
-                                kin_motion* from_n)
+DYAD_KIN_STEP void DYAD_KIN(trt_sides)(const kin_in* in, const kin_state* st, kin_motion* from_m,
+                                       kin_motion* from_n)
 {
     const kin_motion d_m = DYAD_KIN(dyad_kin_on_guide)(&in->k, st->s_k);
     const kin_motion d_n = DYAD_KIN(dyad_kin_on_guide)(&in->p, st->s_p);
@@ -78,7 +78,7 @@ static void DYAD_KIN(trt_sides)(const kin_in* in, const kin_state* st, kin_motio
     *from_n = DYAD_KIN(dyad_kin_arm)(&d_n, st->l_n, st->i_n, st->w_n, st->e_n);
 }
 
-static void DYAD_KIN(trt_motion)(const kin_in* in, kin_state* st)
+DYAD_KIN_STEP void DYAD_KIN(trt_motion)(const kin_in* in, kin_state* st)
 {
     DYAD_KIN(dyad_kin_rates)(in, st, DYAD_KIN(trt_sides), in->k.guide, kv_neg(in->p.guide),
                              &st->s_k.dq, &st->s_k.ddq, &st->s_p.dq, &st->s_p.ddq);

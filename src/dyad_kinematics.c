@@ -45,14 +45,7 @@ static const char* const kin_failure_names[DYAD_KIN_FAILURE_COUNT] = {
 dyad_kin_input dyad_kin_input_default(void)
 {
     /* one copy of a constant: a generated scene starts every dyad's input from it */
-    static const dyad_kin_input defaults = {.k = {.guide = {1, 0}},
-                                            .p = {.guide = {1, 0}},
-                                            .length_m = 1,
-                                            .length_n = 1,
-                                            .turn_m = {1, 0},
-                                            .turn_n = {1, 0},
-                                            .branch = 1,
-                                            .singular_threshold = DYAD_DEFAULT_SINGULAR_THRESHOLD};
+    static const dyad_kin_input defaults = DYAD_KIN_INPUT_DEFAULTS;
     return defaults;
 }
 
@@ -69,16 +62,7 @@ const char* dyad_kin_failure_name(dyad_kin_failure failure)
 dyad_point_motion dyad_point_on_link(const dyad_point_motion* origin, dyad_vec2 dir,
                                      dyad_real omega, dyad_real epsilon, dyad_vec2 at)
 {
-    dyad_kin_motion_plain o, p;
-    dyad_point_motion r;
-    o.pos = origin->position;
-    o.vel = origin->velocity;
-    o.acc = origin->acceleration;
-    p = dyad_kin_on_link_plain(&o, dir, omega, epsilon, at);
-    r.position = p.pos;
-    r.velocity = p.vel;
-    r.acceleration = p.acc;
-    return r;
+    return dyad_kin_point_on_link(origin, dir, omega, epsilon, at);
 }
 
 /* ---- validation ---------------------------------------------------------------------------------
@@ -202,27 +186,7 @@ dyad_status dyad_kin_reject(dyad_kin_result* value, dyad_kin_result* derivative,
     return status;
 }
 
-/* The reals of a result's motion, from m to slide_p: the structs between hold nothing
- * else (no padding between reals), so they are one array. */
-#define MOTION_REALS 50
-typedef char motion_reals_are_contiguous[offsetof(dyad_kin_result, slide_p) + sizeof(dyad_slide) -
-                                                     offsetof(dyad_kin_result, m) ==
-                                                 MOTION_REALS * sizeof(dyad_real)
-                                             ? 1
-                                             : -1];
-
 int dyad_kin_outputs_finite(const dyad_kin_result* r)
 {
-    /* x - x is 0 for a finite x and NaN otherwise: the sum of them is 0 where all are.
-     * Summed in two lanes, which the compiler makes one vector of two (SSE2): half the
-     * operations of one chain of dependent adds. */
-    const dyad_real* v =
-        (const dyad_real*)(const void*)((const char*)r + offsetof(dyad_kin_result, m));
-    dyad_real even = 0, odd = 0;
-    size_t k;
-    for (k = 0; k < MOTION_REALS; k += 2) {
-        even += v[k] - v[k];
-        odd += v[k + 1] - v[k + 1];
-    }
-    return even + odd == 0;
+    return dyad_kin_motion_residue(r) == 0;
 }

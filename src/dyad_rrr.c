@@ -41,28 +41,38 @@
  */
 #include "dyad_internal.h"
 
-DYAD_CLOSED_FORM dyad_status rrr_reactions(const dyad_loaded* p, dyad_result* result)
+/* The denominator i_m . j_n, the sine of the angle between the links; the conditioning |d|. */
+DYAD_CLOSED_FORM dyad_conditioned rrr_conditioning(const dyad_loaded* p)
+{
+    dyad_conditioned c;
+    c.d = dyad_dot(p->m.i, p->n.j);
+    c.conditioning = dyad_abs(c.d);
+    c.dist = 0;
+    return c;
+}
+
+/* The reactions of a dyad whose conditioning is accepted; the sizes of their terms. */
+DYAD_CLOSED_FORM dyad_output_sizes rrr_closed_forms(const dyad_loaded* p, dyad_conditioned c,
+                                                    dyad_result* result)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
-    dyad_status status;
-    dyad_real d, alpha, beta;
-
-    d = dyad_dot(m->i, n->j);
-    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-
-    beta = -dyad_load_moment_about_d(m) / m->l;
-    alpha = (dyad_load_moment_about_d(n) / n->l - beta * dyad_dot(m->j, n->j)) / d;
+    const dyad_real beta = -dyad_load_moment_about_d(m) / m->l;
+    const dyad_real alpha =
+        (dyad_load_moment_about_d(n) / n->l - beta * dyad_dot(m->j, n->j)) / c.d;
+    dyad_size_terms terms;
     result->r_mn = dyad_combine(alpha, m->i, beta, m->j);
     result->r_mk = dyad_neg(dyad_add(result->r_mn, m->f));
     result->r_np = dyad_sub(result->r_mn, n->f);
-    {
-        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(d));
-        return dyad_finish(DYAD_RRR, dyad_sizes_rrr(&terms), result);
-    }
+    terms = dyad_size_terms_of(p, 1 / c.conditioning);
+    return dyad_sizes_rrr(&terms);
+}
+
+#ifndef DYAD_REACT_FORMULAS /* dyad_lanes.h takes the closed forms alone */
+
+DYAD_CLOSED_FORM dyad_status rrr_reactions(const dyad_loaded* p, dyad_result* result)
+{
+    return dyad_reactions(DYAD_RRR, p, rrr_conditioning(p), rrr_closed_forms, result);
 }
 
 dyad_status dyad_react_rrr(const dyad_loaded* dyad, dyad_result* result)
@@ -87,3 +97,5 @@ dyad_status dyad_solve_rrr(const dyad_input* input, dyad_result* result)
     }
     return dyad_name_failure(DYAD_RRR, input, rrr_reactions(&p, result), result);
 }
+
+#endif /* DYAD_REACT_FORMULAS */

@@ -40,30 +40,39 @@
  */
 #include "dyad_internal.h"
 
-DYAD_CLOSED_FORM dyad_status rrt_reactions(const dyad_loaded* p, dyad_result* result)
+/* The denominator i_n . i_k, 0 where the rod stands normal to the guide; the conditioning |d|. */
+DYAD_CLOSED_FORM dyad_conditioned rrt_conditioning(const dyad_loaded* p)
+{
+    dyad_conditioned c;
+    c.d = dyad_dot(p->n.i, p->i_k);
+    c.conditioning = dyad_abs(c.d);
+    c.dist = 0;
+    return c;
+}
+
+/* The reactions of a dyad whose conditioning is accepted; the sizes of their terms. */
+DYAD_CLOSED_FORM dyad_output_sizes rrt_closed_forms(const dyad_loaded* p, dyad_conditioned c,
+                                                    dyad_result* result)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
-    dyad_status status;
-    dyad_real d, tau, gamma;
-
-    d = dyad_dot(n->i, p->i_k);
-    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-
-    tau = dyad_load_moment_about_d(n) / n->l;
-    gamma = -(dyad_dot(m->f, p->i_k) + tau * dyad_dot(n->j, p->i_k)) / d;
+    const dyad_real tau = dyad_load_moment_about_d(n) / n->l;
+    const dyad_real gamma = -(dyad_dot(m->f, p->i_k) + tau * dyad_dot(n->j, p->i_k)) / c.d;
+    dyad_size_terms terms;
     result->r_mn = dyad_combine(gamma, n->i, tau, n->j);
     result->n_mk = -dyad_dot(dyad_add(m->f, result->r_mn), p->j_k);
     result->r_mk = dyad_scale(result->n_mk, p->j_k);
     result->r_np = dyad_sub(result->r_mn, n->f);
     result->m_mk = -dyad_load_moment_about_d(m) - m->l * dyad_cross(m->i, result->r_mn);
-    {
-        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(d));
-        return dyad_finish(DYAD_RRT, dyad_sizes_rrt(&terms), result);
-    }
+    terms = dyad_size_terms_of(p, 1 / c.conditioning);
+    return dyad_sizes_rrt(&terms);
+}
+
+#ifndef DYAD_REACT_FORMULAS /* dyad_lanes.h takes the closed forms alone */
+
+DYAD_CLOSED_FORM dyad_status rrt_reactions(const dyad_loaded* p, dyad_result* result)
+{
+    return dyad_reactions(DYAD_RRT, p, rrt_conditioning(p), rrt_closed_forms, result);
 }
 
 dyad_status dyad_react_rrt(const dyad_loaded* dyad, dyad_result* result)
@@ -88,3 +97,5 @@ dyad_status dyad_solve_rrt(const dyad_input* input, dyad_result* result)
     }
     return dyad_name_failure(DYAD_RRT, input, rrt_reactions(&p, result), result);
 }
+
+#endif /* DYAD_REACT_FORMULAS */

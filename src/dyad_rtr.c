@@ -55,39 +55,51 @@
  */
 #include "dyad_internal.h"
 
-DYAD_CLOSED_FORM dyad_status rtr_reactions(const dyad_loaded* p, dyad_result* result)
+/* The denominator i_beta . i_m (i_beta the direction of D_m D_n) and the conditioning,
+ * at most |D_m D_n| / (l_m + l_n) too. */
+DYAD_CLOSED_FORM dyad_conditioned rtr_conditioning(const dyad_loaded* p)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
-    dyad_status status;
-    dyad_vec2 dm_dn;
-    dyad_real dist, spread, d, conditioning, n_mn;
+    const dyad_vec2 dm_dn = dyad_combine(m->l, m->i, -n->l, n->i);
+    const dyad_real dist = dyad_length(dm_dn);
+    const dyad_real spread = dist / (m->l + n->l);
+    dyad_conditioned c;
+    c.dist = dist;
+    c.d = c.dist > 0 ? dyad_dot(dm_dn, m->i) / c.dist : 0;
+    c.conditioning = dyad_abs(c.d) < spread ? dyad_abs(c.d) : spread;
+    return c;
+}
 
-    dm_dn = dyad_combine(m->l, m->i, -n->l, n->i);
-    dist = dyad_length(dm_dn);
-    spread = dist / (m->l + n->l);
-    d = dist > 0 ? dyad_dot(dm_dn, m->i) / dist : 0; /* i_beta . i_m */
-    conditioning = dyad_abs(d) < spread ? dyad_abs(d) : spread;
-    status = dyad_accept_conditioning(p->singular_threshold, d, conditioning, result);
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-
-    n_mn = -(dyad_load_moment_about_d(m) + dyad_load_moment_about_d(n)) / (dist * d);
+/* The reactions of a dyad whose conditioning is accepted; the sizes of their terms. */
+DYAD_CLOSED_FORM dyad_output_sizes rtr_closed_forms(const dyad_loaded* p, dyad_conditioned c,
+                                                    dyad_result* result)
+{
+    const dyad_body* m = &p->m;
+    const dyad_body* n = &p->n;
+    const dyad_real n_mn =
+        -(dyad_load_moment_about_d(m) + dyad_load_moment_about_d(n)) / (c.dist * c.d);
+    dyad_size_terms terms;
+    dyad_output_sizes sizes;
     result->n_mn = n_mn;
     result->r_mn = dyad_scale(n_mn, m->j);
     result->r_np = dyad_sub(result->r_mn, n->f);
     result->r_mk = dyad_neg(dyad_add(result->r_mn, m->f));
-    {
-        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(dist * d));
-        const dyad_output_sizes sizes = dyad_sizes_rtr(&terms);
-        /* M^R_mn from link m about D_m, or from link n about E: the form of
-         * the smaller size (dyad_amplification.h) keeps more digits. */
-        result->m_mn = sizes.first_form
-                           ? -m->l * n_mn - dyad_load_moment_about_d(m)
-                           : -n->l * dyad_cross(n->i, result->r_np) + dyad_load_moment_about_e(n);
-        return dyad_finish(DYAD_RTR, sizes, result);
-    }
+    terms = dyad_size_terms_of(p, 1 / dyad_abs(c.dist * c.d));
+    sizes = dyad_sizes_rtr(&terms);
+    /* M^R_mn from link m about D_m, or from link n about E: the form of the smaller
+     * size (dyad_amplification.h) keeps more digits. */
+    result->m_mn = sizes.first_form
+                       ? -m->l * n_mn - dyad_load_moment_about_d(m)
+                       : -n->l * dyad_cross(n->i, result->r_np) + dyad_load_moment_about_e(n);
+    return sizes;
+}
+
+#ifndef DYAD_REACT_FORMULAS /* dyad_lanes.h takes the closed forms alone */
+
+DYAD_CLOSED_FORM dyad_status rtr_reactions(const dyad_loaded* p, dyad_result* result)
+{
+    return dyad_reactions(DYAD_RTR, p, rtr_conditioning(p), rtr_closed_forms, result);
 }
 
 dyad_status dyad_react_rtr(const dyad_loaded* dyad, dyad_result* result)
@@ -112,3 +124,5 @@ dyad_status dyad_solve_rtr(const dyad_input* input, dyad_result* result)
     }
     return dyad_name_failure(DYAD_RTR, input, rtr_reactions(&p, result), result);
 }
+
+#endif /* DYAD_REACT_FORMULAS */

@@ -43,22 +43,25 @@
  */
 #include "dyad_internal.h"
 
-DYAD_CLOSED_FORM dyad_status rtt_reactions(const dyad_loaded* p, dyad_result* result)
+/* The denominator j_k . i_m, 0 where the slot is parallel to the guide; the conditioning |d|. */
+DYAD_CLOSED_FORM dyad_conditioned rtt_conditioning(const dyad_loaded* p)
+{
+    dyad_conditioned c;
+    c.d = dyad_dot(p->j_k, p->m.i);
+    c.conditioning = dyad_abs(c.d);
+    c.dist = 0;
+    return c;
+}
+
+/* The reactions of a dyad whose conditioning is accepted; the sizes of their terms. */
+DYAD_CLOSED_FORM dyad_output_sizes rtt_closed_forms(const dyad_loaded* p, dyad_conditioned c,
+                                                    dyad_result* result)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
-    dyad_status status;
-    dyad_real d;
-
-    d = dyad_dot(p->j_k, m->i);
-    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-
-    result->n_mk = -dyad_dot(m->f, m->i) / d;
-    result->n_mn = dyad_dot(m->f, p->i_k) / d;
-
+    dyad_size_terms terms;
+    result->n_mk = -dyad_dot(m->f, m->i) / c.d;
+    result->n_mn = dyad_dot(m->f, p->i_k) / c.d;
     result->r_mk = dyad_scale(result->n_mk, p->j_k);
     result->r_mn = dyad_scale(result->n_mn, m->j);
     /* Where one link outweighs the other, the sums over the light one keep
@@ -71,10 +74,15 @@ DYAD_CLOSED_FORM dyad_status rtt_reactions(const dyad_loaded* p, dyad_result* re
     result->m_mn = dyad_load_moment_about_d(n) - n->l * dyad_cross(n->i, result->r_mn);
     result->m_mk =
         -dyad_load_moment_about_d(m) - m->l * dyad_cross(m->i, result->r_mn) - result->m_mn;
-    {
-        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(d));
-        return dyad_finish(DYAD_RTT, dyad_sizes_rtt(&terms), result);
-    }
+    terms = dyad_size_terms_of(p, 1 / c.conditioning);
+    return dyad_sizes_rtt(&terms);
+}
+
+#ifndef DYAD_REACT_FORMULAS /* dyad_lanes.h takes the closed forms alone */
+
+DYAD_CLOSED_FORM dyad_status rtt_reactions(const dyad_loaded* p, dyad_result* result)
+{
+    return dyad_reactions(DYAD_RTT, p, rtt_conditioning(p), rtt_closed_forms, result);
 }
 
 dyad_status dyad_react_rtt(const dyad_loaded* dyad, dyad_result* result)
@@ -99,3 +107,5 @@ dyad_status dyad_solve_rtt(const dyad_input* input, dyad_result* result)
     }
     return dyad_name_failure(DYAD_RTT, input, rtt_reactions(&p, result), result);
 }
+
+#endif /* DYAD_REACT_FORMULAS */

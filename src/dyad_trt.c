@@ -28,24 +28,26 @@
  */
 #include "dyad_internal.h"
 
-DYAD_CLOSED_FORM dyad_status trt_reactions(const dyad_loaded* p, dyad_result* result)
+/* The denominator j_k . i_p, 0 where the guides are parallel; the conditioning |d|. */
+DYAD_CLOSED_FORM dyad_conditioned trt_conditioning(const dyad_loaded* p)
+{
+    dyad_conditioned c;
+    c.d = dyad_dot(p->j_k, p->i_p);
+    c.conditioning = dyad_abs(c.d);
+    c.dist = 0;
+    return c;
+}
+
+/* The reactions of a dyad whose conditioning is accepted; the sizes of their terms. */
+DYAD_CLOSED_FORM dyad_output_sizes trt_closed_forms(const dyad_loaded* p, dyad_conditioned c,
+                                                    dyad_result* result)
 {
     const dyad_body* m = &p->m;
     const dyad_body* n = &p->n;
-    dyad_status status;
-    dyad_real d;
-    dyad_vec2 f_sum;
-
-    d = dyad_dot(p->j_k, p->i_p);
-    status = dyad_accept_conditioning(p->singular_threshold, d, dyad_abs(d), result);
-    if (status != DYAD_STATUS_OK) {
-        return status;
-    }
-
-    f_sum = dyad_add(m->f, n->f);
-    result->n_mk = -dyad_dot(f_sum, p->i_p) / d;
-    result->n_np = dyad_dot(f_sum, p->i_k) / d;
-
+    const dyad_vec2 f_sum = dyad_add(m->f, n->f);
+    dyad_size_terms terms;
+    result->n_mk = -dyad_dot(f_sum, p->i_p) / c.d;
+    result->n_np = dyad_dot(f_sum, p->i_k) / c.d;
     result->r_mk = dyad_scale(result->n_mk, p->j_k);
     result->r_np = dyad_scale(result->n_np, p->j_p);
     result->r_mn = dyad_smaller_sum(
@@ -53,10 +55,15 @@ DYAD_CLOSED_FORM dyad_status trt_reactions(const dyad_loaded* p, dyad_result* re
         dyad_add(result->r_np, n->f), dyad_norm1(result->r_np) + dyad_norm1(n->f));
     result->m_mk = m->l * dyad_cross(m->i, result->r_mk) - dyad_load_moment_about_e(m);
     result->m_np = n->l * dyad_cross(n->i, result->r_np) - dyad_load_moment_about_e(n);
-    {
-        const dyad_size_terms terms = dyad_size_terms_of(p, 1 / dyad_abs(d));
-        return dyad_finish(DYAD_TRT, dyad_sizes_trt(&terms), result);
-    }
+    terms = dyad_size_terms_of(p, 1 / c.conditioning);
+    return dyad_sizes_trt(&terms);
+}
+
+#ifndef DYAD_REACT_FORMULAS /* dyad_lanes.h takes the closed forms alone */
+
+DYAD_CLOSED_FORM dyad_status trt_reactions(const dyad_loaded* p, dyad_result* result)
+{
+    return dyad_reactions(DYAD_TRT, p, trt_conditioning(p), trt_closed_forms, result);
 }
 
 dyad_status dyad_react_trt(const dyad_loaded* dyad, dyad_result* result)
@@ -81,3 +88,5 @@ dyad_status dyad_solve_trt(const dyad_input* input, dyad_result* result)
     }
     return dyad_name_failure(DYAD_TRT, input, trt_reactions(&p, result), result);
 }
+
+#endif /* DYAD_REACT_FORMULAS */

@@ -21,6 +21,12 @@
 #include "dyadfmu/kinematics.h"
 #include "dyadfmu/loaded.h"
 #include "dyadfmu/vec2.h"
+#define DYAD_LANES_RRR
+#define DYAD_LANES_RRT
+#define DYAD_LANES_RTR
+#define DYAD_LANES_TRT
+#define DYAD_LANES_RTT
+#include "dyad_lanes.h"
 #include "named_tests.h"
 
 #ifdef DYAD_REAL_FLOAT
@@ -2375,6 +2381,115 @@ static int test_kin_point_on_link(void)
     return fails;
 }
 
+/* ---- one sample of a batch (dyad_lanes.h) against its twin ----------------------------------- */
+
+/* Bit for bit: the motion reals and figures of two kinematic results. */
+static int same_kin_outputs(const dyad_kin_result* a, const dyad_kin_result* b)
+{
+    return memcmp(&a->m, &b->m, DYAD_KIN_MOTION_REALS * sizeof(dyad_real)) == 0 &&
+           memcmp(&a->conditioning, &b->conditioning, sizeof a->conditioning) == 0 &&
+           memcmp(&a->closure, &b->closure, sizeof a->closure) == 0 &&
+           memcmp(&a->amplification, &b->amplification, sizeof a->amplification) == 0;
+}
+
+/* Bit for bit: the reactions and figures of two results. */
+static int same_reactions(const dyad_result* a, const dyad_result* b)
+{
+    const dyad_real x[] = {a->r_mk.x, a->r_mk.y, a->r_np.x,      a->r_np.y,       a->r_mn.x,
+                           a->r_mn.y, a->n_mk,   a->n_np,        a->n_mn,         a->m_mk,
+                           a->m_np,   a->m_mn,   a->denominator, a->conditioning, a->amplification};
+    const dyad_real y[] = {b->r_mk.x, b->r_mk.y, b->r_np.x,      b->r_np.y,       b->r_mn.x,
+                           b->r_mn.y, b->n_mk,   b->n_np,        b->n_mn,         b->m_mk,
+                           b->m_np,   b->m_mn,   b->denominator, b->conditioning, b->amplification};
+    return memcmp(x, y, sizeof x) == 0;
+}
+
+/* A kinematic input spoiled one way in four: a mount moved out of reach, a threshold no
+ * conditioning passes, a length NaN; or left as built. */
+static dyad_kin_input spoiled_kin_input(rng* r, dyad_type type)
+{
+    kin_built b;
+    const kin_case c = random_kin_case(r, type);
+    dyad_kin_input in = kin_input_at(&c, uniform(r, -1, 1), &b);
+    switch ((int)uniform(r, 0, 8)) {
+    case 0: in.p.point.position = dyad_scale((dyad_real)40, in.p.point.position); break;
+    case 1: in.singular_threshold = (dyad_real)0.999; break;
+    case 2: in.length_n = (dyad_real)NAN; break;
+    default: break;
+    }
+    return in;
+}
+
+/* dyad_kin_lane_<type> and dyad_react_lane_<type> answer 0 exactly where their twins
+ * say ok, and then give their outputs bit for bit; over random dyads, a quarter of them
+ * spoiled (out of reach, singular, NaN, overflowing loads). */
+static int test_lanes_match_their_twins(void)
+{
+    static dyad_status (*const kin[DYAD_TYPE_COUNT])(const dyad_kin_input*, dyad_kin_result*) = {
+        dyad_kinematics_rrr, dyad_kinematics_rrt, dyad_kinematics_rtr, dyad_kinematics_trt,
+        dyad_kinematics_rtt};
+    static dyad_real (*const kin_lane[DYAD_TYPE_COUNT])(const dyad_kin_input*, dyad_kin_result*) = {
+        dyad_kin_lane_rrr, dyad_kin_lane_rrt, dyad_kin_lane_rtr, dyad_kin_lane_trt,
+        dyad_kin_lane_rtt};
+    static dyad_status (*const react[DYAD_TYPE_COUNT])(const dyad_loaded*, dyad_result*) = {
+        dyad_react_rrr, dyad_react_rrt, dyad_react_rtr, dyad_react_trt, dyad_react_rtt};
+    static dyad_real (*const react_lane[DYAD_TYPE_COUNT])(const dyad_loaded*, dyad_result*) = {
+        dyad_react_lane_rrr, dyad_react_lane_rrt, dyad_react_lane_rtr, dyad_react_lane_trt,
+        dyad_react_lane_rtt};
+    int fails = 0, t, k;
+    for (t = 0; t < DYAD_TYPE_COUNT; ++t) {
+        rng r = {0x1A4E5000u + (uint64_t)t};
+        int ok[2] = {0, 0}, refused[2] = {0, 0};
+        for (k = 0; k < 4000; ++k) {
+            const dyad_kin_input in = spoiled_kin_input(&r, all_types[t]);
+            dyad_kin_result want, got;
+            const dyad_status s = kin[t](&in, &want);
+            const dyad_real bad = kin_lane[t](&in, &got);
+            CHECK((bad == 0) == (s == DYAD_STATUS_OK), "%s kinematics %d: status %s, lane %g",
+                  dyad_type_name(all_types[t]), k, dyad_status_name(s), (double)bad);
+            CHECK(s != DYAD_STATUS_OK || same_kin_outputs(&want, &got),
+                  "%s kinematics %d: the lane's outputs differ", dyad_type_name(all_types[t]), k);
+            ++*(s == DYAD_STATUS_OK ? &ok[0] : &refused[0]);
+        }
+        for (k = 0; k < 4000; ++k) {
+            const dyad_input in = random_input(&r, all_types[t]);
+            dyad_loaded loaded = loaded_of(&in);
+            dyad_result want, got;
+            dyad_status s;
+            dyad_real bad;
+            switch ((int)uniform(&r, 0, 8)) {
+            case 0: loaded.singular_threshold = (dyad_real)0.999; break;
+            case 1: loaded.m.f.x = (dyad_real)NAN; break;
+            case 2:
+                loaded.n.m_d = HUGE_REAL * HUGE_REAL; /* inf */
+                break;
+            default: break;
+            }
+            s = react[t](&loaded, &want);
+            bad = react_lane[t](&loaded, &got);
+            CHECK((bad == 0) == (s == DYAD_STATUS_OK), "%s reactions %d: status %s, lane %g",
+                  dyad_type_name(all_types[t]), k, dyad_status_name(s), (double)bad);
+            CHECK(s != DYAD_STATUS_OK || (same_reactions(&want, &got) &&
+                                          dyad_force_size(&want) == dyad_lane_force_size(&got) &&
+                                          dyad_moment_size(&want) == dyad_lane_moment_size(&got)),
+                  "%s reactions %d: the lane's outputs differ", dyad_type_name(all_types[t]), k);
+            ++*(s == DYAD_STATUS_OK ? &ok[1] : &refused[1]);
+        }
+        /* both sides of every check were reached */
+        CHECK(ok[0] > 1000 && refused[0] > 500 && ok[1] > 1000 && refused[1] > 500,
+              "%s: kinematics %d ok, %d not; reactions %d ok, %d not", dyad_type_name(all_types[t]),
+              ok[0], refused[0], ok[1], refused[1]);
+    }
+    {
+        const dyad_kin_input a = dyad_kin_input_default(), b = dyad_lane_kin_input_default();
+        CHECK(a.length_m == b.length_m && a.length_n == b.length_n && a.branch == b.branch &&
+                  a.singular_threshold == b.singular_threshold && a.k.guide.x == b.k.guide.x &&
+                  a.turn_n.x == b.turn_n.x && a.mount_amplification == b.mount_amplification,
+              "the lane's default kinematic input differs");
+    }
+    return fails;
+}
+
 /* Names: every field and failure has its own, NONE and CLOSES none. */
 static int test_kin_names(void)
 {
@@ -2685,6 +2800,7 @@ static const named_test tests[] = {
     {"kin_invalid_pointers", test_kin_invalid_pointers},
     {"kin_point_on_link", test_kin_point_on_link},
     {"kin_names", test_kin_names},
+    {"lanes_match_their_twins", test_lanes_match_their_twins},
     {"cylinder_equilibrium", test_cylinder_equilibrium},
     {"cylinder_kinematics", test_cylinder_kinematics},
     {"cylinder_energy", test_cylinder_energy},

@@ -231,4 +231,5 @@ const fmu_behaviour fmu_drive_behaviour = {sizeof(fmu_drive_input),
                                            NULL,
                                            &drive_state_table,
                                            NULL,
+                                           NULL,
                                            NULL};

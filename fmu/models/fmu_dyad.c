@@ -139,4 +139,5 @@ const fmu_behaviour fmu_dyad_behaviour = {sizeof(dyad_input),
                                           derivative,
                                           NULL,
                                           NULL,
+                                          NULL,
                                           NULL};

@@ -254,4 +254,4 @@ static const fmu_interpolation motor_interpolation = {
 
 const fmu_behaviour fmu_motor_behaviour = {
     sizeof(fmu_motor_input), sizeof(fmu_motor_output), initialise, evaluate, start, advance, NULL,
-    &motor_state_table,      &motor_interpolation,     NULL};
+    &motor_state_table,      &motor_interpolation,     NULL,       NULL};

@@ -32,6 +32,7 @@ from dyadgen.catalogue import (
 from dyadgen.corefiles import dyad_core_sources, scene_core_sources
 from dyadgen.dyadtypes import PAIRS
 from dyadgen.emit import documentation, fmi2, fmi3
+from dyadgen.emit.batch_c import batch_supported
 from dyadgen.emit.c_table import model_c
 from dyadgen.emit.forward_c import forward_behaviour
 from dyadgen.emit.scene_c import later_members, scene_c, scene_header, scene_tangent_c
@@ -497,9 +498,11 @@ KINDS = {"dyad": DYAD, "drive": DRIVE, "motor": MOTOR}
 def scene_behaviour(table: Table) -> list[str]:
     """The C of a scene's fmu_behaviour, <identifier>_behaviour: its initialise, and its
     evaluate and derivative on the scene's functions; where some outputs can come later
-    (emit/scene_c.py, later_members), the halves of evaluate as its fmu_later."""
+    (emit/scene_c.py, later_members), the halves of evaluate as its fmu_later; where it
+    has a batch evaluation (emit/batch_c.py), that as its fmu_lanes."""
     ident = table.identifier
     later = later_members(table.scene)
+    lanes = batch_supported(table.scene)
     lines = [
         f"/* The scene's functions ({ident}_scene.c, {ident}_scene_tangent.c) as the FMU",
         " * layer calls them. */",
@@ -525,10 +528,12 @@ def scene_behaviour(table: Table) -> list[str]:
         "}",
         "",
         *(_later_behaviour(table, later) if later else []),
+        *(_lanes_behaviour(table, bool(later)) if lanes else []),
         f"static const fmu_behaviour {ident}_behaviour = {{sizeof({ident}_input),",
         f"                                                sizeof({ident}_output), initialise,",
         "                                                evaluate, NULL, NULL, derivative, NULL,",
-        f"                                                NULL, {'&later' if later else 'NULL'}}};",
+        f"                                                NULL, {'&later' if later else 'NULL'},",
+        f"                                                {'&many' if lanes else 'NULL'}}};",
         "",
     ]
     return lines
@@ -558,6 +563,31 @@ def _later_behaviour(table: Table, later: tuple[str, ...]) -> list[str]:
         ]
     halves = "evaluate_first, evaluate_later"
     return [*lines, f"static const fmu_later later = {{later_vrs, {len(vrs)}, {halves}}};", ""]
+
+
+def _lanes_behaviour(table: Table, first: bool) -> list[str]:
+    """The scene's batch evaluation (<identifier>_evaluate_lanes) as its fmu_lanes."""
+    ident, upper = table.identifier, table.identifier.upper()
+    lines = [
+        "/* Many samples at once, in columns: the loop over them vectorises. */",
+    ]
+    for half in ("", "_first") if first else ("",):
+        lines += [
+            f"static void lanes{half}(size_t count, double* lanes, const unsigned char* wanted)",
+            "{",
+            f"    {ident}_evaluate_lanes{half}(count, (dyad_real(*)[{upper}_LANES])(void*)lanes,",
+            f"    {' ' * len(ident)}                {' ' * len(half)}wanted);",
+            "}",
+            "",
+        ]
+    functions = "lanes, lanes_first" if first else "lanes, NULL"
+    return [
+        *lines,
+        f"static const fmu_lanes many = {{{upper}_LANES, {upper}_LANE_INPUTS, "
+        f"{upper}_LANE_OUTPUTS,",
+        f"                               {upper}_LANE_COLUMNS, {functions}}};",
+        "",
+    ]
 
 
 class SceneTable(Table):

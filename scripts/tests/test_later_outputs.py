@@ -9,6 +9,7 @@ checked against <id>_evaluate in C."""
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -148,6 +149,8 @@ def _sources(name: str, out: Path) -> Path:
         (folder / "scene" / f"{name}{suffix}").write_text(
             (out / "fmu" / f"{name}{suffix}").read_text()
         )
+    # the FMU's C also evaluates many samples at once, on the core's lanes
+    shutil.copy(paths.ROOT / "src" / "dyad_lanes.h", folder / "core" / "src")
     return folder
 
 
@@ -216,7 +219,8 @@ def test_the_halves_of_the_scene_s_c_give_what_evaluate_gives(name, tmp_path):
     subprocess.run(
         ["cc", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-O2",
          f"-I{folder / 'scene'}", f"-I{folder / 'core' / 'include'}",
-         "-o", str(tmp_path / "halves"), str(tmp_path / "main.c"), *map(str, sources), "-lm"],
+         f"-I{folder / 'core' / 'src'}", "-o", str(tmp_path / "halves"),
+         str(tmp_path / "main.c"), *map(str, sources), "-lm"],
         check=True,
     )  # fmt: skip
     done = subprocess.run([str(tmp_path / "halves")], capture_output=True, text=True)
@@ -271,7 +275,8 @@ def test_the_whole_evaluation_checks_the_outputs_the_second_half_gives(name, tmp
         main.write_text(CHECK_MAIN.replace("IDENT", name).replace("MEMBER", member))
         subprocess.run(
             ["cc", "-std=c99", "-O1", f"-I{folder / 'scene'}", f"-I{folder / 'core' / 'include'}",
-             "-o", str(tmp_path / "check"), str(main), *map(str, core), "-lm"],
+             f"-I{folder / 'core' / 'src'}", "-o", str(tmp_path / "check"), str(main),
+             *map(str, core), "-lm"],
             check=True,
         )  # fmt: skip
         done = subprocess.run([str(tmp_path / "check")], capture_output=True, text=True)

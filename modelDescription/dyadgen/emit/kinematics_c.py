@@ -159,10 +159,11 @@ def _turn(scene: Scene, d: Dyad, side: str) -> str | None:
     return None if turn is None or turn.is_zero() else _unit(turn)
 
 
-def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad) -> list[str]:
-    """The kinematics of one dyad: its inputs, the call, the early return."""
+def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad, lane: bool = False) -> list[str]:
+    """The kinematics of one dyad: its inputs, the call, the early return; in a batch's
+    `lane`, the call's twin of src/dyad_lanes.h, whose failed checks it counts."""
     out = [f"/* dyad {d.name or ''} ({d.type}) */"]
-    out.append("k = dyad_kin_input_default();")
+    out.append(f"k = {'dyad_lane_kin_input_default' if lane else 'dyad_kin_input_default'}();")
     out += mounts.lines(d.k, "k") + mounts.lines(d.p, "p")
     for side, g in (("m", d.m), ("n", d.n)):
         params = scene.links[g].params
@@ -185,6 +186,8 @@ def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad) -> list[str]:
     if carried is not None:
         out.append(f"k.mount_amplification = {carried};")
     result = f"&kin->{kin_name(d)}"
+    if lane:
+        return [*out, f"bad += dyad_kin_lane_{d.type.lower()}(&k, {result});"]
     out.append(f"if (dyad_kinematics_{d.type.lower()}(&k, {result}) != DYAD_STATUS_OK) {{")
     out.append(f"    *failed = {d.index};")
     out.append(f"    return {result};")
@@ -324,15 +327,40 @@ def _driver_lines(scene: Scene, mounts: _Mounts, driver: Crank) -> list[str]:
     ]
 
 
-def kinematics_body(scene: Scene, dyads: list[Dyad]) -> list[str]:
-    """The statements of the function `kinematics`."""
+def kinematics_body(scene: Scene, dyads: list[Dyad], lane: bool = False) -> list[str]:
+    """The statements of the function `kinematics` (with `lane`, of `kinematics_lane`,
+    which counts the failed checks of a batch's sample; a cylinder has no lane)."""
     mounts = _Mounts(scene)
     body = [line for driver in scene.drivers for line in _driver_lines(scene, mounts, driver)]
     body += ["dyad_kin_input k;"] if dyads else []
     for d in dyads:
-        body += _dyad_lines(scene, mounts, d)
-    body.append("return NULL;")
-    return body
+        body += _dyad_lines(scene, mounts, d, lane)
+    if not lane:
+        return [*body, "return NULL;"]
+    if cylinders(scene):
+        raise ValueError("a batch's lane has no cylinder")
+    body = [line.replace("dyad_point_on_link(", "dyad_lane_point_on_link(") for line in body]
+    return ["dyad_real bad = 0;", *body, "return bad;"]
+
+
+def kinematics_lane_function(scene: Scene, dyads: list[Dyad]) -> str:
+    """`kinematics_lane`: the chain's kinematics as `kinematics` solves them, without a
+    branch, for one sample of a batch (src/dyad_lanes.h); returns the count of failed
+    checks, 0 where `kinematics` returns NULL with the same results."""
+    rates = ", ".join(
+        f"dyad_real {rate}, dyad_real {accel}"
+        for rate, accel in (rate_names(scene, d) for d in scene.drivers)
+    )
+    head = "DYAD_CLOSED_FORM dyad_real kinematics_lane("
+    return "\n".join(
+        [
+            f"{head}const {scene.identifier}_input* in, {rates},",
+            f"{' ' * len(head)}{scene.identifier}_kinematics* kin)",
+            "{",
+            *(f"    {line}" for line in kinematics_body(scene, dyads, lane=True)),
+            "}",
+        ]
+    )
 
 
 def kinematics_type(scene: Scene) -> str:

@@ -24,7 +24,7 @@ from pathlib import Path
 from string import Template
 
 from dyadgen import textsafe
-from dyadgen.emit import kinematics_c, tangent_c
+from dyadgen.emit import batch_c, kinematics_c, tangent_c
 from dyadgen.model import Attachment, Crank, Dyad, Param, Scene, c_real, loaders, member
 from dyadgen.needs import effort_of, inertia_entry_member, kin_name_of_cylinder
 from dyadgen.table import Table
@@ -85,8 +85,11 @@ class Plan:
     the dyads loading those, and for the crank's outputs every dyad on the crank), the
     links whose resultants it forms, and the C names of their pairs' accelerations."""
 
-    def __init__(self, scene: Scene) -> None:
+    def __init__(self, scene: Scene, lane: bool = False) -> None:
         self.scene = scene
+        #: the code of one sample of a batch (src/dyad_lanes.h): no branch, no early
+        #: return; each check's failure counted in `bad`
+        self.lane = lane
         self.drivers = scene.drivers
         self.names = {i.name: i for i in scene.inputs}
         #: every driver's balance is wanted (one output of one of them asks for them all)
@@ -185,6 +188,10 @@ def _kinematics(plan: Plan, code: _Code) -> None:
         f"{rate}, {accel}"
         for rate, accel in (kinematics_c.driver_rates(scene, d) for d in scene.drivers)
     )
+    if plan.lane:
+        code(f"{scene.identifier}_kinematics kin;")
+        code(f"bad += kinematics_lane(in, {rates}, &kin);")
+        return
     code("/* The kinematics from the driver outwards; a dyad that cannot close (or is at a")
     code(" * dead centre) stops here with every output NaN. */")
     code(f"{scene.identifier}_kinematics kin;")
@@ -456,15 +463,20 @@ def _feedback(plan: Plan, code: _Code, d: Dyad, side: str, att: Attachment) -> N
         r = slide if r is None else f"dyad_add({r}, {slide})"
         reactive = f" - {dn}.m_{pair_force[2:]}"
     also = " and the reactive moment" if reactive else ""
+    force_size, moment_size = (
+        ("dyad_lane_force_size", "dyad_lane_moment_size")
+        if plan.lane
+        else ("dyad_force_size", "dyad_moment_size")
+    )
     code(f"    /* on {att.link}: -{pair_force.upper()} at the pair{also} */")
     code(f"    {carrier}_f = dyad_sub({carrier}_f, {dn}.{pair_force});")
-    code(f"    {carrier}_f_size += dyad_force_size(&{dn});")
+    code(f"    {carrier}_f_size += {force_size}(&{dn});")
     if r is None:
         return
-    moment_size = f" + dyad_moment_size(&{dn})" if reactive else ""
+    moment = f" + {moment_size}(&{dn})" if reactive else ""
     code(f"    {{ const dyad_real moment = -dyad_cross({r}, {dn}.{pair_force}){reactive};")
     code(f"      {carrier}_m_d += moment;")
-    code(f"      {carrier}_m_d_size += dyad_norm1({r}) * dyad_force_size(&{dn}){moment_size};")
+    code(f"      {carrier}_m_d_size += dyad_norm1({r}) * {force_size}(&{dn}){moment};")
     if plan.has_com(att.link):
         code(f"      {carrier}_m += moment + dyad_cross({carrier}_r, {dn}.{pair_force}); }}")
     else:
@@ -528,13 +540,16 @@ def _chain(plan: Plan, code: _Code) -> None:
         code(f"{{ /* dyad {d.name or ''} ({d.type}) */")
         _load(plan, code, d)
         code(f"    load.singular_threshold = {threshold};")
-        code(f"    if (dyad_react_{d.type.lower()}(&load, &{dn}) != DYAD_STATUS_OK) {{")
-        code(
-            f"        fail(out, &{dn}, {textsafe.c_string(d.name or d.type)}, "
-            f"{threshold}, evaluation);"
-        )
-        code("        return;")
-        code("    }")
+        if plan.lane:
+            code(f"    bad += dyad_react_lane_{d.type.lower()}(&load, &{dn});")
+        else:
+            code(f"    if (dyad_react_{d.type.lower()}(&load, &{dn}) != DYAD_STATUS_OK) {{")
+            code(
+                f"        fail(out, &{dn}, {textsafe.c_string(d.name or d.type)}, "
+                f"{threshold}, evaluation);"
+            )
+            code("        return;")
+            code("    }")
         _feedback(plan, code, d, "k", d.k)
         _feedback(plan, code, d, "p", d.p)
         code("}")
@@ -592,6 +607,8 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
     on it included) and the barrel's and the rod's own, balanced by the axial force and
     the pins' reactions (dyadfmu/cylinder.h)."""
     scene = plan.scene
+    if plan.lane:
+        raise ValueError("a batch's lane has no cylinder")
     c, link = member(driver.actuator), member(driver.name)
     rate, accel = kinematics_c.driver_rates(scene, driver)
     code()
@@ -705,6 +722,9 @@ def _driver_inertia(plan: Plan, code: _Code) -> None:
 def _unit_kinematics(plan: Plan, code: _Code, target: str, rates: str) -> None:
     """The kinematics at the rates `rates` (C arguments) and zero accelerations."""
     scene = plan.scene
+    if plan.lane:
+        code(f"bad += kinematics_lane(in, {rates}, &{target});")
+        return
     code("{")
     code("    int failed = 0;")
     code(f"    const dyad_kin_result* bad = kinematics(in, {rates}, &{target}, &failed);")
@@ -821,17 +841,48 @@ def _output_exprs(scene: Scene) -> dict[str, str]:
 
 
 def _outputs(plan: Plan, code: _Code, later: tuple[str, ...] = ()) -> None:
-    """Every output written, those given later (see :func:`later_members`) NaN."""
+    """Every output written, those given later (see :func:`later_members`) NaN. In a
+    batch's lane, an angle's direction goes to `turn` (its atan2 would keep the loop
+    from vectorising: :func:`lane_angles`) and the outputs' finiteness is counted."""
     code()
     code("/* Outputs */")
     exprs = _output_exprs(plan.scene)
     if plan.scene.internal():
         exprs[MECHANISM_AMPLIFICATION] = mechanism_amplification(plan)
+    turns = lane_angles(plan.scene, later) if plan.lane else {}
+    for k, (y, x) in enumerate(turns.values()):
+        code(f"turn[{k}] = dyad_vec2_make({x}, {y});")
     for o in plan.scene.outputs:
-        if not o.integer:
+        if not o.integer and o.member not in turns:
             code(f"out->{o.member} = {'NAN' if o.member in later else exprs[o.member]};")
+    if plan.lane:
+        written = [
+            o.member
+            for o in plan.scene.outputs
+            if not o.integer and o.member not in later and o.member not in turns
+        ]
+        residues = [f"(out->{m} - out->{m})" for m in written]
+        residues += [f"dyad_kin_residue(turn[{k}])" for k in range(len(turns))]
+        code(f"return bad + DYAD_FAILED({' + '.join(residues) or '0.0'} == 0);")
+        return
     code("out->status = 0;")
     code("check_first(out, evaluation);" if later else "check(out, evaluation);")
+
+
+def lane_angles(scene: Scene, later: tuple[str, ...] = ()) -> dict[str, tuple[str, str]]:
+    """The angle outputs a batch's lane leaves to after its loop: member -> the C of the
+    (y, x) of its direction, whose atan2 the scalar evaluation writes."""
+    exprs = _output_exprs(scene)
+    found = {}
+    for o in scene.outputs:
+        expr = exprs.get(o.member, "")
+        if o.integer or o.member in later or not expr.startswith("dyad_atan2("):
+            continue
+        arguments = expr[len("dyad_atan2(") : -1].split(", ")
+        if len(arguments) != 2 or not expr.endswith(")"):
+            raise ValueError(f"an angle's expression the batch cannot split: {expr}")
+        found[o.member] = (arguments[0], arguments[1])
+    return found
 
 
 def _inertia_members(plan: Plan) -> tuple[set[str], list[str]]:
@@ -1037,11 +1088,12 @@ def _checks(ident: str, reals: list[str], later: list[str]) -> str:
 
 
 def _evaluation(
-    scene: Scene, later: tuple[str, ...] = ()
+    scene: Scene, later: tuple[str, ...] = (), lane: bool = False
 ) -> tuple[Plan, list[str], list[str], list[str]]:
     """(plan, dyad declarations, crank declarations, body) of the scene's evaluate; with
-    outputs given later (:func:`later_members`), of <identifier>_evaluate_first."""
-    plan = Plan(scene)
+    outputs given later (:func:`later_members`), of <identifier>_evaluate_first; with
+    `lane`, of one sample of its batch (see :class:`Plan`)."""
+    plan = Plan(scene, lane)
     code = _Code()
     for write in PASSES:
         if not later:
@@ -1085,10 +1137,33 @@ def _function(ident: str, name: str, body: list[str]) -> list[str]:
     ]
 
 
-def _functions(scene: Scene, later: tuple[str, ...]) -> tuple[Plan, str]:
+def _batch_code(scene: Scene, later: tuple[str, ...]) -> str:
+    """The scene's batch evaluation (emit/batch_c.py): its kinematics and its evaluation
+    (with outputs ``later``, also its first half) as one sample of a loop, and
+    <identifier>_evaluate_lanes (and _evaluate_lanes_first) over many."""
+    ident = scene.identifier
+    lines = [
+        "/* ---- many samples at once: the evaluation as one sample of a loop that vectorises",
+        " * (src/dyad_lanes.h) ---------------------------------------------------------- */",
+        "",
+        *batch_c.layout_check(scene),
+        "",
+        kinematics_c.kinematics_lane_function(scene, Plan(scene).kinematic),
+    ]
+    for suffix, half in (("", ()), ("_first", later)) if later else (("", ()),):
+        _, dyad_decls, crank_decls, body = _evaluation(scene, half, lane=True)
+        lane = f"lane_evaluate{suffix}"
+        angles = list(lane_angles(scene, half))
+        lines += ["", *batch_c.lane_function(ident, lane, dyad_decls + crank_decls, body)]
+        lines += ["", *batch_c.many_function(scene, f"evaluate_lanes{suffix}", lane, angles)]
+    return "\n".join(lines) + "\n"
+
+
+def _functions(scene: Scene, later: tuple[str, ...], batch: bool) -> tuple[Plan, str]:
     """<identifier>_evaluate; with outputs ``later`` (:func:`later_members`), its two halves
     too, <identifier>_evaluate_first and <identifier>_evaluate_later (the same terms, so
-    the same values bit for bit), for a caller that reads those only now and then."""
+    the same values bit for bit), for a caller that reads those only now and then; with
+    `batch`, its batch evaluation (:func:`_batch_code`)."""
     plan, dyad_decls, crank_decls, body = _evaluation(scene)
     ident = scene.identifier
     lines = _function(ident, "evaluate", [*dyad_decls, *crank_decls, "    (void)in;", *body])
@@ -1097,18 +1172,22 @@ def _functions(scene: Scene, later: tuple[str, ...]) -> tuple[Plan, str]:
         first = [*dyad_decls, *crank_decls, "    (void)in;", *body]
         lines += ["", *_function(ident, "evaluate_first", first), ""]
         lines += _function(ident, "evaluate_later", _later_body(plan, later))
-    return plan, "\n".join(lines) + "\n"
+    text = "\n".join(lines) + "\n"
+    return plan, text + ("\n" + _batch_code(scene, later) if batch else "")
 
 
 def scene_c(scene: Scene, halves: bool = True) -> str:
     """<identifier>_scene.c: the computation of the scene (of its current outputs),
     <identifier>_evaluate; with ``halves``, where some of its outputs can come after the
-    others (:func:`later_members`), <identifier>_evaluate_first and _later too (an FMU's;
-    a bundle for a controller leaves them out)."""
+    others (:func:`later_members`), <identifier>_evaluate_first and _later too, and where
+    the scene has one, its batch evaluation (an FMU's; a bundle for a controller leaves
+    them out)."""
     later = later_members(scene) if halves else ()
-    plan, functions = _functions(scene, later)
+    batch = halves and batch_c.batch_supported(scene)
+    plan, functions = _functions(scene, later, batch)
     return _template().substitute(
         _file_fields(plan),
+        batch_include=batch_c.batch_include(scene) if batch else "",
         description=textsafe.c_comment(scene.description),
         inertia="on" if scene.inertia else "off",
         gravity="on" if scene.gravity else "off",
@@ -1152,6 +1231,7 @@ def scene_header(table: Table, halves: bool = True) -> str:
         f"#ifndef {guard}",
         f"#define {guard}",
         "",
+        *(["#include <stddef.h>", ""] if halves and batch_c.batch_supported(scene) else []),
         '#include "dyadfmu/evaluation.h"',
         '#include "dyadfmu/vec2.h"',
         "",
@@ -1176,6 +1256,9 @@ def scene_header(table: Table, halves: bool = True) -> str:
     lines += [f"}} {ident}_output;", "", *_prototypes(ident)]
     if halves and later_members(scene):
         lines += ["", *_later_prototypes(ident, later_members(scene))]
+    if halves and batch_c.batch_supported(scene):
+        angles = len(lane_angles(scene))
+        lines += ["", *batch_c.prototypes(scene, bool(later_members(scene)), angles)]
     lines += ["", f"#endif /* {guard} */"]
     return "\n".join(lines) + "\n"
 

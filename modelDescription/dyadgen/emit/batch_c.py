@@ -1,0 +1,202 @@
+"""A scene's batch evaluation, <identifier>_evaluate_many (an FMU's: a controller's
+bundle leaves it out, as it does the halves of evaluate).
+
+Many samples in columns: the scene's evaluation written once more as one sample of a
+loop that the compiler vectorises (src/dyad_lanes.h): the same
+terms (emit/scene_c.py writes them with its Plan's `lane`), the core's calls replaced by
+their twins that count their failed checks instead of returning early, so that a sample
+none of whose checks failed has exactly the outputs evaluate gives it. A sample with a
+failed check is flagged, and its caller asks evaluate for its status and reason. An
+angle's atan2, a call, is taken after the loop from the direction the loop leaves.
+
+For now a mechanism whose drivers are cranks or rams: a cylinder has no lane yet.
+"""
+
+from __future__ import annotations
+
+from dyadgen.emit import kinematics_c
+from dyadgen.model import Scene
+
+#: samples per pass of the vector loop: the directions of their angles wait on the stack
+CHUNK = 32
+
+
+def batch_supported(scene: Scene) -> bool:
+    """Whether the scene has a batch evaluation: a mechanism without states or
+    cylinders."""
+    return scene.internal() and not scene.forward() and not kinematics_c.cylinders(scene)
+
+
+def batch_include(scene: Scene) -> str:
+    """The lanes of the scene's dyad types (src/dyad_lanes.h), for the top of its C."""
+    types = sorted({d.type for d in scene.dyads})
+    return "".join(f"#define DYAD_LANES_{t}\n" for t in types) + '#include "dyad_lanes.h"\n'
+
+
+def lane_function(ident: str, name: str, declarations: list[str], body: list[str]) -> list[str]:
+    """One sample's evaluation: the count of its failed checks, its outputs in `out`
+    but for its angles, whose directions it leaves in `turn`."""
+    head = f"DYAD_CLOSED_FORM dyad_real {name}("
+    return [
+        f"{head}const {ident}_input* in, {ident}_output* out,",
+        f"{' ' * len(head)}dyad_vec2* turn)",
+        "{",
+        "    dyad_real bad = 0;",
+        *declarations,
+        "    (void)in;",
+        "    (void)turn;",
+        *body,
+        "}",
+    ]
+
+
+def block_reals(scene: Scene) -> tuple[list[tuple[str, bool]], list[str]]:
+    """The members of the input block (with whether each is an angle's unit vector, two
+    reals) and the real members of the output block: the lanes' columns, where each
+    real's column is its place in its block."""
+    inputs = [(i.member, i.angle) for i in scene.inputs]
+    inputs += [(p.member, False) for p in scene.parameters() if p.tunable]
+    return inputs, [o.member for o in scene.outputs if not o.integer]
+
+
+def many_function(scene: Scene, name: str, lane: str, angles: list[str]) -> list[str]:
+    """<identifier>_<name>: the lane over the samples of the lanes' columns, then the
+    angles of `angles` (output members, in the order of the lane's `turn`)."""
+    ident, upper = scene.identifier, scene.identifier.upper()
+    inputs, outputs = block_reals(scene)
+
+    def place(block: str, m: str) -> str:
+        return f"offsetof({ident}_{block}, {m}) / sizeof(dyad_real)"
+
+    out = f"{upper}_LANE_INPUTS + "
+    bad = f"{upper}_LANE_INPUTS + {upper}_LANE_OUTPUTS"
+    head = f"DYAD_CLOSED_FORM void {name}_in("
+    lines = [
+        f"{head}size_t count, dyad_real (*restrict lanes)[{upper}_LANES],",
+        f"{' ' * len(head)}const unsigned char* wanted)",
+        "{",
+        "    size_t i;",
+        "    for (i = 0; i < count; ++i) {",
+        f"        {ident}_input in;",
+        f"        {ident}_output out;",
+        f"        dyad_vec2 turn[{max(len(angles), 1)}];",
+    ]
+    for m, angle in inputs:
+        if angle:
+            lines.append(f"        in.{m}.x = lanes[{place('input', m)}][i];")
+            lines.append(f"        in.{m}.y = lanes[{place('input', m)} + 1][i];")
+        else:
+            lines.append(f"        in.{m} = lanes[{place('input', m)}][i];")
+    lines.append(f"        lanes[{bad}][i] = {lane}(&in, &out, turn);")
+    for m in outputs:
+        if m in angles:  # its direction, for the loop below: x in its column, y after bad's
+            k = angles.index(m)
+            lines.append(f"        lanes[{out}{place('output', m)}][i] = turn[{k}].x;")
+            lines.append(f"        lanes[{bad} + {1 + k}][i] = turn[{k}].y;")
+        else:
+            lines.append(f"        lanes[{out}{place('output', m)}][i] = out.{m};")
+    lines.append("    }")
+    for k, m in enumerate(angles):
+        column = f"lanes[{out}{place('output', m)}]"
+        lines += [
+            f"    if (wanted == NULL || wanted[{place('output', m)}]) {{",
+            "        for (i = 0; i < count; ++i) {",
+            f"            {column}[i] = dyad_atan2(lanes[{bad} + {1 + k}][i], {column}[i]);",
+            "        }",
+            "    }",
+        ]
+    if not angles:
+        lines.append("    (void)wanted;")
+    return [*lines, "}", "", *_dispatch(scene, name)]
+
+
+def _dispatch(scene: Scene, name: str) -> list[str]:
+    """<identifier>_<name>_baseline and, where the compiler can target AVX2 and ask the
+    CPU for it (src/dyad_lanes.h), <identifier>_<name>_avx2, both <name>_in, and
+    <identifier>_<name>, which takes the second where the CPU has AVX2."""
+    ident, upper = scene.identifier, scene.identifier.upper()
+
+    def function(variant: str, body: list[str], prefix: str = "") -> list[str]:
+        head = f"{prefix}void {ident}_{name}{variant}("
+        return [
+            f"{head}size_t count, dyad_real (*restrict lanes)[{upper}_LANES],",
+            f"{' ' * len(head)}const unsigned char* wanted)",
+            "{",
+            *body,
+            "}",
+        ]
+
+    call = f"{name}_in(count, lanes, wanted);"
+    return [
+        *function("_baseline", [f"    {call}"]),
+        "",
+        "#if DYAD_LANES_AVX2",
+        *function("_avx2", [f"    {call}"], "DYAD_LANES_AVX2_TARGET "),
+        "#endif",
+        "",
+        *function(
+            "",
+            [
+                "#if DYAD_LANES_AVX2",
+                "    if (dyad_lanes_have_avx2()) {",
+                f"        {ident}_{name}_avx2(count, lanes, wanted);",
+                "        return;",
+                "    }",
+                "#endif",
+                f"    {ident}_{name}_baseline(count, lanes, wanted);",
+            ],
+        ),
+    ]
+
+
+def layout_check(scene: Scene) -> list[str]:
+    """That the blocks are reals alone, the output's status last: each real has a column."""
+    ident, upper = scene.identifier, scene.identifier.upper()
+    real = "sizeof(dyad_real)"
+    return [
+        "/* the lanes' columns are the blocks' reals: the blocks hold nothing else, but for",
+        " * the output's status, last */",
+        f"typedef char {ident}_lanes_are_the_blocks",
+        f"    [sizeof({ident}_input) == {upper}_LANE_INPUTS * {real} &&",
+        f"             offsetof({ident}_output, status) == {upper}_LANE_OUTPUTS * {real}",
+        "         ? 1",
+        "         : -1];",
+    ]
+
+
+def prototypes(scene: Scene, first: bool, angles: int) -> list[str]:
+    """The header's declarations of <identifier>_evaluate_lanes (and, with `first`, of
+    <identifier>_evaluate_lanes_first), with the numbers of their columns; `angles`: the
+    angle outputs, whose directions take a column more each while a call runs."""
+    ident = scene.identifier
+    inputs, outputs = block_reals(scene)
+    reals = sum(2 if angle else 1 for _, angle in inputs)
+    upper = ident.upper()
+    names = ["evaluate_lanes", *(["evaluate_lanes_first"] if first else [])]
+    lines = [
+        f"/* {ident}_evaluate at `count` samples (at most {upper}_LANES), in columns:",
+        " * lanes[j][i] is real j of sample i. The input block's reals come first, in its order",
+        " * (an angle as the .x and .y of its unit vector), then the output block's (not its",
+        f" * status), then the count of sample i's failed checks; {upper}_LANE_COLUMNS columns",
+        " * in all, the last ones scratch. Where that count is 0, sample i's outputs are what",
+        f" * {ident}_evaluate gives, bit for bit (status 0); elsewhere they mean nothing, and",
+        f" * {ident}_evaluate says why. Every check is made without a branch, so that the loop",
+        " * over samples vectorises. `wanted`, NULL or a flag per output in its block's order:",
+        " * an output not wanted may be left out (an angle's atan2). _first: as",
+        f" * {ident}_evaluate_first. _baseline: compiled for the platform's baseline; _avx2",
+        " * (x86-64 with GCC or Clang only): for a CPU with AVX2 (no fused multiply-add: the",
+        " * same results bit for bit); without either suffix, the second where the CPU has",
+        " * AVX2. */",
+        f"#define {upper}_LANES {CHUNK}",
+        f"#define {upper}_LANE_INPUTS {reals}",
+        f"#define {upper}_LANE_OUTPUTS {len(outputs)}",
+        f"#define {upper}_LANE_COLUMNS {reals + len(outputs) + 1 + angles}",
+    ]
+    for name in names:
+        for variant in ("", "_baseline", "_avx2"):
+            head = f"void {ident}_{name}{variant}("
+            lines += [
+                f"{head}size_t count, dyad_real (*lanes)[{upper}_LANES],",
+                f"{' ' * len(head)}const unsigned char* wanted);",
+            ]
+    return lines

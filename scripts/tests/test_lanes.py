@@ -1,0 +1,266 @@
+"""A scene's batch evaluation in lanes (<id>_evaluate_lanes: emit/batch_c.py on
+src/dyad_lanes.h), compiled as the FMU compiles its scene C.
+
+For every built-in scene that has one, over random samples of its inputs with failing
+ones mixed in (an input NaN, an input far out of range; the toggles scene's dead centres
+and lost assemblies), a sample's count of failed checks is 0 exactly where the scalar
+<id>_evaluate says status 0, and there its outputs are evaluate's bit for bit: in the
+baseline build and in the AVX2 one (where the CPU has AVX2), both called by name, and
+through the dispatching <id>_evaluate_lanes; also _first against <id>_evaluate_first.
+GCC reports the loop over samples vectorised in both builds. The FMU's columns entry
+runs the lanes (scripts/tests/test_columns_entry.py holds it to the rows entry).
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from dyadfmu import paths
+from dyadgen import pipeline
+from dyadgen.corefiles import scene_core_sources
+from dyadgen.emit.batch_c import batch_supported, block_reals
+from dyadgen.locations import SCENES_DIR, TEST_SCENES_DIR
+from tool_checks import required_tool
+
+ROOT = paths.ROOT
+SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
+#: the flags fmu/CMakeLists.txt gives a scene's C, with the warnings of every build
+FLAGS = [
+    "-std=c99", "-O3", "-fno-trapping-math", "-fno-math-errno",
+    "--param=large-function-growth=10000", "--param=inline-unit-growth=1000",
+    "-Wall", "-Wextra", "-Wpedantic", "-Werror",
+]  # fmt: skip
+SAMPLES = 600
+SCENES = sorted(
+    path
+    for path in [*SCENES_DIR.glob("*.toml"), *TEST_SCENES_DIR.glob("*.toml")]
+    if batch_supported(pipeline.load_scene(path, check_c_names=False))
+)
+
+
+def _table(path: Path):
+    return pipeline.build_table(pipeline.load_scene(path, check_c_names=False))
+
+
+DRIVER = r"""#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "@ID_scene.h"
+
+typedef void (*lanes_fn)(size_t, dyad_real (*)[@UP_LANES], const unsigned char*);
+typedef void (*scalar_fn)(const @ID_input*, @ID_output*, fmu_evaluation*);
+
+/* Every sample of `in` through the lanes of `lanes`, @UP_LANES at a time: per sample its
+ * count of failed checks and its outputs, after the scalar evaluation's status and
+ * outputs. */
+static void run(const double* in, size_t count, lanes_fn lanes, scalar_fn scalar, FILE* out)
+{
+    static dyad_real grid[@UP_LANE_COLUMNS][@UP_LANES];
+    size_t first, i, j;
+    for (first = 0; first < count; first += @UP_LANES) {
+        const size_t n = count - first < @UP_LANES ? count - first : @UP_LANES;
+        for (i = 0; i < n; ++i) {
+            for (j = 0; j < @UP_LANE_INPUTS; ++j) {
+                grid[j][i] = in[(first + i) * @UP_LANE_INPUTS + j];
+            }
+        }
+        lanes(n, grid, NULL);
+        for (i = 0; i < n; ++i) {
+            @ID_input block;
+            @ID_output result;
+            fmu_evaluation evaluation;
+            memcpy(&block, &in[(first + i) * @UP_LANE_INPUTS], sizeof block);
+            scalar(&block, &result, &evaluation);
+            fprintf(out, "%d", result.status);
+            for (j = 0; j < @UP_LANE_OUTPUTS; ++j) {
+                fprintf(out, " %a", ((const dyad_real*)(const void*)&result)[j]);
+            }
+            fprintf(out, " | %a", grid[@UP_LANE_INPUTS + @UP_LANE_OUTPUTS][i]);
+            for (j = 0; j < @UP_LANE_OUTPUTS; ++j) {
+                fprintf(out, " %a", grid[@UP_LANE_INPUTS + j][i]);
+            }
+            fprintf(out, "\n");
+        }
+    }
+}
+
+int main(int argc, char** argv)
+{
+    static double in[@SAMPLES * @UP_LANE_INPUTS];
+    FILE* file = fopen(argv[1], "rb");
+    const char* how = argc > 2 ? argv[2] : "";
+    scalar_fn scalar = @ID_evaluate;
+    lanes_fn lanes = @ID_evaluate_lanes;
+    if (file == NULL || fread(in, sizeof in, 1, file) != 1) {
+        return 2;
+    }
+    fclose(file);
+    if (strstr(how, "first") != NULL) {
+        @FIRST
+    }
+    if (strstr(how, "baseline") != NULL) {
+        lanes = strstr(how, "first") != NULL ? @FIRST_BASELINE : @ID_evaluate_lanes_baseline;
+    }
+#if defined(__x86_64__)
+    if (strstr(how, "avx2") != NULL) {
+        if (!__builtin_cpu_supports("avx2")) {
+            return 3;
+        }
+        lanes = strstr(how, "first") != NULL ? @FIRST_AVX2 : @ID_evaluate_lanes_avx2;
+    }
+#endif
+    run(in, @SAMPLES, lanes, scalar, stdout);
+    return 0;
+}
+"""
+
+
+def _driver(ident: str, has_first: bool) -> str:
+    """The test program of scene `ident`; `has_first`: whether it has halves."""
+    text = DRIVER.replace("@UP_", f"{ident.upper()}_").replace("@SAMPLES", str(SAMPLES))
+    if has_first:
+        text = text.replace("@FIRST_BASELINE", "@ID_evaluate_lanes_first_baseline")
+        text = text.replace("@FIRST_AVX2", "@ID_evaluate_lanes_first_avx2")
+        text = text.replace(
+            "@FIRST", "scalar = @ID_evaluate_first; lanes = @ID_evaluate_lanes_first;"
+        )
+    else:
+        text = text.replace("@FIRST_BASELINE", "@ID_evaluate_lanes_baseline")
+        text = text.replace("@FIRST_AVX2", "@ID_evaluate_lanes_avx2")
+        text = text.replace("@FIRST", "return 4;")
+    return text.replace("@ID_", f"{ident}_")
+
+
+def _inputs(table, rng: np.random.Generator) -> np.ndarray:
+    """SAMPLES input blocks: angles turned at random, other inputs scattered about their
+    starts by their units' sizes; one sample in twenty with an input NaN, one with an
+    input of 1e300."""
+    members, _ = block_reals(table.scene)
+    start = {v.lives.path: float(v.start) for v in table.variables if v.start is not None}
+    unit = {v.lives.path: v.unit for v in table.variables}
+    scale = {"m": 0.02, "rad/s": 20.0, "rad/s2": 200.0, "m/s": 0.5, "m/s2": 20.0, "N": 300.0}
+    columns = []
+    for member, angle in members:
+        if angle:
+            turn = rng.uniform(-np.pi, np.pi, SAMPLES)
+            columns += [np.cos(turn), np.sin(turn)]
+        else:
+            size = scale.get(unit.get(member) or "", 10.0)
+            columns.append(start.get(member, 0.0) + size * rng.standard_normal(SAMPLES))
+    block = np.column_stack(columns)
+    for k in range(SAMPLES):
+        if k % 20 == 7:
+            block[k, rng.integers(block.shape[1])] = np.nan
+        elif k % 20 == 13:
+            block[k, rng.integers(block.shape[1])] = 1e300
+    return block
+
+
+@pytest.fixture(scope="module")
+def programs(tmp_path_factory):
+    """Per scene: its lanes' test program, compiled from the scene's FMU C and the core
+    files it calls."""
+    required_tool("cc")
+    made: dict[str, Path] = {}
+
+    def make(path: Path) -> tuple[Path, object]:
+        table = _table(path)
+        if path.name not in made:
+            work = tmp_path_factory.mktemp(table.identifier)
+            done = subprocess.run(
+                [sys.executable, str(SCENE_TOOL), str(path), "--out", str(work / "gen")],
+                capture_output=True,
+                text=True,
+            )
+            assert done.returncode == 0, done.stderr
+            gen = work / "gen"
+            ident = table.identifier
+            scene_c = (gen / f"{ident}_scene.c").read_text()
+            has_first = f"{ident}_evaluate_lanes_first(" in scene_c
+            (work / "main.c").write_text(_driver(ident, has_first))
+            core = [ROOT / "src" / f for f in scene_core_sources(table.scene, derivatives=False)]
+            includes = [f"-I{d}" for d in (gen, ROOT / "src", ROOT / "src" / "include")]
+            report = subprocess.run(
+                ["cc", *FLAGS, *includes, "-c", str(gen / f"{ident}_scene.c"),
+                 "-o", str(work / "scene.o"), "-fopt-info-vec-optimized"],
+                capture_output=True, text=True,
+            )  # fmt: skip
+            assert report.returncode == 0, report.stderr
+            (work / "vectorised.txt").write_text(report.stderr)
+            link = subprocess.run(
+                ["cc", *FLAGS, *includes, str(work / "main.c"), str(work / "scene.o"),
+                 *map(str, core), "-lm", "-o", str(work / "lanes")],
+                capture_output=True, text=True,
+            )  # fmt: skip
+            assert link.returncode == 0, link.stderr
+            rng = np.random.default_rng(sum(map(ord, ident)))
+            _inputs(table, rng).astype("<f8").tofile(work / "inputs.bin")
+            made[path.name] = work
+        return made[path.name], table
+
+    return make
+
+
+def _rows(text: str) -> list[tuple[int, list[str], float, list[str]]]:
+    rows = []
+    for line in text.splitlines():
+        scalar, lanes = line.split(" | ")
+        status, *outputs = scalar.split()
+        failed, *found = lanes.split()
+        rows.append((int(status), outputs, float.fromhex(failed), found))
+    return rows
+
+
+@pytest.mark.parametrize("how", ["", "baseline", "avx2", "first", "first baseline", "first avx2"])
+@pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
+def test_a_sample_the_lanes_pass_is_what_evaluate_gives(path, how, programs):
+    work, table = programs(path)
+    done = subprocess.run(
+        [str(work / "lanes"), str(work / "inputs.bin"), how], capture_output=True, text=True
+    )
+    if done.returncode == 3:
+        pytest.skip("this CPU has no AVX2")
+    if done.returncode == 4:
+        pytest.skip(f"{table.identifier} has no later outputs: no _first")
+    assert done.returncode == 0, done.stderr
+    rows = _rows(done.stdout)
+    assert len(rows) == SAMPLES
+    passed = 0
+    for k, (status, outputs, failed, found) in enumerate(rows):
+        assert (failed == 0) == (status == 0), (k, status, failed)
+        if status == 0:
+            assert outputs == found, (
+                k,
+                [i for i, (a, b) in enumerate(zip(outputs, found, strict=True)) if a != b],
+            )
+            passed += 1
+    # both sides reached: most samples pass, and some of the spoiled ones do not
+    assert SAMPLES // 2 < passed <= SAMPLES - SAMPLES // 40, passed
+
+
+@pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
+def test_the_loop_over_samples_vectorises(path, programs):
+    """GCC's report: the lane that gives the efforts and the reactions (_first, where the
+    scene has halves, else the whole evaluation) vectorised; the whole evaluation too,
+    but for the lift's, whose effective-inertia pass on its ram does not yet."""
+    work, table = programs(path)
+    scene_c = (work / "gen" / f"{table.identifier}_scene.c").read_text().splitlines()
+    loops = [  # each lane's loop, the whole's first: a sample's input block is its first line
+        n + 1
+        for n, line in enumerate(scene_c[:-1])
+        if line == "    for (i = 0; i < count; ++i) {"
+        and scene_c[n + 1].endswith(f"{table.identifier}_input in;")
+    ]
+    report = (work / "vectorised.txt").read_text()
+    vectorised = {
+        int(m) for m in re.findall(r"_scene\.c:(\d+):\d+: optimized: loop vectorized", report)
+    }
+    assert loops and loops[-1] in vectorised, (loops, sorted(vectorised))
+    if not table.identifier.startswith("lift"):
+        assert set(loops) <= vectorised, (loops, sorted(vectorised))

@@ -1,0 +1,152 @@
+/* dyadfmu: one sample of a batch, for a loop over samples that the compiler vectorises.
+ * Not part of the public API; a generated scene's batch evaluation includes it.
+ *
+ * A vector loop cannot branch per sample, and cannot call: each function here is the
+ * computation of its public twin (dyad_kinematics_<type>, dyad_react_<type>,
+ * dyad_point_on_link, dyad_force_size, ...) with every check made and counted instead
+ * of acted on, inlined from the same source (the kinematics' formulas of
+ * dyad_kin_<type>.c, the reactions' closed forms of dyad_<type>.c). Where a function
+ * returns 0, its twin says DYAD_STATUS_OK and its outputs are its twin's, bit for bit;
+ * elsewhere its outputs mean nothing, and the caller asks the twin what went wrong. A
+ * result's status, field, failure and gap are not written.
+ *
+ * Vectorising needs the compiler to speculate the arithmetic of both sides of a
+ * selection (GCC: -O3 -fno-trapping-math -fno-math-errno, which change no result).
+ */
+#ifndef DYADFMU_LANES_H
+#define DYADFMU_LANES_H
+
+#include "dyad_internal.h"
+#include "dyad_kin_internal.h"
+#include "dyad_kin_generic.h"
+
+/* The lanes of the types its includer defines DYAD_LANES_<TYPE> for (a scene's, whose
+ * files it ships); each type's formulas come from its files. */
+#define DYAD_KIN_FORMULAS
+#define DYAD_REACT_FORMULAS
+#ifdef DYAD_LANES_RRR
+#include "dyad_kin_rrr.c"
+#include "dyad_rrr.c"
+#endif
+#ifdef DYAD_LANES_RRT
+#include "dyad_kin_rrt.c"
+#include "dyad_rrt.c"
+#endif
+#ifdef DYAD_LANES_RTR
+#include "dyad_kin_rtr.c"
+#include "dyad_rtr.c"
+#endif
+#ifdef DYAD_LANES_TRT
+#include "dyad_kin_trt.c"
+#include "dyad_trt.c"
+#endif
+#ifdef DYAD_LANES_RTT
+#include "dyad_kin_rtt.c"
+#include "dyad_rtt.c"
+#endif
+#undef DYAD_KIN_FORMULAS
+#undef DYAD_REACT_FORMULAS
+
+/* The lanes for a CPU with AVX2 beside those for the baseline, chosen as the program runs:
+ * where the compiler can target AVX2 in one function and ask the CPU (GCC or Clang on
+ * x86-64). AVX2 alone, no fused multiply-add: the same operations, the same results. */
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#define DYAD_LANES_AVX2        1
+#define DYAD_LANES_AVX2_TARGET __attribute__((target("avx2")))
+static inline int dyad_lanes_have_avx2(void)
+{
+    return __builtin_cpu_supports("avx2");
+}
+#else
+#define DYAD_LANES_AVX2 0
+#endif
+
+/* dyad_kin_input_default. */
+static inline dyad_kin_input dyad_lane_kin_input_default(void)
+{
+    const dyad_kin_input defaults = DYAD_KIN_INPUT_DEFAULTS;
+    return defaults;
+}
+
+/* dyad_point_on_link. */
+#define dyad_lane_point_on_link dyad_kin_point_on_link
+
+/* The kinematics of one dyad of each type (dyad_kinematics_<type>). */
+#define DYAD_KIN_LANE(type, name)                                                             \
+    DYAD_CLOSED_FORM dyad_real dyad_kin_lane_##name(const dyad_kin_input* input,              \
+                                                    dyad_kin_result* value)                   \
+    {                                                                                         \
+        return dyad_kin_lane(type, name##_position_plain, name##_motion_plain, input, value); \
+    }
+#ifdef DYAD_LANES_RRR
+DYAD_KIN_LANE(DYAD_RRR, rrr)
+#endif
+#ifdef DYAD_LANES_RRT
+DYAD_KIN_LANE(DYAD_RRT, rrt)
+#endif
+#ifdef DYAD_LANES_RTR
+DYAD_KIN_LANE(DYAD_RTR, rtr)
+#endif
+#ifdef DYAD_LANES_TRT
+DYAD_KIN_LANE(DYAD_TRT, trt)
+#endif
+#ifdef DYAD_LANES_RTT
+DYAD_KIN_LANE(DYAD_RTT, rtt)
+#endif
+#undef DYAD_KIN_LANE
+
+/* The reactions of one loaded dyad (dyad_react_<type>): the conditioning stored, the
+ * closed forms and the amplification whatever the conditioning; 0 where it is accepted
+ * and every reaction is finite. */
+DYAD_CLOSED_FORM dyad_real dyad_react_lane(dyad_type type, const dyad_loaded* p, dyad_conditioned c,
+                                           dyad_closed_forms_fn closed_forms, dyad_result* result)
+{
+    dyad_output_sizes sizes;
+    dyad_real bad;
+    dyad_fill_outputs(result, 0);
+    dyad_store_conditioning(c, result);
+    bad = DYAD_FAILED(c.conditioning >= p->singular_threshold);
+    sizes = closed_forms(p, c, result);
+    bad += DYAD_FAILED(dyad_outputs_residue(result) == 0);
+    result->amplification = dyad_result_amplification(type, sizes, result);
+    return bad;
+}
+
+#define DYAD_REACT_LANE(type, name)                                                              \
+    DYAD_CLOSED_FORM dyad_real dyad_react_lane_##name(const dyad_loaded* p, dyad_result* result) \
+    {                                                                                            \
+        return dyad_react_lane(type, p, name##_conditioning(p), name##_closed_forms, result);    \
+    }
+#ifdef DYAD_LANES_RRR
+DYAD_REACT_LANE(DYAD_RRR, rrr)
+#endif
+#ifdef DYAD_LANES_RRT
+DYAD_REACT_LANE(DYAD_RRT, rrt)
+#endif
+#ifdef DYAD_LANES_RTR
+DYAD_REACT_LANE(DYAD_RTR, rtr)
+#endif
+#ifdef DYAD_LANES_TRT
+DYAD_REACT_LANE(DYAD_TRT, trt)
+#endif
+#ifdef DYAD_LANES_RTT
+DYAD_REACT_LANE(DYAD_RTT, rtt)
+#endif
+#undef DYAD_REACT_LANE
+
+/* The largest of three sizes times the amplification: dyad_force_size and
+ * dyad_moment_size of a result that is ok. */
+static inline dyad_real dyad_lane_force_size(const dyad_result* result)
+{
+    return result->amplification * dyad_largest_of3(dyad_norm1(result->r_mk),
+                                                    dyad_norm1(result->r_np),
+                                                    dyad_norm1(result->r_mn));
+}
+
+static inline dyad_real dyad_lane_moment_size(const dyad_result* result)
+{
+    return result->amplification *
+           dyad_largest_of3(dyad_abs(result->m_mk), dyad_abs(result->m_np), dyad_abs(result->m_mn));
+}
+
+#endif /* DYADFMU_LANES_H */
