@@ -2070,6 +2070,7 @@ static void evaluate_samples(const fmu_model* model, column_blocks* b, const col
  * outputs wanted; which samples were stored. */
 typedef struct lane_grid {
     const fmu_lanes* lanes;
+    int baseline;          /* the baseline's lanes whatever the CPU has (DYADFMU_LANES=baseline) */
     double* cells;         /* columns x lanes */
     double** to;           /* n_x */
     const double** from;   /* n_y */
@@ -2139,7 +2140,11 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
     for (lane = 0; lane < count; ++lane) {
         g->stored[lane] = store_values(c, place, g->to, lanes->lanes, first + lane, lane);
     }
-    (halves ? lanes->first : lanes->whole)(count, g->cells, g->wanted);
+    if (g->baseline) {
+        (halves ? lanes->first_baseline : lanes->whole_baseline)(count, g->cells, g->wanted);
+    } else {
+        (halves ? lanes->first : lanes->whole)(count, g->cells, g->wanted);
+    }
     for (lane = 0; lane < count; ++lane) {
         const size_t i = first + lane;
         const int alone = g->stored[lane] && failed[lane] != 0;
@@ -2164,7 +2169,9 @@ static int evaluate_samples_in_lanes(const fmu_model* model, column_blocks* b, c
     lane_grid g;
     size_t first, j, lane;
     int ready;
+    const char* which = getenv("DYADFMU_LANES");
     g.lanes = model->behaviour->lanes;
+    g.baseline = which != NULL && strcmp(which, "baseline") == 0;
     g.cells = (double*)malloc(g.lanes->columns * g.lanes->lanes * sizeof(double));
     g.to = (double**)malloc((c->n_x + 1) * sizeof *g.to);
     g.from = (const double**)malloc((c->n_y + 1) * sizeof *g.from);

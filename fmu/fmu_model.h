@@ -158,6 +158,10 @@ typedef struct fmu_lanes {
     void (*whole)(size_t count, double* lanes, const unsigned char* wanted);
     /* as later->first; NULL where the model has no fmu_later */
     void (*first)(size_t count, double* lanes, const unsigned char* wanted);
+    /* the same compiled for the platform's baseline alone, whatever the CPU has (to
+     * measure the lanes both ways: DYADFMU_LANES=baseline, fmu/README.md) */
+    void (*whole_baseline)(size_t count, double* lanes, const unsigned char* wanted);
+    void (*first_baseline)(size_t count, double* lanes, const unsigned char* wanted);
 } fmu_lanes;
 
 /* What a kind of model computes, on its own input and output blocks. */

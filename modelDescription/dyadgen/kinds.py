@@ -572,20 +572,27 @@ def _lanes_behaviour(table: Table, first: bool) -> list[str]:
         "/* Many samples at once, in columns: the loop over them vectorises. */",
     ]
     for half in ("", "_first") if first else ("",):
-        lines += [
-            f"static void lanes{half}(size_t count, double* lanes, const unsigned char* wanted)",
-            "{",
-            f"    {ident}_evaluate_lanes{half}(count, (dyad_real(*)[{upper}_LANES])(void*)lanes,",
-            f"    {' ' * len(ident)}                {' ' * len(half)}wanted);",
-            "}",
-            "",
-        ]
-    functions = "lanes, lanes_first" if first else "lanes, NULL"
+        for variant in ("", "_baseline"):
+            name = f"lanes{half}{variant}"
+            lines += [
+                f"static void {name}(size_t count, double* lanes, const unsigned char* wanted)",
+                "{",
+                f"    {ident}_evaluate_lanes{half}{variant}(",
+                f"        count, (dyad_real(*)[{upper}_LANES])(void*)lanes, wanted);",
+                "}",
+                "",
+            ]
+    functions = (
+        "lanes, lanes_first, lanes_baseline, lanes_first_baseline"
+        if first
+        else "lanes, NULL, lanes_baseline, NULL"
+    )
     return [
         *lines,
         f"static const fmu_lanes many = {{{upper}_LANES, {upper}_LANE_INPUTS, "
         f"{upper}_LANE_OUTPUTS,",
-        f"                               {upper}_LANE_COLUMNS, {functions}}};",
+        f"                               {upper}_LANE_COLUMNS,",
+        f"                               {functions}}};",
         "",
     ]
 

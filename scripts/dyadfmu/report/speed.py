@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 from ..study.speed import (
+    BASELINE_FLOOR_TARGET,
     FLOPS_TARGET,
     NUMPY_RATIO_TARGET,
     ROWS_PER_SECOND_TARGET,
@@ -103,6 +104,7 @@ BATCH_HEADER = (
     "samples",
     "flops per sample: efforts and reactions / every output (their time at the RRR solve's rate)",
     "efforts and reactions, CPU per sample (to that time)",
+    "the same in the baseline CPU's lanes (to that time)",
     "every output, CPU per sample (to that time)",
     "efforts and reactions through the rows entry, CPU per sample",
     "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
@@ -131,12 +133,14 @@ def _batch_rows(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
             numpy = s.samples.get((count, "numpy"), math.nan)
             some = s.samples[count, False]
             yardstick = "-" if math.isnan(numpy) else f"{_ns(numpy)} ({numpy / some:.1f}x)"
-            times = [_to_floor(some, floor[False]), _to_floor(s.samples[count, True], floor[True])]
+            baseline = s.samples.get((count, "baseline"), math.nan)
+            times = [_to_floor(some, floor[False]), _to_floor(baseline, floor[False])]
+            times.append(_to_floor(s.samples[count, True], floor[True]))
             times += [_ns(s.samples.get((count, "rows"), math.nan)), yardstick]
             rows.append([s.scene, f"{count:,}", work, *times])
     if not rows:
         return []
-    return ["", *markup.table(BATCH_HEADER, rows, "-rrrrrr")]
+    return ["", *markup.table(BATCH_HEADER, rows, "-rrrrrrr")]
 
 
 def _partial(two: object, three: object) -> str:
@@ -167,6 +171,33 @@ def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         f"{ROWS_PER_SECOND_TARGET / 1e6:g} M, "
         f"{_mark(rate >= ROWS_PER_SECOND_TARGET)}.",
         *_numpy_ratio_target(scenes),
+        *_floor_targets(types, scenes),
+    ]
+
+
+def _floor_targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
+    """The target lines of a whole mechanism's batch (efforts and reactions) against the
+    time of the flops a scalar evaluation executes for them, at the largest batch timed:
+    the baseline CPU's lanes within BASELINE_FLOOR_TARGET, this CPU's (AVX2 where it has
+    it) under 1; the worst mechanism of each."""
+    rrr = next((t for t in types if t.dyad == "RRR"), None)
+    timed = [s for s in scenes if s.flops.get(False) and any(k == "baseline" for _, k in s.samples)]
+    if rrr is None or not timed:
+        return []
+    rate = rrr.solve_flops / rrr.numpy_seconds_per_row[True]
+    worst = {"baseline": (0.0, ""), False: (0.0, "")}
+    for s in timed:
+        count = max(c for c, k in s.samples if k == "baseline")
+        for kind in worst:
+            ratio = s.samples[count, kind] / (s.flops[False] / rate)
+            worst[kind] = max(worst[kind], (ratio, f"{s.scene}, {count:,} samples"))
+    base, this = worst["baseline"], worst[False]
+    return [
+        f"- A whole mechanism's batch (the efforts and reactions) against the time of the "
+        f"flops a scalar evaluation executes for them: in the baseline CPU's lanes within "
+        f"{BASELINE_FLOOR_TARGET:g}x, worst {base[0]:.2f}x ({base[1]}), "
+        f"{_mark(base[0] <= BASELINE_FLOOR_TARGET)}; in this CPU's (AVX2 where it has it) "
+        f"under 1x, worst {this[0]:.2f}x ({this[1]}), {_mark(this[0] < 1)}."
     ]
 
 

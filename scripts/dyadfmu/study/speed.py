@@ -9,6 +9,7 @@ its model's evaluation. Instruction counts are callgrind's; times are the best o
 from __future__ import annotations
 
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -34,6 +35,9 @@ FLOPS_TARGET = 2.0
 ROWS_PER_SECOND_TARGET = 10e6
 #: A whole mechanism from NumPy (dyadfmu.evaluate) against the stacked NumPy solve.
 NUMPY_RATIO_TARGET = 20.0
+#: ... and against the time of the flops a scalar evaluation executes for the job (at the
+#: RRR solve's rate): the lanes of the baseline CPU within this, those of AVX2 under 1.
+BASELINE_FLOOR_TARGET = 1.5
 #: Rows per timed call of dyadfmu.solve: inputs and outputs (about 4 MB) fit the caches,
 #: so that the solve is timed and not the memory bus (as the study times the core).
 NUMPY_ROWS = 10_000
@@ -132,10 +136,19 @@ def numpy_yardstick_seconds(scene: str, count: int, rounds: int) -> float:
     return best / count
 
 
-def batch_seconds(scene: str, count: int, every: bool, rounds: int) -> float:
+def batch_seconds(
+    scene: str, count: int, every: bool, rounds: int, baseline: bool = False
+) -> float:
     """CPU seconds per sample of ``dyadfmu.evaluate`` on ``scene`` over ``count`` samples
     of its inputs swinging about their start values (step_rows), asking every Real output
-    or the efforts and reactions alone: the best of ``rounds`` calls."""
+    or the efforts and reactions alone: the best of ``rounds`` calls. ``baseline``: in the
+    lanes compiled for the baseline CPU, whatever this one has (DYADFMU_LANES)."""
+    if baseline:
+        os.environ["DYADFMU_LANES"] = "baseline"
+        try:
+            return batch_seconds(scene, count, every, rounds)
+        finally:
+            del os.environ["DYADFMU_LANES"]
     from ..mechanism_batch import evaluate
 
     md = read_model_description(str(paths.built_fmu(scene, 2)))
@@ -419,6 +432,9 @@ def measure(
                 rounds = 2 if count >= 1_000_000 else 5
                 for every in (False, True):
                     scenes[-1].samples[count, every] = batch_seconds(scene, count, every, rounds)
+                scenes[-1].samples[count, "baseline"] = batch_seconds(
+                    scene, count, False, rounds, baseline=True
+                )
                 scenes[-1].samples[count, "rows"] = rows_seconds(scene, count, rounds)
                 if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
                     scenes[-1].samples[count, "numpy"] = numpy_yardstick_seconds(
