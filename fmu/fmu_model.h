@@ -142,7 +142,7 @@ typedef struct fmu_later {
 } fmu_later;
 
 /* An algebraic model's evaluation at many samples at once, in columns (a scene's
- * <identifier>_evaluate_lanes): lanes[j * lanes + i] is real j of sample i: the input
+ * <identifier>_lanes): lanes[j * lanes + i] is real j of sample i: the input
  * block's reals in its order (an angle as the x and y of its unit vector), then the
  * output block's before its status, then the count of the sample's failed checks, then
  * scratch; `columns` in all. Where the count is 0 the sample's outputs are what

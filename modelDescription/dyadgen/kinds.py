@@ -566,7 +566,7 @@ def _later_behaviour(table: Table, later: tuple[str, ...]) -> list[str]:
 
 
 def _lanes_behaviour(table: Table, first: bool) -> list[str]:
-    """The scene's batch evaluation (<identifier>_evaluate_lanes) as its fmu_lanes."""
+    """The scene's batch evaluation (<identifier>_lanes) as its fmu_lanes."""
     ident, upper = table.identifier, table.identifier.upper()
     lines = [
         "/* Many samples at once, in columns: the loop over them vectorises. */",
@@ -577,7 +577,7 @@ def _lanes_behaviour(table: Table, first: bool) -> list[str]:
             lines += [
                 f"static void {name}(size_t count, double* lanes, const unsigned char* wanted)",
                 "{",
-                f"    {ident}_evaluate_lanes{half}{variant}(",
+                f"    {ident}_lanes{half}{variant}(",
                 f"        count, (dyad_real(*)[{upper}_LANES])(void*)lanes, wanted);",
                 "}",
                 "",

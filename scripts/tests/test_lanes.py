@@ -1,4 +1,4 @@
-"""A scene's batch evaluation in lanes (<id>_evaluate_lanes: emit/batch_c.py on
+"""A scene's batch evaluation in lanes (<id>_lanes: emit/batch_c.py on
 src/dyad_lanes.h), compiled as the FMU compiles its scene C.
 
 For every built-in scene that has one, over random samples of its inputs with failing
@@ -6,7 +6,7 @@ ones mixed in (an input NaN, an input far out of range; the toggles scene's dead
 and lost assemblies), a sample's count of failed checks is 0 exactly where the scalar
 <id>_evaluate says status 0, and there its outputs are evaluate's bit for bit: in the
 baseline build and in the AVX2 one (where the CPU has AVX2), both called by name, and
-through the dispatching <id>_evaluate_lanes; also _first against <id>_evaluate_first.
+through the dispatching <id>_lanes; also _first against <id>_evaluate_first.
 GCC reports the loop over samples vectorised in both builds. The FMU's columns entry
 runs the lanes (scripts/tests/test_columns_entry.py holds it to the rows entry).
 """
@@ -96,7 +96,7 @@ int main(int argc, char** argv)
     FILE* file = fopen(argv[1], "rb");
     const char* how = argc > 2 ? argv[2] : "";
     scalar_fn scalar = @ID_evaluate;
-    lanes_fn lanes = @ID_evaluate_lanes;
+    lanes_fn lanes = @ID_lanes;
     if (file == NULL || fread(in, sizeof in, 1, file) != 1) {
         return 2;
     }
@@ -105,14 +105,14 @@ int main(int argc, char** argv)
         @FIRST
     }
     if (strstr(how, "baseline") != NULL) {
-        lanes = strstr(how, "first") != NULL ? @FIRST_BASELINE : @ID_evaluate_lanes_baseline;
+        lanes = strstr(how, "first") != NULL ? @FIRST_BASELINE : @ID_lanes_baseline;
     }
 #if defined(__x86_64__)
     if (strstr(how, "avx2") != NULL) {
         if (!__builtin_cpu_supports("avx2")) {
             return 3;
         }
-        lanes = strstr(how, "first") != NULL ? @FIRST_AVX2 : @ID_evaluate_lanes_avx2;
+        lanes = strstr(how, "first") != NULL ? @FIRST_AVX2 : @ID_lanes_avx2;
     }
 #endif
     run(in, @SAMPLES, lanes, scalar, stdout);
@@ -125,14 +125,12 @@ def _driver(ident: str, has_first: bool) -> str:
     """The test program of scene `ident`; `has_first`: whether it has halves."""
     text = DRIVER.replace("@UP_", f"{ident.upper()}_").replace("@SAMPLES", str(SAMPLES))
     if has_first:
-        text = text.replace("@FIRST_BASELINE", "@ID_evaluate_lanes_first_baseline")
-        text = text.replace("@FIRST_AVX2", "@ID_evaluate_lanes_first_avx2")
-        text = text.replace(
-            "@FIRST", "scalar = @ID_evaluate_first; lanes = @ID_evaluate_lanes_first;"
-        )
+        text = text.replace("@FIRST_BASELINE", "@ID_lanes_first_baseline")
+        text = text.replace("@FIRST_AVX2", "@ID_lanes_first_avx2")
+        text = text.replace("@FIRST", "scalar = @ID_evaluate_first; lanes = @ID_lanes_first;")
     else:
-        text = text.replace("@FIRST_BASELINE", "@ID_evaluate_lanes_baseline")
-        text = text.replace("@FIRST_AVX2", "@ID_evaluate_lanes_avx2")
+        text = text.replace("@FIRST_BASELINE", "@ID_lanes_baseline")
+        text = text.replace("@FIRST_AVX2", "@ID_lanes_avx2")
         text = text.replace("@FIRST", "return 4;")
     return text.replace("@ID_", f"{ident}_")
 
@@ -182,7 +180,7 @@ def programs(tmp_path_factory):
             gen = work / "gen"
             ident = table.identifier
             scene_c = (gen / f"{ident}_scene.c").read_text()
-            has_first = f"{ident}_evaluate_lanes_first(" in scene_c
+            has_first = f"{ident}_lanes_first(" in scene_c
             (work / "main.c").write_text(_driver(ident, has_first))
             core = [ROOT / "src" / f for f in scene_core_sources(table.scene, derivatives=False)]
             includes = [f"-I{d}" for d in (gen, ROOT / "src", ROOT / "src" / "include")]

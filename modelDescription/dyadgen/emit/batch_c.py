@@ -165,14 +165,14 @@ def layout_check(scene: Scene) -> list[str]:
 
 
 def prototypes(scene: Scene, first: bool, angles: int) -> list[str]:
-    """The header's declarations of <identifier>_evaluate_lanes (and, with `first`, of
-    <identifier>_evaluate_lanes_first), with the numbers of their columns; `angles`: the
+    """The header's declarations of <identifier>_lanes (and, with `first`, of
+    <identifier>_lanes_first), with the numbers of their columns; `angles`: the
     angle outputs, whose directions take a column more each while a call runs."""
     ident = scene.identifier
     inputs, outputs = block_reals(scene)
     reals = sum(2 if angle else 1 for _, angle in inputs)
     upper = ident.upper()
-    names = ["evaluate_lanes", *(["evaluate_lanes_first"] if first else [])]
+    names = ["lanes", *(["lanes_first"] if first else [])]
     lines = [
         f"/* {ident}_evaluate at `count` samples (at most {upper}_LANES), in columns:",
         " * lanes[j][i] is real j of sample i. The input block's reals come first, in its order",

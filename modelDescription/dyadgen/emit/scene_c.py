@@ -1140,7 +1140,7 @@ def _function(ident: str, name: str, body: list[str]) -> list[str]:
 def _batch_code(scene: Scene, later: tuple[str, ...]) -> str:
     """The scene's batch evaluation (emit/batch_c.py): its kinematics and its evaluation
     (with outputs ``later``, also its first half) as one sample of a loop, and
-    <identifier>_evaluate_lanes (and _evaluate_lanes_first) over many."""
+    <identifier>_lanes (and _lanes_first) over many."""
     ident = scene.identifier
     lines = [
         "/* ---- many samples at once: the evaluation as one sample of a loop that vectorises",
@@ -1155,7 +1155,7 @@ def _batch_code(scene: Scene, later: tuple[str, ...]) -> str:
         lane = f"lane_evaluate{suffix}"
         angles = list(lane_angles(scene, half))
         lines += ["", *batch_c.lane_function(ident, lane, dyad_decls + crank_decls, body)]
-        lines += ["", *batch_c.many_function(scene, f"evaluate_lanes{suffix}", lane, angles)]
+        lines += ["", *batch_c.many_function(scene, f"lanes{suffix}", lane, angles)]
     return "\n".join(lines) + "\n"
 
 
