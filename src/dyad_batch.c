@@ -1,321 +1,282 @@
 /* dyadfmu: the solvers over columns of rows (see dyadfmu/batch.h).
  *
- * Rows go through the scalar solver in blocks: a block of dyad_inputs is filled
- * column by column (a column given once for every row is written into the block
- * once, before the first row), solved row by row, and its results are written out
- * column by column. The gather and scatter loops run over one column's rows, so
- * each is a short strided copy. How each column of a whole block is copied is
- * decided once per call, with loops of their own for the layouts NumPy gives
- * dyadfmu.solve: a field's rows contiguous, or x and y of an (N, 2) array, which
- * fill adjacent members and so move together. */
+ * Rows go through a block of DYAD_BATCH_BLOCK at a time, held as columns: each input
+ * column's rows are copied into the block's column (a column given once for every row,
+ * or left out, is written once, before the first block), then one loop over the rows
+ * solves each by its type's lane (dyad_lanes.h: dyad_solve_<type> without a branch, its
+ * checks counted), which the compiler vectorises across rows. A row whose lane counts a
+ * failed check is solved again alone by dyad_solve_<type>, whose status, field and NaN
+ * outputs it then gets; every other row is ok, with the lane's outputs, which are that
+ * solver's bit for bit. The outputs go out column by column.
+ *
+ * On x86-64 with GCC or Clang the loop is compiled twice, for the baseline and for AVX2
+ * (no fused multiply-add: the same results), and each call takes the one the CPU runs. */
 #include "dyadfmu/batch.h"
 
 #include "dyadfmu/dyad.h"
 
+#define DYAD_LANES_RRR
+#define DYAD_LANES_RRT
+#define DYAD_LANES_RTR
+#define DYAD_LANES_TRT
+#define DYAD_LANES_RTT
+#include "dyad_lanes.h"
+
 #include <stddef.h>
 #include <string.h>
 
-#define LINK_OFFSETS(g)                                                                           \
-    offsetof(dyad_input, g.dir.x), offsetof(dyad_input, g.dir.y), offsetof(dyad_input, g.length), \
-        offsetof(dyad_input, g.omega), offsetof(dyad_input, g.epsilon),                           \
-        offsetof(dyad_input, g.accel_d.x), offsetof(dyad_input, g.accel_d.y),                     \
-        offsetof(dyad_input, g.com.x), offsetof(dyad_input, g.com.y),                             \
-        offsetof(dyad_input, g.mass), offsetof(dyad_input, g.inertia),                            \
-        offsetof(dyad_input, g.force.x), offsetof(dyad_input, g.force.y),                         \
-        offsetof(dyad_input, g.moment)
+/* The scalars of a dyad_input in the order of dyad_input_column, and of a dyad_result
+ * in that of dyad_output_column: X(member) for each. */
+/* clang-format off */
+#define BATCH_LINK_MEMBERS(X, g)                                                   \
+    X(g.dir.x) X(g.dir.y) X(g.length) X(g.omega) X(g.epsilon)                      \
+    X(g.accel_d.x) X(g.accel_d.y) X(g.com.x) X(g.com.y) X(g.mass) X(g.inertia)     \
+    X(g.force.x) X(g.force.y) X(g.moment)
+#define BATCH_INPUT_MEMBERS(X)                                                     \
+    BATCH_LINK_MEMBERS(X, m)                                                       \
+    BATCH_LINK_MEMBERS(X, n)                                                       \
+    X(guide_k.x) X(guide_k.y) X(guide_p.x) X(guide_p.y) X(gravity.x) X(gravity.y)  \
+    X(singular_threshold)
+#define BATCH_OUTPUT_MEMBERS(X)                                                    \
+    X(r_mk.x) X(r_mk.y) X(r_np.x) X(r_np.y) X(r_mn.x) X(r_mn.y)                    \
+    X(n_mk) X(n_np) X(n_mn) X(m_mk) X(m_np) X(m_mn)                                \
+    X(denominator) X(conditioning) X(amplification)
+/* clang-format on */
 
-/* Where each column lives in a dyad_input. */
-static const size_t input_offset[DYAD_INPUT_COLUMN_COUNT] = {
-    LINK_OFFSETS(m),
-    LINK_OFFSETS(n),
-    offsetof(dyad_input, guide_k.x),
-    offsetof(dyad_input, guide_k.y),
-    offsetof(dyad_input, guide_p.x),
-    offsetof(dyad_input, guide_p.y),
-    offsetof(dyad_input, gravity.x),
-    offsetof(dyad_input, gravity.y),
-    offsetof(dyad_input, singular_threshold)};
+#define BATCH_ONE(member) +1
+typedef char batch_input_members_are_its_columns
+    [(0 BATCH_INPUT_MEMBERS(BATCH_ONE)) == DYAD_INPUT_COLUMN_COUNT ? 1 : -1];
+typedef char batch_output_members_are_its_columns
+    [(0 BATCH_OUTPUT_MEMBERS(BATCH_ONE)) == DYAD_OUTPUT_COLUMN_COUNT ? 1 : -1];
+#undef BATCH_ONE
 
-/* Where each column lives in a dyad_result. */
-static const size_t output_offset[DYAD_OUTPUT_COLUMN_COUNT] = {
-    offsetof(dyad_result, r_mk.x),       offsetof(dyad_result, r_mk.y),
-    offsetof(dyad_result, r_np.x),       offsetof(dyad_result, r_np.y),
-    offsetof(dyad_result, r_mn.x),       offsetof(dyad_result, r_mn.y),
-    offsetof(dyad_result, n_mk),         offsetof(dyad_result, n_np),
-    offsetof(dyad_result, n_mn),         offsetof(dyad_result, m_mk),
-    offsetof(dyad_result, m_np),         offsetof(dyad_result, m_mn),
-    offsetof(dyad_result, denominator),  offsetof(dyad_result, conditioning),
-    offsetof(dyad_result, amplification)};
+/* A block of rows, column by column. */
+typedef struct batch_block {
+    dyad_real in[DYAD_INPUT_COLUMN_COUNT][DYAD_BATCH_BLOCK];
+    dyad_real out[DYAD_OUTPUT_COLUMN_COUNT][DYAD_BATCH_BLOCK];
+    /* per row, its lane's count of failed checks */
+    dyad_real failed[DYAD_BATCH_BLOCK];
+} batch_block;
 
-static dyad_solver solver_of(dyad_type type)
+/* Row r of the block as a dyad_input, and a result into row r: member by member, so that
+ * in the loop over rows each stays a register. */
+#define BATCH_READ(member)  row.member = block->in[column++][r];
+#define BATCH_WRITE(member) block->out[column++][r] = result->member;
+
+static inline dyad_input batch_row(const batch_block* block, size_t r)
 {
-    switch (type) {
-    case DYAD_RRR: return dyad_solve_rrr;
-    case DYAD_RRT: return dyad_solve_rrt;
-    case DYAD_RTR: return dyad_solve_rtr;
-    case DYAD_TRT: return dyad_solve_trt;
-    case DYAD_RTT: return dyad_solve_rtt;
-    case DYAD_TYPE_COUNT: break;
-    }
-    return NULL;
+    dyad_input row;
+    int column = 0;
+    BATCH_INPUT_MEMBERS(BATCH_READ)
+    return row;
 }
 
-static dyad_real* input_member(dyad_input* row, int column)
+static inline void batch_store(batch_block* block, size_t r, const dyad_result* result)
 {
-    return (dyad_real*)(void*)((char*)row + input_offset[column]);
+    int column = 0;
+    BATCH_OUTPUT_MEMBERS(BATCH_WRITE)
 }
 
-/* Every row of the block: the defaults, then the columns given once for all rows. */
-static void preset(const dyad_batch_input* input, dyad_input block[])
-{
-    int c;
-    size_t r;
-    block[0] = dyad_input_default();
-    for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
-        const dyad_input_array* column = &input->column[c];
-        if (column->data != NULL && column->stride == 0) {
-            *input_member(&block[0], c) = column->data[0];
-        }
+/* The loop of one type's lanes over the first `rows` rows of a block. */
+#define BATCH_LOOP(name, suffix, attributes)                                           \
+    attributes static void solve_lanes_##name##suffix(size_t rows, batch_block* block) \
+    {                                                                                  \
+        size_t r;                                                                      \
+        for (r = 0; r < rows; ++r) {                                                   \
+            const dyad_input row = batch_row(block, r);                                \
+            dyad_result result;                                                        \
+            block->failed[r] = dyad_solve_lane_##name(&row, &result);                  \
+            batch_store(block, r, &result);                                            \
+        }                                                                              \
     }
-    for (r = 1; r < DYAD_BATCH_BLOCK; ++r) {
-        block[r] = block[0];
-    }
-}
-
-/* One column's rows into the block; inlined with rows a constant for a whole
- * block, so that the copy unrolls. */
-static inline void gather_column(const dyad_input_array* column, size_t offset, size_t first,
-                                 size_t rows, dyad_input block[])
-{
-    const ptrdiff_t stride = column->stride;
-    const dyad_real* source = column->data + (ptrdiff_t)first * stride;
-    size_t r;
-    for (r = 0; r < rows; ++r) {
-        *(dyad_real*)(void*)((char*)&block[r] + offset) = source[(ptrdiff_t)r * stride];
-    }
-}
-
-/* The copies of the common layouts, each its own function: inlined, their unrolled
- * moves would crowd the general copies out of unrolling. */
-#if defined(__GNUC__)
-#define BATCH_OUT_OF_LINE __attribute__((noinline))
+#if DYAD_LANES_AVX2
+#define BATCH_LOOPS(name) \
+    BATCH_LOOP(name, , )  \
+    BATCH_LOOP(name, _avx2, DYAD_LANES_AVX2_TARGET)
 #else
-#define BATCH_OUT_OF_LINE
+#define BATCH_LOOPS(name) BATCH_LOOP(name, , )
 #endif
+BATCH_LOOPS(rrr)
+BATCH_LOOPS(rrt)
+BATCH_LOOPS(rtr)
+BATCH_LOOPS(trt)
+BATCH_LOOPS(rtt)
 
-/* A whole block of a column of its own (stride 1: a NumPy array of one field), as
- * plain moves. */
-BATCH_OUT_OF_LINE static void gather_contiguous(const dyad_real* source, size_t offset,
-                                                dyad_input block[])
+typedef void (*batch_lanes)(size_t rows, batch_block* block);
+
+/* The lanes of a type, for this CPU; NULL for an unknown type. */
+static batch_lanes lanes_of(dyad_type type)
 {
-    size_t r;
-    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
-        *(dyad_real*)(void*)((char*)&block[r] + offset) = source[r];
+    static const batch_lanes baseline[DYAD_TYPE_COUNT] = {
+        solve_lanes_rrr, solve_lanes_rrt, solve_lanes_rtr, solve_lanes_trt, solve_lanes_rtt};
+#if DYAD_LANES_AVX2
+    static const batch_lanes avx2[DYAD_TYPE_COUNT] = {solve_lanes_rrr_avx2, solve_lanes_rrt_avx2,
+                                                      solve_lanes_rtr_avx2, solve_lanes_trt_avx2,
+                                                      solve_lanes_rtt_avx2};
+    if ((unsigned)type < DYAD_TYPE_COUNT && dyad_lanes_have_avx2()) {
+        return avx2[type];
     }
+#endif
+    return (unsigned)type < DYAD_TYPE_COUNT ? baseline[type] : NULL;
 }
 
-/* A whole block of x and y of an (N, 2) array (stride 2), as plain moves. */
-BATCH_OUT_OF_LINE static void gather_pairs(const dyad_real* source, size_t offset,
-                                           dyad_input block[])
+/* Every row of the block holds, in each column given once for all rows or left out, that
+ * value: the column's, or dyad_input_default()'s. */
+static void preset(const dyad_batch_input* input, batch_block* block)
 {
+    const dyad_input defaults = dyad_input_default();
     size_t r;
-    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
-        *(dyad_real*)(void*)((char*)&block[r] + offset) = source[2 * r];
-    }
-}
-
-/* A whole block of x and y of an (N, 2) array at once: both members of a vector of
- * dyad_input, adjacent there too. */
-BATCH_OUT_OF_LINE static void gather_vectors(const dyad_real* source, size_t offset,
-                                             dyad_input block[])
-{
-    size_t r;
-    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
-        memcpy((char*)&block[r] + offset, source + 2 * r, 2 * sizeof *source);
-    }
-}
-
-/* Whether columns c and c + 1 are x and y of one (N, 2) array that fill adjacent
- * members: then one copy moves both. */
-static int adjacent_pair(const dyad_real* x, ptrdiff_t x_stride, const dyad_real* y,
-                         ptrdiff_t y_stride, size_t x_offset, size_t y_offset)
-{
-    return x != NULL && x_stride == 2 && y == x + 1 && y_stride == 2 &&
-           y_offset == x_offset + sizeof *x;
-}
-
-/* How a whole block copies each input column, decided once per call. */
-typedef enum copy_kind {
-    COPY_NONE = 0,   /* the block holds its value already (preset), or column c - 1 copies it */
-    COPY_VECTOR,     /* this column and the next, x and y of an (N, 2) array */
-    COPY_CONTIGUOUS, /* stride 1 */
-    COPY_PAIRS,      /* stride 2 alone */
-    COPY_GENERAL     /* any other stride */
-} copy_kind;
-
-static void plan_gather(const dyad_batch_input* input, unsigned char kinds[])
-{
     int c;
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        int column = 0;
+#define BATCH_DEFAULT(member) block->in[column++][r] = defaults.member;
+        BATCH_INPUT_MEMBERS(BATCH_DEFAULT)
+#undef BATCH_DEFAULT
+    }
     for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
         const dyad_input_array* column = &input->column[c];
-        kinds[c] = COPY_NONE;
-        if (column->data == NULL || column->stride == 0) {
-            continue;
-        }
-        if (c + 1 < DYAD_INPUT_COLUMN_COUNT &&
-            adjacent_pair(column->data, column->stride, input->column[c + 1].data,
-                          input->column[c + 1].stride, input_offset[c], input_offset[c + 1])) {
-            kinds[c] = COPY_VECTOR;
-            kinds[++c] = COPY_NONE;
-        } else {
-            kinds[c] = column->stride == 1   ? COPY_CONTIGUOUS
-                       : column->stride == 2 ? COPY_PAIRS
-                                             : COPY_GENERAL;
+        for (r = 0; column->data != NULL && column->stride == 0 && r < DYAD_BATCH_BLOCK; ++r) {
+            block->in[c][r] = column->data[0];
         }
     }
 }
 
 /* Rows first .. first + rows - 1 of the columns that vary by row. */
-static void gather(const dyad_batch_input* input, const unsigned char kinds[], size_t first,
-                   size_t rows, dyad_input block[])
+static void gather(const dyad_batch_input* input, size_t first, size_t rows, batch_block* block)
 {
     int c;
     for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {
         const dyad_input_array* column = &input->column[c];
-        if (rows < DYAD_BATCH_BLOCK) {
-            if (column->data != NULL && column->stride != 0) {
-                gather_column(column, input_offset[c], first, rows, block);
-            }
+        const ptrdiff_t stride = column->stride;
+        if (column->data == NULL || stride == 0) {
             continue;
         }
-        switch ((copy_kind)kinds[c]) {
-        case COPY_NONE: break;
-        case COPY_VECTOR: gather_vectors(column->data + 2 * first, input_offset[c], block); break;
-        case COPY_CONTIGUOUS:
-            gather_contiguous(column->data + first, input_offset[c], block);
-            break;
-        case COPY_PAIRS: gather_pairs(column->data + 2 * first, input_offset[c], block); break;
-        case COPY_GENERAL:
-            gather_column(column, input_offset[c], first, DYAD_BATCH_BLOCK, block);
-            break;
-        }
-    }
-}
-
-static inline void scatter_column(const dyad_output_array* column, size_t offset, size_t first,
-                                  size_t rows, const dyad_result results[])
-{
-    const ptrdiff_t stride = column->stride;
-    dyad_real* target = column->data + (ptrdiff_t)first * stride;
-    size_t r;
-    for (r = 0; r < rows; ++r) {
-        target[(ptrdiff_t)r * stride] =
-            *(const dyad_real*)(const void*)((const char*)&results[r] + offset);
-    }
-}
-
-/* A whole block into a column of its own (stride 1), as plain moves. */
-BATCH_OUT_OF_LINE static void scatter_contiguous(dyad_real* target, size_t offset,
-                                                 const dyad_result results[])
-{
-    size_t r;
-    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
-        target[r] = *(const dyad_real*)(const void*)((const char*)&results[r] + offset);
-    }
-}
-
-/* A whole block into x or y of an (N, 2) array (stride 2), as plain moves. */
-BATCH_OUT_OF_LINE static void scatter_pairs(dyad_real* target, size_t offset,
-                                            const dyad_result results[])
-{
-    size_t r;
-    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
-        target[2 * r] = *(const dyad_real*)(const void*)((const char*)&results[r] + offset);
-    }
-}
-
-/* A whole block into x and y of an (N, 2) array at once, from adjacent members. */
-BATCH_OUT_OF_LINE static void scatter_vectors(dyad_real* target, size_t offset,
-                                              const dyad_result results[])
-{
-    size_t r;
-    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
-        memcpy(target + 2 * r, (const char*)&results[r] + offset, 2 * sizeof *target);
-    }
-}
-
-static void scatter(const dyad_batch_output* output, size_t first, size_t rows,
-                    const dyad_result results[])
-{
-    int c;
-    size_t r;
-    for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
-        const dyad_output_array* column = &output->column[c];
-        if (column->data != NULL) {
-            if (rows == DYAD_BATCH_BLOCK && c + 1 < DYAD_OUTPUT_COLUMN_COUNT &&
-                adjacent_pair(column->data, column->stride, output->column[c + 1].data,
-                              output->column[c + 1].stride, output_offset[c],
-                              output_offset[c + 1])) {
-                scatter_vectors(column->data + 2 * first, output_offset[c], results);
-                ++c;
-            } else if (rows == DYAD_BATCH_BLOCK && column->stride == 1) {
-                scatter_contiguous(column->data + first, output_offset[c], results);
-            } else if (rows == DYAD_BATCH_BLOCK && column->stride == 2) {
-                scatter_pairs(column->data + 2 * first, output_offset[c], results);
-            } else if (rows == DYAD_BATCH_BLOCK) {
-                scatter_column(column, output_offset[c], first, DYAD_BATCH_BLOCK, results);
-            } else {
-                scatter_column(column, output_offset[c], first, rows, results);
+        if (stride == 1) {
+            memcpy(block->in[c], column->data + first, rows * sizeof column->data[0]);
+        } else if (stride == 2) { /* x or y of an (N, 2) array: a loop of its own, vectorised */
+            const dyad_real* source = column->data + 2 * first;
+            size_t r;
+            for (r = 0; r < rows; ++r) {
+                block->in[c][r] = source[2 * r];
+            }
+        } else {
+            const dyad_real* source = column->data + (ptrdiff_t)first * stride;
+            size_t r;
+            for (r = 0; r < rows; ++r) {
+                block->in[c][r] = source[(ptrdiff_t)r * stride];
             }
         }
     }
+}
+
+/* The block's first `rows` rows into rows first .. of the output columns. */
+static void scatter(const dyad_batch_output* output, size_t first, size_t rows,
+                    const batch_block* block)
+{
+    int c;
+    for (c = 0; c < DYAD_OUTPUT_COLUMN_COUNT; ++c) {
+        const dyad_output_array* column = &output->column[c];
+        const ptrdiff_t stride = column->stride;
+        if (column->data == NULL) {
+            continue;
+        }
+        if (stride == 1) {
+            memcpy(column->data + first, block->out[c], rows * sizeof column->data[0]);
+        } else if (stride == 2) {
+            dyad_real* target = column->data + 2 * first;
+            size_t r;
+            for (r = 0; r < rows; ++r) {
+                target[2 * r] = block->out[c][r];
+            }
+        } else {
+            dyad_real* target = column->data + (ptrdiff_t)first * stride;
+            size_t r;
+            for (r = 0; r < rows; ++r) {
+                target[(ptrdiff_t)r * stride] = block->out[c][r];
+            }
+        }
+    }
+}
+
+/* Rows whose lane failed a check, solved again alone: their status and field, and the
+ * solver's outputs in place of the lane's; the others ok. Returns the rows ok. */
+static size_t settle(dyad_type type, size_t rows, batch_block* block, dyad_status status[],
+                     dyad_field field[])
+{
+    size_t r, ok = 0;
+    for (r = 0; r < rows; ++r) {
+        if (block->failed[r] == 0) {
+            status[r] = DYAD_STATUS_OK;
+            field[r] = DYAD_FIELD_NONE;
+            ++ok;
+        } else {
+            const dyad_input row = batch_row(block, r);
+            dyad_result result;
+            status[r] = dyad_solve(type, &row, &result);
+            field[r] = result.field;
+            ok += status[r] == DYAD_STATUS_OK;
+            batch_store(block, r, &result);
+        }
+    }
+    return ok;
+}
+
+static void write_statuses(const dyad_batch_output* output, size_t first, size_t rows,
+                           const dyad_status status[], const dyad_field field[])
+{
+    size_t r;
     for (r = 0; output->status != NULL && r < rows; ++r) {
-        output->status[first + r] = (unsigned char)results[r].status;
+        output->status[first + r] = (unsigned char)status[r];
     }
     for (r = 0; output->field != NULL && r < rows; ++r) {
-        output->field[first + r] = (unsigned char)results[r].field;
+        output->field[first + r] = (unsigned char)field[r];
     }
 }
 
 /* Every row as dyad_solve reports a call it cannot make (unknown type, no input). */
 static void refuse_all(dyad_type type, size_t count, const dyad_batch_output* output)
 {
-    dyad_result refused[DYAD_BATCH_BLOCK];
+    batch_block block;
+    dyad_status status[DYAD_BATCH_BLOCK];
+    dyad_field field[DYAD_BATCH_BLOCK];
+    dyad_result refused;
     size_t first, r;
-    (void)dyad_solve(type, NULL, &refused[0]);
-    for (r = 1; r < DYAD_BATCH_BLOCK; ++r) {
-        refused[r] = refused[0];
+    (void)dyad_solve(type, NULL, &refused);
+    for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
+        batch_store(&block, r, &refused);
+        status[r] = refused.status;
+        field[r] = refused.field;
     }
     for (first = 0; first < count; first += DYAD_BATCH_BLOCK) {
         const size_t rows = count - first < DYAD_BATCH_BLOCK ? count - first : DYAD_BATCH_BLOCK;
-        scatter(output, first, rows, refused);
+        scatter(output, first, rows, &block);
+        write_statuses(output, first, rows, status, field);
     }
 }
 
 size_t dyad_solve_batch(dyad_type type, size_t count, const dyad_batch_input* input,
                         const dyad_batch_output* output)
 {
-    const dyad_solver solve = solver_of(type);
-    dyad_input block[DYAD_BATCH_BLOCK];
-    dyad_result results[DYAD_BATCH_BLOCK];
-    unsigned char kinds[DYAD_INPUT_COLUMN_COUNT];
-    size_t first, r, solved = 0;
+    const batch_lanes lanes = lanes_of(type);
+    batch_block block;
+    dyad_status status[DYAD_BATCH_BLOCK];
+    dyad_field field[DYAD_BATCH_BLOCK];
+    size_t first, solved = 0;
     if (output == NULL) {
         return 0;
     }
-    if (solve == NULL || input == NULL) {
+    if (lanes == NULL || input == NULL) {
         refuse_all(type, count, output);
         return 0;
     }
-    preset(input, block);
-    plan_gather(input, kinds);
+    preset(input, &block);
     for (first = 0; first < count; first += DYAD_BATCH_BLOCK) {
         const size_t rows = count - first < DYAD_BATCH_BLOCK ? count - first : DYAD_BATCH_BLOCK;
-        gather(input, kinds, first, rows, block);
-        for (r = 0; r < rows; ++r) {
-            solved += solve(&block[r], &results[r]) == DYAD_STATUS_OK;
-        }
-        scatter(output, first, rows, results);
+        gather(input, first, rows, &block);
+        lanes(rows, &block);
+        solved += settle(type, rows, &block, status, field);
+        scatter(output, first, rows, &block);
+        write_statuses(output, first, rows, status, field);
     }
     return solved;
 }

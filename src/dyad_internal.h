@@ -177,14 +177,18 @@ static inline int dyad_link_in_domain(const dyad_link* link, int may_be_zero)
  * them through every sum and product, and no input but a length divides), so
  * dyad_name_failure sees it and asks first_bad_field to name it. That keeps the
  * common path to a handful of comparisons. */
+static inline int dyad_in_domain(dyad_type type, const dyad_input* in)
+{
+    return in->singular_threshold > 0 && in->singular_threshold < 1 &&
+           dyad_link_in_domain(&in->m, dyad_zero_length_table[type][DYAD_LINK_M]) &&
+           dyad_link_in_domain(&in->n, dyad_zero_length_table[type][DYAD_LINK_N]) &&
+           (!dyad_guide_used(type, DYAD_PAIR_DM) || dyad_is_unit(in->guide_k)) &&
+           (!dyad_guide_used(type, DYAD_PAIR_DN) || dyad_is_unit(in->guide_p));
+}
+
 static inline dyad_field dyad_validate(dyad_type type, const dyad_input* in)
 {
-    const int in_domain = in->singular_threshold > 0 && in->singular_threshold < 1 &&
-                          dyad_link_in_domain(&in->m, dyad_zero_length_table[type][DYAD_LINK_M]) &&
-                          dyad_link_in_domain(&in->n, dyad_zero_length_table[type][DYAD_LINK_N]) &&
-                          (!dyad_guide_used(type, DYAD_PAIR_DM) || dyad_is_unit(in->guide_k)) &&
-                          (!dyad_guide_used(type, DYAD_PAIR_DN) || dyad_is_unit(in->guide_p));
-    return in_domain ? DYAD_FIELD_NONE : dyad_first_bad_field(type, in);
+    return dyad_in_domain(type, in) ? DYAD_FIELD_NONE : dyad_first_bad_field(type, in);
 }
 
 static inline void dyad_prepare_body(const dyad_link* link, dyad_vec2 gravity, dyad_body* body)

@@ -1,10 +1,11 @@
 /* dyadfmu: one sample of a batch, for a loop over samples that the compiler vectorises.
- * Not part of the public API; a generated scene's batch evaluation includes it.
+ * Not part of the public API; a generated scene's batch evaluation and dyad_solve_batch
+ * include it.
  *
  * A vector loop cannot branch per sample, and cannot call: each function here is the
  * computation of its public twin (dyad_kinematics_<type>, dyad_react_<type>,
- * dyad_point_on_link, dyad_force_size, ...) with every check made and counted instead
- * of acted on, inlined from the same source (the kinematics' formulas of
+ * dyad_solve_<type>, dyad_point_on_link, dyad_force_size, ...) with every check made
+ * and counted instead of acted on, inlined from the same source (the kinematics' formulas of
  * dyad_kin_<type>.c, the reactions' closed forms of dyad_<type>.c). Where a function
  * returns 0, its twin says DYAD_STATUS_OK and its outputs are its twin's, bit for bit;
  * elsewhere its outputs mean nothing, and the caller asks the twin what went wrong. A
@@ -133,6 +134,41 @@ DYAD_REACT_LANE(DYAD_TRT, trt)
 DYAD_REACT_LANE(DYAD_RTT, rtt)
 #endif
 #undef DYAD_REACT_LANE
+
+/* dyad_solve_<type> of one input: its fast check (dyad_validate's, counted), its frames
+ * and resultants, its reactions. */
+DYAD_CLOSED_FORM dyad_real dyad_solve_lane(dyad_type type, const dyad_input* input,
+                                           dyad_conditioned (*conditioning)(const dyad_loaded*),
+                                           dyad_closed_forms_fn closed_forms, dyad_result* result)
+{
+    dyad_prepared p;
+    const dyad_real bad = DYAD_FAILED(dyad_in_domain(type, input));
+    dyad_prepare_valid(type, input, &p, result);
+    return bad + dyad_react_lane(type, &p, conditioning(&p), closed_forms, result);
+}
+
+#define DYAD_SOLVE_LANE(type, name)                                                            \
+    DYAD_CLOSED_FORM dyad_real dyad_solve_lane_##name(const dyad_input* input,                 \
+                                                      dyad_result* result)                     \
+    {                                                                                          \
+        return dyad_solve_lane(type, input, name##_conditioning, name##_closed_forms, result); \
+    }
+#ifdef DYAD_LANES_RRR
+DYAD_SOLVE_LANE(DYAD_RRR, rrr)
+#endif
+#ifdef DYAD_LANES_RRT
+DYAD_SOLVE_LANE(DYAD_RRT, rrt)
+#endif
+#ifdef DYAD_LANES_RTR
+DYAD_SOLVE_LANE(DYAD_RTR, rtr)
+#endif
+#ifdef DYAD_LANES_TRT
+DYAD_SOLVE_LANE(DYAD_TRT, trt)
+#endif
+#ifdef DYAD_LANES_RTT
+DYAD_SOLVE_LANE(DYAD_RTT, rtt)
+#endif
+#undef DYAD_SOLVE_LANE
 
 /* The largest of three sizes times the amplification: dyad_force_size and
  * dyad_moment_size of a result that is ok. */

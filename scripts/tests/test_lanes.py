@@ -273,3 +273,29 @@ def test_the_loop_over_samples_vectorises(path, programs):
     assert loops and loops[-1] in vectorised, (loops, sorted(vectorised))
     if not table.identifier.startswith("lift"):
         assert set(loops) <= vectorised, (loops, sorted(vectorised))
+
+
+def test_dyad_solve_batch_loops_vectorise(tmp_path):
+    """src/dyad_batch.c compiled as CMakeLists.txt compiles it: GCC's report has each
+    type's loop over a block's rows vectorised, two rows a vector for the baseline and,
+    on x86-64, four for AVX2 (src/dyad_lanes.h's solve lanes)."""
+    required_tool("cc")
+    source = ROOT / "src" / "dyad_batch.c"
+    report = subprocess.run(
+        ["cc", *FLAGS, f"-I{ROOT / 'src'}", f"-I{ROOT / 'src' / 'include'}", "-c", str(source),
+         "-o", str(tmp_path / "batch.o"), "-fopt-info-vec-optimized"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert report.returncode == 0, report.stderr
+    lines = source.read_text().splitlines()
+    widths = ["16"] + (["32"] if "x86_64" in _machine() else [])
+    for kind in ("rrr", "rrt", "rtr", "trt", "rtt"):
+        line = lines.index(f"BATCH_LOOPS({kind})") + 1
+        for width in widths:
+            wanted = f"dyad_batch.c:{line}:1: optimized: loop vectorized using {width} byte vectors"
+            assert wanted in report.stderr, (kind, width, report.stderr[-2000:])
+
+
+def _machine() -> str:
+    done = subprocess.run(["cc", "-dumpmachine"], capture_output=True, text=True)
+    return done.stdout

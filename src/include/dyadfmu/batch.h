@@ -1,10 +1,11 @@
 /* dyadfmu: many dyads of one type in one call, structure of arrays in and out.
  *
  * Row r of a batch is the dyad_input whose every scalar is taken from its column
- * at row r; it is solved by the same dyad_solve_<type> as a single call, so each
- * row's outputs are bit for bit those of dyad_solve on that row. Nothing is
+ * at row r; each row's status and outputs are bit for bit those of dyad_solve on
+ * that row (the rows are solved together, in loops the compiler vectorises, from
+ * the same formulas; a row that fails a check is solved again alone). Nothing is
  * allocated: rows are gathered and scattered in blocks of DYAD_BATCH_BLOCK on
- * the stack (DYAD_BATCH_BLOCK * 408 bytes for double). Reentrant.
+ * the stack (DYAD_BATCH_BLOCK * 416 bytes for double). Reentrant.
  */
 #ifndef DYADFMU_BATCH_H
 #define DYADFMU_BATCH_H
@@ -18,7 +19,7 @@ extern "C" {
 #endif
 
 /** Rows gathered, solved and scattered together. */
-#define DYAD_BATCH_BLOCK 16
+#define DYAD_BATCH_BLOCK 32
 
 /** The scalars of a dyad_input, in the order of its fields: link m, link n
  *  (dir.x, dir.y, length, omega, epsilon, accel_d.x, accel_d.y, com.x, com.y,
