@@ -641,8 +641,8 @@ unsigned probe_unused_vr(const probe_model* model)
 /* ---- loading -------------------------------------------------------------------------------- */
 
 #if defined(_WIN32)
-static int resolve(void* library, const char* name, void* function_pointer, char* error,
-                   size_t error_size)
+int probe_resolve(void* library, const char* name, void* function_pointer, char* error,
+                  size_t error_size)
 {
     FARPROC symbol = GetProcAddress((HMODULE)library, name);
     if (symbol == NULL) {
@@ -662,8 +662,8 @@ static void* open_library(const probe_model* model, char* error, size_t error_si
     return (void*)library;
 }
 #else
-static int resolve(void* library, const char* name, void* function_pointer, char* error,
-                   size_t error_size)
+int probe_resolve(void* library, const char* name, void* function_pointer, char* error,
+                  size_t error_size)
 {
     void* symbol = dlsym(library, name);
     if (symbol == NULL) {
@@ -686,9 +686,9 @@ static void* open_library(const probe_model* model, char* error, size_t error_si
 #endif
 
 #define PROBE_RESOLVE2(name) \
-    ok = ok && resolve(api->library, "fmi2" #name, &api->name, error, error_size);
+    ok = ok && probe_resolve(api->library, "fmi2" #name, &api->name, error, error_size);
 #define PROBE_RESOLVE3(name) \
-    ok = ok && resolve(api->library, "fmi3" #name, &api->name, error, error_size);
+    ok = ok && probe_resolve(api->library, "fmi3" #name, &api->name, error, error_size);
 
 int probe_load_fmi2(const probe_model* model, probe_fmi2* api, char* error, size_t error_size)
 {

@@ -147,6 +147,10 @@ typedef struct probe_fmi3 {
 int probe_load_fmi2(const probe_model* model, probe_fmi2* api, char* error, size_t error_size);
 int probe_load_fmi3(const probe_model* model, probe_fmi3* api, char* error, size_t error_size);
 void probe_unload(void* library);
+/* The loaded library's function `name` into *function_pointer: 1, or 0 with the reason in
+ * `error`. */
+int probe_resolve(void* library, const char* name, void* function_pointer, char* error,
+                  size_t error_size);
 
 /* ---- the importer's logger ------------------------------------------------------ */
 

@@ -13,7 +13,10 @@
  * OUTPUT_FILE: "reals R" and their value references, "integers I" and theirs
  * (every output of the FMU), then K lines, one per step: the status of doStep at
  * t = k H after setting row k, the R real outputs (bit patterns) and the I
- * integer outputs.
+ * integer outputs. Then "columns S", S the status dyadfmu_evaluate_columns
+ * returns for the K rows in one call (the FMU's batch evaluation, its lanes where
+ * it has them), and where S is 0 (an algebraic model) K lines: each row's status
+ * and its R real outputs.
  *
  * Exits 0 when every run went through (whatever the FMU's statuses), 1 when a
  * file or an FMU could not be read or loaded, with the reason on stderr. */
@@ -98,6 +101,17 @@ static int instantiate(replay_run* run)
            run->f3.ExitInitializationMode(run->instance) <= fmi3Warning;
 }
 
+static void write_reals(FILE* out, int status, const double* reals, size_t count)
+{
+    size_t j;
+    fprintf(out, "%d", status);
+    for (j = 0; j < count; ++j) {
+        uint64_t bits;
+        memcpy(&bits, &reals[j], sizeof bits);
+        fprintf(out, " %016" PRIx64, bits);
+    }
+}
+
 /* Sets the row's inputs, steps from t over h, and writes the status and outputs. */
 static void step_and_write(replay_run* run, const double* row, double t, double h, double* reals,
                            int* integers, FILE* out)
@@ -118,12 +132,7 @@ static void step_and_write(replay_run* run, const double* row, double t, double 
         run->f3.GetFloat64(run->instance, run->reals, run->n_reals, reals, run->n_reals);
         run->f3.GetInt32(run->instance, run->integers, run->n_integers, integers, run->n_integers);
     }
-    fprintf(out, "%d", status);
-    for (j = 0; j < run->n_reals; ++j) {
-        uint64_t bits;
-        memcpy(&bits, &reals[j], sizeof bits);
-        fprintf(out, " %016" PRIx64, bits);
-    }
+    write_reals(out, status, reals, run->n_reals);
     for (j = 0; j < run->n_integers; ++j) {
         fprintf(out, " %d", integers[j]);
     }
@@ -162,17 +171,67 @@ static int read_header(replay_run* run, FILE* in, long* steps, double* h)
     return run->inputs != NULL;
 }
 
-/* The steps of one run: returns 1, or 0 where a row could not be read. */
+/* Every row through dyadfmu_evaluate_columns in one call, written after the steps. */
+typedef int (*replay_columns_fn)(const char* token, const unsigned int vr_x[], size_t n_x,
+                                 const double* const x[], const ptrdiff_t x_step[],
+                                 const unsigned int vr_y[], size_t n_y, double* const y[],
+                                 const ptrdiff_t y_step[], int status[], size_t count);
+
+static int replay_columns(const replay_run* run, const double* rows, long steps, FILE* out)
+{
+    void* library = run->model.fmi_version == 2 ? run->f2.library : run->f3.library;
+    const size_t count = (size_t)steps;
+    replay_columns_fn columns;
+    char error[200];
+    const double** x = (const double**)malloc((run->n_inputs + 1) * sizeof *x);
+    double** y = (double**)malloc((run->n_reals + 1) * sizeof *y);
+    ptrdiff_t* x_step = (ptrdiff_t*)malloc((run->n_inputs + 1) * sizeof *x_step);
+    ptrdiff_t* y_step = (ptrdiff_t*)malloc((run->n_reals + 1) * sizeof *y_step);
+    double* values = (double*)malloc((count * run->n_reals + 1) * sizeof *values);
+    int* status = (int*)malloc(count * sizeof *status);
+    int ok = x != NULL && y != NULL && x_step != NULL && y_step != NULL && values != NULL &&
+             status != NULL &&
+             probe_resolve(library, "dyadfmu_evaluate_columns", &columns, error, sizeof error);
+    size_t j, k;
+    for (j = 0; ok && j < run->n_inputs; ++j) {
+        x[j] = rows + j;
+        x_step[j] = (ptrdiff_t)run->n_inputs;
+    }
+    for (j = 0; ok && j < run->n_reals; ++j) {
+        y[j] = values + j;
+        y_step[j] = (ptrdiff_t)run->n_reals;
+    }
+    if (ok) {
+        const int called = columns(run->model.token, run->inputs, run->n_inputs, x, x_step,
+                                   run->reals, run->n_reals, y, y_step, status, count);
+        fprintf(out, "columns %d\n", called);
+        for (k = 0; called == 0 && k < count; ++k) {
+            write_reals(out, status[k], values + k * run->n_reals, run->n_reals);
+            fputc('\n', out);
+        }
+    }
+    free((void*)x);
+    free(y);
+    free(x_step);
+    free(y_step);
+    free(values);
+    free(status);
+    return ok;
+}
+
+/* The steps of one run, then the columns entry over the same rows: returns 1, or 0 where
+ * a row could not be read or the columns entry is missing. */
 static int replay_steps(replay_run* run, FILE* in, FILE* out, long steps, double h)
 {
-    double* row = (double*)malloc((run->n_inputs + 1) * sizeof *row);
+    double* rows = (double*)malloc(((size_t)steps * run->n_inputs + 1) * sizeof *rows);
     double* reals = (double*)malloc((run->n_reals + 1) * sizeof *reals);
     int* integers = (int*)malloc((run->n_integers + 1) * sizeof *integers);
-    int ok = row != NULL && reals != NULL && integers != NULL;
+    int ok = rows != NULL && reals != NULL && integers != NULL;
     long k;
     size_t j;
     write_header(run, out);
     for (k = 0; ok && k < steps; ++k) {
+        double* row = rows + (size_t)k * run->n_inputs;
         for (j = 0; ok && j < run->n_inputs; ++j) {
             ok = read_bits(in, &row[j]);
         }
@@ -180,7 +239,8 @@ static int replay_steps(replay_run* run, FILE* in, FILE* out, long steps, double
             step_and_write(run, row, (double)k * h, h, reals, integers, out);
         }
     }
-    free(row);
+    ok = ok && replay_columns(run, rows, steps, out);
+    free(rows);
     free(reals);
     free(integers);
     return ok;
@@ -229,7 +289,8 @@ static int replay(const char* directory, const char* input, const char* output)
                 run.book.last);
         ok = 0;
     } else if (!replay_steps(&run, in, out, steps, h)) {
-        fprintf(stderr, "fmu_replay: %s: a row of %s is short\n", directory, input);
+        fprintf(stderr, "fmu_replay: %s: a row of %s is short, or no dyadfmu_evaluate_columns\n",
+                directory, input);
         ok = 0;
     }
     if (in != NULL) {

@@ -16,6 +16,7 @@ import zipfile
 import pytest
 from dyadfmu import paths
 from dyadfmu.cosim import importers, windows
+from replay_checks import assert_the_columns_entry_ran_where_algebraic
 from tool_checks import required, required_tool
 
 FMI3 = [f"{name}_fmi3" for name in importers.fmu_names()]
@@ -44,8 +45,15 @@ def test_the_arm_binary_gives_the_x86_outputs_bit_for_bit(replays, fmu):
     the same results on both."""
     d = replays[fmu]
     assert d.steps >= 100 and d.outputs > 0
+    assert d.samples in (0, d.steps)  # the columns entry's rows, where the model is algebraic
     assert d.same_status, f"{fmu}: doStep statuses or integer outputs differ"
     assert d.identical == d.outputs, f"{fmu}: {d.ulps} (in units in the last place)"
+
+
+def test_the_columns_entry_ran_on_every_algebraic_fmu(replays):
+    """The batch evaluation too, its lanes compiled for the ARM binary with the flags
+    that vectorise them."""
+    assert_the_columns_entry_ran_where_algebraic(replays)
 
 
 @pytest.mark.parametrize("fmu", FMI3)

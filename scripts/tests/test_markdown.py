@@ -377,7 +377,7 @@ def test_the_importers_windows_and_scene_bench_tables_read_as_tables():
     replay = windows.Difference(HOSTILE, 10, 4, 3, 1e-16, HOSTILE, False)
     (found,) = mc.tables("\n".join(windows.table_lines([replay])))
     assert tuple(found.texts(0)) == windows.TABLE_HEADER
-    assert found.texts(1) == [SHOWN, "10", "4", "3", f"1e-16 ({SHOWN})", "DIFFER"]
+    assert found.texts(1) == [SHOWN, "10", "0", "4", "3", f"1e-16 ({SHOWN})", "DIFFER"]
     bench = long_chain.table_lines([(25, (0.1, 0.05), (0.3, 0.2), 2.5e6)])
     (found,) = mc.tables("\n".join(bench))
     assert tuple(found.texts(0)) == long_chain.TABLE_HEADER

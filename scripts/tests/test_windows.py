@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from dyadfmu import paths
 from dyadfmu.cosim import importers, windows
+from replay_checks import assert_the_columns_entry_ran_where_algebraic
 from tool_checks import required
 
 ALL = [f"{name}_fmi{version}" for name in importers.fmu_names() for version in importers.VERSIONS]
@@ -47,6 +48,7 @@ def test_the_windows_binary_gives_the_linux_outputs_bit_for_bit(replays, fmu):
     from it is."""
     d = replays[fmu]
     assert d.steps >= 100 and d.outputs > 0
+    assert d.samples in (0, d.steps)  # the columns entry's rows, where the model is algebraic
     assert d.same_status, f"{fmu}: doStep statuses or integer outputs differ"
     apart = {n: u for n, u in d.ulps.items() if not (n.endswith(".angle") and u <= 1)}
     assert not apart, (
@@ -54,6 +56,12 @@ def test_the_windows_binary_gives_the_linux_outputs_bit_for_bit(replays, fmu):
         f"({d.worst_output}); in units in the last place: {apart}"
     )
     assert d.identical + len(d.ulps) == d.outputs
+
+
+def test_the_columns_entry_ran_on_every_algebraic_fmu(replays):
+    """The batch evaluation too, its lanes compiled for the Windows binary with the flags
+    that vectorise them."""
+    assert_the_columns_entry_ran_where_algebraic(replays)
 
 
 @pytest.mark.parametrize("fmu", ALL)
@@ -80,13 +88,15 @@ def test_every_fmu_carries_a_windows_binary_needing_only_system_dlls(windows_bui
 def test_the_comparison_sees_one_ulp_and_a_status():
     bits = np.array([1.0, -2.5, 3.0])
     linux = windows.Replay(
-        np.zeros(3, int), {7: bits.copy(), 8: bits.copy()}, {9: np.zeros(3, int)}
+        np.zeros(3, int), {7: bits.copy(), 8: bits.copy()}, {9: np.zeros(2, int)}, 2, 0
     )
     same = windows.compare("x", {7: "a", 8: "b"}, linux, linux)
     assert same.identical == 2 and same.worst == 0 and same.same_status
     moved = bits.copy()
     moved[1] = np.nextafter(moved[1], 0.0)
-    other = windows.Replay(np.array([0, 2, 0]), {7: bits.copy(), 8: moved}, {9: np.zeros(3, int)})
+    other = windows.Replay(
+        np.array([0, 2, 0]), {7: bits.copy(), 8: moved}, {9: np.zeros(2, int)}, 2, 0
+    )
     d = windows.compare("x", {7: "a", 8: "b"}, linux, other)
     assert d.identical == 1 and d.worst_output == "b" and not d.same_status
     assert d.worst == pytest.approx(np.spacing(2.5) / 3.0, rel=1e-12, abs=0)
@@ -95,3 +105,5 @@ def test_the_comparison_sees_one_ulp_and_a_status():
     assert windows.compare("x", {7: "a", 8: "b"}, linux, other).ulps == {"b": 3.0}
     moved[1] = 2.5
     assert windows.compare("x", {7: "a", 8: "b"}, linux, other).ulps == {"b": float("inf")}
+    refused = windows.Replay(linux.status, linux.reals, linux.integers, 2, 3)
+    assert not windows.compare("x", {7: "a", 8: "b"}, linux, refused).same_status

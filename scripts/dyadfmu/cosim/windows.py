@@ -105,11 +105,15 @@ def write_inputs(setup: CoSimSetup, path: Path) -> None:
 @dataclass
 class Replay:
     """One run's outputs: per step the doStep status, the real and the integer outputs,
-    by value reference."""
+    by value reference; then, where the model is algebraic, the same rows through the
+    FMU's columns entry (dyadfmu_evaluate_columns: its batch evaluation) in one call, each
+    row's status and real outputs after the steps' in ``status`` and ``reals``."""
 
     status: np.ndarray
-    reals: dict  # value reference -> values per step
-    integers: dict
+    reals: dict  # value reference -> values per step, then per row of the columns call
+    integers: dict  # value reference -> values per step
+    steps: int
+    columns: int  # the status the columns call returned (0 for an algebraic model)
 
 
 def read_outputs(path: Path) -> Replay:
@@ -117,12 +121,15 @@ def read_outputs(path: Path) -> Replay:
     lines = path.read_text(encoding="ascii").splitlines()
     real_vrs = [int(x) for x in lines[0].split()[2:]]
     integer_vrs = [int(x) for x in lines[1].split()[2:]]
-    rows = [line.split() for line in lines[2:]]
+    marker = next(k for k, line in enumerate(lines) if line.startswith("columns "))
+    steps = [line.split() for line in lines[2:marker]]
+    samples = [line.split() for line in lines[marker + 1 :]]
+    rows = steps + samples
     status = np.array([int(r[0]) for r in rows])
     reals = {vr: np.array([_double(r[1 + j]) for r in rows]) for j, vr in enumerate(real_vrs)}
     base = 1 + len(real_vrs)
-    integers = {vr: np.array([int(r[base + j]) for r in rows]) for j, vr in enumerate(integer_vrs)}
-    return Replay(status, reals, integers)
+    integers = {vr: np.array([int(r[base + j]) for r in steps]) for j, vr in enumerate(integer_vrs)}
+    return Replay(status, reals, integers, len(steps), int(lines[marker].split()[1]))
 
 
 def _windows_path(path: Path) -> str:
@@ -173,13 +180,15 @@ class Difference:
     fmu: str
     steps: int
     outputs: int
-    identical: int  # outputs equal bit for bit at every step
+    identical: int  # outputs equal bit for bit at every step and every columns row
     worst: float  # largest |windows - linux| / peak |linux| over the outputs
     worst_output: str
-    same_status: bool  # doStep statuses and integer outputs equal
+    same_status: bool  # doStep statuses, integer outputs and the columns call's equal
     #: each output that differs -> its largest distance in units in the last place
     #: (inf where one is finite and the other not, or their signs differ)
     ulps: dict = field(default_factory=dict)
+    #: rows compared through the columns entry (0: a model with states has none)
+    samples: int = 0
 
 
 def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference:
@@ -201,12 +210,16 @@ def compare(fmu: str, names: dict, linux: Replay, windows: Replay) -> Difference
         diff = float(np.max(np.abs(a[finite] - b[finite]))) / (peak or 1.0)
         if diff > worst:
             worst, worst_output = diff, names[vr]
-    same_status = np.array_equal(linux.status, windows.status) and all(
-        np.array_equal(v, windows.integers[vr]) for vr, v in linux.integers.items()
+    same_status = (
+        np.array_equal(linux.status, windows.status)
+        and all(np.array_equal(v, windows.integers[vr]) for vr, v in linux.integers.items())
+        and (linux.steps, linux.columns) == (windows.steps, windows.columns)
     )
+    samples = len(linux.status) - linux.steps
     return Difference(
-        fmu, len(linux.status), len(linux.reals), identical, worst, worst_output, same_status, ulps
-    )
+        fmu, linux.steps, len(linux.reals), identical, worst, worst_output, same_status, ulps,
+        samples,
+    )  # fmt: skip
 
 
 def _ulps(a: np.ndarray, b: np.ndarray) -> float:
@@ -278,6 +291,7 @@ def main(argv: list | None = None) -> int:
 TABLE_HEADER = (
     "FMU",
     "steps",
+    "columns rows",
     "outputs",
     "bit-identical",
     "largest difference / peak",
@@ -294,13 +308,14 @@ def table_lines(differences: list[Difference]) -> list[str]:
             [
                 d.fmu,
                 str(d.steps),
+                str(d.samples),
                 str(d.outputs),
                 str(d.identical),
                 f"{d.worst:.2g}{where}",
                 "equal" if d.same_status else "DIFFER",
             ]
         )
-    return markdown.table(TABLE_HEADER, rows, "-rrrr-")
+    return markdown.table(TABLE_HEADER, rows, "-rrrrr-")
 
 
 if __name__ == "__main__":
