@@ -1997,22 +1997,20 @@ static void find_sources(const fmu_model* model, const column_blocks* b, const c
     }
 }
 
-/* Sample `i`'s x values where they go: with `to` NULL into the input block (each to its
- * place's `at`), else into lane `lane` of the columns `to` (an angle's unit vector in
- * two, `stride` apart); 0 where the model refuses one (outside its bounds, or not
- * finite), as a set of it would. */
-static int store_values(const column_call* c, const column_place place[], double* const to[],
-                        size_t stride, size_t i, size_t lane)
+/* Sample `i`'s x values into the input block, each to its place's `at` (an angle's unit
+ * vector in two reals); 0 where the model refuses one (outside its bounds, or not finite),
+ * as a set of it would. */
+static int store_values(const column_call* c, const column_place place[], size_t i)
 {
     size_t k;
     for (k = 0; k < c->n_x; ++k) {
         const double value = c->x[k][(ptrdiff_t)i * c->x_step[k]];
-        double* at = to != NULL ? to[k] + lane : place[k].at;
+        double* at = place[k].at;
         if (!(value >= place[k].low && value <= place[k].high)) {
             return 0;
         }
         if (place[k].angle) {
-            dyad_cos_sin(value, &at[0], &at[stride]);
+            dyad_cos_sin(value, &at[0], &at[1]);
         } else {
             *at = value;
         }
@@ -2051,7 +2049,7 @@ static void evaluate_samples(const fmu_model* model, column_blocks* b, const col
     size_t i, k;
     for (i = 0; i < c->count; ++i) {
         fmu_status s = FMU_ERROR;
-        if (store_values(c, place, NULL, 1, i, 0)) {
+        if (store_values(c, place, i)) {
             evaluate(model, b->input, b->output, &b->evaluation);
             s = sample_status(b->evaluation.status);
         }
@@ -2076,6 +2074,7 @@ typedef struct lane_grid {
     const double** from;   /* n_y */
     unsigned char* wanted; /* outputs */
     int* stored;           /* lanes */
+    int partial;           /* 1 where a y column does not come from the lanes */
 } lane_grid;
 
 /* The column of the real at `at` in `block` (the input's or the output's). */
@@ -2097,6 +2096,7 @@ static void place_lanes(const column_blocks* b, const column_call* c, const colu
         g->to[k] = g->cells + lane_column_of(b->input, place[k].at) * lanes;
     }
     memset(g->wanted, 0, g->lanes->outputs);
+    g->partial = 0;
     for (k = 0; k < c->n_y; ++k) {
         const char* at = (const char*)(const void*)source[k].at;
         g->from[k] = NULL;
@@ -2107,6 +2107,7 @@ static void place_lanes(const column_blocks* b, const column_call* c, const colu
         } else if (at >= in && at < in + g->lanes->inputs * sizeof(double)) {
             g->from[k] = g->cells + lane_column_of(b->input, at) * lanes;
         }
+        g->partial |= g->from[k] == NULL;
     }
 }
 
@@ -2125,8 +2126,52 @@ static fmu_status evaluate_lane_alone(const fmu_model* model, column_blocks* b, 
     return sample_status(b->evaluation.status);
 }
 
-/* The samples from `first` on, at most a call's lanes: stored, evaluated at once, and
- * those whose checks failed once more alone in the blocks. */
+/* The x columns' values of the samples from `first` on into their lane columns, column by
+ * column (an angle as its unit vector); per lane whether every value lies within its
+ * variable's bounds (store_values' check; a sample that fails it is not evaluated). */
+static void store_lanes(const column_call* c, const column_place place[], const lane_grid* g,
+                        size_t first, size_t count)
+{
+    const size_t stride = g->lanes->lanes;
+    size_t k, lane;
+    for (lane = 0; lane < count; ++lane) {
+        g->stored[lane] = 1;
+    }
+    for (k = 0; k < c->n_x; ++k) {
+        const ptrdiff_t step = c->x_step[k];
+        const double* x = c->x[k] + (ptrdiff_t)first * step;
+        const double low = place[k].low, high = place[k].high;
+        double* at = g->to[k];
+        for (lane = 0; lane < count; ++lane) {
+            const double value = x[(ptrdiff_t)lane * step];
+            const int within = value >= low && value <= high;
+            g->stored[lane] &= within;
+            if (!place[k].angle) {
+                at[lane] = value;
+            } else if (within) {
+                dyad_cos_sin(value, &at[lane], &at[lane + stride]);
+            }
+        }
+    }
+}
+
+/* Sample i's y values where the lanes do not hold them: NaN where its status is not ok, as
+ * evaluate gave them where it was evaluated alone, and otherwise those of the columns that
+ * do not come from the lanes. */
+static void put_sample_aside(const column_call* c, const column_source source[], const lane_grid* g,
+                             size_t i, fmu_status s, int alone)
+{
+    size_t k;
+    for (k = 0; k < c->n_y; ++k) {
+        if (s != FMU_OK || alone || g->from[k] == NULL) {
+            c->y[k][(ptrdiff_t)i * c->y_step[k]] =
+                s == FMU_OK ? source[k].at[(ptrdiff_t)i * source[k].step] : NAN;
+        }
+    }
+}
+
+/* The samples from `first` on, at most a call's lanes: stored, evaluated at once, their
+ * outputs copied column by column; those whose checks failed once more alone in the blocks. */
 static void evaluate_lanes(const fmu_model* model, column_blocks* b, const column_call* c,
                            const column_place place[], const column_source source[],
                            const lane_grid* g, size_t first)
@@ -2137,13 +2182,18 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
     const size_t count = c->count - first < lanes->lanes ? c->count - first : lanes->lanes;
     const double* failed = g->cells + (lanes->inputs + lanes->outputs) * lanes->lanes;
     size_t lane, k;
-    for (lane = 0; lane < count; ++lane) {
-        g->stored[lane] = store_values(c, place, g->to, lanes->lanes, first + lane, lane);
-    }
+    store_lanes(c, place, g, first, count);
     if (g->baseline) {
         (halves ? lanes->first_baseline : lanes->whole_baseline)(count, g->cells, g->wanted);
     } else {
         (halves ? lanes->first : lanes->whole)(count, g->cells, g->wanted);
+    }
+    for (k = 0; k < c->n_y; ++k) {
+        const ptrdiff_t step = c->y_step[k];
+        double* y = c->y[k] + (ptrdiff_t)first * step;
+        for (lane = 0; g->from[k] != NULL && lane < count; ++lane) {
+            y[(ptrdiff_t)lane * step] = g->from[k][lane];
+        }
     }
     for (lane = 0; lane < count; ++lane) {
         const size_t i = first + lane;
@@ -2152,11 +2202,8 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
                              : alone          ? evaluate_lane_alone(model, b, g, halves, lane)
                                               : FMU_OK;
         c->status[i] = (int)s;
-        for (k = 0; k < c->n_y; ++k) {
-            const double* from = g->from[k] != NULL && !alone
-                                     ? g->from[k] + lane
-                                     : source[k].at + (ptrdiff_t)i * source[k].step;
-            c->y[k][(ptrdiff_t)i * c->y_step[k]] = s == FMU_OK ? *from : NAN;
+        if (s != FMU_OK || alone || g->partial) {
+            put_sample_aside(c, source, g, i, s, alone);
         }
     }
 }

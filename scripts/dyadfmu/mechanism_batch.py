@@ -173,23 +173,19 @@ def _flat(array: np.ndarray, shape: tuple) -> np.ndarray:
 
 def _by_columns(entry: object, x: dict, wanted: tuple, shape: tuple, units: dict):
     """Every sample in chunks of CHUNK through the columns entry (a value held for every
-    sample passed once); None where the binary refuses it (a model with states)."""
+    sample passed once), each chunk written in place into the outputs' arrays; None where
+    the binary refuses it (a model with states)."""
     count = math.prod(shape)
     flat = {n: _flat(a, shape) for n, a in x.items()}
-    chunks = []
+    block = np.empty((len(wanted), count))  # one row per output
+    status = np.empty(count, dtype=np.intc)
     for start in range(0, max(count, 1), CHUNK):
         stop = min(start + CHUNK, count)
         part = {n: a if a.size == 1 else a[start:stop] for n, a in flat.items()}
-        done = entry.evaluate(part, wanted, stop - start)
-        if done is None:
+        out = (block[:, start:stop], status[start:stop])
+        if entry.evaluate(part, wanted, stop - start, out) is None:
             return None
-        chunks.append(done)
-    if len(chunks) == 1:  # the arrays the binary wrote, as they are
-        values, status = chunks[0]
-    else:
-        values = {n: np.concatenate([c[0][n] for c in chunks]) for n in wanted}
-        status = np.concatenate([c[1] for c in chunks])
-    shaped = {n: np.ascontiguousarray(values[n]).reshape(shape) for n in wanted}
+    shaped = {n: block[k].reshape(shape) for k, n in enumerate(wanted)}
     return Evaluation(shaped, units, status.reshape(shape))
 
 

@@ -207,3 +207,31 @@ def test_exactly_the_models_with_states_are_refused_their_callers_take_the_rows_
             refused.append(name)
     assert refused == [n for n in _all_fmus() if n not in _scene_fmus()]
     assert "slider_crank_forward" in refused and "slider_crank" not in refused
+
+
+def test_outputs_written_in_place_into_strided_views_are_the_same_bits():
+    """``out``: the outputs written straight into views of larger arrays (what
+    dyadfmu.evaluate does chunk by chunk), every other value left as it was; wrong types
+    and shapes refused before the call."""
+    entry = entries.columns_entry(paths.built_fmu("slider_crank", 2))
+    angle = np.linspace(-7.0, 7.0, 301)
+    wanted = ("crank.torque", "engine.R_mn.x", "crank.J")
+    fresh, fresh_status = entry.evaluate({"crank.angle": angle}, wanted, 301)
+    big = np.full((7, 3 * 301 + 4), 12345.0)
+    flags = np.full(2 * 301, -7, dtype=np.intc)
+    block, status = big[1::2, 2 : 2 + 3 * 301 : 3], flags[301:]
+    entry.evaluate({"crank.angle": angle}, wanted, 301, out=(block, status))
+    for k, name in enumerate(wanted):
+        assert fresh[name].tobytes() == block[k].copy().tobytes(), name
+    assert np.array_equal(status, fresh_status) and (flags[:301] == -7).all()
+    untouched = np.ones(big.shape, bool)
+    untouched[1::2, 2 : 2 + 3 * 301 : 3] = False
+    assert (big[untouched] == 12345.0).all()
+    for out in [
+        (np.empty((3, 301), np.float32), np.empty(301, np.intc)),
+        (np.empty((3, 301)), np.empty(301, np.int64)),
+        (np.empty((3, 300)), np.empty(301, np.intc)),
+        (np.empty((3, 301)), np.empty(602, np.intc)[::2]),
+    ]:
+        with pytest.raises(ValueError, match="out:"):
+            entry.evaluate({"crank.angle": angle}, wanted, 301, out=out)

@@ -82,26 +82,38 @@ class ColumnsEntry(_Entry):
     ARGUMENTS += [ctypes.c_void_p, ctypes.c_size_t]
 
     def evaluate(
-        self, x: dict[str, np.ndarray], y_names: tuple, count: int
+        self,
+        x: dict[str, np.ndarray],
+        y_names: tuple,
+        count: int,
+        out: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> tuple[dict[str, np.ndarray], np.ndarray] | None:
         """(the outputs ``y_names``, each an array of ``count`` samples; the FMU status of
         each sample: 0 is OK) at the inputs and parameters ``x`` (name -> an array of
         ``count`` float64 values, or of one for every sample). None where the binary
-        refuses the call (a model with states)."""
+        refuses the call (a model with states). ``out``: (a float64 array of one row per
+        output and ``count`` columns, a C int array of ``count``) written in place, rows
+        and columns at any strides of whole doubles (views of larger arrays, say)."""
         x_names = tuple(x)
         columns = [_column(x[n]) for n in x_names]
         if any(c.size not in (1, count) for c in columns):
             raise ValueError("every column holds one value or one per sample")
         steps = [0 if c.size == 1 else c.strides[0] // c.itemsize for c in columns]
-        block = np.empty((len(y_names), count))  # one row per output
-        start = _address(block)
-        status = np.empty(count, dtype=np.intc)
+        block, status = out or (np.empty((len(y_names), count)), np.empty(count, dtype=np.intc))
+        if block.shape != (len(y_names), count) or status.shape != (count,):
+            raise ValueError("out: one row of count values per output, and count statuses")
+        contiguous = count < 2 or status.strides[0] == status.itemsize
+        if block.dtype != np.float64 or any(s % 8 for s in block.strides):
+            raise ValueError("out: float64 values at strides of whole doubles")
+        if status.dtype != np.intc or not contiguous:
+            raise ValueError("out: contiguous C int statuses")
+        start, (row, step) = _address(block), (s // 8 for s in block.strides)
         done = self._f(
             self._token,
             self._refs(x_names), len(x_names), _addresses(map(_address, columns)), _steps(steps),
             self._refs(y_names), len(y_names),
-            _addresses(start + 8 * count * k for k in range(len(y_names))),
-            _steps([1] * len(y_names)), _address(status), count,
+            _addresses(start + 8 * row * k for k in range(len(y_names))),
+            _steps([step] * len(y_names)), _address(status), count,
         )  # fmt: skip
         return None if done != 0 else (dict(zip(y_names, block, strict=True)), status)
 
