@@ -2126,6 +2126,24 @@ static fmu_status evaluate_lane_alone(const fmu_model* model, column_blocks* b, 
     return sample_status(b->evaluation.status);
 }
 
+/* The angles of `count` lanes into the (cos, sin) of each, in pairs (dyad_cos_sin_pair: the
+ * bits of dyad_cos_sin, which the input block's angles get, in about half its time). */
+static void turn_lanes(double* cos_at, double* sin_at, size_t count)
+{
+    size_t lane;
+    for (lane = 0; lane + 1 < count; lane += 2) {
+        double unit0[2], unit1[2];
+        dyad_cos_sin_pair(cos_at[lane], cos_at[lane + 1], unit0, unit1);
+        cos_at[lane] = unit0[0];
+        sin_at[lane] = unit0[1];
+        cos_at[lane + 1] = unit1[0];
+        sin_at[lane + 1] = unit1[1];
+    }
+    if (lane < count) {
+        dyad_cos_sin(cos_at[lane], &cos_at[lane], &sin_at[lane]);
+    }
+}
+
 /* The x columns' values of the samples from `first` on into their lane columns, column by
  * column (an angle as its unit vector); per lane whether every value lies within its
  * variable's bounds (store_values' check; a sample that fails it is not evaluated). */
@@ -2144,13 +2162,11 @@ static void store_lanes(const column_call* c, const column_place place[], const 
         double* at = g->to[k];
         for (lane = 0; lane < count; ++lane) {
             const double value = x[(ptrdiff_t)lane * step];
-            const int within = value >= low && value <= high;
-            g->stored[lane] &= within;
-            if (!place[k].angle) {
-                at[lane] = value;
-            } else if (within) {
-                dyad_cos_sin(value, &at[lane], &at[lane + stride]);
-            }
+            g->stored[lane] &= value >= low && value <= high;
+            at[lane] = value;
+        }
+        if (place[k].angle) {
+            turn_lanes(at, at + stride, count);
         }
     }
 }
