@@ -518,7 +518,7 @@ DYAD_CLOSED_FORM dyad_real dyad_kin_lane(dyad_type type, kin_position_fn positio
 {
     kin_in in;
     kin_state st;
-    dyad_real bad = DYAD_FAILED(dyad_kin_fields_good(type, input));
+    dyad_real bad = dyad_kin_fields_failed(type, input);
     dyad_kin_load_plain(type, input, input, &in);
     dyad_kin_start_plain(&in, &st);
     bad += DYAD_FAILED(position(&in, &st) == DYAD_KIN_CLOSES);

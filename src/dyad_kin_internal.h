@@ -85,48 +85,74 @@ static inline dyad_real dyad_kin_point_residue(const dyad_point_motion* p)
            dyad_kin_residue(p->acceleration);
 }
 
-/* What a mount must be: its point finite; where it slides, its guide a unit and its
- * rates finite. */
-static inline int dyad_kin_mount_good(const dyad_mount* g, int slides)
+/* 0 where a mount's reals are finite: its point, and where it slides its guide and rates. */
+static inline dyad_real dyad_kin_mount_residue(const dyad_mount* g, int slides)
 {
-    if (!slides) {
-        return dyad_kin_point_residue(&g->point) == 0;
-    }
-    return (dyad_kin_point_residue(&g->point) + dyad_kin_residue(g->guide) + (g->omega - g->omega) +
-                (g->epsilon - g->epsilon) ==
-            0) &
-           dyad_is_unit(g->guide);
+    const dyad_real point = dyad_kin_point_residue(&g->point);
+    return slides ? point + dyad_kin_residue(g->guide) + (g->omega - g->omega) +
+                        (g->epsilon - g->epsilon)
+                  : point;
 }
 
-/* 1 where dyad_kin_first_bad_field finds no bad field: every check at once, without a
- * branch per field (the common case; inlined where the type is a constant, the checks
- * of the fields it does not read go). */
+/* Each check dyad_kin_first_bad_field makes, all at once, without a branch per field
+ * (inlined where the type is a constant, the checks of the fields it does not read go):
+ * CHECK(condition) for each. What a mount must be: its reals finite, and where it slides
+ * its guide a unit. */
+#define DYAD_KIN_FIELD_CHECKS(type, in, CHECK)                                                  \
+    do {                                                                                        \
+        const int slides_dm = dyad_kin_slides(type, DYAD_PAIR_DM);                              \
+        const int slides_e = dyad_kin_slides(type, DYAD_PAIR_E);                                \
+        const int slides_dn = dyad_kin_slides(type, DYAD_PAIR_DN);                              \
+        const dyad_real m = (in)->length_m, n = (in)->length_n;                                 \
+        const dyad_real threshold = (in)->singular_threshold;                                   \
+        const dyad_real mounted = (in)->mount_amplification;                                    \
+        CHECK(dyad_kin_mount_residue(&(in)->k, slides_dm) +                                     \
+                  dyad_kin_mount_residue(&(in)->p, slides_dn) + dyad_kin_residue((in)->com_m) + \
+                  dyad_kin_residue((in)->com_n) + (n - n) + (threshold - threshold) +           \
+                  (mounted - mounted) ==                                                        \
+              0);                                                                               \
+        if (slides_dm) {                                                                        \
+            CHECK(dyad_is_unit((in)->k.guide));                                                 \
+            CHECK(dyad_is_unit((in)->turn_m));                                                  \
+        }                                                                                       \
+        if (slides_dn) {                                                                        \
+            CHECK(dyad_is_unit((in)->p.guide));                                                 \
+        }                                                                                       \
+        if (!slides_e) {                                                                        \
+            CHECK(m - m == 0);                                                                  \
+            CHECK((type) == DYAD_RRR ? m > 0 : m >= 0);                                         \
+        }                                                                                       \
+        CHECK((type) == DYAD_RRR || (type) == DYAD_RRT ? n > 0 : n >= 0);                       \
+        if (slides_e || slides_dn) {                                                            \
+            CHECK(dyad_is_unit((in)->turn_n));                                                  \
+        }                                                                                       \
+        if ((type) == DYAD_RRR || (type) == DYAD_RRT || (type) == DYAD_RTR) {                   \
+            CHECK(((in)->branch == 1) | ((in)->branch == -1));                                  \
+        }                                                                                       \
+        CHECK(threshold > 0);                                                                   \
+        CHECK(threshold < 1);                                                                   \
+        CHECK(mounted >= 0);                                                                    \
+    } while (0)
+
+/* 1 where dyad_kin_first_bad_field finds no bad field. */
 static inline int dyad_kin_fields_good(dyad_type type, const dyad_kin_input* in)
 {
-    const int slides_dm = dyad_kin_slides(type, DYAD_PAIR_DM);
-    const int slides_e = dyad_kin_slides(type, DYAD_PAIR_E);
-    const int slides_dn = dyad_kin_slides(type, DYAD_PAIR_DN);
-    const int two_ways = type == DYAD_RRR || type == DYAD_RRT || type == DYAD_RTR;
-    const dyad_real m = in->length_m, n = in->length_n, threshold = in->singular_threshold;
-    const dyad_real mounted = in->mount_amplification;
-    int good = dyad_kin_mount_good(&in->k, slides_dm) & dyad_kin_mount_good(&in->p, slides_dn);
-    good &= dyad_kin_residue(in->com_m) + dyad_kin_residue(in->com_n) + (n - n) +
-                (threshold - threshold) + (mounted - mounted) ==
-            0;
-    if (!slides_e) {
-        good &= (m - m == 0) & (type == DYAD_RRR ? m > 0 : m >= 0);
-    }
-    good &= type == DYAD_RRR || type == DYAD_RRT ? n > 0 : n >= 0;
-    if (slides_dm) {
-        good &= dyad_is_unit(in->turn_m);
-    }
-    if (slides_e || slides_dn) {
-        good &= dyad_is_unit(in->turn_n);
-    }
-    if (two_ways) {
-        good &= (in->branch == 1) | (in->branch == -1);
-    }
-    return good & (threshold > 0) & (threshold < 1) & (mounted >= 0);
+    int good = 1;
+#define DYAD_KIN_GOOD_IF(condition) good &= (condition)
+    DYAD_KIN_FIELD_CHECKS(type, in, DYAD_KIN_GOOD_IF);
+#undef DYAD_KIN_GOOD_IF
+    return good;
+}
+
+/* The same as the count of the checks that fail, in reals alone: a batch's loop over
+ * samples (dyad_kin_lane) vectorises where its masks are all of one width. */
+static inline dyad_real dyad_kin_fields_failed(dyad_type type, const dyad_kin_input* in)
+{
+    dyad_real bad = 0;
+#define DYAD_KIN_COUNT_UNLESS(condition) bad += DYAD_FAILED(condition)
+    DYAD_KIN_FIELD_CHECKS(type, in, DYAD_KIN_COUNT_UNLESS);
+#undef DYAD_KIN_COUNT_UNLESS
+    return bad;
 }
 
 /* Every motion output, conditioning and amplification of `result` NaN, gap 0,
