@@ -153,7 +153,9 @@ static void gather(const dyad_batch_input* input, size_t first, size_t rows, bat
         }
         if (stride == 1) {
             memcpy(block->in[c], column->data + first, rows * sizeof column->data[0]);
-        } else if (stride == 2) { /* x or y of an (N, 2) array: a loop of its own, vectorised */
+        } else if (stride == 2) {
+            /* x or y of an (N, 2) array, as dyadfmu.solve passes every vector: with the
+             * stride a constant the copy vectorises (3 ns a row of the 35 to 40) */
             const dyad_real* source = column->data + 2 * first;
             size_t r;
             for (r = 0; r < rows; ++r) {

@@ -296,3 +296,25 @@ def test_dyad_solve_batch_loops_vectorise(tmp_path):
 def _machine() -> str:
     done = subprocess.run(["cc", "-dumpmachine"], capture_output=True, text=True)
     return done.stdout
+
+
+def _cmake_flags(text: str, after: str) -> set[str]:
+    """The compiler flags CMake text gives just after ``after`` (a generator expression's
+    list separated by ';', or a set() of words)."""
+    start = text.index(after) + len(after)
+    chunk = text[start : text.index(")", text.index("\n", start) + 1) + 1]
+    return set(re.findall(r"(?:-O3|-f[a-z-]+|--param=[a-z-]+=\d+)", chunk))
+
+
+def test_the_build_compiles_the_lanes_with_the_flags_these_tests_use():
+    """What these tests compile with is what the build gives the lanes: a scene's C
+    (fmu/CMakeLists.txt), the cross-compiled binaries' model C, and src/dyad_batch.c
+    (CMakeLists.txt); a flag dropped there, and the loops would not vectorise in the
+    binaries while these tests still did."""
+    vectorising = {f for f in FLAGS if f.startswith(("-O", "-f", "--param"))}
+    fmu = (ROOT / "fmu" / "CMakeLists.txt").read_text()
+    core = (ROOT / "CMakeLists.txt").read_text()
+    assert _cmake_flags(fmu, "set_source_files_properties(${gen}/${id}_scene.c") == vectorising
+    assert _cmake_flags(fmu, "set(cross_lane_flags") == vectorising
+    wanted = {"-O3", "-fno-trapping-math", "-fno-math-errno"}
+    assert _cmake_flags(core, "set_source_files_properties(src/dyad_batch.c") == wanted
