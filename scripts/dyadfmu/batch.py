@@ -247,28 +247,33 @@ def _given_outputs(out: Reactions, shape: tuple) -> dict[str, np.ndarray]:
     arrays = {}
     kinds = [(name, width, np.float64) for name, width in OUTPUTS]
     for name, width, dtype in kinds + [("status", 1, np.uint8), ("field", 1, np.uint8)]:
-        array = getattr(out, name, None)
         want = shape + ((2,) if width == 2 else ())
-        if not (
-            isinstance(array, np.ndarray)
-            and array.dtype == dtype
-            and array.shape == want
-            and array.flags.c_contiguous
-            and array.flags.writeable
-        ):
-            got = (
-                f"{'a read-only ' if not array.flags.writeable else ''}"
-                f"{'' if array.flags.c_contiguous else 'non-contiguous '}{array.dtype} array "
-                f"of shape {array.shape}"
-                if isinstance(array, np.ndarray)
-                else f"{type(array).__name__} {_shown(array)}"
-            )
-            raise ValueError(
-                f"out.{name} must be a writable C-contiguous {np.dtype(dtype).name} array "
-                f"of shape {want}, not {got}"
-            )
-        arrays[name] = array
+        arrays[name] = _writable(f"out.{name}", getattr(out, name, None), dtype, want)
     return arrays
+
+
+def _writable(label: str, array: object, dtype: type, want: tuple) -> np.ndarray:
+    """`array` where it is a writable C-contiguous array of `dtype` and shape `want`;
+    otherwise refused with `label` and what it is."""
+    if not (
+        isinstance(array, np.ndarray)
+        and array.dtype == dtype
+        and array.shape == want
+        and array.flags.c_contiguous
+        and array.flags.writeable
+    ):
+        got = (
+            f"{'a read-only ' if not array.flags.writeable else ''}"
+            f"{'' if array.flags.c_contiguous else 'non-contiguous '}{array.dtype} array "
+            f"of shape {array.shape}"
+            if isinstance(array, np.ndarray)
+            else f"{type(array).__name__} {_shown(array)}"
+        )
+        raise ValueError(
+            f"{label} must be a writable C-contiguous {np.dtype(dtype).name} array "
+            f"of shape {want}, not {got}"
+        )
+    return array
 
 
 def _span(array: np.ndarray, address: int) -> tuple[int, int]:
@@ -282,12 +287,26 @@ def _span(array: np.ndarray, address: int) -> tuple[int, int]:
     return first, last + array.itemsize
 
 
-def _refuse_overlap(written: dict[str, tuple[int, int]], read: list[tuple[int, int]]) -> None:
-    """A batch's outputs (spans by name) must not share memory with its inputs (spans) nor
-    with each other: the rows are solved in blocks, and an earlier block's results would
-    become a later one's inputs, or be overwritten by another output's. In order of their
-    first byte, a span overlaps an earlier one of a kind exactly when it starts before the
-    furthest end of that kind's spans so far (the output reaching it is `widest`)."""
+def _bounds(array: np.ndarray) -> tuple[int, int]:
+    """_span of an array at its own address (a strided one's read once from NumPy)."""
+    if array.flags.c_contiguous:
+        first = _address(array)
+        return first, first + array.nbytes
+    return _span(array, array.__array_interface__["data"][0])
+
+
+def _refuse_overlap(
+    written: dict[str, tuple[int, int]],
+    read: list[tuple[int, int]],
+    label: str = "out.{}",
+    inputs: str = "an input field",
+) -> None:
+    """A batch's outputs (spans by name; `label` names one in a refusal, `inputs` the
+    inputs) must not share memory with its inputs (spans) nor with each other: the rows
+    are solved in blocks, and an earlier block's results would become a later one's
+    inputs, or be overwritten by another output's. In order of their first byte, a span
+    overlaps an earlier one of a kind exactly when it starts before the furthest end of
+    that kind's spans so far (the output reaching it is `widest`)."""
     spans = [(first, last, name) for name, (first, last) in written.items() if first < last]
     spans += [(first, last, "") for first, last in read if first < last]
     spans.sort()
@@ -297,13 +316,14 @@ def _refuse_overlap(written: dict[str, tuple[int, int]], read: list[tuple[int, i
         if not name:  # an input
             if first < output_end:
                 name = next(n for n, (f, e) in written.items() if f < last and first < e)
-                raise ValueError(f"out.{name} shares memory with an input field: pass a copy")
+                raise ValueError(f"{label.format(name)} shares memory with {inputs}: pass a copy")
             input_end = max(input_end, last)
         elif first < input_end:
-            raise ValueError(f"out.{name} shares memory with an input field: pass a copy")
+            raise ValueError(f"{label.format(name)} shares memory with {inputs}: pass a copy")
         elif first < output_end:
             raise ValueError(
-                f"out.{widest} and out.{name} share memory: each output needs its own array"
+                f"{label.format(widest)} and {label.format(name)} share memory: each output "
+                "needs its own array"
             )
         else:
             output_end, widest = last, name

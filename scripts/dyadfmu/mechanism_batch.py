@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from . import paths
-from .batch import _shown
+from .batch import _bounds, _refuse_overlap, _shown, _writable
 
 __all__ = ["Evaluation", "evaluate"]
 
@@ -137,10 +137,13 @@ def evaluate(
     outputs: list | tuple = (),
     parameters: dict | None = None,
     fmi: int = 2,
+    out: Evaluation | None = None,
 ) -> Evaluation:
     """The ``outputs`` (names of the FMU's Real variables) of ``mechanism`` at every sample
     of ``inputs`` (name -> array or number) with ``parameters`` (tunable parameters,
-    name -> array or number); see the module's text."""
+    name -> array or number); see the module's text. With ``out`` (the Evaluation of an
+    earlier call of the same shape and outputs) the results are written into its arrays,
+    which are returned: a sweep of many batches allocates nothing."""
     from .sweep.rows import columns_entry, rows_entry
 
     fmu = _fmu(mechanism, fmi)
@@ -158,9 +161,37 @@ def evaluate(
         )
     shape = _shape({**x, **p})
     units = {n: units[n] for n in wanted}
+    into = _into(out, wanted, shape, [*x.values(), *p.values()], units)
     by_columns = columns_entry(fmu)
-    done = _by_columns(by_columns, {**x, **p}, wanted, shape, units) if by_columns else None
-    return done if done is not None else _run(entry, x, p, wanted, shape, units)
+    done = _by_columns(by_columns, {**x, **p}, wanted, shape, into) if by_columns else None
+    return done if done is not None else _run(entry, x, p, wanted, shape, into)
+
+
+def _into(
+    out: Evaluation | None, wanted: tuple, shape: tuple, read: list, units: dict
+) -> Evaluation:
+    """The Evaluation the results go into: `out`'s arrays, each checked for its type,
+    shape and layout and that it shares no memory with another or with an input, or new
+    ones (the outputs one row each of a block)."""
+    if out is None:
+        block = np.empty((len(wanted), math.prod(shape)))
+        values = {n: block[k].reshape(shape) for k, n in enumerate(wanted)}
+        return Evaluation(values, units, np.empty(shape, dtype=np.intc))
+    if not isinstance(out, Evaluation):
+        raise TypeError(
+            f"out must be the Evaluation of an earlier dyadfmu.evaluate, not "
+            f"{type(out).__name__} {_shown(out)}"
+        )
+    missing = [n for n in wanted if n not in out.values]
+    if missing:
+        raise ValueError(f"out has no array for {', '.join(missing)}: pass the Evaluation "
+                         "of a call that asked the same outputs")  # fmt: skip
+    arrays = {f"out[{n!r}]": _writable(f"out[{n!r}]", out.values[n], np.float64, shape)
+              for n in wanted}  # fmt: skip
+    arrays["out.status"] = _writable("out.status", out.status, np.intc, shape)
+    spans = {label: _bounds(a) for label, a in arrays.items()}
+    _refuse_overlap(spans, [_bounds(a) for a in read], "{}", "an input or parameter")
+    return Evaluation({n: out.values[n] for n in wanted}, units, out.status)
 
 
 def _flat(array: np.ndarray, shape: tuple) -> np.ndarray:
@@ -171,35 +202,35 @@ def _flat(array: np.ndarray, shape: tuple) -> np.ndarray:
     return np.broadcast_to(array, shape).reshape(-1)
 
 
-def _by_columns(entry: object, x: dict, wanted: tuple, shape: tuple, units: dict):
+def _by_columns(entry: object, x: dict, wanted: tuple, shape: tuple, into: Evaluation):
     """Every sample in chunks of CHUNK through the columns entry (a value held for every
-    sample passed once), each chunk written in place into the outputs' arrays; None where
-    the binary refuses it (a model with states)."""
+    sample passed once), each chunk written in place into `into`'s arrays (checked by
+    _into); None where the binary refuses it (a model with states)."""
     count = math.prod(shape)
     flat = {n: _flat(a, shape) for n, a in x.items()}
-    block = np.empty((len(wanted), count))  # one row per output
-    status = np.empty(count, dtype=np.intc)
+    columns = [into[n].reshape(-1) for n in wanted]  # views: C-contiguous
+    status = into.status.reshape(-1)
     for start in range(0, max(count, 1), CHUNK):
         stop = min(start + CHUNK, count)
         part = {n: a if a.size == 1 else a[start:stop] for n, a in flat.items()}
-        out = (block[:, start:stop], status[start:stop])
-        if entry.evaluate(part, wanted, stop - start, out) is None:
+        ys = [c[start:stop] for c in columns]
+        if entry.write(part, wanted, stop - start, ys, status[start:stop]) is None:
             return None
-    shaped = {n: block[k].reshape(shape) for k, n in enumerate(wanted)}
-    return Evaluation(shaped, units, status.reshape(shape))
+    return into
 
 
-def _run(entry: object, x: dict, p: dict, wanted: tuple, shape: tuple, units: dict) -> Evaluation:
-    """Every sample in chunks of CHUNK, into the outputs' arrays."""
+def _run(entry: object, x: dict, p: dict, wanted: tuple, shape: tuple, into: Evaluation):
+    """Every sample in chunks of CHUNK, into `into`'s arrays."""
     count = math.prod(shape)
-    y = np.empty((count, len(wanted)))
-    status = np.empty(count, dtype=np.intc)
+    columns = [into[n].reshape(-1) for n in wanted]
+    status = into.status.reshape(-1)
     x_names, p_names = tuple(x), tuple(p)
     for start in range(0, count, CHUNK):
         stop = min(start + CHUNK, count)
-        y[start:stop], status[start:stop] = entry.evaluate(
+        y, status[start:stop] = entry.evaluate(
             p_names, _columns(p, p_names, shape, start, stop),
             x_names, _columns(x, x_names, shape, start, stop), wanted,
         )  # fmt: skip
-    values = {n: np.ascontiguousarray(y[:, k]).reshape(shape) for k, n in enumerate(wanted)}
-    return Evaluation(values, units, status.reshape(shape))
+        for k, column in enumerate(columns):
+            column[start:stop] = y[:, k]
+    return into

@@ -8,6 +8,7 @@ refuses write nothing."""
 from __future__ import annotations
 
 import ctypes
+import re
 
 import numpy as np
 import pytest
@@ -235,3 +236,25 @@ def test_outputs_written_in_place_into_strided_views_are_the_same_bits():
     ]:
         with pytest.raises(ValueError, match="out:"):
             entry.evaluate({"crank.angle": angle}, wanted, 301, out=out)
+
+
+def test_outputs_that_share_memory_with_an_input_or_each_other_are_refused():
+    """The binary reads a chunk's inputs while it writes earlier samples' outputs: an
+    output over an input would be read back as one; two outputs in one place lose one."""
+    entry = entries.columns_entry(paths.built_fmu("slider_crank", 2))
+    angle = np.linspace(-7.0, 7.0, 301)
+    wanted = ("crank.torque", "engine.R_mn.x")
+    status = np.zeros(301, np.intc)
+    for columns, message in [
+        ([np.zeros(301), angle], "the output engine.R_mn.x shares memory with an input"),
+        ([np.zeros(301), np.zeros(300)], "out: one array of count values"),
+        ([np.zeros(301)] * 2, "the output crank.torque and the output engine.R_mn.x share memory"),
+        ([np.zeros(301), np.zeros(602)[::2]], None),
+    ]:
+        before = angle.copy()
+        if message is None:
+            assert entry.evaluate({"crank.angle": angle}, wanted, 301, (columns, status))
+            continue
+        with pytest.raises(ValueError, match=re.escape(message)):
+            entry.evaluate({"crank.angle": angle}, wanted, 301, (columns, status))
+        assert np.array_equal(angle, before) and not status.any()

@@ -246,6 +246,7 @@ def _speeds() -> tuple[list[TypeSpeed], list[SceneSpeed]]:
     batch = {(73, False): 1e-6, (73, True): 2e-6, (10_000, False): 3e-7, (10_000, True): 5e-7}
     batch[10_000, "numpy"] = batch[73, "rows"] = 2e-6
     batch[73, "baseline"], batch[10_000, "baseline"] = 2e-6, 2.4e-6
+    batch[10_000, "into"], batch[10_000, "baseline into"] = 2.5e-7, 1.8e-6
     plant = {v: Step(4000.0, 250.0, 0.0, 200.0) for v in (2, 3)}  # 20x: not the rule's
     flops = {False: 900.0, True: 1500.0}
     scenes = [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step), batch, flops)]
@@ -281,6 +282,8 @@ def test_the_study_report_and_its_speed_section_read_as_tables(tmp_path):
     # against the flops' time (900 at RRR's 70 flops in 1e-7 s: 1.29e-6 s), at 10,000
     assert "within 1.5x, worst 1.87x (shaper, 10,000 samples), **not met**" in printed
     assert "under 1x, worst 0.23x (shaper, 10,000 samples), met." in printed
+    assert "Into an earlier call's arrays (`out=`): worst 1.40x and 0.19x." in printed
+    assert _cell(found[4], 2, 5) == "250 ns (0.2x) / 1800 ns (1.4x)"
 
 
 def _cosim_row(name: str, scheme: str, step: float, diverged: bool) -> dict:

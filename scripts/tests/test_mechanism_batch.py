@@ -7,6 +7,7 @@ before anything runs."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -130,3 +131,91 @@ def test_ten_million_samples_with_one_bad_value_are_refused_before_anything_runs
     angle[-1] = np.inf
     with pytest.raises(ValueError, match=r"crank.angle\[9999999\] is inf"):
         evaluate("slider_crank", {"crank.angle": angle}, OUTPUTS)
+
+
+def test_out_takes_the_results_into_an_earlier_evaluation_s_arrays():
+    """``out``: the arrays of an earlier call of the same shape and outputs written in
+    place and returned, each value what a fresh call gives; by the columns entry and by a
+    plant's rows entry alike."""
+    angle = np.linspace(0.0, 6.0, 2 * 150).reshape(2, 150)
+    cases = [
+        ("slider_crank", "crank.angle", {"crank.omega": 80.0}, ["crank.torque", "crank.R_O.x"]),
+        ("slider_crank_forward", "crank.torque", {"piston.force.x": -3.0}, ["crank.R_O.x"]),
+    ]
+    for scene, swept, other, asked in cases:
+        earlier = evaluate(scene, {swept: angle}, asked)
+        kept = {n: earlier[n] for n in asked}
+        changed = {swept: angle[::-1], **other}
+        again = evaluate(scene, changed, asked, out=earlier)
+        fresh = evaluate(scene, changed, asked)
+        assert again.status is earlier.status and np.array_equal(again.status, fresh.status)
+        for name in asked:
+            assert again[name] is kept[name], name
+            assert again[name].tobytes() == fresh[name].tobytes(), (scene, name)
+            assert not np.array_equal(fresh[name], evaluate(scene, {swept: angle}, asked)[name])
+
+
+def _filled(values: dict, shape: tuple) -> object:
+    from dyadfmu.mechanism_batch import Evaluation
+
+    return Evaluation(values, {}, np.full(shape, 9, dtype=np.intc))
+
+
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda a, t: {"crank.torque": t}, "out has no array for engine.R_mk.x"),
+        (lambda a, t: {"crank.torque": t, "engine.R_mk.x": t.astype(np.float32)}, "float64"),
+        (lambda a, t: {"crank.torque": t, "engine.R_mk.x": t[:-1].copy()}, "of shape (40,)"),
+        (lambda a, t: {"crank.torque": t, "engine.R_mk.x": np.full(80, 5.0)[::2]}, "contiguous"),
+        (lambda a, t: {"crank.torque": t, "engine.R_mk.x": _read_only(40)}, "a read-only"),
+        (lambda a, t: {"crank.torque": t, "engine.R_mk.x": t}, "share memory"),
+        (lambda a, t: {"crank.torque": t, "engine.R_mk.x": a}, "shares memory with an input"),
+    ],
+)
+def test_an_unfit_out_is_refused_by_name_and_nothing_is_written(make, message):
+    angle = np.linspace(0.0, 6.0, 40)
+    torque = np.full(40, 5.0)
+    out = _filled(make(angle, torque), (40,))
+    before = {n: np.array(a) for n, a in out.values.items()}
+    with pytest.raises(ValueError, match="out") as refused:
+        evaluate("slider_crank", {"crank.angle": angle}, ["crank.torque", "engine.R_mk.x"],
+                 out=out)  # fmt: skip
+    assert message in str(refused.value)
+    for name, array in out.values.items():
+        assert np.array_equal(array, before[name]), name
+    assert (out.status == 9).all() and np.array_equal(angle, np.linspace(0.0, 6.0, 40))
+
+
+def test_out_of_another_kind_or_with_unfit_statuses_is_refused():
+    angle = np.linspace(0.0, 6.0, 40)
+    with pytest.raises(TypeError, match="out must be the Evaluation of an earlier"):
+        evaluate("slider_crank", {"crank.angle": angle}, ["crank.torque"], out={})
+    from dyadfmu.mechanism_batch import Evaluation
+
+    for status, why in [(np.zeros(40, np.int64), "int64"), (np.zeros(41, np.intc), "(41,)")]:
+        out = Evaluation({"crank.torque": np.zeros(40)}, {}, status)
+        with pytest.raises(ValueError, match=r"out.status must be .*" + re.escape(why)):
+            evaluate("slider_crank", {"crank.angle": angle}, ["crank.torque"], out=out)
+        assert not out["crank.torque"].any()
+
+
+def _read_only(count: int) -> np.ndarray:
+    array = np.zeros(count)
+    array.flags.writeable = False
+    return array
+
+
+def test_an_out_that_overlaps_an_input_only_in_a_later_chunk_is_refused(monkeypatch):
+    """Chunk by chunk no output meets its own chunk's inputs, yet the first chunk's
+    results would become a later chunk's angles: refused before any chunk runs."""
+    from dyadfmu import mechanism_batch
+
+    monkeypatch.setattr(mechanism_batch, "CHUNK", 16)
+    shared = np.linspace(0.0, 6.0, 16 + 40)
+    angle, torque = shared[:40], shared[16:]
+    before = shared.copy()
+    out = _filled({"crank.torque": torque}, (40,))
+    with pytest.raises(ValueError, match=r"out\['crank.torque'\] shares memory with an input"):
+        evaluate("slider_crank", {"crank.angle": angle}, ["crank.torque"], out=out)
+    assert np.array_equal(shared, before) and (out.status == 9).all()

@@ -105,6 +105,7 @@ BATCH_HEADER = (
     "flops per sample: efforts and reactions / every output (their time at the RRR solve's rate)",
     "efforts and reactions, CPU per sample (to that time)",
     "the same in the baseline CPU's lanes (to that time)",
+    "the same two into an earlier call's arrays (out=)",
     "every output, CPU per sample (to that time)",
     "efforts and reactions through the rows entry, CPU per sample",
     "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
@@ -135,12 +136,14 @@ def _batch_rows(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
             yardstick = "-" if math.isnan(numpy) else f"{_ns(numpy)} ({numpy / some:.1f}x)"
             baseline = s.samples.get((count, "baseline"), math.nan)
             times = [_to_floor(some, floor[False]), _to_floor(baseline, floor[False])]
+            into = [s.samples.get((count, k), math.nan) for k in ("into", "baseline into")]
+            times.append(" / ".join(_to_floor(t, floor[False]) for t in into))
             times.append(_to_floor(s.samples[count, True], floor[True]))
             times += [_ns(s.samples.get((count, "rows"), math.nan)), yardstick]
             rows.append([s.scene, f"{count:,}", work, *times])
     if not rows:
         return []
-    return ["", *markup.table(BATCH_HEADER, rows, "-rrrrrrr")]
+    return ["", *markup.table(BATCH_HEADER, rows, "-" + "r" * (len(BATCH_HEADER) - 1))]
 
 
 def _partial(two: object, three: object) -> str:
@@ -185,19 +188,22 @@ def _floor_targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str
     if rrr is None or not timed:
         return []
     rate = rrr.solve_flops / rrr.numpy_seconds_per_row[True]
-    worst = {"baseline": (0.0, ""), False: (0.0, "")}
+    kinds = ("baseline", False, "baseline into", "into")
+    worst = {kind: (0.0, "") for kind in kinds}
     for s in timed:
         count = max(c for c, k in s.samples if k == "baseline")
-        for kind in worst:
-            ratio = s.samples[count, kind] / (s.flops[False] / rate)
+        for kind in kinds:
+            ratio = s.samples.get((count, kind), math.nan) / (s.flops[False] / rate)
             worst[kind] = max(worst[kind], (ratio, f"{s.scene}, {count:,} samples"))
     base, this = worst["baseline"], worst[False]
+    base_into, this_into = worst["baseline into"], worst["into"]
     return [
         f"- A whole mechanism's batch (the efforts and reactions) against the time of the "
         f"flops a scalar evaluation executes for them: in the baseline CPU's lanes within "
         f"{BASELINE_FLOOR_TARGET:g}x, worst {base[0]:.2f}x ({base[1]}), "
         f"{_mark(base[0] <= BASELINE_FLOOR_TARGET)}; in this CPU's (AVX2 where it has it) "
-        f"under 1x, worst {this[0]:.2f}x ({this[1]}), {_mark(this[0] < 1)}."
+        f"under 1x, worst {this[0]:.2f}x ({this[1]}), {_mark(this[0] < 1)}. Into an earlier "
+        f"call's arrays (`out=`): worst {base_into[0]:.2f}x and {this_into[0]:.2f}x."
     ]
 
 

@@ -137,16 +137,18 @@ def numpy_yardstick_seconds(scene: str, count: int, rounds: int) -> float:
 
 
 def batch_seconds(
-    scene: str, count: int, every: bool, rounds: int, baseline: bool = False
+    scene: str, count: int, every: bool, rounds: int, baseline: bool = False, into: bool = False
 ) -> float:
     """CPU seconds per sample of ``dyadfmu.evaluate`` on ``scene`` over ``count`` samples
     of its inputs swinging about their start values (step_rows), asking every Real output
     or the efforts and reactions alone: the best of ``rounds`` calls. ``baseline``: in the
-    lanes compiled for the baseline CPU, whatever this one has (DYADFMU_LANES)."""
+    lanes compiled for the baseline CPU, whatever this one has (DYADFMU_LANES). ``into``:
+    each call writes into an earlier call's arrays (``out=``), as a sweep of many batches
+    does, instead of new ones (whose pages the system clears on their first write)."""
     if baseline:
         os.environ["DYADFMU_LANES"] = "baseline"
         try:
-            return batch_seconds(scene, count, every, rounds)
+            return batch_seconds(scene, count, every, rounds, into=into)
         finally:
             del os.environ["DYADFMU_LANES"]
     from ..mechanism_batch import evaluate
@@ -156,10 +158,11 @@ def batch_seconds(
     asked = [v.name for v in (outputs if every else efforts_and_reactions(outputs))]
     given = {v.name: rows[:, k] for k, v in enumerate(inputs)}
     evaluate(scene, {n: a[:1] for n, a in given.items()}, asked)  # loaded before timing
+    out = evaluate(scene, given, asked) if into else None
     best = math.inf
     for _ in range(rounds):
         started = clock.process_time()
-        evaluate(scene, given, asked)
+        evaluate(scene, given, asked, out=out)
         best = min(best, clock.process_time() - started)
     return best / count
 
@@ -435,6 +438,10 @@ def measure(
                 scenes[-1].samples[count, "baseline"] = batch_seconds(
                     scene, count, False, rounds, baseline=True
                 )
+                for kind, baseline in (("into", False), ("baseline into", True)):
+                    scenes[-1].samples[count, kind] = batch_seconds(
+                        scene, count, False, rounds, baseline, into=True
+                    )
                 scenes[-1].samples[count, "rows"] = rows_seconds(scene, count, rounds)
                 if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
                     scenes[-1].samples[count, "numpy"] = numpy_yardstick_seconds(

@@ -17,6 +17,7 @@ import numpy as np
 from fmpy.model_description import ModelDescription
 
 from .. import paths
+from ..batch import _address, _bounds, _refuse_overlap
 from ..fmi.slave import unpacked
 
 __all__ = ["ColumnsEntry", "RowsEntry", "columns_entry", "rows_entry"]
@@ -86,36 +87,61 @@ class ColumnsEntry(_Entry):
         x: dict[str, np.ndarray],
         y_names: tuple,
         count: int,
-        out: tuple[np.ndarray, np.ndarray] | None = None,
+        out: tuple[object, np.ndarray] | None = None,
     ) -> tuple[dict[str, np.ndarray], np.ndarray] | None:
         """(the outputs ``y_names``, each an array of ``count`` samples; the FMU status of
         each sample: 0 is OK) at the inputs and parameters ``x`` (name -> an array of
         ``count`` float64 values, or of one for every sample). None where the binary
-        refuses the call (a model with states). ``out``: (a float64 array of one row per
-        output and ``count`` columns, a C int array of ``count``) written in place, rows
-        and columns at any strides of whole doubles (views of larger arrays, say)."""
+        refuses the call (a model with states). ``out``: (one float64 array of ``count``
+        values per output, such as the rows of a block; a C int array of ``count``)
+        written in place, each at any stride of whole doubles (views of larger arrays,
+        say), none sharing memory with another or with an input."""
+        if out is None:
+            block, status = np.empty((len(y_names), count)), np.empty(count, dtype=np.intc)
+            out = (list(block), status)
+        else:
+            out = _written(out, y_names, count, [_column(a) for a in x.values()])
+        return self.write(x, y_names, count, *out)
+
+    def write(
+        self, x: dict[str, np.ndarray], y_names: tuple, count: int, ys: list, status: np.ndarray
+    ) -> tuple[dict[str, np.ndarray], np.ndarray] | None:
+        """evaluate into ``ys`` and ``status``, which the caller has checked as evaluate
+        checks its ``out`` (dyadfmu.evaluate checks a whole batch's arrays once)."""
         x_names = tuple(x)
         columns = [_column(x[n]) for n in x_names]
         if any(c.size not in (1, count) for c in columns):
             raise ValueError("every column holds one value or one per sample")
         steps = [0 if c.size == 1 else c.strides[0] // c.itemsize for c in columns]
-        block, status = out or (np.empty((len(y_names), count)), np.empty(count, dtype=np.intc))
-        if block.shape != (len(y_names), count) or status.shape != (count,):
-            raise ValueError("out: one row of count values per output, and count statuses")
-        contiguous = count < 2 or status.strides[0] == status.itemsize
-        if block.dtype != np.float64 or any(s % 8 for s in block.strides):
-            raise ValueError("out: float64 values at strides of whole doubles")
-        if status.dtype != np.intc or not contiguous:
-            raise ValueError("out: contiguous C int statuses")
-        start, (row, step) = _address(block), (s // 8 for s in block.strides)
         done = self._f(
             self._token,
             self._refs(x_names), len(x_names), _addresses(map(_address, columns)), _steps(steps),
-            self._refs(y_names), len(y_names),
-            _addresses(start + 8 * row * k for k in range(len(y_names))),
-            _steps([step] * len(y_names)), _address(status), count,
+            self._refs(y_names), len(y_names), _addresses(map(_address, ys)),
+            _steps([y.strides[0] // 8 for y in ys]), _address(status), count,
         )  # fmt: skip
-        return None if done != 0 else (dict(zip(y_names, block, strict=True)), status)
+        return None if done != 0 else (dict(zip(y_names, ys, strict=True)), status)
+
+
+def _written(
+    out: tuple[object, np.ndarray], y_names: tuple, count: int, columns: list
+) -> tuple[list[np.ndarray], np.ndarray]:
+    """``out``'s output arrays and statuses, checked: float64 outputs of ``count`` at
+    strides of whole doubles, contiguous C int statuses, nothing shared."""
+    block, status = out
+    ys = list(block)
+    if len(ys) != len(y_names) or any(np.shape(y) != (count,) for y in ys):
+        raise ValueError("out: one array of count values per output, and count statuses")
+    if np.shape(status) != (count,):
+        raise ValueError("out: one array of count values per output, and count statuses")
+    if any(y.dtype != np.float64 or y.strides[0] % 8 or not y.flags.writeable for y in ys):
+        raise ValueError("out: writable float64 values at strides of whole doubles")
+    contiguous = count < 2 or status.strides[0] == status.itemsize
+    if status.dtype != np.intc or not contiguous or not status.flags.writeable:
+        raise ValueError("out: writable contiguous C int statuses")
+    spans = {name: _bounds(y) for name, y in zip(y_names, ys, strict=True)}
+    spans["status"] = _bounds(status)
+    _refuse_overlap(spans, [_bounds(c) for c in columns], "the output {}", "an input")
+    return ys, status
 
 
 def _column(values: object) -> np.ndarray:
@@ -125,10 +151,6 @@ def _column(values: object) -> np.ndarray:
     if column.size > 1 and column.strides[0] % column.itemsize != 0:
         column = np.ascontiguousarray(column)
     return column
-
-
-def _address(array: np.ndarray) -> int:
-    return array.__array_interface__["data"][0]
 
 
 def _addresses(addresses: object) -> ctypes.Array:
