@@ -9,12 +9,14 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 from . import paths
 from .argtypes import real, whole
-from .cosim import harness, scenes
-from .mechanisms import builtin
-from .report import tables
+from .cosim import SCENE_NAMES
+
+if TYPE_CHECKING:  # imported where a command runs: a sweep needs none of them
+    from .cosim import harness, scenes
 
 DEFAULT_MECHANISM = "slider-crank"
 
@@ -337,6 +339,8 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _list(args: argparse.Namespace) -> int:
+    from .mechanisms import builtin
+
     for name in builtin.NAMES:
         mech = builtin.load(name)
         print(f"{name:14s} {mech.dyad}  {mech.description}")
@@ -369,6 +373,9 @@ def _print_written(worst: float, written: list[Path]) -> None:
 
 def _mechanism_outputs(args: argparse.Namespace, result: harness.MechanismResult) -> list[Path]:
     """Print one mechanism run's table; write its tables and plots."""
+    from .cosim import harness
+    from .report import tables
+
     rows = tables.error_rows(result.errors)
     print(harness.summary(result))
     print(tables.format_text(rows))
@@ -410,6 +417,9 @@ def _run_each(args: argparse.Namespace, names: list[str], run: Callable, outputs
 
 
 def _run(args: argparse.Namespace) -> int:
+    from .cosim import harness, scenes
+    from .mechanisms import builtin
+
     names = _chosen(args.mechanisms, builtin.NAMES, "mechanism")
     if names is None:
         return 2
@@ -428,11 +438,14 @@ def _run(args: argparse.Namespace) -> int:
 
 def scenes_names() -> tuple[str, ...]:
     """The example scenes, for the help text."""
-    return scenes.NAMES
+    return SCENE_NAMES
 
 
 def _scene_outputs(args: argparse.Namespace, result: scenes.SceneRun) -> list[Path]:
     """Print one scene run's table; write its tables and, for a chain, its drawing."""
+    from .cosim import scenes
+    from .report import tables
+
     rows = tables.error_rows(result.errors)
     print(scenes.summary(result))
     print(tables.format_text(rows))
@@ -460,8 +473,10 @@ def _is_file(name: str) -> bool:
 
 
 def _scene(args: argparse.Namespace) -> int:
+    from .cosim import scenes
+
     files = [Path(n) for n in args.scenes if _is_file(n)]
-    names = _chosen([n for n in args.scenes if not _is_file(n)], scenes.NAMES, "scene")
+    names = _chosen([n for n in args.scenes if not _is_file(n)], SCENE_NAMES, "scene")
     if names is None:
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
@@ -489,10 +504,12 @@ def _own_scene(args: argparse.Namespace, file: Path) -> int:
 def _problem(args: argparse.Namespace) -> str | None:
     """What is wrong with the arguments of a run or scene command beyond each option's own
     type, or None: the names, the length of the run, the output folder."""
+    from .mechanisms import builtin
+
     if args.command == "run":
         names, what, known = args.mechanisms, "mechanism", builtin.NAMES
     else:
-        names, what, known = args.scenes, "scene", scenes.NAMES
+        names, what, known = args.scenes, "scene", SCENE_NAMES
         missing = [n for n in names if _is_file(n) and not Path(n).is_file()]
         if missing:
             return f"no such scene file: {', '.join(missing)}"

@@ -500,3 +500,17 @@ def test_the_fuzz_driver_takes_a_good_count():
         timeout=60,
     )
     assert done.returncode == 1 and "no-such-fmu" in done.stdout + done.stderr
+
+
+def test_the_command_line_imports_no_co_simulation_until_a_command_needs_one():
+    """A sweep's or a study's process starts with the parser: the co-simulations, their
+    mpmath references and matplotlib are imported by the commands that use them (each
+    import a few tens of milliseconds of a sweep that takes a few hundred)."""
+    probe = (
+        "import sys; from dyadfmu import cli; cli.parser(); "
+        "print([m for m in ('mpmath', 'matplotlib', 'dyadfmu.cosim.harness', "
+        "'dyadfmu.cosim.scenes', 'dyadfmu.reference.newton_euler') if m in sys.modules])"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"

@@ -34,6 +34,7 @@ from ..mechanisms import builtin, chains, driven
 from ..mechanisms import geometry as geo
 from ..mechanisms.motion import CrankMotion
 from ..reference import newton_euler
+from . import SCENE_NAMES
 from .compare import (
     NEAR_SINGULAR,
     communication_grid,
@@ -45,7 +46,7 @@ from .compare import (
 SCENES_DIR = paths.SCENES_DIR
 
 #: The tailored example scenes, in the order of the report.
-NAMES = ("press", "monitor", "engine", "shaper", "sixbar", "rocker_slider")
+NAMES = SCENE_NAMES
 
 #: Single-dyad scenes: the mechanism whose kinematics they take, and which scene link is
 #: the mechanism's link m and n.

@@ -26,6 +26,7 @@ from fmpy.fmi2 import (
     fmi2CallbackLoggerTYPE,
 )
 from fmpy.fmi3 import FMU3Slave, fmi3FMUState
+from fmpy.model_description import ModelDescription
 
 __all__ = ["SlaveError", "Slave", "unpacked"]
 
@@ -47,18 +48,33 @@ class SlaveError(FMICallException):
 
 
 _UNPACKED: dict = {}
+_DESCRIBED: dict = {}
+
+
+def _file_version(path: Path | str) -> tuple:
+    """An FMU file's identity: its path, its modification time and its size."""
+    path = Path(path).resolve()
+    stat = path.stat()
+    return str(path), stat.st_mtime_ns, stat.st_size
+
+
+def described(path: Path | str) -> ModelDescription:
+    """An FMU's model description, read once per file version (a study reads it where it
+    checks its names, where it loads the binary and where it runs)."""
+    key = _file_version(path)
+    if key not in _DESCRIBED:
+        _DESCRIBED[key] = read_model_description(key[0])
+    return _DESCRIBED[key]
 
 
 def unpacked(path: Path | str) -> tuple:
     """(model description, directory) of an FMU, unpacked once per file version."""
-    path = Path(path).resolve()
-    stat = path.stat()
-    key = (str(path), stat.st_mtime_ns, stat.st_size)
+    key = _file_version(path)
     if key not in _UNPACKED:
         directory = tempfile.mkdtemp(prefix="dyadfmu_fmu_")
-        with zipfile.ZipFile(path) as archive:
+        with zipfile.ZipFile(key[0]) as archive:
             archive.extractall(directory)
-        _UNPACKED[key] = (read_model_description(str(path)), directory)
+        _UNPACKED[key] = (described(key[0]), directory)
     return _UNPACKED[key]
 
 

@@ -24,6 +24,7 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .. import paths
+from ..fmi.slave import described
 from .scenebuild import BuildError, build_folder, generator, scene_fmu, stale
 from .studyfile import Counterweight, Driven, MultiStroke, Stroke, Study, StudyError, line_of
 
@@ -228,7 +229,7 @@ def planned_model_description(study: Study, out: Path) -> tuple[ModelDescription
     identifier = tomllib.loads(scene.read_text(encoding="utf-8"))["scene"]["identifier"]
     built = build_folder(out) / "fmus" / f"{identifier}_fmi{study.fmi}.fmu"
     if not stale(built, scene, paths.project_dir()):  # the one it will run: no generator
-        return read_model_description(str(built)), built.name
+        return described(built), built.name
     with tempfile.TemporaryDirectory(prefix="dyadfmu-sweep-") as generated:
         done = subprocess.run(
             [sys.executable, str(generator()), str(scene), "--out", generated],
@@ -288,7 +289,7 @@ def model_description(fmu: Path, trial: bool = True) -> ModelDescription:
     whose binary loads (``trial``: tried in a process of its own; the project's own build
     of a study's scene needs no trial)."""
     try:
-        md = read_model_description(str(fmu))
+        md = described(fmu)
         with zipfile.ZipFile(fmu) as archive:
             members = set(archive.namelist())
     except Exception as e:  # a broken archive or XML: zipfile, lxml and fmpy raise their own
