@@ -125,11 +125,7 @@ static const char* const cylinder_field_names[DYAD_CYL_FIELD_COUNT] = {
 dyad_cylinder_input dyad_cylinder_input_default(void)
 {
     /* one copy of a constant: a generated scene starts every cylinder's input from it */
-    static const dyad_cylinder_input defaults = {.pin_b = {1, 0},
-                                                 .length = 1,
-                                                 .branch = 1,
-                                                 .singular_threshold =
-                                                     DYAD_DEFAULT_SINGULAR_THRESHOLD};
+    static const dyad_cylinder_input defaults = DYAD_CYL_INPUT_DEFAULTS;
     return defaults;
 }
 
@@ -161,38 +157,15 @@ static int cyl_part_bad(const dyad_cylinder_part* p, dyad_cylinder_field first,
     return *bad != DYAD_CYL_FIELD_NONE;
 }
 
-static dyad_real cyl_residue(dyad_vec2 v)
-{
-    return (v.x - v.x) + (v.y - v.y);
-}
-
-static dyad_real cyl_motion_residue(const dyad_point_motion* p)
-{
-    return cyl_residue(p->position) + cyl_residue(p->velocity) + cyl_residue(p->acceleration);
-}
-
-static dyad_real cyl_part_residue(const dyad_cylinder_part* p)
-{
-    return (p->mass - p->mass) + (p->com - p->com) + (p->inertia - p->inertia);
-}
-
 /* 1 where cyl_first_bad finds no bad field: every check at once, without a branch per
- * field (x - x is 0 for a finite x, NaN otherwise; a sum of them 0 where all are). */
+ * field (DYAD_CYL_FIELD_CHECKS). */
 static int cyl_fields_good(const dyad_cylinder_input* in)
 {
-    const dyad_cylinder_link* l = &in->link;
-    const dyad_real residue =
-        cyl_motion_residue(&in->a) + cyl_motion_residue(&in->o) + cyl_residue(in->pin_b) +
-        (in->length - in->length) + (in->rate - in->rate) + (in->accel - in->accel) +
-        cyl_part_residue(&in->barrel) + cyl_part_residue(&in->rod) + (l->mass - l->mass) +
-        cyl_residue(l->com) + (l->inertia - l->inertia) + cyl_residue(l->force) +
-        (l->moment - l->moment) + cyl_residue(in->gravity) +
-        (in->mount_amplification - in->mount_amplification);
-    return (residue == 0) & (dyad_dot(in->pin_b, in->pin_b) > 0) & (in->length > 0) &
-           ((in->branch == 1) | (in->branch == -1)) & (in->barrel.mass >= 0) &
-           (in->barrel.inertia >= 0) & (in->rod.mass >= 0) & (in->rod.inertia >= 0) &
-           (l->mass >= 0) & (l->inertia >= 0) & (in->singular_threshold > 0) &
-           (in->singular_threshold < 1) & (in->mount_amplification >= 0);
+    int good = 1;
+#define DYAD_CYL_GOOD_IF(condition) good &= (condition)
+    DYAD_CYL_FIELD_CHECKS(in, DYAD_CYL_GOOD_IF);
+#undef DYAD_CYL_GOOD_IF
+    return good;
 }
 
 /* The first field out of its domain, in the order of dyad_cylinder_field. */
@@ -281,6 +254,64 @@ dyad_status dyad_cyl_reject(dyad_cylinder_result* value, dyad_cylinder_result* r
     return status;
 }
 
+int dyad_cyl_outputs_finite(const dyad_cylinder_result* r)
+{
+    return dyad_cyl_outputs_residue(r) == 0;
+}
+
+dyad_status dyad_cylinder(const dyad_cylinder_input* input, dyad_cylinder_result* result)
+{
+    return cyl_run_plain(input, input, result, result);
+}
+
+#else /* the formulas, over the pass's scalar */
+
+#ifndef DYAD_CYL_FIELD_CHECKS /* once, whatever the passes */
+/* dyad_cylinder_input_default's values: pin_b (1, 0), length 1, branch +1, the default
+ * threshold, everything else 0. */
+#define DYAD_CYL_INPUT_DEFAULTS \
+    {.pin_b = {1, 0},           \
+     .length = 1,               \
+     .branch = 1,               \
+     .singular_threshold = DYAD_DEFAULT_SINGULAR_THRESHOLD}
+
+/* x - x: 0 for a finite x, NaN otherwise; a sum of them is 0 where all are finite. */
+static inline dyad_real dyad_cyl_part_residue(const dyad_cylinder_part* p)
+{
+    return (p->mass - p->mass) + (p->com - p->com) + (p->inertia - p->inertia);
+}
+
+static inline dyad_real dyad_cyl_link_residue(const dyad_cylinder_link* l)
+{
+    return (l->mass - l->mass) + dyad_kin_residue(l->com) + (l->inertia - l->inertia) +
+           dyad_kin_residue(l->force) + (l->moment - l->moment);
+}
+
+/* Each check dyad_cyl_first_bad_field makes, all at once, without a branch per field:
+ * CHECK(condition) for each. */
+#define DYAD_CYL_FIELD_CHECKS(in, CHECK)                                                     \
+    do {                                                                                     \
+        CHECK(dyad_kin_point_residue(&(in)->a) + dyad_kin_point_residue(&(in)->o) +          \
+                  dyad_kin_residue((in)->pin_b) + ((in)->length - (in)->length) +            \
+                  ((in)->rate - (in)->rate) + ((in)->accel - (in)->accel) +                  \
+                  dyad_cyl_part_residue(&(in)->barrel) + dyad_cyl_part_residue(&(in)->rod) + \
+                  dyad_cyl_link_residue(&(in)->link) + dyad_kin_residue((in)->gravity) +     \
+                  ((in)->mount_amplification - (in)->mount_amplification) ==                 \
+              0);                                                                            \
+        CHECK(dyad_dot((in)->pin_b, (in)->pin_b) > 0);                                       \
+        CHECK((in)->length > 0);                                                             \
+        CHECK(((in)->branch == 1) | ((in)->branch == -1));                                   \
+        CHECK((in)->barrel.mass >= 0);                                                       \
+        CHECK((in)->barrel.inertia >= 0);                                                    \
+        CHECK((in)->rod.mass >= 0);                                                          \
+        CHECK((in)->rod.inertia >= 0);                                                       \
+        CHECK((in)->link.mass >= 0);                                                         \
+        CHECK((in)->link.inertia >= 0);                                                      \
+        CHECK((in)->singular_threshold > 0);                                                 \
+        CHECK((in)->singular_threshold < 1);                                                 \
+        CHECK((in)->mount_amplification >= 0);                                               \
+    } while (0)
+
 /* The four motions of a result (B and the centres of mass), one after the other: one
  * array of reals. */
 #define CYL_MOTION_REALS 24
@@ -291,27 +322,20 @@ typedef char cyl_motions_are_contiguous[offsetof(dyad_cylinder_result, link_com)
                                             ? 1
                                             : -1];
 
-int dyad_cyl_outputs_finite(const dyad_cylinder_result* r)
+/* 0 where every output dyad_cylinder checks is finite (x - x is 0 for a finite x and NaN
+ * otherwise: the sum of them is 0 where all are). */
+static inline dyad_real dyad_cyl_outputs_residue(const dyad_cylinder_result* r)
 {
-    /* x - x is 0 for a finite x and NaN otherwise: the sum of them is 0 where all are */
     const dyad_real* v =
         (const dyad_real*)(const void*)((const char*)r + offsetof(dyad_cylinder_result, b));
-    const dyad_real residue =
-        dyad_residue_of(v, CYL_MOTION_REALS) + (r->link_omega - r->link_omega) +
-        (r->link_epsilon - r->link_epsilon) + (r->cylinder_omega - r->cylinder_omega) +
-        (r->cylinder_epsilon - r->cylinder_epsilon) + (r->axial_force - r->axial_force) +
-        (r->r_a.x - r->r_a.x) + (r->r_a.y - r->r_a.y) + (r->r_b.x - r->r_b.x) +
-        (r->r_b.y - r->r_b.y) + (r->r_o.x - r->r_o.x) + (r->r_o.y - r->r_o.y) +
-        (r->n_rod - r->n_rod) + (r->m_rod - r->m_rod);
-    return residue == 0;
+    return dyad_residue_of(v, CYL_MOTION_REALS) + (r->link_omega - r->link_omega) +
+           (r->link_epsilon - r->link_epsilon) + (r->cylinder_omega - r->cylinder_omega) +
+           (r->cylinder_epsilon - r->cylinder_epsilon) + (r->axial_force - r->axial_force) +
+           (r->r_a.x - r->r_a.x) + (r->r_a.y - r->r_a.y) + (r->r_b.x - r->r_b.x) +
+           (r->r_b.y - r->r_b.y) + (r->r_o.x - r->r_o.x) + (r->r_o.y - r->r_o.y) +
+           (r->n_rod - r->n_rod) + (r->m_rod - r->m_rod);
 }
-
-dyad_status dyad_cylinder(const dyad_cylinder_input* input, dyad_cylinder_result* result)
-{
-    return cyl_run_plain(input, input, result, result);
-}
-
-#else /* the formulas, over the pass's scalar */
+#endif
 
 dyad_cylinder_field dyad_cyl_first_bad_field(const dyad_cylinder_input* in);
 dyad_status dyad_cyl_reject(dyad_cylinder_result* value, dyad_cylinder_result* rate,
@@ -353,7 +377,8 @@ typedef struct DYAD_KIN(cyl_state) {
     dyad_kv r_a, r_bf, r_o;
 } DYAD_KIN(cyl_state);
 
-static kin_motion DYAD_KIN(cyl_motion_in)(const dyad_point_motion* v, const dyad_point_motion* s)
+DYAD_KIN_STEP kin_motion DYAD_KIN(cyl_motion_in)(const dyad_point_motion* v,
+                                                 const dyad_point_motion* s)
 {
     kin_motion m;
     (void)s; /* the seed: read on the dual pass only */
@@ -363,7 +388,7 @@ static kin_motion DYAD_KIN(cyl_motion_in)(const dyad_point_motion* v, const dyad
     return m;
 }
 
-static DYAD_KIN(cyl_body)
+DYAD_KIN_STEP DYAD_KIN(cyl_body)
     DYAD_KIN(cyl_body_in)(dyad_real mass, dyad_real dmass, dyad_real inertia, dyad_real dinertia)
 {
     DYAD_KIN(cyl_body) b;
@@ -375,8 +400,8 @@ static DYAD_KIN(cyl_body)
     return b;
 }
 
-static void DYAD_KIN(cyl_load_input)(const dyad_cylinder_input* v, const dyad_cylinder_input* s,
-                                     DYAD_KIN(cyl_in) * in)
+DYAD_KIN_STEP void DYAD_KIN(cyl_load_input)(const dyad_cylinder_input* v,
+                                            const dyad_cylinder_input* s, DYAD_KIN(cyl_in) * in)
 {
     in->a = DYAD_KIN(cyl_motion_in)(&v->a, &s->a);
     in->o = DYAD_KIN(cyl_motion_in)(&v->o, &s->o);
@@ -399,8 +424,8 @@ static void DYAD_KIN(cyl_load_input)(const dyad_cylinder_input* v, const dyad_cy
 }
 
 /* The triangle O, A, B (the derivation at the top). */
-static dyad_kin_failure DYAD_KIN(cyl_position)(const DYAD_KIN(cyl_in) * in,
-                                               DYAD_KIN(cyl_state) * st)
+DYAD_KIN_STEP dyad_kin_failure DYAD_KIN(cyl_position)(const DYAD_KIN(cyl_in) * in,
+                                                      DYAD_KIN(cyl_state) * st)
 {
     const dyad_kv d = kv_sub(in->a.pos, in->o.pos);
     const dyad_ks l2 = kv_dot(d, d), len = ks_sqrt(l2);
@@ -442,8 +467,8 @@ static dyad_kin_failure DYAD_KIN(cyl_position)(const DYAD_KIN(cyl_in) * in,
 /* The motion's round-off bound: the triangle's own, and the mounts' carried in,
  * their positions' round-off (relative to their distance from the origin) taken
  * relative to the triangle's size (dyad_kin_amplification does the same). */
-static dyad_ks DYAD_KIN(cyl_kin_amplification)(const DYAD_KIN(cyl_in) * in,
-                                               const DYAD_KIN(cyl_state) * st)
+DYAD_KIN_STEP dyad_ks DYAD_KIN(cyl_kin_amplification)(const DYAD_KIN(cyl_in) * in,
+                                                      const DYAD_KIN(cyl_state) * st)
 {
     const dyad_ks own =
         ks_add(ks_add(ks_c(1), ks_div(ks_c(1), st->closure)), ks_div(ks_c(1), st->conditioning));
@@ -453,15 +478,15 @@ static dyad_ks DYAD_KIN(cyl_kin_amplification)(const DYAD_KIN(cyl_in) * in,
 }
 
 /* B from O along the link and from A along the cylinder, with the rates in st. */
-static void DYAD_KIN(cyl_sides)(const DYAD_KIN(cyl_in) * in, const DYAD_KIN(cyl_state) * st,
-                                kin_motion* from_o, kin_motion* from_a)
+DYAD_KIN_STEP void DYAD_KIN(cyl_sides)(const DYAD_KIN(cyl_in) * in, const DYAD_KIN(cyl_state) * st,
+                                       kin_motion* from_o, kin_motion* from_a)
 {
     const kin_coord r = DYAD_KIN(dyad_kin_coord_of)(st->r_b, ks_c(0), ks_c(0));
     *from_o = DYAD_KIN(dyad_kin_arm)(&in->o, r, st->e, st->w_l, st->e_l);
     *from_a = DYAD_KIN(dyad_kin_arm)(&in->a, in->s, st->u, st->w_c, st->e_c);
 }
 
-static void DYAD_KIN(cyl_motion)(const DYAD_KIN(cyl_in) * in, DYAD_KIN(cyl_state) * st)
+DYAD_KIN_STEP void DYAD_KIN(cyl_motion)(const DYAD_KIN(cyl_in) * in, DYAD_KIN(cyl_state) * st)
 {
     const dyad_kv col_l = kv_scale(st->r_b, kv_perp(st->e));
     const dyad_kv col_c = kv_scale(ks_neg(in->s.q), kv_perp(st->u));
@@ -480,7 +505,7 @@ static void DYAD_KIN(cyl_motion)(const DYAD_KIN(cyl_in) * in, DYAD_KIN(cyl_state
 }
 
 /* A body's resultant about its pin p, its centre of mass at p + q (the derivation). */
-static DYAD_KIN(cyl_load)
+DYAD_KIN_STEP DYAD_KIN(cyl_load)
     DYAD_KIN(cyl_reduce)(const DYAD_KIN(cyl_body) * b, const kin_motion* p, dyad_kv q,
                          dyad_ks omega, dyad_ks epsilon, dyad_kv gravity)
 {
@@ -500,7 +525,7 @@ static DYAD_KIN(cyl_load)
 }
 
 /* size / largest in [1, 1/eps], as dyad_data_factor. */
-static dyad_ks DYAD_KIN(cyl_data_factor)(dyad_ks size, dyad_ks largest)
+DYAD_KIN_STEP dyad_ks DYAD_KIN(cyl_data_factor)(dyad_ks size, dyad_ks largest)
 {
     if (!(ks_val(size) <= ks_val(largest) * (1 / DYAD_REAL_EPSILON))) {
         return ks_c(1 / DYAD_REAL_EPSILON);
@@ -508,20 +533,22 @@ static dyad_ks DYAD_KIN(cyl_data_factor)(dyad_ks size, dyad_ks largest)
     return ks_val(size) > ks_val(largest) ? ks_div(size, largest) : ks_c(1);
 }
 
-static dyad_ks DYAD_KIN(cyl_max)(dyad_ks a, dyad_ks b)
+DYAD_KIN_STEP dyad_ks DYAD_KIN(cyl_max)(dyad_ks a, dyad_ks b)
 {
     return ks_val(a) > ks_val(b) ? a : b;
 }
 
-static dyad_ks DYAD_KIN(cyl_largest)(dyad_kv a)
+DYAD_KIN_STEP dyad_ks DYAD_KIN(cyl_largest)(dyad_kv a)
 {
     return DYAD_KIN(cyl_max)(ks_abs(kv_x(a)), ks_abs(kv_y(a)));
 }
 
 /* amplification = data factor x kin_amplification, from the loads' sizes. */
-static void DYAD_KIN(cyl_amplification)(const DYAD_KIN(cyl_load) * c, const DYAD_KIN(cyl_load) * r,
-                                        const DYAD_KIN(cyl_load) * l, const DYAD_KIN(cyl_in) * in,
-                                        DYAD_KIN(cyl_state) * st)
+DYAD_KIN_STEP void DYAD_KIN(cyl_amplification)(const DYAD_KIN(cyl_load) * c,
+                                               const DYAD_KIN(cyl_load) * r,
+                                               const DYAD_KIN(cyl_load) * l,
+                                               const DYAD_KIN(cyl_in) * in,
+                                               DYAD_KIN(cyl_state) * st)
 {
     const dyad_ks n_size = ks_div(ks_add(c->m_size, r->m_size), in->s.q);
     const dyad_ks q_size = ks_add(n_size, r->f_size);
@@ -540,7 +567,7 @@ static void DYAD_KIN(cyl_amplification)(const DYAD_KIN(cyl_load) * c, const DYAD
 }
 
 /* The nine unknowns, each from one equation (the derivation at the top). */
-static void DYAD_KIN(cyl_reactions)(const DYAD_KIN(cyl_in) * in, DYAD_KIN(cyl_state) * st)
+DYAD_KIN_STEP void DYAD_KIN(cyl_reactions)(const DYAD_KIN(cyl_in) * in, DYAD_KIN(cyl_state) * st)
 {
     const dyad_kv j = kv_perp(st->u);
     const dyad_kv q_c = kv_scale(in->com_c, st->u), q_r = kv_scale(ks_neg(in->com_r), st->u);
@@ -564,7 +591,7 @@ static void DYAD_KIN(cyl_reactions)(const DYAD_KIN(cyl_in) * in, DYAD_KIN(cyl_st
     DYAD_KIN(cyl_amplification)(&c, &r, &l, in, st);
 }
 
-static dyad_ks DYAD_KIN(cyl_angle)(dyad_kv a)
+DYAD_KIN_STEP dyad_ks DYAD_KIN(cyl_angle)(dyad_kv a)
 {
 #if DYAD_KIN_IS_DUAL
     return dyad_kd_atan2(kv_y(a), kv_x(a));
@@ -573,8 +600,8 @@ static dyad_ks DYAD_KIN(cyl_angle)(dyad_kv a)
 #endif
 }
 
-static void DYAD_KIN(cyl_put_motion)(const kin_motion* a, dyad_point_motion* to,
-                                     dyad_point_motion* rate)
+DYAD_KIN_STEP void DYAD_KIN(cyl_put_motion)(const kin_motion* a, dyad_point_motion* to,
+                                            dyad_point_motion* rate)
 {
     (void)rate;
     kv_put(a->pos, &to->position, &rate->position);
@@ -582,8 +609,9 @@ static void DYAD_KIN(cyl_put_motion)(const kin_motion* a, dyad_point_motion* to,
     kv_put(a->acc, &to->acceleration, &rate->acceleration);
 }
 
-static void DYAD_KIN(cyl_put_figures)(const DYAD_KIN(cyl_state) * st, dyad_cylinder_result* value,
-                                      dyad_cylinder_result* rate)
+DYAD_KIN_STEP void DYAD_KIN(cyl_put_figures)(const DYAD_KIN(cyl_state) * st,
+                                             dyad_cylinder_result* value,
+                                             dyad_cylinder_result* rate)
 {
     (void)rate;
     ks_put(st->conditioning, &value->conditioning, &rate->conditioning);
@@ -591,16 +619,16 @@ static void DYAD_KIN(cyl_put_figures)(const DYAD_KIN(cyl_state) * st, dyad_cylin
     ks_put(st->kin_amp, &value->kin_amplification, &rate->kin_amplification);
 }
 
-static void DYAD_KIN(cyl_store)(const DYAD_KIN(cyl_state) * st, dyad_cylinder_result* value,
-                                dyad_cylinder_result* rate)
+/* Every output but the two angles (whose atan2 a batch's loop takes after it). */
+DYAD_KIN_STEP void DYAD_KIN(cyl_store_but_angles)(const DYAD_KIN(cyl_state) * st,
+                                                  dyad_cylinder_result* value,
+                                                  dyad_cylinder_result* rate)
 {
     (void)rate;
     kv_put(st->i_l, &value->link_dir, &rate->link_dir);
-    ks_put(DYAD_KIN(cyl_angle)(st->i_l), &value->link_angle, &rate->link_angle);
     ks_put(st->w_l, &value->link_omega, &rate->link_omega);
     ks_put(st->e_l, &value->link_epsilon, &rate->link_epsilon);
     kv_put(st->u, &value->axis, &rate->axis);
-    ks_put(DYAD_KIN(cyl_angle)(st->u), &value->cylinder_angle, &rate->cylinder_angle);
     ks_put(st->w_c, &value->cylinder_omega, &rate->cylinder_omega);
     ks_put(st->e_c, &value->cylinder_epsilon, &rate->cylinder_epsilon);
     DYAD_KIN(cyl_put_motion)(&st->b, &value->b, &rate->b);
@@ -617,11 +645,19 @@ static void DYAD_KIN(cyl_store)(const DYAD_KIN(cyl_state) * st, dyad_cylinder_re
     DYAD_KIN(cyl_put_figures)(st, value, rate);
 }
 
+DYAD_KIN_STEP void DYAD_KIN(cyl_store)(const DYAD_KIN(cyl_state) * st, dyad_cylinder_result* value,
+                                       dyad_cylinder_result* rate)
+{
+    DYAD_KIN(cyl_store_but_angles)(st, value, rate);
+    ks_put(DYAD_KIN(cyl_angle)(st->i_l), &value->link_angle, &rate->link_angle);
+    ks_put(DYAD_KIN(cyl_angle)(st->u), &value->cylinder_angle, &rate->cylinder_angle);
+}
+
 /* The whole of dyad_cylinder (plain pass: seed = input, rate = value) and of
  * its tangent (dual pass). */
-static dyad_status DYAD_KIN(cyl_run)(const dyad_cylinder_input* input,
-                                     const dyad_cylinder_input* seed, dyad_cylinder_result* value,
-                                     dyad_cylinder_result* rate)
+DYAD_KIN_STEP dyad_status DYAD_KIN(cyl_run)(const dyad_cylinder_input* input,
+                                            const dyad_cylinder_input* seed,
+                                            dyad_cylinder_result* value, dyad_cylinder_result* rate)
 {
     static const DYAD_KIN(cyl_state) cleared;
     DYAD_KIN(cyl_state) st = cleared;
@@ -659,5 +695,34 @@ static dyad_status DYAD_KIN(cyl_run)(const dyad_cylinder_input* input,
     value->gap = rate->gap = 0;
     return DYAD_STATUS_OK;
 }
+
+#if !DYAD_KIN_IS_DUAL
+/* One sample of a batch (dyad_lanes.h): cyl_run's steps without a branch, so that a loop
+ * over samples vectorises. Every check is made and counted: 0 is returned where
+ * dyad_cylinder gives DYAD_STATUS_OK, and then `value` holds its outputs bit for bit but
+ * for the two angles, which are not written (an angle's atan2, a call, would keep the loop
+ * from vectorising: a scene takes them from link_dir and axis after it), nor are the
+ * status, field, failure and gap; elsewhere the count of the failed checks, and outputs
+ * that mean nothing (dyad_cylinder says why). */
+DYAD_CLOSED_FORM dyad_real dyad_cylinder_lane(const dyad_cylinder_input* input,
+                                              dyad_cylinder_result* value)
+{
+    static const DYAD_KIN(cyl_state) cleared;
+    DYAD_KIN(cyl_state) st = cleared;
+    DYAD_KIN(cyl_in) in;
+    dyad_real bad = 0;
+#define DYAD_CYL_COUNT_UNLESS(condition) bad += DYAD_FAILED(condition)
+    DYAD_CYL_FIELD_CHECKS(input, DYAD_CYL_COUNT_UNLESS);
+#undef DYAD_CYL_COUNT_UNLESS
+    DYAD_KIN(cyl_load_input)(input, input, &in);
+    bad += DYAD_FAILED(DYAD_KIN(cyl_position)(&in, &st) == DYAD_KIN_CLOSES);
+    st.kin_amp = DYAD_KIN(cyl_kin_amplification)(&in, &st);
+    bad += DYAD_FAILED(st.kin_amp * in.threshold <= 1);
+    DYAD_KIN(cyl_motion)(&in, &st);
+    DYAD_KIN(cyl_reactions)(&in, &st);
+    DYAD_KIN(cyl_store_but_angles)(&st, value, value);
+    return bad + DYAD_FAILED(dyad_cyl_outputs_residue(value) == 0);
+}
+#endif
 
 #endif

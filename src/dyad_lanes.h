@@ -4,7 +4,7 @@
  *
  * A vector loop cannot branch per sample, and cannot call: each function here is the
  * computation of its public twin (dyad_kinematics_<type>, dyad_react_<type>,
- * dyad_solve_<type>, dyad_point_on_link, dyad_force_size, ...) with every check made
+ * dyad_solve_<type>, dyad_cylinder, dyad_point_on_link, dyad_force_size, ...) with every check made
  * and counted instead of acted on, inlined from the same source (the kinematics' formulas of
  * dyad_kin_<type>.c, the reactions' closed forms of dyad_<type>.c). Where a function
  * returns 0, its twin says DYAD_STATUS_OK and its outputs are its twin's, bit for bit;
@@ -45,6 +45,10 @@
 #include "dyad_kin_rtt.c"
 #include "dyad_rtt.c"
 #endif
+#ifdef DYAD_LANES_CYLINDER
+#include "dyadfmu/cylinder.h"
+#include "dyad_cylinder.c"
+#endif
 #undef DYAD_KIN_FORMULAS
 #undef DYAD_REACT_FORMULAS
 
@@ -68,6 +72,15 @@ static inline dyad_kin_input dyad_lane_kin_input_default(void)
     const dyad_kin_input defaults = DYAD_KIN_INPUT_DEFAULTS;
     return defaults;
 }
+
+#ifdef DYAD_LANES_CYLINDER
+/* dyad_cylinder_input_default. */
+static inline dyad_cylinder_input dyad_lane_cylinder_input_default(void)
+{
+    const dyad_cylinder_input defaults = DYAD_CYL_INPUT_DEFAULTS;
+    return defaults;
+}
+#endif
 
 /* dyad_point_on_link. */
 #define dyad_lane_point_on_link dyad_kin_point_on_link

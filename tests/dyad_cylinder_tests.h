@@ -630,3 +630,64 @@ static int test_cylinder_invalid(void)
           "field name");
     return fails;
 }
+
+/* dyad_cylinder_lane answers 0 exactly where dyad_cylinder says ok, and then gives its
+ * outputs bit for bit but for the two angles (taken after a batch's loop); over random
+ * cylinders, half of them spoiled: beyond the stroke, a threshold no conditioning
+ * passes, a field NaN, infinite or negative, a load that overflows. */
+static int test_cylinder_lane_matches_cylinder(void)
+{
+    int fails = 0, k, ok = 0, refused = 0;
+    rng r = {0xC7100007u};
+    const size_t fields = sizeof cyl_real_fields / sizeof cyl_real_fields[0];
+    const size_t angles[2] = {offsetof(dyad_cylinder_result, link_angle),
+                              offsetof(dyad_cylinder_result, cylinder_angle)};
+    for (k = 0; k < 6000; ++k) {
+        dyad_cylinder_input in = cyl_random(&r, k % 2);
+        dyad_cylinder_result want, got;
+        dyad_status s;
+        dyad_real bad;
+        size_t j;
+        switch ((int)uniform(&r, 0, 10)) {
+        case 0: in.length = (dyad_real)(3 * in.length + 5); break;
+        case 1: in.singular_threshold = (dyad_real)0.999; break;
+        case 2:
+        case 3: {
+            const cyl_real_field* f = &cyl_real_fields[(size_t)uniform(&r, 0, (double)fields)];
+            const double poison = k % 3 == 0 ? NAN : k % 3 == 1 ? INFINITY : -1;
+            *(dyad_real*)(void*)((char*)&in + f->offset) = (dyad_real)poison;
+            break;
+        }
+        case 4: in.link.moment = (dyad_real)(HUGE_REAL * 0.5); break;
+        default: break;
+        }
+        memset(&want, 0, sizeof want); /* the padding too: compared as bytes */
+        memset(&got, 0, sizeof got);
+        s = dyad_cylinder(&in, &want);
+        bad = dyad_cylinder_lane(&in, &got);
+        CHECK((bad == 0) == (s == DYAD_STATUS_OK), "cylinder %d: status %s, lane %g", k,
+              dyad_status_name(s), (double)bad);
+        if (s == DYAD_STATUS_OK) {
+            for (j = 0; j < 2; ++j) { /* the angles the lane leaves: the same as the twin's */
+                memcpy((char*)&got + angles[j], (const char*)&want + angles[j], sizeof(dyad_real));
+            }
+            got.status = want.status;
+            got.field = want.field;
+            got.failure = want.failure;
+            got.gap = want.gap;
+            CHECK(memcmp(&got, &want, sizeof got) == 0, "cylinder %d: the lane's outputs differ",
+                  k);
+            ++ok;
+        } else {
+            ++refused;
+        }
+    }
+    CHECK(ok > 2000 && refused > 2000, "%d ok, %d not: both sides of the checks reached", ok,
+          refused);
+    {
+        const dyad_cylinder_input a = dyad_cylinder_input_default();
+        const dyad_cylinder_input b = dyad_lane_cylinder_input_default();
+        CHECK(memcmp(&a, &b, sizeof a) == 0, "the lane's default cylinder input differs");
+    }
+    return fails;
+}

@@ -26,6 +26,7 @@
 #define DYAD_LANES_RTR
 #define DYAD_LANES_TRT
 #define DYAD_LANES_RTT
+#define DYAD_LANES_CYLINDER
 #include "dyad_lanes.h"
 #include "named_tests.h"
 
@@ -2809,6 +2810,7 @@ static const named_test tests[] = {
     {"cylinder_pins_close", test_cylinder_pins_close},
     {"cylinder_invalid", test_cylinder_invalid},
     {"cylinder_every_field_poisoned", test_cylinder_every_field_poisoned},
+    {"cylinder_lane_matches_cylinder", test_cylinder_lane_matches_cylinder},
 };
 
 int main(int argc, char** argv)

@@ -138,7 +138,8 @@ def _driver(ident: str, has_first: bool) -> str:
 
 def _inputs(table, rng: np.random.Generator) -> np.ndarray:
     """SAMPLES input blocks: angles turned at random, other inputs scattered about their
-    starts by their units' sizes; one sample in twenty with an input NaN, one with an
+    starts by their units' sizes, a tunable branch kept (the other assembly of a chain
+    may not close anywhere near); one sample in twenty with an input NaN, one with an
     input of 1e300."""
     members, _ = block_reals(table.scene)
     start = {v.lives.path: float(v.start) for v in table.variables if v.start is not None}
@@ -149,6 +150,8 @@ def _inputs(table, rng: np.random.Generator) -> np.ndarray:
         if angle:
             turn = rng.uniform(-np.pi, np.pi, SAMPLES)
             columns += [np.cos(turn), np.sin(turn)]
+        elif member.endswith("branch"):
+            columns.append(np.full(SAMPLES, start.get(member, 1.0)))
         else:
             size = scale.get(unit.get(member) or "", 10.0)
             columns.append(start.get(member, 0.0) + size * rng.standard_normal(SAMPLES))

@@ -9,7 +9,7 @@ none of whose checks failed has exactly the outputs evaluate gives it. A sample 
 failed check is flagged, and its caller asks evaluate for its status and reason. An
 angle's atan2, a call, is taken after the loop from the direction the loop leaves.
 
-For now a mechanism whose drivers are cranks or rams: a cylinder has no lane yet.
+A mechanism whose drivers are cranks, rams or cylinders (dyad_cylinder_lane).
 """
 
 from __future__ import annotations
@@ -22,14 +22,15 @@ CHUNK = 32
 
 
 def batch_supported(scene: Scene) -> bool:
-    """Whether the scene has a batch evaluation: a mechanism without states or
-    cylinders."""
-    return scene.internal() and not scene.forward() and not kinematics_c.cylinders(scene)
+    """Whether the scene has a batch evaluation: a mechanism without states."""
+    return scene.internal() and not scene.forward()
 
 
 def batch_include(scene: Scene) -> str:
-    """The lanes of the scene's dyad types (src/dyad_lanes.h), for the top of its C."""
+    """The lanes of the scene's dyad types and of its cylinders (src/dyad_lanes.h), for
+    the top of its C."""
     types = sorted({d.type for d in scene.dyads})
+    types += ["CYLINDER"] if kinematics_c.cylinders(scene) else []
     return "".join(f"#define DYAD_LANES_{t}\n" for t in types) + '#include "dyad_lanes.h"\n'
 
 

@@ -270,8 +270,9 @@ def _pin_motion(mounts: _Mounts, driver: Crank, key: str) -> str:
     return f"dyad_point_on_link({origin}, {direction}, {omega}, {epsilon}, {point})"
 
 
-def _cylinder_lines(scene: Scene, mounts: _Mounts, driver: Crank) -> list[str]:
-    """A cylinder's motion and that of the link it turns."""
+def _cylinder_lines(scene: Scene, mounts: _Mounts, driver: Crank, lane: bool) -> list[str]:
+    """A cylinder's motion and that of the link it turns (with `lane`, by its twin of
+    src/dyad_lanes.h, whose failed checks it counts)."""
     c = member(driver.name)
     result = f"kin->{kin_name_of_cylinder(driver)}"
     cin = "cin" if len(scene.drivers) == 1 else f"cin_{member(driver.actuator)}"
@@ -291,6 +292,8 @@ def _cylinder_lines(scene: Scene, mounts: _Mounts, driver: Crank) -> list[str]:
     ]
     if carried:
         out.append(f"{cin}.mount_amplification = {' + '.join(carried)};")
+    if lane:
+        return [*out, f"bad += dyad_cylinder_lane(&{cin}, &{result});"]
     failed = len(scene.dyads) + cylinders(scene).index(driver)
     out += [
         f"if (dyad_cylinder(&{cin}, &{result}) != DYAD_STATUS_OK) {{",
@@ -306,10 +309,10 @@ def cylinders(scene: Scene) -> list[Crank]:
     return [d for d in scene.drivers if d.is_cylinder()]
 
 
-def _driver_lines(scene: Scene, mounts: _Mounts, driver: Crank) -> list[str]:
+def _driver_lines(scene: Scene, mounts: _Mounts, driver: Crank, lane: bool) -> list[str]:
     """A driver's frame and the motion of its origin (O or R)."""
     if driver.is_cylinder():
-        return _cylinder_lines(scene, mounts, driver)
+        return _cylinder_lines(scene, mounts, driver, lane)
     c = member(driver.name)
     at = _vec(driver.params["at.x"].c(), driver.params["at.y"].c())
     if driver.is_ram():
@@ -329,18 +332,24 @@ def _driver_lines(scene: Scene, mounts: _Mounts, driver: Crank) -> list[str]:
 
 def kinematics_body(scene: Scene, dyads: list[Dyad], lane: bool = False) -> list[str]:
     """The statements of the function `kinematics` (with `lane`, of `kinematics_lane`,
-    which counts the failed checks of a batch's sample; a cylinder has no lane)."""
+    which counts the failed checks of a batch's sample)."""
     mounts = _Mounts(scene)
-    body = [line for driver in scene.drivers for line in _driver_lines(scene, mounts, driver)]
+    body = [line for driver in scene.drivers for line in _driver_lines(scene, mounts, driver, lane)]
     body += ["dyad_kin_input k;"] if dyads else []
     for d in dyads:
         body += _dyad_lines(scene, mounts, d, lane)
     if not lane:
         return [*body, "return NULL;"]
-    if cylinders(scene):
-        raise ValueError("a batch's lane has no cylinder")
-    body = [line.replace("dyad_point_on_link(", "dyad_lane_point_on_link(") for line in body]
+    body = [lane_twins(line) for line in body]
     return ["dyad_real bad = 0;", *body, "return bad;"]
+
+
+def lane_twins(line: str) -> str:
+    """A line of C with the core's calls that have an inline twin for a batch's loop
+    (src/dyad_lanes.h) calling the twin."""
+    for call in ("dyad_point_on_link(", "dyad_cylinder_input_default("):
+        line = line.replace(call, call.replace("dyad_", "dyad_lane_", 1))
+    return line
 
 
 def kinematics_lane_function(scene: Scene, dyads: list[Dyad]) -> str:

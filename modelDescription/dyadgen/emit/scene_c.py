@@ -607,8 +607,6 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
     on it included) and the barrel's and the rod's own, balanced by the axial force and
     the pins' reactions (dyadfmu/cylinder.h)."""
     scene = plan.scene
-    if plan.lane:
-        raise ValueError("a batch's lane has no cylinder")
     c, link = member(driver.actuator), member(driver.name)
     rate, accel = kinematics_c.driver_rates(scene, driver)
     code()
@@ -623,17 +621,20 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
         pins = (kinematics_c.fixed_pin(driver, "base"), kinematics_c.fixed_pin(driver, "at"))
     lines = kinematics_c.cylinder_input_lines(scene, driver, "cyl_in", (rate, accel), pins)
     for line in lines:
-        code("    " + line)
+        code("    " + (kinematics_c.lane_twins(line) if plan.lane else line))
     code(f"    cyl_in.link.force = {link}_f;")
     code(f"    cyl_in.link.moment = {link}_m_d;")
     if scene.gravity:
         gx, gy = scene.gravity_params
         code(f"    cyl_in.gravity = {_vec(gx.c(), gy.c())};")
-    code(f"    if (dyad_cylinder(&cyl_in, &{c}_cyl) != DYAD_STATUS_OK) {{")
-    name = textsafe.c_string(driver.actuator)
-    code(f"        fail_cylinder(out, &{c}_cyl, {name}, evaluation);")
-    code("        return;")
-    code("    }")
+    if plan.lane:
+        code(f"    bad += dyad_cylinder_lane(&cyl_in, &{c}_cyl);")
+    else:
+        code(f"    if (dyad_cylinder(&cyl_in, &{c}_cyl) != DYAD_STATUS_OK) {{")
+        name = textsafe.c_string(driver.actuator)
+        code(f"        fail_cylinder(out, &{c}_cyl, {name}, evaluation);")
+        code("        return;")
+        code("    }")
     code("}")
     code(f"{c}_force = {c}_cyl.axial_force;")
     code(f"const dyad_real {c}_bound = {_cylinder_bound(driver)};")
@@ -869,14 +870,26 @@ def _outputs(plan: Plan, code: _Code, later: tuple[str, ...] = ()) -> None:
     code("check_first(out, evaluation);" if later else "check(out, evaluation);")
 
 
+#: A cylinder's angles (dyad_cylinder_result) by the direction each is the atan2 of.
+CYLINDER_ANGLES = {"link_angle": "link_dir", "cylinder_angle": "axis"}
+
+
 def lane_angles(scene: Scene, later: tuple[str, ...] = ()) -> dict[str, tuple[str, str]]:
     """The angle outputs a batch's lane leaves to after its loop: member -> the C of the
-    (y, x) of its direction, whose atan2 the scalar evaluation writes."""
+    (y, x) of its direction, whose atan2 the scalar evaluation writes (or reads from a
+    cylinder's result, which holds that atan2)."""
     exprs = _output_exprs(scene)
     found = {}
     for o in scene.outputs:
         expr = exprs.get(o.member, "")
-        if o.integer or o.member in later or not expr.startswith("dyad_atan2("):
+        if o.integer or o.member in later:
+            continue
+        result, _, field = expr.rpartition(".")
+        if field in CYLINDER_ANGLES and result.startswith("kin."):
+            direction = f"{result}.{CYLINDER_ANGLES[field]}"
+            found[o.member] = (f"{direction}.y", f"{direction}.x")
+            continue
+        if not expr.startswith("dyad_atan2("):
             continue
         arguments = expr[len("dyad_atan2(") : -1].split(", ")
         if len(arguments) != 2 or not expr.endswith(")"):

@@ -105,7 +105,7 @@ class SceneSpeed:
 
 #: The mechanisms whose batch over arrays (dyadfmu.evaluate) is timed, and the batch sizes
 #: (the quick study: the first two).
-BATCH_SCENES = ("slider_crank", "four_bar", "shaper", "lift")
+BATCH_SCENES = ("slider_crank", "four_bar", "shaper", "lift", "tipper")
 BATCH_SIZES = (73, 10_000, 1_000_000)
 
 
