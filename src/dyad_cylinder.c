@@ -83,7 +83,9 @@
  *
  * The formulas are written over a scalar of choice (dyad_kin_generic.h): this
  * file compiles them over dyad_real for dyad_cylinder, and
- * dyad_cylinder_tangent.c over dual numbers for the exact derivative.
+ * dyad_cylinder_tangent.c over dual numbers for the exact derivative; a scene's
+ * batch (dyad_lanes.h) takes them over dyad_real once more for
+ * dyad_cylinder_lane, one sample of a loop without branches.
  */
 #ifndef DYAD_KIN_FORMULAS
 #include "dyadfmu/cylinder.h"
