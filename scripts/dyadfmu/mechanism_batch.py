@@ -182,7 +182,7 @@ def _into(
             f"out must be the Evaluation of an earlier dyadfmu.evaluate, not "
             f"{type(out).__name__} {_shown(out)}"
         )
-    missing = [n for n in wanted if n not in out.values]
+    missing = [n for n in wanted if not isinstance(out.values, dict) or n not in out.values]
     if missing:
         raise ValueError(f"out has no array for {', '.join(missing)}: pass the Evaluation "
                          "of a call that asked the same outputs")  # fmt: skip

@@ -248,6 +248,7 @@ def test_outputs_that_share_memory_with_an_input_or_each_other_are_refused():
     for columns, message in [
         ([np.zeros(301), angle], "the output engine.R_mn.x shares memory with an input"),
         ([np.zeros(301), np.zeros(300)], "out: one array of count values"),
+        ([np.zeros(301), [0.0] * 301], "out: one array of count values"),
         ([np.zeros(301)] * 2, "the output crank.torque and the output engine.R_mn.x share memory"),
         ([np.zeros(301), np.zeros(602)[::2]], None),
     ]:

@@ -193,6 +193,9 @@ def test_out_of_another_kind_or_with_unfit_statuses_is_refused():
         evaluate("slider_crank", {"crank.angle": angle}, ["crank.torque"], out={})
     from dyadfmu.mechanism_batch import Evaluation
 
+    with pytest.raises(ValueError, match="out has no array for crank.torque"):
+        out = Evaluation([np.zeros(40)], {}, np.zeros(40, np.intc))
+        evaluate("slider_crank", {"crank.angle": angle}, ["crank.torque"], out=out)
     for status, why in [(np.zeros(40, np.int64), "int64"), (np.zeros(41, np.intc), "(41,)")]:
         out = Evaluation({"crank.torque": np.zeros(40)}, {}, status)
         with pytest.raises(ValueError, match=r"out.status must be .*" + re.escape(why)):

@@ -129,9 +129,8 @@ def _written(
     strides of whole doubles, contiguous C int statuses, nothing shared."""
     block, status = out
     ys = list(block)
-    if len(ys) != len(y_names) or any(np.shape(y) != (count,) for y in ys):
-        raise ValueError("out: one array of count values per output, and count statuses")
-    if np.shape(status) != (count,):
+    arrays = all(isinstance(a, np.ndarray) for a in [*ys, status])
+    if not arrays or len(ys) != len(y_names) or any(a.shape != (count,) for a in [*ys, status]):
         raise ValueError("out: one array of count values per output, and count statuses")
     if any(y.dtype != np.float64 or y.strides[0] % 8 or not y.flags.writeable for y in ys):
         raise ValueError("out: writable float64 values at strides of whole doubles")
