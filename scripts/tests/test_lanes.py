@@ -34,7 +34,7 @@ SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
 FLAGS = [
     "-std=c99", "-O3", "-fno-trapping-math", "-fno-math-errno",
     "--param=large-function-growth=10000", "--param=inline-unit-growth=1000",
-    "-Wall", "-Wextra", "-Wpedantic", "-Werror",
+    "--param=max-combine-insns=2", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
 ]  # fmt: skip
 SAMPLES = 600
 SCENES = sorted(
