@@ -2068,7 +2068,7 @@ static void evaluate_samples(const fmu_model* model, column_blocks* b, const col
  * outputs wanted; which samples were stored. */
 typedef struct lane_grid {
     const fmu_lanes* lanes;
-    int baseline;          /* the baseline's lanes whatever the CPU has (DYADFMU_LANES=baseline) */
+    dyad_lanes_isa cap;    /* the widest lanes to take (fmu_lanes; DYADFMU_LANES) */
     double* cells;         /* columns x lanes */
     double** to;           /* n_x */
     const double** from;   /* n_y */
@@ -2151,19 +2151,26 @@ static void store_lanes(const column_call* c, const column_place place[], const 
                         size_t first, size_t count)
 {
     const size_t stride = g->lanes->lanes;
+    int* stored = g->stored;
     size_t k, lane;
     for (lane = 0; lane < count; ++lane) {
-        g->stored[lane] = 1;
+        stored[lane] = 1;
     }
     for (k = 0; k < c->n_x; ++k) {
         const ptrdiff_t step = c->x_step[k];
         const double* x = c->x[k] + (ptrdiff_t)first * step;
         const double low = place[k].low, high = place[k].high;
         double* at = g->to[k];
-        for (lane = 0; lane < count; ++lane) {
-            const double value = x[(ptrdiff_t)lane * step];
-            g->stored[lane] &= value >= low && value <= high;
-            at[lane] = value;
+        if (step == 1) { /* the common case, a loop without a branch that vectorises */
+            memcpy(at, x, count * sizeof *at);
+        } else {
+            for (lane = 0; lane < count; ++lane) {
+                at[lane] = x[(ptrdiff_t)lane * step];
+            }
+        }
+        for (lane = 0; lane < count; ++lane) { /* in this form it vectorises */
+            const double value = at[lane];
+            stored[lane] = value >= low && value <= high ? stored[lane] : 0;
         }
         if (place[k].angle) {
             turn_lanes(at, at + stride, count);
@@ -2199,11 +2206,7 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
     const double* failed = g->cells + (lanes->inputs + lanes->outputs) * lanes->lanes;
     size_t lane, k;
     store_lanes(c, place, g, first, count);
-    if (g->baseline) {
-        (halves ? lanes->first_baseline : lanes->whole_baseline)(count, g->cells, g->wanted);
-    } else {
-        (halves ? lanes->first : lanes->whole)(count, g->cells, g->wanted);
-    }
+    (halves ? lanes->first : lanes->whole)(g->cap, count, g->cells, g->wanted);
     for (k = 0; k < c->n_y; ++k) {
         const ptrdiff_t step = c->y_step[k];
         double* y = c->y[k] + (ptrdiff_t)first * step;
@@ -2224,6 +2227,19 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
     }
 }
 
+/* The widest lanes DYADFMU_LANES lets a call take: "baseline" or "avx2" (to measure each,
+ * fmu/README.md), and otherwise the widest. */
+static dyad_lanes_isa lanes_cap(const char* which)
+{
+    if (which != NULL && strcmp(which, "baseline") == 0) {
+        return DYAD_LANES_BASELINE;
+    }
+    if (which != NULL && strcmp(which, "avx2") == 0) {
+        return DYAD_LANES_AVX2;
+    }
+    return DYAD_LANES_AVX512;
+}
+
 /* Every sample in the model's lanes: the start values into every lane once, then the
  * samples a call's lanes at a time. 0 where memory ran out. */
 static int evaluate_samples_in_lanes(const fmu_model* model, column_blocks* b, const column_call* c,
@@ -2234,7 +2250,7 @@ static int evaluate_samples_in_lanes(const fmu_model* model, column_blocks* b, c
     int ready;
     const char* which = getenv("DYADFMU_LANES");
     g.lanes = model->behaviour->lanes;
-    g.baseline = which != NULL && strcmp(which, "baseline") == 0;
+    g.cap = lanes_cap(which);
     g.cells = (double*)malloc(g.lanes->columns * g.lanes->lanes * sizeof(double));
     g.to = (double**)malloc((c->n_x + 1) * sizeof *g.to);
     g.from = (const double**)malloc((c->n_y + 1) * sizeof *g.from);

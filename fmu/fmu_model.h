@@ -154,14 +154,12 @@ typedef struct fmu_lanes {
     size_t outputs; /* reals of the output block, its status aside */
     size_t columns;
     /* `wanted`: NULL, or a flag per real of the output block; an output not wanted may be
-     * left out */
-    void (*whole)(size_t count, double* lanes, const unsigned char* wanted);
+     * left out. `cap`: the widest instruction set the lanes may take (dyad_lanes_isa); they
+     * take the widest this CPU runs up to it (to measure each: DYADFMU_LANES,
+     * fmu/README.md) */
+    void (*whole)(dyad_lanes_isa cap, size_t count, double* lanes, const unsigned char* wanted);
     /* as later->first; NULL where the model has no fmu_later */
-    void (*first)(size_t count, double* lanes, const unsigned char* wanted);
-    /* the same compiled for the platform's baseline alone, whatever the CPU has (to
-     * measure the lanes both ways: DYADFMU_LANES=baseline, fmu/README.md) */
-    void (*whole_baseline)(size_t count, double* lanes, const unsigned char* wanted);
-    void (*first_baseline)(size_t count, double* lanes, const unsigned char* wanted);
+    void (*first)(dyad_lanes_isa cap, size_t count, double* lanes, const unsigned char* wanted);
 } fmu_lanes;
 
 /* What a kind of model computes, on its own input and output blocks. */

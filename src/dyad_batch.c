@@ -89,7 +89,12 @@ static inline void batch_store(batch_block* block, size_t r, const dyad_result* 
             batch_store(block, r, &result);                                            \
         }                                                                              \
     }
-#if DYAD_LANES_AVX2
+#if DYAD_LANES_HAVE_AVX512
+#define BATCH_LOOPS(name)                           \
+    BATCH_LOOP(name, , )                            \
+    BATCH_LOOP(name, _avx2, DYAD_LANES_AVX2_TARGET) \
+    BATCH_LOOP(name, _avx512, DYAD_LANES_AVX512_TARGET)
+#elif DYAD_LANES_HAVE_AVX2
 #define BATCH_LOOPS(name) \
     BATCH_LOOP(name, , )  \
     BATCH_LOOP(name, _avx2, DYAD_LANES_AVX2_TARGET)
@@ -109,15 +114,29 @@ static batch_lanes lanes_of(dyad_type type)
 {
     static const batch_lanes baseline[DYAD_TYPE_COUNT] = {
         solve_lanes_rrr, solve_lanes_rrt, solve_lanes_rtr, solve_lanes_trt, solve_lanes_rtt};
-#if DYAD_LANES_AVX2
-    static const batch_lanes avx2[DYAD_TYPE_COUNT] = {solve_lanes_rrr_avx2, solve_lanes_rrt_avx2,
-                                                      solve_lanes_rtr_avx2, solve_lanes_trt_avx2,
-                                                      solve_lanes_rtt_avx2};
-    if ((unsigned)type < DYAD_TYPE_COUNT && dyad_lanes_have_avx2()) {
+    dyad_lanes_isa widest;
+    if ((unsigned)type >= DYAD_TYPE_COUNT) {
+        return NULL;
+    }
+    widest = dyad_lanes_widest(DYAD_LANES_AVX512);
+#if DYAD_LANES_HAVE_AVX512
+    if (widest == DYAD_LANES_AVX512) {
+        static const batch_lanes avx512[DYAD_TYPE_COUNT] = {
+            solve_lanes_rrr_avx512, solve_lanes_rrt_avx512, solve_lanes_rtr_avx512,
+            solve_lanes_trt_avx512, solve_lanes_rtt_avx512};
+        return avx512[type];
+    }
+#endif
+#if DYAD_LANES_HAVE_AVX2
+    if (widest == DYAD_LANES_AVX2) {
+        static const batch_lanes avx2[DYAD_TYPE_COUNT] = {
+            solve_lanes_rrr_avx2, solve_lanes_rrt_avx2, solve_lanes_rtr_avx2, solve_lanes_trt_avx2,
+            solve_lanes_rtt_avx2};
         return avx2[type];
     }
 #endif
-    return (unsigned)type < DYAD_TYPE_COUNT ? baseline[type] : NULL;
+    (void)widest;
+    return baseline[type];
 }
 
 /* Every row of the block holds, in each column given once for all rows or left out, that

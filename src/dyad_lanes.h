@@ -18,6 +18,7 @@
 #define DYADFMU_LANES_H
 
 #include "dyad_internal.h"
+#include "dyadfmu/evaluation.h"
 #include "dyad_kin_internal.h"
 #include "dyad_kin_generic.h"
 
@@ -52,18 +53,43 @@
 #undef DYAD_KIN_FORMULAS
 #undef DYAD_REACT_FORMULAS
 
-/* The lanes for a CPU with AVX2 beside those for the baseline, chosen as the program runs:
- * where the compiler can target AVX2 in one function and ask the CPU (GCC or Clang on
- * x86-64). AVX2 alone, no fused multiply-add: the same operations, the same results. */
+/* The lanes for a CPU with AVX2, and for one with AVX-512, beside those for the baseline,
+ * chosen as the program runs: where the compiler can target an instruction set in one
+ * function and ask the CPU (GCC or Clang on x86-64). No fused multiply-add in either (ISO
+ * C99 contracts nothing): the same operations, the same results. AVX-512 in 512-bit
+ * vectors (eight samples), which GCC would otherwise avoid; AVX-512F alone, which every
+ * CPU with AVX-512 has. On Windows the stack is aligned to 16 bytes only, and GCC for
+ * MinGW-w64 moves a wider vector to and from it as if it were aligned to the vector (GCC
+ * bug 54412) unless patched as Debian's is, which builds the project's Windows binaries
+ * (scripts/tests/test_windows.py holds their DLLs to unaligned moves).
+ * dyad_lanes_widest: the widest this CPU runs, at most `cap` (dyadfmu/evaluation.h). */
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
-#define DYAD_LANES_AVX2        1
+#define DYAD_LANES_HAVE_AVX2   1
+#define DYAD_LANES_HAVE_AVX512 1
 #define DYAD_LANES_AVX2_TARGET __attribute__((target("avx2")))
-static inline int dyad_lanes_have_avx2(void)
+#if defined(__clang__)
+#define DYAD_LANES_AVX512_TARGET __attribute__((target("avx512f"), min_vector_width(512)))
+#else
+#define DYAD_LANES_AVX512_TARGET __attribute__((target("avx512f,prefer-vector-width=512")))
+#endif
+static inline dyad_lanes_isa dyad_lanes_widest(dyad_lanes_isa cap)
 {
-    return __builtin_cpu_supports("avx2");
+    if (cap >= DYAD_LANES_AVX512 && __builtin_cpu_supports("avx512f")) {
+        return DYAD_LANES_AVX512;
+    }
+    if (cap >= DYAD_LANES_AVX2 && __builtin_cpu_supports("avx2")) {
+        return DYAD_LANES_AVX2;
+    }
+    return DYAD_LANES_BASELINE;
 }
 #else
-#define DYAD_LANES_AVX2 0
+#define DYAD_LANES_HAVE_AVX2   0
+#define DYAD_LANES_HAVE_AVX512 0
+static inline dyad_lanes_isa dyad_lanes_widest(dyad_lanes_isa cap)
+{
+    (void)cap;
+    return DYAD_LANES_BASELINE;
+}
 #endif
 
 /* dyad_kin_input_default. */

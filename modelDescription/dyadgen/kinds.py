@@ -572,21 +572,18 @@ def _lanes_behaviour(table: Table, first: bool) -> list[str]:
         "/* Many samples at once, in columns: the loop over them vectorises. */",
     ]
     for half in ("", "_first") if first else ("",):
-        for variant in ("", "_baseline"):
-            name = f"lanes{half}{variant}"
-            lines += [
-                f"static void {name}(size_t count, double* lanes, const unsigned char* wanted)",
-                "{",
-                f"    {ident}_lanes{half}{variant}(",
-                f"        count, (dyad_real(*)[{upper}_LANES])(void*)lanes, wanted);",
-                "}",
-                "",
-            ]
-    functions = (
-        "lanes, lanes_first, lanes_baseline, lanes_first_baseline"
-        if first
-        else "lanes, NULL, lanes_baseline, NULL"
-    )
+        name = f"lanes{half}"
+        head = f"static void {name}("
+        lines += [
+            f"{head}dyad_lanes_isa cap, size_t count, double* lanes,",
+            f"{' ' * len(head)}const unsigned char* wanted)",
+            "{",
+            f"    {ident}_lanes{half}_at_most(",
+            f"        cap, count, (dyad_real(*)[{upper}_LANES])(void*)lanes, wanted);",
+            "}",
+            "",
+        ]
+    functions = "lanes, lanes_first" if first else "lanes, NULL"
     return [
         *lines,
         f"static const fmu_lanes many = {{{upper}_LANES, {upper}_LANE_INPUTS, "

@@ -61,8 +61,12 @@ def _samples(md, rng) -> tuple[dict, dict]:
     return drawn["input"], drawn["parameter"]
 
 
+@pytest.mark.parametrize("lanes", ["", "avx2", "baseline"], ids=["widest", "avx2", "baseline"])
 @pytest.mark.parametrize("name", _scene_fmus())
-def test_each_sample_is_what_the_rows_entry_gives_bit_for_bit(name):
+def test_each_sample_is_what_the_rows_entry_gives_bit_for_bit(name, lanes, monkeypatch):
+    """In the widest lanes this CPU runs, and capped at AVX2's and the baseline's
+    (DYADFMU_LANES, fmu/README.md)."""
+    monkeypatch.setenv("DYADFMU_LANES", lanes)
     fmu = paths.built_fmu(name, 2)
     columns, rows = entries.columns_entry(fmu), entries.rows_entry(fmu)
     md = rows.md

@@ -115,6 +115,12 @@ int main(int argc, char** argv)
         }
         lanes = strstr(how, "first") != NULL ? @FIRST_AVX2 : @ID_lanes_avx2;
     }
+    if (strstr(how, "avx512") != NULL) {
+        if (!__builtin_cpu_supports("avx512f")) {
+            return 3;
+        }
+        lanes = strstr(how, "first") != NULL ? @FIRST_AVX512 : @ID_lanes_avx512;
+    }
 #endif
     run(in, @SAMPLES, lanes, scalar, stdout);
     return 0;
@@ -128,10 +134,12 @@ def _driver(ident: str, has_first: bool) -> str:
     if has_first:
         text = text.replace("@FIRST_BASELINE", "@ID_lanes_first_baseline")
         text = text.replace("@FIRST_AVX2", "@ID_lanes_first_avx2")
+        text = text.replace("@FIRST_AVX512", "@ID_lanes_first_avx512")
         text = text.replace("@FIRST", "scalar = @ID_evaluate_first; lanes = @ID_lanes_first;")
     else:
         text = text.replace("@FIRST_BASELINE", "@ID_lanes_baseline")
         text = text.replace("@FIRST_AVX2", "@ID_lanes_avx2")
+        text = text.replace("@FIRST_AVX512", "@ID_lanes_avx512")
         text = text.replace("@FIRST", "return 4;")
     return text.replace("@ID_", f"{ident}_")
 
@@ -219,16 +227,17 @@ def _rows(text: str) -> list[tuple[int, list[str], float, list[str]]]:
     return rows
 
 
-#: (scene, how): the whole evaluation three ways, and where the scene has halves its first
+#: each instruction set's lanes, called by name
+ISAS = ("baseline", "avx2", "avx512")
+#: (scene, how): the whole evaluation dispatched and each instruction set's, and where the
+#: scene has halves its first the same ways
 CASES = [
-    (path, how)
+    (path, f"{half}{isa}".strip())
     for path in SCENES
-    for how in ("", "baseline", "avx2")
-    + (
-        ("first", "first baseline", "first avx2")
-        if later_members(pipeline.load_scene(path, check_c_names=False))
-        else ()
+    for half in (
+        ("", "first ") if later_members(pipeline.load_scene(path, check_c_names=False)) else ("",)
     )
+    for isa in ("", *ISAS)
 ]
 
 
@@ -239,7 +248,7 @@ def test_a_sample_the_lanes_pass_is_what_evaluate_gives(path, how, programs):
         [str(work / "lanes"), str(work / "inputs.bin"), how], capture_output=True, text=True
     )
     if done.returncode == 3:
-        pytest.skip("this CPU has no AVX2")
+        pytest.skip(f"this CPU has no {how.split()[-1].upper()}")
     assert done.returncode == 0, done.stderr
     rows = _rows(done.stdout)
     assert len(rows) == SAMPLES
@@ -259,7 +268,8 @@ def test_a_sample_the_lanes_pass_is_what_evaluate_gives(path, how, programs):
 @pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
 def test_the_loop_over_samples_vectorises(path, programs):
     """GCC's report: every lane's loop over samples vectorised (the whole evaluation's, and
-    _first's where the scene has halves: the efforts and the reactions)."""
+    _first's where the scene has halves: the efforts and the reactions), for each
+    instruction set (_widths)."""
     work, table = programs(path)
     scene_c = (work / "gen" / f"{table.identifier}_scene.c").read_text().splitlines()
     loops = [  # each lane's loop, the whole's first: a sample's input block is its first line
@@ -269,16 +279,20 @@ def test_the_loop_over_samples_vectorises(path, programs):
         and scene_c[n + 1].endswith(f"{table.identifier}_input in;")
     ]
     report = (work / "vectorised.txt").read_text()
-    vectorised = {
-        int(m) for m in re.findall(r"_scene\.c:(\d+):\d+: optimized: loop vectorized", report)
-    }
-    assert loops and set(loops) <= vectorised, (loops, sorted(vectorised))
+    vectorised = set(
+        (int(line), width)
+        for line, width in re.findall(
+            r"_scene\.c:(\d+):\d+: optimized: loop vectorized using (\d+) byte vectors", report
+        )
+    )
+    wanted = {(line, width) for line in loops for width in _widths()}
+    assert loops and wanted <= vectorised, sorted(wanted - vectorised)
 
 
 def test_dyad_solve_batch_loops_vectorise(tmp_path):
     """src/dyad_batch.c compiled as CMakeLists.txt compiles it: GCC's report has each
     type's loop over a block's rows vectorised, two rows a vector for the baseline and,
-    on x86-64, four for AVX2 (src/dyad_lanes.h's solve lanes)."""
+    on x86-64, four for AVX2 and eight for AVX-512 (src/dyad_lanes.h's solve lanes)."""
     required_tool("cc")
     source = ROOT / "src" / "dyad_batch.c"
     report = subprocess.run(
@@ -288,17 +302,18 @@ def test_dyad_solve_batch_loops_vectorise(tmp_path):
     )  # fmt: skip
     assert report.returncode == 0, report.stderr
     lines = source.read_text().splitlines()
-    widths = ["16"] + (["32"] if "x86_64" in _machine() else [])
     for kind in ("rrr", "rrt", "rtr", "trt", "rtt"):
         line = lines.index(f"BATCH_LOOPS({kind})") + 1
-        for width in widths:
+        for width in _widths():
             wanted = f"dyad_batch.c:{line}:1: optimized: loop vectorized using {width} byte vectors"
             assert wanted in report.stderr, (kind, width, report.stderr[-2000:])
 
 
-def _machine() -> str:
+def _widths() -> list[str]:
+    """The bytes of a vector of each instruction set's lanes the compiler builds: 16
+    (SSE2, NEON), and on x86-64 (not Windows) 32 (AVX2) and 64 (AVX-512)."""
     done = subprocess.run(["cc", "-dumpmachine"], capture_output=True, text=True)
-    return done.stdout
+    return ["16", "32", "64"] if "x86_64" in done.stdout else ["16"]
 
 
 def _cmake_flags(text: str, after: str) -> set[str]:

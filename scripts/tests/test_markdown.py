@@ -246,10 +246,13 @@ def _speeds() -> tuple[list[TypeSpeed], list[SceneSpeed]]:
     batch = {(73, False): 1e-6, (73, True): 2e-6, (10_000, False): 3e-7, (10_000, True): 5e-7}
     batch[10_000, "numpy"] = batch[73, "rows"] = 2e-6
     batch[73, "baseline"], batch[10_000, "baseline"] = 2e-6, 2.4e-6
+    batch[73, "avx2"], batch[10_000, "avx2"] = 1.5e-6, 1.2e-6
     batch[10_000, "into"], batch[10_000, "baseline into"] = 2.5e-7, 1.8e-6
+    batch[10_000, "avx2 into"] = 1.1e-6
     plant = {v: Step(4000.0, 250.0, 0.0, 200.0) for v in (2, 3)}  # 20x: not the rule's
     flops = {False: 900.0, True: 1500.0}
-    scenes = [SceneSpeed(HOSTILE, dict(step)), SceneSpeed("shaper", dict(step), batch, flops)]
+    shaper = SceneSpeed("shaper", dict(step), batch, flops, lanes="avx512")
+    scenes = [SceneSpeed(HOSTILE, dict(step)), shaper]
     return types, [*scenes, SceneSpeed("plant", plant, plant=True)]
 
 
@@ -281,9 +284,15 @@ def test_the_study_report_and_its_speed_section_read_as_tables(tmp_path):
     assert "stacked NumPy solve: worst 6.7x (shaper, 10,000 samples), **not met**." in printed
     # against the flops' time (900 at RRR's 70 flops in 1e-7 s: 1.29e-6 s), at 10,000
     assert "within 1.5x, worst 1.87x (shaper, 10,000 samples), **not met**" in printed
-    assert "under 1x, worst 0.23x (shaper, 10,000 samples), met." in printed
-    assert "Into an earlier call's arrays (`out=`): worst 1.40x and 0.19x." in printed
-    assert _cell(found[4], 2, 5) == "250 ns (0.2x) / 1800 ns (1.4x)"
+    assert "AVX2's under 1x, worst 0.93x (shaper, 10,000 samples), met." in printed
+    assert "AVX-512's, under 1x: worst 0.23x (shaper, 10,000 samples), met." in printed
+    assert (
+        "(`out=`), worst: AVX-512's 0.19x (shaper, 10,000 samples), AVX2's 0.86x (shaper, "
+        "10,000 samples), the baseline's 1.40x (shaper, 10,000 samples)." in printed
+    )
+    assert _cell(found[4], 2, 3) == "300 ns (0.2x)"
+    assert _cell(found[4], 2, 4) == "1200 ns (0.9x) / 2400 ns (1.9x)"
+    assert _cell(found[4], 2, 5) == "250 ns (0.2x) / 1100 ns (0.9x) / 1800 ns (1.4x)"
 
 
 def _cosim_row(name: str, scheme: str, step: float, diverged: bool) -> dict:
@@ -408,3 +417,18 @@ def test_a_report_says_when_on_what_and_by_which_command():
         line,
     ), line
     assert markdown.machine() in line.replace("\\", "")
+
+
+def test_the_speed_section_on_a_cpu_without_avx512_says_what_its_widest_lanes_did():
+    """Where the widest lanes are AVX2's, they are the AVX2 figures, and no AVX-512 line."""
+    types, scenes = _speeds()
+    shaper = scenes[1]
+    shaper.lanes = "avx2"
+    shaper.samples = {k: v for k, v in shaper.samples.items() if k[1] not in ("avx2", "avx2 into")}
+    printed = "\n".join(speed_report.markdown(types, scenes))
+    assert "AVX2's under 1x, worst 0.23x (shaper, 10,000 samples), met." in printed
+    assert "AVX-512" not in printed
+    assert "worst: AVX2's 0.19x (shaper, 10,000 samples), the baseline's 1.40x" in printed
+    batch = mc.tables(printed)[-1]
+    assert _cell(batch, 2, 4) == "300 ns (0.2x) / 2400 ns (1.9x)"
+    assert _cell(batch, 2, 5) == "250 ns (0.2x) / 1800 ns (1.4x)"

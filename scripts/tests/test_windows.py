@@ -9,6 +9,7 @@ fail: scripts/run-tests installs both and configures build/ with -DDYADFMU_WINDO
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import zipfile
@@ -18,7 +19,7 @@ import pytest
 from dyadfmu import paths
 from dyadfmu.cosim import importers, windows
 from replay_checks import assert_the_columns_entry_ran_where_algebraic
-from tool_checks import required
+from tool_checks import required, required_tool
 
 ALL = [f"{name}_fmi{version}" for name in importers.fmu_names() for version in importers.VERSIONS]
 #: The DLLs a Windows binary may import: the system's, which every Windows has.
@@ -83,6 +84,48 @@ def test_every_fmu_carries_a_windows_binary_needing_only_system_dlls(windows_bui
         line.split(":", 1)[1].strip() for line in dump.stdout.splitlines() if "DLL Name:" in line
     }
     assert imported <= SYSTEM_DLLS, imported - SYSTEM_DLLS
+
+
+#: An aligned move of a vector wider than 16 bytes against the stack (rsp or rbp): Win64
+#: aligns the stack to 16 bytes only, so it faults wherever the frame falls otherwise
+#: (src/dyad_lanes.h: GCC bug 54412, which Debian's MinGW-w64 GCC is patched against).
+ALIGNED_WIDE_STACK_MOVE = re.compile(
+    r"\bvmov(?:ap[sd]|dqa(?:32|64)?)\s+(?:%[yz]mm\d+,.*\(%r[sb]p\)|.*\(%r[sb]p\),%[yz]mm\d+)"
+)
+
+
+def _aligned_wide_stack_moves(disassembly: str) -> list[str]:
+    return [line for line in disassembly.splitlines() if ALIGNED_WIDE_STACK_MOVE.search(line)]
+
+
+def test_the_check_of_stack_moves_sees_an_aligned_wide_one():
+    dump = "\n".join(
+        [
+            "  4010: c5 fd 29 44 24 40  vmovapd %ymm0,0x40(%rsp)",
+            "  4016: 62 f1 fd 48 28 45 02  vmovapd 0x80(%rbp),%zmm0",
+            "  401d: 62 f1 fe 48 6f 04 24  vmovdqa64 %zmm8,(%rsp)",
+            "  4024: c5 fd 11 44 24 40  vmovupd %ymm0,0x40(%rsp)",
+            "  402a: c5 f9 29 44 24 40  vmovapd %xmm0,0x40(%rsp)",
+            "  4030: c5 fd 28 03  vmovapd (%rbx),%ymm0",
+        ]
+    )
+    assert len(_aligned_wide_stack_moves(dump)) == 3
+
+
+def test_no_windows_binary_moves_a_wide_vector_aligned_against_the_stack(windows_build):
+    """The lanes for AVX2 and AVX-512 spill 32- and 64-byte vectors to the stack; in a
+    Windows DLL each such move must be an unaligned one (vmovupd, vmovdqu)."""
+    objdump = required_tool("x86_64-w64-mingw32-objdump")
+    dlls = sorted((windows_build / "fmus" / "stage").glob("*/binaries/*/*.dll"))
+    assert dlls
+    wide, found = 0, {}
+    for dll in dlls:
+        dump = subprocess.run([objdump, "-d", str(dll)], capture_output=True, text=True).stdout
+        wide += dump.count("%zmm")
+        if moves := _aligned_wide_stack_moves(dump):
+            found[dll.name] = moves[:3]
+    assert wide > 0  # the AVX-512 lanes are there
+    assert not found, found
 
 
 def test_the_comparison_sees_one_ulp_and_a_status():

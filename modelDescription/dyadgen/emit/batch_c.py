@@ -112,41 +112,51 @@ def many_function(scene: Scene, name: str, lane: str, angles: list[str]) -> list
 
 
 def _dispatch(scene: Scene, name: str) -> list[str]:
-    """<identifier>_<name>_baseline and, where the compiler can target AVX2 and ask the
-    CPU for it (src/dyad_lanes.h), <identifier>_<name>_avx2, both <name>_in, and
-    <identifier>_<name>, which takes the second where the CPU has AVX2."""
+    """<identifier>_<name>_baseline and, where the compiler can target them and ask the
+    CPU for them (src/dyad_lanes.h), <identifier>_<name>_avx2 and _avx512, each <name>_in;
+    <identifier>_<name>_at_most, which takes the widest the CPU runs up to a cap, and
+    <identifier>_<name>, the widest."""
     ident, upper = scene.identifier, scene.identifier.upper()
+    columns = f"dyad_real (*restrict lanes)[{upper}_LANES]"
 
-    def function(variant: str, body: list[str], prefix: str = "") -> list[str]:
+    def function(variant: str, body: list[str], prefix: str = "", cap: bool = False) -> list[str]:
         head = f"{prefix}void {ident}_{name}{variant}("
-        return [
-            f"{head}size_t count, dyad_real (*restrict lanes)[{upper}_LANES],",
-            f"{' ' * len(head)}const unsigned char* wanted)",
-            "{",
-            *body,
-            "}",
-        ]
+        indent = " " * len(head)
+        params = [f"size_t count, {columns},", "const unsigned char* wanted)"]
+        if cap:
+            params = ["dyad_lanes_isa cap, size_t count,", f"{columns},", params[1]]
+        return [head + params[0], *(indent + p for p in params[1:]), "{", *body, "}"]
 
     call = f"{name}_in(count, lanes, wanted);"
-    return [
-        *function("_baseline", [f"    {call}"]),
-        "",
-        "#if DYAD_LANES_AVX2",
-        *function("_avx2", [f"    {call}"], "DYAD_LANES_AVX2_TARGET "),
-        "#endif",
-        "",
-        *function(
+    lines = [*function("_baseline", [f"    {call}"]), ""]
+    cases = []
+    for isa, target in (("avx512", "AVX512"), ("avx2", "AVX2")):
+        lines += [
+            f"#if DYAD_LANES_HAVE_{target}",
+            *function(f"_{isa}", [f"    {call}"], f"DYAD_LANES_{target}_TARGET "),
+            "#endif",
             "",
-            [
-                "#if DYAD_LANES_AVX2",
-                "    if (dyad_lanes_have_avx2()) {",
-                f"        {ident}_{name}_avx2(count, lanes, wanted);",
-                "        return;",
-                "    }",
-                "#endif",
-                f"    {ident}_{name}_baseline(count, lanes, wanted);",
-            ],
-        ),
+        ]
+        cases += [
+            f"#if DYAD_LANES_HAVE_{target}",
+            f"    case DYAD_LANES_{target}:",
+            f"        {ident}_{name}_{isa}(count, lanes, wanted);",
+            "        return;",
+            "#endif",
+        ]
+    at_most = [
+        "    switch (dyad_lanes_widest(cap)) {",
+        *cases,
+        "    default:",
+        f"        {ident}_{name}_baseline(count, lanes, wanted);",
+        "    }",
+    ]
+    widest = [f"    {ident}_{name}_at_most(DYAD_LANES_AVX512, count, lanes, wanted);"]
+    return [
+        *lines,
+        *function("_at_most", at_most, cap=True),
+        "",
+        *function("", widest),
     ]
 
 
@@ -185,19 +195,21 @@ def prototypes(scene: Scene, first: bool, angles: int) -> list[str]:
         " * over samples vectorises. `wanted`, NULL or a flag per output in its block's order:",
         " * an output not wanted may be left out (an angle's atan2). _first: as",
         f" * {ident}_evaluate_first. _baseline: compiled for the platform's baseline; _avx2",
-        " * (x86-64 with GCC or Clang only): for a CPU with AVX2 (no fused multiply-add: the",
-        " * same results bit for bit); without either suffix, the second where the CPU has",
-        " * AVX2. */",
+        " * and _avx512 (x86-64 with GCC or Clang only; not _avx512 on Windows): for a CPU with",
+        " * AVX2, with AVX-512 (no fused multiply-add: the same results bit for bit); _at_most:",
+        " * the widest this CPU runs up to `cap` (dyad_lanes_isa, dyadfmu/evaluation.h);",
+        " * without a suffix, the widest this CPU runs. */",
         f"#define {upper}_LANES {CHUNK}",
         f"#define {upper}_LANE_INPUTS {reals}",
         f"#define {upper}_LANE_OUTPUTS {len(outputs)}",
         f"#define {upper}_LANE_COLUMNS {reals + len(outputs) + 1 + angles}",
     ]
     for name in names:
-        for variant in ("", "_baseline", "_avx2"):
+        for variant in ("", "_baseline", "_avx2", "_avx512", "_at_most"):
             head = f"void {ident}_{name}{variant}("
+            cap = "dyad_lanes_isa cap, " if variant == "_at_most" else ""
             lines += [
-                f"{head}size_t count, dyad_real (*lanes)[{upper}_LANES],",
+                f"{head}{cap}size_t count, dyad_real (*lanes)[{upper}_LANES],",
                 f"{' ' * len(head)}const unsigned char* wanted);",
             ]
     return lines

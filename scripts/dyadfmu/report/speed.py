@@ -10,6 +10,7 @@ from pathlib import Path
 from ..study.speed import (
     BASELINE_FLOOR_TARGET,
     FLOPS_TARGET,
+    LANES,
     NUMPY_RATIO_TARGET,
     ROWS_PER_SECOND_TARGET,
     STEP_TARGET,
@@ -103,13 +104,24 @@ BATCH_HEADER = (
     "mechanism",
     "samples",
     "flops per sample: efforts and reactions / every output (their time at the RRR solve's rate)",
-    "efforts and reactions, CPU per sample (to that time)",
-    "the same in the baseline CPU's lanes (to that time)",
-    "the same two into an earlier call's arrays (out=)",
+    "efforts and reactions, CPU per sample, this CPU's widest lanes (to that time)",
+    "the same in AVX2's / the baseline's lanes (to that time)",
+    "the same three into an earlier call's arrays (out=)",
     "every output, CPU per sample (to that time)",
     "efforts and reactions through the rows entry, CPU per sample",
     "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
 )
+#: How the report names each of the lanes (study.speed.LANES).
+LANE_NAMES = {"baseline": "the baseline's", "avx2": "AVX2's", "avx512": "AVX-512's"}
+
+
+def _lane_kinds(s: SceneSpeed, into: bool = False) -> dict[str, object]:
+    """Per lanes timed, widest first, the key of their time in ``s.samples``: the widest
+    this CPU runs under False (or "into"), the others under their names."""
+    names = list(LANES)[: list(LANES).index(s.lanes) + 1]
+    kinds = {name: f"{name} into" if into else name for name in names}
+    kinds[s.lanes] = "into" if into else False
+    return dict(reversed(kinds.items()))
 
 
 def _ns(seconds: float) -> str:
@@ -134,9 +146,13 @@ def _batch_rows(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
             numpy = s.samples.get((count, "numpy"), math.nan)
             some = s.samples[count, False]
             yardstick = "-" if math.isnan(numpy) else f"{_ns(numpy)} ({numpy / some:.1f}x)"
-            baseline = s.samples.get((count, "baseline"), math.nan)
-            times = [_to_floor(some, floor[False]), _to_floor(baseline, floor[False])]
-            into = [s.samples.get((count, k), math.nan) for k in ("into", "baseline into")]
+            narrower = [
+                s.samples.get((count, kind), math.nan)
+                for kind in _narrower(s, ("avx2", "baseline"))
+            ]
+            into = [s.samples.get((count, k), math.nan) for k in _lane_kinds(s, into=True).values()]
+            times = [_to_floor(some, floor[False])]
+            times.append(" / ".join(_to_floor(t, floor[False]) for t in narrower))
             times.append(" / ".join(_to_floor(t, floor[False]) for t in into))
             times.append(_to_floor(s.samples[count, True], floor[True]))
             times += [_ns(s.samples.get((count, "rows"), math.nan)), yardstick]
@@ -178,33 +194,60 @@ def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
     ]
 
 
+def _narrower(s: SceneSpeed, names: tuple[str, ...]) -> list[object]:
+    """The keys in ``s.samples`` of the lanes ``names`` (each its own where it is not the
+    widest this CPU runs, False where it is, and none where it is wider)."""
+    kinds = _lane_kinds(s)
+    return [kinds.get(name, "none") for name in names]
+
+
 def _floor_targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
     """The target lines of a whole mechanism's batch (efforts and reactions) against the
     time of the flops a scalar evaluation executes for them, at the largest batch timed:
-    the baseline CPU's lanes within BASELINE_FLOOR_TARGET, this CPU's (AVX2 where it has
-    it) under 1; the worst mechanism of each."""
+    the baseline's lanes within BASELINE_FLOOR_TARGET, AVX2's under 1, and this CPU's
+    widest (where wider than AVX2) against 1 too; the worst mechanism of each."""
     rrr = next((t for t in types if t.dyad == "RRR"), None)
-    timed = [s for s in scenes if s.flops.get(False) and any(k == "baseline" for _, k in s.samples)]
+    timed = [s for s in scenes if s.flops.get(False) and any(k is False for _, k in s.samples)]
     if rrr is None or not timed:
         return []
     rate = rrr.solve_flops / rrr.numpy_seconds_per_row[True]
-    kinds = ("baseline", False, "baseline into", "into")
-    worst = {kind: (0.0, "") for kind in kinds}
+    worst: dict[tuple[str, bool], tuple[float, str]] = {}
     for s in timed:
-        count = max(c for c, k in s.samples if k == "baseline")
-        for kind in kinds:
-            ratio = s.samples.get((count, kind), math.nan) / (s.flops[False] / rate)
-            worst[kind] = max(worst[kind], (ratio, f"{s.scene}, {count:,} samples"))
-    base, this = worst["baseline"], worst[False]
-    base_into, this_into = worst["baseline into"], worst["into"]
-    return [
+        count = max(c for c, k in s.samples if k is False)
+        for into in (False, True):
+            for name, kind in _lane_kinds(s, into).items():
+                ratio = s.samples.get((count, kind), math.nan) / (s.flops[False] / rate)
+                worst[name, into] = max(
+                    worst.get((name, into), (0.0, "")), (ratio, f"{s.scene}, {count:,} samples")
+                )
+
+    def figure(name: str, into: bool = False) -> str:
+        ratio, where = worst.get((name, into), (math.nan, ""))
+        return f"{ratio:.2f}x ({where})" if where else "not timed (this CPU has none)"
+
+    def ratio(name: str) -> float:
+        return worst.get((name, False), (math.nan, ""))[0]
+
+    widest = max((s.lanes for s in timed), key=list(LANES).index)
+    lines = [
         f"- A whole mechanism's batch (the efforts and reactions) against the time of the "
-        f"flops a scalar evaluation executes for them: in the baseline CPU's lanes within "
-        f"{BASELINE_FLOOR_TARGET:g}x, worst {base[0]:.2f}x ({base[1]}), "
-        f"{_mark(base[0] <= BASELINE_FLOOR_TARGET)}; in this CPU's (AVX2 where it has it) "
-        f"under 1x, worst {this[0]:.2f}x ({this[1]}), {_mark(this[0] < 1)}. Into an earlier "
-        f"call's arrays (`out=`): worst {base_into[0]:.2f}x and {this_into[0]:.2f}x."
+        f"flops a scalar evaluation executes for them: in the baseline's lanes within "
+        f"{BASELINE_FLOOR_TARGET:g}x, worst {figure('baseline')}, "
+        f"{_mark(ratio('baseline') <= BASELINE_FLOOR_TARGET)}; in AVX2's under 1x, worst "
+        f"{figure('avx2')}, {_mark(ratio('avx2') < 1)}."
     ]
+    if list(LANES).index(widest) > list(LANES).index("avx2"):
+        lines.append(
+            f"  In this CPU's widest, {LANE_NAMES[widest]}, under 1x: worst "
+            f"{figure(widest)}, {_mark(ratio(widest) < 1)}."
+        )
+    into = ", ".join(
+        f"{LANE_NAMES[name]} {figure(name, True)}"
+        for name in reversed(list(LANES))
+        if (name, True) in worst
+    )
+    lines.append(f"  Into an earlier call's arrays (`out=`), worst: {into}.")
+    return lines
 
 
 def _numpy_ratio_target(scenes: list[SceneSpeed]) -> list[str]:

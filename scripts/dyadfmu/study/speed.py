@@ -90,7 +90,10 @@ class SceneSpeed:
     """One built-in scene FMU's step against its evaluation, per FMI version; for the
     mechanisms of BATCH_SCENES, ``dyadfmu.evaluate``'s CPU seconds per sample, by (batch
     size, whether every Real output is asked, else the efforts and reactions alone), and
-    by (batch size, "numpy") the stacked NumPy solve of a chain (the yardstick); ``flops``:
+    by (batch size, "numpy") the stacked NumPy solve of a chain (the yardstick), by (batch
+    size, "avx2" or "baseline") the efforts and reactions in those lanes (this CPU's widest
+    where not said), and by (batch size, "into", "avx2 into" or "baseline into") the same
+    into an earlier call's arrays; ``flops``:
     the floating-point operations a step executes per sample, by whether every Real output
     is read (else the efforts and reactions alone)."""
 
@@ -98,6 +101,8 @@ class SceneSpeed:
     steps: dict[int, Step] = field(default_factory=dict)
     samples: dict = field(default_factory=dict)
     flops: dict[bool, float] = field(default_factory=dict)
+    #: the widest lanes this CPU runs, where ``samples`` has (size, False) (LANES)
+    lanes: str = "baseline"
     #: a plant (dynamics = "forward"): its step integrates its motion over many
     #: evaluations, so the step-to-evaluation rule is not its (dyadfmu plants measures it)
     plant: bool = False
@@ -136,17 +141,34 @@ def numpy_yardstick_seconds(scene: str, count: int, rounds: int) -> float:
     return best / count
 
 
+#: The lanes an FMU binary carries for x86-64 (fmu/README.md), by the name DYADFMU_LANES
+#: takes and the CPU flag each needs (/proc/cpuinfo), the widest last.
+LANES = {"baseline": "", "avx2": "avx2", "avx512": "avx512f"}
+
+
+def widest_lanes() -> str:
+    """The widest of LANES this CPU runs (Linux: /proc/cpuinfo's flags; elsewhere, or on
+    another CPU than x86-64, "baseline")."""
+    try:
+        flags = Path("/proc/cpuinfo").read_text().split()
+    except OSError:
+        return "baseline"
+    if "flags" not in flags:  # not x86
+        return "baseline"
+    return [name for name, flag in LANES.items() if not flag or flag in flags][-1]
+
+
 def batch_seconds(
-    scene: str, count: int, every: bool, rounds: int, baseline: bool = False, into: bool = False
+    scene: str, count: int, every: bool, rounds: int, lanes: str = "", into: bool = False
 ) -> float:
     """CPU seconds per sample of ``dyadfmu.evaluate`` on ``scene`` over ``count`` samples
     of its inputs swinging about their start values (step_rows), asking every Real output
-    or the efforts and reactions alone: the best of ``rounds`` calls. ``baseline``: in the
-    lanes compiled for the baseline CPU, whatever this one has (DYADFMU_LANES). ``into``:
-    each call writes into an earlier call's arrays (``out=``), as a sweep of many batches
-    does, instead of new ones (whose pages the system clears on their first write)."""
-    if baseline:
-        os.environ["DYADFMU_LANES"] = "baseline"
+    or the efforts and reactions alone: the best of ``rounds`` calls. ``lanes``: in those
+    of LANES at most (DYADFMU_LANES), else in the widest this CPU runs. ``into``: each call
+    writes into an earlier call's arrays (``out=``), as a sweep of many batches does,
+    instead of new ones (whose pages the system clears on their first write)."""
+    if lanes:
+        os.environ["DYADFMU_LANES"] = lanes
         try:
             return batch_seconds(scene, count, every, rounds, into=into)
         finally:
@@ -433,15 +455,18 @@ def measure(
                 scenes[-1].flops[every] = step_flops(build, scene, steps, work, every)
             for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
                 rounds = 2 if count >= 1_000_000 else 5
+                scenes[-1].lanes = widest_lanes()
+                narrower = list(LANES)[: list(LANES).index(scenes[-1].lanes)]
                 for every in (False, True):
                     scenes[-1].samples[count, every] = batch_seconds(scene, count, every, rounds)
-                scenes[-1].samples[count, "baseline"] = batch_seconds(
-                    scene, count, False, rounds, baseline=True
+                scenes[-1].samples[count, "into"] = batch_seconds(
+                    scene, count, False, rounds, into=True
                 )
-                for kind, baseline in (("into", False), ("baseline into", True)):
-                    scenes[-1].samples[count, kind] = batch_seconds(
-                        scene, count, False, rounds, baseline, into=True
-                    )
+                for lanes in narrower:
+                    for kind, into in ((lanes, False), (f"{lanes} into", True)):
+                        scenes[-1].samples[count, kind] = batch_seconds(
+                            scene, count, False, rounds, lanes, into
+                        )
                 scenes[-1].samples[count, "rows"] = rows_seconds(scene, count, rounds)
                 if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
                     scenes[-1].samples[count, "numpy"] = numpy_yardstick_seconds(
