@@ -104,7 +104,8 @@ def _named(given: dict, allowed: dict, what: str, fmu: Path) -> dict[str, np.nda
             array = np.asarray(value, dtype=np.float64)
         except (TypeError, ValueError, OverflowError):
             raise ValueError(f"{name} must be real numbers, not {_shown(value)}") from None
-        bad = np.flatnonzero(~np.isfinite(array))
+        finite = np.isfinite(array)
+        bad = () if finite.all() else np.flatnonzero(~finite)
         if len(bad):
             at = f"[{', '.join(map(str, np.unravel_index(bad[0], array.shape)))}]"
             raise ValueError(
