@@ -10,6 +10,7 @@
 
 /* fmu_status and fmu_evaluation, which a scene's generated code reports with too */
 #include "dyadfmu/evaluation.h"
+#include "dyadfmu/types.h"
 
 /* A path that is rarely taken (a refusal, a log message) kept out of the function that
  * calls it, so that the common path saves and restores fewer registers. */

@@ -109,8 +109,8 @@ BATCH_LOOPS(rtt)
 
 typedef void (*batch_lanes)(size_t rows, batch_block* block);
 
-/* The lanes of a type, for this CPU; NULL for an unknown type. */
-static batch_lanes lanes_of(dyad_type type)
+/* The lanes of a type, for this CPU up to `cap`; NULL for an unknown type. */
+static batch_lanes lanes_of(dyad_type type, dyad_lanes_isa cap)
 {
     static const batch_lanes baseline[DYAD_TYPE_COUNT] = {
         solve_lanes_rrr, solve_lanes_rrt, solve_lanes_rtr, solve_lanes_trt, solve_lanes_rtt};
@@ -118,7 +118,7 @@ static batch_lanes lanes_of(dyad_type type)
     if ((unsigned)type >= DYAD_TYPE_COUNT) {
         return NULL;
     }
-    widest = dyad_lanes_widest(DYAD_LANES_AVX512);
+    widest = dyad_lanes_widest(cap);
 #if DYAD_LANES_HAVE_AVX512
     if (widest == DYAD_LANES_AVX512) {
         static const batch_lanes avx512[DYAD_TYPE_COUNT] = {
@@ -278,7 +278,13 @@ static void refuse_all(dyad_type type, size_t count, const dyad_batch_output* ou
 size_t dyad_solve_batch(dyad_type type, size_t count, const dyad_batch_input* input,
                         const dyad_batch_output* output)
 {
-    const batch_lanes lanes = lanes_of(type);
+    return dyad_solve_batch_at_most(DYAD_LANES_AVX512, type, count, input, output);
+}
+
+size_t dyad_solve_batch_at_most(dyad_lanes_isa cap, dyad_type type, size_t count,
+                                const dyad_batch_input* input, const dyad_batch_output* output)
+{
+    const batch_lanes lanes = lanes_of(type, cap);
     batch_block block;
     dyad_status status[DYAD_BATCH_BLOCK];
     dyad_field field[DYAD_BATCH_BLOCK];

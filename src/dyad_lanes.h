@@ -18,7 +18,6 @@
 #define DYADFMU_LANES_H
 
 #include "dyad_internal.h"
-#include "dyadfmu/evaluation.h"
 #include "dyad_kin_internal.h"
 #include "dyad_kin_generic.h"
 
@@ -62,7 +61,7 @@
  * MinGW-w64 moves a wider vector to and from it as if it were aligned to the vector (GCC
  * bug 54412) unless patched as Debian's is, which builds the project's Windows binaries
  * (scripts/tests/test_windows.py holds their DLLs to unaligned moves).
- * dyad_lanes_widest: the widest this CPU runs, at most `cap` (dyadfmu/evaluation.h). */
+ * dyad_lanes_widest: the widest this CPU runs, at most `cap` (dyadfmu/types.h). */
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
 #define DYAD_LANES_HAVE_AVX2   1
 #define DYAD_LANES_HAVE_AVX512 1

@@ -197,7 +197,7 @@ def prototypes(scene: Scene, first: bool, angles: int) -> list[str]:
         f" * {ident}_evaluate_first. _baseline: compiled for the platform's baseline; _avx2",
         " * and _avx512 (x86-64 with GCC or Clang only; not _avx512 on Windows): for a CPU with",
         " * AVX2, with AVX-512 (no fused multiply-add: the same results bit for bit); _at_most:",
-        " * the widest this CPU runs up to `cap` (dyad_lanes_isa, dyadfmu/evaluation.h);",
+        " * the widest this CPU runs up to `cap` (dyad_lanes_isa, dyadfmu/types.h);",
         " * without a suffix, the widest this CPU runs. */",
         f"#define {upper}_LANES {CHUNK}",
         f"#define {upper}_LANE_INPUTS {reals}",

@@ -119,6 +119,11 @@ typedef struct dyad_batch_output {
 size_t dyad_solve_batch(dyad_type type, size_t count, const dyad_batch_input* input,
                         const dyad_batch_output* output);
 
+/** dyad_solve_batch in the widest lanes this CPU runs up to `cap` (dyadfmu/types.h;
+ *  dyad_solve_batch takes the widest): to measure or test each. The same results. */
+size_t dyad_solve_batch_at_most(dyad_lanes_isa cap, dyad_type type, size_t count,
+                                const dyad_batch_input* input, const dyad_batch_output* output);
+
 #ifdef __cplusplus
 }
 #endif

@@ -25,12 +25,4 @@ typedef struct fmu_evaluation {
     char reason[320];
 } fmu_evaluation;
 
-/* The widest instruction set a scene's batch evaluation (<id>_lanes_at_most) may take,
- * the widest the CPU runs up to it; the widest where no cap is asked. */
-typedef enum dyad_lanes_isa {
-    DYAD_LANES_BASELINE = 0, /* the platform's baseline (x86-64: SSE2) */
-    DYAD_LANES_AVX2 = 1,
-    DYAD_LANES_AVX512 = 2
-} dyad_lanes_isa;
-
 #endif /* DYADFMU_EVALUATION_H */

@@ -217,4 +217,13 @@ typedef struct dyad_result {
     dyad_real amplification;
 } dyad_result;
 
+/* The widest instruction set a batch (dyad_solve_batch_at_most, a scene's
+ * <id>_lanes_at_most) may take: it takes the widest the CPU runs up to it. Without a
+ * cap, the widest. */
+typedef enum dyad_lanes_isa {
+    DYAD_LANES_BASELINE = 0, /* the platform's baseline (x86-64: SSE2) */
+    DYAD_LANES_AVX2 = 1,
+    DYAD_LANES_AVX512 = 2
+} dyad_lanes_isa;
+
 #endif /* DYADFMU_TYPES_H */
