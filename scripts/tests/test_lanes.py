@@ -5,9 +5,9 @@ For every built-in scene that has one, over random samples of its inputs with fa
 ones mixed in (an input NaN, an input far out of range; the toggles scene's dead centres
 and lost assemblies), a sample's count of failed checks is 0 exactly where the scalar
 <id>_evaluate says status 0, and there its outputs are evaluate's bit for bit: in the
-baseline build and in the AVX2 one (where the CPU has AVX2), both called by name, and
-through the dispatching <id>_lanes; also _first against <id>_evaluate_first.
-GCC reports every loop over samples vectorised in both builds. The FMU's columns entry
+baseline build, the AVX2 one and the AVX-512 one (where the CPU has them), each called by
+name, and through the dispatching <id>_lanes; also _first against <id>_evaluate_first.
+GCC reports every loop over samples vectorised in each build. The FMU's columns entry
 runs the lanes (scripts/tests/test_columns_entry.py holds it to the rows entry).
 """
 
@@ -311,7 +311,7 @@ def test_dyad_solve_batch_loops_vectorise(tmp_path):
 
 def _widths() -> list[str]:
     """The bytes of a vector of each instruction set's lanes the compiler builds: 16
-    (SSE2, NEON), and on x86-64 (not Windows) 32 (AVX2) and 64 (AVX-512)."""
+    (SSE2, NEON), and on x86-64 32 (AVX2) and 64 (AVX-512)."""
     done = subprocess.run(["cc", "-dumpmachine"], capture_output=True, text=True)
     return ["16", "32", "64"] if "x86_64" in done.stdout else ["16"]
 
