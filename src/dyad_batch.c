@@ -94,10 +94,6 @@ static inline void batch_store(batch_block* block, size_t r, const dyad_result* 
     BATCH_LOOP(name, , )                            \
     BATCH_LOOP(name, _avx2, DYAD_LANES_AVX2_TARGET) \
     BATCH_LOOP(name, _avx512, DYAD_LANES_AVX512_TARGET)
-#elif DYAD_LANES_HAVE_AVX2
-#define BATCH_LOOPS(name) \
-    BATCH_LOOP(name, , )  \
-    BATCH_LOOP(name, _avx2, DYAD_LANES_AVX2_TARGET)
 #else
 #define BATCH_LOOPS(name) BATCH_LOOP(name, , )
 #endif

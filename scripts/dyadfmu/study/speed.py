@@ -453,10 +453,10 @@ def measure(
         if scene in BATCH_SCENES:
             for every in (False, True):
                 scenes[-1].flops[every] = step_flops(build, scene, steps, work, every)
+            scenes[-1].lanes = widest_lanes()
+            narrower = list(LANES)[: list(LANES).index(scenes[-1].lanes)]
             for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
                 rounds = 2 if count >= 1_000_000 else 5
-                scenes[-1].lanes = widest_lanes()
-                narrower = list(LANES)[: list(LANES).index(scenes[-1].lanes)]
                 for every in (False, True):
                     scenes[-1].samples[count, every] = batch_seconds(scene, count, every, rounds)
                 scenes[-1].samples[count, "into"] = batch_seconds(
