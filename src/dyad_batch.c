@@ -9,12 +9,14 @@
  * outputs it then gets; every other row is ok, with the lane's outputs, which are that
  * solver's bit for bit. The outputs go out column by column.
  *
- * On x86-64 with GCC or Clang the loop is compiled twice, for the baseline and for AVX2
- * (no fused multiply-add: the same results), and each call takes the one the CPU runs. */
+ * On x86-64 with GCC or Clang the loop is compiled three times, for the baseline, AVX2 and
+ * AVX-512 (no fused multiply-add: the same results), and each call takes the widest the CPU
+ * runs. */
 #include "dyadfmu/batch.h"
 
 #include "dyadfmu/dyad.h"
 
+#define DYAD_LANES_NO_KINEMATICS
 #define DYAD_LANES_RRR
 #define DYAD_LANES_RRT
 #define DYAD_LANES_RTR
@@ -25,29 +27,11 @@
 #include <stddef.h>
 #include <string.h>
 
-/* The scalars of a dyad_input in the order of dyad_input_column, and of a dyad_result
- * in that of dyad_output_column: X(member) for each. */
-/* clang-format off */
-#define BATCH_LINK_MEMBERS(X, g)                                                   \
-    X(g.dir.x) X(g.dir.y) X(g.length) X(g.omega) X(g.epsilon)                      \
-    X(g.accel_d.x) X(g.accel_d.y) X(g.com.x) X(g.com.y) X(g.mass) X(g.inertia)     \
-    X(g.force.x) X(g.force.y) X(g.moment)
-#define BATCH_INPUT_MEMBERS(X)                                                     \
-    BATCH_LINK_MEMBERS(X, m)                                                       \
-    BATCH_LINK_MEMBERS(X, n)                                                       \
-    X(guide_k.x) X(guide_k.y) X(guide_p.x) X(guide_p.y) X(gravity.x) X(gravity.y)  \
-    X(singular_threshold)
-#define BATCH_OUTPUT_MEMBERS(X)                                                    \
-    X(r_mk.x) X(r_mk.y) X(r_np.x) X(r_np.y) X(r_mn.x) X(r_mn.y)                    \
-    X(n_mk) X(n_np) X(n_mn) X(m_mk) X(m_np) X(m_mn)                                \
-    X(denominator) X(conditioning) X(amplification)
-/* clang-format on */
-
 #define BATCH_ONE(member) +1
 typedef char batch_input_members_are_its_columns
-    [(0 BATCH_INPUT_MEMBERS(BATCH_ONE)) == DYAD_INPUT_COLUMN_COUNT ? 1 : -1];
+    [(0 DYAD_LANE_INPUT_MEMBERS(BATCH_ONE)) == DYAD_INPUT_COLUMN_COUNT ? 1 : -1];
 typedef char batch_output_members_are_its_columns
-    [(0 BATCH_OUTPUT_MEMBERS(BATCH_ONE)) == DYAD_OUTPUT_COLUMN_COUNT ? 1 : -1];
+    [(0 DYAD_LANE_OUTPUT_MEMBERS(BATCH_ONE)) == DYAD_OUTPUT_COLUMN_COUNT ? 1 : -1];
 #undef BATCH_ONE
 
 /* A block of rows, column by column. */
@@ -67,14 +51,14 @@ static inline dyad_input batch_row(const batch_block* block, size_t r)
 {
     dyad_input row;
     int column = 0;
-    BATCH_INPUT_MEMBERS(BATCH_READ)
+    DYAD_LANE_INPUT_MEMBERS(BATCH_READ)
     return row;
 }
 
 static inline void batch_store(batch_block* block, size_t r, const dyad_result* result)
 {
     int column = 0;
-    BATCH_OUTPUT_MEMBERS(BATCH_WRITE)
+    DYAD_LANE_OUTPUT_MEMBERS(BATCH_WRITE)
 }
 
 /* The loop of one type's lanes over the first `rows` rows of a block. */
@@ -145,7 +129,7 @@ static void preset(const dyad_batch_input* input, batch_block* block)
     for (r = 0; r < DYAD_BATCH_BLOCK; ++r) {
         int column = 0;
 #define BATCH_DEFAULT(member) block->in[column++][r] = defaults.member;
-        BATCH_INPUT_MEMBERS(BATCH_DEFAULT)
+        DYAD_LANE_INPUT_MEMBERS(BATCH_DEFAULT)
 #undef BATCH_DEFAULT
     }
     for (c = 0; c < DYAD_INPUT_COLUMN_COUNT; ++c) {

@@ -25,6 +25,10 @@ typedef dyad_loaded dyad_prepared;
 #define DYAD_CLOSED_FORM static inline
 #endif
 
+/* 0 where `ok`, else 1, as a real: a batch's count of failed checks (dyad_lanes.h), in the
+ * scalar of the values it is taken from, so that the count stays in the vector's lanes. */
+#define DYAD_FAILED(ok) ((ok) ? (dyad_real)0 : (dyad_real)1)
+
 /* Marks the result with a failure status and field, outputs NaN; returns status. */
 dyad_status dyad_reject(dyad_result* result, dyad_status status, dyad_field field);
 

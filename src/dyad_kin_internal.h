@@ -20,10 +20,6 @@
 #include <math.h>
 #include <stddef.h>
 
-/* 0 where `ok`, else 1, as a real: a batch's count of failed checks (dyad_lanes.h), in the
- * scalar of the values it is taken from, so that the count stays in the vector's lanes. */
-#define DYAD_FAILED(ok) ((ok) ? (dyad_real)0 : (dyad_real)1)
-
 /* A type's steps (its position, its two sides of the closure, its rates): inlined into
  * dyad_kin_run, where they are called through pointers, and into a batch's loop
  * (dyad_lanes.h), which a call would keep from vectorising. */

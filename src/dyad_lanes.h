@@ -1,6 +1,6 @@
 /* dyadfmu: one sample of a batch, for a loop over samples that the compiler vectorises.
- * Not part of the public API; a generated scene's batch evaluation and dyad_solve_batch
- * include it.
+ * Not part of the public API; a generated scene's batch evaluation, dyad_solve_batch and a
+ * generic dyad FMU's lanes (fmu/models/fmu_dyad_lanes.h) include it.
  *
  * A vector loop cannot branch per sample, and cannot call: each function here is the
  * computation of its public twin (dyad_kinematics_<type>, dyad_react_<type>,
@@ -18,39 +18,76 @@
 #define DYADFMU_LANES_H
 
 #include "dyad_internal.h"
-#include "dyad_kin_internal.h"
-#include "dyad_kin_generic.h"
 
 /* The lanes of the types its includer defines DYAD_LANES_<TYPE> for (a scene's, whose
- * files it ships); each type's formulas come from its files. */
-#define DYAD_KIN_FORMULAS
+ * files it ships); each type's formulas come from its files. Their kinematics too unless
+ * it defines DYAD_LANES_NO_KINEMATICS (a generic dyad FMU, which solves one dyad whose
+ * motion is given). */
 #define DYAD_REACT_FORMULAS
 #ifdef DYAD_LANES_RRR
-#include "dyad_kin_rrr.c"
 #include "dyad_rrr.c"
 #endif
 #ifdef DYAD_LANES_RRT
-#include "dyad_kin_rrt.c"
 #include "dyad_rrt.c"
 #endif
 #ifdef DYAD_LANES_RTR
-#include "dyad_kin_rtr.c"
 #include "dyad_rtr.c"
 #endif
 #ifdef DYAD_LANES_TRT
-#include "dyad_kin_trt.c"
 #include "dyad_trt.c"
 #endif
 #ifdef DYAD_LANES_RTT
-#include "dyad_kin_rtt.c"
 #include "dyad_rtt.c"
+#endif
+#undef DYAD_REACT_FORMULAS
+
+#ifndef DYAD_LANES_NO_KINEMATICS
+#include "dyad_kin_internal.h"
+#include "dyad_kin_generic.h"
+#define DYAD_KIN_FORMULAS
+#ifdef DYAD_LANES_RRR
+#include "dyad_kin_rrr.c"
+#endif
+#ifdef DYAD_LANES_RRT
+#include "dyad_kin_rrt.c"
+#endif
+#ifdef DYAD_LANES_RTR
+#include "dyad_kin_rtr.c"
+#endif
+#ifdef DYAD_LANES_TRT
+#include "dyad_kin_trt.c"
+#endif
+#ifdef DYAD_LANES_RTT
+#include "dyad_kin_rtt.c"
 #endif
 #ifdef DYAD_LANES_CYLINDER
 #include "dyadfmu/cylinder.h"
+#define DYAD_REACT_FORMULAS
 #include "dyad_cylinder.c"
+#undef DYAD_REACT_FORMULAS
 #endif
 #undef DYAD_KIN_FORMULAS
-#undef DYAD_REACT_FORMULAS
+#endif /* DYAD_LANES_NO_KINEMATICS */
+
+/* The scalars of a dyad_input in the order of dyad_input_column, and of a dyad_result
+ * after its status and field in that of dyad_output_column (dyadfmu/batch.h): X(member)
+ * for each, so that a loop over samples reads and writes them member by member, each
+ * staying a register. */
+/* clang-format off */
+#define DYAD_LANE_LINK_MEMBERS(X, g)                                               \
+    X(g.dir.x) X(g.dir.y) X(g.length) X(g.omega) X(g.epsilon)                      \
+    X(g.accel_d.x) X(g.accel_d.y) X(g.com.x) X(g.com.y) X(g.mass) X(g.inertia)     \
+    X(g.force.x) X(g.force.y) X(g.moment)
+#define DYAD_LANE_INPUT_MEMBERS(X)                                                 \
+    DYAD_LANE_LINK_MEMBERS(X, m)                                                   \
+    DYAD_LANE_LINK_MEMBERS(X, n)                                                   \
+    X(guide_k.x) X(guide_k.y) X(guide_p.x) X(guide_p.y) X(gravity.x) X(gravity.y)  \
+    X(singular_threshold)
+#define DYAD_LANE_OUTPUT_MEMBERS(X)                                                \
+    X(r_mk.x) X(r_mk.y) X(r_np.x) X(r_np.y) X(r_mn.x) X(r_mn.y)                    \
+    X(n_mk) X(n_np) X(n_mn) X(m_mk) X(m_np) X(m_mn)                                \
+    X(denominator) X(conditioning) X(amplification)
+/* clang-format on */
 
 /* The lanes for a CPU with AVX2, and for one with AVX-512, beside those for the baseline,
  * chosen as the program runs: where the compiler can target an instruction set in one
@@ -91,6 +128,7 @@ static inline dyad_lanes_isa dyad_lanes_widest(dyad_lanes_isa cap)
 }
 #endif
 
+#ifndef DYAD_LANES_NO_KINEMATICS
 /* dyad_kin_input_default. */
 static inline dyad_kin_input dyad_lane_kin_input_default(void)
 {
@@ -133,6 +171,7 @@ DYAD_KIN_LANE(DYAD_TRT, trt)
 DYAD_KIN_LANE(DYAD_RTT, rtt)
 #endif
 #undef DYAD_KIN_LANE
+#endif /* DYAD_LANES_NO_KINEMATICS */
 
 /* The reactions of one loaded dyad (dyad_react_<type>): the conditioning stored, the
  * closed forms and the amplification whatever the conditioning; 0 where it is accepted

@@ -2584,10 +2584,10 @@ static int test_rrt_fmi3_singular(void)
 static int test_exports_only_fmi(void)
 {
     static const char* const internal[] = {
-        "fmu_instantiate",    "fmu_this_model",      "fmu_log",           "fmu_do_step",
-        "fmu_dyad_behaviour", "fmu_drive_behaviour", "dyad_solve_rrr",    "dyad_solve_rrt",
-        "dyad_solve_rtr",     "dyad_solve_trt",      "dyad_solve_rtt",    "dyad_react_rrr",
-        "dyad_react_rrt",     "dyad_field_name",     "dyad_input_default"};
+        "fmu_instantiate",   "fmu_this_model",      "fmu_log",           "fmu_do_step",
+        "fmu_dyad_evaluate", "fmu_drive_behaviour", "dyad_solve_rrr",    "dyad_solve_rrt",
+        "dyad_solve_rtr",    "dyad_solve_trt",      "dyad_solve_rtt",    "dyad_react_rrr",
+        "dyad_react_rrt",    "dyad_field_name",     "dyad_input_default"};
     int fails = 0;
     size_t k;
     for (k = 0; k < sizeof internal / sizeof internal[0]; ++k) {

@@ -65,7 +65,7 @@ static void report(const fmu_model* model, const dyad_input* input, const dyad_r
     report_failure(model, input, result, evaluation);
 }
 
-static void initialise(const fmu_model* model, void* input)
+void fmu_dyad_initialise(const fmu_model* model, void* input)
 {
     (void)model;
     *(dyad_input*)input = dyad_input_default();
@@ -77,8 +77,8 @@ static void initialise(const fmu_model* model, void* input)
  * restored), so the common solve skips the core's check of its input. Where that
  * solve has no answer, the checking solve runs again to say whether an input is to
  * blame. */
-static void evaluate(const fmu_model* model, const void* input, void* output,
-                     fmu_evaluation* evaluation)
+void fmu_dyad_evaluate(const fmu_model* model, const void* input, void* output,
+                       fmu_evaluation* evaluation)
 {
     const fmu_dyad_data* dyad = (const fmu_dyad_data*)model->data;
     if (dyad->solve_valid((const dyad_input*)input, (dyad_result*)output) != DYAD_STATUS_OK) {
@@ -114,8 +114,8 @@ FMU_COLD static void refuse_rate(const fmu_model* model, int bad, fmu_evaluation
              model->variables[bad].name);
 }
 
-static void derivative(const fmu_model* model, const void* input, const void* seed, void* output,
-                       void* rate, fmu_evaluation* evaluation)
+void fmu_dyad_derivative(const fmu_model* model, const void* input, const void* seed, void* output,
+                         void* rate, fmu_evaluation* evaluation)
 {
     const fmu_dyad_data* dyad = (const fmu_dyad_data*)model->data;
     dyad_solve_tangent_of(dyad->tangent, (const dyad_input*)input, (const dyad_input*)seed,
@@ -129,15 +129,3 @@ static void derivative(const fmu_model* model, const void* input, const void* se
         }
     }
 }
-
-const fmu_behaviour fmu_dyad_behaviour = {sizeof(dyad_input),
-                                          sizeof(dyad_result),
-                                          initialise,
-                                          evaluate,
-                                          NULL,
-                                          NULL,
-                                          derivative,
-                                          NULL,
-                                          NULL,
-                                          NULL,
-                                          NULL};

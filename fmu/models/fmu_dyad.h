@@ -22,6 +22,27 @@ typedef struct fmu_dyad_data {
     size_t feed_count;
 } fmu_dyad_data;
 
-extern const fmu_behaviour fmu_dyad_behaviour;
+/* The behaviour's functions: the input block dyad_input_default(), the outputs (the
+ * solve that trusts its input, which the layer has checked, and where it has no answer the
+ * checking solve, for the reason), and the outputs with their directional derivative. */
+void fmu_dyad_initialise(const fmu_model* model, void* input);
+void fmu_dyad_evaluate(const fmu_model* model, const void* input, void* output,
+                       fmu_evaluation* evaluation);
+void fmu_dyad_derivative(const fmu_model* model, const void* input, const void* seed, void* output,
+                         void* rate, fmu_evaluation* evaluation);
+
+/* The fmu_behaviour of a dyad whose many samples go through `lanes` (fmu_dyad_lanes.h). */
+#define FMU_DYAD_BEHAVIOUR(lanes) \
+    {sizeof(dyad_input),          \
+     sizeof(dyad_result),         \
+     fmu_dyad_initialise,         \
+     fmu_dyad_evaluate,           \
+     NULL,                        \
+     NULL,                        \
+     fmu_dyad_derivative,         \
+     NULL,                        \
+     NULL,                        \
+     NULL,                        \
+     lanes}
 
 #endif /* DYADFMU_FMU_DYAD_H */

@@ -263,6 +263,12 @@ class DyadKind(Kind):
             f"static const fmu_dyad_data dyad = {{dyad_solve_{t}, dyad_solve_valid_{t}, "
             f"&dyad_tangent_{t}, feeds, {len(feeds)}}};",
             "",
+            "/* The columns entry's samples solved together (fmu_dyad_lanes.h), this type's",
+            " * only. */",
+            f"#define DYAD_LANES_{t.upper()}",
+            '#include "fmu_dyad_lanes.h"',
+            f"FMU_DYAD_LANES({t})",
+            "",
         ], "&dyad"
 
     def documentation(self, table: Table) -> str:
@@ -471,7 +477,7 @@ DYAD = DyadKind(
     INPUT_MEMBERS,
     RESULT_MEMBERS,
     "fmu_dyad.h",
-    "fmu_dyad_behaviour",
+    "fmu_dyad_lane_behaviour",
 )
 DRIVE = DriveKind(
     "drive",

@@ -7,7 +7,8 @@ and lost assemblies), a sample's count of failed checks is 0 exactly where the s
 <id>_evaluate says status 0, and there its outputs are evaluate's bit for bit: in the
 baseline build, the AVX2 one and the AVX-512 one (where the CPU has them), each called by
 name, and through the dispatching <id>_lanes; also _first against <id>_evaluate_first.
-GCC reports every loop over samples vectorised in each build. The FMU's columns entry
+GCC reports every loop over samples vectorised in each build: a scene's, dyad_solve_batch's
+and a generic dyad FMU's (fmu/models/fmu_dyad_lanes.h). The FMU's columns entry
 runs the lanes (scripts/tests/test_columns_entry.py holds it to the rows entry).
 """
 
@@ -309,6 +310,34 @@ def test_dyad_solve_batch_loops_vectorise(tmp_path):
             assert wanted in report.stderr, (kind, width, report.stderr[-2000:])
 
 
+@pytest.mark.parametrize("kind", ["rrr", "rrt", "rtr", "trt", "rtt"])
+def test_a_generic_dyad_fmus_lanes_vectorise(kind, tmp_path):
+    """A generic dyad FMU's variable table (dyad_<type>_model.c, which holds its lanes:
+    fmu/models/fmu_dyad_lanes.h) compiled as fmu/CMakeLists.txt compiles it: GCC's report
+    has its loop over samples vectorised in each instruction set's lanes (_widths)."""
+    required_tool("cc")
+    scene = SCENES_DIR / f"dyad_{kind}.toml"
+    gen = tmp_path / "gen"
+    done = subprocess.run(
+        [sys.executable, str(SCENE_TOOL), str(scene), "--out", str(gen)],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    model = gen / f"dyad_{kind}_model.c"
+    includes = [ROOT / "src", ROOT / "src" / "include", ROOT / "fmu", ROOT / "fmu" / "models"]
+    report = subprocess.run(
+        ["cc", *FLAGS, *(f"-I{d}" for d in includes), "-c", str(model),
+         "-o", str(tmp_path / "model.o"), "-fopt-info-vec-optimized"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert report.returncode == 0, report.stderr
+    line = model.read_text().splitlines().index(f"FMU_DYAD_LANES({kind})") + 1
+    for width in _widths():
+        wanted = f"_model.c:{line}:1: optimized: loop vectorized using {width} byte vectors"
+        assert wanted in report.stderr, (kind, width, report.stderr[-2000:])
+
+
 def _widths() -> list[str]:
     """The bytes of a vector of each instruction set's lanes the compiler builds: 16
     (SSE2, NEON), and on x86-64 32 (AVX2) and 64 (AVX-512)."""
@@ -325,14 +354,20 @@ def _cmake_flags(text: str, after: str) -> set[str]:
 
 
 def test_the_build_compiles_the_lanes_with_the_flags_these_tests_use():
-    """What these tests compile with is what the build gives the lanes: a scene's C
-    (fmu/CMakeLists.txt), the cross-compiled binaries' model C, and src/dyad_batch.c
+    """What these tests compile with is what the build gives the lanes: a scene's C and a
+    generic dyad's variable table (fmu/CMakeLists.txt), the cross-compiled binaries' model
+    C, and src/dyad_batch.c
     (CMakeLists.txt); a flag dropped there, and the loops would not vectorise in the
     binaries while these tests still did."""
     vectorising = {f for f in FLAGS if f.startswith(("-O", "-f", "--param"))}
     fmu = (ROOT / "fmu" / "CMakeLists.txt").read_text()
     core = (ROOT / "CMakeLists.txt").read_text()
-    assert _cmake_flags(fmu, "set_source_files_properties(${gen}/${id}_scene.c") == vectorising
+    assert _cmake_flags(fmu, "set(lane_options") == vectorising
+    for source in ("${gen}/${id}_scene.c", "${gen}/${id}_model.c"):
+        assert (
+            f'set_source_files_properties({source} PROPERTIES COMPILE_OPTIONS "${{lane_options}}")'
+            in fmu
+        )
     assert _cmake_flags(fmu, "set(cross_lane_flags") == vectorising
     wanted = {"-O3", "-fno-trapping-math", "-fno-math-errno"}
     assert _cmake_flags(core, "set_source_files_properties(src/dyad_batch.c") == wanted

@@ -611,6 +611,7 @@ def test_c_table_compiles(generated, dyad_type, tmp_path):
             "-Wpedantic",
             "-Werror",
             f"-I{ROOT / 'src' / 'include'}",
+            f"-I{ROOT / 'src'}",  # its lanes: the core's solve lane (fmu_dyad_lanes.h)
             f"-I{ROOT / 'fmu'}",
             f"-I{ROOT / 'fmu' / 'models'}",
             "-c",
@@ -654,7 +655,9 @@ def test_c_table_matches_the_table(generated, dyad_type):
         if v["name"] == "on_singular":
             assert (target, offset) == ("FMU_TARGET_SETTING", "FMU_SETTING_ON_SINGULAR")
     vr_limit = len(raw["variable"]) + 1
-    assert re.search(rf"index_of_vr, {vr_limit}, &fmu_dyad_behaviour, &dyad, &copies\}};", c_text)
+    assert re.search(
+        rf"index_of_vr, {vr_limit}, &fmu_dyad_lane_behaviour, &dyad, &copies\}};", c_text
+    )
     assert re.search(r"index_of_vr\[\d+\] = \{\s*-1, 0, 1, 2,", c_text)
     # the straight copies of every step: each input from its place in the call to where
     # the layer keeps it (an angle as set, per variable), each output from its result
