@@ -2228,7 +2228,8 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
 }
 
 /* The widest lanes DYADFMU_LANES lets a call take: "baseline" or "avx2" (to measure each,
- * fmu/README.md), and otherwise the widest. */
+ * fmu/README.md), and otherwise ("avx512", unset or unknown: dyadfmu's Python refuses an
+ * unknown value before the call) the widest. */
 static dyad_lanes_isa lanes_cap(const char* which)
 {
     if (which != NULL && strcmp(which, "baseline") == 0) {

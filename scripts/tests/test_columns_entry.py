@@ -94,6 +94,20 @@ def test_each_sample_is_what_the_rows_entry_gives_bit_for_bit(name, lanes, monke
         assert (status == 3).any() and (status == 0).any(), (name, "the samples mix outcomes")
 
 
+def test_a_lanes_name_the_binary_would_not_know_is_refused_by_name(monkeypatch):
+    """DYADFMU_LANES=avx-2 (a typo) would run in the widest lanes, whatever it meant: it is
+    refused, naming the variable and its value; avx512 is taken."""
+    fmu = paths.built_fmu("dyad_rrr", 2)
+    columns = entries.columns_entry(fmu)
+    angle = np.linspace(0.4, 0.6, 5)
+    monkeypatch.setenv("DYADFMU_LANES", "avx-2")
+    with pytest.raises(ValueError, match=r"DYADFMU_LANES = 'avx-2': not one of baseline, avx2"):
+        columns.evaluate({"link_m.angle": angle}, ("R_mk.x",), 5)
+    monkeypatch.setenv("DYADFMU_LANES", "avx512")
+    y, status = columns.evaluate({"link_m.angle": angle}, ("R_mk.x",), 5)
+    assert (status == 0).all() and np.isfinite(y["R_mk.x"]).all()
+
+
 def test_a_scene_with_samples_without_an_answer_gives_their_status():
     """The toggles scene, which turns through part of a revolution only: the samples where
     it does not assemble or sits at a dead centre have status 1 (Warning, as a get reports

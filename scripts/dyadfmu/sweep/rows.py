@@ -11,6 +11,7 @@ its outputs read straight out, for a model without states.
 from __future__ import annotations
 
 import ctypes
+import os
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +27,8 @@ _UINT_P = ctypes.POINTER(ctypes.c_uint)
 _DOUBLE_P = ctypes.POINTER(ctypes.c_double)
 _INT_P = ctypes.POINTER(ctypes.c_int)
 _STEP_P = ctypes.POINTER(ctypes.c_ssize_t)
+#: The values of DYADFMU_LANES, the widest lanes the columns entry may take (fmu/README.md)
+LANES = ("baseline", "avx2", "avx512")
 
 
 class _Entry:
@@ -108,6 +111,7 @@ class ColumnsEntry(_Entry):
     ) -> tuple[dict[str, np.ndarray], np.ndarray] | None:
         """evaluate into ``ys`` and ``status``, which the caller has checked as evaluate
         checks its ``out`` (dyadfmu.evaluate checks a whole batch's arrays once)."""
+        _check_lanes()
         x_names = tuple(x)
         columns = [_column(x[n]) for n in x_names]
         if any(c.size not in (1, count) for c in columns):
@@ -120,6 +124,17 @@ class ColumnsEntry(_Entry):
             _steps([y.strides[0] // 8 for y in ys]), _address(status), count,
         )  # fmt: skip
         return None if done != 0 else (dict(zip(y_names, ys, strict=True)), status)
+
+
+def _check_lanes() -> None:
+    """Refuses a DYADFMU_LANES the binary would not know (it would take the widest lanes,
+    whatever a typo meant), naming it."""
+    lanes = os.environ.get("DYADFMU_LANES", "")
+    if lanes not in ("", *LANES):
+        raise ValueError(
+            f"DYADFMU_LANES = {lanes!r}: not one of {', '.join(LANES)} (the widest lanes the "
+            "columns entry may take; unset: the widest this CPU runs)"
+        )
 
 
 def _written(
