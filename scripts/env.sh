@@ -123,15 +123,19 @@ dyadfmu_build() {
     fi
     dyadfmu_log "building in $dir $*"
     if [ "$last" != "$wanted" ] || [ ! -f "$dir/CMakeCache.txt" ]; then
-        cmake -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
+        # the last build's products are not those of the options configured now
+        rm -f "$stamp"
+        "$(dyadfmu_cmake_of "$dir")" -S "$DYADFMU_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
             -DPython3_EXECUTABLE="$DYADFMU_VENV/bin/python" "$@" >/dev/null || {
             local status=$?
             dyadfmu_log "configuring $dir failed (CMake's messages above)"
             return "$status"
         }
     fi
-    # the stamp's time is the build's start: a source saved during the build is newer
-    rm -f "$stamp"
+    # The stamp's time is the build's start: a source saved during the build is newer. A
+    # build that fails leaves the last one's stamp, older than the sources that made this
+    # one run: the next call builds again, and a build that cannot reach the compiler (a
+    # tool missing) costs the next one nothing.
     printf '%s' "$wanted" >"$stamp.new"
     dyadfmu_build_logged "$dir" "$dir/build.log" || return $?
     find "$dir" "$dir/fmus" -maxdepth 1 \( -name '*.fmu' -o -name 'lib*.so' \) -print \
@@ -149,6 +153,20 @@ dyadfmu_products_there() {
     done <"$1"
 }
 
+# dyadfmu_cmake_of DIR: the cmake that configured DIR (its cache's CMAKE_COMMAND), else the
+# first on PATH. The venv has a CMake of its own (the package's build needs one) and puts it
+# first on PATH where it is activated: another version configures the whole build again and
+# makes every object anew.
+dyadfmu_cmake_of() {
+    local cached
+    cached=$(sed -n 's/^CMAKE_COMMAND:INTERNAL=//p' "$1/CMakeCache.txt" 2>/dev/null || true)
+    if [ -n "$cached" ] && [ -x "$cached" ]; then
+        printf '%s' "$cached"
+    else
+        printf 'cmake'
+    fi
+}
+
 # dyadfmu_build_logged DIR LOG [cmake --build options...]: build, the output in LOG, a line
 # per FMU packaged on stderr; on failure the log's last 40 lines and where it is.
 dyadfmu_build_logged() {
@@ -156,7 +174,8 @@ dyadfmu_build_logged() {
     shift 2
     local status
     # PIPESTATUS read in either branch: with or without pipefail, cmake's own status
-    if cmake --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" "$@" 2>&1 | tee "$log" |
+    if "$(dyadfmu_cmake_of "$dir")" --build "$dir" -j "$(nproc 2>/dev/null || echo 2)" "$@" 2>&1 |
+        tee "$log" |
         sed -un 's/^\[ *\([0-9]*\)%\] Packaging \(.*\.fmu\)$/== [\1%] packaged \2/p' >&2; then
         status=${PIPESTATUS[0]}
     else

@@ -348,8 +348,11 @@ def test_a_wrapper_refuses_a_bad_path_in_one_line_before_it_builds(tmp_path, scr
     assert calls == "" and "Traceback" not in done.stderr
 
 
-def test_a_wrapper_with_good_arguments_goes_on_to_build(tmp_path):
-    """(The fake venv is newer than any build: the build is not skipped.)"""
+def test_a_wrapper_with_good_arguments_goes_on_to_build(tmp_path, monkeypatch):
+    """(On a checkout of its own, whose build/ is not configured: the stub cmake
+    configures it, and fails.)"""
+    (tmp_path / "checkout").mkdir()
+    monkeypatch.setenv("DYADFMU_ROOT", str(tmp_path / "checkout"))
     done, calls = _wrapper(tmp_path, "run-main", "four-bar", "--steps", "36")
     assert done.returncode == 97 and calls.startswith("cmake "), (done.stderr, calls)
     assert "failed" in done.stderr.splitlines()[-1]
@@ -406,6 +409,45 @@ def test_a_build_no_source_is_newer_than_is_left_as_it_is(tmp_path):
     (build / "fmus" / "x_fmi2.fmu").unlink()
     done = _build_in(root, build, env)
     assert done.returncode == 0 and calls() == ["--build"], done.stderr
+    # a build that fails (the compiler, say) leaves the last whole build's stamp: the call
+    # after it builds again, without configuring (its options are still known), and a
+    # failure that never reached the compiler costs the next build nothing
+    (tmp_path / "bin" / "cmake").write_text(f'#!/bin/sh\necho "cmake $*" >> "{log}"\nexit 3\n')
+    (root / "src" / "dyad_newer.c").write_text("")
+    assert _build_in(root, build, env).returncode == 3 and calls() == ["--build"]
+    assert (build / ".dyadfmu-built").read_text() == "options: -DX=2"
+    assert _build_in(root, build, env).returncode == 3 and calls() == ["--build"]
+
+
+def test_a_build_is_made_by_the_cmake_that_configured_it(tmp_path):
+    """Another CMake first on PATH (the venv's, where it is activated) would configure the
+    build again and make every object anew: dyadfmu_build runs the one its cache names, for
+    the build and for new options, and the first on PATH only where there is none."""
+    env, log = _fake_machine(tmp_path)  # its cmake on PATH logs "cmake ..." and fails
+    configured = tmp_path / "configured" / "cmake"
+    configured.parent.mkdir()
+    configured.write_text(f'#!/bin/sh\necho "configured $*" >> "{log}"\n')
+    configured.chmod(0o755)
+    root, build = tmp_path / "checkout", tmp_path / "build"
+    for folder in ("src", "fmu", "modelDescription", "tests"):
+        (root / folder).mkdir(parents=True)
+    build.mkdir()
+    (build / "CMakeCache.txt").write_text(f"CMAKE_COMMAND:INTERNAL={configured}\n")
+    (build / ".dyadfmu-built").write_text("options: -DX=1")
+    for options in ((), ("-DX=2",)):
+        log.write_text("")
+        done = _build_in(root, build, dict(env, DYADFMU_REBUILD="1"), *options)
+        assert done.returncode == 0, done.stderr
+        calls = log.read_text().splitlines()
+        assert calls and all(
+            c.startswith(f"configured -{'S' if options else '-build'}")
+            or c.startswith("configured --build")
+            for c in calls
+        ), calls
+    (build / "CMakeCache.txt").write_text("")
+    log.write_text("")
+    assert _build_in(root, build, dict(env, DYADFMU_REBUILD="1")).returncode == 97
+    assert log.read_text().startswith("cmake --build")
 
 
 @pytest.mark.parametrize("args", [["--quick"], ["extra"], ["--help-me"], ["--serial", "-s"]])
