@@ -25,6 +25,7 @@ from fmpy.model_description import ModelDescription
 
 from .. import paths
 from ..batch import FIELDS, solve
+from ..sweep.rows import LANES as LANE_NAMES
 from . import bench, flops
 from . import configurations as cfg
 
@@ -142,8 +143,8 @@ def numpy_yardstick_seconds(scene: str, count: int, rounds: int) -> float:
 
 
 #: The lanes an FMU binary carries for x86-64 (fmu/README.md), by the name DYADFMU_LANES
-#: takes and the CPU flag each needs (/proc/cpuinfo), the widest last.
-LANES = {"baseline": "", "avx2": "avx2", "avx512": "avx512f"}
+#: takes (sweep/rows.py) and the CPU flag each needs (/proc/cpuinfo), the widest last.
+LANES = dict(zip(LANE_NAMES, ("", "avx2", "avx512f"), strict=True))
 
 
 def widest_lanes() -> str:
