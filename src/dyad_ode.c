@@ -476,8 +476,18 @@ static void ode_accept(dyad_ode_state* s, const ode_work* w, dyad_real h, dyad_r
 
 /* ---- the call ------------------------------------------------------------------------------- */
 
+/* The shortest step the error control may ask for at the state's time: the caller's
+ * h_min and the resolution of the time. */
+static dyad_real ode_shortest_step(const dyad_ode_state* s)
+{
+    return fmax(s->options.h_min, 16 * DYAD_REAL_EPSILON * fabs(s->t));
+}
+
 /* A first step from the sizes of y and f (Hairer, Norsett, Wanner I, II.4):
- * 1e-2 |y| / |f| in the error's norm, 1e-6 where either is too small. */
+ * 1e-2 |y| / |f| in the error's norm, 1e-6 where either is too small; at least 256
+ * times the shortest step, since a y barely above its tolerance (a start a few eps
+ * from rest) makes |y| / |f| no guess at all: the error control shrinks a step too
+ * long, down to the shortest, where it must. */
 static dyad_real ode_first_step(const dyad_ode_state* s, const dyad_real* f0)
 {
     int i;
@@ -492,7 +502,8 @@ static dyad_real ode_first_step(const dyad_ode_state* s, const dyad_real* f0)
     }
     ny = sqrt(ny / s->n);
     nf = sqrt(nf / s->n);
-    return ny < 1e-5 || nf < 1e-5 ? (dyad_real)1e-6 : (dyad_real)1e-2 * ny / nf;
+    return fmax(ny < 1e-5 || nf < 1e-5 ? (dyad_real)1e-6 : (dyad_real)1e-2 * ny / nf,
+                256 * ode_shortest_step(s));
 }
 
 /* The fewest steps the controller could cover `span` in from step size h
@@ -526,8 +537,7 @@ static dyad_real ode_planned_step(const dyad_ode_state* s)
 
 static int ode_step_too_small(const dyad_ode_state* s, dyad_real h)
 {
-    return !(h >= 16 * DYAD_REAL_EPSILON * fabs(s->t)) || !(s->t + h != s->t) ||
-           h < s->options.h_min;
+    return !(h >= ode_shortest_step(s)) || !(s->t + h != s->t);
 }
 
 /* One accepted step from the state's point toward t_end, with the attempts

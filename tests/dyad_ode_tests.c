@@ -901,6 +901,44 @@ static int test_step_underflow(void)
     return fails;
 }
 
+/* A body at rest but for a speed of a few eps, under a constant acceleration of 100. */
+static int falling_rhs(void* user, double t, const double* y, double* f)
+{
+    (void)user, (void)t;
+    f[0] = y[1];
+    f[1] = 100;
+    return 0;
+}
+
+/* A start a few eps from rest, as a plant's states may be given: |y| / |f| in the
+ * error's norm asks for a first step of 1e-19 s, below the shortest a caller that
+ * integrates a 1 ms step from 0 allows (16 eps of it). The first step starts 256 times
+ * above that shortest one instead, and the motion is the exact one. Before, the call
+ * stopped at once with STEP_UNDERFLOW. */
+static int test_first_step_near_rest(void)
+{
+    const dyad_ode_method methods[2] = {DYAD_ODE_RODASP, DYAD_ODE_DOP853};
+    int fails = 0, m;
+    for (m = 0; m < 2; ++m) {
+        double y0[2] = {0, 1e-14};
+        dyad_ode_system sys = system_of(2, falling_rhs, NULL, NULL);
+        dyad_ode_options o = tolerances(1e-8 / 64, 1e-8 / 64);
+        dyad_ode_state s;
+        dyad_ode_status st;
+        o.method = methods[m];
+        o.h_min = 16 * DBL_EPSILON * 1e-3;
+        sys.autonomous = 1;
+        dyad_ode_init(&s, 2, 0, y0, &o);
+        st = dyad_ode_advance(&s, &sys, 1e-3);
+        REPORT("%s: %s after %ld steps\n", dyad_ode_status_name(st), m ? "DOP853" : "RODASP",
+               s.counters.accepted_steps);
+        CHECK(st == DYAD_ODE_OK, "%s: %s", m ? "DOP853" : "RODASP", dyad_ode_status_name(st));
+        CHECK(fabs(s.y[1] - (1e-14 + 0.1)) < 1e-15 && fabs(s.y[0] - (1e-17 + 5e-5)) < 1e-18,
+              "%s: y = (%.17g, %.17g)", m ? "DOP853" : "RODASP", s.y[0], s.y[1]);
+    }
+    return fails;
+}
+
 /* y' = J y with J = diag(8, 16, ..., 256): I / (h gamma) - J is singular at
  * h = 1/2, 1/4, ..., 1/64 (gamma = 1/4), every halving the first step tries. */
 static int singular_rhs(void* user, double t, const double* y, double* f)
@@ -995,6 +1033,7 @@ static const named_test tests[] = {
     {"step_cap", test_step_cap},
     {"growth_stays_finite", test_growth_stays_finite},
     {"step_underflow", test_step_underflow},
+    {"first_step_near_rest", test_first_step_near_rest},
     {"singular", test_singular},
     {"invalid_arguments", test_invalid_arguments},
 };
