@@ -261,8 +261,11 @@ def parser() -> argparse.ArgumentParser:
     """The parser of the dyadfmu command and its subcommands."""
     top = argparse.ArgumentParser(
         prog="dyadfmu",
-        description="Co-simulate the dyad FMUs of planar mechanisms with fmpy and check every "
-        "joint reaction against an independent Newton-Euler solve in NumPy.",
+        description="Joint reactions of planar linkages: build a scene's FMUs (build-scene), "
+        "evaluate them over tables (rows), draw and sweep designs (animate, sweep), and check "
+        "them: co-simulate the FMUs with fmpy against an independent Newton-Euler solve in "
+        "NumPy (run, scene, scenes, study, cosim, plants, speed, embedded), whose reports go "
+        "under out/ of the current folder unless --out says otherwise.",
     )
     sub = top.add_subparsers(dest="command", required=True)
     listing = sub.add_parser(
