@@ -263,9 +263,9 @@ def parser() -> argparse.ArgumentParser:
         prog="dyadfmu",
         description="Joint reactions of planar linkages: build a scene's FMUs (build-scene), "
         "evaluate them over tables (rows), draw and sweep designs (animate, sweep), and check "
-        "them: co-simulate the FMUs with fmpy against an independent Newton-Euler solve in "
-        "NumPy (run, scene, scenes, study, cosim, plants, speed, embedded), whose reports go "
-        "under out/ of the current folder unless --out says otherwise.",
+        "them: co-simulations against an independent Newton-Euler solve in NumPy (run, "
+        "scene, scenes, study, cosim, plants), speed and firmware figures (speed, embedded). "
+        "Each subcommand's --help says what it writes where.",
     )
     sub = top.add_subparsers(dest="command", required=True)
     listing = sub.add_parser(

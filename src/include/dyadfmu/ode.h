@@ -109,7 +109,8 @@ typedef struct dyad_ode_options {
     dyad_real atol;
     /** The largest internal step (> 0; default +inf). */
     dyad_real h_max;
-    /** The first step (0: chosen from the tolerances and f). */
+    /** The first step (0: chosen from the tolerances and f, and at least 256 times
+     *  the shortest step below). */
     dyad_real h_initial;
     /** The shortest step the error control may ask for (default 0) before the
      *  call gives up with DYAD_ODE_STEP_UNDERFLOW, as it does below 16 eps |t|:
