@@ -58,7 +58,9 @@
  * continuous output against exact solutions.
  *
  * The error control (rodas.f's): the error of a step is the root mean square
- * of u_6,i / (atol + rtol max(|y0_i|, |y1_i|)); accepted at <= 1; the next
+ * of u_6,i / (atol + rtol max(|y0_i|, |y1_i|)), a scale the system may lower
+ * (error_scale: a quantity computed from the states, held to its own
+ * tolerance, tightens its states' error); accepted at <= 1; the next
  * step is h / fac, fac = err^(1/4) / 0.9 limited to [1/6, 5], with
  * Gustafsson's predictive factor (from the last accepted step's h and error,
  * kept in the state) after an accepted step, and no growth right after a
@@ -171,6 +173,27 @@ static dyad_real ode_scale(const dyad_ode_state* s, int i, dyad_real y1)
 {
     const dyad_real big = fmax(fmax(fabs(s->y[i]), fabs(y1)), s->options.magnitude[i]);
     return s->options.atol + s->options.rtol * big;
+}
+
+/* Every component's error scale for a step from s->y to y1: ode_scale(), lowered where the
+ * system's error_scale() says so (to a positive value only). */
+static void ode_scales(const dyad_ode_state* s, const dyad_ode_system* sys, const dyad_real* y1,
+                       dyad_real* sc)
+{
+    int i;
+    dyad_real asked[DYAD_ODE_MAX_DIM];
+    for (i = 0; i < s->n; ++i) {
+        sc[i] = asked[i] = ode_scale(s, i, y1[i]);
+    }
+    if (sys->error_scale == NULL) {
+        return;
+    }
+    sys->error_scale(sys->user, s->y, y1, asked);
+    for (i = 0; i < s->n; ++i) {
+        if (asked[i] > 0 && asked[i] < sc[i]) {
+            sc[i] = asked[i];
+        }
+    }
 }
 
 dyad_ode_status dyad_ode_init(dyad_ode_state* state, int n, dyad_real t0, const dyad_real* y0,
@@ -406,7 +429,7 @@ static dyad_ode_status ode_attempt(dyad_ode_state* s, const dyad_ode_system* sys
                                    dyad_real h, dyad_real* error)
 {
     int i, k, n = s->n;
-    dyad_real sum = 0;
+    dyad_real sum = 0, scale[DYAD_ODE_MAX_DIM];
     for (k = 0; k < ODE_STAGES; ++k) {
         dyad_ode_status status = ode_stage(s, sys, w, h, k);
         if (status != DYAD_ODE_OK) {
@@ -414,10 +437,11 @@ static dyad_ode_status ode_attempt(dyad_ode_state* s, const dyad_ode_system* sys
         }
     }
     for (i = 0; i < n; ++i) {
-        dyad_real scale, ratio;
         w->ynew[i] = w->arg[i] + w->u[5][i];
-        scale = ode_scale(s, i, w->ynew[i]);
-        ratio = w->u[5][i] / scale;
+    }
+    ode_scales(s, sys, w->ynew, scale);
+    for (i = 0; i < n; ++i) {
+        const dyad_real ratio = w->u[5][i] / scale[i];
         sum += ratio * ratio;
     }
     *error = sqrt(sum / n);
@@ -721,6 +745,8 @@ typedef struct dop_work {
     dyad_real k[DOP_STAGES + 1][DYAD_ODE_MAX_DIM];
     dyad_real arg[DYAD_ODE_MAX_DIM];
     dyad_real ynew[DYAD_ODE_MAX_DIM];
+    dyad_real e5[DYAD_ODE_MAX_DIM]; /* the embedded errors of orders 5 and 3 */
+    dyad_real e3[DYAD_ODE_MAX_DIM];
 } dop_work;
 
 /* One attempt from (t, y) with step h: the solution in w->ynew and its error. */
@@ -728,7 +754,7 @@ static dyad_ode_status dop_attempt(dyad_ode_state* s, const dyad_ode_system* sys
                                    dyad_real h, dyad_real* error)
 {
     int i, j, k, n = s->n;
-    dyad_real e5 = 0, e3 = 0;
+    dyad_real e5 = 0, e3 = 0, scale[DYAD_ODE_MAX_DIM];
     for (k = 1; k < DOP_STAGES; ++k) {
         for (i = 0; i < n; ++i) {
             dyad_real sum = 0;
@@ -743,16 +769,20 @@ static dyad_ode_status dop_attempt(dyad_ode_state* s, const dyad_ode_system* sys
         }
     }
     for (i = 0; i < n; ++i) {
-        dyad_real sum = 0, d5 = 0, d3 = 0, scale;
+        dyad_real sum = 0, d5 = 0, d3 = 0;
         for (j = 0; j < DOP_STAGES; ++j) {
             sum += dop_b[j] * w->k[j][i];
             d5 += dop_e5[j] * w->k[j][i];
             d3 += dop_e3[j] * w->k[j][i];
         }
         w->ynew[i] = s->y[i] + h * sum;
-        scale = ode_scale(s, i, w->ynew[i]);
-        e5 += (d5 / scale) * (d5 / scale);
-        e3 += (d3 / scale) * (d3 / scale);
+        w->e5[i] = d5;
+        w->e3[i] = d3;
+    }
+    ode_scales(s, sys, w->ynew, scale);
+    for (i = 0; i < n; ++i) {
+        e5 += (w->e5[i] / scale[i]) * (w->e5[i] / scale[i]);
+        e3 += (w->e3[i] / scale[i]) * (w->e3[i] / scale[i]);
     }
     /* not finite where the stages overflow: rejected, the step shrinks */
     *error = e5 > 0 ? fabs(h) * e5 / sqrt((e5 + (dyad_real)0.01 * e3) * n) : 0;

@@ -211,6 +211,7 @@ static dyad_ode_system system_of(int n, dyad_ode_rhs rhs, dyad_ode_jacobian jac,
     s.rhs = rhs;
     s.jacobian = jac;
     s.autonomous = 0;
+    s.error_scale = NULL;
     s.user = user;
     return s;
 }
@@ -687,6 +688,88 @@ static int test_magnitude(void)
     return fails;
 }
 
+/* ---- (b'') a quantity computed from the states, held to its own tolerance ----------------- */
+
+/* A crank driven by a motor without inductance: M w' = c (w_free - w) - load sin W t, with a
+ * damping c = k^2 / R so strong that the speed sits a hair below w_free. The motor's torque
+ * c (w_free - w), which the reactions follow, carries the speed's error times c: held to
+ * rtol |w| the speed leaves it far beyond rtol of the load; the system's error_scale holds
+ * the speed to rtol of the torque's own scale over c instead. */
+#define STIFF_CRANK_DT 0.005 /* s, the communication step; 200 of them */
+
+typedef struct stiff_crank {
+    double inertia, damping, free_speed, load, frequency;
+    double rtol, atol;
+} stiff_crank;
+
+static int stiff_crank_rhs(void* user, dyad_real t, const dyad_real* y, dyad_real* dydt)
+{
+    const stiff_crank* c = (const stiff_crank*)user;
+    dydt[0] = y[1];
+    dydt[1] = (c->damping * (c->free_speed - y[1]) - c->load * sin(c->frequency * t)) / c->inertia;
+    return 0;
+}
+
+static void stiff_crank_scale(void* user, const dyad_real* y0, const dyad_real* y1, dyad_real* sc)
+{
+    const stiff_crank* c = (const stiff_crank*)user;
+    const double torque = fabs(c->damping * (c->free_speed - y1[1]));
+    (void)y0;
+    sc[1] = c->atol + c->rtol * (torque + c->load) / c->damping;
+}
+
+/* The torque c (w_free - w) at t from w(0) = w_free: with u = w - w_free, a = c / M and the
+ * load's frequency W, u' = -a u - (load / M) sin W t, whose solution is
+ * u = B (cos W t - e^(-a t)) - (a / W) B sin W t, B = (load / M) W / (W^2 + a^2). */
+static double stiff_crank_torque(const stiff_crank* c, double t)
+{
+    const double a = c->damping / c->inertia, w = c->frequency;
+    const double b = c->load / c->inertia * w / (w * w + a * a);
+    return -c->damping * (b * (cos(w * t) - exp(-a * t)) - a / w * b * sin(w * t));
+}
+
+static double stiff_crank_error(stiff_crank* c, int scaled, dyad_ode_method method, long* steps)
+{
+    int k;
+    double y0[2] = {0, 0}, out[201 * 2], worst = 0;
+    dyad_ode_system sys = system_of(2, stiff_crank_rhs, NULL, c);
+    dyad_ode_options o = tolerances(c->rtol, c->atol);
+    dyad_ode_state s;
+    o.method = method;
+    y0[1] = c->free_speed;
+    sys.autonomous = 0;
+    sys.error_scale = scaled ? stiff_crank_scale : NULL;
+    if (run_grid(&s, &sys, y0, &o, STIFF_CRANK_DT, 200, out) != DYAD_ODE_OK) {
+        return INFINITY;
+    }
+    for (k = 1; k <= 200; ++k) {
+        const double torque = c->damping * (c->free_speed - out[2 * k + 1]);
+        worst = fmax(worst, fabs(torque - stiff_crank_torque(c, STIFF_CRANK_DT * k)) / c->load);
+    }
+    *steps = s.counters.accepted_steps + s.counters.rejected_steps;
+    return worst;
+}
+
+static int test_error_scale(void)
+{
+    int fails = 0, m;
+    const dyad_ode_method methods[2] = {DYAD_ODE_RODASP, DYAD_ODE_DOP853};
+    const char* names[2] = {"RODASP", "DOP853"};
+    for (m = 0; m < 2; ++m) {
+        stiff_crank c = {1e-2, 1e2, 1e3, 1, 300, 1e-8, 1e-12};
+        long plain_steps = 0, scaled_steps = 0;
+        const double plain = stiff_crank_error(&c, 0, methods[m], &plain_steps);
+        const double scaled = stiff_crank_error(&c, 1, methods[m], &scaled_steps);
+        REPORT("%s: torque error / load %.2e in %ld steps held to rtol |w|, %.2e in %ld steps "
+               "with error_scale\n",
+               names[m], plain, plain_steps, scaled, scaled_steps);
+        CHECK(plain > 100 * c.rtol, "%s: the torque is within %g without error_scale: no test",
+              names[m], plain);
+        CHECK(scaled < 10 * c.rtol, "%s: torque error %g with error_scale", names[m], scaled);
+    }
+    return fails;
+}
+
 /* ---- (c) reproducibility ------------------------------------------------------------------ */
 
 static int test_reproducible(void)
@@ -1027,6 +1110,7 @@ static const named_test tests[] = {
     {"gsl_skipped", test_gsl_skipped},
 #endif
     {"magnitude", test_magnitude},
+    {"error_scale", test_error_scale},
     {"reproducible", test_reproducible},
     {"save_restore", test_save_restore},
     {"rhs_failure", test_rhs_failure},

@@ -514,16 +514,26 @@ def _motor_partials(ident: str, drivers: list[ForwardDriver], n: int) -> list[st
 
 
 def _steady_lost(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list[str]:
-    """steady_lost(): whether a motor without inductance's torque is lost in round-off."""
+    """steady_lost(): whether a motor without inductance's torque is lost in round-off, and
+    the speed error that moves it by the torques its crank balances."""
     lines = [
         "/* 1 where the current of a motor without inductance, (V - k r q') / R, carries more",
         " * round-off in its torque than solver.rtol of the torques its crank balances (the",
         " * torque, h and the inertia torque M_aa q'^2): a resistance so small that the motor",
-        " * is a speed source to double precision, whose current no double can resolve. */",
+        " * is a speed source to double precision, whose current no double can resolve.",
+        " * speed_scale[a] (rad/s): the change of driver a's rate that moves its motor's",
+        " * torque, r^2 k^2 / R times it, by |torque| + |h|, the torques its acceleration",
+        " * balances (+inf without such a motor); the rate's error is held to rtol of it, so",
+        " * that the current, the acceleration and the reactions, which carry the rate's",
+        " * error times r^2 k^2 / R, are held to rtol of those torques too. */",
         f"static int steady_lost(const {ident}_input* in, const {ident}_output* out, "
         "const double* y,",
-        "                       const double* m, fmu_evaluation* evaluation)",
+        "                       const double* m, double* speed_scale, fmu_evaluation* evaluation)",
         "{",
+        "    int a;",
+        "    for (a = 0; a < PLANT_DRIVERS; ++a) {",
+        "        speed_scale[a] = INFINITY;",
+        "    }",
     ]
     steady = [f for f in drivers if f.steady]
     if not steady:
@@ -546,6 +556,8 @@ def _steady_lost(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list
             f"            {resistance};",
             "        const double scale =",
             f"            fabs(torque) + fabs({h}) + m[{k * n + k}] * {rate} * {rate};",
+            f"        speed_scale[{k}] = (fabs(torque) + fabs({h})) /",
+            f"                         fabs(ratio * ratio * kt * kt / {resistance});",
             "        if (noise > in->plant_rtol * scale) {",
             "            evaluation->status = FMU_DISCARD;",
             "            snprintf(evaluation->reason, sizeof evaluation->reason,",

@@ -490,6 +490,41 @@ def test_a_stiff_damping_without_inductance_takes_the_rosenbrock_method():
         slave.close()
 
 
+@pytest.mark.parametrize("resistance", [1e-2, 1e-4])
+def test_a_stiff_motor_without_inductance_holds_its_torque_to_the_tolerance(resistance):
+    """slider_crank_linear_motor at 290 V with a small resistance: its torque at the crank,
+    r k (V - k r q') / R, carries the speed's error times r^2 k^2 / R. Found by an attack on
+    the plant: held to solver.rtol |q'| alone, the speed left the torque, and with it the
+    acceleration and the reactions, 9 (1e-2 ohm) and 190 (1e-4 ohm) times solver.rtol of
+    the torques the crank balances (|torque| + |h|, h = torque0) off a run at rtol 1e-10,
+    with status 0. The speed is now held to rtol of those torques over r^2 k^2 / R too. The
+    bound here is 5 times that: the angle, within rtol of its travel, moves h as well."""
+    rtol = 1e-8
+    start = {"crank.motor.resistance": resistance, "crank.motor.voltage": 290.0}
+
+    def run(tolerance: float | None) -> np.ndarray:
+        tolerances = {} if tolerance is None else _tolerances(tolerance)
+        return simulate_fmu(
+            _fmu("slider_crank_linear_motor"),
+            stop_time=0.1,
+            output_interval=1e-3,
+            start_values={**start, **tolerances},
+        )
+
+    rows, tight = run(None), run(1e-10)
+    assert np.all(rows["status"] == 0) and np.all(tight["status"] == 0)
+    balanced = rtol * (np.abs(tight["crank.torque"]) + np.abs(tight["crank.torque0"]))
+    torque = np.max(np.abs(rows["crank.torque"] - tight["crank.torque"]) / balanced)
+    inertia = np.abs(rows["crank.epsilon"] - tight["crank.epsilon"]) * tight["crank.J"]
+    acceleration = np.max(inertia / balanced)
+    per_ms = _per_ms(rows, "solver.evaluations")
+    print(
+        f"R = {resistance:g} ohm: torque {torque:.2f}, J q'' {acceleration:.2f} of rtol "
+        f"(|torque| + |h|); {per_ms:.0f} evaluations per ms"
+    )
+    assert torque < 5 and acceleration < 5
+
+
 @pytest.mark.parametrize("resistance", [1e-13, 1e-16, 1e-300])
 def test_a_current_lost_in_round_off_is_refused(resistance):
     """slider_crank_linear_motor with R far below 1e-5 ohm: the motor is a speed source to
