@@ -965,13 +965,15 @@ static int bound_refused(const fmu_variable* v, double value, char* why, size_t 
 {
     if ((v->bounds & FMU_HAS_MIN) &&
         ((v->bounds & FMU_MIN_EXCLUSIVE) ? !(value > v->min) : !(value >= v->min))) {
-        snprintf(why, size, "%s = %g %s: it must be %s %g", v->name, value, v->unit,
+        snprintf(why, size, "%s = %g%s%s: it must be %s %g", v->name, value,
+                 v->unit[0] != '\0' ? " " : "", v->unit,
                  (v->bounds & FMU_MIN_EXCLUSIVE) ? ">" : ">=", v->min);
         return 1;
     }
     if ((v->bounds & FMU_HAS_MAX) &&
         ((v->bounds & FMU_MAX_EXCLUSIVE) ? !(value < v->max) : !(value <= v->max))) {
-        snprintf(why, size, "%s = %g %s: it must be %s %g", v->name, value, v->unit,
+        snprintf(why, size, "%s = %g%s%s: it must be %s %g", v->name, value,
+                 v->unit[0] != '\0' ? " " : "", v->unit,
                  (v->bounds & FMU_MAX_EXCLUSIVE) ? "<" : "<=", v->max);
         return 1;
     }
@@ -1572,7 +1574,7 @@ static fmu_status check_unknowns(fmu_instance* instance, const unsigned int unkn
             return FMU_ERROR;
         }
         if (v->causality != FMU_OUTPUT) {
-            fmu_log(instance, FMU_ERROR, "%s: unknown %s is not an output", function, v->name);
+            fmu_log(instance, FMU_ERROR, "%s: %s is not an output", function, v->name);
             return FMU_ERROR;
         }
     }

@@ -95,3 +95,30 @@ def test_a_crafted_state_is_refused_naming_its_field(name, version):
         set_(deserialize(data))
     finally:
         s.close()
+
+
+@pytest.mark.parametrize("count", ("solver.steps", "solver.evaluations"))
+@pytest.mark.parametrize("value", (-0.0, 2.5, 2.0**53, 1e300))
+def test_a_plants_counts_are_what_steps_could_leave(count, value):
+    """A plant's counts of internal steps and evaluations are sums of whole numbers from 0:
+    a state holding -0, a fraction, or a count a double no longer counts on from (2^53,
+    1e300) is refused naming the count. Found by an attack on the plant, which restored
+    -0 and 1e300 and read them back."""
+    path = importers.setup_of("slider_crank_motor", 2).path
+    s = Slave(path, instance_name="counts")
+    try:
+        s.set("crank.motor.voltage", 290.0)
+        s.initialize()
+        for k in range(3):
+            s.do_step(k * 1e-3, 1e-3)
+        get, set_, free, serialize, deserialize = s.state_calls()
+        data = bytearray(serialize(get()))
+        kept = np.array([s.get(count)]).tobytes()
+        fields = [k for k in range(32, len(data), 8) if data[k : k + 8] == kept]
+        assert len(fields) == 1, (count, fields)
+        data[fields[0] : fields[0] + 8] = np.array([value]).tobytes()
+        with pytest.raises(Exception, match="status 3|Error|error"):
+            deserialize(_seal(data))
+        assert f"{count} = " in s.messages[-1] and "could leave" in s.messages[-1], s.messages[-1]
+    finally:
+        s.close()
