@@ -288,8 +288,8 @@ static int model_states_refused(const fmu_model* m, const unsigned char* payload
     }
     if (bad >= 0) {
         const fmu_model_state* s = &states->states[bad];
-        snprintf(why, size, "%s = %g %s is not a state %s could leave", s->name,
-                 real_at(payload, first + (size_t)bad), s->unit,
+        snprintf(why, size, "%s = %g%s%s is not a state %s could leave", s->name,
+                 real_at(payload, first + (size_t)bad), s->unit[0] != '\0' ? " " : "", s->unit,
                  (integer_at(payload, AT_MACHINE) & BEFORE_STEPS)
                      ? "its start values before initialization ends"
                      : "a step");

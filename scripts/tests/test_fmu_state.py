@@ -122,3 +122,19 @@ def test_a_plants_counts_are_what_steps_could_leave(count, value):
         assert f"{count} = " in s.messages[-1] and "could leave" in s.messages[-1], s.messages[-1]
     finally:
         s.close()
+
+
+def test_a_plant_takes_back_the_state_of_a_start_step_of_minus_zero():
+    """solver.step_start = -0 is a start value the bound allows (>= 0): the state right
+    after initialisation holds it, and the plant takes that state back (a review found it
+    refused once -0 counts were)."""
+    path = importers.setup_of("slider_crank_motor", 2).path
+    s = Slave(path, instance_name="minus_zero")
+    try:
+        s.initialize({"solver.step_start": -0.0})
+        get, set_, free, serialize, deserialize = s.state_calls()
+        set_(deserialize(serialize(get())))
+        s.do_step(0.0, 1e-3)
+        assert s.get("status") == 0
+    finally:
+        s.close()
