@@ -58,9 +58,9 @@
  * continuous output against exact solutions.
  *
  * The error control (rodas.f's): the error of a step is the root mean square
- * of u_6,i / (atol + rtol max(|y0_i|, |y1_i|)), a scale the system may lower
- * (error_scale: a quantity computed from the states, held to its own
- * tolerance, tightens its states' error); accepted at <= 1; the next
+ * of u_6,i / (atol + rtol max(|y0_i|, |y1_i|)), a magnitude the system may
+ * lower (error_magnitude: a quantity computed from the states, held to its
+ * own tolerance, tightens its states' error); accepted at <= 1; the next
  * step is h / fac, fac = err^(1/4) / 0.9 limited to [1/6, 5], with
  * Gustafsson's predictive factor (from the last accepted step's h and error,
  * kept in the state) after an accepted step, and no growth right after a
@@ -167,32 +167,36 @@ static int ode_options_valid(const dyad_ode_options* o)
            (o->method == DYAD_ODE_RODASP || o->method == DYAD_ODE_DOP853);
 }
 
-/* The scale of component i's error where it goes from y_i to y1: atol + rtol times the
- * larger magnitude, at least the component's own (options.magnitude). */
-static dyad_real ode_scale(const dyad_ode_state* s, int i, dyad_real y1)
+/* The magnitude rtol applies to where component i goes from y_i to y1: the larger, at
+ * least the component's own (options.magnitude). */
+static dyad_real ode_magnitude(const dyad_ode_state* s, int i, dyad_real y1)
 {
-    const dyad_real big = fmax(fmax(fabs(s->y[i]), fabs(y1)), s->options.magnitude[i]);
-    return s->options.atol + s->options.rtol * big;
+    return fmax(fmax(fabs(s->y[i]), fabs(y1)), s->options.magnitude[i]);
 }
 
-/* Every component's error scale for a step from s->y to y1: ode_scale(), lowered where the
- * system's error_scale() says so (to a positive value only). */
+/* The scale of component i's error where it goes from y_i to y1: atol + rtol times its
+ * magnitude. */
+static dyad_real ode_scale(const dyad_ode_state* s, int i, dyad_real y1)
+{
+    return s->options.atol + s->options.rtol * ode_magnitude(s, i, y1);
+}
+
+/* Every component's error scale for a step from s->y to y1: ode_scale(), its magnitude
+ * lowered where the system's error_magnitude() says so. */
 static void ode_scales(const dyad_ode_state* s, const dyad_ode_system* sys, const dyad_real* y1,
                        dyad_real* sc)
 {
     int i;
-    dyad_real asked[DYAD_ODE_MAX_DIM];
+    dyad_real own[DYAD_ODE_MAX_DIM], asked[DYAD_ODE_MAX_DIM];
     for (i = 0; i < s->n; ++i) {
-        sc[i] = asked[i] = ode_scale(s, i, y1[i]);
+        own[i] = asked[i] = ode_magnitude(s, i, y1[i]);
     }
-    if (sys->error_scale == NULL) {
-        return;
+    if (sys->error_magnitude != NULL) {
+        sys->error_magnitude(sys->user, s->y, y1, asked);
     }
-    sys->error_scale(sys->user, s->y, y1, asked);
     for (i = 0; i < s->n; ++i) {
-        if (asked[i] > 0 && asked[i] < sc[i]) {
-            sc[i] = asked[i];
-        }
+        const dyad_real kept = asked[i] < own[i] ? fmax(asked[i], 0) : own[i];
+        sc[i] = s->options.atol + s->options.rtol * kept;
     }
 }
 

@@ -78,15 +78,16 @@ typedef int (*dyad_ode_rhs)(void* user, dyad_real t, const dyad_real* y, dyad_re
 typedef int (*dyad_ode_jacobian)(void* user, dyad_real t, const dyad_real* y, const dyad_real* f,
                                  dyad_real* jac, dyad_real* dfdt);
 
-/** Tightens the error scales of a step from (t, y0) to y1: sc[i] holds atol + rtol
- *  max(|y0_i|, |y1_i|, magnitude[i]) on entry and may only be lowered (to a positive
- *  value; a larger, zero or NaN one is ignored). For a quantity the caller computes from
- *  the states and whose error must stay within its own tolerance, such as the current of
- *  a motor without inductance, (V - k q') / R, which carries the speed's error times
- *  k / R. Called after every attempt's stages, the last of which was evaluated at
+/** Lowers the magnitudes rtol applies to in a step from (t, y0) to y1: magnitude[i]
+ *  holds max(|y0_i|, |y1_i|, options.magnitude[i]) on entry and may only be lowered (a
+ *  larger value or NaN is ignored, a negative one counts as 0); component i's error is
+ *  then held to atol + rtol magnitude[i]. For a quantity the caller computes from the
+ *  states and whose error must stay within its own tolerance, such as the torque of a
+ *  motor without inductance, k (V - k q') / R, which carries the speed's error times
+ *  k^2 / R. Called after every attempt's stages, the last of which was evaluated at
  *  t + h. */
-typedef void (*dyad_ode_error_scale)(void* user, const dyad_real* y0, const dyad_real* y1,
-                                     dyad_real* sc);
+typedef void (*dyad_ode_error_magnitude)(void* user, const dyad_real* y0, const dyad_real* y1,
+                                         dyad_real* magnitude);
 
 /** What is integrated: not part of the state (it holds pointers). */
 typedef struct dyad_ode_system {
@@ -99,7 +100,7 @@ typedef struct dyad_ode_system {
      *  of the difference Jacobian). */
     int autonomous;
     /** NULL: each component's error within atol + rtol max(|y0|, |y1|, magnitude). */
-    dyad_ode_error_scale error_scale;
+    dyad_ode_error_magnitude error_magnitude;
     void* user; /**< passed to the callbacks */
 } dyad_ode_system;
 
