@@ -39,6 +39,9 @@ EXPLICIT_LIMIT_DEFAULT = 3.0
 EXPLICIT_LIMIT_MAX = 5.0
 #: The share of the tolerances each internal step's error is held to, by either method.
 STEP_SHARE = 1.0 / 64.0
+#: The share of a step's tolerances the slow system's own error may take (the three terms
+#: of a stiff circuit's manifold leave out eps^3 k r |q''''| / R of its current).
+SLOW_SHARE = 0.5
 
 
 @dataclass
@@ -839,37 +842,72 @@ def _motion_seed(ident: str, drivers: list[ForwardDriver]) -> list[str]:
 
 
 def _stiffness(ident: str, drivers: list[ForwardDriver]) -> list[str]:
-    """stiff_at(): whether an internal step would be held to the explicit method's
-    stability limit by the motors: their circuits' decay rates R / L, and a motor
-    without inductance's damping on its rotor, (c + k^2 / R) / J_r (1/s)."""
+    """damping_rate(): how fast the damping of a motor without inductance slows its crank,
+    (c + k^2 / R) / J_r (1/s), the fastest of the plant's; 0 where it has none."""
     lines = [
-        "/* Whether a step of `step` seconds is beyond what the explicit method takes on:",
-        " * the fastest decay of the plant's own stiff parts times the step above",
-        " * solver.explicit_limit. They are the motors' armature circuits (R / L) and the",
-        " * damping a motor without inductance puts on its crank, r^2 (c + k^2 / R), which",
-        " * slows the crank's speed at most at (c + k^2 / R) / J_r, its rotor's share of the",
-        " * inertia (a rotor without inertia gives no bound). A mechanism driven by efforts",
-        " * alone is not stiff. */",
-        f"static int stiff_at(const {ident}_input* in, double step)",
+        "/* How fast the plant's stiffest motor without inductance slows its crank (1/s): the",
+        " * damping it puts on it, r^2 (c + k^2 / R), over its rotor's share of the inertia,",
+        " * r^2 J_r (a rotor without inertia gives no bound). A mechanism driven by efforts",
+        " * alone is not stiff; the motors' circuits are circuit_values()'. */",
+        f"static double damping_rate(const {ident}_input* in)",
         "{",
     ]
-    geared = [f for f in drivers if f.motor is not None]
-    if not geared:
-        return lines + ["    (void)in;", "    (void)step;", "    return 0;", "}", ""]
+    limit = [
+        "/* solver.explicit_limit: an internal step times a rate above it is the implicit",
+        " * method's (a scene without motors has none). */",
+        f"static double explicit_limit(const {ident}_input* in)",
+        "{",
+        *(
+            ["    return in->plant_explicit_limit;"]
+            if any(f.motor is not None for f in drivers)
+            else ["    (void)in;", "    return INFINITY;"]
+        ),
+        "}",
+        "",
+    ]
+    steady = [f for f in drivers if f.steady]
+    if not steady:
+        return limit + lines + ["    (void)in;", "    return 0;", "}", ""]
     lines.append("    double rate = 0;")
-    for f in geared:
-        resistance = f"in->{f.c('motor_resistance')}"
-        if f.circuit:
-            lines.append(f"    rate = fmax(rate, {resistance} / in->{f.c('motor_inductance')});")
-            continue
+    for f in steady:
         k, rotor = f"in->{f.c('motor_torque_constant')}", f"in->{f.c('motor_rotor_inertia')}"
         lines += [
             f"    if ({rotor} > 0) {{",
-            f"        rate = fmax(rate, (in->{f.c('motor_friction')} + {k} * {k} / {resistance}) /",
+            f"        rate = fmax(rate, (in->{f.c('motor_friction')} + {k} * {k} / "
+            f"in->{f.c('motor_resistance')}) /",
             f"                              {rotor});",
             "    }",
         ]
-    return lines + ["    return rate * step > in->plant_explicit_limit;", "}", ""]
+    return limit + lines + ["    return rate;", "}", ""]
+
+
+def _circuits(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list[str]:
+    """PLANT_CIRCUITS and circuit_values(): each motor with an inductance, the place of its
+    current in y, its driver and its circuit's values at the inputs ``in``."""
+    geared = [f for f in drivers if f.circuit]
+    lines = [
+        f"#define PLANT_CIRCUITS {len(geared)}",
+        "",
+        "/* The motors whose armature current is a state, with their circuits' values. */",
+        f"static void circuit_values(const {ident}_input* in, plant_circuit* c)",
+        "{",
+    ]
+    if not geared:
+        return lines + ["    (void)in;", "    (void)c;", "}", ""]
+    for j, f in enumerate(geared):
+        lines += [
+            f"    c[{j}].driver = {f.index};",
+            f"    c[{j}].current = {f.current};",
+            f"    c[{j}].resistance = in->{f.c('motor_resistance')};",
+            f"    c[{j}].inductance = in->{f.c('motor_inductance')};",
+            f"    c[{j}].torque_constant = in->{f.c('motor_torque_constant')};",
+            f"    c[{j}].ratio = in->{f.c('motor_ratio')};",
+            f"    c[{j}].voltage = in->{f.c('motor_voltage')};",
+            f"    c[{j}].rotor_inertia = in->{f.c('motor_rotor_inertia')};",
+            f"    c[{j}].friction = in->{f.c('motor_friction')};",
+            f"    c[{j}].voltage_rate = in->{slope_member(_effort_input(scene, f))};",
+        ]
+    return lines + ["}", ""]
 
 
 def _current_magnitudes(ident: str, drivers: list[ForwardDriver]) -> list[str]:
@@ -964,6 +1002,7 @@ def behaviour_parts(scene: Scene) -> tuple[int, int, int, list[str]]:
         + _ramp_partials(scene, ident, drivers)
         + _motion_seed(ident, drivers)
         + _stiffness(ident, drivers)
+        + _circuits(scene, ident, drivers)
         + _nearest_singular(scene, ident)
         + _current_magnitudes(ident, drivers)
     )

@@ -13,6 +13,7 @@ from dyadgen.forward import (
     MAX_STEPS,
     POSITION_START_LIMIT,
     RTOL_MIN,
+    SLOW_SHARE,
     STEP_SHARE,
     behaviour_parts,
     forward_drivers,
@@ -139,6 +140,15 @@ def _plant(scene: Scene) -> list[str]:
         " * FLT_EPSILON, 1.9e-6). */",
         f"#define PLANT_RTOL_MIN (16 * (double)DYAD_REAL_EPSILON > {RTOL_MIN!r} ? \\",
         f"                        16 * (double)DYAD_REAL_EPSILON : {RTOL_MIN!r})",
+        "/* The share of each internal step's tolerances the slow system's own error may",
+        " * take (slow_error_check()). */",
+        f"#define PLANT_SLOW_SHARE {SLOW_SHARE!r}",
+        "/* A motor's armature circuit, L i' = V - R i - k r q' (circuit_values()). */",
+        "typedef struct plant_circuit {",
+        "    int driver, current;",
+        "    double resistance, inductance, torque_constant, ratio, voltage, voltage_rate;",
+        "    double rotor_inertia, friction;",
+        "} plant_circuit;",
         "",
     ]
     return head + parts + _lines("forward_behaviour.c.in", ident=ident) + [""]
