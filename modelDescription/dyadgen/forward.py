@@ -906,6 +906,8 @@ def _circuits(scene: Scene, ident: str, drivers: list[ForwardDriver]) -> list[st
             f"    c[{j}].rotor_inertia = in->{f.c('motor_rotor_inertia')};",
             f"    c[{j}].friction = in->{f.c('motor_friction')};",
             f"    c[{j}].voltage_rate = in->{slope_member(_effort_input(scene, f))};",
+            f"    c[{j}].eps = c[{j}].inductance / c[{j}].resistance;",
+            f"    c[{j}].kr = c[{j}].torque_constant * c[{j}].ratio;",
         ]
     return lines + ["}", ""]
 

@@ -99,6 +99,7 @@ STUDY_TEST_FMUS |= {
         "shaper_motor",
         "slider_crank_linear_motor",
         "leg_mixed_motor",
+        "leg_two_circuit_motor",
     )
     for version in (2, 3)
 }

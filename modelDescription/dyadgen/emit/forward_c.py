@@ -148,6 +148,8 @@ def _plant(scene: Scene) -> list[str]:
         "    int driver, current;",
         "    double resistance, inductance, torque_constant, ratio, voltage, voltage_rate;",
         "    double rotor_inertia, friction;",
+        "    double eps; /* L / R, the circuit's time constant (s) */",
+        "    double kr;  /* k r, the torque at the crank per ampere (N.m/A) */",
         "} plant_circuit;",
         "",
     ]

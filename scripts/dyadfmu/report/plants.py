@@ -286,7 +286,8 @@ def _target_lines(table: list[dict]) -> list[str]:
         f"{slow['evaluations_per_ms']:.1f} ({_f(slow['per_ms'], 0)}): DOP853 takes both, "
         "the stiff circuit's current on its slow manifold (an evaluation there adds a "
         "directional derivative of the inverse scene, for the manifold's third term), and "
-        "RODASP only where the current is off it, through its transient. Target, no more "
+        "RODASP only through a transient where the current is off it and the transient's "
+        "closed form does not hold (here the start from rest). Target, no more "
         f"evaluations than on the slow motor: {held}. RODASP throughout on the slow motor: "
         f"{kept['evaluations_per_ms']:.1f} ({_f(kept['per_ms'], 0)} instructions)."
     )
@@ -345,7 +346,9 @@ def markdown(
         "An evaluation is one of the equation of motion q'' = M^-1 (efforts - h): the "
         "inverse scene's evaluation at zero acceleration and an N x N solve, and where a "
         "stiff circuit's current follows its slow manifold one directional derivative of "
-        "the inverse scene along the motion (for the manifold's third term); a Jacobian is "
+        "the inverse scene along the motion (for the manifold's third term), and where a "
+        "transient is closed in its formula, its directional derivatives counted as "
+        "evaluations; a Jacobian is "
         "the inverse scene's directional derivatives along each driver's position and "
         "rate (RODASP only). Instructions are callgrind's, inclusive.",
         "",
