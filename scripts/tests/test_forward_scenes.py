@@ -330,7 +330,7 @@ def _supply_rows(
     rates: bool, stop: float, inductance: float = 7.25e-7, square: bool = False, **parameters
 ) -> np.ndarray:
     """slider_crank_motor (R = 0.725 ohm; by default the stiff circuit, L / R = 1 us) from
-    rest, its supply a 20 Hz sine about 250 V, its current on the manifold, or (`square`)
+    rest, its supply a 20 Hz sine about 250 V, its current at V / R, or (`square`)
     switching between 250 and 180 V every 5 ms, its current starting at 0, set at every
     1 ms step (and the sine's rate, where `rates`): the crank's angle and speed, the
     armature current, the torque and the evaluations after each step."""
@@ -378,9 +378,9 @@ def test_a_stiff_motor_follows_a_moving_supply_at_no_cost(rates):
     the rates and positions it leaves shifted, to second order in eps), so that the plant
     costs no more evaluations than with L / R = 1.4 ms, where DOP853 takes the whole
     system, and the motion, the current and the torque agree with RODASP at tolerances of
-    1e-12 within 1e-8 of their peaks. Measured over 50 ms: held, 19.9 evaluations per ms
-    against 25.8 with L / R = 1.4 ms and 645 by RODASP (575 when RODASP took each
-    transient), the speed within 1.0e-11 of its peak; with the rate, 20.0 against 25.6
+    1e-12 within 1e-8 of their peaks. Measured over 50 ms: held, 22.8 evaluations per ms
+    against 25.8 with L / R = 1.4 ms and 645 by RODASP (582 when RODASP took each
+    transient), the speed within 1.1e-11 of its peak; with the rate, 23.0 against 25.6
     and 391."""
     stop = 0.05
     reference = _supply_rows(rates, stop, **REFERENCE)
@@ -405,7 +405,7 @@ def test_a_stiff_motors_supply_steps_agree_with_the_reference(inductance, rtol):
     transient, elsewhere RODASP takes it, and at rtol 1e-10, where the manifold's own
     bound fails, RODASP takes the step on from the shifted start; every output within
     1e-9 of its peak against RODASP at tolerances of 1e-12 over 60 ms (1e-10 at rtol
-    1e-10). Measured: at most 6.9e-11, and 3.5e-12 at rtol 1e-10; with a bound that left
+    1e-10). Measured: at most 6.9e-11, and 1.7e-12 at rtol 1e-10; with a bound that left
     out what M's rate along the accelerations adds (a shift accepted from rest), 7.8e-9
     at L / R = 10 us."""
     reference = _supply_rows(False, 0.06, inductance, square=True, **REFERENCE)
@@ -691,10 +691,10 @@ def test_two_stiff_circuits_close_their_transients_together():
     a transient's formula carries the other circuit's lag behind the manifold it moves
     (without it the rear rate was 6.4e-9 off), and every output stays within 1e-9 of its
     peak against RODASP at tolerances of 1e-12, for fewer evaluations than RODASP takes.
-    The bound of that lag's next order refuses the rear's transients at the leg's low
-    speeds, where atol sets the tolerance: measured 1.1e-11, 368 evaluations per ms
-    against RODASP's 586 (with the scene's inductances, DOP853 on the whole system,
-    39.6)."""
+    The bound of the next order (the lags' products above all) refuses most of them at the
+    leg's low speeds, where atol sets the tolerance: measured 7.8e-12, 542 evaluations
+    per ms against RODASP's 586 (with the scene's inductances, DOP853 on the whole
+    system, 39.6)."""
     stiff = (1.2e-6, 3.0e-6)
     reference = _two_circuit_rows(stiff, **REFERENCE)
     chosen = _two_circuit_rows(stiff)
