@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 from ..study.speed import (
@@ -110,6 +111,8 @@ BATCH_HEADER = (
     "every output, CPU per sample (to that time)",
     "efforts and reactions through the rows entry, CPU per sample",
     "stacked NumPy Newton-Euler, CPU per sample (its ratio)",
+    "counted closed-form floor per sample: with the dyads' closed forms as stated "
+    "/ the minimal evaluation's, flops (their time at that rate; the widest lanes' time to each)",
 )
 #: How the report names each of the lanes (study.speed.LANES).
 LANE_NAMES = {"baseline": "the baseline's", "avx2": "AVX2's", "avx512": "AVX-512's"}
@@ -135,8 +138,7 @@ def _to_floor(seconds: float, floor: float) -> str:
 def _batch_rows(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
     """dyadfmu.evaluate per sample, where it was timed, against the flops a step executes
     for the job at the rate the RRR solve executes its own; none timed: no table."""
-    rrr = next((t for t in types if t.dyad == "RRR"), None)
-    rate = rrr.solve_flops / rrr.numpy_seconds_per_row[True] if rrr else math.nan
+    rate = _rate(types)
     rows = []
     for s in scenes:
         some_flops, every_flops = s.flops.get(False, math.nan), s.flops.get(True, math.nan)
@@ -156,10 +158,23 @@ def _batch_rows(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
             times.append(" / ".join(_to_floor(t, floor[False]) for t in into))
             times.append(_to_floor(s.samples[count, True], floor[True]))
             times += [_ns(s.samples.get((count, "rows"), math.nan)), yardstick]
+            times.append(_counted_cell(s, rate, some))
             rows.append([s.scene, f"{count:,}", work, *times])
     if not rows:
         return []
     return ["", *markup.table(BATCH_HEADER, rows, "-" + "r" * (len(BATCH_HEADER) - 1))]
+
+
+def _counted_cell(s: SceneSpeed, rate: float, seconds: float) -> str:
+    """The counted floor (study.floor) of a mechanism, the stated and the minimal, and
+    their time at ``rate`` (flops per second); the batch's time to each."""
+    if s.counted is None:
+        return "-"
+    stated, minimal = s.counted.stated_total / rate, s.counted.total / rate
+    return (
+        f"{s.counted.stated_total} / {s.counted.total} ({_ns(stated)} / {_ns(minimal)}; "
+        f"{seconds / stated:.1f}x / {seconds / minimal:.1f}x)"
+    )
 
 
 def _partial(two: object, three: object) -> str:
@@ -191,6 +206,7 @@ def _targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         f"{_mark(rate >= ROWS_PER_SECOND_TARGET)}.",
         *_numpy_ratio_target(scenes),
         *_floor_targets(types, scenes),
+        *_counted_targets(types, scenes),
     ]
 
 
@@ -201,53 +217,100 @@ def _narrower(s: SceneSpeed, names: tuple[str, ...]) -> list[object]:
     return [kinds.get(name, "none") for name in names]
 
 
-def _floor_targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
-    """The target lines of a whole mechanism's batch (efforts and reactions) against the
-    time of the flops a scalar evaluation executes for them, at the largest batch timed:
-    the baseline's lanes within BASELINE_FLOOR_TARGET, AVX2's under 1, and this CPU's
-    widest (where wider than AVX2) against 1 too; the worst mechanism of each."""
+def _rate(types: list[TypeSpeed]) -> float:
+    """Flops per CPU second of the RRR solve from NumPy (outputs reused); NaN without it."""
     rrr = next((t for t in types if t.dyad == "RRR"), None)
-    timed = [s for s in scenes if s.flops.get(False) and any(k is False for _, k in s.samples)]
-    if rrr is None or not timed:
-        return []
-    rate = rrr.solve_flops / rrr.numpy_seconds_per_row[True]
-    worst: dict[tuple[str, bool], tuple[float, str]] = {}
+    return rrr.solve_flops / rrr.numpy_seconds_per_row[True] if rrr else math.nan
+
+
+Worst = dict[tuple[str, bool], tuple[float, str]]
+
+
+def _worst(timed: list[SceneSpeed], floor_of: Callable[[SceneSpeed], float]) -> Worst:
+    """Per (lanes, into) the worst mechanism's batch time (efforts and reactions, at the
+    largest batch timed) over its floor's time ``floor_of``, and where."""
+    worst: Worst = {}
     for s in timed:
         count = max(c for c, k in s.samples if k is False)
         for into in (False, True):
             for name, kind in _lane_kinds(s, into).items():
-                ratio = s.samples.get((count, kind), math.nan) / (s.flops[False] / rate)
+                ratio = s.samples.get((count, kind), math.nan) / floor_of(s)
                 worst[name, into] = max(
                     worst.get((name, into), (0.0, "")), (ratio, f"{s.scene}, {count:,} samples")
                 )
+    return worst
 
-    def figure(name: str, into: bool = False) -> str:
-        ratio, where = worst.get((name, into), (math.nan, ""))
-        return f"{ratio:.2f}x ({where})" if where else "not timed (this CPU has none)"
 
-    def ratio(name: str) -> float:
-        return worst.get((name, False), (math.nan, ""))[0]
+def _figure(worst: Worst, name: str, into: bool = False) -> str:
+    ratio, where = worst.get((name, into), (math.nan, ""))
+    return f"{ratio:.2f}x ({where})" if where else "not timed (this CPU has none)"
 
-    widest = max((s.lanes for s in timed), key=list(LANES).index)
+
+def _ratio(worst: Worst, name: str) -> float:
+    return worst.get((name, False), (math.nan, ""))[0]
+
+
+def _lane_targets(worst: Worst, widest: str, against: str) -> list[str]:
+    """The target lines against one floor: the baseline's lanes within
+    BASELINE_FLOOR_TARGET, AVX2's under 1, this CPU's widest (where wider) under 1 too,
+    and the same into an earlier call's arrays."""
     lines = [
-        f"- A whole mechanism's batch (the efforts and reactions) against the time of the "
-        f"flops a scalar evaluation executes for them: in the baseline's lanes within "
-        f"{BASELINE_FLOOR_TARGET:g}x, worst {figure('baseline')}, "
-        f"{_mark(ratio('baseline') <= BASELINE_FLOOR_TARGET)}; in AVX2's under 1x, worst "
-        f"{figure('avx2')}, {_mark(ratio('avx2') < 1)}."
+        f"- A whole mechanism's batch (the efforts and reactions) against {against}: in the "
+        f"baseline's lanes within {BASELINE_FLOOR_TARGET:g}x, worst "
+        f"{_figure(worst, 'baseline')}, {_mark(_ratio(worst, 'baseline') <= BASELINE_FLOOR_TARGET)}"
+        f"; in AVX2's under 1x, worst {_figure(worst, 'avx2')}, "
+        f"{_mark(_ratio(worst, 'avx2') < 1)}."
     ]
     if list(LANES).index(widest) > list(LANES).index("avx2"):
         lines.append(
             f"  In this CPU's widest, {LANE_NAMES[widest]}, under 1x: worst "
-            f"{figure(widest)}, {_mark(ratio(widest) < 1)}."
+            f"{_figure(worst, widest)}, {_mark(_ratio(worst, widest) < 1)}."
         )
     into = ", ".join(
-        f"{LANE_NAMES[name]} {figure(name, True)}"
+        f"{LANE_NAMES[name]} {_figure(worst, name, True)}"
         for name in reversed(list(LANES))
         if (name, True) in worst
     )
     lines.append(f"  Into an earlier call's arrays (`out=`), worst: {into}.")
     return lines
+
+
+def _timed(scenes: list[SceneSpeed]) -> list[SceneSpeed]:
+    return [s for s in scenes if any(k is False for _, k in s.samples)]
+
+
+def _floor_targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
+    """The target lines of a whole mechanism's batch (efforts and reactions) against the
+    time of the flops a scalar evaluation executes for them, at the largest batch timed:
+    the baseline's lanes within BASELINE_FLOOR_TARGET, AVX2's under 1, and this CPU's
+    widest (where wider than AVX2) against 1 too; the worst mechanism of each."""
+    timed = [s for s in _timed(scenes) if s.flops.get(False)]
+    rate = _rate(types)
+    if math.isnan(rate) or not timed:
+        return []
+    worst = _worst(timed, lambda s: s.flops[False] / rate)
+    widest = max((s.lanes for s in timed), key=list(LANES).index)
+    against = "the time of the flops a scalar evaluation executes for them"
+    return _lane_targets(worst, widest, against)
+
+
+def _counted_targets(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
+    """The same target lines against the counted closed-form floor (study.floor: the
+    stated count, the dyads' closed forms as stated atop src/) at the same rate, and
+    the worst batch against the minimal evaluation's count beside them."""
+    timed = [s for s in _timed(scenes) if s.counted is not None]
+    rate = _rate(types)
+    if math.isnan(rate) or not timed:
+        return []
+    worst = _worst(timed, lambda s: s.counted.stated_total / rate)
+    widest = max((s.lanes for s in timed), key=list(LANES).index)
+    against = "the time of its counted closed-form floor (`dyadfmu.study.floor`)"
+    minimal = _worst(timed, lambda s: s.counted.total / rate)
+    return [
+        *_lane_targets(worst, widest, against),
+        f"  Against the minimal evaluation's count instead, worst: the baseline's "
+        f"{_figure(minimal, 'baseline')}, AVX2's {_figure(minimal, 'avx2')}.",
+    ]
 
 
 def _numpy_ratio_target(scenes: list[SceneSpeed]) -> list[str]:
@@ -303,7 +366,11 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "Newton-Euler equations, one `np.linalg.solve` over the samples), the yardstick. Beside "
         "them the flops an FMU step executes for the job (callgrind, libm's among them) and "
         "their time at the rate `dyadfmu.solve` executes the RRR solve's own (flops per CPU "
-        "second): a time near it says the evaluation is bound by the arithmetic it does.",
+        "second): a time near it says the evaluation is bound by the arithmetic it does. "
+        "Last, the job's closed-form floor counted per mechanism (`dyadfmu.study.floor`, "
+        "checked against the Newton-Euler reference): the stated count, with each dyad's "
+        "closed forms as stated atop `src/dyad_<type>.c`, and a minimal evaluation's, their "
+        "time at the same rate.",
         "",
         *_type_rows(types),
         "",

@@ -28,6 +28,7 @@ from ..batch import FIELDS, solve
 from ..sweep.rows import LANES as LANE_NAMES
 from . import bench, flops
 from . import configurations as cfg
+from . import floor as counted_floor
 
 #: The speed targets: an FMU step and the solve's operations within twice their floor,
 #: and this many rows a second from NumPy (RRR).
@@ -107,6 +108,8 @@ class SceneSpeed:
     #: a plant (dynamics = "forward"): its step integrates its motion over many
     #: evaluations, so the step-to-evaluation rule is not its (dyadfmu plants measures it)
     plant: bool = False
+    #: the job's closed-form floor per sample, counted (study.floor), where it is written
+    counted: counted_floor.Floor | None = None
 
 
 #: The mechanisms whose batch over arrays (dyadfmu.evaluate) is timed, and the batch sizes
@@ -451,26 +454,31 @@ def measure(
                 plant=is_plant(scene),
             )
         )
+        if scene in counted_floor.MECHANISMS:
+            scenes[-1].counted = counted_floor.floor(scene)
         if scene in BATCH_SCENES:
-            for every in (False, True):
-                scenes[-1].flops[every] = step_flops(build, scene, steps, work, every)
-            scenes[-1].lanes = widest_lanes()
-            narrower = list(LANES)[: list(LANES).index(scenes[-1].lanes)]
-            for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
-                rounds = 2 if count >= 1_000_000 else 5
-                for every in (False, True):
-                    scenes[-1].samples[count, every] = batch_seconds(scene, count, every, rounds)
-                scenes[-1].samples[count, "into"] = batch_seconds(
-                    scene, count, False, rounds, into=True
-                )
-                for lanes in narrower:
-                    for kind, into in ((lanes, False), (f"{lanes} into", True)):
-                        scenes[-1].samples[count, kind] = batch_seconds(
-                            scene, count, False, rounds, lanes, into
-                        )
-                scenes[-1].samples[count, "rows"] = rows_seconds(scene, count, rounds)
-                if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
-                    scenes[-1].samples[count, "numpy"] = numpy_yardstick_seconds(
-                        scene, count, rounds
-                    )
+            _batch_figures(scenes[-1], build, steps, work, quick)
     return types, scenes
+
+
+def _batch_figures(figures: SceneSpeed, build: Path, steps: int, work: Path, quick: bool) -> None:
+    """A mechanism's batch over arrays (BATCH_SCENES): the flops a step executes, and
+    dyadfmu.evaluate, the rows entry and the stacked NumPy solve timed per sample."""
+    scene = figures.scene
+    for every in (False, True):
+        figures.flops[every] = step_flops(build, scene, steps, work, every)
+    figures.lanes = widest_lanes()
+    narrower = list(LANES)[: list(LANES).index(figures.lanes)]
+    for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
+        rounds = 2 if count >= 1_000_000 else 5
+        for every in (False, True):
+            figures.samples[count, every] = batch_seconds(scene, count, every, rounds)
+        figures.samples[count, "into"] = batch_seconds(scene, count, False, rounds, into=True)
+        for lanes in narrower:
+            for kind, into in ((lanes, False), (f"{lanes} into", True)):
+                figures.samples[count, kind] = batch_seconds(
+                    scene, count, False, rounds, lanes, into
+                )
+        figures.samples[count, "rows"] = rows_seconds(scene, count, rounds)
+        if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
+            figures.samples[count, "numpy"] = numpy_yardstick_seconds(scene, count, rounds)
