@@ -2113,6 +2113,21 @@ static void place_lanes(const column_blocks* b, const column_call* c, const colu
     }
 }
 
+/* The lanes a call takes: without the bounds where it reads none of them (fmu_lanes.bare),
+ * else its first half where it reads none of the later outputs (`halves`), else the whole. */
+static fmu_lanes_fn lanes_for(const fmu_lanes* lanes, int halves, const unsigned char* wanted)
+{
+    size_t j;
+    int bounds = 0;
+    for (j = 0; lanes->bare != NULL && j < lanes->outputs; ++j) {
+        bounds |= wanted[j] && lanes->bounds[j];
+    }
+    if (lanes->bare != NULL && !bounds && (halves || lanes->first == NULL)) {
+        return lanes->bare;
+    }
+    return halves ? lanes->first : lanes->whole;
+}
+
 /* Sample `i`, in lane `lane`, alone in the blocks: its status and its outputs as evaluate
  * gives them, where its checks failed in the lanes. */
 static fmu_status evaluate_lane_alone(const fmu_model* model, column_blocks* b, const lane_grid* g,
@@ -2208,7 +2223,7 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
     const double* failed = g->cells + (lanes->inputs + lanes->outputs) * lanes->lanes;
     size_t lane, k;
     store_lanes(c, place, g, first, count);
-    (halves ? lanes->first : lanes->whole)(g->cap, count, g->cells, g->wanted);
+    lanes_for(lanes, halves, g->wanted)(g->cap, count, g->cells, g->wanted);
     for (k = 0; k < c->n_y; ++k) {
         const ptrdiff_t step = c->y_step[k];
         double* y = c->y[k] + (ptrdiff_t)first * step;

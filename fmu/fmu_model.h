@@ -149,18 +149,22 @@ typedef struct fmu_later {
  * scratch; `columns` in all. Where the count is 0 the sample's outputs are what
  * `evaluate` (or `later->first`) gives, bit for bit, with FMU_OK; elsewhere they mean
  * nothing, and `evaluate` says what went wrong. The loop over samples vectorises. */
+/* `wanted`: NULL, or a flag per real of the output block; an output not wanted may be left
+ * out. `cap`: the widest instruction set the lanes may take (dyad_lanes_isa); they take the
+ * widest this CPU runs up to it (to measure each: DYADFMU_LANES, fmu/README.md) */
+typedef void (*fmu_lanes_fn)(dyad_lanes_isa cap, size_t count, double* lanes,
+                             const unsigned char* wanted);
 typedef struct fmu_lanes {
     size_t lanes;   /* samples per call, at most */
     size_t inputs;  /* reals of the input block */
     size_t outputs; /* reals of the output block, its status aside */
     size_t columns;
-    /* `wanted`: NULL, or a flag per real of the output block; an output not wanted may be
-     * left out. `cap`: the widest instruction set the lanes may take (dyad_lanes_isa); they
-     * take the widest this CPU runs up to it (to measure each: DYADFMU_LANES,
-     * fmu/README.md) */
-    void (*whole)(dyad_lanes_isa cap, size_t count, double* lanes, const unsigned char* wanted);
-    /* as later->first; NULL where the model has no fmu_later */
-    void (*first)(dyad_lanes_isa cap, size_t count, double* lanes, const unsigned char* wanted);
+    fmu_lanes_fn whole;
+    fmu_lanes_fn first; /* as later->first; NULL where the model has no fmu_later */
+    /* as first (or whole where first is NULL) with the outputs flagged in `bounds` NaN and
+     * the same statuses, for a call that reads none of those; NULL where there is none */
+    fmu_lanes_fn bare;
+    const unsigned char* bounds; /* a flag per real of the output block; NULL without bare */
 } fmu_lanes;
 
 /* What a kind of model computes, on its own input and output blocks. */

@@ -174,10 +174,15 @@ DYAD_KIN_LANE(DYAD_RTT, rtt)
 #endif /* DYAD_LANES_NO_KINEMATICS */
 
 /* The reactions of one loaded dyad (dyad_react_<type>): the conditioning stored, the
- * closed forms and the amplification whatever the conditioning; 0 where it is accepted
- * and every reaction is finite. */
+ * closed forms and, with `bounded`, the amplification whatever the conditioning; 0 where
+ * it is accepted and every reaction is finite. Without `bounded` the amplification is
+ * NaN, and the caller reads neither it nor the links' sizes, which the compiler then
+ * drops; a reaction beyond DYAD_REAL_MAX eps (4e292 N in double) is counted too, since
+ * up to it the amplification's data factor is at most 1 / eps (dyad_amplification_of),
+ * which is what keeps a scene's bounds finite (emit/scene_c.py, bare_lanes). */
 DYAD_CLOSED_FORM dyad_real dyad_react_lane(dyad_type type, const dyad_loaded* p, dyad_conditioned c,
-                                           dyad_closed_forms_fn closed_forms, dyad_result* result)
+                                           dyad_closed_forms_fn closed_forms, int bounded,
+                                           dyad_result* result)
 {
     dyad_output_sizes sizes;
     dyad_real bad;
@@ -186,14 +191,31 @@ DYAD_CLOSED_FORM dyad_real dyad_react_lane(dyad_type type, const dyad_loaded* p,
     bad = DYAD_FAILED(c.conditioning >= p->singular_threshold);
     sizes = closed_forms(p, c, result);
     bad += DYAD_FAILED(dyad_outputs_residue(result) == 0);
-    result->amplification = dyad_result_amplification(type, sizes, result);
+    if (bounded) {
+        result->amplification = dyad_result_amplification(type, sizes, result);
+    } else {
+        const dyad_real beyond = DYAD_REAL_MAX * DYAD_REAL_EPSILON;
+        const dyad_real moment =
+            dyad_largest_moment(result, result, dyad_guide_used(type, DYAD_PAIR_DM),
+                                dyad_guide_used(type, DYAD_PAIR_E),
+                                dyad_guide_used(type, DYAD_PAIR_DN))
+                .v;
+        bad += DYAD_FAILED(dyad_largest_force(result, result).v <= beyond && moment <= beyond);
+        result->amplification = NAN;
+    }
     return bad;
 }
 
+/* dyad_react_lane_<type>, and dyad_react_lane_bare_<type> without the amplification. */
 #define DYAD_REACT_LANE(type, name)                                                              \
     DYAD_CLOSED_FORM dyad_real dyad_react_lane_##name(const dyad_loaded* p, dyad_result* result) \
     {                                                                                            \
-        return dyad_react_lane(type, p, name##_conditioning(p), name##_closed_forms, result);    \
+        return dyad_react_lane(type, p, name##_conditioning(p), name##_closed_forms, 1, result); \
+    }                                                                                            \
+    DYAD_CLOSED_FORM dyad_real dyad_react_lane_bare_##name(const dyad_loaded* p,                 \
+                                                           dyad_result* result)                  \
+    {                                                                                            \
+        return dyad_react_lane(type, p, name##_conditioning(p), name##_closed_forms, 0, result); \
     }
 #ifdef DYAD_LANES_RRR
 DYAD_REACT_LANE(DYAD_RRR, rrr)
@@ -221,7 +243,7 @@ DYAD_CLOSED_FORM dyad_real dyad_solve_lane(dyad_type type, const dyad_input* inp
     dyad_prepared p;
     const dyad_real bad = DYAD_FAILED(dyad_in_domain(type, input));
     dyad_prepare_valid(type, input, &p, result);
-    return bad + dyad_react_lane(type, &p, conditioning(&p), closed_forms, result);
+    return bad + dyad_react_lane(type, &p, conditioning(&p), closed_forms, 1, result);
 }
 
 #define DYAD_SOLVE_LANE(type, name)                                                            \

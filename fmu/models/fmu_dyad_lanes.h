@@ -94,12 +94,17 @@ typedef char fmu_dyad_result_is_its_columns[FMU_DYAD_RESULT_FITS ? 1 : -1];
 #endif
 
 /* The lanes of type `name` (rrr, ...) and the behaviour on them, fmu_dyad_lane_behaviour. */
-#define FMU_DYAD_LANES(name)                                                                 \
-    FMU_DYAD_LANE_LOOPS(name)                                                                \
-    FMU_DYAD_LANE_WHOLE(name)                                                                \
-    static const fmu_lanes fmu_dyad_many = {FMU_DYAD_LANE_COUNT,   FMU_DYAD_LANE_INPUTS,     \
-                                            FMU_DYAD_LANE_OUTPUTS, FMU_DYAD_LANE_FAILED + 1, \
-                                            fmu_dyad_whole,        NULL};                    \
+#define FMU_DYAD_LANES(name)                                          \
+    FMU_DYAD_LANE_LOOPS(name)                                         \
+    FMU_DYAD_LANE_WHOLE(name)                                         \
+    static const fmu_lanes fmu_dyad_many = {FMU_DYAD_LANE_COUNT,      \
+                                            FMU_DYAD_LANE_INPUTS,     \
+                                            FMU_DYAD_LANE_OUTPUTS,    \
+                                            FMU_DYAD_LANE_FAILED + 1, \
+                                            fmu_dyad_whole,           \
+                                            NULL,                     \
+                                            NULL,                     \
+                                            NULL};                    \
     static const fmu_behaviour fmu_dyad_lane_behaviour = FMU_DYAD_BEHAVIOUR(&fmu_dyad_many);
 
 #endif /* DYADFMU_FMU_DYAD_LANES_H */

@@ -35,7 +35,14 @@ from dyadgen.emit import documentation, fmi2, fmi3
 from dyadgen.emit.batch_c import batch_supported
 from dyadgen.emit.c_table import model_c
 from dyadgen.emit.forward_c import forward_behaviour
-from dyadgen.emit.scene_c import later_members, scene_c, scene_header, scene_tangent_c
+from dyadgen.emit.scene_c import (
+    bare_lanes,
+    bound_members,
+    later_members,
+    scene_c,
+    scene_header,
+    scene_tangent_c,
+)
 from dyadgen.model import Input, Param, Scene, member
 from dyadgen.scenefile.problems import SceneError
 from dyadgen.settings import ON_SINGULAR
@@ -534,7 +541,7 @@ def scene_behaviour(table: Table) -> list[str]:
         "}",
         "",
         *(_later_behaviour(table, later) if later else []),
-        *(_lanes_behaviour(table, bool(later)) if lanes else []),
+        *(_lanes_behaviour(table, table.scene, bool(later)) if lanes else []),
         f"static const fmu_behaviour {ident}_behaviour = {{sizeof({ident}_input),",
         f"                                                sizeof({ident}_output), initialise,",
         "                                                evaluate, NULL, NULL, derivative, NULL,",
@@ -571,13 +578,14 @@ def _later_behaviour(table: Table, later: tuple[str, ...]) -> list[str]:
     return [*lines, f"static const fmu_later later = {{later_vrs, {len(vrs)}, {halves}}};", ""]
 
 
-def _lanes_behaviour(table: Table, first: bool) -> list[str]:
+def _lanes_behaviour(table: Table, scene: Scene, first: bool) -> list[str]:
     """The scene's batch evaluation (<identifier>_lanes) as its fmu_lanes."""
     ident, upper = table.identifier, table.identifier.upper()
+    bare = bare_lanes(scene)
     lines = [
         "/* Many samples at once, in columns: the loop over them vectorises. */",
     ]
-    for half in ("", "_first") if first else ("",):
+    for half in ("", *(["_first"] if first else []), *(["_bare"] if bare else [])):
         name = f"lanes{half}"
         head = f"static void {name}("
         lines += [
@@ -589,13 +597,24 @@ def _lanes_behaviour(table: Table, first: bool) -> list[str]:
             "}",
             "",
         ]
-    functions = "lanes, lanes_first" if first else "lanes, NULL"
+    functions = f"lanes, {'lanes_first' if first else 'NULL'}, {'lanes_bare' if bare else 'NULL'}"
+    flags = [
+        f"    [offsetof({ident}_output, {m}) / sizeof(dyad_real)] = 1,"
+        for m in bound_members(scene)
+    ]
+    lines += [
+        "/* The outputs _bare leaves NaN: the reactions' bounds. */",
+        f"static const unsigned char bounds[{upper}_LANE_OUTPUTS + 1] = {{",
+        *(flags or ["    0,"]),
+        "};",
+        "",
+    ]
     return [
         *lines,
         f"static const fmu_lanes many = {{{upper}_LANES, {upper}_LANE_INPUTS, "
         f"{upper}_LANE_OUTPUTS,",
         f"                               {upper}_LANE_COLUMNS,",
-        f"                               {functions}}};",
+        f"                               {functions}, bounds}};",
         "",
     ]
 

@@ -6,7 +6,9 @@ ones mixed in (an input NaN, an input far out of range; the toggles scene's dead
 and lost assemblies), a sample's count of failed checks is 0 exactly where the scalar
 <id>_evaluate says status 0, and there its outputs are evaluate's bit for bit: in the
 baseline build, the AVX2 one and the AVX-512 one (where the CPU has them), each called by
-name, and through the dispatching <id>_lanes; also _first against <id>_evaluate_first.
+name, and through the dispatching <id>_lanes; also _first against <id>_evaluate_first,
+and _bare (the bounds left out: NaN) against the same, but for the bounds and for a
+sample with a reaction beyond DBL_MAX eps, which _bare sends to be evaluated alone.
 GCC reports every loop over samples vectorised in each build: a scene's, dyad_solve_batch's
 and a generic dyad FMU's (fmu/models/fmu_dyad_lanes.h). The FMU's columns entry
 runs the lanes (scripts/tests/test_columns_entry.py holds it to the rows entry).
@@ -25,7 +27,7 @@ from dyadfmu import paths
 from dyadgen import pipeline
 from dyadgen.corefiles import scene_core_sources
 from dyadgen.emit.batch_c import batch_supported, block_reals
-from dyadgen.emit.scene_c import later_members
+from dyadgen.emit.scene_c import bare_lanes, bound_members, later_members
 from dyadgen.locations import SCENES_DIR, TEST_SCENES_DIR
 from tool_checks import required_tool
 
@@ -103,24 +105,28 @@ int main(int argc, char** argv)
         return 2;
     }
     fclose(file);
-    if (strstr(how, "first") != NULL) {
+    const int bare = strstr(how, "bare") != NULL, first = strstr(how, "first") != NULL;
+    if (first) {
         @FIRST
     }
+    if (bare) {
+        @BARE
+    }
     if (strstr(how, "baseline") != NULL) {
-        lanes = strstr(how, "first") != NULL ? @FIRST_BASELINE : @ID_lanes_baseline;
+        lanes = bare ? @BARE_BASELINE : first ? @FIRST_BASELINE : @ID_lanes_baseline;
     }
 #if defined(__x86_64__)
     if (strstr(how, "avx2") != NULL) {
         if (!__builtin_cpu_supports("avx2")) {
             return 3;
         }
-        lanes = strstr(how, "first") != NULL ? @FIRST_AVX2 : @ID_lanes_avx2;
+        lanes = bare ? @BARE_AVX2 : first ? @FIRST_AVX2 : @ID_lanes_avx2;
     }
     if (strstr(how, "avx512") != NULL) {
         if (!__builtin_cpu_supports("avx512f")) {
             return 3;
         }
-        lanes = strstr(how, "first") != NULL ? @FIRST_AVX512 : @ID_lanes_avx512;
+        lanes = bare ? @BARE_AVX512 : first ? @FIRST_AVX512 : @ID_lanes_avx512;
     }
 #endif
     run(in, @SAMPLES, lanes, scalar, stdout);
@@ -129,9 +135,16 @@ int main(int argc, char** argv)
 """
 
 
-def _driver(ident: str, has_first: bool) -> str:
-    """The test program of scene `ident`; `has_first`: whether it has halves."""
+def _driver(ident: str, has_first: bool, has_bare: bool) -> str:
+    """The test program of scene `ident`; `has_first`: whether it has halves; `has_bare`:
+    lanes without the bounds, held to the first half (or the whole) bit for bit."""
     text = DRIVER.replace("@UP_", f"{ident.upper()}_").replace("@SAMPLES", str(SAMPLES))
+    scalar = "@ID_evaluate_first" if has_first else "@ID_evaluate"
+    for isa in ("_BASELINE", "_AVX2", "_AVX512"):
+        text = text.replace(f"@BARE{isa}", f"@ID_lanes_bare{isa.lower()}" if has_bare else "lanes")
+    text = text.replace(
+        "@BARE", f"scalar = {scalar}; lanes = @ID_lanes_bare;" if has_bare else "return 4;"
+    )
     if has_first:
         text = text.replace("@FIRST_BASELINE", "@ID_lanes_first_baseline")
         text = text.replace("@FIRST_AVX2", "@ID_lanes_first_avx2")
@@ -194,7 +207,8 @@ def programs(tmp_path_factory):
             ident = table.identifier
             scene_c = (gen / f"{ident}_scene.c").read_text()
             has_first = f"{ident}_lanes_first(" in scene_c
-            (work / "main.c").write_text(_driver(ident, has_first))
+            has_bare = f"{ident}_lanes_bare(" in scene_c
+            (work / "main.c").write_text(_driver(ident, has_first, has_bare))
             core = [ROOT / "src" / f for f in scene_core_sources(table.scene, derivatives=False)]
             includes = [f"-I{d}" for d in (gen, ROOT / "src", ROOT / "src" / "include")]
             report = subprocess.run(
@@ -228,16 +242,30 @@ def _rows(text: str) -> list[tuple[int, list[str], float, list[str]]]:
     return rows
 
 
+#: the reaction above which the lanes without the bounds send a sample to be evaluated
+#: alone (src/dyad_lanes.h): its bounds could overflow
+BEYOND = sys.float_info.max * sys.float_info.epsilon
 #: each instruction set's lanes, called by name
 ISAS = ("baseline", "avx2", "avx512")
+
+
+def _halves(path: Path) -> tuple[str, ...]:
+    """The scene's lanes: the whole, its first half where it has halves, and those without
+    the bounds where it has them."""
+    scene = pipeline.load_scene(path, check_c_names=False)
+    return (
+        "",
+        *(["first "] if later_members(scene) else []),
+        *(["bare "] if bare_lanes(scene) else []),
+    )
+
+
 #: (scene, how): the whole evaluation dispatched and each instruction set's, and where the
-#: scene has halves its first the same ways
+#: scene has halves its first, and its lanes without the bounds, the same ways
 CASES = [
     (path, f"{half}{isa}".strip())
     for path in SCENES
-    for half in (
-        ("", "first ") if later_members(pipeline.load_scene(path, check_c_names=False)) else ("",)
-    )
+    for half in _halves(path)
     for isa in ("", *ISAS)
 ]
 
@@ -253,10 +281,19 @@ def test_a_sample_the_lanes_pass_is_what_evaluate_gives(path, how, programs):
     assert done.returncode == 0, done.stderr
     rows = _rows(done.stdout)
     assert len(rows) == SAMPLES
+    _, members = block_reals(table.scene)
+    bounds = [members.index(m) for m in bound_members(table.scene)] if "bare" in how else []
+    assert bounds or "bare" not in how, "lanes without bounds for a scene that reports none"
     passed = 0
     for k, (status, outputs, failed, found) in enumerate(rows):
+        if bounds and failed != 0 and status == 0:  # a reaction beyond DBL_MAX eps
+            assert max(abs(float.fromhex(o)) for o in outputs) >= BEYOND, (k, failed)
+            continue
         assert (failed == 0) == (status == 0), (k, status, failed)
         if status == 0:
+            assert all("nan" in found[i] for i in bounds), (k, [found[i] for i in bounds])
+            outputs = [o for i, o in enumerate(outputs) if i not in bounds]
+            found = [o for i, o in enumerate(found) if i not in bounds]
             assert outputs == found, (
                 k,
                 [i for i, (a, b) in enumerate(zip(outputs, found, strict=True)) if a != b],
@@ -371,3 +408,24 @@ def test_the_build_compiles_the_lanes_with_the_flags_these_tests_use():
     assert _cmake_flags(fmu, "set(cross_lane_flags") == vectorising
     wanted = {"-O3", "-fno-trapping-math", "-fno-math-errno"}
     assert _cmake_flags(core, "set_source_files_properties(src/dyad_batch.c") == wanted
+
+
+@pytest.mark.parametrize(("threshold", "bare"), [(None, True), (1e-12, True), (1e-300, False)])
+def test_lanes_leave_the_bounds_out_only_where_no_status_can_need_them(threshold, bare, tmp_path):
+    """Every built-in scene without a cylinder has lanes without the bounds; a scene
+    with a cylinder (whose bound divides by its forces) has none, nor one whose threshold
+    lets a bound overflow where the scalar evaluation would then say status 3: the
+    slider-crank at 1e-300 (a dyad's amplification up to (1 / eps) / 1e-300)."""
+    from dyadgen.emit import kinematics_c
+
+    for path in SCENES:
+        scene = pipeline.load_scene(path, check_c_names=False)
+        assert bare_lanes(scene) == (not kinematics_c.cylinders(scene)), path.name
+    text = (SCENES_DIR / "slider_crank.toml").read_text()
+    text = text.replace('identifier = "slider_crank"', 'identifier = "thresholded"', 1)
+    if threshold is not None:
+        text = text.replace("[scene]\n", f"[scene]\nsingular_threshold = {threshold!r}\n", 1)
+    (tmp_path / "slider_crank.toml").write_text(text)
+    scene = pipeline.load_scene(tmp_path / "slider_crank.toml", check_c_names=False)
+    assert scene.threshold.value == (threshold or scene.threshold.value)
+    assert bare_lanes(scene) == bare

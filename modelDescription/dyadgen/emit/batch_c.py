@@ -175,15 +175,16 @@ def layout_check(scene: Scene) -> list[str]:
     ]
 
 
-def prototypes(scene: Scene, first: bool, angles: int) -> list[str]:
+def prototypes(scene: Scene, first: bool, bare: bool, angles: int) -> list[str]:
     """The header's declarations of <identifier>_lanes (and, with `first`, of
-    <identifier>_lanes_first), with the numbers of their columns; `angles`: the
-    angle outputs, whose directions take a column more each while a call runs."""
+    <identifier>_lanes_first; with `bare`, of <identifier>_lanes_bare), with the numbers
+    of their columns; `angles`: the angle outputs, whose directions take a column more
+    each while a call runs."""
     ident = scene.identifier
     inputs, outputs = block_reals(scene)
     reals = sum(2 if angle else 1 for _, angle in inputs)
     upper = ident.upper()
-    names = ["lanes", *(["lanes_first"] if first else [])]
+    names = ["lanes", *(["lanes_first"] if first else []), *(["lanes_bare"] if bare else [])]
     lines = [
         f"/* {ident}_evaluate at `count` samples (at most {upper}_LANES), in columns:",
         " * lanes[j][i] is real j of sample i. The input block's reals come first, in its order",
@@ -194,8 +195,11 @@ def prototypes(scene: Scene, first: bool, angles: int) -> list[str]:
         f" * {ident}_evaluate says why. Every check is made without a branch, so that the loop",
         " * over samples vectorises. `wanted`, NULL or a flag per output in its block's order:",
         " * an output not wanted may be left out (an angle's atan2). _first: as",
-        f" * {ident}_evaluate_first. _baseline: compiled for the platform's baseline; _avx2",
-        " * and _avx512 (x86-64 with GCC or Clang only): for a CPU with AVX2, with AVX-512",
+        f" * {ident}_evaluate_first. _bare: as _first (or as the whole where there are no",
+        " * halves) with the reactions' bounds (each dyad's amplification and the",
+        " * mechanism's) NaN, the statuses the same. _baseline: compiled for the platform's",
+        " * baseline; _avx2 and _avx512 (x86-64 with GCC or Clang only): for a CPU with AVX2,",
+        " * with AVX-512",
         " * (no fused multiply-add: the same results bit for bit); _at_most:",
         " * the widest this CPU runs up to `cap` (dyad_lanes_isa, dyadfmu/types.h);",
         " * without a suffix, the widest this CPU runs. */",

@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 import math
 import re
+import sys
 from pathlib import Path
 from string import Template
 
@@ -85,11 +86,13 @@ class Plan:
     the dyads loading those, and for the crank's outputs every dyad on the crank), the
     links whose resultants it forms, and the C names of their pairs' accelerations."""
 
-    def __init__(self, scene: Scene, lane: bool = False) -> None:
+    def __init__(self, scene: Scene, lane: bool = False, bounds: bool = True) -> None:
         self.scene = scene
         #: the code of one sample of a batch (src/dyad_lanes.h): no branch, no early
         #: return; each check's failure counted in `bad`
         self.lane = lane
+        #: the reactions' bounds computed (a batch may leave them out: :func:`bare_lanes`)
+        self.bounds = bounds
         self.drivers = scene.drivers
         self.names = {i.name: i for i in scene.inputs}
         #: every driver's balance is wanted (one output of one of them asks for them all)
@@ -493,6 +496,8 @@ def _bound(plan: Plan, code: _Code, d: Dyad) -> None:
     conditioning (dyad_amplification.h); so does an extra error e of a loader's
     reactions, relative to its largest."""
     dn = member(d.name or "dyad")
+    if not plan.bounds:
+        return
     extra = []
     if d in plan.kinematic:
         extra.append(f"DYAD_R(2.0) * kin.{kinematics_c.kin_name(d)}.amplification")
@@ -541,7 +546,8 @@ def _chain(plan: Plan, code: _Code) -> None:
         _load(plan, code, d)
         code(f"    load.singular_threshold = {threshold};")
         if plan.lane:
-            code(f"    bad += dyad_react_lane_{d.type.lower()}(&load, &{dn});")
+            bare = "" if plan.bounds else "bare_"
+            code(f"    bad += dyad_react_lane_{bare}{d.type.lower()}(&load, &{dn});")
         else:
             code(f"    if (dyad_react_{d.type.lower()}(&load, &{dn}) != DYAD_STATUS_OK) {{")
             code(
@@ -935,6 +941,43 @@ def later_members(scene: Scene) -> tuple[str, ...]:
     return tuple(o.member for o in scene.outputs if o.member in gives)
 
 
+def bound_members(scene: Scene) -> tuple[str, ...]:
+    """The outputs that are the reactions' bounds: each dyad's amplification and the
+    mechanism's."""
+    exprs = _output_exprs(scene)
+    return tuple(
+        o.member
+        for o in scene.outputs
+        if o.member == MECHANISM_AMPLIFICATION or exprs.get(o.member, "").endswith("_bound")
+    )
+
+
+def bare_lanes(scene: Scene) -> bool:
+    """Whether the scene's batch has lanes without the bounds (<identifier>_lanes_bare),
+    for a call that reads none of them: where leaving them out cannot change a status.
+    The scalar evaluation says 3 where a bound overflows; with the threshold t a constant
+    and no cylinder (whose bound divides by its forces), none can. A dyad accepted has
+    conditioning c >= t and its motion's amplification at most 1 / t (else its status is
+    not 0); its amplification a is its data factor, at most 1 / eps while its reactions
+    stay below DYAD_REAL_MAX eps (the lanes count a sample beyond as failed: it is
+    evaluated alone), over c (dyad_amplification.h), so its bound a + a c (2 / t + its
+    loaders' bounds) is at most
+    (1 / eps) (1 / t + 2 / t + those bounds), and the mechanism's 1 + their sum + 3 / t
+    per dyad whose motion alone is reported: checked finite here, with a margin."""
+    if kinematics_c.cylinders(scene) or scene.threshold.tunable:
+        return False
+    plan = Plan(scene)
+    threshold, factor = scene.threshold.value, 1 / sys.float_info.epsilon
+    bound: dict[int, float] = {}
+    for d in reversed(plan.solved):
+        loaders = sum(bound.get(x.index, 0.0) for x in plan.direct_loaders(d))
+        motion = 2 / threshold if d in plan.kinematic else 0.0
+        bound[d.index] = factor * (1 / threshold + motion + loaders)
+    solved = {d.index for d in plan.solved}
+    motions = sum(3 / threshold for d in plan.kinematic if d.index not in solved)
+    return 1 + sum(bound.values()) + motions < sys.float_info.max / 4
+
+
 def _later_body(plan: Plan, later: tuple[str, ...]) -> list[str]:
     """<identifier>_evaluate_later's body: the efforts from the outputs, the effective
     inertia's pass, its outputs and their check."""
@@ -1101,19 +1144,19 @@ def _checks(ident: str, reals: list[str], later: list[str]) -> str:
 
 
 def _evaluation(
-    scene: Scene, later: tuple[str, ...] = (), lane: bool = False
+    scene: Scene, later: tuple[str, ...] = (), lane: bool = False, bounds: bool = True
 ) -> tuple[Plan, list[str], list[str], list[str]]:
     """(plan, dyad declarations, crank declarations, body) of the scene's evaluate; with
     outputs given later (:func:`later_members`), of <identifier>_evaluate_first; with
-    `lane`, of one sample of its batch (see :class:`Plan`)."""
-    plan = Plan(scene, lane)
+    `lane`, of one sample of its batch (see :class:`Plan`), and without `bounds`, of one
+    that leaves them NaN (:func:`bare_lanes`)."""
+    plan = Plan(scene, lane, bounds)
     code = _Code()
+    left = later + (() if bounds else bound_members(scene))
     for write in PASSES:
-        if not later:
-            write(plan, code)
-        elif write is _outputs:
-            _outputs(plan, code, later)
-        elif write is not _driver_inertia:
+        if write is _outputs:
+            _outputs(plan, code, left)
+        elif not (later and write is _driver_inertia):
             write(plan, code)
     dyad_decls, crank_decls = _declarations(plan)
     return plan, dyad_decls, crank_decls, drop_unused_constants(code.lines)
@@ -1153,7 +1196,7 @@ def _function(ident: str, name: str, body: list[str]) -> list[str]:
 def _batch_code(scene: Scene, later: tuple[str, ...]) -> str:
     """The scene's batch evaluation (emit/batch_c.py): its kinematics and its evaluation
     (with outputs ``later``, also its first half) as one sample of a loop, and
-    <identifier>_lanes (and _lanes_first) over many."""
+    <identifier>_lanes (and _lanes_first, and _lanes_bare: :func:`bare_lanes`) over many."""
     ident = scene.identifier
     lines = [
         "/* ---- many samples at once: the evaluation as one sample of a loop that vectorises",
@@ -1163,8 +1206,10 @@ def _batch_code(scene: Scene, later: tuple[str, ...]) -> str:
         "",
         kinematics_c.kinematics_lane_function(scene, Plan(scene).kinematic),
     ]
-    for suffix, half in (("", ()), ("_first", later)) if later else (("", ()),):
-        _, dyad_decls, crank_decls, body = _evaluation(scene, half, lane=True)
+    variants = [("", (), True)] + ([("_first", later, True)] if later else [])
+    variants += [("_bare", later, False)] if bare_lanes(scene) else []
+    for suffix, half, bounds in variants:
+        _, dyad_decls, crank_decls, body = _evaluation(scene, half, lane=True, bounds=bounds)
         lane = f"lane_evaluate{suffix}"
         angles = list(lane_angles(scene, half))
         lines += ["", *batch_c.lane_function(ident, lane, dyad_decls + crank_decls, body)]
@@ -1271,7 +1316,8 @@ def scene_header(table: Table, halves: bool = True) -> str:
         lines += ["", *_later_prototypes(ident, later_members(scene))]
     if halves and batch_c.batch_supported(scene):
         angles = len(lane_angles(scene))
-        lines += ["", *batch_c.prototypes(scene, bool(later_members(scene)), angles)]
+        first, bare = bool(later_members(scene)), bare_lanes(scene)
+        lines += ["", *batch_c.prototypes(scene, first, bare, angles)]
     lines += ["", f"#endif /* {guard} */"]
     return "\n".join(lines) + "\n"
 
