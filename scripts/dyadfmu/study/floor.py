@@ -402,12 +402,26 @@ def _force(v: Mapping[str, Counted], link: str) -> Vec:
     return (v[f"{link}.force.x"], v[f"{link}.force.y"])
 
 
+def _crank_pin(scene: Mapping, v: Mapping[str, Counted]) -> tuple[Frame, Point]:
+    """The crank's frame and the motion of its pin, where the first dyad rides."""
+    crank = _crank_inputs(scene, v)
+    return crank, crank.point((float(scene["crank"]["length"]), 0.0))
+
+
+def _with_balance(
+    scene: Mapping, crank: Frame, pin: Point, g: Vec, named: Reactions, r_np: Vec, tally: Tally
+) -> Reactions:
+    """The dyads' reactions `named` and the crank's balance against R_np at its pin."""
+    with tally.counting("balance"):
+        balance = crank_balance(crank, scene["crank"], g, sub(pin.pos, crank.d.pos), r_np)
+    return named | _prefixed(scene["crank"]["name"], balance)
+
+
 def slider_crank(scene: Mapping, v: Mapping[str, Counted], tally: Tally) -> Reactions:
     """Crank and RRT (piston m on the frame guide, rod n from the crank pin)."""
     dyad, links, g = scene["dyad"][0], _links(scene), _gravity(scene, v)
     rod = links[dyad["n"]]
-    crank = _crank_inputs(scene, v)
-    pin = crank.point((float(scene["crank"]["length"]), 0.0))
+    crank, pin = _crank_pin(scene, v)
     at, direction = _guide(dyad["k"])
     motion = rrt_motion(pin, at, direction, float(rod["length"]), float(dyad.get("branch", 1)))
     with tally.counting("loads"):
@@ -415,11 +429,8 @@ def slider_crank(scene: Mapping, v: Mapping[str, Counted], tally: Tally) -> Reac
         n = resultant(motion.n, rod, g)
     with tally.counting("reactions"):
         out = rrt_reactions(motion, m, n)
-    with tally.counting("balance"):
-        r_np = (out["R_np.x"], out["R_np.y"])
-        pin_offset = sub(pin.pos, crank.d.pos)
-        balance = crank_balance(crank, scene["crank"], g, pin_offset, r_np)
-    return _prefixed(dyad["name"], out) | _prefixed(scene["crank"]["name"], balance)
+    r_np = (out["R_np.x"], out["R_np.y"])
+    return _with_balance(scene, crank, pin, g, _prefixed(dyad["name"], out), r_np, tally)
 
 
 def four_bar(scene: Mapping, v: Mapping[str, Counted], tally: Tally) -> Reactions:
@@ -428,18 +439,15 @@ def four_bar(scene: Mapping, v: Mapping[str, Counted], tally: Tally) -> Reaction
     dyad, links, g = scene["dyad"][0], _links(scene), _gravity(scene, v)
     rocker, coupler = links[dyad["m"]], links[dyad["n"]]
     lm, ln = float(rocker["length"]), float(coupler["length"])
-    crank = _crank_inputs(scene, v)
-    pin = crank.point((float(scene["crank"]["length"]), 0.0))
+    crank, pin = _crank_pin(scene, v)
     motion = rrr_motion(Point(tuple(dyad["k"]["at"])), pin, lm, ln, float(dyad["branch"]))
     with tally.counting("loads"):
         m = resultant(motion.m, rocker, g, moment=v[f"{dyad['m']}.moment"])
         n = resultant(motion.n, coupler, g)
     with tally.counting("reactions"):
         out = rrr_reactions(motion, m, n)
-    with tally.counting("balance"):
-        r_np = (out["R_np.x"], out["R_np.y"])
-        balance = crank_balance(crank, scene["crank"], g, sub(pin.pos, crank.d.pos), r_np)
-    return _prefixed(dyad["name"], out) | _prefixed(scene["crank"]["name"], balance)
+    r_np = (out["R_np.x"], out["R_np.y"])
+    return _with_balance(scene, crank, pin, g, _prefixed(dyad["name"], out), r_np, tally)
 
 
 def shaper(scene: Mapping, v: Mapping[str, Counted], tally: Tally) -> Reactions:
@@ -453,8 +461,7 @@ def shaper(scene: Mapping, v: Mapping[str, Counted], tally: Tally) -> Reactions:
         _gravity(scene, v),
     )
     rod = links[ram["n"]]
-    crank = _crank_inputs(scene, v)
-    pin = crank.point((float(scene["crank"]["length"]), 0.0))
+    crank, pin = _crank_pin(scene, v)
     slot_motion, inv_length = rtr_motion(Point(tuple(slot["k"]["at"])), pin)
     r_tip = slot_motion.m.offset(tuple(ram["p"]["at"]))
     tip = slot_motion.m.at(r_tip)
@@ -472,11 +479,8 @@ def shaper(scene: Mapping, v: Mapping[str, Counted], tally: Tally) -> Reactions:
         lever = carried(lever, r_tip, (-outer["R_np.x"], -outer["R_np.y"]))
     with tally.counting("reactions"):
         inner = rtr_reactions(slot_motion, inv_length, lever, block)
-    with tally.counting("balance"):
-        r_np = (inner["R_np.x"], inner["R_np.y"])
-        balance = crank_balance(crank, scene["crank"], g, sub(pin.pos, crank.d.pos), r_np)
     named = _prefixed("slot", inner) | _prefixed("ram", outer)
-    return named | _prefixed(scene["crank"]["name"], balance)
+    return _with_balance(scene, crank, pin, g, named, (inner["R_np.x"], inner["R_np.y"]), tally)
 
 
 def ram_balance(scene: Mapping, ram: Frame, gravity: Vec, r_np: Vec) -> Reactions:
