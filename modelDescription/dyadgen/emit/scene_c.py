@@ -960,10 +960,10 @@ def bare_lanes(scene: Scene) -> bool:
     conditioning c >= t and its motion's amplification at most 1 / t (else its status is
     not 0); its amplification a is its data factor, at most 1 / eps while its reactions
     stay below DYAD_REAL_MAX eps (the lanes count a sample beyond as failed: it is
-    evaluated alone), over c (dyad_amplification.h), so its bound a + a c (2 / t + its
-    loaders' bounds) is at most
-    (1 / eps) (1 / t + 2 / t + those bounds), and the mechanism's 1 + their sum + 3 / t
-    per dyad whose motion alone is reported: checked finite here, with a margin."""
+    evaluated alone), over c (dyad_amplification.h). So its bound a + a c (2 / t + its
+    loaders' bounds) is at most (1 / eps) (1 / t + 2 / t + those bounds), and the
+    mechanism's 1 + their sum + 3 / t per dyad whose motion alone is reported: checked
+    finite here, with a margin."""
     if kinematics_c.cylinders(scene) or scene.threshold.tunable:
         return False
     plan = Plan(scene)
