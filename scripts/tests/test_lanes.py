@@ -429,3 +429,49 @@ def test_lanes_leave_the_bounds_out_only_where_no_status_can_need_them(threshold
     scene = pipeline.load_scene(tmp_path / "slider_crank.toml", check_c_names=False)
     assert scene.threshold.value == (threshold or scene.threshold.value)
     assert bare_lanes(scene) == bare
+
+
+def _chain_scene(stages: int, threshold: float) -> str:
+    """A crank and `stages` RRR stages in series, each on the last one's rocker: every
+    stage loads the one before it."""
+    lines = [
+        "[scene]",
+        'identifier = "stages"',
+        f"singular_threshold = {threshold!r}",
+        'description = "RRR stages in series"',
+        'outputs = ["all"]',
+        "[crank]",
+        'name = "crank"',
+        "length = 0.3",
+    ]
+    for k in range(1, stages + 1):
+        carrier = '"crank"' if k == 1 else f'{{ link = "r{k - 1}", at = [0.3, 0.0] }}'
+        lines += [
+            "[[dyad]]",
+            f'name = "s{k}"',
+            'type = "RRR"',
+            f'm = "c{k}"',
+            f'n = "r{k}"',
+            f"k = {carrier}",
+            f'p = {{ link = "frame", at = [{k}.0, 0.0] }}',
+            "branch = 1",
+        ]
+    for k in range(1, stages + 1):
+        for name, length in ((f"c{k}", 1.0), (f"r{k}", 0.3)):
+            lines += ["[[link]]", f'name = "{name}"', f"length = {length}", "com = [0.1, 0.0]"]
+            lines += ["mass = 1.0", "inertia = 0.01"]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(("stages", "bare"), [(2, True), (6, False)])
+def test_a_chain_whose_bounds_float_could_overflow_has_no_lanes_without_them(
+    stages, bare, tmp_path
+):
+    """Six stages loading each other at a threshold of 1e-16: in double every bound stays
+    finite, but the scene's C also compiles in float (DYAD_REAL_FLOAT), where each data
+    factor reaches 2^23 and six of them overflow FLT_MAX: no lanes without the bounds.
+    Two stages keep them."""
+    (tmp_path / "stages.toml").write_text(_chain_scene(stages, 1e-16))
+    scene = pipeline.load_scene(tmp_path / "stages.toml", check_c_names=False)
+    assert batch_supported(scene) and len(scene.dyads) == stages
+    assert bare_lanes(scene) == bare

@@ -952,6 +952,14 @@ def bound_members(scene: Scene) -> tuple[str, ...]:
     )
 
 
+#: Each scalar the scene's C compiles with (DYAD_REAL_FLOAT: float): its eps, its largest
+#: finite value and DYAD_DEFAULT_SINGULAR_THRESHOLD (dyadfmu/types.h), sqrt(eps).
+SCALARS = (
+    (2.0**-52, sys.float_info.max, 1.4901161193847656e-8),
+    (2.0**-23, 3.4028234663852886e38, 3.4526698e-4),
+)
+
+
 def bare_lanes(scene: Scene) -> bool:
     """Whether the scene's batch has lanes without the bounds (<identifier>_lanes_bare),
     for a call that reads none of them: where leaving them out cannot change a status.
@@ -963,19 +971,23 @@ def bare_lanes(scene: Scene) -> bool:
     evaluated alone), over c (dyad_amplification.h). So its bound a + a c (2 / t + its
     loaders' bounds) is at most (1 / eps) (1 / t + 2 / t + those bounds), and the
     mechanism's 1 + their sum + 3 / t per dyad whose motion alone is reported: checked
-    finite here, with a margin."""
+    finite here, with a margin, in double and in float (SCALARS), where a chain of dyads
+    loading each other multiplies the data factors (2^23 each) sooner."""
     if kinematics_c.cylinders(scene) or scene.threshold.tunable:
         return False
     plan = Plan(scene)
-    threshold, factor = scene.threshold.value, 1 / sys.float_info.epsilon
-    bound: dict[int, float] = {}
-    for d in reversed(plan.solved):
-        loaders = sum(bound.get(x.index, 0.0) for x in plan.direct_loaders(d))
-        motion = 2 / threshold if d in plan.kinematic else 0.0
-        bound[d.index] = factor * (1 / threshold + motion + loaders)
-    solved = {d.index for d in plan.solved}
-    motions = sum(3 / threshold for d in plan.kinematic if d.index not in solved)
-    return 1 + sum(bound.values()) + motions < sys.float_info.max / 4
+    for eps, largest, default in SCALARS:
+        threshold = default if scene.threshold.macro else scene.threshold.value
+        bound: dict[int, float] = {}
+        for d in reversed(plan.solved):
+            loaders = sum(bound.get(x.index, 0.0) for x in plan.direct_loaders(d))
+            motion = 2 / threshold if d in plan.kinematic else 0.0
+            bound[d.index] = (1 / eps) * (1 / threshold + motion + loaders)
+        solved = {d.index for d in plan.solved}
+        motions = sum(3 / threshold for d in plan.kinematic if d.index not in solved)
+        if not 1 + sum(bound.values()) + motions < largest / 4:
+            return False
+    return True
 
 
 def _later_body(plan: Plan, later: tuple[str, ...]) -> list[str]:
