@@ -19,13 +19,15 @@ TEST_SCENES_DIR = ROOT / "tests" / "scenes"
 HAND_TABLES = ("drive.toml", "motor.toml")
 #: A scene with every feature of the generated code (see the file and scenefile.c_names).
 C_NAMES_PROBE = INTERFACE_DIR / "c_names_probe.toml"
-#: every probe: external kinematics, internal with a crank, a ram, a cylinder
+#: every probe: external kinematics, internal with a crank, a ram, a cylinder, several
+#: drivers, and internal with nothing tunable (the lanes without the bounds)
 C_NAMES_PROBES = (
     C_NAMES_PROBE,
     INTERFACE_DIR / "c_names_probe_internal.toml",
     INTERFACE_DIR / "c_names_probe_ram.toml",
     INTERFACE_DIR / "c_names_probe_cylinder.toml",
     INTERFACE_DIR / "c_names_probe_drivers.toml",
+    INTERFACE_DIR / "c_names_probe_bare.toml",
 )
 #: Where the headers the generated code includes are found.
 HEADER_DIRS = (ROOT / "src" / "include", ROOT / "src", ROOT / "fmu")

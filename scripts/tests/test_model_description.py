@@ -1017,6 +1017,7 @@ def test_tables_are_the_drive_the_motor_and_the_scenes_of_the_five_dyads():
         "c_names_probe_ram.toml",
         "c_names_probe_cylinder.toml",
         "c_names_probe_drivers.toml",
+        "c_names_probe_bare.toml",
     }
     assert golden_module.TABLES == ("drive.toml", "motor.toml")
     assert {p.name for p in TABLE_OF.values()} == set(golden_module.GOLDEN_SCENES)
