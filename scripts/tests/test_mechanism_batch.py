@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from dyadfmu import evaluate, paths, run_table
 from dyadfmu.cosim import mechanism_fmus
+from dyadfmu.mechanism_batch import _finite_owners
 from tool_checks import required_tool
 
 OUTPUTS = ["crank.torque", "crank.R_O.x", "crank.R_O.y", "engine.R_mk.x", "engine.R_np.y"]
@@ -124,6 +125,40 @@ def test_strided_and_reversed_inputs_give_what_their_contiguous_copies_give():
     for name in OUTPUTS:
         assert np.array_equal(found[name], want[name]), name
         assert np.array_equal(every_other[name], plain[name]), name
+
+
+@pytest.mark.parametrize("columns", [2, 3])
+def test_the_columns_of_a_table_are_checked_in_one_pass_and_a_bad_value_named(columns):
+    """Inputs that are the columns of one table of samples are checked in one pass over it
+    where they are the whole table (2 columns), column by column where it has more (3):
+    either way a value that is not finite is named with its row, one in a column the call
+    does not read refuses nothing, and the results are the contiguous copies'."""
+    table = np.zeros((300, columns))
+    table[:, 0], table[:, 1] = np.linspace(0.0, 7.0, 300), 10.0
+    given = {"crank.angle": table[:, 0], "crank.omega": table[:, 1]}
+    assert _finite_owners(given) == (set(given) if columns == 2 else set())
+    if columns == 3:
+        table[5, 2] = np.nan  # read by no input
+    found = evaluate("slider_crank", given, OUTPUTS)
+    want = evaluate("slider_crank", {n: a.copy() for n, a in given.items()}, OUTPUTS)
+    for name in OUTPUTS:
+        assert np.array_equal(found[name], want[name]), name
+    table[7, 1] = -np.inf
+    with pytest.raises(ValueError, match=r"crank.omega\[7\] is -inf"):
+        evaluate("slider_crank", given, OUTPUTS, out=found)
+    assert np.array_equal(found["crank.torque"], want["crank.torque"])  # nothing written
+
+
+def test_a_view_across_its_table_s_values_is_checked_on_its_own():
+    """A view that reads doubles made of two halves of its table's (bytes 4 on): the table
+    is all finite, the view's first value NaN, and it is refused by name."""
+    table = np.zeros(200)
+    nan = np.frombuffer(np.array([np.nan]).tobytes(), np.uint8)
+    table.view(np.uint8)[4:12] = nan  # the high half of value 0, the low half of value 1
+    across = table.view(np.uint8)[4 : 4 + 8 * 100].view(np.float64)
+    assert np.isfinite(table).all() and np.isnan(across[0])
+    with pytest.raises(ValueError, match=r"crank.angle\[0\] is nan"):
+        evaluate("slider_crank", {"crank.angle": across, "crank.omega": table[100:]}, OUTPUTS)
 
 
 def test_ten_million_samples_with_one_bad_value_are_refused_before_anything_runs():

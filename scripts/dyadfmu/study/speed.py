@@ -469,8 +469,8 @@ def _batch_figures(figures: SceneSpeed, build: Path, steps: int, work: Path, qui
         figures.flops[every] = step_flops(build, scene, steps, work, every)
     figures.lanes = widest_lanes()
     narrower = list(LANES)[: list(LANES).index(figures.lanes)]
+    rounds = 5  # the best of five: one or two calls of a million samples met slow spells
     for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
-        rounds = 2 if count >= 1_000_000 else 5
         for every in (False, True):
             figures.samples[count, every] = batch_seconds(scene, count, every, rounds)
         figures.samples[count, "into"] = batch_seconds(scene, count, False, rounds, into=True)
