@@ -2212,6 +2212,12 @@ static void put_sample_aside(const column_call* c, const column_source source[],
     }
 }
 
+/* How many samples from `first` on a block of at most `lanes` holds: 0 past the last. */
+static size_t block_count(const column_call* c, size_t first, size_t lanes)
+{
+    return first < c->count ? (c->count - first < lanes ? c->count - first : lanes) : 0;
+}
+
 /* The contiguous columns' cache lines of the samples from `first` on, at most `lanes`,
  * asked of memory while the lanes compute earlier samples: each phase of a block (its
  * columns in, the lanes, its columns out) would otherwise wait for memory in turn (the
@@ -2222,8 +2228,7 @@ static void fetch_block(const column_call* c, size_t first, size_t lanes)
 {
 #if defined(__GNUC__)
     const size_t line = 64 / sizeof(double);
-    const size_t count =
-        first < c->count ? (c->count - first < lanes ? c->count - first : lanes) : 0;
+    const size_t count = block_count(c, first, lanes);
     size_t k, lane;
     for (k = 0; k < c->n_x; ++k) {
         for (lane = 0; c->x_step[k] == 1 && lane < count; lane += line) {
@@ -2261,7 +2266,7 @@ static void evaluate_lanes(const fmu_model* model, column_blocks* b, const colum
                            const lane_grid* g, size_t first)
 {
     const fmu_lanes* lanes = g->lanes;
-    const size_t count = c->count - first < lanes->lanes ? c->count - first : lanes->lanes;
+    const size_t count = block_count(c, first, lanes->lanes);
     const double* failed = g->cells + (lanes->inputs + lanes->outputs) * lanes->lanes;
     size_t lane, k;
     store_lanes(c, place, g, first, count);

@@ -15,7 +15,7 @@ and generates C that computes only what the scene needs (dyadgen/emit/scene_c.py
 Usage:
     scene.py SCENE.toml --out DIR    generate the FMU's files (see generate.py)
     scene.py SCENE.toml --check      validate only; print the variable counts
-    scene.py SCENE.toml --cmake-info print 'identifier;realisation;types...' for CMake
+    scene.py SCENE.toml --cmake-info print 'identifier;realisation;lanes;types...' for CMake
 
 A malformed scene is rejected with every problem, each naming the file, the line
 and what is wrong; nothing is written.

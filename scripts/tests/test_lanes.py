@@ -26,7 +26,7 @@ import pytest
 from dyadfmu import paths
 from dyadgen import pipeline
 from dyadgen.corefiles import scene_core_sources
-from dyadgen.emit.batch_c import batch_supported, block_reals
+from dyadgen.emit.batch_c import batch_supported, block_reals, scheduled_lanes
 from dyadgen.emit.scene_c import bare_lanes, bound_members, later_members
 from dyadgen.locations import SCENES_DIR, TEST_SCENES_DIR
 from tool_checks import required_tool
@@ -40,6 +40,8 @@ FLAGS = [
     "--param=max-combine-insns=2", "-fno-tree-pre",
     "-Wall", "-Wextra", "-Wpedantic", "-Werror",
 ]  # fmt: skip
+#: ... and adds to a scene's C where its lanes are scheduled (batch_c.scheduled_lanes)
+SCHEDULE = ["-fschedule-insns", "-fsched-pressure"]
 SAMPLES = 600
 SCENES = sorted(
     path
@@ -219,8 +221,9 @@ def programs(tmp_path_factory):
             (work / "main.c").write_text(_driver(ident, has_first, has_bare))
             core = [ROOT / "src" / f for f in scene_core_sources(table.scene, derivatives=False)]
             includes = [f"-I{d}" for d in (gen, ROOT / "src", ROOT / "src" / "include")]
+            schedule = SCHEDULE if scheduled_lanes(table.scene) else []
             report = subprocess.run(
-                ["cc", *FLAGS, *includes, "-c", str(gen / f"{ident}_scene.c"),
+                ["cc", *FLAGS, *schedule, *includes, "-c", str(gen / f"{ident}_scene.c"),
                  "-o", str(work / "scene.o"), "-fopt-info-vec-optimized"],
                 capture_output=True, text=True,
             )  # fmt: skip
@@ -370,7 +373,7 @@ def test_a_generic_dyad_fmus_lanes_vectorise(kind, tmp_path):
     model = gen / f"dyad_{kind}_model.c"
     includes = [ROOT / "src", ROOT / "src" / "include", ROOT / "fmu", ROOT / "fmu" / "models"]
     report = subprocess.run(
-        ["cc", *FLAGS, *(f"-I{d}" for d in includes), "-c", str(model),
+        ["cc", *FLAGS, *SCHEDULE, *(f"-I{d}" for d in includes), "-c", str(model),
          "-o", str(tmp_path / "model.o"), "-fopt-info-vec-optimized"],
         capture_output=True, text=True,
     )  # fmt: skip
@@ -407,11 +410,14 @@ def test_the_build_compiles_the_lanes_with_the_flags_these_tests_use():
     core = (ROOT / "CMakeLists.txt").read_text()
     assert _cmake_flags(fmu, "set(lane_options") == vectorising
     for source in ("${gen}/${id}_scene.c", "${gen}/${id}_model.c"):
-        assert (
-            f'set_source_files_properties({source} PROPERTIES COMPILE_OPTIONS "${{lane_options}}")'
-            in fmu
-        )
+        assert f"set_source_files_properties({source} PROPERTIES COMPILE_OPTIONS" in fmu
     assert _cmake_flags(fmu, "set(cross_lane_flags") == vectorising
+    assert _cmake_flags(fmu, 'set(lane_schedule "') == set(SCHEDULE)
+    assert _cmake_flags(fmu, "set(cross_lane_schedule") == set(SCHEDULE)
+    # given a scene's C (and a generic dyad's table) where the generator says "scheduled"
+    assert 'if(lanes STREQUAL "scheduled")\n    set(scene_lane_schedule "${lane_schedule}")' in fmu
+    assert fmu.count('"${lane_options};${scene_lane_schedule}")') == 2
+    assert "${cross_lane_flags} ${scene_cross_schedule}" in fmu
     wanted = {"-O3", "-fno-trapping-math", "-fno-math-errno"}
     assert _cmake_flags(core, "set_source_files_properties(src/dyad_batch.c") == wanted
 

@@ -3,6 +3,7 @@ compressed per-instruction positions, and the closed forms' counts atop each typ
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -104,3 +105,34 @@ def test_generic_fmu_rows_come_from_the_build_given(tmp_path: Path, monkeypatch)
         bench.fmu_rows("RRT", 4, seed=1, build=tmp_path / "empty")
     md, inputs, outputs, rows = bench.fmu_rows("RRT", 4, seed=1, build=built)
     assert md.modelName and rows.shape == (4, len(inputs)) and outputs
+
+
+def test_the_batch_kinds_are_timed_in_turn_and_the_lanes_restored(monkeypatch):
+    """batch_seconds calls each kind once a round, in turn (a slow spell then slows one
+    call of each kind, not every call of one), each in its lanes (DYADFMU_LANES, "" the
+    widest), each into the one earlier call's arrays where it says so, and leaves a
+    DYADFMU_LANES given before as it was."""
+    from dyadfmu import mechanism_batch
+    from dyadfmu.study import speed
+
+    real = mechanism_batch.evaluate
+    calls = []
+
+    def evaluate(scene, given, asked, out=None):
+        calls.append((os.environ.get("DYADFMU_LANES"), len(asked), out))
+        return real(scene, given, asked, out=out)
+
+    monkeypatch.setattr(mechanism_batch, "evaluate", evaluate)
+    monkeypatch.setenv("DYADFMU_LANES", "avx2")
+    kinds = {"wide": (False, "", False), "every": (True, "", False),
+             "baseline into": (False, "baseline", True)}  # fmt: skip
+    seconds = speed.batch_seconds("slider_crank", 50, kinds, rounds=3)
+    assert set(seconds) == set(kinds) and all(0 < s < 1e-3 for s in seconds.values())
+    assert os.environ["DYADFMU_LANES"] == "avx2"
+    timed = calls[2:]  # after the loading call and the arrays the `into` kind reuses
+    into = calls[1][2] is None and timed[2][2]
+    assert [lanes for lanes, _, _ in timed] == ["", "", "baseline"] * 3
+    few, every = calls[1][1], calls[0][1]
+    assert [n for _, n, _ in timed] == [few, every, few] * 3 and few < every
+    assert [out is None for _, _, out in timed] == [True, True, False] * 3
+    assert into and all(out is timed[2][2] for _, _, out in timed[2::3])

@@ -11,6 +11,7 @@ import tempfile
 from pathlib import Path
 
 from dyadgen.bundle import BundleError, block_members, write_bundle
+from dyadgen.emit.batch_c import scheduled_lanes
 from dyadgen.model import Scene
 from dyadgen.pipeline import build_table, load_scene, outputs_of, write_files
 from dyadgen.scenefile.problems import SceneError
@@ -42,8 +43,10 @@ def _parser() -> argparse.ArgumentParser:
     what.add_argument(
         "--cmake-info",
         action="store_true",
-        help="print 'identifier;realisation;type;...' (its dyad types, lower case) for CMake, "
-        "a line per scene file, in their order (one Python run for every scene of a build)",
+        help="print 'identifier;realisation;lanes;type;...' for CMake (lanes: 'scheduled' "
+        "where the build schedules its lanes for register pressure, else 'plain'; its dyad "
+        "types, lower case), a line per scene file, in their order (one Python run for "
+        "every scene of a build)",
     )
     what.add_argument(
         "--blocks",
@@ -180,7 +183,8 @@ def _cmake_info(paths: list[Path]) -> int:
         types = sorted({d.type.lower() for d in scene.dyads})
         if any(d.is_cylinder() for d in scene.drivers):
             types.append("cylinder")  # its closed forms link as a type's do
-        print(";".join([scene.identifier, table.kind.realisation] + types))
+        lanes = "scheduled" if scheduled_lanes(scene) else "plain"
+        print(";".join([scene.identifier, table.kind.realisation, lanes] + types))
     return 0
 
 

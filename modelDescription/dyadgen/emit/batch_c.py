@@ -26,6 +26,22 @@ def batch_supported(scene: Scene) -> bool:
     return scene.internal() and not scene.forward()
 
 
+#: The most closed-form stages (dyads and cylinders) of a scene whose lanes the build
+#: schedules for register pressure (scheduled_lanes).
+SCHEDULED_STAGES = 2
+
+
+def scheduled_lanes(scene: Scene) -> bool:
+    """Whether the build has GCC schedule the scene's C before register allocation
+    (-fschedule-insns -fsched-pressure; scene.py --cmake-info says "scheduled"). A lane's
+    loop body holds the whole mechanism, and so scheduled it spills far fewer registers
+    (the shaper's lanes without the bounds: baseline 104 -> 83 ns a sample, AVX2 53 -> 42),
+    but GCC's time grows faster than the body: a scene of at most two stages compiles
+    1.1 to 1.5 times as long, the excavator's study copy (four, its parameters variables)
+    2.4 times (79 -> 189 s), which a study's user would wait for."""
+    return len(scene.dyads) + len(kinematics_c.cylinders(scene)) <= SCHEDULED_STAGES
+
+
 def batch_include(scene: Scene) -> str:
     """The lanes of the scene's dyad types and of its cylinders (src/dyad_lanes.h), for
     the top of its C."""

@@ -162,35 +162,39 @@ def widest_lanes() -> str:
     return [name for name, flag in LANES.items() if not flag or flag in flags][-1]
 
 
-def batch_seconds(
-    scene: str, count: int, every: bool, rounds: int, lanes: str = "", into: bool = False
-) -> float:
+def batch_seconds(scene: str, count: int, kinds: dict, rounds: int) -> dict:
     """CPU seconds per sample of ``dyadfmu.evaluate`` on ``scene`` over ``count`` samples
-    of its inputs swinging about their start values (step_rows), asking every Real output
-    or the efforts and reactions alone: the best of ``rounds`` calls. ``lanes``: in those
-    of LANES at most (DYADFMU_LANES), else in the widest this CPU runs. ``into``: each call
-    writes into an earlier call's arrays (``out=``), as a sweep of many batches does,
-    instead of new ones (whose pages the system clears on their first write)."""
-    if lanes:
-        os.environ["DYADFMU_LANES"] = lanes
-        try:
-            return batch_seconds(scene, count, every, rounds, into=into)
-        finally:
-            del os.environ["DYADFMU_LANES"]
+    of its inputs swinging about their start values (step_rows), for each of ``kinds``:
+    its key's (every, lanes, into), the best of ``rounds`` calls, the kinds called in turn
+    in each round (a slow spell of this shared machine then slows one call of each, not
+    every call of one). ``every``: every Real output asked, else the efforts and reactions
+    alone. ``lanes``: in those of LANES at most (DYADFMU_LANES), else ("") in the widest
+    this CPU runs. ``into``: each call writes into an earlier call's arrays (``out=``), as
+    a sweep of many batches does, instead of new ones (whose pages the system clears on
+    their first write)."""
     from ..mechanism_batch import evaluate
 
     md = read_model_description(str(paths.built_fmu(scene, 2)))
     inputs, outputs, rows = step_rows(md, count, seed=11)
-    asked = [v.name for v in (outputs if every else efforts_and_reactions(outputs))]
     given = {v.name: rows[:, k] for k, v in enumerate(inputs)}
-    evaluate(scene, {n: a[:1] for n, a in given.items()}, asked)  # loaded before timing
-    out = evaluate(scene, given, asked) if into else None
-    best = math.inf
-    for _ in range(rounds):
-        started = clock.process_time()
-        evaluate(scene, given, asked, out=out)
-        best = min(best, clock.process_time() - started)
-    return best / count
+    asked = {e: [v.name for v in (outputs if e else efforts_and_reactions(outputs))]
+             for e in (False, True)}  # fmt: skip
+    evaluate(scene, {n: a[:1] for n, a in given.items()}, asked[True])  # loaded before timing
+    out = evaluate(scene, given, asked[False]) if any(k[2] for k in kinds.values()) else None
+    best = dict.fromkeys(kinds, math.inf)
+    saved = os.environ.pop("DYADFMU_LANES", None)
+    try:
+        for _ in range(rounds):
+            for name, (every, lanes, into) in kinds.items():
+                os.environ["DYADFMU_LANES"] = lanes
+                started = clock.process_time()
+                evaluate(scene, given, asked[every], out=out if into else None)
+                best[name] = min(best[name], clock.process_time() - started)
+    finally:
+        os.environ.pop("DYADFMU_LANES", None)
+        if saved is not None:
+            os.environ["DYADFMU_LANES"] = saved
+    return {name: seconds / count for name, seconds in best.items()}
 
 
 def rows_seconds(scene: str, count: int, rounds: int) -> float:
@@ -470,15 +474,13 @@ def _batch_figures(figures: SceneSpeed, build: Path, steps: int, work: Path, qui
     figures.lanes = widest_lanes()
     narrower = list(LANES)[: list(LANES).index(figures.lanes)]
     rounds = 5  # the best of five: one or two calls of a million samples met slow spells
+    kinds = {False: (False, "", False), True: (True, "", False), "into": (False, "", True)}
+    for lanes in narrower:
+        kinds[lanes] = (False, lanes, False)
+        kinds[f"{lanes} into"] = (False, lanes, True)
     for count in BATCH_SIZES[:2] if quick else BATCH_SIZES:
-        for every in (False, True):
-            figures.samples[count, every] = batch_seconds(scene, count, every, rounds)
-        figures.samples[count, "into"] = batch_seconds(scene, count, False, rounds, into=True)
-        for lanes in narrower:
-            for kind, into in ((lanes, False), (f"{lanes} into", True)):
-                figures.samples[count, kind] = batch_seconds(
-                    scene, count, False, rounds, lanes, into
-                )
+        for kind, seconds in batch_seconds(scene, count, kinds, rounds).items():
+            figures.samples[count, kind] = seconds
         figures.samples[count, "rows"] = rows_seconds(scene, count, rounds)
         if count <= 10_000:  # the stacked solve's matrices: 1e6 x 9 x 9 is 650 MB
             figures.samples[count, "numpy"] = numpy_yardstick_seconds(scene, count, rounds)
