@@ -252,13 +252,15 @@ def test_the_generic_scenes_are_the_per_type_fmus():
 @pytest.mark.parametrize(
     "name, lanes",
     [("dyad_rtr", "scheduled"), ("slider_crank", "scheduled"), ("shaper", "scheduled"),
-     ("tipper", "scheduled"), ("excavator", "plain"), ("loader", "plain")],
+     ("tipper", "scheduled"), ("excavator", "plain"), ("loader", "plain"),
+     ("press", "plain"), ("slider_crank_forward", "plain")],
 )  # fmt: skip
 def test_the_build_schedules_the_lanes_of_scenes_of_two_stages_at_most(name, lanes):
-    """--cmake-info's third field: the shaper's two dyads and the tipper's dyad and cylinder
-    compile scheduled for register pressure (fmu/CMakeLists.txt); the excavator's dyad and
-    three cylinders and the loader's dyad and two do not (GCC's time for it grows faster
-    than the loop body)."""
+    """--cmake-info's third field: a generic dyad's lanes, the shaper's two dyads and the
+    tipper's dyad and cylinder compile scheduled for register pressure (fmu/CMakeLists.txt);
+    the excavator's dyad and three cylinders and the loader's dyad and two do not (GCC's
+    time for it grows faster than the loop body), nor a scene without a batch (the press,
+    tailored; a plant)."""
     done = run_tool(SCENES_DIR / f"{name}.toml", "--cmake-info")
     assert done.returncode == 0 and done.stdout.split(";")[2] == lanes, done.stdout
 

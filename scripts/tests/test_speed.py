@@ -107,11 +107,12 @@ def test_generic_fmu_rows_come_from_the_build_given(tmp_path: Path, monkeypatch)
     assert md.modelName and rows.shape == (4, len(inputs)) and outputs
 
 
-def test_the_batch_kinds_are_timed_in_turn_and_the_lanes_restored(monkeypatch):
+@pytest.mark.parametrize("before", [None, "avx2"])
+def test_the_batch_kinds_are_timed_in_turn_and_the_lanes_restored(before, monkeypatch):
     """batch_seconds calls each kind once a round, in turn (a slow spell then slows one
     call of each kind, not every call of one), each in its lanes (DYADFMU_LANES, "" the
-    widest), each into the one earlier call's arrays where it says so, and leaves a
-    DYADFMU_LANES given before as it was."""
+    widest) and asking its outputs, those that say so into the arrays of one earlier call
+    that asked the same outputs, and leaves DYADFMU_LANES as it was, set or not."""
     from dyadfmu import mechanism_batch
     from dyadfmu.study import speed
 
@@ -119,20 +120,28 @@ def test_the_batch_kinds_are_timed_in_turn_and_the_lanes_restored(monkeypatch):
     calls = []
 
     def evaluate(scene, given, asked, out=None):
-        calls.append((os.environ.get("DYADFMU_LANES"), len(asked), out))
-        return real(scene, given, asked, out=out)
+        done = real(scene, given, asked, out=out)
+        calls.append((os.environ.get("DYADFMU_LANES"), tuple(asked), out, done))
+        return done
 
     monkeypatch.setattr(mechanism_batch, "evaluate", evaluate)
-    monkeypatch.setenv("DYADFMU_LANES", "avx2")
+    if before is None:
+        monkeypatch.delenv("DYADFMU_LANES", raising=False)
+    else:
+        monkeypatch.setenv("DYADFMU_LANES", before)
     kinds = {"wide": (False, "", False), "every": (True, "", False),
-             "baseline into": (False, "baseline", True)}  # fmt: skip
+             "baseline into": (False, "baseline", True),
+             "every avx2 into": (True, "avx2", True)}  # fmt: skip
     seconds = speed.batch_seconds("slider_crank", 50, kinds, rounds=3)
-    assert set(seconds) == set(kinds) and all(0 < s < 1e-3 for s in seconds.values())
-    assert os.environ["DYADFMU_LANES"] == "avx2"
-    timed = calls[2:]  # after the loading call and the arrays the `into` kind reuses
-    into = calls[1][2] is None and timed[2][2]
-    assert [lanes for lanes, _, _ in timed] == ["", "", "baseline"] * 3
-    few, every = calls[1][1], calls[0][1]
-    assert [n for _, n, _ in timed] == [few, every, few] * 3 and few < every
-    assert [out is None for _, _, out in timed] == [True, True, False] * 3
-    assert into and all(out is timed[2][2] for _, _, out in timed[2::3])
+    assert list(seconds) == list(kinds) and all(0 < s < 1e-3 for s in seconds.values())
+    assert os.environ.get("DYADFMU_LANES") == before
+    loading, few_arrays, every_arrays = calls[:3]
+    few, every = few_arrays[1], every_arrays[1]
+    assert loading[1] == every and len(few) < len(every)
+    timed = calls[3:]
+    assert [lanes for lanes, *_ in timed] == ["", "", "baseline", "avx2"] * 3
+    assert [asked for _, asked, *_ in timed] == [few, every, few, every] * 3
+    outs = [out for _, _, out, _ in timed]
+    assert outs[0::4] == outs[1::4] == [None] * 3
+    assert all(out is few_arrays[3] for out in outs[2::4])
+    assert all(out is every_arrays[3] for out in outs[3::4])

@@ -44,9 +44,10 @@ def _parser() -> argparse.ArgumentParser:
         "--cmake-info",
         action="store_true",
         help="print 'identifier;realisation;lanes;type;...' for CMake (lanes: 'scheduled' "
-        "where the build schedules its lanes for register pressure, else 'plain'; its dyad "
-        "types, lower case), a line per scene file, in their order (one Python run for "
-        "every scene of a build)",
+        "where the build schedules its C for register pressure, a generic dyad's or a "
+        "batch's of at most two dyads and cylinders, else 'plain'; its dyad types, lower "
+        "case), a line per scene file, in their order (one Python run for every scene of a "
+        "build)",
     )
     what.add_argument(
         "--blocks",
@@ -183,7 +184,8 @@ def _cmake_info(paths: list[Path]) -> int:
         types = sorted({d.type.lower() for d in scene.dyads})
         if any(d.is_cylinder() for d in scene.drivers):
             types.append("cylinder")  # its closed forms link as a type's do
-        lanes = "scheduled" if scheduled_lanes(scene) else "plain"
+        generic = table.kind.realisation == "generic"  # its variable table holds lanes
+        lanes = "scheduled" if generic or scheduled_lanes(scene) else "plain"
         print(";".join([scene.identifier, table.kind.realisation, lanes] + types))
     return 0
 

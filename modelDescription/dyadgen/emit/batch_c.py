@@ -33,13 +33,17 @@ SCHEDULED_STAGES = 2
 
 def scheduled_lanes(scene: Scene) -> bool:
     """Whether the build has GCC schedule the scene's C before register allocation
-    (-fschedule-insns -fsched-pressure; scene.py --cmake-info says "scheduled"). A lane's
-    loop body holds the whole mechanism, and so scheduled it spills far fewer registers
-    (the shaper's lanes without the bounds: baseline 104 -> 83 ns a sample, AVX2 53 -> 42),
-    but GCC's time grows faster than the body: a scene of at most two stages compiles
-    1.1 to 1.5 times as long, the excavator's study copy (four, its parameters variables)
-    2.4 times (79 -> 189 s), which a study's user would wait for."""
-    return len(scene.dyads) + len(kinematics_c.cylinders(scene)) <= SCHEDULED_STAGES
+    (-fschedule-insns -fsched-pressure; scene.py --cmake-info says "scheduled", as it does
+    for a generic dyad, whose variable table holds its type's lanes): a scene with a batch
+    evaluation of at most SCHEDULED_STAGES. A lane's loop body holds the whole mechanism,
+    and so scheduled it spills far fewer registers (the shaper's lanes without the bounds
+    alone, 512 samples: baseline 104 -> 83 ns a sample, AVX2 53 -> 42), but GCC's time for
+    it grows faster than the body: the scene C of the built-in shaper and the studies'
+    copies of the engine, the shaper and the tipper (its dyad and cylinder) took 1.06 to
+    1.45 times as long, the excavator's study copy (a dyad and three cylinders, its
+    parameters variables) 2.4 times (79 -> 189 s), which a study's user would wait for."""
+    stages = len(scene.dyads) + len(kinematics_c.cylinders(scene))
+    return batch_supported(scene) and stages <= SCHEDULED_STAGES
 
 
 def batch_include(scene: Scene) -> str:
