@@ -2065,6 +2065,44 @@ static void evaluate_samples(const fmu_model* model, column_blocks* b, const col
 
 /* ---- the same in a model's lanes (fmu_lanes): many samples at once ---------------------- */
 
+/* `count` angles into the (cos, sin) of each (dyadfmu/angle.h: the bits of dyad_cos_sin,
+ * which the input block's angles get); `angle` may be `cos_out`. */
+typedef void (*turn_fn)(const double* angle, double* cos_out, double* sin_out, size_t count);
+
+/* In pairs (dyad_cos_sin_pair: in about half the time of one at a time). */
+static void turn_in_pairs(const double* angle, double* cos_out, double* sin_out, size_t count)
+{
+    size_t lane;
+    for (lane = 0; lane + 1 < count; lane += 2) {
+        double unit0[2], unit1[2];
+        dyad_cos_sin_pair(angle[lane], angle[lane + 1], unit0, unit1);
+        cos_out[lane] = unit0[0];
+        sin_out[lane] = unit0[1];
+        cos_out[lane + 1] = unit1[0];
+        sin_out[lane + 1] = unit1[1];
+    }
+    if (lane < count) {
+        dyad_cos_sin(angle[lane], &cos_out[lane], &sin_out[lane]);
+    }
+}
+
+/* The widest turning this CPU runs up to `cap`, as the lanes are chosen (an angle in
+ * AVX2's lanes in half the time of a pair's, in AVX-512's in a third). */
+static turn_fn turn_for(dyad_lanes_isa cap)
+{
+#if defined(DYAD_ANGLE_HAVE_WIDE)
+    if (cap >= DYAD_LANES_AVX512 && __builtin_cpu_supports("avx512f")) {
+        return dyad_cos_sin_avx512;
+    }
+    if (cap >= DYAD_LANES_AVX2 && __builtin_cpu_supports("avx2")) {
+        return dyad_cos_sin_avx2;
+    }
+#else
+    (void)cap;
+#endif
+    return turn_in_pairs;
+}
+
 /* The call's lanes: the grid of columns; per x column, the lane column its values go to;
  * per y column, the lane column its values come from (NULL: where find_sources said); the
  * outputs wanted; which samples were stored. */
@@ -2072,6 +2110,7 @@ typedef struct lane_grid {
     const fmu_lanes* lanes;
     dyad_lanes_isa cap;    /* the widest lanes to take (fmu_lanes; DYADFMU_LANES) */
     fmu_lanes_fn evaluate; /* the lanes the call takes (lanes_for) */
+    turn_fn turn;          /* how its angles are turned (turn_for) */
     int halves;            /* 1 where they are the first half's: a sample alone too */
     double* cells;         /* columns x lanes */
     double** to;           /* n_x */
@@ -2145,24 +2184,6 @@ static fmu_status evaluate_lane_alone(const fmu_model* model, column_blocks* b, 
     return sample_status(b->evaluation.status);
 }
 
-/* The angles of `count` lanes into the (cos, sin) of each, in pairs (dyad_cos_sin_pair: the
- * bits of dyad_cos_sin, which the input block's angles get, in about half its time). */
-static void turn_lanes(double* cos_at, double* sin_at, size_t count)
-{
-    size_t lane;
-    for (lane = 0; lane + 1 < count; lane += 2) {
-        double unit0[2], unit1[2];
-        dyad_cos_sin_pair(cos_at[lane], cos_at[lane + 1], unit0, unit1);
-        cos_at[lane] = unit0[0];
-        sin_at[lane] = unit0[1];
-        cos_at[lane + 1] = unit1[0];
-        sin_at[lane + 1] = unit1[1];
-    }
-    if (lane < count) {
-        dyad_cos_sin(cos_at[lane], &cos_at[lane], &sin_at[lane]);
-    }
-}
-
 /* The x columns' values of the samples from `first` on into their lane columns, column by
  * column (an angle as its unit vector); per lane whether every value lies within its
  * variable's bounds (store_values' check; a sample that fails it is not evaluated). */
@@ -2192,7 +2213,7 @@ static void store_lanes(const column_call* c, const column_place place[], const 
             stored[lane] = value >= low && value <= high ? stored[lane] : 0;
         }
         if (place[k].angle) {
-            turn_lanes(at, at + stride, count);
+            g->turn(at, at, at + stride, count);
         }
     }
 }
@@ -2323,6 +2344,7 @@ static int evaluate_samples_in_lanes(const fmu_model* model, column_blocks* b, c
     const char* which = getenv("DYADFMU_LANES");
     g.lanes = model->behaviour->lanes;
     g.cap = lanes_cap(which);
+    g.turn = turn_for(g.cap);
     g.cells = (double*)malloc(g.lanes->columns * g.lanes->lanes * sizeof(double));
     g.to = (double**)malloc((c->n_x + 1) * sizeof *g.to);
     g.from = (const double**)malloc((c->n_y + 1) * sizeof *g.from);

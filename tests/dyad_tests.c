@@ -2772,6 +2772,85 @@ static int test_angle_pair_matches_single(void)
     return fails;
 }
 
+#if defined(DYAD_ANGLE_HAVE_WIDE)
+/* `count` angles turned by `turn` against dyad_cos_sin one at a time, both ways of
+ * calling it (apart and in place, cos_out = angle): the count of angles whose bits differ. */
+static long wide_mismatches(void (*turn)(const double*, double*, double*, size_t),
+                            const double* angle, size_t count)
+{
+    double one_cos[24], one_sin[24], wide_cos[24], wide_sin[24], inplace_sin[24];
+    long differ = 0;
+    size_t i;
+    for (i = 0; i < count; ++i) {
+        dyad_cos_sin(angle[i], &one_cos[i], &one_sin[i]);
+    }
+    turn(angle, wide_cos, wide_sin, count);
+    for (i = 0; i < count; ++i) {
+        differ += !same_real(one_cos[i], wide_cos[i]) || !same_real(one_sin[i], wide_sin[i]);
+    }
+    memcpy(wide_cos, angle, count * sizeof *angle);
+    turn(wide_cos, wide_cos, inplace_sin, count);
+    for (i = 0; i < count; ++i) {
+        differ += !same_real(one_cos[i], wide_cos[i]) || !same_real(one_sin[i], inplace_sin[i]);
+    }
+    return differ;
+}
+#endif
+
+/* dyad_cos_sin_avx2 and _avx512, where this CPU runs them, give what dyad_cos_sin gives
+ * for each angle, bit for bit: over a sweep of 24 angles a call, every count up to 24 (the
+ * rest one at a time), and each odd angle (beyond the fast range, infinite, NaN, signed
+ * zero) in every lane of a call among angles in range. */
+static int test_angle_wide_matches_single(void)
+{
+    static const double odd[] = {
+        3e9,         -1.5e6, 1e6,  -1e6,   1.0000000001e6, (double)INFINITY, -(double)INFINITY,
+        (double)NAN, 0.0,    -0.0, 1e-300, 2.5e-2};
+    int fails = 0;
+#if defined(DYAD_ANGLE_HAVE_WIDE)
+    struct {
+        const char* name;
+        void (*turn)(const double*, double*, double*, size_t);
+    } ways[2];
+    size_t w, n_ways = 0;
+    if (__builtin_cpu_supports("avx2")) {
+        ways[n_ways].name = "avx2";
+        ways[n_ways++].turn = dyad_cos_sin_avx2;
+    }
+    if (__builtin_cpu_supports("avx512f")) {
+        ways[n_ways].name = "avx512";
+        ways[n_ways++].turn = dyad_cos_sin_avx512;
+    }
+    for (w = 0; w < n_ways; ++w) {
+        double angle[24];
+        long sweep = 0, odd_lanes = 0;
+        long k;
+        size_t a, lane, count;
+        for (k = -100000; k <= 100000; ++k) {
+            for (lane = 0; lane < 24; ++lane) {
+                angle[lane] = (double)(k * 24 + (long)lane) * (k % 2 ? 7.3e-5 : 1.37) - 0.01;
+            }
+            sweep += wide_mismatches(ways[w].turn, angle, (size_t)(k % 25 + 25) % 25);
+        }
+        CHECK(sweep == 0, "%s: %ld angles of the sweep differ from one at a time", ways[w].name,
+              sweep);
+        for (a = 0; a < sizeof odd / sizeof odd[0]; ++a) {
+            for (lane = 0; lane < 24; ++lane) {
+                for (count = 0; count < 24; ++count) {
+                    angle[count] = count == lane ? odd[a] : 0.3 * (double)count - 2;
+                }
+                odd_lanes += wide_mismatches(ways[w].turn, angle, 24);
+            }
+        }
+        CHECK(odd_lanes == 0, "%s: %ld angles differ where an odd one is among them", ways[w].name,
+              odd_lanes);
+    }
+#else
+    (void)odd;
+#endif
+    return fails;
+}
+
 #include "dyad_cylinder_tests.h"
 
 static const named_test tests[] = {
@@ -2795,6 +2874,7 @@ static const named_test tests[] = {
     {"batch_refusals", test_batch_refusals},
     {"angle_cos_sin_near_libm", test_angle_cos_sin_near_libm},
     {"angle_pair_matches_single", test_angle_pair_matches_single},
+    {"angle_wide_matches_single", test_angle_wide_matches_single},
     {"tangent_of_each_type", test_tangent_of_each_type},
     {"react_tangent_finite_differences", test_react_tangent_finite_differences},
     {"kin_reproduces_built", test_kin_reproduces_built},

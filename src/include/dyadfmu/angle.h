@@ -33,9 +33,13 @@
 #define DYADFMU_ANGLE_H
 
 #include <math.h>
+#include <stddef.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#include <immintrin.h>
 #endif
 
 /** Largest |angle| (rad) reduced here; libm reduces a larger one. */
@@ -290,5 +294,128 @@ static inline void dyad_cos_sin_pair(double angle0, double angle1, double unit0[
     dyad_cos_sin(angle1, &unit1[0], &unit1[1]);
 #endif
 }
+
+/* Many angles at once in AVX2's or AVX-512's lanes, where the compiler can target either
+ * in one function (GCC or Clang on x86-64) and the caller has asked the CPU whether it
+ * runs it (__builtin_cpu_supports). Each is dyad_cos_sin_pair's operations four or eight
+ * angles wide, the table read by a gather: the same bits as dyad_cos_sin (a test compares
+ * them), as the pair's are. A group of lanes holding an angle that libm turns is turned
+ * one angle at a time. `angle` may be `cos_out` itself, nothing else of either output. */
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#define DYAD_ANGLE_HAVE_WIDE             1
+#define DYAD_ANGLE_AVX2_CONSTANT(name)   _mm256_set1_pd(DYAD_ANGLE_##name)
+#define DYAD_ANGLE_AVX512_CONSTANT(name) _mm512_set1_pd(DYAD_ANGLE_##name)
+
+/** cos_out[i], sin_out[i] = dyad_cos_sin(angle[i]) (-) for i < count, four at a time in
+ *  AVX2's lanes: call it only where the CPU has AVX2. */
+__attribute__((target("avx2"))) static inline void
+dyad_cos_sin_avx2(const double* angle, double* cos_out, double* sin_out, size_t count)
+{
+    const double* table = &dyad_angle_table()[0][0];
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    size_t i, lane;
+    for (i = 0; i + 4 <= count; i += 4) {
+        const __m256d x = _mm256_loadu_pd(angle + i);
+        __m256d k, r, z, sin_r, cos_m1, c_hi, c_lo, s_hi, s_lo;
+        __m128i j;
+        if (_mm256_movemask_pd(_mm256_cmp_pd(_mm256_andnot_pd(sign, x),
+                                             DYAD_ANGLE_AVX2_CONSTANT(FAST_LIMIT), _CMP_LE_OQ)) !=
+            15) {
+            for (lane = i; lane < i + 4; ++lane) {
+                dyad_cos_sin(angle[lane], &cos_out[lane], &sin_out[lane]);
+            }
+            continue;
+        }
+        j = _mm256_cvttpd_epi32(
+            _mm256_add_pd(_mm256_mul_pd(x, DYAD_ANGLE_AVX2_CONSTANT(STEPS_PER_RAD)),
+                          _mm256_or_pd(_mm256_and_pd(sign, x), _mm256_set1_pd(0.5))));
+        k = _mm256_cvtepi32_pd(j);
+        r = _mm256_sub_pd(
+            _mm256_sub_pd(_mm256_sub_pd(x, _mm256_mul_pd(k, DYAD_ANGLE_AVX2_CONSTANT(P1))),
+                          _mm256_mul_pd(k, DYAD_ANGLE_AVX2_CONSTANT(P2))),
+            _mm256_mul_pd(k, DYAD_ANGLE_AVX2_CONSTANT(P3)));
+        z = _mm256_mul_pd(r, r);
+        sin_r = _mm256_add_pd(
+            r, _mm256_mul_pd(_mm256_mul_pd(r, z), DYAD_SIN_SERIES(z, _mm256_add_pd, _mm256_mul_pd,
+                                                                  DYAD_ANGLE_AVX2_CONSTANT)));
+        cos_m1 = _mm256_mul_pd(
+            z, DYAD_COS_SERIES(z, _mm256_add_pd, _mm256_mul_pd, DYAD_ANGLE_AVX2_CONSTANT));
+        j = _mm_slli_epi32(_mm_and_si128(j, _mm_set1_epi32(63)), 2); /* a row: 4 doubles */
+        c_hi = _mm256_i32gather_pd(table, j, 8);
+        c_lo = _mm256_i32gather_pd(table + 1, j, 8);
+        s_hi = _mm256_i32gather_pd(table + 2, j, 8);
+        s_lo = _mm256_i32gather_pd(table + 3, j, 8);
+        _mm256_storeu_pd(
+            cos_out + i,
+            _mm256_add_pd(c_hi, _mm256_add_pd(_mm256_sub_pd(_mm256_mul_pd(c_hi, cos_m1),
+                                                            _mm256_mul_pd(s_hi, sin_r)),
+                                              c_lo)));
+        _mm256_storeu_pd(
+            sin_out + i,
+            _mm256_add_pd(s_hi, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(s_hi, cos_m1),
+                                                            _mm256_mul_pd(c_hi, sin_r)),
+                                              s_lo)));
+    }
+    for (; i < count; ++i) {
+        dyad_cos_sin(angle[i], &cos_out[i], &sin_out[i]);
+    }
+}
+
+/** The same eight at a time in AVX-512's lanes (AVX-512F): call it only where the CPU has
+ *  AVX-512F. */
+__attribute__((target("avx512f"))) static inline void
+dyad_cos_sin_avx512(const double* angle, double* cos_out, double* sin_out, size_t count)
+{
+    const double* table = &dyad_angle_table()[0][0];
+    const __m512i sign = _mm512_castpd_si512(_mm512_set1_pd(-0.0));
+    const __m512i half = _mm512_castpd_si512(_mm512_set1_pd(0.5));
+    size_t i, lane;
+    for (i = 0; i + 8 <= count; i += 8) {
+        const __m512d x = _mm512_loadu_pd(angle + i);
+        __m512d k, r, z, sin_r, cos_m1, c_hi, c_lo, s_hi, s_lo;
+        __m256i j;
+        if (_mm512_cmp_pd_mask(_mm512_abs_pd(x), DYAD_ANGLE_AVX512_CONSTANT(FAST_LIMIT),
+                               _CMP_LE_OQ) != 0xFF) {
+            for (lane = i; lane < i + 8; ++lane) {
+                dyad_cos_sin(angle[lane], &cos_out[lane], &sin_out[lane]);
+            }
+            continue;
+        }
+        j = _mm512_cvttpd_epi32(
+            _mm512_add_pd(_mm512_mul_pd(x, DYAD_ANGLE_AVX512_CONSTANT(STEPS_PER_RAD)),
+                          _mm512_castsi512_pd(_mm512_or_si512(
+                              _mm512_and_si512(_mm512_castpd_si512(x), sign), half))));
+        k = _mm512_cvtepi32_pd(j);
+        r = _mm512_sub_pd(
+            _mm512_sub_pd(_mm512_sub_pd(x, _mm512_mul_pd(k, DYAD_ANGLE_AVX512_CONSTANT(P1))),
+                          _mm512_mul_pd(k, DYAD_ANGLE_AVX512_CONSTANT(P2))),
+            _mm512_mul_pd(k, DYAD_ANGLE_AVX512_CONSTANT(P3)));
+        z = _mm512_mul_pd(r, r);
+        sin_r = _mm512_add_pd(
+            r, _mm512_mul_pd(_mm512_mul_pd(r, z), DYAD_SIN_SERIES(z, _mm512_add_pd, _mm512_mul_pd,
+                                                                  DYAD_ANGLE_AVX512_CONSTANT)));
+        cos_m1 = _mm512_mul_pd(
+            z, DYAD_COS_SERIES(z, _mm512_add_pd, _mm512_mul_pd, DYAD_ANGLE_AVX512_CONSTANT));
+        j = _mm256_slli_epi32(_mm256_and_si256(j, _mm256_set1_epi32(63)), 2);
+        c_hi = _mm512_i32gather_pd(j, table, 8);
+        c_lo = _mm512_i32gather_pd(j, table + 1, 8);
+        s_hi = _mm512_i32gather_pd(j, table + 2, 8);
+        s_lo = _mm512_i32gather_pd(j, table + 3, 8);
+        _mm512_storeu_pd(
+            cos_out + i,
+            _mm512_add_pd(c_hi, _mm512_add_pd(_mm512_sub_pd(_mm512_mul_pd(c_hi, cos_m1),
+                                                            _mm512_mul_pd(s_hi, sin_r)),
+                                              c_lo)));
+        _mm512_storeu_pd(
+            sin_out + i,
+            _mm512_add_pd(s_hi, _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(s_hi, cos_m1),
+                                                            _mm512_mul_pd(c_hi, sin_r)),
+                                              s_lo)));
+    }
+    for (; i < count; ++i) {
+        dyad_cos_sin(angle[i], &cos_out[i], &sin_out[i]);
+    }
+}
+#endif
 
 #endif
