@@ -361,6 +361,8 @@ def markdown(types: list[TypeSpeed], scenes: list[SceneSpeed]) -> list[str]:
         "the best of five calls, asking the efforts and the reactions or every output, in "
         "the widest lanes this CPU runs and capped at AVX2's and the baseline's "
         "(`DYADFMU_LANES`, fmu/README.md), each way of a size called once a round in turn; "
+        "without `--quick`, these times and those of `dyadfmu.solve` are each the better of "
+        "two passes minutes apart; "
         "the same samples through its rows entry (a set and "
         "a get per sample); against "
         "the harness's stacked NumPy solve of the mechanism (its kinematics and every body's "
