@@ -824,3 +824,53 @@ def test_dyadfmu_build_scene_says_what_it_lacks_in_one_line(monkeypatch, tmp_pat
     said = capsys.readouterr().err
     assert "--windows on needs the MinGW-w64 cross compiler" in said and said.count("\n") == 1
     assert not (tmp_path / "fmus").exists()
+
+
+OVERFLOW_MAIN = r"""#include <stdio.h>
+#include "over_bar_scene.h"
+
+/* The crank at 1 rad, the rocker's moment from the command line: the status and reason. */
+int main(int argc, char** argv)
+{
+    over_bar_input in;
+    over_bar_output out;
+    fmu_evaluation evaluation;
+    float moment = 0;
+    if (argc < 2 || sscanf(argv[1], "%f", &moment) != 1) return 2;
+    in.crank_dir = dyad_vec2_make((dyad_real)0.5403023058681398, (dyad_real)0.8414709848078965);
+    in.crank_omega = 10;
+    in.crank_epsilon = 0;
+    in.rocker_moment = moment;
+    in.linkage_branch = -1;
+    in.gravity_x = 0;
+    in.gravity_y = -9.81;
+    over_bar_evaluate(&in, &out, &evaluation);
+    printf("%d %s\n", out.status, evaluation.reason);
+    return 0;
+}
+"""
+
+
+def test_a_float_build_says_its_reactions_overflow_float(tmp_path):
+    """A rocker moment of 3e38 N m is a float, and the reactions it drives are not: the
+    float build gives status 3 and says they overflow float, not double. Double resolves
+    them."""
+    required_tool("cc")
+    scene = tmp_path / "over_bar.toml"
+    scene.write_text((SCENES_DIR / "four_bar.toml").read_text().replace('"four_bar"', '"over_bar"'))
+    done = _scene_tool(scene, "--bundle", tmp_path / "written")
+    assert done.returncode == 0, done.stderr
+    folder = tmp_path / "written" / "over_bar"
+    (tmp_path / "main.c").write_text(OVERFLOW_MAIN)
+    sources = sorted(folder.glob("scene/*.c")) + sorted(folder.glob("core/src/*.c"))
+    said = {}
+    for real, flags in (("double", []), ("float", [FLOAT])):
+        program = tmp_path / f"main_{real}"
+        _run(
+            "cc", *WARNINGS, *flags, f"-I{folder / 'scene'}", f"-I{folder / 'core' / 'include'}",
+            "-o", program, tmp_path / "main.c", *sources, "-lm",
+        )  # fmt: skip
+        said[real] = _run(program, "3e38").strip()
+    assert said["double"] == "0", said
+    assert said["float"].startswith("3 ") and "overflow float" in said["float"], said
+    assert "double" not in said["float"], said

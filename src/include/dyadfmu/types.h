@@ -21,6 +21,7 @@ typedef float dyad_real;
 #define DYAD_REAL_EPSILON FLT_EPSILON
 #define DYAD_REAL_MAX     FLT_MAX
 #define DYAD_REAL_MIN     FLT_MIN
+#define DYAD_REAL_NAME    "float" /* in messages: what a value overflowed */
 /** Default singular threshold: sqrt(FLT_EPSILON) = 2^-11.5. */
 #define DYAD_DEFAULT_SINGULAR_THRESHOLD 3.4526698e-4f
 #else
@@ -28,6 +29,7 @@ typedef double dyad_real;
 #define DYAD_REAL_EPSILON               DBL_EPSILON
 #define DYAD_REAL_MAX                   DBL_MAX
 #define DYAD_REAL_MIN                   DBL_MIN
+#define DYAD_REAL_NAME                  "double"
 /** Default singular threshold: sqrt(DBL_EPSILON) = 2^-26. At this conditioning
  *  the round-off bound eps * amplification is sqrt(eps): half the digits survive. */
 #define DYAD_DEFAULT_SINGULAR_THRESHOLD 1.4901161193847656e-8
