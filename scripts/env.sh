@@ -26,8 +26,10 @@ dyadfmu_check_args() {
 # dyadfmu_ensure_system [NEED...]: the Debian packages a command needs. Always the
 # compiler, make, CMake, pkg-config (scripts/tests/test_install.py) and Python with
 # venv; NEED `study`: GSL (the generic-solve baseline of the benchmark) and valgrind
-# (its instruction counts); `windows`: the MinGW-w64 cross compiler and Wine (the
-# FMUs' Windows binaries, tested under Wine); `browser`: chromium and chromium-driver (the
+# (its instruction counts); `clang`: Clang (the lanes and the angles compiled as an
+# importer's compiler in its default mode may rebuild an FMU's sources); `windows`: the
+# MinGW-w64 cross compiler and Wine (the FMUs' Windows binaries, tested under Wine);
+# `browser`: chromium and chromium-driver (the
 # animation's page in a real browser, headless); `embedded`: the Cortex-M4F toolchain
 # with newlib and QEMU's ARM machines (dyadfmu embedded), the 64-bit ARM Linux cross
 # compiler and QEMU's user mode (the FMUs' aarch64-linux binaries, replayed under it).
@@ -53,6 +55,9 @@ dyadfmu_ensure_system() {
             command -v x86_64-w64-mingw32-gcc >/dev/null 2>&1 || missing+=(gcc-mingw-w64-x86-64)
             command -v wine >/dev/null 2>&1 || missing+=(wine wine64)
             ;;
+        clang)
+            command -v clang >/dev/null 2>&1 || missing+=(clang)
+            ;;
         browser)
             command -v chromium >/dev/null 2>&1 || missing+=(chromium)
             command -v chromedriver >/dev/null 2>&1 || missing+=(chromium-driver)
@@ -66,7 +71,7 @@ dyadfmu_ensure_system() {
             command -v qemu-aarch64 >/dev/null 2>&1 || missing+=(qemu-user)
             ;;
         *)
-            dyadfmu_log "dyadfmu_ensure_system: unknown need '$need' (study, windows, browser, embedded)"
+            dyadfmu_log "dyadfmu_ensure_system: unknown need '$need' (study, clang, windows, browser, embedded)"
             return 2
             ;;
         esac

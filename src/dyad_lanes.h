@@ -17,6 +17,14 @@
 #ifndef DYADFMU_LANES_H
 #define DYADFMU_LANES_H
 
+/* No a * b + c fused into one operation in the functions that follow, whatever the
+ * includer's options: Clang fuses within an expression by default (even in ISO C), and in
+ * the AVX-512 lanes, whose target has FMA, a fused one would change their bits; GCC's
+ * are told so by DYAD_LANES_AVX512_TARGET (it fuses only in its GNU modes). */
+#if defined(__clang__)
+#pragma clang fp contract(off)
+#endif
+
 #include "dyad_internal.h"
 
 /* The lanes of the types its includer defines DYAD_LANES_<TYPE> for (a scene's, whose
@@ -91,8 +99,8 @@
 
 /* The lanes for a CPU with AVX2, and for one with AVX-512, beside those for the baseline,
  * chosen as the program runs: where the compiler can target an instruction set in one
- * function and ask the CPU (GCC or Clang on x86-64). No fused multiply-add in either (ISO
- * C99 contracts nothing): the same operations, the same results. AVX-512 in 512-bit
+ * function and ask the CPU (GCC or Clang on x86-64). No fused multiply-add in either (see
+ * the top of this file): the same operations, the same results. AVX-512 in 512-bit
  * vectors (eight samples), which GCC would otherwise avoid; AVX-512F alone, which every
  * CPU with AVX-512 has. On Windows the stack is aligned to 16 bytes only, and GCC for
  * MinGW-w64 moves a wider vector to and from it as if it were aligned to the vector (GCC
@@ -106,7 +114,8 @@
 #if defined(__clang__)
 #define DYAD_LANES_AVX512_TARGET __attribute__((target("avx512f"), min_vector_width(512)))
 #else
-#define DYAD_LANES_AVX512_TARGET __attribute__((target("avx512f,prefer-vector-width=512")))
+#define DYAD_LANES_AVX512_TARGET \
+    __attribute__((target("avx512f,prefer-vector-width=512"), optimize("fp-contract=off")))
 #endif
 static inline dyad_lanes_isa dyad_lanes_widest(dyad_lanes_isa cap)
 {

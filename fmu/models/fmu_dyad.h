@@ -3,6 +3,10 @@
 #ifndef DYADFMU_FMU_DYAD_H
 #define DYADFMU_FMU_DYAD_H
 
+#if defined(__clang__) /* no a * b + c fused, by default or not: the lanes' bits (dyad_lanes.h) */
+#pragma clang fp contract(off)
+#endif
+
 #include "dyadfmu/dyad.h"
 #include "fmu_model.h"
 

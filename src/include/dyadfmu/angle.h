@@ -24,10 +24,12 @@
  * SSE2 registers, for about the instructions of one. A dyad has two link angles,
  * and the FMUs convert theirs in pairs. It gives the same bits as two calls of
  * dyad_cos_sin (a test compares them) where the compiler rounds every product and
- * sum in double, as the project builds it (ISO C, -std=c99): a compiler that fuses
- * a * b + c into one operation (GCC's GNU modes on a target with FMA) or keeps
- * x87 extended precision (32-bit x86) changes the scalar code alone, and the two
- * may then differ in the last place.
+ * sum in double. The functions here forbid fusing a * b + c into one operation (Clang
+ * by a pragma in each; GCC fuses only in its GNU modes on a target with FMA, and the
+ * wide functions, whose target has it, forbid it by an attribute): only a GNU-mode GCC
+ * build for a target with FMA (-mfma, -march=native), or one keeping x87 extended
+ * precision (32-bit x86), changes the scalar code alone, and the results may then
+ * differ in the last place.
  */
 #ifndef DYADFMU_ANGLE_H
 #define DYADFMU_ANGLE_H
@@ -40,6 +42,15 @@
 #endif
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
 #include <immintrin.h>
+#endif
+
+/* Inside each function of this file: no a * b + c fused into one operation, whatever the
+ * includer's mode (Clang contracts within an expression by default, even in ISO C, and
+ * the wide functions' targets have FMA). */
+#if defined(__clang__)
+#define DYAD_ANGLE_UNFUSED _Pragma("clang fp contract(off)")
+#else
+#define DYAD_ANGLE_UNFUSED
 #endif
 
 /** Largest |angle| (rad) reduced here; libm reduces a larger one. */
@@ -152,6 +163,7 @@ static inline const double (*dyad_angle_table(void))[4]
 /** cos(angle) and sin(angle) (-) of `angle` (rad), to about 1.1e-16. */
 static inline void dyad_cos_sin(double angle, double* cos_out, double* sin_out)
 {
+    DYAD_ANGLE_UNFUSED
     const double* t;
     double k, r, z, sin_r, cos_m1;
     long j;
@@ -249,6 +261,7 @@ DYAD_ANGLE_RARE void dyad_cos_sin_by_libm(int fast, double angle0, double angle1
  *  where SSE2 computes both at once. */
 static inline void dyad_cos_sin_pair(double angle0, double angle1, double unit0[2], double unit1[2])
 {
+    DYAD_ANGLE_UNFUSED
 #if defined(__SSE2__)
     const dyad_angle_pair* pairs = dyad_angle_pairs();
     const double (*table)[4] = dyad_angle_table();
@@ -302,15 +315,22 @@ static inline void dyad_cos_sin_pair(double angle0, double angle1, double unit0[
  * them), as the pair's are. A group of lanes holding an angle that libm turns is turned
  * one angle at a time. `angle` may be `cos_out` itself, nothing else of either output. */
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
-#define DYAD_ANGLE_HAVE_WIDE             1
+#define DYAD_ANGLE_HAVE_WIDE 1
+#if defined(__clang__)
+#define DYAD_ANGLE_WIDE_TARGET(isa) __attribute__((target(isa)))
+#else /* GCC fuses in a target with FMA (AVX-512F's) unless told not to, in GNU modes */
+#define DYAD_ANGLE_WIDE_TARGET(isa) __attribute__((target(isa), optimize("fp-contract=off")))
+#endif
 #define DYAD_ANGLE_AVX2_CONSTANT(name)   _mm256_set1_pd(DYAD_ANGLE_##name)
 #define DYAD_ANGLE_AVX512_CONSTANT(name) _mm512_set1_pd(DYAD_ANGLE_##name)
 
 /** cos_out[i], sin_out[i] = dyad_cos_sin(angle[i]) (-) for i < count, four at a time in
  *  AVX2's lanes: call it only where the CPU has AVX2. */
-__attribute__((target("avx2"))) static inline void
-dyad_cos_sin_avx2(const double* angle, double* cos_out, double* sin_out, size_t count)
+DYAD_ANGLE_WIDE_TARGET("avx2")
+static inline void dyad_cos_sin_avx2(const double* angle, double* cos_out, double* sin_out,
+                                     size_t count)
 {
+    DYAD_ANGLE_UNFUSED
     const double* table = &dyad_angle_table()[0][0];
     const __m256d sign = _mm256_set1_pd(-0.0);
     size_t i, lane;
@@ -363,9 +383,11 @@ dyad_cos_sin_avx2(const double* angle, double* cos_out, double* sin_out, size_t 
 
 /** The same eight at a time in AVX-512's lanes (AVX-512F): call it only where the CPU has
  *  AVX-512F. */
-__attribute__((target("avx512f"))) static inline void
-dyad_cos_sin_avx512(const double* angle, double* cos_out, double* sin_out, size_t count)
+DYAD_ANGLE_WIDE_TARGET("avx512f")
+static inline void dyad_cos_sin_avx512(const double* angle, double* cos_out, double* sin_out,
+                                       size_t count)
 {
+    DYAD_ANGLE_UNFUSED
     const double* table = &dyad_angle_table()[0][0];
     const __m512i sign = _mm512_castpd_si512(_mm512_set1_pd(-0.0));
     const __m512i half = _mm512_castpd_si512(_mm512_set1_pd(0.5));
