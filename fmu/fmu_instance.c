@@ -2195,20 +2195,17 @@ static void copy_strided(double* to, ptrdiff_t to_step, const double* from, ptrd
         memcpy(to, from, count * sizeof *to);
         return;
     }
-    for (; i + 4 <= count; i += 4) {
-        const double a = from[0], b = from[from_step], c = from[2 * from_step],
-                     d = from[3 * from_step];
-        to[0] = a;
-        to[to_step] = b;
-        to[2 * to_step] = c;
-        to[3 * to_step] = d;
-        from += 4 * from_step;
-        to += 4 * to_step;
+    for (; i + 4 <= count; i += 4) { /* indexed: no pointer past either column's end */
+        const ptrdiff_t f = (ptrdiff_t)i * from_step, t = (ptrdiff_t)i * to_step;
+        const double a = from[f], b = from[f + from_step], c = from[f + 2 * from_step],
+                     d = from[f + 3 * from_step];
+        to[t] = a;
+        to[t + to_step] = b;
+        to[t + 2 * to_step] = c;
+        to[t + 3 * to_step] = d;
     }
     for (; i < count; ++i) {
-        *to = *from;
-        from += from_step;
-        to += to_step;
+        to[(ptrdiff_t)i * to_step] = from[(ptrdiff_t)i * from_step];
     }
 }
 

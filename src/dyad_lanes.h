@@ -17,10 +17,12 @@
 #ifndef DYADFMU_LANES_H
 #define DYADFMU_LANES_H
 
-/* No a * b + c fused into one operation in the functions that follow, whatever the
- * includer's options: Clang fuses within an expression by default (even in ISO C), and in
- * the AVX-512 lanes, whose target has FMA, a fused one would change their bits; GCC's
- * are told so by DYAD_LANES_AVX512_TARGET (it fuses only in its GNU modes). */
+/* No a * b + c fused into one operation in the functions that follow, in the compilers'
+ * default modes: Clang fuses within an expression by default (even in ISO C), and in the
+ * AVX-512 lanes, whose target has FMA, a fused one would change their bits; GCC's are told
+ * so by DYAD_LANES_AVX512_TARGET (it fuses only in its GNU modes). A build for a target
+ * with FMA (-mfma, -march=native) without -ffp-contract=off fuses in the scalar twins'
+ * files, which have no such pragma, and the lanes then differ from them in the last bits. */
 #if defined(__clang__)
 #pragma clang fp contract(off)
 #endif
