@@ -2191,21 +2191,25 @@ static void copy_strided(double* to, ptrdiff_t to_step, const double* from, ptrd
                          size_t count)
 {
     size_t i = 0;
+    ptrdiff_t f = 0, t = 0; /* offsets, not pointers: none is formed past a column's end */
     if (to_step == 1 && from_step == 1) {
         memcpy(to, from, count * sizeof *to);
         return;
     }
-    for (; i + 4 <= count; i += 4) { /* indexed: no pointer past either column's end */
-        const ptrdiff_t f = (ptrdiff_t)i * from_step, t = (ptrdiff_t)i * to_step;
+    for (; i + 4 <= count; i += 4) {
         const double a = from[f], b = from[f + from_step], c = from[f + 2 * from_step],
                      d = from[f + 3 * from_step];
         to[t] = a;
         to[t + to_step] = b;
         to[t + 2 * to_step] = c;
         to[t + 3 * to_step] = d;
+        f += 4 * from_step;
+        t += 4 * to_step;
     }
     for (; i < count; ++i) {
-        to[(ptrdiff_t)i * to_step] = from[(ptrdiff_t)i * from_step];
+        to[t] = from[f];
+        f += from_step;
+        t += to_step;
     }
 }
 
@@ -2291,12 +2295,16 @@ static void fetch_block(const column_call* c, size_t first, size_t lanes)
  * all OK, and a call whose y columns all come from the lanes has written them. */
 static int lanes_all_ok(const lane_grid* g, const double* failed, size_t count)
 {
-    int ok = 1;
+    int stored = 1;
+    long long passed = 1; /* as wide as a double: the loops vectorise without packing */
     size_t lane;
     for (lane = 0; lane < count; ++lane) {
-        ok &= g->stored[lane] & (failed[lane] == 0);
+        stored &= g->stored[lane];
     }
-    return ok;
+    for (lane = 0; lane < count; ++lane) {
+        passed = failed[lane] == 0 ? passed : 0;
+    }
+    return stored && passed;
 }
 
 /* The samples from `first` on, at most a call's lanes: stored, evaluated at once, their

@@ -30,6 +30,8 @@ import csv
 import functools
 import math
 import os
+import tempfile
+import zipfile
 from pathlib import Path
 
 import markdown_check
@@ -326,6 +328,16 @@ def test_cli_help_and_missing_drive(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("DYADFMU_BUILD", str(tmp_path / "nowhere"))
     assert cosim_report.main(["--quick", "--out", str(tmp_path)]) == 2
     assert "drive_fmi2.fmu does not exist" in capsys.readouterr().err
+
+
+def test_a_file_that_is_no_fmu_leaves_no_directory_behind(tmp_path, monkeypatch):
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    not_an_fmu = tmp_path / "broken.fmu"
+    not_an_fmu.write_bytes(b"PK\x03\x04 not a whole archive")
+    with pytest.raises(zipfile.BadZipFile):
+        Slave(not_an_fmu)
+    assert list((tmp_path / "tmp").iterdir()) == []
 
 
 # ---------------------------------------------------------------------------

@@ -72,9 +72,13 @@ def unpacked(path: Path | str) -> tuple:
     key = _file_version(path)
     if key not in _UNPACKED:
         directory = tempfile.mkdtemp(prefix="dyadfmu_fmu_")
-        with zipfile.ZipFile(key[0]) as archive:
-            archive.extractall(directory)
-        _UNPACKED[key] = (described(key[0]), directory)
+        try:
+            with zipfile.ZipFile(key[0]) as archive:
+                archive.extractall(directory)
+            _UNPACKED[key] = (described(key[0]), directory)
+        except BaseException:  # not an FMU, say: no directory left behind
+            shutil.rmtree(directory, ignore_errors=True)
+            raise
     return _UNPACKED[key]
 
 
