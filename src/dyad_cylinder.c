@@ -705,8 +705,9 @@ DYAD_KIN_STEP dyad_status DYAD_KIN(cyl_run)(const dyad_cylinder_input* input,
  * for the two angles, which are not written (an angle's atan2, a call, would keep the loop
  * from vectorising: a scene takes them from link_dir and axis after it), nor are the
  * status, field, failure and gap; elsewhere the count of the failed checks, and outputs
- * that mean nothing (dyad_cylinder says why). */
-DYAD_CLOSED_FORM dyad_real dyad_cylinder_lane(const dyad_cylinder_input* input,
+ * that mean nothing (dyad_cylinder says why). The branch comes as the real `branch`, as
+ * dyad_kin_lane's does (dyad_kin_generic.h says why). */
+DYAD_CLOSED_FORM dyad_real dyad_cylinder_lane(const dyad_cylinder_input* input, dyad_real branch,
                                               dyad_cylinder_result* value)
 {
     static const DYAD_KIN(cyl_state) cleared;
@@ -717,6 +718,8 @@ DYAD_CLOSED_FORM dyad_real dyad_cylinder_lane(const dyad_cylinder_input* input,
     DYAD_CYL_FIELD_CHECKS(input, DYAD_CYL_COUNT_UNLESS);
 #undef DYAD_CYL_COUNT_UNLESS
     DYAD_KIN(cyl_load_input)(input, input, &in);
+    bad += DYAD_FAILED((branch == 1) | (branch == -1));
+    in.branch = branch;
     bad += DYAD_FAILED(DYAD_KIN(cyl_position)(&in, &st) == DYAD_KIN_CLOSES);
     st.kin_amp = DYAD_KIN(cyl_kin_amplification)(&in, &st);
     bad += DYAD_FAILED(st.kin_amp * in.threshold <= 1);

@@ -511,15 +511,21 @@ static inline dyad_point_motion dyad_kin_point_on_link(const dyad_point_motion* 
  * dyad_kin_run gives DYAD_STATUS_OK, and then `value` holds its outputs bit for bit
  * (not its status, field, failure or gap, which are not written); elsewhere the count
  * of the failed checks, and outputs that mean nothing (dyad_kinematics_<type> says
- * why). */
+ * why). The assembly branch comes as the real `branch`, checked as input->branch is (which
+ * a caller leaves at its default): an int chosen per sample would be the loop's one value
+ * of 32 bits, and GCC would then take twice the lanes, each double in two registers. */
 DYAD_CLOSED_FORM dyad_real dyad_kin_lane(dyad_type type, kin_position_fn position,
                                          kin_motion_fn motion, const dyad_kin_input* input,
-                                         dyad_kin_result* value)
+                                         dyad_real branch, dyad_kin_result* value)
 {
     kin_in in;
     kin_state st;
     dyad_real bad = dyad_kin_fields_failed(type, input);
     dyad_kin_load_plain(type, input, input, &in);
+    if (type == DYAD_RRR || type == DYAD_RRT || type == DYAD_RTR) {
+        bad += DYAD_FAILED((branch == 1) | (branch == -1));
+        in.branch = branch;
+    }
     dyad_kin_start_plain(&in, &st);
     bad += DYAD_FAILED(position(&in, &st) == DYAD_KIN_CLOSES);
     st.amplification = dyad_kin_amplification_plain(&in, &st);

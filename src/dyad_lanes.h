@@ -160,11 +160,12 @@ static inline dyad_cylinder_input dyad_lane_cylinder_input_default(void)
 #define dyad_lane_point_on_link dyad_kin_point_on_link
 
 /* The kinematics of one dyad of each type (dyad_kinematics_<type>). */
-#define DYAD_KIN_LANE(type, name)                                                             \
-    DYAD_CLOSED_FORM dyad_real dyad_kin_lane_##name(const dyad_kin_input* input,              \
-                                                    dyad_kin_result* value)                   \
-    {                                                                                         \
-        return dyad_kin_lane(type, name##_position_plain, name##_motion_plain, input, value); \
+#define DYAD_KIN_LANE(type, name)                                                                  \
+    DYAD_CLOSED_FORM dyad_real dyad_kin_lane_##name(const dyad_kin_input* input, dyad_real branch, \
+                                                    dyad_kin_result* value)                        \
+    {                                                                                              \
+        return dyad_kin_lane(type, name##_position_plain, name##_motion_plain, input, branch,      \
+                             value);                                                               \
     }
 #ifdef DYAD_LANES_RRR
 DYAD_KIN_LANE(DYAD_RRR, rrr)

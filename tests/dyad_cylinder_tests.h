@@ -633,8 +633,8 @@ static int test_cylinder_invalid(void)
 
 /* dyad_cylinder_lane answers 0 exactly where dyad_cylinder says ok, and then gives its
  * outputs bit for bit but for the two angles (taken after a batch's loop); over random
- * cylinders, half of them spoiled: beyond the stroke, a threshold no conditioning
- * passes, a field NaN, infinite or negative, a load that overflows. */
+ * cylinders, most of them spoiled: beyond the stroke, a threshold no conditioning
+ * passes, a field NaN, infinite or negative, a load that overflows, a branch 0 or 2. */
 static int test_cylinder_lane_matches_cylinder(void)
 {
     int fails = 0, k, ok = 0, refused = 0;
@@ -659,12 +659,17 @@ static int test_cylinder_lane_matches_cylinder(void)
             break;
         }
         case 4: in.link.moment = (dyad_real)(HUGE_REAL * 0.5); break;
+        case 5: in.branch = k % 3 == 0 ? 0 : 2; break;
         default: break;
         }
         memset(&want, 0, sizeof want); /* the padding too: compared as bytes */
         memset(&got, 0, sizeof got);
         s = dyad_cylinder(&in, &want);
-        bad = dyad_cylinder_lane(&in, &got);
+        {
+            dyad_cylinder_input lane_in = in;
+            lane_in.branch = 1; /* left at its default: the lane takes the branch as a real */
+            bad = dyad_cylinder_lane(&lane_in, (dyad_real)in.branch, &got);
+        }
         CHECK((bad == 0) == (s == DYAD_STATUS_OK), "cylinder %d: status %s, lane %g", k,
               dyad_status_name(s), (double)bad);
         if (s == DYAD_STATUS_OK) {

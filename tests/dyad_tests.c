@@ -2405,8 +2405,9 @@ static int same_reactions(const dyad_result* a, const dyad_result* b)
     return memcmp(x, y, sizeof x) == 0;
 }
 
-/* A kinematic input spoiled one way in four: a mount moved out of reach, a threshold no
- * conditioning passes, a length NaN; or left as built. */
+/* A kinematic input spoiled one way in two: a mount moved out of reach, a threshold no
+ * conditioning passes, a length NaN, a branch 0 or 2 (which the types with none ignore);
+ * or left as built. */
 static dyad_kin_input spoiled_kin_input(rng* r, dyad_type type)
 {
     kin_built b;
@@ -2416,6 +2417,8 @@ static dyad_kin_input spoiled_kin_input(rng* r, dyad_type type)
     case 0: in.p.point.position = dyad_scale((dyad_real)40, in.p.point.position); break;
     case 1: in.singular_threshold = (dyad_real)0.999; break;
     case 2: in.length_n = (dyad_real)NAN; break;
+    case 3: in.branch = 0; break;
+    case 4: in.branch = 2; break;
     default: break;
     }
     return in;
@@ -2429,9 +2432,10 @@ static int test_lanes_match_their_twins(void)
     static dyad_status (*const kin[DYAD_TYPE_COUNT])(const dyad_kin_input*, dyad_kin_result*) = {
         dyad_kinematics_rrr, dyad_kinematics_rrt, dyad_kinematics_rtr, dyad_kinematics_trt,
         dyad_kinematics_rtt};
-    static dyad_real (*const kin_lane[DYAD_TYPE_COUNT])(const dyad_kin_input*, dyad_kin_result*) = {
-        dyad_kin_lane_rrr, dyad_kin_lane_rrt, dyad_kin_lane_rtr, dyad_kin_lane_trt,
-        dyad_kin_lane_rtt};
+    static dyad_real (*const kin_lane[DYAD_TYPE_COUNT])(
+        const dyad_kin_input*, dyad_real, dyad_kin_result*) = {dyad_kin_lane_rrr, dyad_kin_lane_rrt,
+                                                               dyad_kin_lane_rtr, dyad_kin_lane_trt,
+                                                               dyad_kin_lane_rtt};
     static dyad_status (*const react[DYAD_TYPE_COUNT])(const dyad_loaded*, dyad_result*) = {
         dyad_react_rrr, dyad_react_rrt, dyad_react_rtr, dyad_react_trt, dyad_react_rtt};
     static dyad_real (*const react_lane[DYAD_TYPE_COUNT])(const dyad_loaded*, dyad_result*) = {
@@ -2443,9 +2447,12 @@ static int test_lanes_match_their_twins(void)
         int ok[2] = {0, 0}, refused[2] = {0, 0};
         for (k = 0; k < 4000; ++k) {
             const dyad_kin_input in = spoiled_kin_input(&r, all_types[t]);
+            dyad_kin_input lane_in = in;
             dyad_kin_result want, got;
             const dyad_status s = kin[t](&in, &want);
-            const dyad_real bad = kin_lane[t](&in, &got);
+            dyad_real bad;
+            lane_in.branch = 1; /* left at its default: the lane takes the branch as a real */
+            bad = kin_lane[t](&lane_in, (dyad_real)in.branch, &got);
             CHECK((bad == 0) == (s == DYAD_STATUS_OK), "%s kinematics %d: status %s, lane %g",
                   dyad_type_name(all_types[t]), k, dyad_status_name(s), (double)bad);
             CHECK(s != DYAD_STATUS_OK || same_kin_outputs(&want, &got),

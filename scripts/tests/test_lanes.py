@@ -360,6 +360,57 @@ def test_the_loop_over_samples_vectorises(path, programs):
     assert loops and wanted <= vectorised, sorted(wanted - vectorised)
 
 
+#: scenes whose lanes choose an assembly branch per sample (a tunable branch input): a
+#: dyad's (RRT, RRR) and a cylinder's
+BRANCHED = [p for p in SCENES if p.stem in ("slider_crank", "four_bar", "cylinder_arm")]
+
+
+@pytest.mark.parametrize("path", BRANCHED, ids=[p.stem for p in BRANCHED])
+def test_a_loop_over_samples_holds_each_double_in_one_register(path, programs):
+    """GCC's vectoriser takes as many samples a vector as a vector holds doubles (SSE2 2,
+    AVX2 4, AVX-512 8) in each lane's loop over samples, with a branch input among them: a
+    32-bit value in the loop (an int branch, say) would make it take twice as many, each
+    double then in two registers (the slider-crank's AVX2 lanes: 290 -> 266 instructions a
+    sample through the columns entry without it)."""
+    work, table = programs(path)
+    ident = table.identifier
+    scene_c = work / "gen" / f"{ident}_scene.c"
+    assert "< 0 ? DYAD_R(-1.0) : DYAD_R(1.0)" in scene_c.read_text()  # a branch per sample
+    lines = scene_c.read_text().splitlines()
+    loops = {
+        n + 1
+        for n, line in enumerate(lines[:-1])
+        if line == "    for (i = 0; i < count; ++i) {"
+        and lines[n + 1].endswith(f"{ident}_input in;")
+    }
+    dump = work / "vect"
+    dump.mkdir(exist_ok=True)
+    includes = [f"-I{d}" for d in (work / "gen", ROOT / "src", ROOT / "src" / "include")]
+    done = subprocess.run(
+        ["cc", *FLAGS, *includes, "-c", str(scene_c), "-o", str(dump / "scene.o"),
+         f"-fdump-tree-vect-details={dump / 'scene.vect'}"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    doubles = {"baseline": 2, "avx2": 4, "avx512": 8}
+    wanted = {isa: n for isa, n in doubles.items() if str(8 * n) in _widths()}
+    first: dict[tuple[str, int], int] = {}  # (function, loop line): its first factor
+    function = ""
+    with open(dump / "scene.vect") as report:
+        for line in report:
+            if line.startswith(";; Function "):
+                function = line.split()[2]
+                continue
+            found = re.search(r"_scene\.c:(\d+):\d+: note: +vectorization factor = (\d+)", line)
+            if found and int(found[1]) in loops:
+                first.setdefault((function, int(found[1])), int(found[2]))
+    lanes = {(f, n): factor for (f, n), factor in first.items() if f.startswith(f"{ident}_lanes")}
+    checked = [(f, n, factor, wanted[f.rsplit("_", 1)[1]]) for (f, n), factor in lanes.items()
+               if f.rsplit("_", 1)[1] in wanted]  # fmt: skip
+    assert len(checked) >= len(wanted), sorted(first)
+    assert all(factor == n for _, _, factor, n in checked), checked
+
+
 def test_dyad_solve_batch_loops_vectorise(tmp_path):
     """src/dyad_batch.c compiled as CMakeLists.txt compiles it: GCC's report has each
     type's loop over a block's rows vectorised, two rows a vector for the baseline and,

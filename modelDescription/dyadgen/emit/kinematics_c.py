@@ -159,6 +159,17 @@ def _turn(scene: Scene, d: Dyad, side: str) -> str | None:
     return None if turn is None or turn.is_zero() else _unit(turn)
 
 
+def branch_real(branch: Param | None) -> str:
+    """A branch as the real that a batch's lane takes in place of the input's int
+    (src/dyad_lanes.h): the same value as the int the scalar path converts (+1 where a
+    type has none)."""
+    if branch is None:
+        return "DYAD_R(1.0)"
+    if branch.tunable:
+        return f"({branch.c()} < 0 ? DYAD_R(-1.0) : DYAD_R(1.0))"
+    return f"DYAD_R({int(branch.value)}.0)"
+
+
 def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad, lane: bool = False) -> list[str]:
     """The kinematics of one dyad: its inputs, the call, the early return; in a batch's
     `lane`, the call's twin of src/dyad_lanes.h, whose failed checks it counts."""
@@ -174,7 +185,7 @@ def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad, lane: bool = False) -> l
             out.append(f"k.turn_{side} = {turn};")
         if "com.x" in params:
             out.append(f"k.com_{side} = {_vec(params['com.x'].c(), params['com.y'].c())};")
-    if d.branch is not None:
+    if d.branch is not None and not lane:
         branch = d.branch
         out.append(
             f"k.branch = {branch.c()} < 0 ? -1 : 1;"
@@ -187,7 +198,8 @@ def _dyad_lines(scene: Scene, mounts: _Mounts, d: Dyad, lane: bool = False) -> l
         out.append(f"k.mount_amplification = {carried};")
     result = f"&kin->{kin_name(d)}"
     if lane:
-        return [*out, f"bad += dyad_kin_lane_{d.type.lower()}(&k, {result});"]
+        branch = branch_real(d.branch)
+        return [*out, f"bad += dyad_kin_lane_{d.type.lower()}(&k, {branch}, {result});"]
     out.append(f"if (dyad_kinematics_{d.type.lower()}(&k, {result}) != DYAD_STATUS_OK) {{")
     out.append(f"    *failed = {d.index};")
     out.append(f"    return {result};")
@@ -215,12 +227,14 @@ def cylinder_input_lines(
     rates: tuple[str, str],
     pins: tuple[str, str],
     motion_only: bool = False,
+    lane: bool = False,
 ) -> list[str]:
     """The assignments of a dyad_cylinder_input `target`: the frame pins (O's motion
-    `pivot`), the pin B, the length and its `rates`, the branch and, for the kinematics
-    alone (`motion_only`), the centres of mass, or for the forces every mass of the
-    barrel and the rod (the link's resultant is the scene's, at O). `pins`: the motion
-    of A and of O, in C."""
+    `pivot`), the pin B, the length and its `rates`, the branch (but in a batch's `lane`,
+    whose call takes it as a real: branch_real) and, for the kinematics alone
+    (`motion_only`), the centres of mass, or for the forces every mass of the barrel and
+    the rod (the link's resultant is the scene's, at O). `pins`: the motion of A and of
+    O, in C."""
     params = driver.params
     branch = params["branch"]
     rate, accel = rates
@@ -232,11 +246,14 @@ def cylinder_input_lines(
         f"{target}.length = in->{member(driver.actuator)}_length;",
         f"{target}.rate = {rate};",
         f"{target}.accel = {accel};",
-        f"{target}.branch = {branch.c()} < 0 ? -1 : 1;"
-        if branch.tunable
-        else f"{target}.branch = {int(branch.value)};",
-        f"{target}.singular_threshold = {scene.threshold.c()};",
     ]
+    if not lane:
+        out.append(
+            f"{target}.branch = {branch.c()} < 0 ? -1 : 1;"
+            if branch.tunable
+            else f"{target}.branch = {int(branch.value)};"
+        )
+    out.append(f"{target}.singular_threshold = {scene.threshold.c()};")
     if "com.x" in params and motion_only:
         out.append(f"{target}.link.com = {_vec(params['com.x'].c(), params['com.y'].c())};")
     return out + _cylinder_part_lines(params, target, motion_only)
@@ -284,7 +301,7 @@ def _cylinder_lines(scene: Scene, mounts: _Mounts, driver: Crank, lane: bool) ->
         base = f"kin->{mount_a}"
     out.append(f"dyad_cylinder_input {cin};")
     rates = rate_names(scene, driver)
-    out += cylinder_input_lines(scene, driver, cin, rates, (base, f"{c}_o"), True)
+    out += cylinder_input_lines(scene, driver, cin, rates, (base, f"{c}_o"), True, lane)
     carried = [
         f"kin->{kin_name_of_cylinder(d)}.kin_amplification"
         for d in scene.drivers
@@ -293,7 +310,8 @@ def _cylinder_lines(scene: Scene, mounts: _Mounts, driver: Crank, lane: bool) ->
     if carried:
         out.append(f"{cin}.mount_amplification = {' + '.join(carried)};")
     if lane:
-        return [*out, f"bad += dyad_cylinder_lane(&{cin}, &{result});"]
+        branch = branch_real(driver.params["branch"])
+        return [*out, f"bad += dyad_cylinder_lane(&{cin}, {branch}, &{result});"]
     failed = len(scene.dyads) + cylinders(scene).index(driver)
     out += [
         f"if (dyad_cylinder(&{cin}, &{result}) != DYAD_STATUS_OK) {{",

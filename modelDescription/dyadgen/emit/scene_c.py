@@ -625,7 +625,9 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
         pins = tuple(f"kin.{name}" for name in kinematics_c.mount_names(driver))
     else:
         pins = (kinematics_c.fixed_pin(driver, "base"), kinematics_c.fixed_pin(driver, "at"))
-    lines = kinematics_c.cylinder_input_lines(scene, driver, "cyl_in", (rate, accel), pins)
+    lines = kinematics_c.cylinder_input_lines(
+        scene, driver, "cyl_in", (rate, accel), pins, lane=plan.lane
+    )
     for line in lines:
         code("    " + (kinematics_c.lane_twins(line) if plan.lane else line))
     code(f"    cyl_in.link.force = {link}_f;")
@@ -634,7 +636,8 @@ def _cylinder(plan: Plan, code: _Code, driver: Crank) -> None:
         gx, gy = scene.gravity_params
         code(f"    cyl_in.gravity = {_vec(gx.c(), gy.c())};")
     if plan.lane:
-        code(f"    bad += dyad_cylinder_lane(&cyl_in, &{c}_cyl);")
+        branch = kinematics_c.branch_real(driver.params["branch"])
+        code(f"    bad += dyad_cylinder_lane(&cyl_in, {branch}, &{c}_cyl);")
     else:
         code(f"    if (dyad_cylinder(&cyl_in, &{c}_cyl) != DYAD_STATUS_OK) {{")
         name = textsafe.c_string(driver.actuator)
