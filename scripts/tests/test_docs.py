@@ -115,16 +115,18 @@ def examples() -> list[tuple[Path, int, str, str, str | None]]:
     return found
 
 
-def _environment() -> dict:
+def _environment(tmp_path: Path) -> dict:
     env = dict(os.environ)
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
     # absolute: the Python examples run from a temporary folder
     env["DYADFMU_BUILD"] = str((ROOT / paths.build_dir()).resolve())
+    # an example's `mktemp -d` (its --out) inside the test's folder, which pytest removes
+    env["TMPDIR"] = str(tmp_path)
     return env
 
 
 def _run(language: str, code: str, tmp_path: Path) -> subprocess.CompletedProcess:
-    env = _environment()
+    env = _environment(tmp_path)
     if language == "sh":
         return subprocess.run(
             ["bash", "-e", "-c", code], cwd=ROOT, env=env, capture_output=True, text=True

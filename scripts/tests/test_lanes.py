@@ -1,5 +1,6 @@
 """A scene's batch evaluation in lanes (<id>_lanes: emit/batch_c.py on
-src/dyad_lanes.h), compiled as the FMU compiles its scene C.
+src/dyad_lanes.h), compiled as the FMU compiles its scene C: the build's object of that C
+where it is current (_built_scene), else compiled here.
 
 For every built-in scene that has one, over random samples of its inputs with failing
 ones mixed in (an input NaN, an input far out of range; the toggles scene's dead centres
@@ -16,7 +17,9 @@ runs the lanes (scripts/tests/test_columns_entry.py holds it to the rows entry).
 
 from __future__ import annotations
 
+import json
 import re
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -29,7 +32,7 @@ from dyadgen.corefiles import scene_core_sources
 from dyadgen.emit.batch_c import batch_supported, block_reals, scheduled_lanes
 from dyadgen.emit.scene_c import bare_lanes, bound_members, later_members
 from dyadgen.locations import SCENES_DIR, TEST_SCENES_DIR
-from tool_checks import required_tool
+from tool_checks import CI, required_tool
 
 ROOT = paths.ROOT
 SCENE_TOOL = ROOT / "modelDescription" / "scene.py"
@@ -204,10 +207,70 @@ def _inputs(table, rng: np.random.Generator) -> np.ndarray:
     return block
 
 
+def _dependencies(depfile: Path) -> list[Path] | None:
+    """The files a Make-style dependency file lists after its target; None where one is not
+    there."""
+    text = depfile.read_text().replace("\\\n", " ")
+    named = re.split(r"(?<!\\)\s+", text.split(": ", 1)[1].strip())
+    found = [Path(name.replace("\\ ", " ")) for name in named if name]
+    if not found or not all(path.is_absolute() and path.is_file() for path in found):
+        return None
+    return found
+
+
+def _built_scene(ident: str, gen: Path, schedule: list[str]) -> tuple[Path, str] | None:
+    """(object, GCC's report of the loops it vectorised) of the scene's C as the build
+    compiled it (fmu/CMakeLists.txt), where the build compiled this very C (what the
+    generator writes today) with FLAGS and `schedule`, at -O3 without a sanitizer, and no
+    file the compile read is newer than its object. Else None: the scene's C is compiled
+    here."""
+    build = paths.build_dir().resolve()
+    source = build / "generated" / ident / f"{ident}_scene.c"
+    report = source.with_suffix(".vect")
+    commands = build / "compile_commands.json"
+    if not (commands.is_file() and source.is_file() and report.is_file()):
+        return None
+    if source.read_bytes() != (gen / source.name).read_bytes():
+        return None
+    entries = [e for e in json.loads(commands.read_text()) if Path(e["file"]) == source]
+    if len(entries) != 1:
+        return None
+    args = shlex.split(entries[0]["command"])
+    levels = [a for a in args if a.startswith("-O")]
+    compiled_as_here = (
+        Path(args[0]).name in ("cc", "gcc")
+        and set(FLAGS) <= set(args)
+        and (set(SCHEDULE) <= set(args)) == bool(schedule)
+        and levels[-1:] == ["-O3"]
+        and not any(a.startswith("-fsanitize") for a in args)
+        and f"-fdump-tree-vect-optimized={report}" in args
+        and "-o" in args
+    )
+    if not compiled_as_here:
+        return None
+    built = Path(entries[0]["directory"]) / args[args.index("-o") + 1]
+    read = _dependencies(built.with_name(built.name + ".d")) if built.is_file() else None
+    if read is None or source not in read:
+        return None
+    made = built.stat().st_mtime_ns
+    if any(path.stat().st_mtime_ns > made for path in read):
+        return None
+    if report.stat().st_mtime_ns < max(path.stat().st_mtime_ns for path in read):
+        return None
+    with open(report) as lines:
+        vectorised = "".join(line for line in lines if ": optimized: " in line)
+    return built, vectorised
+
+
+#: per scene, whether its lanes' test program linked the build's object of its C
+LINKED_FROM_BUILD: dict[str, bool] = {}
+
+
 @pytest.fixture(scope="module")
 def programs(tmp_path_factory):
-    """Per scene: its lanes' test program, compiled from the scene's FMU C and the core
-    files it calls."""
+    """Per scene: its lanes' test program, from the scene's FMU C and the core files it
+    calls. The scene's C is the build's object where the build compiled it as this would
+    (_built_scene; the excavator's takes 75 s), else compiled here."""
     required_tool("cc")
     made: dict[tuple[str, str], Path] = {}
 
@@ -232,15 +295,21 @@ def programs(tmp_path_factory):
             core = [ROOT / "src" / f for f in scene_core_sources(table.scene, derivatives=False)]
             includes = [f"-I{d}" for d in (gen, ROOT / "src", ROOT / "src" / "include")]
             schedule = SCHEDULE if scheduled_lanes(table.scene) and not rebuild else []
-            report = subprocess.run(
-                [*compile_with, *schedule, *includes, "-c", str(gen / f"{ident}_scene.c"),
-                 "-o", str(work / "scene.o"), *([] if rebuild else ["-fopt-info-vec-optimized"])],
-                capture_output=True, text=True,
-            )  # fmt: skip
-            assert report.returncode == 0, report.stderr
-            (work / "vectorised.txt").write_text(report.stderr)
+            built = None if rebuild else _built_scene(ident, gen, schedule)
+            if not rebuild:
+                LINKED_FROM_BUILD[ident] = built is not None
+            if built is None:
+                report = subprocess.run(
+                    [*compile_with, *schedule, *includes, "-c", str(gen / f"{ident}_scene.c"),
+                     "-o", str(work / "scene.o"),
+                     *([] if rebuild else ["-fopt-info-vec-optimized"])],
+                    capture_output=True, text=True,
+                )  # fmt: skip
+                assert report.returncode == 0, report.stderr
+                built = work / "scene.o", report.stderr
+            (work / "vectorised.txt").write_text(built[1])
             link = subprocess.run(
-                [*compile_with, *includes, str(work / "main.c"), str(work / "scene.o"),
+                [*compile_with, *includes, str(work / "main.c"), str(built[0]),
                  *map(str, core), "-lm", "-o", str(work / "lanes")],
                 capture_output=True, text=True,
             )  # fmt: skip
@@ -484,9 +553,13 @@ def test_the_build_compiles_the_lanes_with_the_flags_these_tests_use():
     fmu = (ROOT / "fmu" / "CMakeLists.txt").read_text()
     core = (ROOT / "CMakeLists.txt").read_text()
     assert _cmake_flags(fmu, "set(lane_options") == vectorising
-    for source in ("${gen}/${id}_scene.c", "${gen}/${id}_model.c"):
+    for source, after in (
+        ("${gen}/${id}_scene.c", ";${lane_report}"),
+        ("${gen}/${id}_model.c", ""),
+    ):
         given = re.escape(f"set_source_files_properties({source} PROPERTIES COMPILE_OPTIONS")
-        assert re.search(given + r'\s+"\$\{lane_options\};\$\{scene_lane_schedule\}"\)', fmu)
+        options = re.escape(f'"${{lane_options}};${{scene_lane_schedule}}{after}")')
+        assert re.search(given + r"\s+" + options, fmu), source
     assert _cmake_flags(fmu, "set(cross_lane_flags") == vectorising
     # ... and where the generator says "scheduled" (a scene's C, a generic dyad's table and
     # a cross build's model C) the flags for register pressure
@@ -568,3 +641,16 @@ def test_a_chain_whose_bounds_float_could_overflow_has_no_lanes_without_them(
     scene = pipeline.load_scene(tmp_path / "stages.toml", check_c_names=False)
     assert batch_supported(scene) and len(scene.dyads) == stages
     assert bare_lanes(scene) == bare
+
+
+def test_each_scenes_program_links_the_builds_object(programs):
+    """Under CI, where build/ is built before the tests run, every scene's lanes program
+    links the build's object of the scene's C (_built_scene) rather than compiling the C
+    again: this file then takes minutes rather than ten. Elsewhere a build that is older
+    than the sources, or configured otherwise, is compiled around, and this says which."""
+    for path in SCENES:
+        programs(path)
+    compiled = sorted(ident for ident, linked in LINKED_FROM_BUILD.items() if not linked)
+    if compiled and not CI:
+        pytest.skip(f"compiled here, as {paths.build_dir()} has none current: {compiled}")
+    assert not compiled, f"{paths.build_dir()} holds no current object of {compiled}"

@@ -18,6 +18,7 @@ solve, and the instantiation token follows the table.
 
 from __future__ import annotations
 
+import atexit
 import math
 import re
 import shutil
@@ -1737,6 +1738,7 @@ def test_motor_documentation_is_complete(generated_motor):
 
 def _write_generic_tables():
     out = Path(tempfile.mkdtemp(prefix="dyadfmu_tables_"))
+    atexit.register(shutil.rmtree, out, ignore_errors=True)  # written at import, read by tests
     for t in TYPES:
         path = out / f"dyad_{t.lower()}.toml"
         write_toml(kinds.generic_data(pipeline.load_scene(SCENES_DIR / path.name)), path)
