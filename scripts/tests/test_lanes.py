@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -208,54 +209,83 @@ def _inputs(table, rng: np.random.Generator) -> np.ndarray:
 
 
 def _dependencies(depfile: Path) -> list[Path] | None:
-    """The files a Make-style dependency file lists after its target; None where one is not
-    there."""
-    text = depfile.read_text().replace("\\\n", " ")
-    named = re.split(r"(?<!\\)\s+", text.split(": ", 1)[1].strip())
+    """The files a Make-style dependency file lists after its target, resolved; None where
+    it or one of them is not there, or it is not one rule of absolute paths."""
+    try:
+        text = depfile.read_text().replace("\\\n", " ")
+        named = re.split(r"(?<!\\)\s+", text.split(": ", 1)[1].strip())
+    except (OSError, IndexError):
+        return None
     found = [Path(name.replace("\\ ", " ")) for name in named if name]
     if not found or not all(path.is_absolute() and path.is_file() for path in found):
         return None
-    return found
+    return [path.resolve() for path in found]
+
+
+def _built_object(build: Path, source: Path, report: Path, schedule: list[str]) -> Path | None:
+    """The object the build's compile command of `source` (compile_commands.json) writes,
+    where that command is the compiler these tests call (cc) with FLAGS and `schedule`, -O3
+    last, no sanitizer, and GCC's report to `report`."""
+    commands = build / "compile_commands.json"
+    if not commands.is_file():
+        return None
+    entries = [e for e in json.loads(commands.read_text()) if Path(e["file"]).resolve() == source]
+    if len(entries) != 1:
+        return None
+    args = shlex.split(entries[0]["command"])
+    levels = [a for a in args if a.startswith("-O")]
+    dumps = [a.split("=", 1)[1] for a in args if a.startswith("-fdump-tree-vect-optimized=")]
+    cc = shutil.which("cc")
+    compiled_as_here = (
+        cc is not None
+        and Path(args[0]).resolve() == Path(cc).resolve()
+        and set(FLAGS) <= set(args)
+        and (set(SCHEDULE) <= set(args)) == bool(schedule)
+        and levels[-1:] == ["-O3"]
+        and not any(a.startswith("-fsanitize") for a in args)
+        and [Path(d).resolve() for d in dumps] == [report]
+        and "-o" in args[:-1]
+    )
+    if not compiled_as_here:
+        return None
+    return (Path(entries[0]["directory"]) / args[args.index("-o") + 1]).resolve()
+
+
+def _current(built: Path, source: Path, report: Path, gen: Path) -> bool:
+    """Whether the object `built` and GCC's `report` of its compile are what the build
+    would make now of the C that `gen` holds: every file the compile read that the
+    generator wrote is byte for byte that in `gen`; the others are this checkout's or the
+    system's (/usr); none is newer than the object, nor the target's makefiles (its flags),
+    and the report is not older than any."""
+    read = _dependencies(built.with_name(built.name + ".d")) if built.is_file() else None
+    if read is None or source not in read:
+        return False
+    for path in read:
+        if path.parent == source.parent:
+            if path.read_bytes() != (gen / path.name).read_bytes():
+                return False
+        elif not path.is_relative_to(ROOT.resolve()) and not path.is_relative_to("/usr"):
+            return False
+    target = next((d for d in built.parents if d.suffix == ".dir"), None)
+    rules = [target / name for name in ("flags.make", "build.make")] if target else []
+    made = built.stat().st_mtime_ns
+    if any(path.stat().st_mtime_ns > made for path in [*read, *rules] if path.is_file()):
+        return False
+    return report.stat().st_mtime_ns >= max(path.stat().st_mtime_ns for path in read)
 
 
 def _built_scene(ident: str, gen: Path, schedule: list[str]) -> tuple[Path, str] | None:
     """(object, GCC's report of the loops it vectorised) of the scene's C as the build
     compiled it (fmu/CMakeLists.txt), where the build compiled this very C (what the
-    generator writes today) with FLAGS and `schedule`, at -O3 without a sanitizer, and no
-    file the compile read is newer than its object. Else None: the scene's C is compiled
-    here."""
+    generator writes today, in `gen`) as these tests would (_built_object) and the object
+    is current (_current). Else None: the scene's C is compiled here."""
     build = paths.build_dir().resolve()
     source = build / "generated" / ident / f"{ident}_scene.c"
     report = source.with_suffix(".vect")
-    commands = build / "compile_commands.json"
-    if not (commands.is_file() and source.is_file() and report.is_file()):
+    if not (source.is_file() and report.is_file()):
         return None
-    if source.read_bytes() != (gen / source.name).read_bytes():
-        return None
-    entries = [e for e in json.loads(commands.read_text()) if Path(e["file"]) == source]
-    if len(entries) != 1:
-        return None
-    args = shlex.split(entries[0]["command"])
-    levels = [a for a in args if a.startswith("-O")]
-    compiled_as_here = (
-        Path(args[0]).name in ("cc", "gcc")
-        and set(FLAGS) <= set(args)
-        and (set(SCHEDULE) <= set(args)) == bool(schedule)
-        and levels[-1:] == ["-O3"]
-        and not any(a.startswith("-fsanitize") for a in args)
-        and f"-fdump-tree-vect-optimized={report}" in args
-        and "-o" in args
-    )
-    if not compiled_as_here:
-        return None
-    built = Path(entries[0]["directory"]) / args[args.index("-o") + 1]
-    read = _dependencies(built.with_name(built.name + ".d")) if built.is_file() else None
-    if read is None or source not in read:
-        return None
-    made = built.stat().st_mtime_ns
-    if any(path.stat().st_mtime_ns > made for path in read):
-        return None
-    if report.stat().st_mtime_ns < max(path.stat().st_mtime_ns for path in read):
+    built = _built_object(build, source, report, schedule)
+    if built is None or not _current(built, source, report, gen):
         return None
     with open(report) as lines:
         vectorised = "".join(line for line in lines if ": optimized: " in line)
