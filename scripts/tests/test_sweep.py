@@ -12,6 +12,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import tomllib
 from pathlib import Path
 
@@ -698,13 +699,18 @@ def _edited_fmu(tmp_path: Path, name: str, edit) -> Path:
     return out
 
 
-def test_a_binary_that_crashes_or_will_not_instantiate_is_refused(tmp_path):
+def test_a_binary_that_crashes_or_will_not_instantiate_is_refused(tmp_path, monkeypatch):
     _needs_balance()
     truncated = _edited_fmu(
         tmp_path, "trunc.fmu", lambda n, b: b[:5000] if n.endswith(".so") else b
     )
+    scratch = tmp_path / "scratch"  # where the trial's process unpacks the FMU
+    scratch.mkdir()
+    monkeypatch.setenv("TMPDIR", str(scratch))
+    monkeypatch.setattr(tempfile, "tempdir", None)
     with pytest.raises(sources.SourceError, match="does not load or instantiate"):
         sources.model_description(truncated)
+    assert list(scratch.iterdir()) == []  # the crashed process's folder removed too
     other_guid = _edited_fmu(
         tmp_path,
         "guid.fmu",

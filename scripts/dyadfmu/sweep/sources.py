@@ -315,18 +315,21 @@ _TRIAL = (
 
 def _check_instantiates(fmu: Path) -> None:
     """SourceError unless the FMU's binary loads and makes an instance, tried in a
-    separate process first: a damaged binary can crash the process that loads it."""
-    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2]))
-    try:
-        done = subprocess.run(
-            [sys.executable, "-c", _TRIAL, str(fmu)],
-            capture_output=True,
-            text=True,
-            env=env,
-            timeout=120,
-        )
-    except subprocess.TimeoutExpired:
-        raise SourceError(f"{fmu}: its binary did not load within 120 s") from None
+    separate process first: a damaged binary can crash the process that loads it. That
+    process unpacks the FMU in a folder of this one's, removed whatever became of it (a
+    crashed process removes nothing)."""
+    with tempfile.TemporaryDirectory(prefix="dyadfmu_trial_") as scratch:
+        env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2]), TMPDIR=scratch)
+        try:
+            done = subprocess.run(
+                [sys.executable, "-c", _TRIAL, str(fmu)],
+                capture_output=True,
+                text=True,
+                env=env,
+                timeout=120,
+            )
+        except subprocess.TimeoutExpired:
+            raise SourceError(f"{fmu}: its binary did not load within 120 s") from None
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
         if done.returncode < 0:
